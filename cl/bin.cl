@@ -1,0 +1,83 @@
+/* Stage 3, tile raster: one work-item per MTA bins it into the 3D tiles (PMR_TILE_X x PMR_TILE_Y
+ * pixels x PMR_TILE_V views) it may cover. Per view slab it takes the MTA's exact bounding box over
+ * those views, then tests every tile of the box with the 8-corner test: the edge functions are
+ * multilinear in (x, y, view), so their maximum over a box of voxel centers is at one of its 8
+ * corners, and a tile is rejected exactly when some edge fails at all 8.
+ *
+ * The queues are built in two passes that enumerate identically: bin_count counts entries per tile,
+ * the host turns the counts into offsets (exclusive scan) and sizes the queue, and bin_fill writes each
+ * entry at offset + (count - 1) while decrementing the count, which leaves the counts at zero for the
+ * next frame. Entry order within a tile is arbitrary; fine raster's result does not depend on it. */
+#include "common.h"
+
+inline long min3l(long a, long b, long c) { return min(a, min(b, c)); }
+inline long max3l(long a, long b, long c) { return max(a, max(b, c)); }
+
+/* Max over the 8 corners of sign * E_ab - bias (>= 0 means the tile may hold a covered voxel). */
+inline bool edge_may_pass(const PmrMta* m, int a, int b, long X0, long X1, long Y0, long Y1, int i0, int i1) {
+  const long bias = mta_edge_bias(m, a, b);
+  const long s = m->sign;
+  long best = s * mta_edge(m, a, b, X0, Y0, i0);
+  best = max(best, s * mta_edge(m, a, b, X1, Y0, i0));
+  best = max(best, s * mta_edge(m, a, b, X0, Y1, i0));
+  best = max(best, s * mta_edge(m, a, b, X1, Y1, i0));
+  best = max(best, s * mta_edge(m, a, b, X0, Y0, i1));
+  best = max(best, s * mta_edge(m, a, b, X1, Y0, i1));
+  best = max(best, s * mta_edge(m, a, b, X0, Y1, i1));
+  best = max(best, s * mta_edge(m, a, b, X1, Y1, i1));
+  return best >= bias;
+}
+
+/* Calls BIN_EMIT(tile) for every tile the MTA may cover. */
+#define BIN_ENUMERATE(P, m)                                                                          \
+  for (int tv = (m).view_lo / PMR_TILE_V; tv <= (m).view_hi / PMR_TILE_V; ++tv) {                   \
+    const int i0 = max((m).view_lo, tv * PMR_TILE_V);                                                \
+    const int i1 = min((m).view_hi, tv * PMR_TILE_V + PMR_TILE_V - 1);                               \
+    long xlo = LONG_MAX, xhi = LONG_MIN;                                                             \
+    for (int k = 0; k < 3; ++k) {                                                                    \
+      const long xa = (long)(m).x0[k] + (long)i0 * (m).dx[k];                                        \
+      const long xb = (long)(m).x0[k] + (long)i1 * (m).dx[k];                                        \
+      xlo = min(xlo, min(xa, xb));                                                                   \
+      xhi = max(xhi, max(xa, xb));                                                                   \
+    }                                                                                                \
+    const long ylo = min3l((m).y[0], (m).y[1], (m).y[2]), yhi = max3l((m).y[0], (m).y[1], (m).y[2]); \
+    /* pixels whose centers lie inside the box */                                                   \
+    const int px0 = (int)max(0L, -floor_div_l(PMR_HALF_X - xlo, PMR_X_ONE));                        \
+    const int px1 = (int)min((long)(P)->view_w - 1, floor_div_l(xhi - PMR_HALF_X, PMR_X_ONE));      \
+    const int py0 = (int)max(0L, -floor_div_l(PMR_HALF_Y - ylo, PMR_Y_ONE));                        \
+    const int py1 = (int)min((long)(P)->view_h - 1, floor_div_l(yhi - PMR_HALF_Y, PMR_Y_ONE));      \
+    for (int ty = py0 / PMR_TILE_Y; py0 <= py1 && ty <= py1 / PMR_TILE_Y; ++ty) {                  \
+      const long Y0 = (long)max(py0, ty * PMR_TILE_Y) * PMR_Y_ONE + PMR_HALF_Y;                      \
+      const long Y1 = (long)min(py1, ty * PMR_TILE_Y + PMR_TILE_Y - 1) * PMR_Y_ONE + PMR_HALF_Y;     \
+      for (int tx = px0 / PMR_TILE_X; px0 <= px1 && tx <= px1 / PMR_TILE_X; ++tx) {                \
+        const long X0 = (long)max(px0, tx * PMR_TILE_X) * PMR_X_ONE + PMR_HALF_X;                    \
+        const long X1 = (long)min(px1, tx * PMR_TILE_X + PMR_TILE_X - 1) * PMR_X_ONE + PMR_HALF_X;   \
+        if (edge_may_pass(&(m), 1, 2, X0, X1, Y0, Y1, i0, i1) &&                                     \
+            edge_may_pass(&(m), 2, 0, X0, X1, Y0, Y1, i0, i1) &&                                     \
+            edge_may_pass(&(m), 0, 1, X0, X1, Y0, Y1, i0, i1)) {                                     \
+          BIN_EMIT(((uint)tv * (P)->tiles_y + (uint)ty) * (P)->tiles_x + (uint)tx);                  \
+        }                                                                                            \
+      }                                                                                              \
+    }                                                                                                \
+  }
+
+kernel void bin_count(global const PmrParams* P, global const PmrMta* mtas, uint num_mtas,
+                      volatile global uint* tile_counts) {
+  const uint id = get_global_id(0);
+  if (id >= num_mtas) return;
+  const PmrMta m = mtas[id];
+#define BIN_EMIT(tile) atomic_inc(&tile_counts[tile])
+  BIN_ENUMERATE(P, m)
+#undef BIN_EMIT
+}
+
+kernel void bin_fill(global const PmrParams* P, global const PmrMta* mtas, uint num_mtas,
+                     volatile global uint* tile_counts, global const uint* tile_offsets,
+                     global uint* tile_queue) {
+  const uint id = get_global_id(0);
+  if (id >= num_mtas) return;
+  const PmrMta m = mtas[id];
+#define BIN_EMIT(tile) tile_queue[tile_offsets[tile] + atomic_dec(&tile_counts[tile]) - 1u] = id
+  BIN_ENUMERATE(P, m)
+#undef BIN_EMIT
+}

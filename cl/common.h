@@ -1,0 +1,95 @@
+/* Device helpers shared by the stage kernels: fixed-point snapping and the exact multi-view edge
+ * functions (DESIGN sections 2 and 3). Every stage includes this; it includes the host/kernel
+ * shared structs. */
+#ifndef PMR_CL_COMMON_H
+#define PMR_CL_COMMON_H
+
+#include "pmr/shared.h"
+
+/* The C++ references round exactly like this code only if no multiply-add is fused. */
+#pragma OPENCL FP_CONTRACT OFF
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+
+#define PMR_HALF_X (PMR_X_ONE / 2)
+#define PMR_HALF_Y (PMR_Y_ONE / 2)
+
+inline long floor_div_l(long a, long b) { /* b > 0 */
+  long q = a / b;
+  return (a % b != 0 && a < 0) ? q - 1 : q;
+}
+
+/* Outcodes and snapped raster data of a point given in center-camera view space. Every vertex of
+ * the scene goes through this exactly once (vertex stage), and every vertex created by clipping goes
+ * through it too (setup stage), so a vertex's snapped position in view i depends on its data and i
+ * alone. */
+inline void project_vertex(global const PmrParams* P, double xv, double yv, double zv, PmrVertex* out) {
+  const double w = -zv;
+  const double kk = P->disparity_k / (double)P->view_w; /* NDC disparity per unit (1 - D/w) / 2 */
+  const double xc = P->ndc_scale_x * xv;                 /* x_ndc(center) * w */
+  const double xfirst = xc - kk * (w - P->focal);        /* x_ndc(view 0) * w */
+  const double xlast = xc + kk * (w - P->focal);         /* x_ndc(view N-1) * w */
+  const double yc = P->ndc_scale_y * yv;                 /* y_ndc * w */
+  const double gx = P->guard_ndc_x * w, gy = P->guard_ndc_y * w;
+  uint oc = 0;
+  if (w < P->near_eff) oc |= PMR_CLIP_NEAR | PMR_CULL_NEAR;
+  if (w > P->far) oc |= PMR_CLIP_FAR | PMR_CULL_FAR;
+  if (xfirst > gx) oc |= 1u << 2;
+  if (xfirst < -gx) oc |= 1u << 3;
+  if (xlast > gx) oc |= 1u << 4;
+  if (xlast < -gx) oc |= 1u << 5;
+  if (yc > gy) oc |= 1u << 6;
+  if (yc < -gy) oc |= 1u << 7;
+  if (xfirst < -w && xlast < -w) oc |= PMR_CULL_LEFT;
+  if (xfirst > w && xlast > w) oc |= PMR_CULL_RIGHT;
+  if (yc < -w) oc |= PMR_CULL_BOTTOM;
+  if (yc > w) oc |= PMR_CULL_TOP;
+  out->pos_view[0] = xv;
+  out->pos_view[1] = yv;
+  out->pos_view[2] = zv;
+  out->pad = 0.0;
+  out->outcode = oc;
+  out->x0 = 0;
+  out->dx = 0;
+  out->y = 0;
+  out->z = 0.0f;
+  out->inv_w = 0.0f;
+  if (oc & (PMR_CLIP_NEAR | PMR_CLIP_FAR | PMR_CLIP_GUARD)) return; /* will be clipped first */
+  const double half_w = 0.5 * (double)P->view_w, half_h = 0.5 * (double)P->view_h;
+  const double x_center = (xc / w + 1.0) * half_w;
+  double x_first = x_center, d = 0.0;
+  if (P->views > 1) {
+    const double delta = P->disparity_k * (1.0 - P->focal / w); /* Delta(w), px */
+    x_first = x_center - 0.5 * delta;
+    d = delta / (double)(P->views - 1);
+  }
+  const double y = (1.0 - yc / w) * half_h;
+  out->x0 = (int)floor(x_first * (double)PMR_X_ONE + 0.5);
+  out->dx = (int)floor(d * (double)PMR_X_ONE + 0.5);
+  out->y = (int)floor(y * (double)PMR_Y_ONE + 0.5);
+  out->z = (float)(P->far * (w - P->near_eff) / ((P->far - P->near_eff) * w));
+  out->inv_w = (float)(1.0 / w);
+}
+
+/* Edge function of edge (a -> b) of an MTA at raster point (X, Y) (16.16 / 24.8) in view i:
+ *   E = (yb - ya) (X - xa(i)) - (xb(i) - xa(i)) (Y - ya),   xa(i) = x0a + i * dxa.
+ * Units are 2^-24 px^2. Multilinear in (X, Y, i). */
+inline long mta_edge(const PmrMta* m, int a, int b, long X, long Y, int i) {
+  const long xa = (long)m->x0[a] + (long)i * (long)m->dx[a];
+  const long xb = (long)m->x0[b] + (long)i * (long)m->dx[b];
+  return (long)(m->y[b] - m->y[a]) * (X - xa) - (xb - xa) * (Y - (long)m->y[a]);
+}
+
+/* Top-left fill rule. With the edge functions multiplied by m->sign the inside is >= 0; an edge owns
+ * the pixel centers lying exactly on it only if it is a top or a left edge, so the test is
+ * sign * E >= bias with bias 0 for top/left edges and 1 otherwise. Within one MTA the orientation is
+ * constant, so the classification (evaluated at view_lo) holds for all its views. */
+inline long mta_edge_bias(const PmrMta* m, int a, int b) {
+  const long dy = (long)(m->y[b] - m->y[a]) * m->sign;
+  const long i = m->view_lo;
+  const long dx = ((long)m->x0[b] + i * (long)m->dx[b] - (long)m->x0[a] - i * (long)m->dx[a]) * m->sign;
+  /* inside is where sign*E >= 0, i.e. the interior normal is (dy, -dx): a left edge has dy > 0,
+   * a top edge (raster y grows downwards) is horizontal with dx < 0. */
+  return (dy > 0 || (dy == 0 && dx < 0)) ? 0 : 1;
+}
+
+#endif

@@ -1,0 +1,168 @@
+/* Stage 2, primitive setup: one work-item per triangle. Culls conservatively against the union of the
+ * N frusta, clips ONCE for all views (near, far and the guard band; all are linear in view space, so a
+ * clipped vertex keeps an affine disparity), splits the view range by orientation (twice the signed
+ * area is affine in the view index, so it flips at most once), and appends one MTA per (fan triangle,
+ * orientation) to the global MTA queue. A full queue is counted, not written: the host compares the
+ * counter with the capacity, grows the queue and runs the frame again. */
+#include "common.h"
+
+#define CULL_BITS (PMR_CULL_LEFT | PMR_CULL_RIGHT | PMR_CULL_BOTTOM | PMR_CULL_TOP | PMR_CULL_NEAR | PMR_CULL_FAR)
+#define CLIP_BITS (PMR_CLIP_NEAR | PMR_CLIP_FAR | PMR_CLIP_GUARD)
+
+/* Views v in [0, n) with a0 + v a1 > 0, as [*lo, *hi] (empty when *lo > *hi). */
+inline void positive_views(long a0, long a1, int n, int* lo, int* hi) {
+  *lo = 0;
+  *hi = n - 1;
+  if (a1 == 0) {
+    if (a0 <= 0) *lo = n;
+  } else if (a1 > 0) {
+    const long first = floor_div_l(-a0, a1) + 1;
+    if (first > *lo) *lo = first > n ? n : (int)first;
+  } else {
+    const long b = -a1; /* a0 - v b > 0  <=>  v < a0 / b */
+    const long last = -floor_div_l(-a0, b) - 1; /* ceil(a0 / b) - 1 */
+    if (last < *hi) *hi = last < -1 ? -1 : (int)last;
+  }
+}
+
+inline void emit_mta(global const PmrParams* P, global PmrMta* mtas, volatile global uint* counter,
+                     PmrMta* m, int lo, int hi, int sign, uint flags) {
+  if (lo > hi) return;
+  m->view_lo = lo;
+  m->view_hi = hi;
+  m->sign = sign;
+  m->flags = flags;
+  const uint slot = atomic_inc(counter);
+  if (slot < P->mta_capacity) mtas[slot] = *m;
+}
+
+/* One (possibly clipped) triangle: its orientation ranges become MTAs. */
+inline void emit_triangle(global const PmrParams* P, global PmrMta* mtas, volatile global uint* counter,
+                          const PmrVertex* a, const PmrVertex* b, const PmrVertex* c,
+                          const double* bary_a, const double* bary_b, const double* bary_c,
+                          uint tri, uint sub, uint double_sided, uint mask) {
+  PmrMta m;
+  const PmrVertex* v[3] = {a, b, c};
+  const double* bary[3] = {bary_a, bary_b, bary_c};
+  for (int k = 0; k < 3; ++k) {
+    m.x0[k] = v[k]->x0;
+    m.dx[k] = v[k]->dx;
+    m.y[k] = v[k]->y;
+    m.z[k] = v[k]->z;
+    m.inv_w[k] = v[k]->inv_w;
+    m.bary[k][0] = (float)bary[k][0];
+    m.bary[k][1] = (float)bary[k][1];
+  }
+  m.tri = tri;
+  m.key = (tri << PMR_KEY_SUB_BITS) | sub;
+  /* Twice the signed area in view i, A(i) = E_ab(c) = a0 + i a1; A > 0 is counter-clockwise in NDC
+   * (raster y points down), i.e. front-facing. */
+  const long ya = m.y[0], yb = m.y[1], yc = m.y[2];
+  const long a0 = (yb - ya) * ((long)m.x0[2] - m.x0[0]) - ((long)m.x0[1] - m.x0[0]) * (yc - ya);
+  const long a1 = (yb - ya) * ((long)m.dx[2] - m.dx[0]) - ((long)m.dx[1] - m.dx[0]) * (yc - ya);
+  const uint mflag = mask ? PMR_MTA_MASK : 0u;
+  int lo, hi;
+  positive_views(a0, a1, P->views, &lo, &hi);
+  emit_mta(P, mtas, counter, &m, lo, hi, 1, mflag);
+  if (double_sided) {
+    positive_views(-a0, -a1, P->views, &lo, &hi);
+    emit_mta(P, mtas, counter, &m, lo, hi, -1, mflag | PMR_MTA_BACK);
+  }
+}
+
+/* Signed distance-like value of a view-space point to clip plane `k` (>= 0 inside). */
+inline double plane_value(global const PmrParams* P, int k, const double* p) {
+  const double w = -p[2];
+  const double kk = P->disparity_k / (double)P->view_w;
+  const double xc = P->ndc_scale_x * p[0];
+  switch (k) {
+    case 0: return w - P->near_eff;
+    case 1: return P->far - w;
+    case 2: return P->guard_ndc_x * w - (xc - kk * (w - P->focal));
+    case 3: return P->guard_ndc_x * w + (xc - kk * (w - P->focal));
+    case 4: return P->guard_ndc_x * w - (xc + kk * (w - P->focal));
+    case 5: return P->guard_ndc_x * w + (xc + kk * (w - P->focal));
+    case 6: return P->guard_ndc_y * w - P->ndc_scale_y * p[1];
+    default: return P->guard_ndc_y * w + P->ndc_scale_y * p[1];
+  }
+}
+
+/* True if point p sorts before q; clipping computes an edge's intersection from its first point, so
+ * both triangles sharing the edge create bit-identical vertices. */
+inline bool point_before(const double* p, const double* q) {
+  if (p[0] != q[0]) return p[0] < q[0];
+  if (p[1] != q[1]) return p[1] < q[1];
+  return p[2] < q[2];
+}
+
+typedef struct {
+  double p[3];   /* view space */
+  double b[2];   /* barycentrics (b1, b2) in the source triangle */
+  int src;       /* 0..2: an original vertex, -1: created by clipping */
+} ClipVertex;
+
+kernel void setup_triangles(global const PmrParams* P, global const PmrTriangle* tris,
+                            global const PmrVertex* verts, global const PmrMaterial* materials,
+                            global PmrMta* mtas, volatile global uint* counter) {
+  const uint t = get_global_id(0);
+  if (t >= P->num_triangles) return;
+  const PmrTriangle tri = tris[t];
+  PmrVertex v[3] = {verts[tri.v[0]], verts[tri.v[1]], verts[tri.v[2]]};
+  const uint oc_and = v[0].outcode & v[1].outcode & v[2].outcode;
+  const uint oc_or = v[0].outcode | v[1].outcode | v[2].outcode;
+  if (oc_and & CULL_BITS) return;
+  const PmrMaterial mat = materials[tri.material];
+  const uint ds = mat.double_sided, mask = mat.alpha_mode == PMR_ALPHA_MASK;
+  const double ident[3][2] = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
+
+  if (!(oc_or & CLIP_BITS)) {
+    emit_triangle(P, mtas, counter, &v[0], &v[1], &v[2], ident[0], ident[1], ident[2], t, 0, ds, mask);
+    return;
+  }
+
+  /* Sutherland-Hodgman against the planes some vertex is outside of. */
+  ClipVertex poly[2][PMR_MAX_CLIP_VERTS];
+  int n = 3, cur = 0;
+  for (int k = 0; k < 3; ++k) {
+    for (int c = 0; c < 3; ++c) poly[0][k].p[c] = v[k].pos_view[c];
+    poly[0][k].b[0] = ident[k][0];
+    poly[0][k].b[1] = ident[k][1];
+    poly[0][k].src = k;
+  }
+  for (int plane = 0; plane < 8 && n >= 3; ++plane) {
+    if (!(oc_or & (1u << plane))) continue;
+    int m = 0;
+    for (int k = 0; k < n; ++k) {
+      const ClipVertex* A = &poly[cur][k];
+      const ClipVertex* B = &poly[cur][(k + 1) % n];
+      const double fa = plane_value(P, plane, A->p), fb = plane_value(P, plane, B->p);
+      if (fa >= 0.0) poly[1 - cur][m++] = *A;
+      if ((fa >= 0.0) != (fb >= 0.0)) {
+        const bool a_first = point_before(A->p, B->p);
+        const ClipVertex* F = a_first ? A : B;
+        const ClipVertex* S = a_first ? B : A;
+        const double ff = a_first ? fa : fb, fs = a_first ? fb : fa;
+        const double s = ff / (ff - fs);
+        ClipVertex* o = &poly[1 - cur][m++];
+        for (int c = 0; c < 3; ++c) o->p[c] = F->p[c] + s * (S->p[c] - F->p[c]);
+        for (int c = 0; c < 2; ++c) o->b[c] = F->b[c] + s * (S->b[c] - F->b[c]);
+        o->src = -1;
+      }
+    }
+    n = m;
+    cur = 1 - cur;
+  }
+  if (n < 3) return;
+
+  PmrVertex pv[PMR_MAX_CLIP_VERTS];
+  for (int k = 0; k < n; ++k) {
+    const ClipVertex* c = &poly[cur][k];
+    if (c->src >= 0)
+      pv[k] = v[c->src];
+    else
+      project_vertex(P, c->p[0], c->p[1], c->p[2], &pv[k]);
+  }
+  for (int k = 1; k + 1 < n; ++k)
+    emit_triangle(P, mtas, counter, &pv[0], &pv[k], &pv[k + 1], poly[cur][0].b, poly[cur][k].b,
+                  poly[cur][k + 1].b, t, (uint)(k - 1), ds, mask);
+}

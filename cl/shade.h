@@ -1,0 +1,98 @@
+/* Shading (DESIGN section 4): view-independent Lambert with one directional light, base colour from
+ * baseColorFactor * baseColorTexture (sRGB-decoded, bilinear, glTF wrap modes) * COLOR_0. */
+#ifndef PMR_CL_SHADE_H
+#define PMR_CL_SHADE_H
+
+#include "common.h"
+
+inline int wrap_texel(int c, int size, int mode) {
+  if (mode == PMR_WRAP_CLAMP) return clamp(c, 0, size - 1);
+  if (mode == PMR_WRAP_MIRROR) {
+    const int period = 2 * size;
+    int r = c % period;
+    if (r < 0) r += period;
+    return r < size ? r : period - 1 - r;
+  }
+  int r = c % size; /* REPEAT */
+  return r < 0 ? r + size : r;
+}
+
+inline float4 texel(global const uchar4* texels, global const float* srgb_lut, const PmrTexture* t, int x, int y) {
+  const uchar4 c = texels[t->offset + (uint)(y * t->width + x)];
+  return (float4)(srgb_lut[c.x], srgb_lut[c.y], srgb_lut[c.z], (float)c.w * (1.0f / 255.0f));
+}
+
+/* Bilinear sample; uv (0,0) is the top-left corner of the image (row 0). */
+inline float4 sample_texture(global const uchar4* texels, global const float* srgb_lut, const PmrTexture* t, float u, float v) {
+  const float fx = u * (float)t->width - 0.5f, fy = v * (float)t->height - 0.5f;
+  const float x0f = floor(fx), y0f = floor(fy);
+  const float ax = fx - x0f, ay = fy - y0f;
+  /* clamp before converting so huge UVs stay well defined */
+  const int x0 = (int)clamp(x0f, -1.0e8f, 1.0e8f), y0 = (int)clamp(y0f, -1.0e8f, 1.0e8f);
+  const int xa = wrap_texel(x0, t->width, t->wrap_s), xb = wrap_texel(x0 + 1, t->width, t->wrap_s);
+  const int ya = wrap_texel(y0, t->height, t->wrap_t), yb = wrap_texel(y0 + 1, t->height, t->wrap_t);
+  const float4 c00 = texel(texels, srgb_lut, t, xa, ya), c10 = texel(texels, srgb_lut, t, xb, ya);
+  const float4 c01 = texel(texels, srgb_lut, t, xa, yb), c11 = texel(texels, srgb_lut, t, xb, yb);
+  const float4 top = c00 + (c10 - c00) * ax, bottom = c01 + (c11 - c01) * ax;
+  return top + (bottom - top) * ay;
+}
+
+/* Barycentrics of voxel point in the SOURCE triangle, perspective-correct. e[k] are the (sign-
+ * corrected, non-negative) edge functions opposite MTA vertex k. */
+inline float3 source_barycentrics(const PmrMta* m, const long* e) {
+  const float pa = (float)e[0] * m->inv_w[0], pb = (float)e[1] * m->inv_w[1], pc = (float)e[2] * m->inv_w[2];
+  const float s = pa + pb + pc;
+  const float la = pa / s, lb = pb / s, lc = pc / s;
+  const float b1 = la * m->bary[0][0] + lb * m->bary[1][0] + lc * m->bary[2][0];
+  const float b2 = la * m->bary[0][1] + lb * m->bary[1][1] + lc * m->bary[2][1];
+  return (float3)(1.0f - b1 - b2, b1, b2);
+}
+
+typedef struct {
+  global const PmrTriangle* tris;
+  global const PmrVertexAttr* attrs;
+  global const PmrMaterial* materials;
+  global const PmrTexture* textures;
+  global const uchar4* texels;
+  global const float* srgb_lut;
+} ShadeInputs;
+
+/* Unlit base colour (RGBA) at source barycentrics b of triangle `tri`. */
+inline float4 base_color(const ShadeInputs* in, uint tri, float3 b) {
+  const PmrTriangle t = in->tris[tri];
+  const PmrMaterial mat = in->materials[t.material];
+  global const PmrVertexAttr* a0 = &in->attrs[t.v[0]];
+  global const PmrVertexAttr* a1 = &in->attrs[t.v[1]];
+  global const PmrVertexAttr* a2 = &in->attrs[t.v[2]];
+  float4 c = (float4)(mat.base_color[0], mat.base_color[1], mat.base_color[2], mat.base_color[3]);
+  const float4 vc = b.x * vload4(0, a0->color) + b.y * vload4(0, a1->color) + b.z * vload4(0, a2->color);
+  c *= vc;
+  if (mat.texture >= 0) {
+    const PmrTexture tex = in->textures[mat.texture];
+    const float u = b.x * a0->uv[0] + b.y * a1->uv[0] + b.z * a2->uv[0];
+    const float v = b.x * a0->uv[1] + b.y * a1->uv[1] + b.z * a2->uv[1];
+    c *= sample_texture(in->texels, in->srgb_lut, &tex, u, v);
+  }
+  return c;
+}
+
+/* Lit colour; alpha is coverage (1). */
+inline float4 shade(const ShadeInputs* in, global const PmrParams* P, uint tri, float3 b, bool back) {
+  const PmrTriangle t = in->tris[tri];
+  float3 n;
+  if (t.has_normals) {
+    n = b.x * vload3(0, in->attrs[t.v[0]].normal) + b.y * vload3(0, in->attrs[t.v[1]].normal) +
+        b.z * vload3(0, in->attrs[t.v[2]].normal);
+    const float len = length(n);
+    n = len > 0.0f ? n / len : vload3(0, t.face_normal);
+  } else {
+    n = vload3(0, t.face_normal);
+  }
+  if (back) n = -n;
+  const float3 l = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
+  const float lambert = 0.2f + 0.8f * max(0.0f, dot(n, l));
+  const float4 c = base_color(in, tri, b);
+  return (float4)(c.x * lambert, c.y * lambert, c.z * lambert, 1.0f);
+}
+
+#endif

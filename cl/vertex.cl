@@ -1,0 +1,17 @@
+/* Stage 1, vertex transform: every scene vertex is transformed ONCE, world -> center view space,
+ * and projected to its view-0 raster x, per-view disparity, raster y, depth and 1/w. */
+#include "common.h"
+
+kernel void vertex_transform(global const PmrParams* P, global const float* positions,
+                             global PmrVertex* out) {
+  const uint v = get_global_id(0);
+  if (v >= P->num_vertices) return;
+  const double px = positions[3 * v], py = positions[3 * v + 1], pz = positions[3 * v + 2];
+  global const double* V = P->view; /* column-major */
+  const double xv = V[0] * px + V[4] * py + V[8] * pz + V[12];
+  const double yv = V[1] * px + V[5] * py + V[9] * pz + V[13];
+  const double zv = V[2] * px + V[6] * py + V[10] * pz + V[14];
+  PmrVertex r;
+  project_vertex(P, xv, yv, zv, &r);
+  out[v] = r;
+}

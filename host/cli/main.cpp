@@ -1,0 +1,37 @@
+// The `pmr` command line: turns every failure into one line on stderr and a non-zero exit status.
+#include <cstdio>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "cli/options.h"
+#include "cli/render_command.h"
+#include "pmr/error.h"
+#include "runtime/cl_runtime.h"
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  try {
+    if (args.empty() || args[0] == "-h" || args[0] == "--help" || args[0] == "help") {
+      std::fputs(pmr::main_help().c_str(), args.empty() ? stderr : stdout);
+      return args.empty() ? 2 : 0;
+    }
+    const std::string cmd = args[0];
+    args.erase(args.begin());
+    if (cmd == "render") return pmr::run_render(args);
+    if (cmd == "info") {
+      for (const auto& line : pmr::describe_opencl_devices()) std::printf("%s\n", line.c_str());
+      return 0;
+    }
+    throw pmr::Error("unknown command '" + cmd + "' (try pmr --help)");
+  } catch (const pmr::Error& e) {
+    std::fprintf(stderr, "pmr: error: %s\n", e.what());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "pmr: error: out of host memory\n");
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pmr: internal error: %s\n", e.what());
+    return 2;
+  }
+}

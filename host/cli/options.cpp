@@ -1,0 +1,159 @@
+#include "cli/options.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "pmr/error.h"
+
+namespace pmr {
+
+namespace {
+
+double parse_double(const std::string& text, const std::string& opt) {
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || errno != 0 || !std::isfinite(v))
+    throw Error("invalid " + opt + " '" + text + "': expected a number");
+  return v;
+}
+
+int parse_int(const std::string& text, const std::string& opt, int lo, int hi) {
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || errno != 0 || v < lo || v > hi)
+    throw Error("invalid " + opt + " '" + text + "': expected an integer in " + std::to_string(lo) + ".." +
+                std::to_string(hi));
+  return int(v);
+}
+
+// "WxH" or "XxYxV".
+std::vector<int> parse_dims(const std::string& text, const std::string& opt, size_t count, int hi) {
+  std::vector<int> out;
+  std::stringstream ss(text);
+  std::string part;
+  while (std::getline(ss, part, 'x')) out.push_back(parse_int(part, opt, 1, hi));
+  if (out.size() != count || text.back() == 'x')
+    throw Error("invalid " + opt + " '" + text + "': expected " + (count == 2 ? "WxH" : "XxYxV"));
+  return out;
+}
+
+}  // namespace
+
+RenderOptions parse_render_options(const std::vector<std::string>& args) {
+  RenderOptions o;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= args.size()) throw Error("option " + a + " needs a value (see pmr render --help)");
+      return args[++i];
+    };
+    if (a == "-h" || a == "--help") o.help = true;
+    else if (a == "--out" || a == "-o") o.out_dir = value();
+    else if (a == "--preset") {
+      const std::string p = value();
+      if (p != "paper-8k") throw Error("unknown --preset '" + p + "' (known: paper-8k)");
+    } else if (a == "--views") o.rig.views = parse_int(value(), a, 1, 4096);
+    else if (a == "--view-size") {
+      const auto d = parse_dims(value(), a, 2, PMR_MAX_RASTER);
+      o.rig.view_w = d[0], o.rig.view_h = d[1];
+    } else if (a == "--display") {
+      const auto d = parse_dims(value(), a, 2, 65536);
+      o.display.width = d[0], o.display.height = d[1];
+    } else if (a == "--display-size") {
+      const std::string v = value();
+      const auto x = v.find('x');
+      if (x == std::string::npos) throw Error("invalid --display-size '" + v + "': expected WxH in cm");
+      o.display.size_w_cm = parse_double(v.substr(0, x), a);
+      o.display.size_h_cm = parse_double(v.substr(x + 1), a);
+    } else if (a == "--viewing-distance") o.display.viewing_distance_cm = parse_double(value(), a);
+    else if (a == "--cone") o.rig.cone_deg = parse_double(value(), a);
+    else if (a == "--yfov") o.rig.yfov_deg = parse_double(value(), a);
+    else if (a == "--lens-pitch") o.display.lens_pitch = parse_rational(value(), "--lens-pitch");
+    else if (a == "--tan-slant") o.display.tan_slant = parse_rational(value(), "--tan-slant");
+    else if (a == "--offset") {
+      o.display.offset = parse_rational(value(), "--offset");
+      o.offset_given = true;
+    } else if (a == "--reverse-views") o.display.reversed = true;
+    else if (a == "--bilinear") o.display.bilinear = true;
+    else if (a == "--tile") {
+      const auto d = parse_dims(value(), a, 3, 64);
+      o.pipeline.tile_x = d[0], o.pipeline.tile_y = d[1], o.pipeline.tile_v = d[2];
+    } else if (a == "--camera") o.rig.camera = parse_int(value(), a, 0, 1 << 30);
+    else if (a == "--write") {
+      o.write_encoded = o.write_views = false;
+      std::stringstream ss(value());
+      std::string w;
+      while (std::getline(ss, w, ',')) {
+        if (w == "encoded") o.write_encoded = true;
+        else if (w == "views") o.write_views = true;
+        else throw Error("invalid --write '" + w + "': expected encoded, views or encoded,views");
+      }
+    } else if (a == "--compression") o.compression = value();
+    else if (a == "--frame") o.frame = parse_int(value(), a, 0, 9999);
+    else if (a == "--verbose" || a == "-v") o.verbose = true;
+    else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see pmr render --help)");
+    else if (o.scene.empty()) o.scene = a;
+    else throw Error("more than one scene given ('" + o.scene + "' and '" + a + "')");
+  }
+  return o;
+}
+
+void finalize_render_options(RenderOptions& o) {
+  if (!o.offset_given) {
+    // offset = -L / (2N): N t lands half-way between view boundaries (DESIGN section 5).
+    const Rational& L = o.display.lens_pitch;
+    o.display.offset = parse_rational(std::to_string(-L.num) + "/" + std::to_string(2 * L.den * o.rig.views), "offset");
+  }
+}
+
+std::string main_help() {
+  return "pmr - multi-view light-field renderer (parallel multi-view polygon rasterization on OpenCL)\n"
+         "\n"
+         "usage:\n"
+         "  pmr render [SCENE.gltf|SCENE.glb] [options]   render N views and the encoded display image\n"
+         "  pmr info                                     list OpenCL platforms and devices\n"
+         "  pmr --help | pmr render --help\n";
+}
+
+std::string render_help() {
+  return "usage: pmr render [SCENE] [options]\n"
+         "Renders SCENE (glTF 2.0, .gltf or .glb; default: the bundled data/default_scene.glb) as N views\n"
+         "and interlaces them into the display's subpixel image. Defaults are the preset paper-8k:\n"
+         "96 views of 1024x512, a 7680x4320 display of 166x93 cm seen from 200 cm, 80 degree view cone.\n"
+         "\n"
+         "output:\n"
+         "  --out DIR              output folder (created if missing; default: out)\n"
+         "  --write LIST           encoded, views or encoded,views (default: encoded). DIR/frame_NNNN.exr is\n"
+         "                         the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view;\n"
+         "                         DIR/frame_NNNN.json (rig, display, every view's matrices) is always written\n"
+         "  --frame N              frame number used in the file names (default 0)\n"
+         "  --compression C        EXR compression: none, zip, piz, rle (default zip)\n"
+         "rig:\n"
+         "  --preset NAME          paper-8k (the only preset; also the default)\n"
+         "  --views N              number of views (default 96)\n"
+         "  --view-size WxH        view raster in pixels (default 1024x512; each side <= 8192)\n"
+         "  --cone DEG             view cone (default 80)\n"
+         "  --yfov DEG             vertical field of view (default from the display: 2 atan(46.5 / 200))\n"
+         "  --camera K             use the scene's glTF camera K (pose and field of view) instead of framing\n"
+         "                         the scene's bounding sphere\n"
+         "display:\n"
+         "  --display WxH          display image in pixels (default 7680x4320)\n"
+         "  --display-size WxH     physical size in cm (default 166x93; sets the aspect A)\n"
+         "  --viewing-distance CM  (default 200)\n"
+         "  --lens-pitch L         lens pitch in subpixels (default 16)\n"
+         "  --tan-slant T          tangent of the lens slant (default 1/18)\n"
+         "  --offset O             subpixel offset (default -L/(2N) = -1/12)\n"
+         "                         (L, T, O accept decimals or fractions like 1/18; evaluated exactly)\n"
+         "  --reverse-views        use view N-1-v instead of v\n"
+         "  --bilinear             sample views bilinearly (default nearest)\n"
+         "pipeline:\n"
+         "  --tile XxYxV           3D tile of the tile/fine raster, voxels over x, y, view (default 4x4x4)\n"
+         "  --verbose              per-stage device times and queue sizes\n"
+         "Environment: PMR_DEVICE=substring selects the OpenCL device by name (default: first CPU device).\n";
+}
+
+}  // namespace pmr

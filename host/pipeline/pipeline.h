@@ -1,0 +1,73 @@
+// The PMR pipeline on an OpenCL device: vertex transform -> primitive setup -> tile raster (bin) ->
+// fine raster -> pixel encoding. Buffers are allocated once per configuration and reused across frames;
+// the MTA queue and the tile queues are sized from the scene and grown (and the frame redone) when a
+// frame needs more, so no work is ever dropped.
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pmr/rig.h"
+#include "pmr/scene.h"
+#include "pmr/shared.h"
+#include "runtime/cl_runtime.h"
+
+namespace pmr {
+
+struct PipelineConfig {
+  int tile_x = 4, tile_y = 4, tile_v = 4;  // 3D tile (voxels over x, y, view) = one fine work-group
+  bool debug_outputs = false;              // fine raster also writes per-voxel key, depth, count
+};
+
+struct StageTimes {  // milliseconds
+  double vertex = 0, setup = 0, bin = 0, fine = 0, encode = 0;
+  double device_total = 0;  // first kernel start to last kernel end (includes host work in between)
+  double wall = 0;          // host wall-clock time of render()
+  int retries = 0;          // frames redone because a queue was full
+  uint32_t mtas = 0;        // MTAs produced by setup
+  uint64_t bin_entries = 0; // (tile, MTA) pairs produced by the tile raster
+};
+
+class Pipeline {
+ public:
+  Pipeline(const ClRuntime& runtime, const PipelineConfig& config);
+  ~Pipeline();
+
+  // Uploads geometry, materials and textures. Call again to switch scenes.
+  void set_scene(const Scene& scene);
+  // Allocates the per-configuration buffers (view volume, tile queues, display image). The display
+  // may be null when only the view volume is needed.
+  void configure(const Rig& rig, const Display* display);
+  // Renders one frame with the rig given to configure() (camera pose may change between frames).
+  StageTimes render(const Rig& rig);
+
+  const PipelineConfig& config() const { return config_; }
+  int tiles_x() const { return tiles_x_; }
+  int tiles_y() const { return tiles_y_; }
+  int tiles_v() const { return tiles_v_; }
+  size_t volume_bytes() const;
+  size_t display_bytes() const;
+
+  // Read-back of the last frame. Volume: [view][y][x][RGBA] halves. Display: [y][x][RGBA] halves.
+  void read_volume(std::vector<uint16_t>& out) const;
+  void read_display(std::vector<uint16_t>& out) const;
+  // Requires debug_outputs: per voxel the winning key (PMR_NO_KEY if empty), depth and coverage count.
+  void read_debug(std::vector<uint32_t>& keys, std::vector<float>& depth, std::vector<uint32_t>& count) const;
+  // The MTAs of the last frame, in queue order (arbitrary), and the tile queues (offsets has one entry
+  // per tile plus one; queue[offsets[t] .. offsets[t+1]) are MTA indices).
+  std::vector<PmrMta> read_mtas() const;
+  void read_tile_queues(std::vector<uint32_t>& offsets, std::vector<uint32_t>& queue) const;
+  // Vertex-stage output of the last frame.
+  std::vector<PmrVertex> read_vertices() const;
+  // The MTA queue capacity (for tests of the grow-and-redo path).
+  void set_mta_capacity(uint32_t capacity);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  PipelineConfig config_;
+  int tiles_x_ = 0, tiles_y_ = 0, tiles_v_ = 0;
+};
+
+}  // namespace pmr

@@ -1,0 +1,146 @@
+// The camera rig (DESIGN section 2): N off-axis cameras sharing one window on the focal plane.
+#include "pmr/rig.h"
+
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "pmr/error.h"
+
+namespace pmr {
+
+double Rig::baseline() const { return 2.0 * focal * std::tan(cone / 2.0); }
+
+double Rig::camera_offset(int i) const {
+  if (views <= 1) return 0.0;
+  return (double(i) / double(views - 1) - 0.5) * baseline();
+}
+
+glm::dmat4 Rig::view_matrix(int i) const {
+  return glm::translate(glm::dmat4(1.0), glm::dvec3(-camera_offset(i), 0.0, 0.0)) * center_view;
+}
+
+glm::dmat4 Rig::projection(int i) const {
+  const double h = focal * std::tan(yfov / 2.0);
+  const double a = aspect * h;
+  const double s = camera_offset(i);
+  const double n = near_eff;
+  const double l = (-a - s) * n / focal, r = (a - s) * n / focal;
+  const double t = n * std::tan(yfov / 2.0), b = -t;
+  return glm::frustum(l, r, b, t, n, far);
+}
+
+double Rig::disparity_k() const {
+  return double(view_w) * std::tan(cone / 2.0) / (aspect * std::tan(yfov / 2.0));
+}
+
+double Rig::disparity_px(double w) const { return disparity_k() * (1.0 - focal / w); }
+
+glm::dvec3 Rig::light_view() const { return glm::normalize(glm::dvec3(0.3, 0.5, 1.0)); }
+
+glm::dvec3 Rig::light_world() const {
+  // Directions transform with the inverse of the view matrix's rotation part.
+  const glm::dmat3 rot(center_view);
+  return glm::normalize(glm::inverse(rot) * light_view());
+}
+
+namespace {
+
+// Guard band in NDC units along x for a raster of width w_px (see PMR_GUARD_PX), with 1% margin.
+double guard_ndc(int size_px) { return 0.99 * PMR_GUARD_PX / (0.5 * size_px); }
+
+void check_positive(double v, const char* what) {
+  if (!(v > 0.0) || !std::isfinite(v)) throw Error(std::string("invalid ") + what + ": must be positive");
+}
+
+}  // namespace
+
+Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo,
+             const glm::dvec3& hi, const glm::dmat4* camera_pose, double camera_yfov,
+             std::vector<std::string>* warnings) {
+  if (config.views < 1) throw Error("invalid --views: need at least 1 view");
+  if (config.views > 4096) throw Error("invalid --views: at most 4096 views are supported");
+  if (config.view_w < 1 || config.view_h < 1 || config.view_w > PMR_MAX_RASTER ||
+      config.view_h > PMR_MAX_RASTER)
+    throw Error("invalid --view-size: each side must be 1.." + std::to_string(PMR_MAX_RASTER));
+  check_positive(display.size_w_cm, "display width");
+  check_positive(display.size_h_cm, "display height");
+  check_positive(display.viewing_distance_cm, "viewing distance");
+  if (!(config.cone_deg > 0.0 && config.cone_deg < 180.0)) throw Error("invalid --cone: must be in (0, 180) degrees");
+
+  Rig rig;
+  rig.views = config.views;
+  rig.view_w = config.view_w;
+  rig.view_h = config.view_h;
+  rig.aspect = display.aspect();
+  rig.cone = glm::radians(config.cone_deg);
+  rig.yfov = config.yfov_deg > 0.0 ? glm::radians(config.yfov_deg)
+                                   : 2.0 * std::atan(0.5 * display.size_h_cm / display.viewing_distance_cm);
+  if (camera_pose && camera_yfov > 0.0 && !(config.yfov_deg > 0.0)) rig.yfov = camera_yfov;
+  if (!(rig.yfov > 0.0 && rig.yfov < glm::pi<double>())) throw Error("invalid --yfov: must be in (0, 180) degrees");
+
+  const glm::dvec3 c = 0.5 * (lo + hi);
+  const double R = 0.5 * glm::length(hi - lo);
+  if (!(R > 0.0) || !std::isfinite(R)) throw Error("the scene has zero or non-finite extent; nothing to frame");
+  const double tan_half = std::tan(rig.yfov / 2.0);
+
+  if (camera_pose) {
+    // The camera's rotation and position; scale in the node matrix is dropped (glTF forbids it).
+    glm::dmat4 pose = *camera_pose;
+    for (int k = 0; k < 3; ++k) pose[k] = glm::dvec4(glm::normalize(glm::dvec3(pose[k])), 0.0);
+    rig.center_view = glm::inverse(pose);
+    rig.focal = -(rig.center_view * glm::dvec4(c, 1.0)).z;
+    if (!(rig.focal > 0.0)) throw Error("the selected camera looks away from the scene (its center is behind the camera)");
+  } else {
+    rig.focal = R / tan_half;
+    rig.center_view = glm::translate(glm::dmat4(1.0), -(c + glm::dvec3(0.0, 0.0, rig.focal)));
+  }
+  rig.near = std::max(rig.focal - 1.001 * R, 1e-3 * rig.focal);
+  rig.far = rig.focal + 1.001 * R;
+
+  // Keep every vertex that is visible in some view inside the fixed-point guard band of every view:
+  // views differ by at most 2 k_ndc |1 - D/w| in NDC x. Behind the focal plane |1 - D/w| < 1, in front
+  // of it the bound sets the nearest usable depth.
+  rig.near_eff = rig.near;
+  if (rig.views > 1) {
+    const double k_ndc = std::tan(rig.cone / 2.0) / (rig.aspect * tan_half);
+    const double room = (guard_ndc(rig.view_w) - 1.0) / (2.0 * k_ndc);
+    if (!(room > 1.0))
+      throw Error("the view cone is too wide for a " + std::to_string(rig.view_w) +
+                  "-pixel view: disparity would leave the fixed-point guard band");
+    const double w_min = rig.focal / (1.0 + room);
+    if (w_min > rig.near_eff) {
+      if (warnings)
+        warnings->push_back("near plane raised from " + std::to_string(rig.near) + " to " +
+                            std::to_string(w_min) + " to keep the disparity within the fixed-point range");
+      rig.near_eff = w_min;
+    }
+  }
+  if (!(rig.near_eff < rig.far)) throw Error("near plane is not in front of the far plane");
+  return rig;
+}
+
+PmrParams make_params(const Rig& rig) {
+  PmrParams p{};
+  const double* v = &rig.center_view[0][0];
+  for (int k = 0; k < 16; ++k) p.view[k] = v[k];
+  const double tan_half = std::tan(rig.yfov / 2.0);
+  p.ndc_scale_x = 1.0 / (rig.aspect * tan_half);
+  p.ndc_scale_y = 1.0 / tan_half;
+  p.disparity_k = rig.views > 1 ? rig.disparity_k() : 0.0;
+  p.focal = rig.focal;
+  p.near_eff = rig.near_eff;
+  p.far = rig.far;
+  p.guard_ndc_x = guard_ndc(rig.view_w);
+  p.guard_ndc_y = guard_ndc(rig.view_h);
+  const glm::dvec3 l = rig.light_world();
+  p.light_world[0] = float(l.x);
+  p.light_world[1] = float(l.y);
+  p.light_world[2] = float(l.z);
+  p.view_w = rig.view_w;
+  p.view_h = rig.view_h;
+  p.views = rig.views;
+  return p;
+}
+
+}  // namespace pmr

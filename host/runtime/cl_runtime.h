@@ -1,0 +1,100 @@
+// A thin RAII layer over the OpenCL C API: device selection, buffers, program build from the
+// embedded kernel sources, kernel launches with profiling events. Every failure is a pmr::Error that
+// names the call, the OpenCL error and (for builds) carries the build log.
+#pragma once
+#include <CL/cl.h>
+
+#include <cstddef>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace pmr {
+
+const char* cl_error_name(cl_int code);
+// Throws pmr::Error("<what>: <CL_ERROR_NAME>") unless code == CL_SUCCESS.
+void cl_check(cl_int code, const std::string& what);
+
+// One line per platform and device, for `pmr info`.
+std::vector<std::string> describe_opencl_devices();
+
+class ClBuffer {
+ public:
+  ClBuffer() = default;
+  ClBuffer(cl_context ctx, cl_mem_flags flags, size_t bytes, const std::string& name);
+  ~ClBuffer();
+  ClBuffer(ClBuffer&& o) noexcept;
+  ClBuffer& operator=(ClBuffer&& o) noexcept;
+  ClBuffer(const ClBuffer&) = delete;
+  ClBuffer& operator=(const ClBuffer&) = delete;
+  cl_mem get() const { return mem_; }
+  size_t size() const { return bytes_; }
+
+ private:
+  cl_mem mem_ = nullptr;
+  size_t bytes_ = 0;
+};
+
+class ClKernel {
+ public:
+  ClKernel() = default;
+  ClKernel(cl_program program, const std::string& name);
+  ~ClKernel();
+  ClKernel(ClKernel&& o) noexcept;
+  ClKernel& operator=(ClKernel&& o) noexcept;
+  ClKernel(const ClKernel&) = delete;
+  ClKernel& operator=(const ClKernel&) = delete;
+  cl_kernel get() const { return kernel_; }
+  const std::string& name() const { return name_; }
+  template <typename T>
+  void arg(cl_uint index, const T& value) { set(index, sizeof(T), &value); }
+  void arg(cl_uint index, const ClBuffer& b) { cl_mem m = b.get(); set(index, sizeof(cl_mem), &m); }
+
+ private:
+  void set(cl_uint index, size_t size, const void* value);
+  cl_kernel kernel_ = nullptr;
+  std::string name_;
+};
+
+class ClRuntime {
+ public:
+  // Picks the first CPU device (or the device named in the PMR_DEVICE environment variable, a
+  // substring of its name); throws if there is none.
+  ClRuntime();
+  ~ClRuntime();
+  ClRuntime(const ClRuntime&) = delete;
+  ClRuntime& operator=(const ClRuntime&) = delete;
+
+  cl_context context() const { return context_; }
+  cl_command_queue queue() const { return queue_; }
+  cl_device_id device() const { return device_; }
+  std::string device_name() const;
+  size_t max_alloc_bytes() const;
+  size_t global_mem_bytes() const;
+  size_t max_work_group_size() const;
+
+  // Builds a program from embedded sources: `files` are names from the embedded table, concatenated in
+  // order, with `#include "x"` lines replaced by the embedded file x (once). Options are logged with
+  // the build log on failure.
+  cl_program build_program(const std::vector<std::string>& files, const std::string& options) const;
+
+  ClBuffer buffer(size_t bytes, const std::string& name, cl_mem_flags flags = CL_MEM_READ_WRITE) const;
+  void write(const ClBuffer& b, const void* data, size_t bytes, size_t offset = 0) const;
+  void read(const ClBuffer& b, void* data, size_t bytes, size_t offset = 0) const;
+  void fill_zero(const ClBuffer& b) const;
+  // Launches a kernel; returns its event (caller releases) for profiling.
+  cl_event launch(const ClKernel& k, size_t global, size_t local) const;
+  void finish() const;
+
+ private:
+  cl_device_id device_ = nullptr;
+  cl_context context_ = nullptr;
+  cl_command_queue queue_ = nullptr;
+};
+
+// Elapsed device time of a finished event in milliseconds (profiling start to end).
+double event_ms(cl_event e);
+// Device time from the start of `first` to the end of `last`.
+double event_span_ms(cl_event first, cl_event last);
+
+}  // namespace pmr

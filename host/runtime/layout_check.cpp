@@ -1,0 +1,18 @@
+// Compile-time check that the structs in include/pmr/shared.h have the layout the kernels assume
+// (OpenCL C aligns every scalar to its size, as x86-64 C++ does; these asserts catch a field added
+// without thinking about padding). tests/test_layout.cpp checks the device side at run time.
+#include <cstddef>
+
+#include "pmr/shared.h"
+
+static_assert(sizeof(PmrParams) == 16 * 8 + 8 * 8 + 16 + 12 * 4, "PmrParams layout");
+static_assert(offsetof(PmrParams, light_world) == 192, "PmrParams layout");
+static_assert(offsetof(PmrParams, view_w) == 208, "PmrParams layout");
+static_assert(sizeof(PmrVertex) == 64 && offsetof(PmrVertex, x0) == 32 && offsetof(PmrVertex, z) == 48, "PmrVertex layout");
+static_assert(sizeof(PmrMta) == 27 * 4, "PmrMta layout");
+static_assert(offsetof(PmrMta, bary) == 60 && offsetof(PmrMta, tri) == 84 && offsetof(PmrMta, flags) == 104, "PmrMta layout");
+static_assert(sizeof(PmrVertexAttr) == 36, "PmrVertexAttr layout");
+static_assert(sizeof(PmrTriangle) == 32, "PmrTriangle layout");
+static_assert(sizeof(PmrMaterial) == 32, "PmrMaterial layout");
+static_assert(sizeof(PmrTexture) == 32, "PmrTexture layout");
+static_assert(sizeof(PmrEncodeParams) == 64 && offsetof(PmrEncodeParams, display_w) == 32, "PmrEncodeParams layout");

@@ -1,0 +1,78 @@
+// The camera rig (DESIGN section 2) and the display (DESIGN section 5).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "pmr/shared.h"
+
+namespace pmr {
+
+// An exact rational number p / q with q > 0, used for the encoder's display parameters so that the
+// view index of every subpixel is computed exactly.
+struct Rational {
+  int64_t num = 0, den = 1;
+  double value() const { return double(num) / double(den); }
+};
+// Parses "16", "-0.0833", "1/18", "-1/12". Throws pmr::Error naming `what` on bad input.
+Rational parse_rational(const std::string& text, const std::string& what);
+std::string to_string(const Rational& r);
+
+struct Display {
+  int width = 7680, height = 4320;   // pixels
+  double size_w_cm = 166.0, size_h_cm = 93.0, viewing_distance_cm = 200.0;
+  Rational lens_pitch{16, 1};        // L, in subpixels
+  Rational tan_slant{1, 18};         // tan(alpha)
+  Rational offset{-1, 12};           // subpixels
+  bool reversed = false;             // v -> N - 1 - v
+  bool bilinear = false;             // sample views bilinearly instead of nearest
+  double aspect() const { return size_w_cm / size_h_cm; }
+};
+
+struct RigConfig {
+  int views = 96;
+  int view_w = 1024, view_h = 512;
+  double cone_deg = 80.0;
+  double yfov_deg = 0.0;   // 0 = from the display: 2 atan(size_h / 2 / viewing_distance)
+  int camera = -1;         // glTF camera index, -1 = frame the scene's bounding sphere
+};
+
+// The resolved rig of one frame.
+struct Rig {
+  int views = 0, view_w = 0, view_h = 0;
+  double yfov = 0, cone = 0;      // radians
+  double aspect = 0;              // display physical aspect A
+  double focal = 0;               // D
+  double near = 0, far = 0;       // the planes as requested (default or camera)
+  double near_eff = 0;            // near raised (if needed) to keep disparity inside the guard band
+  glm::dmat4 center_view{1.0};    // world -> center view space
+
+  double baseline() const;                    // B = 2 D tan(theta / 2)
+  double camera_offset(int i) const;          // s_i
+  glm::dmat4 view_matrix(int i) const;        // V_i = T(-s_i, 0, 0) V
+  glm::dmat4 projection(int i) const;         // glFrustum(l_i, r_i, b, t, near_eff, far)
+  double disparity_k() const;                 // W tan(theta/2) / (A tan(phi/2))
+  double disparity_px(double w) const;        // Delta(w) = disparity_k * (1 - D / w)
+  glm::dvec3 light_view() const;              // normalize(0.3, 0.5, 1.0)
+  glm::dvec3 light_world() const;             // the same direction in world space
+};
+
+// Builds the rig for a scene whose world bounds are [lo, hi]. `camera_pose` (world_from_camera) and
+// `camera_yfov` are used when config.camera >= 0. Throws pmr::Error on an impossible configuration.
+Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo,
+             const glm::dvec3& hi, const glm::dmat4* camera_pose = nullptr,
+             double camera_yfov = 0.0, std::vector<std::string>* warnings = nullptr);
+
+// Frame parameters for the kernels (tile grid and capacities are filled in by the pipeline).
+PmrParams make_params(const Rig& rig);
+
+// Encoder parameters with exact integer coefficients. Throws pmr::Error if they could overflow.
+PmrEncodeParams make_encode_params(const Display& display, int views, int view_w, int view_h);
+
+// Direct evaluation of DESIGN section 5 in exact rational arithmetic: the view of subpixel k of
+// display pixel (j, i). The reference the encoder kernel is tested against.
+int encode_view_index(const Display& display, int views, int j, int i, int k);
+
+}  // namespace pmr

@@ -1,0 +1,48 @@
+// A glTF scene flattened for rendering: every mesh instance baked into world space.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "pmr/shared.h"
+
+namespace pmr {
+
+struct SceneTexture {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgba;  // width * height * 4 bytes, sRGB-encoded colour, row 0 = top of image
+  int wrap_s = PMR_WRAP_REPEAT, wrap_t = PMR_WRAP_REPEAT;
+};
+
+// A perspective glTF camera placed by the first node (in scene traversal order) that uses it.
+struct SceneCamera {
+  std::string name;
+  glm::dmat4 world_from_camera{1.0};  // the node's world matrix (camera looks along its -Z)
+  double yfov = 0.0;                  // radians
+  double znear = 0.0;
+  double zfar = 0.0;                  // 0 = infinite
+  double aspect = 0.0;                // 0 = not given
+  bool perspective = true;            // orthographic cameras are listed but cannot drive the rig
+};
+
+struct Scene {
+  std::vector<glm::vec3> positions;       // world space, one per vertex
+  std::vector<PmrVertexAttr> attributes;  // one per vertex (normal in world space)
+  std::vector<PmrTriangle> triangles;     // CCW front (winding already fixed for mirrored nodes)
+  std::vector<PmrMaterial> materials;     // at least one: index 0 may be the glTF default material
+  std::vector<SceneTexture> textures;     // referenced by PmrMaterial::texture
+  std::vector<SceneCamera> cameras;       // glTF cameras array order (only those placed by a node)
+  std::vector<std::string> warnings;      // non-fatal problems, one line each
+};
+
+// Loads a .gltf or .glb file (detected by content, not by extension) and validates it completely
+// before returning. Throws pmr::Error with one clear line on anything that cannot be rendered.
+Scene load_scene(const std::string& path);
+
+// World-space axis-aligned bounds of all vertices referenced by triangles. Throws if there are none.
+void scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi);
+
+}  // namespace pmr

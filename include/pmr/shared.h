@@ -1,0 +1,171 @@
+/* Structs and constants shared by the C++ host and the OpenCL C kernels.
+ *
+ * This header is compiled twice: as C++17 by the host (which static_asserts every size and offset in
+ * host/runtime/layout_check.cpp) and as OpenCL C 1.2 by the device (the host embeds it into the program
+ * source). Only 32-bit scalars, 64-bit doubles and fixed-size arrays of them are used, so the layout
+ * is the same on both sides without packing pragmas.
+ *
+ * Fixed-point formats (DESIGN section 3):
+ *   raster x: signed 16.16 (PMR_X_FRAC_BITS), range |x| < 2^15 px, stored in int32
+ *   raster y: signed 24.8  (PMR_Y_FRAC_BITS), stored in int32
+ * Edge functions are evaluated in int64: (dy)*(x - xA) is at most 2^23 * 2^32 = 2^55 in magnitude and
+ * (dx)*(y - yA) the same, so a sum of two fits with room to spare.
+ * x gets more fractional bits than y because the per-view disparity d is snapped on the same grid and
+ * multiplied by up to N - 1 views: 16 bits keep x_0 + i*d within 0.002 px of the exact projection at
+ * i = 95.
+ */
+#ifndef PMR_SHARED_H
+#define PMR_SHARED_H
+
+#ifdef __OPENCL_VERSION__
+typedef int pmr_i32;
+typedef uint pmr_u32;
+typedef long pmr_i64;
+#else
+#include <cstdint>
+typedef int32_t pmr_i32;
+typedef uint32_t pmr_u32;
+typedef int64_t pmr_i64;
+#endif
+
+#define PMR_X_FRAC_BITS 16
+#define PMR_Y_FRAC_BITS 8
+#define PMR_X_ONE (1 << PMR_X_FRAC_BITS)
+#define PMR_Y_ONE (1 << PMR_Y_FRAC_BITS)
+
+/* Guard band: after clipping, every vertex satisfies |x_raster - W/2| <= PMR_GUARD_PX in every view
+ * (and |y_raster - H/2| <= PMR_GUARD_PX), so |x| < 2^15 px fits 16.16 in int32 for W, H <= 2^13. */
+#define PMR_GUARD_PX 16384.0
+#define PMR_MAX_RASTER 8192
+
+/* A triangle clipped by near, far and the six guard-band planes has at most 3 + 8 vertices, i.e. a fan
+ * of 9 triangles; a double-sided one whose orientation flips across the views splits once more. */
+#define PMR_MAX_CLIP_VERTS 11
+#define PMR_MAX_MTA_PER_TRI 18
+/* Visibility key = (triangle index << PMR_KEY_SUB_BITS) | sub-triangle index; lower key wins ties. */
+#define PMR_KEY_SUB_BITS 5
+#define PMR_MAX_TRIANGLES (1u << (32 - PMR_KEY_SUB_BITS))
+#define PMR_NO_KEY 0xffffffffu
+
+/* Outcode bits of a vertex, computed once per vertex in clip space of the center camera. */
+#define PMR_CLIP_NEAR   (1u << 0)   /* w < near_eff              */
+#define PMR_CLIP_FAR    (1u << 1)   /* w > far                   */
+#define PMR_CLIP_GUARD  (0x3fu << 2) /* outside one of 6 guard-band planes (x in views 0 and N-1, y) */
+#define PMR_CULL_LEFT   (1u << 8)   /* left of every view's frustum  */
+#define PMR_CULL_RIGHT  (1u << 9)
+#define PMR_CULL_BOTTOM (1u << 10)
+#define PMR_CULL_TOP    (1u << 11)
+#define PMR_CULL_NEAR   (1u << 12)  /* same as PMR_CLIP_NEAR, kept in the cull set */
+#define PMR_CULL_FAR    (1u << 13)
+
+/* Material alpha modes (glTF). */
+#define PMR_ALPHA_OPAQUE 0
+#define PMR_ALPHA_MASK 1
+#define PMR_ALPHA_BLEND 2
+
+/* Texture wrap modes (glTF sampler enums). */
+#define PMR_WRAP_REPEAT 10497
+#define PMR_WRAP_CLAMP 33071
+#define PMR_WRAP_MIRROR 33648
+
+/* Mta.flags */
+#define PMR_MTA_BACK 1u   /* back-facing in its view range (double-sided): shading flips the normal */
+#define PMR_MTA_MASK 2u   /* material uses alphaMode MASK: visibility must evaluate alpha */
+
+/* Frame parameters, one copy per frame, read by every stage. Producer: host/pipeline. */
+typedef struct {
+  double view[16];        /* center camera view matrix, column-major (world -> center view space) */
+  double ndc_scale_x;     /* x_ndc(center) = ndc_scale_x * x_view / w, = D / a              */
+  double ndc_scale_y;     /* y_ndc = ndc_scale_y * y_view / w, = 1 / tan(phi / 2)           */
+  double disparity_k;     /* Delta(w) = disparity_k * (1 - D / w), px; = W tan(theta/2) / (A tan(phi/2)) */
+  double focal;           /* D, focal (zero-parallax) distance                              */
+  double near_eff;        /* near plane actually used (>= user near, see rig.cpp)           */
+  double far;             /* far plane                                                      */
+  double guard_ndc_x;     /* guard band half-width in NDC x: PMR_GUARD_PX / (W / 2)         */
+  double guard_ndc_y;     /* guard band half-height in NDC y                                */
+  float light_world[4];   /* unit vector toward the light, world space (xyz, w unused)      */
+  pmr_i32 view_w, view_h; /* view raster size (px)                                          */
+  pmr_i32 views;          /* N                                                              */
+  pmr_i32 tiles_x, tiles_y, tiles_v; /* tile grid size                                      */
+  pmr_u32 num_vertices, num_triangles;
+  pmr_u32 mta_capacity;   /* size of the MTA queue; setup counts past it and stops writing   */
+  pmr_u32 debug_outputs;  /* 1: fine raster writes per-voxel key, depth and coverage count   */
+  pmr_u32 pad0, pad1;
+} PmrParams;
+
+/* Vertex-stage output, one per scene vertex. Producer: cl/vertex.cl. */
+typedef struct {
+  double pos_view[3];     /* position in center-camera view space (used by the clipper)      */
+  double pad;
+  pmr_i32 x0;             /* snapped raster x in view 0, 16.16                               */
+  pmr_i32 dx;             /* snapped disparity per view, 16.16: x_i = x0 + i * dx            */
+  pmr_i32 y;              /* snapped raster y, 24.8                                          */
+  pmr_u32 outcode;        /* PMR_CLIP_* | PMR_CULL_* bits                                    */
+  float z;                /* window depth in [0, 1] (glFrustum depth mapped from NDC)         */
+  float inv_w;            /* 1 / w_clip                                                      */
+  float pad1, pad2;
+} PmrVertex;
+
+/* Multi-view triangle: one (possibly clipped) triangle over a contiguous view range with constant
+ * orientation. Producer: cl/setup.cl. Consumers: cl/bin.cl, cl/fine.cl. */
+typedef struct {
+  pmr_i32 x0[3];          /* vertex raster x in view 0, 16.16                                */
+  pmr_i32 dx[3];          /* per-view disparity, 16.16                                       */
+  pmr_i32 y[3];           /* raster y, 24.8                                                  */
+  float z[3];             /* window depth                                                    */
+  float inv_w[3];         /* 1 / w                                                           */
+  float bary[3][2];       /* each vertex's barycentrics (b1, b2) in the source triangle        */
+  pmr_u32 tri;            /* source triangle index                                           */
+  pmr_u32 key;            /* visibility tie-break key (see PMR_KEY_SUB_BITS)                  */
+  pmr_i32 view_lo, view_hi; /* inclusive view range in which the MTA is rasterized          */
+  pmr_i32 sign;           /* +1 or -1: multiplies the edge functions so that inside is >= 0   */
+  pmr_u32 flags;          /* PMR_MTA_*                                                       */
+} PmrMta;
+
+/* Per-vertex shading attributes. Producer: host (scene flattening). */
+typedef struct {
+  float normal[3];        /* world-space unit normal (unused when the triangle has none)     */
+  float uv[2];            /* TEXCOORD_0, (0,0) = top-left of the image                       */
+  float color[4];         /* COLOR_0 (linear), (1,1,1,1) when absent                         */
+} PmrVertexAttr;
+
+/* Per-triangle data. Producer: host. */
+typedef struct {
+  pmr_u32 v[3];           /* vertex indices, counter-clockwise = front                        */
+  pmr_u32 material;
+  float face_normal[3];   /* world-space unit face normal (used when has_normals == 0)        */
+  pmr_u32 has_normals;
+} PmrTriangle;
+
+typedef struct {
+  float base_color[4];    /* baseColorFactor (linear)                                        */
+  pmr_i32 texture;        /* index into the texture table, -1 = none                         */
+  pmr_i32 alpha_mode;     /* PMR_ALPHA_*                                                     */
+  float alpha_cutoff;
+  pmr_u32 double_sided;
+} PmrMaterial;
+
+typedef struct {
+  pmr_u32 offset;         /* first texel in the texel buffer (RGBA8, sRGB-encoded colour)     */
+  pmr_i32 width, height;
+  pmr_i32 wrap_s, wrap_t; /* PMR_WRAP_*                                                      */
+  pmr_u32 pad0, pad1, pad2;
+} PmrTexture;
+
+/* Encoder parameters (DESIGN section 5), exact rational arithmetic. For subpixel (j, i, k):
+ *   N * t = (num_jk * (3j + k) - num_i * i - num_0) / den
+ * and v = floor(N t) mod N. Producer: host/display. */
+typedef struct {
+  pmr_i64 num_jk;         /* see above; the host checks that nothing overflows               */
+  pmr_i64 num_i;
+  pmr_i64 num_0;
+  pmr_i64 den;                  /* > 0                                                             */
+  pmr_i32 display_w, display_h;
+  pmr_i32 views;
+  pmr_i32 view_w, view_h;
+  pmr_i32 reversed;       /* 1: v -> N - 1 - v                                                 */
+  pmr_i32 bilinear;       /* 1: bilinear sampling of the view, 0: nearest                     */
+  pmr_i32 pad0;
+} PmrEncodeParams;
+
+#endif /* PMR_SHARED_H */

@@ -1,0 +1,252 @@
+#include "reference/reference.h"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+namespace pmr::ref {
+
+namespace {
+
+constexpr uint32_t kCullBits = PMR_CULL_LEFT | PMR_CULL_RIGHT | PMR_CULL_BOTTOM | PMR_CULL_TOP | PMR_CULL_NEAR | PMR_CULL_FAR;
+constexpr uint32_t kClipBits = PMR_CLIP_NEAR | PMR_CLIP_FAR | PMR_CLIP_GUARD;
+
+PmrVertex project(const PmrParams& P, double xv, double yv, double zv) {
+  PmrVertex out{};
+  const double w = -zv;
+  const double kk = P.disparity_k / double(P.view_w);
+  const double xc = P.ndc_scale_x * xv;
+  const double xfirst = xc - kk * (w - P.focal), xlast = xc + kk * (w - P.focal);
+  const double yc = P.ndc_scale_y * yv;
+  const double gx = P.guard_ndc_x * w, gy = P.guard_ndc_y * w;
+  uint32_t oc = 0;
+  if (w < P.near_eff) oc |= PMR_CLIP_NEAR | PMR_CULL_NEAR;
+  if (w > P.far) oc |= PMR_CLIP_FAR | PMR_CULL_FAR;
+  if (xfirst > gx) oc |= 1u << 2;
+  if (xfirst < -gx) oc |= 1u << 3;
+  if (xlast > gx) oc |= 1u << 4;
+  if (xlast < -gx) oc |= 1u << 5;
+  if (yc > gy) oc |= 1u << 6;
+  if (yc < -gy) oc |= 1u << 7;
+  if (xfirst < -w && xlast < -w) oc |= PMR_CULL_LEFT;
+  if (xfirst > w && xlast > w) oc |= PMR_CULL_RIGHT;
+  if (yc < -w) oc |= PMR_CULL_BOTTOM;
+  if (yc > w) oc |= PMR_CULL_TOP;
+  out.pos_view[0] = xv;
+  out.pos_view[1] = yv;
+  out.pos_view[2] = zv;
+  out.outcode = oc;
+  if (oc & kClipBits) return out;
+  const double half_w = 0.5 * P.view_w, half_h = 0.5 * P.view_h;
+  const double x_center = (xc / w + 1.0) * half_w;
+  double x_first = x_center, d = 0.0;
+  if (P.views > 1) {
+    const double delta = P.disparity_k * (1.0 - P.focal / w);
+    x_first = x_center - 0.5 * delta;
+    d = delta / double(P.views - 1);
+  }
+  const double y = (1.0 - yc / w) * half_h;
+  out.x0 = int32_t(std::floor(x_first * PMR_X_ONE + 0.5));
+  out.dx = int32_t(std::floor(d * PMR_X_ONE + 0.5));
+  out.y = int32_t(std::floor(y * PMR_Y_ONE + 0.5));
+  out.z = float(P.far * (w - P.near_eff) / ((P.far - P.near_eff) * w));
+  out.inv_w = float(1.0 / w);
+  return out;
+}
+
+double plane_value(const PmrParams& P, int k, const double* p) {
+  const double w = -p[2];
+  const double kk = P.disparity_k / double(P.view_w);
+  const double xc = P.ndc_scale_x * p[0];
+  switch (k) {
+    case 0: return w - P.near_eff;
+    case 1: return P.far - w;
+    case 2: return P.guard_ndc_x * w - (xc - kk * (w - P.focal));
+    case 3: return P.guard_ndc_x * w + (xc - kk * (w - P.focal));
+    case 4: return P.guard_ndc_x * w - (xc + kk * (w - P.focal));
+    case 5: return P.guard_ndc_x * w + (xc + kk * (w - P.focal));
+    case 6: return P.guard_ndc_y * w - P.ndc_scale_y * p[1];
+    default: return P.guard_ndc_y * w + P.ndc_scale_y * p[1];
+  }
+}
+
+struct CV {
+  double p[3], b[2];
+  int src;
+};
+
+}  // namespace
+
+PmrVertex transform_vertex(const PmrParams& P, const float* pos) {
+  const double* V = P.view;
+  const double px = pos[0], py = pos[1], pz = pos[2];
+  return project(P, V[0] * px + V[4] * py + V[8] * pz + V[12], V[1] * px + V[5] * py + V[9] * pz + V[13],
+                 V[2] * px + V[6] * py + V[10] * pz + V[14]);
+}
+
+std::vector<ClippedTriangle> clip_triangles(const PmrParams& P, const Scene& scene, const std::vector<PmrVertex>& verts) {
+  std::vector<ClippedTriangle> out;
+  const double ident[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+  for (uint32_t t = 0; t < scene.triangles.size(); ++t) {
+    const PmrTriangle& tri = scene.triangles[t];
+    const PmrMaterial& mat = scene.materials[tri.material];
+    const PmrVertex v[3] = {verts[tri.v[0]], verts[tri.v[1]], verts[tri.v[2]]};
+    const uint32_t oc_and = v[0].outcode & v[1].outcode & v[2].outcode;
+    const uint32_t oc_or = v[0].outcode | v[1].outcode | v[2].outcode;
+    if (oc_and & kCullBits) continue;
+    std::vector<CV> poly(3);
+    for (int k = 0; k < 3; ++k) {
+      poly[k] = CV{{v[k].pos_view[0], v[k].pos_view[1], v[k].pos_view[2]}, {ident[k][0], ident[k][1]}, k};
+    }
+    for (int plane = 0; plane < 8 && poly.size() >= 3; ++plane) {
+      if (!(oc_or & (1u << plane))) continue;
+      std::vector<CV> next;
+      for (size_t k = 0; k < poly.size(); ++k) {
+        const CV& A = poly[k];
+        const CV& B = poly[(k + 1) % poly.size()];
+        const double fa = plane_value(P, plane, A.p), fb = plane_value(P, plane, B.p);
+        if (fa >= 0.0) next.push_back(A);
+        if ((fa >= 0.0) != (fb >= 0.0)) {
+          // the intersection is computed from the lexicographically smaller end point
+          const bool a_first = std::make_tuple(A.p[0], A.p[1], A.p[2]) < std::make_tuple(B.p[0], B.p[1], B.p[2]);
+          const CV& F = a_first ? A : B;
+          const CV& S = a_first ? B : A;
+          const double ff = a_first ? fa : fb, fs = a_first ? fb : fa;
+          const double s = ff / (ff - fs);
+          CV o;
+          for (int c = 0; c < 3; ++c) o.p[c] = F.p[c] + s * (S.p[c] - F.p[c]);
+          for (int c = 0; c < 2; ++c) o.b[c] = F.b[c] + s * (S.b[c] - F.b[c]);
+          o.src = -1;
+          next.push_back(o);
+        }
+      }
+      poly.swap(next);
+    }
+    if (poly.size() < 3) continue;
+    std::vector<PmrVertex> pv(poly.size());
+    for (size_t k = 0; k < poly.size(); ++k)
+      pv[k] = poly[k].src >= 0 ? v[poly[k].src] : project(P, poly[k].p[0], poly[k].p[1], poly[k].p[2]);
+    for (size_t k = 1; k + 1 < poly.size(); ++k) {
+      ClippedTriangle c;
+      const size_t idx[3] = {0, k, k + 1};
+      for (int j = 0; j < 3; ++j) {
+        c.v[j] = pv[idx[j]];
+        c.bary[j][0] = poly[idx[j]].b[0];
+        c.bary[j][1] = poly[idx[j]].b[1];
+      }
+      c.tri = t;
+      c.key = (t << PMR_KEY_SUB_BITS) | uint32_t(k - 1);
+      c.double_sided = mat.double_sided != 0;
+      c.mask = mat.alpha_mode == PMR_ALPHA_MASK;
+      out.push_back(c);
+    }
+  }
+  return out;
+}
+
+std::vector<PmrMta> make_mtas(const PmrParams& P, const std::vector<ClippedTriangle>& tris) {
+  std::vector<PmrMta> out;
+  for (const ClippedTriangle& c : tris) {
+    PmrMta m{};
+    for (int k = 0; k < 3; ++k) {
+      m.x0[k] = c.v[k].x0;
+      m.dx[k] = c.v[k].dx;
+      m.y[k] = c.v[k].y;
+      m.z[k] = c.v[k].z;
+      m.inv_w[k] = c.v[k].inv_w;
+      m.bary[k][0] = float(c.bary[k][0]);
+      m.bary[k][1] = float(c.bary[k][1]);
+    }
+    m.tri = c.tri;
+    m.key = c.key;
+    // Orientation by brute force over the views: the runs of positive and negative area.
+    for (int sign : {1, -1}) {
+      if (sign < 0 && !c.double_sided) break;
+      int lo = -1, hi = -1;
+      for (int i = 0; i < P.views; ++i) {
+        int64_t xs[3];
+        for (int k = 0; k < 3; ++k) xs[k] = int64_t(m.x0[k]) + int64_t(i) * m.dx[k];
+        const int64_t area = int64_t(m.y[1] - m.y[0]) * (xs[2] - xs[0]) - (xs[1] - xs[0]) * int64_t(m.y[2] - m.y[0]);
+        if (sign * area > 0) {
+          if (lo < 0) lo = i;
+          hi = i;
+        }
+      }
+      if (lo < 0) continue;
+      PmrMta r = m;
+      r.view_lo = lo;
+      r.view_hi = hi;
+      r.sign = sign;
+      r.flags = (c.mask ? PMR_MTA_MASK : 0u) | (sign < 0 ? PMR_MTA_BACK : 0u);
+      out.push_back(r);
+    }
+  }
+  sort_mtas(out);
+  return out;
+}
+
+void sort_mtas(std::vector<PmrMta>& mtas) {
+  std::sort(mtas.begin(), mtas.end(), [](const PmrMta& a, const PmrMta& b) {
+    return std::make_pair(a.key, a.view_lo) < std::make_pair(b.key, b.view_lo);
+  });
+}
+
+RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& tris) {
+  const size_t W = size_t(P.view_w), H = size_t(P.view_h), N = size_t(P.views);
+  RasterResult r;
+  r.key.assign(W * H * N, PMR_NO_KEY);
+  r.depth.assign(W * H * N, INFINITY);
+  r.count.assign(W * H * N, 0);
+  for (size_t i = 0; i < N; ++i) {
+    for (const ClippedTriangle& c : tris) {
+      int64_t x[3], y[3];
+      for (int k = 0; k < 3; ++k) {
+        x[k] = int64_t(c.v[k].x0) + int64_t(i) * c.v[k].dx;
+        y[k] = c.v[k].y;
+      }
+      // twice the signed area; > 0 is counter-clockwise in NDC (front) because raster y points down
+      const int64_t area = (y[1] - y[0]) * (x[2] - x[0]) - (x[1] - x[0]) * (y[2] - y[0]);
+      if (area == 0 || (area < 0 && !c.double_sided)) continue;
+      const int64_t s = area > 0 ? 1 : -1;
+      // edge k is opposite vertex k: (1,2), (2,0), (0,1)
+      const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
+      int64_t bias[3];
+      for (int k = 0; k < 3; ++k) {
+        // oriented edge direction; top edge: horizontal going left (y down); left edge: going down
+        const int64_t dx = s * (x[eb[k]] - x[ea[k]]), dy = s * (y[eb[k]] - y[ea[k]]);
+        const bool top_left = dy > 0 || (dy == 0 && dx < 0);
+        bias[k] = top_left ? 0 : 1;
+      }
+      for (size_t py = 0; py < H; ++py) {
+        for (size_t px = 0; px < W; ++px) {
+          const int64_t X = int64_t(px) * PMR_X_ONE + PMR_X_ONE / 2, Y = int64_t(py) * PMR_Y_ONE + PMR_Y_ONE / 2;
+          int64_t e[3];
+          bool inside = true;
+          for (int k = 0; k < 3; ++k) {
+            const int a = ea[k], b = eb[k];
+            e[k] = s * ((y[b] - y[a]) * (X - x[a]) - (x[b] - x[a]) * (Y - y[a]));
+            inside = inside && e[k] >= bias[k];
+          }
+          if (!inside) continue;
+          const size_t vox = (i * H + py) * W + px;
+          ++r.count[vox];
+          const float depth = (float(e[0]) * c.v[0].z + float(e[1]) * c.v[1].z + float(e[2]) * c.v[2].z) /
+                              float(e[0] + e[1] + e[2]);
+          if (depth < r.depth[vox] || (depth == r.depth[vox] && c.key < r.key[vox])) {
+            r.depth[vox] = depth;
+            r.key[vox] = c.key;
+          }
+        }
+      }
+    }
+  }
+  return r;
+}
+
+RasterResult render(const PmrParams& P, const Scene& scene) {
+  std::vector<PmrVertex> verts;
+  for (const auto& p : scene.positions) verts.push_back(transform_vertex(P, &p.x));
+  return rasterize(P, clip_triangles(P, scene, verts));
+}
+
+}  // namespace pmr::ref

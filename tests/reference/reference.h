@@ -1,0 +1,41 @@
+// Plain C++ references for the kernels. They are written the obvious, slow way (per view, per pixel)
+// so that the tiled multi-view kernels can be checked against them: the snapping and clipping are the
+// definitions of DESIGN sections 2-3 transcribed in scalar double arithmetic, the rasterizer is a
+// conventional single-view rasterizer fed each view's snapped positions x0 + i * dx.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "pmr/scene.h"
+#include "pmr/shared.h"
+
+namespace pmr::ref {
+
+// Vertex stage: world position -> snapped vertex record.
+PmrVertex transform_vertex(const PmrParams& P, const float* world_pos);
+
+// One clipped triangle with its snapped vertices, before the orientation split.
+struct ClippedTriangle {
+  PmrVertex v[3];
+  double bary[3][2];
+  uint32_t tri = 0, key = 0;
+  bool double_sided = false, mask = false;
+};
+// Setup without the orientation split: culling, clipping, fan triangulation.
+std::vector<ClippedTriangle> clip_triangles(const PmrParams& P, const Scene& scene, const std::vector<PmrVertex>& verts);
+// The MTA records setup must produce, sorted by (key, view_lo).
+std::vector<PmrMta> make_mtas(const PmrParams& P, const std::vector<ClippedTriangle>& tris);
+void sort_mtas(std::vector<PmrMta>& mtas);
+
+struct RasterResult {
+  std::vector<uint32_t> key;    // [view][y][x], PMR_NO_KEY when empty
+  std::vector<float> depth;     // INFINITY when empty
+  std::vector<uint32_t> count;  // number of triangles covering the voxel (before depth test)
+};
+// Conventional per-view rasterization with the top-left rule and (depth, key) visibility.
+RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& tris);
+
+// Convenience: the whole reference pipeline for a scene.
+RasterResult render(const PmrParams& P, const Scene& scene);
+
+}  // namespace pmr::ref

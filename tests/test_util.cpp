@@ -1,0 +1,92 @@
+#include "test_util.h"
+
+#include <sys/stat.h>
+
+#include <memory>
+
+namespace pmr::test {
+
+const ClRuntime& runtime() {
+  static std::unique_ptr<ClRuntime> rt(new ClRuntime());
+  return *rt;
+}
+
+Scene empty_scene(bool double_sided) {
+  Scene s;
+  PmrMaterial m{};
+  for (int c = 0; c < 4; ++c) m.base_color[c] = 1.0f;
+  m.texture = -1;
+  m.alpha_mode = PMR_ALPHA_OPAQUE;
+  m.alpha_cutoff = 0.5f;
+  m.double_sided = double_sided ? 1u : 0u;
+  s.materials.push_back(m);
+  return s;
+}
+
+void add_triangle(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t material) {
+  const uint32_t base = uint32_t(s.positions.size());
+  const glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+  for (const glm::vec3& p : {a, b, c}) {
+    s.positions.push_back(p);
+    PmrVertexAttr at{};
+    at.normal[0] = n.x, at.normal[1] = n.y, at.normal[2] = n.z;
+    for (int k = 0; k < 4; ++k) at.color[k] = 1.0f;
+    s.attributes.push_back(at);
+  }
+  PmrTriangle t{};
+  t.v[0] = base, t.v[1] = base + 1, t.v[2] = base + 2;
+  t.material = material;
+  t.face_normal[0] = n.x, t.face_normal[1] = n.y, t.face_normal[2] = n.z;
+  t.has_normals = 1;
+  s.triangles.push_back(t);
+}
+
+Scene random_scene(int n, uint32_t seed, bool double_sided) {
+  Scene s = empty_scene(double_sided);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), size(0.002f, 0.6f);
+  for (int i = 0; i < n; ++i) {
+    const glm::vec3 c(u(rng), u(rng), u(rng));
+    const float r = size(rng);
+    const glm::vec3 a = c + r * glm::vec3(u(rng), u(rng), u(rng));
+    const glm::vec3 b = c + r * glm::vec3(u(rng), u(rng), u(rng));
+    const glm::vec3 d = c + r * glm::vec3(u(rng), u(rng), u(rng));
+    if (glm::length(glm::cross(b - a, d - a)) < 1e-7f) continue;
+    add_triangle(s, a, b, d);
+  }
+  // keep the framing fixed: the scene bounds are always the unit box
+  return s;
+}
+
+Rig small_rig(int views, int w, int h) {
+  RigConfig rc;
+  rc.views = views;
+  rc.view_w = w;
+  rc.view_h = h;
+  return make_rig(rc, Display{}, glm::dvec3(-1.0), glm::dvec3(1.0));
+}
+
+Rendered render(const Scene& scene, const Rig& rig, int tx, int ty, int tv, const Display* display,
+                std::vector<uint16_t>* encoded) {
+  PipelineConfig pc;
+  pc.tile_x = tx, pc.tile_y = ty, pc.tile_v = tv;
+  pc.debug_outputs = true;
+  Pipeline p(runtime(), pc);
+  p.set_scene(scene);
+  p.configure(rig, display);
+  Rendered r;
+  r.times = p.render(rig);
+  p.read_debug(r.key, r.depth, r.count);
+  p.read_volume(r.volume);
+  r.mtas = p.read_mtas();
+  if (encoded) p.read_display(*encoded);
+  return r;
+}
+
+std::string corpus_dir() {
+  const std::string d = std::string(PMR_SOURCE_DIR) + "/../shared/gltf";
+  struct stat st;
+  return stat(d.c_str(), &st) == 0 && S_ISDIR(st.st_mode) ? d : std::string();
+}
+
+}  // namespace pmr::test

@@ -1,0 +1,43 @@
+// Shared helpers for the tests: one OpenCL runtime for the whole test binary, small rigs, and
+// procedural scenes with known properties.
+#pragma once
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "pipeline/pipeline.h"
+#include "pmr/rig.h"
+#include "pmr/scene.h"
+#include "runtime/cl_runtime.h"
+
+namespace pmr::test {
+
+const ClRuntime& runtime();
+
+// A scene with one default material (opaque; double_sided as given) and no triangles.
+Scene empty_scene(bool double_sided = false);
+// Adds a triangle with world-space corners (counter-clockwise seen from +Z = front for the default
+// rig, which looks down -Z).
+void add_triangle(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t material = 0);
+// `n` random triangles inside the box [-1,1]^3, sizes from sub-pixel to a good part of the screen.
+Scene random_scene(int n, uint32_t seed, bool double_sided);
+
+// The default rig (paper-8k display, framing the unit box [-1,1]^3) with a small view raster.
+Rig small_rig(int views, int w, int h);
+
+// Renders the scene with the given rig and tile size; returns the pipeline for read-back.
+struct Rendered {
+  std::vector<uint32_t> key, count;
+  std::vector<float> depth;
+  std::vector<uint16_t> volume;
+  std::vector<PmrMta> mtas;
+  StageTimes times;
+};
+Rendered render(const Scene& scene, const Rig& rig, int tx = 4, int ty = 4, int tv = 4, const Display* display = nullptr,
+                std::vector<uint16_t>* encoded = nullptr);
+
+// Path of the shared glTF corpus (PMR_SOURCE_DIR/../shared/gltf), empty if absent.
+std::string corpus_dir();
+
+}  // namespace pmr::test

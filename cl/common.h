@@ -53,7 +53,10 @@ inline void project_vertex(global const PmrParams* P, double xv, double yv, doub
   out->y = 0;
   out->z = 0.0f;
   out->inv_w = 0.0f;
-  if (oc & (PMR_CLIP_NEAR | PMR_CLIP_FAR | PMR_CLIP_GUARD)) return; /* will be clipped first */
+  /* Vertices outside the guard band are clipped before their snapped data is used; vertices created
+   * by clipping lie on a plane up to rounding, so snapping must not depend on the outcode. The clamp
+   * only keeps the conversion defined for far-away vertices whose data is never used. */
+  if (!(w > 0.0)) return;
   const double half_w = 0.5 * (double)P->view_w, half_h = 0.5 * (double)P->view_h;
   const double x_center = (xc / w + 1.0) * half_w;
   double x_first = x_center, d = 0.0;
@@ -63,9 +66,9 @@ inline void project_vertex(global const PmrParams* P, double xv, double yv, doub
     d = delta / (double)(P->views - 1);
   }
   const double y = (1.0 - yc / w) * half_h;
-  out->x0 = (int)floor(x_first * (double)PMR_X_ONE + 0.5);
-  out->dx = (int)floor(d * (double)PMR_X_ONE + 0.5);
-  out->y = (int)floor(y * (double)PMR_Y_ONE + 0.5);
+  out->x0 = (int)clamp(floor(x_first * (double)PMR_X_ONE + 0.5), -2.0e9, 2.0e9);
+  out->dx = (int)clamp(floor(d * (double)PMR_X_ONE + 0.5), -2.0e9, 2.0e9);
+  out->y = (int)clamp(floor(y * (double)PMR_Y_ONE + 0.5), -2.0e9, 2.0e9);
   out->z = (float)(P->far * (w - P->near_eff) / ((P->far - P->near_eff) * w));
   out->inv_w = (float)(1.0 / w);
 }

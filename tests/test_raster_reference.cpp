@@ -19,20 +19,12 @@ struct Case {
 
 class RasterReference : public ::testing::TestWithParam<Case> {};
 
-PmrParams params_for(const Rig& rig, int tx, int ty, int tv) {
-  PmrParams P = make_params(rig);
-  P.tiles_x = (rig.view_w + tx - 1) / tx;
-  P.tiles_y = (rig.view_h + ty - 1) / ty;
-  P.tiles_v = (rig.views + tv - 1) / tv;
-  return P;
-}
-
 TEST_P(RasterReference, MatchesReferenceBitForBit) {
   const Case c = GetParam();
   const Scene scene = test::random_scene(c.tris, 1234u + c.views, c.double_sided);
   const Rig rig = test::small_rig(c.views, c.w, c.h);
   const test::Rendered out = test::render(scene, rig);
-  const PmrParams P = params_for(rig, 4, 4, 4);
+  const PmrParams P = test::params_for(rig);
 
   // setup records
   std::vector<PmrVertex> verts;

@@ -90,3 +90,23 @@ std::string corpus_dir() {
 }
 
 }  // namespace pmr::test
+
+namespace pmr::test {
+
+glm::vec3 focal_point(const Rig& rig, double x, double y) {
+  const PmrParams P = make_params(rig);
+  const double xv = (2.0 * x / rig.view_w - 1.0) * rig.focal / P.ndc_scale_x;
+  const double yv = (1.0 - 2.0 * y / rig.view_h) * rig.focal / P.ndc_scale_y;
+  const glm::dvec4 world = glm::inverse(rig.center_view) * glm::dvec4(xv, yv, -rig.focal, 1.0);
+  return glm::vec3(world);
+}
+
+PmrParams params_for(const Rig& rig, int tx, int ty, int tv) {
+  PmrParams P = make_params(rig);
+  P.tiles_x = (rig.view_w + tx - 1) / tx;
+  P.tiles_y = (rig.view_h + ty - 1) / ty;
+  P.tiles_v = (rig.views + tv - 1) / tv;
+  return P;
+}
+
+}  // namespace pmr::test

@@ -41,3 +41,11 @@ Rendered render(const Scene& scene, const Rig& rig, int tx = 4, int ty = 4, int 
 std::string corpus_dir();
 
 }  // namespace pmr::test
+
+namespace pmr::test {
+// World point on the focal plane (zero disparity) that projects to raster position (x, y) in every
+// view of a rig made by small_rig (camera on +Z looking at the origin).
+glm::vec3 focal_point(const Rig& rig, double x, double y);
+// Parameters the kernels see for this rig and tile size.
+PmrParams params_for(const Rig& rig, int tx = 4, int ty = 4, int tv = 4);
+}  // namespace pmr::test

@@ -9,7 +9,6 @@ namespace pmr::ref {
 namespace {
 
 constexpr uint32_t kCullBits = PMR_CULL_LEFT | PMR_CULL_RIGHT | PMR_CULL_BOTTOM | PMR_CULL_TOP | PMR_CULL_NEAR | PMR_CULL_FAR;
-constexpr uint32_t kClipBits = PMR_CLIP_NEAR | PMR_CLIP_FAR | PMR_CLIP_GUARD;
 
 PmrVertex project(const PmrParams& P, double xv, double yv, double zv) {
   PmrVertex out{};
@@ -36,7 +35,7 @@ PmrVertex project(const PmrParams& P, double xv, double yv, double zv) {
   out.pos_view[1] = yv;
   out.pos_view[2] = zv;
   out.outcode = oc;
-  if (oc & kClipBits) return out;
+  if (!(w > 0.0)) return out;
   const double half_w = 0.5 * P.view_w, half_h = 0.5 * P.view_h;
   const double x_center = (xc / w + 1.0) * half_w;
   double x_first = x_center, d = 0.0;
@@ -46,9 +45,10 @@ PmrVertex project(const PmrParams& P, double xv, double yv, double zv) {
     d = delta / double(P.views - 1);
   }
   const double y = (1.0 - yc / w) * half_h;
-  out.x0 = int32_t(std::floor(x_first * PMR_X_ONE + 0.5));
-  out.dx = int32_t(std::floor(d * PMR_X_ONE + 0.5));
-  out.y = int32_t(std::floor(y * PMR_Y_ONE + 0.5));
+  auto snap = [](double v) { return int32_t(std::min(std::max(std::floor(v + 0.5), -2.0e9), 2.0e9)); };
+  out.x0 = snap(x_first * PMR_X_ONE);
+  out.dx = snap(d * PMR_X_ONE);
+  out.y = snap(y * PMR_Y_ONE);
   out.z = float(P.far * (w - P.near_eff) / ((P.far - P.near_eff) * w));
   out.inv_w = float(1.0 / w);
   return out;

@@ -322,6 +322,23 @@ StageTimes Pipeline::render(const Rig& rig) {
   return times;
 }
 
+StageTimes Pipeline::encode_volume(const std::vector<uint16_t>& volume) {
+  Impl& m = *impl_;
+  if (!m.encode) throw Error("internal error: no display configured");
+  if (volume.size() * 2 != volume_bytes()) throw Error("internal error: volume size mismatch");
+  m.rt.write(m.volume, volume.data(), volume_bytes());
+  m.rt.write(m.encode_buf, &m.encode_params, sizeof m.encode_params);
+  m.k_encode.arg(0, m.encode_buf);
+  m.k_encode.arg(1, m.volume);
+  m.k_encode.arg(2, m.display);
+  Events ev;
+  cl_event e = ev.add(m.rt.launch(m.k_encode, size_t(m.encode_params.display_w) * m.encode_params.display_h, 0));
+  m.rt.finish();
+  StageTimes t;
+  t.encode = event_ms(e);
+  return t;
+}
+
 void Pipeline::read_volume(std::vector<uint16_t>& out) const {
   out.resize(volume_bytes() / 2);
   impl_->rt.read(impl_->volume, out.data(), volume_bytes());

@@ -60,6 +60,8 @@ class Pipeline {
   void read_tile_queues(std::vector<uint32_t>& offsets, std::vector<uint32_t>& queue) const;
   // Vertex-stage output of the last frame.
   std::vector<PmrVertex> read_vertices() const;
+  // Encodes a given view volume ([view][y][x][RGBA] halves) without rendering: the encoder alone.
+  StageTimes encode_volume(const std::vector<uint16_t>& volume);
   // The MTA queue capacity (for tests of the grow-and-redo path).
   void set_mta_capacity(uint32_t capacity);
 

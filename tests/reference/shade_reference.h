@@ -1,0 +1,17 @@
+// Double-precision reference of DESIGN section 4 (shading) for one voxel.
+#pragma once
+#include <glm/glm.hpp>
+
+#include "pmr/scene.h"
+#include "pmr/shared.h"
+
+namespace pmr::ref {
+
+// Perspective-correct barycentrics of voxel (px, py, view) in the MTA's SOURCE triangle.
+glm::dvec3 source_barycentrics(const PmrMta& m, int px, int py, int view);
+// Unlit base colour (factor * texture * COLOR_0) at source barycentrics b of triangle `tri`.
+glm::dvec4 base_color(const Scene& scene, uint32_t tri, const glm::dvec3& b);
+// Lit colour (alpha = 1) with the light direction `light` (world space, unit).
+glm::dvec4 shade(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool back, const glm::dvec3& light);
+
+}  // namespace pmr::ref

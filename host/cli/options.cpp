@@ -61,7 +61,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
       const auto d = parse_dims(value(), a, 2, PMR_MAX_RASTER);
       o.rig.view_w = d[0], o.rig.view_h = d[1];
     } else if (a == "--display") {
-      const auto d = parse_dims(value(), a, 2, 65536);
+      const auto d = parse_dims(value(), a, 2, 16384);
       o.display.width = d[0], o.display.height = d[1];
     } else if (a == "--display-size") {
       const std::string v = value();

@@ -81,8 +81,8 @@ std::string to_string(const Rational& r) {
 }
 
 PmrEncodeParams make_encode_params(const Display& display, int views, int view_w, int view_h) {
-  if (display.width < 1 || display.height < 1 || display.width > 65536 || display.height > 65536)
-    throw Error("invalid --display: each side must be 1..65536");
+  if (display.width < 1 || display.height < 1 || display.width > 16384 || display.height > 16384)  // encode.cl indexes in 32 bits
+    throw Error("invalid --display: each side must be 1..16384");
   if (display.lens_pitch.num <= 0) throw Error("invalid --lens-pitch: must be positive");
   const Rational& L = display.lens_pitch;
   const Rational& T = display.tan_slant;

@@ -1,0 +1,90 @@
+// Atomic file creation (temporary name + rename) and the output-folder check.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <system_error>
+
+#include "pmr/error.h"
+#include "pmr/output.h"
+
+namespace pmr {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::atomic<unsigned> g_counter{0};
+
+// Creates `path` exclusively (0666 minus the umask, like any new file). Returns errno, 0 on success.
+int create_exclusive(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) return errno;
+  ::close(fd);
+  return 0;
+}
+
+// "<dir>/.<name>.tmp-<pid>-<n>": hidden, in the same folder (so rename stays on one file system).
+std::string temp_name(const fs::path& final_path) {
+  const std::string name = "." + final_path.filename().string() + ".tmp-" + std::to_string(::getpid()) +
+                           "-" + std::to_string(g_counter.fetch_add(1));
+  return (final_path.parent_path() / name).string();
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(std::string final_path) : final_path_(std::move(final_path)) {
+  const fs::path p(final_path_);
+  if (final_path_.empty() || !p.has_filename())
+    throw Error("cannot write '" + final_path_ + "': not a file name");
+  int err = 0;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    temp_path_ = temp_name(p);
+    err = create_exclusive(temp_path_);
+    if (err != EEXIST) break;
+  }
+  if (err != 0) {
+    const std::string reason = std::strerror(err);
+    temp_path_.clear();
+    throw Error("cannot write " + final_path_ + ": cannot create a file in its folder: " + reason);
+  }
+}
+
+AtomicFile::~AtomicFile() {
+  if (!committed_ && !temp_path_.empty()) ::unlink(temp_path_.c_str());
+}
+
+void AtomicFile::commit() {
+  if (committed_) return;
+  if (std::rename(temp_path_.c_str(), final_path_.c_str()) != 0)
+    throw Error("cannot write " + final_path_ + ": cannot rename the finished temporary file " + temp_path_ +
+                " into place: " + std::strerror(errno));
+  committed_ = true;
+}
+
+void prepare_output_dir(const std::string& dir) {
+  const std::string what = "cannot write to output folder " + dir + ": ";
+  if (dir.empty()) throw Error("cannot write to output folder '': empty path");
+  std::error_code ec;
+  const fs::path p(dir);
+  const fs::file_status st = fs::status(p, ec);
+  if (fs::exists(st)) {
+    if (!fs::is_directory(st)) throw Error(what + "exists and is not a folder");
+  } else {
+    fs::create_directories(p, ec);
+    if (ec) throw Error(what + ec.message());
+    if (!fs::is_directory(p, ec)) throw Error(what + "could not create it");
+  }
+  // Probe: create and remove a file (access(W_OK) would not tell the truth for root or read-only mounts).
+  const std::string probe =
+      (p / (".pmr-write-probe-" + std::to_string(::getpid()) + "-" + std::to_string(g_counter.fetch_add(1))))
+          .string();
+  const int err = create_exclusive(probe);
+  if (err != 0) throw Error(what + std::strerror(err));
+  if (::unlink(probe.c_str()) != 0) throw Error(what + "cannot remove the probe file " + probe + ": " + std::strerror(errno));
+}
+
+}  // namespace pmr

@@ -1,0 +1,226 @@
+// EXR writers and readers: the encoded image (half RGBA) and the multi-part views file.
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputPart.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfMultiPartOutputFile.h>
+#include <ImfOutputPart.h>
+#include <ImfPartType.h>
+#include <ImfRgbaFile.h>
+#include <ImfThreading.h>
+
+#include <cmath>
+#include <exception>
+#include <limits>
+
+#include "pmr/error.h"
+#include "pmr/output.h"
+
+namespace pmr {
+namespace {
+
+static_assert(sizeof(Imf::Rgba) == 4 * sizeof(uint16_t), "Imf::Rgba must be four packed halves");
+static_assert(sizeof(half) == sizeof(uint16_t), "half must be 16 bits");
+
+// One line: OpenEXR messages may span lines and name the temporary file instead of the final one.
+std::string clean_message(std::string msg, const std::string& temp, const std::string& final_path) {
+  if (!temp.empty())
+    for (size_t at = msg.find(temp); at != std::string::npos; at = msg.find(temp, at + final_path.size()))
+      msg.replace(at, temp.size(), final_path);
+  for (char& ch : msg)
+    if (ch == '\n' || ch == '\r') ch = ' ';
+  return msg;
+}
+
+// Runs f, turning OpenEXR / standard exceptions into pmr::Error("<verb> <path>: <reason>").
+template <class F>
+void guarded(const char* verb, const std::string& path, const std::string& temp, F&& f) {
+  try {
+    f();
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {  // Iex::BaseExc derives from std::exception
+    throw Error(std::string(verb) + " " + path + ": " + clean_message(e.what(), temp, path));
+  } catch (...) {
+    throw Error(std::string(verb) + " " + path + ": unknown error");
+  }
+}
+
+Imf::Compression to_imf(ExrCompression c, const std::string& path) {
+  switch (c) {
+    case ExrCompression::None: return Imf::NO_COMPRESSION;
+    case ExrCompression::Zip: return Imf::ZIP_COMPRESSION;
+    case ExrCompression::Piz: return Imf::PIZ_COMPRESSION;
+    case ExrCompression::Rle: return Imf::RLE_COMPRESSION;
+  }
+  throw Error("cannot write " + path + ": invalid EXR compression value " + std::to_string(int(c)));
+}
+
+void check_image(const std::string& path, int width, int height, int layers, const void* data) {
+  if (width < 1 || height < 1 || layers < 1)
+    throw Error("cannot write " + path + ": invalid image size " + std::to_string(width) + "x" +
+                std::to_string(height) + (layers != 1 ? "x" + std::to_string(layers) : std::string()));
+  if (!data) throw Error("cannot write " + path + ": no pixel data");
+  // Element counts must fit size_t (and stay far from overflow when multiplied by 8 bytes).
+  const double elems = double(width) * double(height) * double(layers) * 4.0;
+  if (elems * 8.0 > double(std::numeric_limits<size_t>::max()) / 2.0)
+    throw Error("cannot write " + path + ": image too large");
+}
+
+void set_threads(int threads) {
+  if (threads > 0 && threads != Imf::globalThreadCount()) Imf::setGlobalThreadCount(threads);
+}
+
+void insert_half_rgba(Imf::FrameBuffer& fb, const uint16_t* pixels, int width) {
+  char* base = const_cast<char*>(reinterpret_cast<const char*>(pixels));  // OpenEXR only reads it
+  const size_t xs = 4 * sizeof(uint16_t), ys = xs * size_t(width);
+  fb.insert("R", Imf::Slice(Imf::HALF, base + 0 * sizeof(uint16_t), xs, ys));
+  fb.insert("G", Imf::Slice(Imf::HALF, base + 1 * sizeof(uint16_t), xs, ys));
+  fb.insert("B", Imf::Slice(Imf::HALF, base + 2 * sizeof(uint16_t), xs, ys));
+  fb.insert("A", Imf::Slice(Imf::HALF, base + 3 * sizeof(uint16_t), xs, ys));
+}
+
+void check_read_size(const std::string& path, const Imath::Box2i& dw, int& width, int& height) {
+  const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
+  if (w < 1 || h < 1 || w > (1 << 20) || h > (1 << 20) || w * h > (int64_t(1) << 32))
+    throw Error("cannot read " + path + ": unsupported data window size " + std::to_string(w) + "x" +
+                std::to_string(h));
+  width = int(w);
+  height = int(h);
+}
+
+}  // namespace
+
+ExrCompression parse_exr_compression(const std::string& name) {
+  if (name == "none") return ExrCompression::None;
+  if (name == "zip") return ExrCompression::Zip;
+  if (name == "piz") return ExrCompression::Piz;
+  if (name == "rle") return ExrCompression::Rle;
+  throw Error("invalid EXR compression '" + name + "': expected none, zip, piz or rle");
+}
+
+const char* to_string(ExrCompression c) {
+  switch (c) {
+    case ExrCompression::None: return "none";
+    case ExrCompression::Zip: return "zip";
+    case ExrCompression::Piz: return "piz";
+    case ExrCompression::Rle: return "rle";
+  }
+  return "invalid";
+}
+
+std::string view_part_name(int i, int views) {
+  int digits = 3;
+  for (int64_t limit = 1000; int64_t(views) - 1 >= limit; limit *= 10) ++digits;
+  std::string num = std::to_string(i);
+  if (int(num.size()) < digits) num.insert(0, size_t(digits) - num.size(), '0');
+  return "view_" + num;
+}
+
+void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half,
+                    ExrCompression c, int threads) {
+  check_image(path, width, height, 1, rgba_half);
+  AtomicFile file(path);
+  guarded("cannot write", path, file.temp_path(), [&] {
+    set_threads(threads);
+    Imf::Header header(width, height);  // display and data window (0,0)-(w-1,h-1), INCREASING_Y
+    header.compression() = to_imf(c, path);
+    Imf::RgbaOutputFile out(file.temp_path().c_str(), header, Imf::WRITE_RGBA);
+    // Pixel (x, y) at base + x + y * width: the caller's memory, row 0 = EXR's top scanline.
+    out.setFrameBuffer(reinterpret_cast<const Imf::Rgba*>(rgba_half), 1, size_t(width));
+    out.writePixels(height);
+  });  // the file is closed here
+  file.commit();
+}
+
+void write_views_exr(const std::string& path, int width, int height, int views, const uint16_t* volume,
+                     const float* depth, ExrCompression c, int threads, float pixel_aspect) {
+  check_image(path, width, height, views, volume);
+  if (!(pixel_aspect > 0.0f) || !std::isfinite(pixel_aspect))
+    throw Error("cannot write " + path + ": invalid pixel aspect ratio " + std::to_string(pixel_aspect));
+  AtomicFile file(path);
+  guarded("cannot write", path, file.temp_path(), [&] {
+    set_threads(threads);
+    const Imf::Compression comp = to_imf(c, path);
+    std::vector<Imf::Header> headers;
+    headers.reserve(size_t(views));
+    for (int i = 0; i < views; ++i) {
+      Imf::Header h(width, height, pixel_aspect);
+      h.compression() = comp;
+      h.setName(view_part_name(i, views));
+      h.setType(Imf::SCANLINEIMAGE);
+      for (const char* ch : {"R", "G", "B", "A"}) h.channels().insert(ch, Imf::Channel(Imf::HALF));
+      if (depth) h.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+      headers.push_back(std::move(h));
+    }
+    Imf::MultiPartOutputFile out(file.temp_path().c_str(), headers.data(), views);
+    const size_t plane = size_t(width) * size_t(height);
+    for (int i = 0; i < views; ++i) {
+      Imf::OutputPart part(out, i);
+      Imf::FrameBuffer fb;
+      insert_half_rgba(fb, volume + size_t(i) * plane * 4, width);
+      if (depth) {
+        char* z = const_cast<char*>(reinterpret_cast<const char*>(depth + size_t(i) * plane));
+        fb.insert("Z", Imf::Slice(Imf::FLOAT, z, sizeof(float), sizeof(float) * size_t(width)));
+      }
+      part.setFrameBuffer(fb);
+      part.writePixels(height);
+    }
+  });
+  file.commit();
+}
+
+void read_rgba_exr(const std::string& path, int& width, int& height, std::vector<uint16_t>& rgba_half) {
+  guarded("cannot read", path, "", [&] {
+    Imf::RgbaInputFile in(path.c_str());
+    const Imath::Box2i dw = in.dataWindow();
+    check_read_size(path, dw, width, height);
+    rgba_half.assign(size_t(width) * size_t(height) * 4, 0);
+    Imf::Rgba* pixels = reinterpret_cast<Imf::Rgba*>(rgba_half.data());
+    in.setFrameBuffer(Imf::ComputeBasePointer(pixels, dw), 1, size_t(width));
+    in.readPixels(dw.min.y, dw.max.y);
+  });
+}
+
+std::vector<std::string> read_exr_part_names(const std::string& path) {
+  std::vector<std::string> names;
+  guarded("cannot read", path, "", [&] {
+    Imf::MultiPartInputFile in(path.c_str());
+    for (int i = 0; i < in.parts(); ++i)
+      names.push_back(in.header(i).hasName() ? in.header(i).name() : std::string());
+  });
+  return names;
+}
+
+void read_views_exr_part(const std::string& path, int part, int& width, int& height,
+                         std::vector<uint16_t>& rgba_half, std::vector<float>* depth) {
+  guarded("cannot read", path, "", [&] {
+    Imf::MultiPartInputFile file(path.c_str());
+    if (part < 0 || part >= file.parts())
+      throw Error("cannot read " + path + ": no part " + std::to_string(part) + " (the file has " +
+                  std::to_string(file.parts()) + ")");
+    Imf::InputPart in(file, part);
+    const Imf::Header& header = in.header();
+    const Imath::Box2i dw = header.dataWindow();
+    check_read_size(path, dw, width, height);
+    rgba_half.assign(size_t(width) * size_t(height) * 4, 0);
+    Imf::FrameBuffer fb;
+    const size_t xs = 4 * sizeof(uint16_t), ys = xs * size_t(width);
+    const char* names[4] = {"R", "G", "B", "A"};
+    for (int k = 0; k < 4; ++k)
+      fb.insert(names[k], Imf::Slice::Make(Imf::HALF, rgba_half.data() + k, dw, xs, ys, 1, 1, k == 3 ? 1.0 : 0.0));
+    if (depth) {
+      if (header.channels().findChannel("Z")) {
+        depth->assign(size_t(width) * size_t(height), 0.0f);
+        fb.insert("Z", Imf::Slice::Make(Imf::FLOAT, depth->data(), dw, sizeof(float), sizeof(float) * size_t(width)));
+      } else {
+        depth->clear();
+      }
+    }
+    in.setFrameBuffer(fb);
+    in.readPixels(dw.min.y, dw.max.y);
+  });
+}
+
+}  // namespace pmr

@@ -1,0 +1,174 @@
+// The per-frame JSON sidecar (DESIGN section 6): everything needed to reproduce or check a frame.
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+
+#include <glm/gtc/constants.hpp>
+#include <nlohmann/json.hpp>
+
+#include "pmr/error.h"
+#include "pmr/output.h"
+
+namespace pmr {
+namespace {
+
+// Insertion order kept, so "format" comes first and related fields stay together.
+using json = nlohmann::ordered_json;
+
+std::string scalar_text(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+
+// Pretty printing with two-space indentation like json::dump(2), except that arrays of scalars (the
+// matrices and vectors) stay on one line. Numbers are printed by nlohmann::json (round-trip precision).
+void emit(const json& j, int indent, std::string& out) {
+  const std::string pad(size_t(indent) + 2, ' ');
+  if (j.is_object() && !j.empty()) {
+    out += "{\n";
+    bool first = true;
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      if (!first) out += ",\n";
+      first = false;
+      out += pad + scalar_text(json(it.key())) + ": ";
+      emit(it.value(), indent + 2, out);
+    }
+    out += "\n" + std::string(size_t(indent), ' ') + "}";
+  } else if (j.is_array() && !j.empty()) {
+    bool flat = true;
+    for (const json& e : j) flat = flat && !e.is_structured();
+    out += flat ? "[" : "[\n";
+    bool first = true;
+    for (const json& e : j) {
+      if (!first) out += flat ? ", " : ",\n";
+      first = false;
+      if (flat) {
+        out += scalar_text(e);
+      } else {
+        out += pad;
+        emit(e, indent + 2, out);
+      }
+    }
+    out += flat ? "]" : "\n" + std::string(size_t(indent), ' ') + "]";
+  } else {
+    out += scalar_text(j);
+  }
+}
+
+// 16 numbers, column-major as glTF stores them: element c * 4 + r is row r of column c (glm: m[c][r]).
+json matrix_json(const glm::dmat4& m) {
+  json a = json::array();
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) a.push_back(m[c][r]);
+  return a;
+}
+
+json vec3_json(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }
+
+double degrees(double rad) { return rad * (180.0 / glm::pi<double>()); }
+
+}  // namespace
+
+std::string sidecar_json(const Rig& rig, const Display& display, const SidecarInfo& info) {
+  json j;
+  j["format"] = "pmr-sidecar-1";
+  j["scene"] = info.scene;
+  j["frame"] = info.frame;
+  j["method"] = info.method;
+  j["tile"] = {{"x", info.tile_x}, {"y", info.tile_y}, {"v", info.tile_v}};
+  j["camera"] = info.camera;
+  if (info.has_bounds)
+    j["scene_bounds"] = {{"min", vec3_json(info.bounds_lo)}, {"max", vec3_json(info.bounds_hi)}};
+  if (!info.compression.empty()) j["compression"] = info.compression;
+  json outputs = json::object();
+  for (const auto& [kind, file] : info.outputs) outputs[kind] = file;
+  j["outputs"] = outputs;
+  j["warnings"] = info.warnings;
+
+  json d;
+  d["width"] = display.width;
+  d["height"] = display.height;
+  d["size_cm"] = {display.size_w_cm, display.size_h_cm};
+  d["viewing_distance_cm"] = display.viewing_distance_cm;
+  d["aspect"] = display.aspect();
+  d["lens_pitch"] = display.lens_pitch.value();
+  d["lens_pitch_fraction"] = to_string(display.lens_pitch);
+  d["tan_slant"] = display.tan_slant.value();
+  d["tan_slant_fraction"] = to_string(display.tan_slant);
+  d["offset"] = display.offset.value();
+  d["offset_fraction"] = to_string(display.offset);
+  d["reversed"] = display.reversed;
+  d["sampling"] = display.bilinear ? "bilinear" : "nearest";
+  j["display"] = d;
+
+  json r;
+  r["views"] = rig.views;
+  r["view_width"] = rig.view_w;
+  r["view_height"] = rig.view_h;
+  r["cone_deg"] = degrees(rig.cone);
+  r["cone_rad"] = rig.cone;
+  r["yfov_deg"] = degrees(rig.yfov);
+  r["yfov_rad"] = rig.yfov;
+  r["aspect"] = rig.aspect;
+  r["focal_distance"] = rig.focal;
+  r["baseline"] = rig.baseline();
+  r["near"] = rig.near;
+  r["near_used"] = rig.near_eff;
+  r["far"] = rig.far;
+  const double k = rig.disparity_k();
+  r["disparity_px_at_infinity"] = rig.views > 1 ? k : 0.0;  // Delta(inf): view 0 to view N-1
+  r["disparity_px_per_view_at_infinity"] = rig.views > 1 ? k / double(rig.views - 1) : 0.0;
+  j["rig"] = r;
+
+  j["center_view"] = matrix_json(rig.center_view);
+  j["light_dir_view"] = vec3_json(rig.light_view());
+  j["light_dir_world"] = vec3_json(rig.light_world());
+
+  json views = json::array();
+  for (int i = 0; i < rig.views; ++i)
+    views.push_back({{"index", i},
+                     {"offset", rig.camera_offset(i)},
+                     {"view", matrix_json(rig.view_matrix(i))},
+                     {"proj", matrix_json(rig.projection(i))}});
+  j["views"] = views;
+
+  j["conventions"] = {
+      {"coordinates", "glTF: right-handed, +Y up, cameras look along -Z, +X right; rig distances in scene units"},
+      {"raster", "row 0 is the top row; pixel (px, py) counts px from the left and py from the top, its center is "
+                 "(px + 0.5, py + 0.5)"},
+      {"ndc_to_raster", "x = (x_ndc + 1) / 2 * view_width, y = (1 - y_ndc) / 2 * view_height"},
+      {"views", "view 0 is the leftmost camera; camera i sits at 'offset' s_i along +X of the center camera: "
+                "view = T(-s_i, 0, 0) * center_view; views[i] is part view_NNN of the views EXR"},
+      {"matrices", "4x4, 16 numbers column-major as glTF stores them (element 4 * c + r is row r of column c); "
+                   "clip = proj * view * (x, y, z, 1); OpenGL clip space, NDC z in [-1, 1]"},
+      {"depth", "the Z channel of the views EXR (when written) is window depth in [0, 1]: (z_ndc + 1) / 2"},
+      {"color", "linear-light RGB; alpha = coverage; background (0, 0, 0, 0)"},
+      {"light", "directional, toward the light, fixed in the center camera's view space; "
+                "color = base * (0.2 + 0.8 * max(0, dot(n, l)))"},
+      {"encoding", "display pixel (j, i), row 0 at the top, subpixel k in {0,1,2} (R,G,B left to right): "
+                   "t = (3 j + k - 3 i tan_slant - offset) / lens_pitch, v = floor(frac(t) * views) evaluated "
+                   "exactly, v -> views - 1 - v if reversed; channel k of view v sampled at "
+                   "((j + (k + 0.5) / 3) / width, (i + 0.5) / height)"},
+  };
+  std::string text;
+  emit(j, 0, text);
+  return text + "\n";
+}
+
+void write_sidecar(const std::string& path, const Rig& rig, const Display& display, const SidecarInfo& info) {
+  std::string text;
+  try {
+    text = sidecar_json(rig, display, info);
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {  // e.g. nlohmann::json::type_error on a name that is not UTF-8
+    throw Error("cannot write " + path + ": " + e.what());
+  }
+  AtomicFile file(path);
+  {
+    std::ofstream out(file.temp_path(), std::ios::binary | std::ios::trunc);
+    if (out) out.write(text.data(), std::streamsize(text.size()));
+    if (out) out.close();
+    if (!out) throw Error("cannot write " + path + ": " + std::strerror(errno));
+  }
+  file.commit();
+}
+
+}  // namespace pmr

@@ -1,0 +1,33 @@
+// The shared structs have the same size and field offsets on the device as on the host.
+#include <gtest/gtest.h>
+
+#include <cstddef>
+
+#include "test_util.h"
+
+namespace pmr {
+namespace {
+
+TEST(Layout, DeviceStructsMatchHost) {
+  const ClRuntime& rt = test::runtime();
+  cl_program program = rt.build_program({"layout_probe.cl"}, "-cl-std=CL1.2");
+  ClKernel k(program, "layout_probe");
+  ClBuffer out = rt.buffer(64 * 4, "probe");
+  k.arg(0, out);
+  cl_event e = rt.launch(k, 1, 1);
+  clReleaseEvent(e);
+  uint32_t got[64] = {};
+  rt.read(out, got, sizeof got);
+  clReleaseProgram(program);
+  const uint32_t want[] = {
+      sizeof(PmrParams), offsetof(PmrParams, ndc_scale_x), offsetof(PmrParams, light_world), offsetof(PmrParams, view_w),
+      offsetof(PmrParams, debug_outputs), sizeof(PmrVertex), offsetof(PmrVertex, x0), offsetof(PmrVertex, z),
+      sizeof(PmrMta), offsetof(PmrMta, bary), offsetof(PmrMta, key), offsetof(PmrMta, flags),
+      sizeof(PmrVertexAttr), offsetof(PmrVertexAttr, color), sizeof(PmrTriangle), offsetof(PmrTriangle, face_normal),
+      sizeof(PmrMaterial), offsetof(PmrMaterial, alpha_cutoff), sizeof(PmrTexture), offsetof(PmrTexture, wrap_t),
+      sizeof(PmrEncodeParams), offsetof(PmrEncodeParams, display_w), offsetof(PmrEncodeParams, bilinear)};
+  for (size_t i = 0; i < sizeof want / sizeof want[0]; ++i) EXPECT_EQ(got[i], want[i]) << "probe " << i;
+}
+
+}  // namespace
+}  // namespace pmr

@@ -1,0 +1,96 @@
+// The data products (DESIGN section 6): EXR images, the multi-part views EXR and the JSON sidecar.
+// Every writer writes to a temporary file in the destination folder and renames it into place once the
+// file is complete, so a failed or interrupted run never leaves a partial file under the final name.
+// All errors are pmr::Error with one line naming the file.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "pmr/rig.h"
+
+namespace pmr {
+
+enum class ExrCompression { None, Zip, Piz, Rle };
+// "none", "zip", "piz", "rle" (lower case, as the CLI documents); pmr::Error otherwise.
+ExrCompression parse_exr_compression(const std::string& name);
+// The inverse of parse_exr_compression.
+const char* to_string(ExrCompression c);
+
+// Ensures the directory exists (creating it and its parents) and is writable (creates and removes a
+// probe file). Throws pmr::Error "cannot write to output folder X: <reason>". Call it before long work.
+void prepare_output_dir(const std::string& dir);
+
+// A file written under a temporary name in the same folder as `final_path` and renamed into place by
+// commit(). The constructor creates the (empty) temporary file, so an unwritable or missing folder
+// fails early with pmr::Error. The destructor removes the temporary if commit() was not reached.
+// commit() replaces an existing file at final_path atomically (POSIX rename); it does not fsync.
+class AtomicFile {
+ public:
+  explicit AtomicFile(std::string final_path);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  const std::string& final_path() const { return final_path_; }
+  const std::string& temp_path() const { return temp_path_; }
+  bool committed() const { return committed_; }
+  // Renames the temporary to the final path. Throws pmr::Error on failure (the temporary is then
+  // still removed by the destructor). Every stream writing the temporary must be closed before.
+  void commit();
+
+ private:
+  std::string final_path_, temp_path_;
+  bool committed_ = false;
+};
+
+// Half RGBA EXR (scanline, one part), row 0 at the top (data window (0,0)-(width-1,height-1)).
+// rgba_half: width*height*4 uint16 (IEEE half bits), row-major, RGBA, read in place (no copy).
+// threads > 0 sets OpenEXR's global thread count used for compression (Imf::setGlobalThreadCount).
+void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half,
+                    ExrCompression c, int threads = 0);
+
+// The name of part i of a views file with `views` parts: view_000, view_001, ... with 3 digits, or as
+// many as views - 1 needs (view_0000 .. view_1000 for 1001 views) so names sort in view order.
+std::string view_part_name(int i, int views);
+
+// Multi-part EXR: one scanline part per view, named by view_part_name, each half RGBA width x height.
+// volume: [view][y][x][4] halves, contiguous, row 0 at the top. If depth != nullptr each part also gets
+// a FLOAT channel "Z" from depth [view][y][x]. pixel_aspect is stored as each part's pixelAspectRatio
+// (a view raster's pixels are not square when its aspect differs from the display's: pass
+// A * height / width so that viewers show the views undistorted; 1 = square pixels).
+void write_views_exr(const std::string& path, int width, int height, int views, const uint16_t* volume,
+                     const float* depth, ExrCompression c, int threads = 0, float pixel_aspect = 1.0f);
+
+// Readers (used by the tests). They return the data window's size and the pixels row 0 at the top,
+// RGBA half bits; a missing alpha channel reads as 1.0, missing colour channels as 0.
+void read_rgba_exr(const std::string& path, int& width, int& height, std::vector<uint16_t>& rgba_half);
+// Names of all parts of a (single- or multi-part) EXR file; "" for a part without a name.
+std::vector<std::string> read_exr_part_names(const std::string& path);
+// Pixels of part `part` (0-based). If depth != nullptr it receives the part's "Z" channel as floats
+// ([y][x]), or is cleared if the part has no "Z" channel.
+void read_views_exr_part(const std::string& path, int part, int& width, int& height,
+                         std::vector<uint16_t>& rgba_half, std::vector<float>* depth = nullptr);
+
+// What the sidecar records besides the rig and the display.
+struct SidecarInfo {
+  std::string scene;            // the scene file as given (empty = the bundled default scene)
+  int frame = 0;
+  std::string method = "pmr";   // "pmr" or the baseline's name
+  int tile_x = 4, tile_y = 4, tile_v = 4;
+  int camera = -1;              // glTF camera index, -1 = the default framing of the bounding sphere
+  bool has_bounds = false;      // world bounds of the scene the default framing used
+  glm::dvec3 bounds_lo{0.0}, bounds_hi{0.0};
+  std::string compression;      // EXR compression of the images ("" = not recorded)
+  // Files written for this frame, as (kind, file name) pairs, e.g. {"encoded", "frame_0000.exr"}.
+  std::vector<std::pair<std::string, std::string>> outputs;
+  std::vector<std::string> warnings;   // e.g. "near plane raised ..."
+};
+
+// The sidecar's JSON text (pretty printed, doubles with round-trip precision).
+std::string sidecar_json(const Rig& rig, const Display& display, const SidecarInfo& info);
+// Writes the JSON sidecar (DESIGN section 6) atomically. Matrices are 16 numbers, column-major.
+void write_sidecar(const std::string& path, const Rig& rig, const Display& display, const SidecarInfo& info);
+
+}  // namespace pmr

@@ -109,26 +109,38 @@ int run_render(const std::vector<std::string>& args) {
   }
 
   const auto t_write = std::chrono::steady_clock::now();
-  if (o.write_encoded) {
-    std::vector<uint16_t> image;
-    pipeline.read_display(image);
-    const std::string path = frame_name(o.out_dir, o.frame, ".exr");
-    write_rgba_exr(path, o.display.width, o.display.height, image.data(), compression, 2);
-    std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());
-  }
-  if (o.write_views) {
-    std::vector<uint16_t> volume;
-    pipeline.read_volume(volume);
-    const std::string path = frame_name(o.out_dir, o.frame, ".views.exr");
-    write_views_exr(path, rig.view_w, rig.view_h, rig.views, volume.data(), nullptr, compression, 2);
-    std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());
-  }
   SidecarInfo info;
   info.scene = o.scene;
   info.frame = o.frame;
   info.tile_x = o.pipeline.tile_x;
   info.tile_y = o.pipeline.tile_y;
   info.tile_v = o.pipeline.tile_v;
+  info.camera = o.rig.camera;
+  info.has_bounds = true;
+  info.bounds_lo = lo;
+  info.bounds_hi = hi;
+  info.compression = to_string(compression);
+  info.warnings = scene.warnings;
+  info.warnings.insert(info.warnings.end(), warnings.begin(), warnings.end());
+  auto base = [](const std::string& path) { return path.substr(path.rfind('/') + 1); };
+  if (o.write_encoded) {
+    std::vector<uint16_t> image;
+    pipeline.read_display(image);
+    const std::string path = frame_name(o.out_dir, o.frame, ".exr");
+    write_rgba_exr(path, o.display.width, o.display.height, image.data(), compression, 2);
+    info.outputs.push_back({"encoded", base(path)});
+    std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());
+  }
+  if (o.write_views) {
+    std::vector<uint16_t> volume;
+    pipeline.read_volume(volume);
+    const std::string path = frame_name(o.out_dir, o.frame, ".views.exr");
+    // pixels of a view are non-square: the view spans the display's aspect A
+    const float pixel_aspect = float(rig.aspect * rig.view_h / rig.view_w);
+    write_views_exr(path, rig.view_w, rig.view_h, rig.views, volume.data(), nullptr, compression, 2, pixel_aspect);
+    info.outputs.push_back({"views", base(path)});
+    std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());
+  }
   const std::string sidecar = frame_name(o.out_dir, o.frame, ".json");
   write_sidecar(sidecar, rig, o.display, info);
   std::fprintf(stderr, "pmr: wrote %s\n", sidecar.c_str());

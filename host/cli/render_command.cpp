@@ -80,7 +80,7 @@ int run_render(const std::vector<std::string>& args) {
       throw Error("--camera " + std::to_string(o.rig.camera) + ": the scene has " +
                   std::to_string(scene.cameras.size()) + " camera(s)");
     const SceneCamera& cam = scene.cameras[size_t(o.rig.camera)];
-    if (!cam.perspective)
+    if (!cam.perspective || !cam.placed)
       throw Error("--camera " + std::to_string(o.rig.camera) + " is not a perspective camera placed in the scene");
     pose = &cam.world_from_camera;
     cam_yfov = cam.yfov;

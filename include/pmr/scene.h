@@ -17,7 +17,8 @@ struct SceneTexture {
   int wrap_s = PMR_WRAP_REPEAT, wrap_t = PMR_WRAP_REPEAT;
 };
 
-// A perspective glTF camera placed by the first node (in scene traversal order) that uses it.
+// A glTF camera, placed by the first node (in scene traversal order) that uses it. Cameras that no
+// node of the rendered scene uses, or whose perspective parameters are invalid, keep placed = false.
 struct SceneCamera {
   std::string name;
   glm::dmat4 world_from_camera{1.0};  // the node's world matrix (camera looks along its -Z)
@@ -26,6 +27,7 @@ struct SceneCamera {
   double zfar = 0.0;                  // 0 = infinite
   double aspect = 0.0;                // 0 = not given
   bool perspective = true;            // orthographic cameras are listed but cannot drive the rig
+  bool placed = false;                // true: a node of the scene places it (world_from_camera valid)
 };
 
 struct Scene {
@@ -33,8 +35,9 @@ struct Scene {
   std::vector<PmrVertexAttr> attributes;  // one per vertex (normal in world space)
   std::vector<PmrTriangle> triangles;     // CCW front (winding already fixed for mirrored nodes)
   std::vector<PmrMaterial> materials;     // at least one: index 0 may be the glTF default material
+                                          // (load_scene: 0 is the default, glTF material i is i + 1)
   std::vector<SceneTexture> textures;     // referenced by PmrMaterial::texture
-  std::vector<SceneCamera> cameras;       // glTF cameras array order (only those placed by a node)
+  std::vector<SceneCamera> cameras;       // one per glTF camera, same order (see SceneCamera::placed)
   std::vector<std::string> warnings;      // non-fatal problems, one line each
 };
 

@@ -1,0 +1,92 @@
+// Private to host/scene: the glTF loader, split by concern.
+//   gltf_validate.cpp   the file before tinygltf sees it (reading, GLB container, JSON pre-checks) and
+//                       the structure after (reference ranges, bufferView bounds, node hierarchy)
+//   gltf_accessors.cpp  bounds-checked typed reads of accessors (stride, normalization, sparse)
+//   gltf_loader.cpp     the tinygltf call, materials and textures, the scene walk, flattening
+//
+// tinygltf 2.7 parses but checks almost nothing: indices, offsets and counts are taken as written.
+// Everything read from the model therefore goes through the checks here first, in 64-bit arithmetic,
+// and every failure is a pmr::Error naming the file and the offending element.
+#pragma once
+#include <cstdint>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+// Debian ships tinygltf prebuilt (libtinygltf.so): the header only declares, nothing is implemented
+// here, and the JSON library is the system nlohmann one.
+#define TINYGLTF_NO_INCLUDE_JSON
+#include <nlohmann/json.hpp>
+#include <tiny_gltf.h>
+
+namespace pmr::gltf {
+
+// Throws pmr::Error("<file>: <what>").
+[[noreturn]] void fail(const std::string& file, const std::string& what);
+
+// Text quoted from the file or a parser made fit for a one-line message: newlines become spaces,
+// other control bytes (and with ascii_only, non-ASCII bytes) '?', cut to a few hundred characters.
+std::string one_line(const std::string& text, bool ascii_only = false);
+
+// ---- gltf_validate.cpp: before tinygltf ----------------------------------------------------------
+
+// The file as read, after the checks tinygltf does not do (or does too late to give a clear message):
+// GLB container layout, JSON syntax and nesting depth, asset.version, extensionsRequired, external
+// buffer files. Throws pmr::Error on any of them.
+struct SourceFile {
+  std::vector<unsigned char> bytes;     // the whole file (a GLB is cut to the length its header gives)
+  bool glb = false;                     // detected by the magic bytes, not by the extension
+  std::string base_dir;                 // directory relative URIs are resolved against
+  std::set<int> base_color_images;      // images some material uses as baseColorTexture
+  std::vector<std::string> ignored_extensions;  // in extensionsUsed, not required, not implemented
+};
+SourceFile read_source(const std::string& path);
+
+// Percent-decodes a relative URI the way tinygltf does and joins it to base_dir.
+std::string resolve_uri(const std::string& base_dir, const std::string& uri);
+
+// ---- gltf_validate.cpp: after tinygltf ------------------------------------------------------------
+
+// Checks every cross reference the loader follows (scene -> node -> mesh -> accessor / material ->
+// texture -> image / sampler, node -> camera), that each bufferView lies inside its buffer, and that
+// the nodes form a forest (no cycle, at most one parent). Returns each node's parent (-1 = root).
+std::vector<int> validate_model(const tinygltf::Model& model, const std::string& file);
+
+// Root nodes of the scene to render: the default scene (scene 0 when none is named) or, with no
+// scenes at all, every node without a parent.
+std::vector<int> scene_roots(const tinygltf::Model& model, const std::vector<int>& parent,
+                             const std::string& file);
+
+// The node's local transform (matrix, or T * R * S), checked for size and finiteness.
+glm::dmat4 node_local_matrix(const tinygltf::Node& node, int index, const std::string& file);
+
+// ---- gltf_accessors.cpp ----------------------------------------------------------------------------
+
+enum class Semantic { Position, Normal, Texcoord, Color, Indices };
+
+// One vertex attribute, decoded to float (normalized integers mapped per the glTF spec), sparse
+// substitutions applied. values.size() == count * components.
+struct AttributeData {
+  size_t count = 0;
+  int components = 0;
+  std::vector<float> values;
+};
+
+// `what` names the use for messages, e.g. "POSITION of mesh 0 primitive 1". Checks the type and
+// component type against what the semantic allows (core glTF plus KHR_mesh_quantization).
+AttributeData read_attribute(const tinygltf::Model& model, int accessor, Semantic semantic,
+                             const std::string& what, const std::string& file);
+
+// Runs the checks of read_attribute / read_indices (type, component type, bounds) without reading, so
+// that counts can be trusted before anything is allocated from them.
+void check_accessor(const tinygltf::Model& model, int accessor, Semantic semantic, const std::string& what,
+                    const std::string& file);
+
+// A SCALAR u8 / u16 / u32 index accessor. Values are not range-checked here (the caller knows the
+// vertex count).
+std::vector<uint32_t> read_indices(const tinygltf::Model& model, int accessor, const std::string& what,
+                                   const std::string& file);
+
+}  // namespace pmr::gltf

@@ -1,0 +1,675 @@
+// load_scene: a glTF 2.0 file flattened into world-space triangles (DESIGN sections 1 and 4).
+//
+// Order of work: read_source() checks the file and its JSON before tinygltf parses it (so that Draco,
+// unknown required extensions, truncated GLBs and missing buffers get clear messages), tinygltf parses,
+// validate_model() checks every reference the walk follows, then the default scene is walked and each
+// mesh instance is emitted with its node's world matrix. Only base-colour images are decoded.
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <map>
+
+#include "pmr/error.h"
+#include "pmr/scene.h"
+#include "scene/gltf_internal.h"
+
+namespace pmr {
+namespace {
+
+using namespace gltf;
+
+// ---- tinygltf callbacks ------------------------------------------------------------------------------
+
+struct FsContext {
+  std::string prefix;  // base_dir with a trailing '/'
+};
+
+// tinygltf looks for external files in base_dir and then in the working directory; only the former
+// is the file's own folder. Empty files count as missing so that an empty image is a warning (tinygltf
+// would fail the whole load on it); empty buffers were already refused by read_source().
+bool fs_exists(const std::string& path, void* user) {
+  const auto* ctx = static_cast<const FsContext*>(user);
+  if (path.compare(0, ctx->prefix.size(), ctx->prefix) != 0) return false;
+  struct stat st {};
+  return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0;
+}
+
+std::string fs_expand(const std::string& path, void*) { return path; }
+
+bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  const std::streamoff size = in ? std::streamoff(in.tellg()) : -1;
+  if (size < 0) {
+    if (err) *err += "cannot open " + path + "\n";
+    return false;
+  }
+  out->resize(size_t(size));
+  in.seekg(0);
+  if (size > 0 && !in.read(reinterpret_cast<char*>(out->data()), size)) {
+    if (err) *err += "cannot read " + path + "\n";
+    return false;
+  }
+  return true;
+}
+
+bool fs_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "writing is disabled\n";
+  return false;
+}
+
+struct ImageContext {
+  const tinygltf::Model* model = nullptr;  // the model tinygltf is filling (buffers come before images)
+  const std::set<int>* wanted = nullptr;   // images to decode
+  std::map<int, std::string> failures;     // image index -> why it could not be decoded
+};
+
+// Decodes with tinygltf's own stb_image loader but never fails the load: an undecodable image is a
+// warning and an untextured material. Also checks what tinygltf does not: a GLB image's bufferView
+// must lie inside its buffer before its bytes are read.
+bool load_image(tinygltf::Image* image, int index, std::string*, std::string*, int, int, const unsigned char* bytes,
+                int size, void* user) {
+  auto* ctx = static_cast<ImageContext*>(user);
+  if (!ctx->wanted->count(index)) return true;  // never sampled: skip the decode
+  if (image->bufferView >= 0) {
+    const tinygltf::Model& m = *ctx->model;
+    bool inside = size_t(image->bufferView) < m.bufferViews.size();
+    if (inside) {
+      const tinygltf::BufferView& bv = m.bufferViews[size_t(image->bufferView)];
+      uint64_t end = 0;
+      inside = size_t(bv.buffer) < m.buffers.size() && !__builtin_add_overflow(bv.byteOffset, bv.byteLength, &end) &&
+               end <= m.buffers[size_t(bv.buffer)].data.size() && bv.byteLength <= uint64_t(INT32_MAX);
+    }
+    if (!inside) {
+      ctx->failures[index] = "its bufferView " + std::to_string(image->bufferView) + " lies outside the buffer";
+      return true;
+    }
+  }
+  if (size <= 0 || !bytes) {
+    ctx->failures[index] = "the image data is empty";
+    return true;
+  }
+  std::string err, warn;
+  if (!tinygltf::LoadImageData(image, index, &err, &warn, 0, 0, bytes, size, nullptr)) {
+    err = one_line(err.substr(0, err.find('\n')));
+    ctx->failures[index] = "cannot decode it" + (err.empty() ? std::string() : " (" + err + ")");
+    image->image.clear();
+    image->width = image->height = 0;
+  }
+  return true;
+}
+
+void load_model(const std::string& path, const SourceFile& src, tinygltf::Model& model, ImageContext& images) {
+  FsContext fs{src.base_dir.back() == '/' ? src.base_dir : src.base_dir + "/"};
+  images.model = &model;
+  images.wanted = &src.base_color_images;
+  tinygltf::TinyGLTF loader;
+  loader.SetFsCallbacks({&fs_exists, &fs_expand, &fs_read, &fs_write, &fs});
+  loader.SetImageLoader(&load_image, &images);
+  std::string err, warn;
+  bool ok = false;
+  try {
+    // The bytes were already read and checked by read_source(); parse them from memory.
+    if (src.glb)
+      ok = loader.LoadBinaryFromMemory(&model, &err, &warn, src.bytes.data(), unsigned(src.bytes.size()), src.base_dir);
+    else
+      ok = loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(src.bytes.data()),
+                                      unsigned(src.bytes.size()), src.base_dir);
+  } catch (const std::exception& e) {  // nlohmann type errors on odd JSON
+    fail(path, "not a valid glTF file: " + one_line(e.what()));
+  }
+  if (!ok) {
+    const std::string msg = one_line(err.empty() ? warn : err);
+    fail(path, "not a valid glTF file: " + (msg.empty() ? std::string("tinygltf gave no reason") : msg));
+  }
+}
+
+// ---- materials and textures ---------------------------------------------------------------------------
+
+// uv' = T * R * S * uv (KHR_texture_transform). The extension's GLSL reads as
+// u' = cos*sx*u + sin*sy*v + ox, v' = -sin*sx*u + cos*sy*v + oy: this is what the Khronos sample viewer
+// does and what the extension's own example needs (offset (0,1), rotation pi/2, scale 0.5 selects the
+// lower-left quadrant of the image).
+struct UvTransform {
+  bool active = false;
+  double a = 1, b = 0, c = 0, d = 1, tx = 0, ty = 0;
+};
+
+struct MaterialUv {
+  int set = 0;  // TEXCOORD_n of the base colour texture
+  UvTransform transform;
+};
+
+struct Loader {
+  Loader(const tinygltf::Model& m, const std::string& f, const ImageContext& i, Scene& s)
+      : model(m), file(f), images(i), scene(s) {}
+
+  const tinygltf::Model& model;
+  const std::string& file;
+  const ImageContext& images;
+  Scene& scene;
+  std::set<std::string> seen;
+  std::vector<MaterialUv> material_uv;   // per glTF material
+  std::map<int, int> scene_texture_of;   // glTF texture -> Scene::textures index (-1: unusable)
+  std::set<int> used_materials;          // glTF materials of emitted primitives
+  size_t point_line_primitives = 0, skipped_triangles = 0, nonfinite_attributes = 0, leftover_indices = 0;
+  bool skinned = false, morphed = false;
+
+  void warn(const std::string& line) {
+    if (seen.insert(line).second) scene.warnings.push_back(file + ": " + one_line(line));
+  }
+};
+
+bool finite_numbers(const tinygltf::Value& v, size_t n, double* out) {
+  if (!v.IsArray() || v.ArrayLen() != n) return false;
+  for (size_t i = 0; i < n; ++i) {
+    const tinygltf::Value& e = v.Get(int(i));
+    if (!e.IsNumber() || !std::isfinite(e.GetNumberAsDouble())) return false;
+    out[i] = e.GetNumberAsDouble();
+  }
+  return true;
+}
+
+MaterialUv material_uv(Loader& L, const tinygltf::TextureInfo& info, int material) {
+  MaterialUv uv;
+  uv.set = info.texCoord;
+  auto ext = info.extensions.find("KHR_texture_transform");
+  if (ext == info.extensions.end()) return uv;
+  const tinygltf::Value& t = ext->second;
+  const std::string name = "material " + std::to_string(material) + " KHR_texture_transform";
+  if (!t.IsObject()) {
+    L.warn(name + " is not an object; ignored");
+    return uv;
+  }
+  double offset[2] = {0, 0}, scale[2] = {1, 1}, rotation = 0;
+  bool ok = (!t.Has("offset") || finite_numbers(t.Get("offset"), 2, offset)) &&
+            (!t.Has("scale") || finite_numbers(t.Get("scale"), 2, scale));
+  if (t.Has("rotation")) {
+    const tinygltf::Value& r = t.Get("rotation");
+    ok = ok && r.IsNumber() && std::isfinite(r.GetNumberAsDouble());
+    if (ok) rotation = r.GetNumberAsDouble();
+  }
+  if (!ok) {
+    L.warn(name + " has an invalid offset, rotation or scale; ignored");
+    return uv;
+  }
+  if (t.Has("texCoord")) {
+    const tinygltf::Value& tc = t.Get("texCoord");
+    if (tc.IsInt() && tc.GetNumberAsInt() >= 0) uv.set = tc.GetNumberAsInt();
+    else L.warn(name + " has an invalid texCoord; ignored");
+  }
+  const double c = std::cos(rotation), s = std::sin(rotation);
+  uv.transform = {true, c * scale[0], s * scale[1], -s * scale[0], c * scale[1], offset[0], offset[1]};
+  return uv;
+}
+
+// Any tinygltf image (1..4 channels, 8 or 16 bits) to RGBA8, rows top first as decoded.
+bool to_rgba8(const tinygltf::Image& img, SceneTexture& out, std::string& why) {
+  const int bytes = img.bits == 16 ? 2 : img.bits == 8 ? 1 : 0;
+  if (img.width <= 0 || img.height <= 0 || img.component < 1 || img.component > 4 || bytes == 0) {
+    why = "unsupported image layout (" + std::to_string(img.component) + " channels, " + std::to_string(img.bits) + " bits)";
+    return false;
+  }
+  const uint64_t pixels = uint64_t(img.width) * uint64_t(img.height);
+  if (img.image.size() != pixels * uint64_t(img.component) * uint64_t(bytes)) {
+    why = "image data size does not match its dimensions";
+    return false;
+  }
+  out.width = img.width;
+  out.height = img.height;
+  out.rgba.resize(size_t(pixels) * 4);
+  const unsigned char* src = img.image.data();
+  auto channel = [&](size_t i) -> uint8_t {
+    if (bytes == 1) return src[i];
+    uint16_t v;
+    std::memcpy(&v, src + 2 * i, 2);  // stb_image gives native-endian 16-bit samples
+    return uint8_t((uint32_t(v) * 255u + 32767u) / 65535u);
+  };
+  const size_t n = size_t(img.component);
+  for (size_t p = 0; p < size_t(pixels); ++p) {
+    uint8_t* dst = &out.rgba[4 * p];
+    const size_t i = p * n;
+    if (n <= 2) {  // grey, grey + alpha
+      dst[0] = dst[1] = dst[2] = channel(i);
+      dst[3] = n == 2 ? channel(i + 1) : 255;
+    } else {
+      dst[0] = channel(i), dst[1] = channel(i + 1), dst[2] = channel(i + 2);
+      dst[3] = n == 4 ? channel(i + 3) : 255;
+    }
+  }
+  return true;
+}
+
+int wrap_mode(Loader& L, int mode, int sampler) {
+  if (mode == PMR_WRAP_REPEAT || mode == PMR_WRAP_CLAMP || mode == PMR_WRAP_MIRROR) return mode;
+  L.warn("sampler " + std::to_string(sampler) + " has wrap mode " + std::to_string(mode) + "; using REPEAT");
+  return PMR_WRAP_REPEAT;
+}
+
+int scene_texture(Loader& L, int texture) {
+  auto cached = L.scene_texture_of.find(texture);
+  if (cached != L.scene_texture_of.end()) return cached->second;
+  int& result = L.scene_texture_of[texture] = -1;
+  const tinygltf::Texture& t = L.model.textures[size_t(texture)];
+  const std::string name = "texture " + std::to_string(texture);
+  if (t.source < 0) {
+    L.warn(name + " has no PNG/JPEG image (other formats are not supported); drawn untextured");
+    return result;
+  }
+  const tinygltf::Image& img = L.model.images[size_t(t.source)];
+  const std::string image_name = "image " + std::to_string(t.source) +
+                                 (img.uri.empty() ? (img.name.empty() ? "" : " '" + img.name + "'") : " '" + img.uri + "'");
+  SceneTexture st;
+  std::string why;
+  if (img.image.empty()) {
+    auto f = L.images.failures.find(t.source);
+    why = f != L.images.failures.end() ? f->second
+          : img.uri.empty()            ? std::string("no image data")
+                                       : "file not found or unreadable";
+  } else {
+    to_rgba8(img, st, why);
+  }
+  if (!why.empty()) {
+    L.warn(name + " (" + image_name + "): " + why + "; drawn untextured");
+    return result;
+  }
+  if (t.sampler >= 0) {
+    const tinygltf::Sampler& s = L.model.samplers[size_t(t.sampler)];
+    st.wrap_s = wrap_mode(L, s.wrapS, t.sampler);
+    st.wrap_t = wrap_mode(L, s.wrapT, t.sampler);
+  }
+  L.scene.textures.push_back(std::move(st));
+  return result = int(L.scene.textures.size() - 1);
+}
+
+PmrMaterial default_material() {
+  PmrMaterial m{};
+  for (float& c : m.base_color) c = 1.0f;
+  m.texture = -1;
+  m.alpha_mode = PMR_ALPHA_OPAQUE;
+  m.alpha_cutoff = 0.5f;
+  m.double_sided = 0;
+  return m;
+}
+
+// Scene::materials[0] is the default material; glTF material i is Scene::materials[i + 1].
+void build_materials(Loader& L) {
+  L.scene.materials.push_back(default_material());
+  for (size_t i = 0; i < L.model.materials.size(); ++i) {
+    const tinygltf::Material& g = L.model.materials[i];
+    const std::string name = "material " + std::to_string(i);
+    PmrMaterial m = default_material();
+    const std::vector<double>& f = g.pbrMetallicRoughness.baseColorFactor;
+    if (f.size() == 4 && std::all_of(f.begin(), f.end(), [](double x) { return std::isfinite(x); })) {
+      for (int c = 0; c < 4; ++c) m.base_color[c] = float(f[size_t(c)]);
+    } else {
+      L.warn(name + " has an invalid baseColorFactor; using white");
+    }
+    if (g.alphaMode == "MASK") m.alpha_mode = PMR_ALPHA_MASK;
+    else if (g.alphaMode == "BLEND") m.alpha_mode = PMR_ALPHA_BLEND;
+    else if (g.alphaMode != "OPAQUE") L.warn(name + " has unknown alphaMode '" + g.alphaMode + "'; drawn opaque");
+    if (std::isfinite(g.alphaCutoff) && g.alphaCutoff >= 0.0) m.alpha_cutoff = float(g.alphaCutoff);
+    else L.warn(name + " has an invalid alphaCutoff; using 0.5");
+    m.double_sided = g.doubleSided ? 1u : 0u;
+    const tinygltf::TextureInfo& info = g.pbrMetallicRoughness.baseColorTexture;
+    L.material_uv.push_back(material_uv(L, info, int(i)));
+    if (info.index >= 0) m.texture = scene_texture(L, info.index);
+    L.scene.materials.push_back(m);
+  }
+}
+
+// ---- scene walk and primitives ---------------------------------------------------------------------------
+
+struct Instance {
+  int mesh;
+  glm::dmat4 world;
+};
+
+bool finite(const glm::dmat4& m) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
+}
+
+// Pre-order walk, children in their listed order. The hierarchy is a checked forest, so each node is
+// visited once and the walk ends.
+std::vector<Instance> walk(Loader& L, const std::vector<int>& roots) {
+  std::vector<Instance> instances;
+  std::vector<std::pair<int, glm::dmat4>> stack;
+  for (auto r = roots.rbegin(); r != roots.rend(); ++r) stack.push_back({*r, glm::dmat4(1.0)});
+  while (!stack.empty()) {
+    const auto [index, parent] = stack.back();
+    stack.pop_back();
+    const tinygltf::Node& node = L.model.nodes[size_t(index)];
+    const glm::dmat4 world = parent * node_local_matrix(node, index, L.file);
+    if (!finite(world)) fail(L.file, "node " + std::to_string(index) + " has a world matrix that overflows");
+    if (node.mesh >= 0) instances.push_back({node.mesh, world});
+    if (node.skin >= 0) L.skinned = true;
+    if (node.camera >= 0 && !L.scene.cameras[size_t(node.camera)].placed) {
+      L.scene.cameras[size_t(node.camera)].placed = true;
+      L.scene.cameras[size_t(node.camera)].world_from_camera = world;
+    }
+    for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
+  }
+  return instances;
+}
+
+// One primitive decoded in its mesh's space, shared by all instances of the mesh.
+struct Decoded {
+  size_t vertices = 0;
+  std::vector<float> pos, nrm, uv, col;  // nrm, uv, col empty when the attribute is absent
+  std::vector<uint32_t> tris;            // 3 local vertex indices per triangle, as authored (CCW front)
+  uint32_t material = 0;                 // Scene::materials index
+};
+
+const int* attribute(const tinygltf::Primitive& p, const std::string& name) {
+  auto it = p.attributes.find(name);
+  return it == p.attributes.end() ? nullptr : &it->second;
+}
+
+Decoded decode_primitive(Loader& L, int mesh, int index) {
+  const tinygltf::Primitive& p = L.model.meshes[size_t(mesh)].primitives[size_t(index)];
+  const std::string where = "mesh " + std::to_string(mesh) + " primitive " + std::to_string(index);
+  Decoded d;
+  const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+  if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+    ++L.point_line_primitives;
+    return d;
+  }
+  const int* position = attribute(p, "POSITION");
+  if (!position) {
+    L.warn(where + " has no POSITION attribute; skipped");
+    return d;
+  }
+  if (!p.targets.empty()) L.morphed = true;
+  if (p.material >= 0) L.used_materials.insert(p.material);
+  d.material = p.material >= 0 ? uint32_t(p.material + 1) : 0u;
+  AttributeData pos = read_attribute(L.model, *position, Semantic::Position, "POSITION of " + where, L.file);
+  d.vertices = pos.count;
+  d.pos = std::move(pos.values);
+  auto read = [&](const std::string& name, Semantic semantic) -> std::vector<float> {
+    const int* a = attribute(p, name);
+    if (!a) return {};
+    AttributeData data = read_attribute(L.model, *a, semantic, name + " of " + where, L.file);
+    if (data.count != d.vertices)
+      fail(L.file, "accessor " + std::to_string(*a) + " (" + name + " of " + where + ") has " + std::to_string(data.count) +
+                       " elements but POSITION has " + std::to_string(d.vertices));
+    if (semantic == Semantic::Color && data.components == 3) {  // RGB -> RGBA, alpha 1
+      std::vector<float> rgba(d.vertices * 4, 1.0f);
+      for (size_t v = 0; v < d.vertices; ++v) std::copy_n(&data.values[3 * v], 3, &rgba[4 * v]);
+      return rgba;
+    }
+    return std::move(data.values);
+  };
+  d.nrm = read("NORMAL", Semantic::Normal);
+  const MaterialUv uv = p.material >= 0 ? L.material_uv[size_t(p.material)] : MaterialUv{};
+  d.uv = read("TEXCOORD_" + std::to_string(uv.set), Semantic::Texcoord);
+  if (uv.transform.active) {
+    const UvTransform& t = uv.transform;
+    for (size_t v = 0; v < d.uv.size(); v += 2) {
+      const double u0 = d.uv[v], v0 = d.uv[v + 1];
+      d.uv[v] = float(t.a * u0 + t.b * v0 + t.tx);
+      d.uv[v + 1] = float(t.c * u0 + t.d * v0 + t.ty);
+    }
+  }
+  d.col = read("COLOR_0", Semantic::Color);
+
+  std::vector<uint32_t> indices;
+  if (p.indices >= 0) {
+    const std::string what = "indices of " + where;
+    indices = read_indices(L.model, p.indices, what, L.file);
+    for (uint32_t i : indices)
+      if (i >= d.vertices)
+        fail(L.file, "accessor " + std::to_string(p.indices) + " (" + what + ") reads index " + std::to_string(i) +
+                         " but POSITION has " + std::to_string(d.vertices) + " vertices");
+  }
+  const size_t n = p.indices >= 0 ? indices.size() : d.vertices;
+  auto at = [&](size_t k) { return p.indices >= 0 ? indices[k] : uint32_t(k); };
+  const size_t triangles = mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : n >= 3 ? n - 2 : 0;  // < 2^27: check_totals
+  d.tris.reserve(3 * triangles);
+  for (size_t k = 0; k < triangles; ++k) {
+    uint32_t t[3];
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      t[0] = at(3 * k), t[1] = at(3 * k + 1), t[2] = at(3 * k + 2);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {  // every other triangle is reversed to stay CCW
+      t[0] = at(k), t[1] = at(k + 1 + k % 2), t[2] = at(k + 2 - k % 2);
+    } else {  // fan around vertex 0, in the spec's order
+      t[0] = at(k + 1), t[1] = at(k + 2), t[2] = at(0);
+    }
+    d.tris.insert(d.tris.end(), t, t + 3);
+  }
+  if (mode == TINYGLTF_MODE_TRIANGLES && n % 3 != 0) ++L.leftover_indices;
+  return d;
+}
+
+glm::vec3 face_normal(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  const glm::dvec3 n = glm::cross(glm::dvec3(b) - glm::dvec3(a), glm::dvec3(c) - glm::dvec3(a));
+  const double len = glm::length(n);
+  if (!(len > 0.0) || !std::isfinite(len)) return {0.0f, 0.0f, 1.0f};  // zero area
+  return glm::vec3(n / len);
+}
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// Appends one instance: positions to world space, normals by the inverse transpose, winding reversed
+// under a mirroring matrix so that counter-clockwise stays the front face.
+void emit(Loader& L, const Decoded& d, const glm::dmat4& world) {
+  Scene& s = L.scene;
+  const size_t ntri = d.tris.size() / 3;
+  if (ntri == 0) return;  // (totals were checked by check_totals)
+  const glm::dmat3 m3(world);
+  const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(m3));
+  const bool mirrored = glm::determinant(m3) < 0.0;
+  const uint32_t base = uint32_t(s.positions.size());
+  std::vector<uint8_t> bad_position(d.vertices, 0), bad_normal(d.vertices, 0);
+  for (size_t v = 0; v < d.vertices; ++v) {
+    const glm::dvec4 p = world * glm::dvec4(d.pos[3 * v], d.pos[3 * v + 1], d.pos[3 * v + 2], 1.0);
+    glm::vec3 pf(p);
+    if (!finite(pf)) {  // NaN in the data, or beyond float range
+      bad_position[v] = 1;
+      pf = glm::vec3(0.0f);
+    }
+    s.positions.push_back(pf);
+    PmrVertexAttr a{};
+    if (!d.nrm.empty()) {
+      const glm::dvec3 n = normal_matrix * glm::dvec3(d.nrm[3 * v], d.nrm[3 * v + 1], d.nrm[3 * v + 2]);
+      const double len = glm::length(n);
+      if (len > 0.0 && std::isfinite(len)) {
+        for (int c = 0; c < 3; ++c) a.normal[c] = float(n[c] / len);
+      } else {
+        bad_normal[v] = 1;
+      }
+    }
+    for (int c = 0; c < 2; ++c) {
+      a.uv[c] = d.uv.empty() ? 0.0f : d.uv[2 * v + size_t(c)];
+      if (!std::isfinite(a.uv[c])) a.uv[c] = 0.0f, ++L.nonfinite_attributes;
+    }
+    for (int c = 0; c < 4; ++c) {
+      a.color[c] = d.col.empty() ? 1.0f : d.col[4 * v + size_t(c)];
+      if (!std::isfinite(a.color[c])) a.color[c] = 1.0f, ++L.nonfinite_attributes;
+    }
+    s.attributes.push_back(a);
+  }
+  for (size_t t = 0; t < ntri; ++t) {
+    uint32_t v[3] = {d.tris[3 * t], d.tris[3 * t + 1], d.tris[3 * t + 2]};
+    if (mirrored) std::swap(v[1], v[2]);
+    if (bad_position[v[0]] || bad_position[v[1]] || bad_position[v[2]]) {
+      ++L.skipped_triangles;
+      continue;
+    }
+    PmrTriangle tri{};
+    for (int c = 0; c < 3; ++c) tri.v[c] = base + v[c];
+    tri.material = d.material;
+    const glm::vec3 n = face_normal(s.positions[tri.v[0]], s.positions[tri.v[1]], s.positions[tri.v[2]]);
+    tri.face_normal[0] = n.x, tri.face_normal[1] = n.y, tri.face_normal[2] = n.z;
+    tri.has_normals = !d.nrm.empty() && !bad_normal[v[0]] && !bad_normal[v[1]] && !bad_normal[v[2]];
+    s.triangles.push_back(tri);
+  }
+}
+
+// Triangles and vertices a primitive will produce, from its accessor counts alone (after checking
+// that those accessors fit in their bufferViews, which bounds the counts by the file's data).
+std::pair<uint64_t, uint64_t> primitive_size(const Loader& L, int mesh, int index) {
+  const tinygltf::Primitive& p = L.model.meshes[size_t(mesh)].primitives[size_t(index)];
+  const int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+  const int* position = attribute(p, "POSITION");
+  if (!position || mode < TINYGLTF_MODE_TRIANGLES) return {0, 0};
+  const std::string where = " of mesh " + std::to_string(mesh) + " primitive " + std::to_string(index);
+  check_accessor(L.model, *position, Semantic::Position, "POSITION" + where, L.file);
+  if (p.indices >= 0) check_accessor(L.model, p.indices, Semantic::Indices, "indices" + where, L.file);
+  const uint64_t vertices = L.model.accessors[size_t(*position)].count;
+  const uint64_t n = p.indices >= 0 ? L.model.accessors[size_t(p.indices)].count : vertices;
+  const uint64_t triangles = mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : n >= 3 ? n - 2 : 0;
+  return {triangles, triangles ? vertices : 0};
+}
+
+// Sums the whole scene before anything is decoded: a small file instancing a big mesh many times must
+// fail here, not after allocating gigabytes. The vertex cap is what the triangle cap can reference.
+void check_totals(Loader& L, const std::vector<Instance>& instances) {
+  std::map<int, std::pair<uint64_t, uint64_t>> mesh_size;  // per mesh: triangles, vertices
+  uint64_t triangles = 0, vertices = 0;
+  for (const Instance& inst : instances) {
+    auto it = mesh_size.find(inst.mesh);
+    if (it == mesh_size.end()) {
+      std::pair<uint64_t, uint64_t> sum{0, 0};
+      for (size_t p = 0; p < L.model.meshes[size_t(inst.mesh)].primitives.size(); ++p) {
+        const auto [t, v] = primitive_size(L, inst.mesh, int(p));
+        if (__builtin_add_overflow(sum.first, t, &sum.first)) sum.first = UINT64_MAX;
+        if (__builtin_add_overflow(sum.second, v, &sum.second)) sum.second = UINT64_MAX;
+      }
+      it = mesh_size.emplace(inst.mesh, sum).first;
+    }
+    if (__builtin_add_overflow(triangles, it->second.first, &triangles)) triangles = UINT64_MAX;
+    if (__builtin_add_overflow(vertices, it->second.second, &vertices)) vertices = UINT64_MAX;
+  }
+  const uint64_t max_triangles = PMR_MAX_TRIANGLES - 1, max_vertices = 3 * max_triangles;
+  if (triangles > max_triangles)
+    fail(L.file, "the scene has " + std::to_string(triangles) + " triangles; the renderer supports at most " +
+                     std::to_string(max_triangles));
+  if (vertices > max_vertices)
+    fail(L.file, "the scene has " + std::to_string(vertices) + " vertices; the renderer supports at most " +
+                     std::to_string(max_vertices));
+  L.scene.triangles.reserve(size_t(triangles));
+  L.scene.positions.reserve(size_t(vertices));
+  L.scene.attributes.reserve(size_t(vertices));
+}
+
+void emit_instances(Loader& L, const std::vector<Instance>& instances) {
+  check_totals(L, instances);
+  // Decode each mesh once and keep it only while instances of it remain.
+  std::map<int, size_t> remaining;
+  for (const Instance& i : instances) ++remaining[i.mesh];
+  std::map<int, std::vector<Decoded>> cache;
+  for (const Instance& inst : instances) {
+    auto it = cache.find(inst.mesh);
+    if (it == cache.end()) {
+      std::vector<Decoded> prims;
+      const size_t count = L.model.meshes[size_t(inst.mesh)].primitives.size();
+      for (size_t p = 0; p < count; ++p) prims.push_back(decode_primitive(L, inst.mesh, int(p)));
+      it = cache.emplace(inst.mesh, std::move(prims)).first;
+    }
+    for (const Decoded& d : it->second) emit(L, d, inst.world);
+    if (--remaining[inst.mesh] == 0) cache.erase(it);
+  }
+}
+
+void build_cameras(Loader& L) {
+  for (const tinygltf::Camera& c : L.model.cameras) {
+    SceneCamera sc;
+    sc.name = c.name;
+    sc.perspective = c.type == "perspective";
+    if (sc.perspective) {
+      sc.yfov = c.perspective.yfov;
+      sc.znear = c.perspective.znear;
+      sc.zfar = c.perspective.zfar;
+      sc.aspect = c.perspective.aspectRatio;
+    }
+    L.scene.cameras.push_back(sc);
+  }
+}
+
+// A perspective camera with unusable parameters cannot drive the rig: unplace it, with a warning.
+void check_cameras(Loader& L) {
+  for (size_t i = 0; i < L.scene.cameras.size(); ++i) {
+    SceneCamera& c = L.scene.cameras[i];
+    if (!c.placed || !c.perspective) continue;
+    const double pi = 3.14159265358979323846;
+    const bool ok = std::isfinite(c.yfov) && c.yfov > 0 && c.yfov < pi && std::isfinite(c.znear) && c.znear > 0 &&
+                    std::isfinite(c.zfar) && (c.zfar == 0 || c.zfar > c.znear) && std::isfinite(c.aspect) &&
+                    c.aspect >= 0;
+    if (!ok) {
+      c.placed = false;
+      L.warn("camera " + std::to_string(i) + " has invalid perspective parameters; ignored");
+    }
+  }
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string s;
+  for (const std::string& i : items) s += (s.empty() ? "" : ", ") + i;
+  return s;
+}
+
+void summary_warnings(Loader& L, const SourceFile& src) {
+  if (!src.ignored_extensions.empty())
+    L.warn("extensions used but not implemented, ignored: " + join(src.ignored_extensions));
+  if (!L.model.animations.empty()) L.warn("animations ignored: the static pose is rendered");
+  if (L.skinned) L.warn("skins ignored: skinned meshes are drawn in their bind pose");
+  if (L.morphed) L.warn("morph targets ignored: meshes are drawn with their base shape");
+  if (L.point_line_primitives)
+    L.warn(std::to_string(L.point_line_primitives) + " point or line primitive(s) skipped: only triangles are drawn");
+  if (L.leftover_indices) L.warn("TRIANGLES primitive(s) with a vertex count not divisible by 3: extra vertices ignored");
+  if (L.skipped_triangles)
+    L.warn(std::to_string(L.skipped_triangles) + " triangle(s) with non-finite vertex positions skipped");
+  if (L.nonfinite_attributes) L.warn("non-finite texture coordinates or colours replaced by defaults");
+  std::vector<std::string> blend;
+  for (int m : L.used_materials)
+    if (L.model.materials[size_t(m)].alphaMode == "BLEND") blend.push_back(std::to_string(m));
+  if (!blend.empty()) {
+    if (blend.size() > 8) blend.resize(8), blend.push_back("...");
+    L.warn("alphaMode BLEND drawn as opaque (material " + join(blend) + ")");
+  }
+}
+
+}  // namespace
+
+Scene load_scene(const std::string& path) {
+  const SourceFile src = read_source(path);
+  tinygltf::Model model;
+  ImageContext images;
+  load_model(path, src, model, images);
+  const std::vector<int> parent = validate_model(model, path);
+  const std::vector<int> roots = scene_roots(model, parent, path);
+
+  Scene scene;
+  Loader L(model, path, images, scene);
+  build_materials(L);
+  build_cameras(L);
+  emit_instances(L, walk(L, roots));
+  check_cameras(L);
+  summary_warnings(L, src);
+  if (scene.triangles.empty()) fail(path, "the scene has no triangles to render");
+  return scene;
+}
+
+void scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi) {
+  lo = glm::dvec3(std::numeric_limits<double>::infinity());
+  hi = -lo;
+  bool any = false;
+  for (const PmrTriangle& t : scene.triangles) {
+    for (uint32_t v : t.v) {
+      if (v >= scene.positions.size()) throw Error("scene_bounds: triangle vertex index out of range");
+      const glm::dvec3 p(scene.positions[v]);
+      lo = glm::min(lo, p);
+      hi = glm::max(hi, p);
+      any = true;
+    }
+  }
+  if (!any) throw Error("scene_bounds: the scene has no triangles");
+}
+
+}  // namespace pmr

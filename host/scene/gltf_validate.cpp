@@ -1,0 +1,470 @@
+// glTF checks that tinygltf 2.7 does not do: the container and JSON before parsing, the structure
+// (references, bufferView bounds, node hierarchy) after. See gltf_internal.h.
+#include <sys/stat.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+#include "pmr/error.h"
+#include "scene/gltf_internal.h"
+
+namespace pmr::gltf {
+
+using nlohmann::json;
+
+void fail(const std::string& file, const std::string& what) { throw pmr::Error(file + ": " + what); }
+
+std::string one_line(const std::string& text, bool ascii_only) {
+  constexpr size_t kMax = 300;
+  std::string out;
+  for (char c : text) {
+    if (out.size() == kMax) return out + "...";
+    const unsigned char u = static_cast<unsigned char>(c);
+    out += c == '\n' ? ' ' : (u < 0x20 || u == 0x7f || (ascii_only && u > 0x7f)) ? '?' : c;
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
+}
+
+namespace {
+
+// tinygltf's extras/extensions parser recurses once per nesting level, so a hostile file nested a
+// million levels deep would overflow the stack. Real glTF nests less than ten levels.
+constexpr int kMaxJsonDepth = 128;
+
+// Required extensions we implement. KHR_mesh_quantization only widens the component types the generic
+// accessor reader already accepts; KHR_texture_transform is applied to the stored UVs.
+bool extension_supported(const std::string& name) {
+  return name == "KHR_mesh_quantization" || name == "KHR_texture_transform";
+}
+
+uint32_t read_u32le(const unsigned char* p) {
+  return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
+}
+
+std::vector<unsigned char> read_whole_file(const std::string& path) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT || errno == ENOTDIR) fail(path, "file not found");
+    fail(path, std::string("cannot access file: ") + std::strerror(errno));
+  }
+  if (S_ISDIR(st.st_mode)) fail(path, "is a directory, not a glTF file");
+  if (!S_ISREG(st.st_mode)) fail(path, "is not a regular file");
+  // tinygltf takes the length as unsigned int; a GLB cannot exceed 4 GiB anyway.
+  if (uint64_t(st.st_size) > std::numeric_limits<uint32_t>::max())
+    fail(path, "file is larger than 4 GiB, which glTF loading does not support");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, std::string("cannot open file: ") + std::strerror(errno));
+  std::vector<unsigned char> bytes(size_t(st.st_size));
+  if (!bytes.empty() && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size())))
+    fail(path, "cannot read file (I/O error or file changed while reading)");
+  if (bytes.empty()) fail(path, "file is empty");
+  return bytes;
+}
+
+// Validates the GLB container strictly (tinygltf 2.7 lets the BIN chunk header run past the end) and
+// returns the JSON chunk. bin_length gets the BIN chunk payload size, or -1 without a BIN chunk.
+std::string glb_json(const std::string& path, std::vector<unsigned char>& bytes, int64_t& bin_length) {
+  const uint64_t size = bytes.size();
+  if (size < 12) fail(path, "truncated GLB: " + std::to_string(size) + " bytes, the header alone needs 12");
+  const uint32_t version = read_u32le(&bytes[4]);
+  if (version != 2)
+    fail(path, "GLB container version " + std::to_string(version) + " is not supported (glTF 2.0 uses 2)");
+  const uint64_t length = read_u32le(&bytes[8]);
+  if (length > size)
+    fail(path, "truncated GLB: the header says " + std::to_string(length) + " bytes but the file has " +
+                   std::to_string(size));
+  bytes.resize(size_t(length));  // anything after the declared length is not part of the GLB
+  if (length < 20) fail(path, "truncated GLB: no room for the JSON chunk header");
+  const uint64_t json_length = read_u32le(&bytes[12]);
+  if (read_u32le(&bytes[16]) != 0x4E4F534Au) fail(path, "invalid GLB: the first chunk is not JSON");
+  if (json_length == 0) fail(path, "invalid GLB: the JSON chunk is empty");
+  if (20 + json_length > length)
+    fail(path, "truncated GLB: the JSON chunk needs " + std::to_string(json_length) + " bytes but only " +
+                   std::to_string(length - 20) + " remain");
+  bin_length = -1;
+  const uint64_t next = 20 + json_length;
+  if (next < length) {
+    if (next + 8 > length) fail(path, "truncated GLB: incomplete chunk header at byte " + std::to_string(next));
+    const uint64_t chunk_length = read_u32le(&bytes[size_t(next)]);
+    if (next + 8 + chunk_length > length)
+      fail(path, "truncated GLB: the BIN chunk needs " + std::to_string(chunk_length) + " bytes but only " +
+                     std::to_string(length - next - 8) + " remain");
+    if (read_u32le(&bytes[size_t(next) + 4]) == 0x004E4942u) bin_length = int64_t(chunk_length);
+  }
+  return std::string(reinterpret_cast<const char*>(&bytes[20]), size_t(json_length));
+}
+
+// Nesting depth of JSON text, counting brackets outside strings (cheap, no recursion).
+int json_depth(const std::string& text) {
+  int depth = 0, max_depth = 0;
+  bool in_string = false, escaped = false;
+  for (char c : text) {
+    if (in_string) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      max_depth = std::max(max_depth, ++depth);
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return max_depth;
+}
+
+const json* member(const json& object, const char* key) {
+  if (!object.is_object()) return nullptr;
+  auto it = object.find(key);
+  return it == object.end() ? nullptr : &*it;
+}
+
+// An index-like JSON value (non-negative integer); -1 when absent or of another type.
+int64_t json_index(const json* v) {
+  if (!v || !v->is_number_integer()) return -1;
+  if (v->is_number_unsigned()) {
+    uint64_t u = v->get<uint64_t>();
+    return u > uint64_t(std::numeric_limits<int>::max()) ? -1 : int64_t(u);
+  }
+  return std::max<int64_t>(-1, v->get<int64_t>());
+}
+
+void check_extensions(const std::string& path, const json& doc, SourceFile& src) {
+  if (const json* req = member(doc, "extensionsRequired")) {
+    if (!req->is_array()) fail(path, "extensionsRequired is not an array");
+    for (const json& e : *req) {
+      if (!e.is_string()) fail(path, "extensionsRequired contains a non-string entry");
+      const std::string name = e.get<std::string>();
+      if (name == "KHR_draco_mesh_compression")
+        fail(path, "requires KHR_draco_mesh_compression (Draco-compressed meshes), which this renderer does not support");
+      if (!extension_supported(name))
+        fail(path, "requires extension " + name + ", which this renderer does not support");
+    }
+  }
+  if (const json* used = member(doc, "extensionsUsed")) {
+    if (!used->is_array()) return;
+    for (const json& e : *used)
+      if (e.is_string() && !extension_supported(e.get<std::string>()))
+        src.ignored_extensions.push_back(e.get<std::string>());
+  }
+}
+
+// Buffers are checked here so that a missing or short .bin gets a message naming the file (tinygltf
+// would say "File not found", or fail later with an unrelated error).
+void check_buffers(const std::string& path, const json& doc, const SourceFile& src, int64_t bin_length) {
+  const json* buffers = member(doc, "buffers");
+  if (!buffers || !buffers->is_array()) return;
+  for (size_t i = 0; i < buffers->size(); ++i) {
+    const json& b = (*buffers)[i];
+    const std::string name = "buffer " + std::to_string(i);
+    const json* len = member(b, "byteLength");
+    if (!len || !len->is_number_unsigned()) fail(path, name + " has no valid byteLength");
+    const uint64_t byte_length = len->get<uint64_t>();
+    const json* uri = member(b, "uri");
+    if (uri && !uri->is_string()) fail(path, name + ": uri is not a string");
+    const std::string u = uri ? uri->get<std::string>() : std::string();
+    if (u.empty()) {
+      if (!src.glb) fail(path, name + " has no uri (only a .glb can store a buffer inside the file)");
+      if (bin_length < 0) fail(path, name + " refers to the GLB BIN chunk, but the file has none");
+      if (byte_length > uint64_t(bin_length))
+        fail(path, name + " declares " + std::to_string(byte_length) + " bytes but the GLB BIN chunk has " +
+                       std::to_string(bin_length));
+      continue;
+    }
+    if (u.rfind("data:", 0) == 0) {
+      if (!tinygltf::IsDataURI(u))
+        fail(path, name + " uses an unsupported data URI (base64 application/octet-stream or "
+                          "application/gltf-buffer expected)");
+      continue;  // tinygltf decodes it and checks the decoded size against byteLength
+    }
+    const std::string file = resolve_uri(src.base_dir, u);
+    struct stat st {};
+    if (stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
+      fail(path, name + ": file '" + one_line(u) + "' not found (looked for " + one_line(file) + ")");
+    if (uint64_t(st.st_size) != byte_length)
+      fail(path, name + ": file '" + one_line(u) + "' has " + std::to_string(st.st_size) + " bytes but byteLength is " +
+                     std::to_string(byte_length));
+  }
+}
+
+// Only images used as a base colour are decoded; normal, ORM and other maps are never sampled.
+std::set<int> base_color_images(const json& doc) {
+  std::set<int> images;
+  const json* materials = member(doc, "materials");
+  const json* textures = member(doc, "textures");
+  if (!materials || !materials->is_array() || !textures || !textures->is_array()) return images;
+  for (const json& m : *materials) {
+    const json* pbr = member(m, "pbrMetallicRoughness");
+    const json* info = pbr ? member(*pbr, "baseColorTexture") : nullptr;
+    const int64_t t = json_index(info ? member(*info, "index") : nullptr);
+    if (t < 0 || size_t(t) >= textures->size()) continue;
+    const int64_t image = json_index(member((*textures)[size_t(t)], "source"));
+    if (image >= 0) images.insert(int(image));
+  }
+  return images;
+}
+
+std::string base_dir_of(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  if (slash == 0) return "/";
+  return path.substr(0, slash);
+}
+
+}  // namespace
+
+std::string resolve_uri(const std::string& base_dir, const std::string& uri) {
+  // Same decoding as tinygltf's dlib::urldecode ('+' is a space, %XX a byte), so that the file checked
+  // here is the file tinygltf then opens.
+  auto hex = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return 0;
+  };
+  std::string decoded;
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '+') {
+      decoded += ' ';
+    } else if (uri[i] == '%' && uri.size() > i + 2) {
+      decoded += char(hex(uri[i + 1]) << 4 | hex(uri[i + 2]));
+      i += 2;
+    } else {
+      decoded += uri[i];
+    }
+  }
+  if (base_dir.empty()) return decoded;
+  return base_dir.back() == '/' ? base_dir + decoded : base_dir + "/" + decoded;
+}
+
+SourceFile read_source(const std::string& path) {
+  SourceFile src;
+  src.bytes = read_whole_file(path);
+  src.base_dir = base_dir_of(path);
+  src.glb = src.bytes.size() >= 4 && std::memcmp(src.bytes.data(), "glTF", 4) == 0;
+  int64_t bin_length = -1;
+  const std::string text = src.glb ? glb_json(path, src.bytes, bin_length)
+                                   : std::string(src.bytes.begin(), src.bytes.end());
+  if (json_depth(text) > kMaxJsonDepth)
+    fail(path, "invalid JSON: nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::exception& e) {
+    // Drop nlohmann's "[json.exception.parse_error.101] " prefix: the user needs the position.
+    std::string what = e.what();
+    const size_t close = what.find("] ");
+    if (what.rfind("[json.exception", 0) == 0 && close != std::string::npos) what = what.substr(close + 2);
+    fail(path, "invalid JSON: " + one_line(what, /*ascii_only=*/true));
+  }
+  if (!doc.is_object()) fail(path, "not a glTF file: the JSON top level is not an object");
+  const json* asset = member(doc, "asset");
+  const json* version = asset ? member(*asset, "version") : nullptr;
+  if (!version || !version->is_string()) fail(path, "not a glTF file: asset.version is missing");
+  const std::string v = version->get<std::string>();
+  if (v.rfind("2.", 0) != 0) fail(path, "glTF version " + v + " is not supported (2.x only)");
+  check_extensions(path, doc, src);
+  check_buffers(path, doc, src, bin_length);
+  src.base_color_images = base_color_images(doc);
+  return src;
+}
+
+// ---- after tinygltf ----------------------------------------------------------------------------------
+
+namespace {
+
+template <class T>
+bool in_range(int index, const std::vector<T>& v) {
+  return index >= 0 && size_t(index) < v.size();
+}
+
+std::string ref_error(const std::string& owner, const char* kind, int index, size_t count) {
+  return owner + " refers to " + kind + " " + std::to_string(index) + ", which does not exist (the file has " +
+         std::to_string(count) + ")";
+}
+
+void check_buffer_views(const tinygltf::Model& m, const std::string& file) {
+  for (size_t i = 0; i < m.bufferViews.size(); ++i) {
+    const tinygltf::BufferView& bv = m.bufferViews[i];
+    const std::string name = "bufferView " + std::to_string(i);
+    if (!in_range(bv.buffer, m.buffers)) fail(file, ref_error(name, "buffer", bv.buffer, m.buffers.size()));
+    const uint64_t size = m.buffers[size_t(bv.buffer)].data.size();
+    uint64_t end = 0;
+    if (__builtin_add_overflow(uint64_t(bv.byteOffset), uint64_t(bv.byteLength), &end) || end > size)
+      fail(file, name + " (byteOffset " + std::to_string(bv.byteOffset) + ", byteLength " +
+                     std::to_string(bv.byteLength) + ") overruns buffer " + std::to_string(bv.buffer) +
+                     ", which has " + std::to_string(size) + " bytes");
+  }
+}
+
+void check_meshes(const tinygltf::Model& m, const std::string& file) {
+  for (size_t i = 0; i < m.meshes.size(); ++i) {
+    for (size_t p = 0; p < m.meshes[i].primitives.size(); ++p) {
+      const tinygltf::Primitive& prim = m.meshes[i].primitives[p];
+      const std::string name = "mesh " + std::to_string(i) + " primitive " + std::to_string(p);
+      if (prim.mode < -1 || prim.mode > 6)
+        fail(file, name + " has mode " + std::to_string(prim.mode) + ", which is not a glTF primitive mode");
+      if (prim.indices != -1 && !in_range(prim.indices, m.accessors))
+        fail(file, ref_error(name + " indices", "accessor", prim.indices, m.accessors.size()));
+      for (const auto& [semantic, accessor] : prim.attributes)
+        if (!in_range(accessor, m.accessors))
+          fail(file, ref_error(name + " attribute " + semantic, "accessor", accessor, m.accessors.size()));
+      if (prim.material != -1 && !in_range(prim.material, m.materials))
+        fail(file, ref_error(name, "material", prim.material, m.materials.size()));
+    }
+  }
+}
+
+void check_materials(const tinygltf::Model& m, const std::string& file) {
+  for (size_t i = 0; i < m.materials.size(); ++i) {
+    const tinygltf::TextureInfo& info = m.materials[i].pbrMetallicRoughness.baseColorTexture;
+    const std::string name = "material " + std::to_string(i) + " baseColorTexture";
+    if (info.index != -1 && !in_range(info.index, m.textures))
+      fail(file, ref_error(name, "texture", info.index, m.textures.size()));
+    if (info.texCoord < 0) fail(file, name + " has a negative texCoord");
+  }
+  for (size_t i = 0; i < m.textures.size(); ++i) {
+    const tinygltf::Texture& t = m.textures[i];
+    const std::string name = "texture " + std::to_string(i);
+    if (t.source != -1 && !in_range(t.source, m.images)) fail(file, ref_error(name, "image", t.source, m.images.size()));
+    if (t.sampler != -1 && !in_range(t.sampler, m.samplers))
+      fail(file, ref_error(name, "sampler", t.sampler, m.samplers.size()));
+  }
+}
+
+// Iterative DFS with an on-stack mark: node chains can be as long as the file is big, so recursion
+// could overflow the stack.
+void check_cycles(const tinygltf::Model& m, const std::string& file) {
+  enum : uint8_t { kNew, kOnStack, kDone };
+  std::vector<uint8_t> state(m.nodes.size(), kNew);
+  std::vector<std::pair<int, size_t>> stack;  // node, next child to visit
+  for (size_t start = 0; start < m.nodes.size(); ++start) {
+    if (state[start] != kNew) continue;
+    stack.push_back({int(start), 0});
+    state[start] = kOnStack;
+    while (!stack.empty()) {
+      auto& [node, next] = stack.back();
+      const std::vector<int>& children = m.nodes[size_t(node)].children;
+      if (next == children.size()) {
+        state[size_t(node)] = kDone;
+        stack.pop_back();
+        continue;
+      }
+      const int child = children[next++];
+      if (state[size_t(child)] == kOnStack) fail(file, "node cycle through node " + std::to_string(child));
+      if (state[size_t(child)] == kNew) {
+        state[size_t(child)] = kOnStack;
+        stack.push_back({child, 0});
+      }
+    }
+  }
+}
+
+std::vector<int> check_nodes(const tinygltf::Model& m, const std::string& file) {
+  for (size_t i = 0; i < m.nodes.size(); ++i) {
+    const tinygltf::Node& n = m.nodes[i];
+    const std::string name = "node " + std::to_string(i);
+    for (int child : n.children)
+      if (!in_range(child, m.nodes)) fail(file, ref_error(name + " children", "node", child, m.nodes.size()));
+    if (n.mesh != -1 && !in_range(n.mesh, m.meshes)) fail(file, ref_error(name, "mesh", n.mesh, m.meshes.size()));
+    if (n.camera != -1 && !in_range(n.camera, m.cameras))
+      fail(file, ref_error(name, "camera", n.camera, m.cameras.size()));
+  }
+  check_cycles(m, file);
+  // A node shared by two parents would be instanced once per path; the spec forbids it, and chains of
+  // such nodes would multiply the instance count exponentially.
+  std::vector<int> parent(m.nodes.size(), -1);
+  for (size_t i = 0; i < m.nodes.size(); ++i) {
+    for (int child : m.nodes[i].children) {
+      if (parent[size_t(child)] != -1)
+        fail(file, "node " + std::to_string(child) + " has two parents (nodes " +
+                       std::to_string(parent[size_t(child)]) + " and " + std::to_string(i) + ")");
+      parent[size_t(child)] = int(i);
+    }
+  }
+  return parent;
+}
+
+}  // namespace
+
+std::vector<int> validate_model(const tinygltf::Model& model, const std::string& file) {
+  check_buffer_views(model, file);
+  check_meshes(model, file);
+  check_materials(model, file);
+  return check_nodes(model, file);
+}
+
+std::vector<int> scene_roots(const tinygltf::Model& m, const std::vector<int>& parent, const std::string& file) {
+  std::vector<int> roots;
+  if (m.scenes.empty()) {
+    if (m.defaultScene > 0) fail(file, "scene " + std::to_string(m.defaultScene) + " is the default but there are no scenes");
+    for (size_t i = 0; i < m.nodes.size(); ++i)
+      if (parent[i] == -1) roots.push_back(int(i));
+    return roots;
+  }
+  const int s = m.defaultScene < 0 ? 0 : m.defaultScene;
+  if (!in_range(s, m.scenes)) fail(file, ref_error("the default scene", "scene", s, m.scenes.size()));
+  std::vector<bool> listed(m.nodes.size(), false);
+  for (int n : m.scenes[size_t(s)].nodes) {
+    const std::string name = "scene " + std::to_string(s);
+    if (!in_range(n, m.nodes)) fail(file, ref_error(name, "node", n, m.nodes.size()));
+    if (parent[size_t(n)] != -1)
+      fail(file, name + " lists node " + std::to_string(n) + " as a root, but it is a child of node " +
+                     std::to_string(parent[size_t(n)]));
+    if (listed[size_t(n)]) fail(file, name + " lists node " + std::to_string(n) + " twice");
+    listed[size_t(n)] = true;
+    roots.push_back(n);
+  }
+  return roots;
+}
+
+glm::dmat4 node_local_matrix(const tinygltf::Node& n, int index, const std::string& file) {
+  const std::string name = "node " + std::to_string(index);
+  auto finite = [](const std::vector<double>& v) {
+    for (double x : v)
+      if (!std::isfinite(x)) return false;
+    return true;
+  };
+  if (!n.matrix.empty()) {
+    if (n.matrix.size() != 16) fail(file, name + " has a matrix of " + std::to_string(n.matrix.size()) + " values (16 expected)");
+    if (!finite(n.matrix)) fail(file, name + " has a non-finite matrix");
+    glm::dmat4 m;
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[size_t(c * 4 + r)];  // glTF is column-major, like glm
+    return m;
+  }
+  auto check = [&](const std::vector<double>& v, size_t size, const char* what) {
+    if (!v.empty() && v.size() != size)
+      fail(file, name + " has a " + what + " of " + std::to_string(v.size()) + " values (" + std::to_string(size) + " expected)");
+    if (!finite(v)) fail(file, name + " has a non-finite " + what);
+  };
+  check(n.translation, 3, "translation");
+  check(n.rotation, 4, "rotation");
+  check(n.scale, 3, "scale");
+  const glm::dvec3 t = n.translation.empty() ? glm::dvec3(0.0) : glm::dvec3(n.translation[0], n.translation[1], n.translation[2]);
+  const glm::dvec3 s = n.scale.empty() ? glm::dvec3(1.0) : glm::dvec3(n.scale[0], n.scale[1], n.scale[2]);
+  double x = 0, y = 0, z = 0, w = 1;
+  if (!n.rotation.empty()) {
+    x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
+    // The spec wants unit quaternions; exporters write them rounded to a few digits, so normalize.
+    const double len = std::sqrt(x * x + y * y + z * z + w * w);
+    if (!(len > 0.0) || !std::isfinite(len)) fail(file, name + " has a zero-length rotation quaternion");
+    x /= len, y /= len, z /= len, w /= len;
+  }
+  // Rotation matrix of the unit quaternion (x, y, z, w); glm matrices are indexed [column][row].
+  glm::dmat3 r;
+  r[0] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w)};
+  r[1] = {2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w)};
+  r[2] = {2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)};
+  glm::dmat4 m(1.0);
+  for (int c = 0; c < 3; ++c) m[c] = glm::dvec4(r[c] * s[c], 0.0);
+  m[3] = glm::dvec4(t, 1.0);
+  return m;
+}
+
+}  // namespace pmr::gltf

@@ -61,6 +61,15 @@ struct Pipeline::Impl {
   uint64_t num_tiles = 0;
 
   explicit Impl(const ClRuntime& r) : rt(r) {}
+
+  // Stage 5: interleaves the view volume into the display image.
+  cl_event launch_encode(Events& ev) {
+    rt.write(encode_buf, &encode_params, sizeof encode_params);
+    k_encode.arg(0, encode_buf);
+    k_encode.arg(1, volume);
+    k_encode.arg(2, display);
+    return ev.add(rt.launch(k_encode, size_t(encode_params.display_w) * encode_params.display_h, 0));
+  }
   ~Impl() {
     if (program) clReleaseProgram(program);
   }
@@ -302,17 +311,9 @@ StageTimes Pipeline::render(const Rig& rig) {
 
   // 5. pixel encoding
   cl_event e_last = e_fine;
-  if (m.encode) {
-    rt.write(m.encode_buf, &m.encode_params, sizeof m.encode_params);
-    m.k_encode.arg(0, m.encode_buf);
-    m.k_encode.arg(1, m.volume);
-    m.k_encode.arg(2, m.display);
-    const size_t pixels = size_t(m.encode_params.display_w) * m.encode_params.display_h;
-    e_last = ev.add(rt.launch(m.k_encode, pixels, 0));
-    clWaitForEvents(1, &e_last);
-    times.encode = event_ms(e_last);
-  }
+  if (m.encode) e_last = m.launch_encode(ev);
   rt.finish();
+  if (m.encode) times.encode = event_ms(e_last);
   times.vertex = event_ms(e_vertex);
   times.setup = event_ms(e_setup);
   times.bin = event_ms(e_bin0) + event_ms(e_bin1);
@@ -327,12 +328,8 @@ StageTimes Pipeline::encode_volume(const std::vector<uint16_t>& volume) {
   if (!m.encode) throw Error("internal error: no display configured");
   if (volume.size() * 2 != volume_bytes()) throw Error("internal error: volume size mismatch");
   m.rt.write(m.volume, volume.data(), volume_bytes());
-  m.rt.write(m.encode_buf, &m.encode_params, sizeof m.encode_params);
-  m.k_encode.arg(0, m.encode_buf);
-  m.k_encode.arg(1, m.volume);
-  m.k_encode.arg(2, m.display);
   Events ev;
-  cl_event e = ev.add(m.rt.launch(m.k_encode, size_t(m.encode_params.display_w) * m.encode_params.display_h, 0));
+  cl_event e = m.launch_encode(ev);
   m.rt.finish();
   StageTimes t;
   t.encode = event_ms(e);

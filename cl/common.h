@@ -25,7 +25,7 @@ inline long floor_div_l(long a, long b) { /* b > 0 */
 inline void project_vertex(global const PmrParams* P, double xv, double yv, double zv, PmrVertex* out) {
   const double w = -zv;
   const double kk = P->disparity_k / (double)P->view_w; /* NDC disparity per unit (1 - D/w) / 2 */
-  const double xc = P->ndc_scale_x * xv;                 /* x_ndc(center) * w */
+  const double xc = P->ndc_scale_x * xv + P->ndc_offset_x * w; /* x_ndc(center) * w */
   const double xfirst = xc - kk * (w - P->focal);        /* x_ndc(view 0) * w */
   const double xlast = xc + kk * (w - P->focal);         /* x_ndc(view N-1) * w */
   const double yc = P->ndc_scale_y * yv;                 /* y_ndc * w */

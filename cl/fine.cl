@@ -58,7 +58,7 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
   }
   if (!valid) return;
 
-  const size_t voxel = ((size_t)view * (size_t)P->view_h + (size_t)py) * (size_t)P->view_w + (size_t)px;
+  const size_t voxel = ((size_t)(view + (int)P->view_base) * (size_t)P->view_h + (size_t)py) * (size_t)P->view_w + (size_t)px;
   float4 color = (float4)(0.0f);
   if (best_key != PMR_NO_KEY) {
     const PmrMta m = mtas[best_mta];

@@ -28,10 +28,19 @@ inline void positive_views(long a0, long a1, int n, int* lo, int* hi) {
 inline void emit_mta(global const PmrParams* P, global PmrMta* mtas, volatile global uint* counter,
                      PmrMta* m, int lo, int hi, int sign, uint flags) {
   if (lo > hi) return;
-  m->view_lo = lo;
-  m->view_hi = hi;
   m->sign = sign;
   m->flags = flags;
+  if (P->setup_mode == PMR_SETUP_DUPLICATE) {
+    /* baseline: the triangle duplicated once per view, each copy rasterized in its own view only */
+    for (int v = lo; v <= hi; ++v) {
+      m->view_lo = m->view_hi = v;
+      const uint slot = atomic_inc(counter);
+      if (slot < P->mta_capacity) mtas[slot] = *m;
+    }
+    return;
+  }
+  m->view_lo = lo;
+  m->view_hi = hi;
   const uint slot = atomic_inc(counter);
   if (slot < P->mta_capacity) mtas[slot] = *m;
 }
@@ -74,7 +83,7 @@ inline void emit_triangle(global const PmrParams* P, global PmrMta* mtas, volati
 inline double plane_value(global const PmrParams* P, int k, const double* p) {
   const double w = -p[2];
   const double kk = P->disparity_k / (double)P->view_w;
-  const double xc = P->ndc_scale_x * p[0];
+  const double xc = P->ndc_scale_x * p[0] + P->ndc_offset_x * w;
   switch (k) {
     case 0: return w - P->near_eff;
     case 1: return P->far - w;

@@ -15,3 +15,15 @@ kernel void vertex_transform(global const PmrParams* P, global const float* posi
   project_vertex(P, xv, yv, zv, &r);
   out[v] = r;
 }
+
+/* Test mode of the multipass baseline: view `view`'s snapped positions taken from PMR's vertex records
+ * (x = x0 + view * dx, no disparity), so that a single-view pass sees exactly PMR's positions. */
+kernel void vertex_select_view(global const PmrParams* P, global const PmrVertex* pmr_verts, int view,
+                               global PmrVertex* out) {
+  const uint v = get_global_id(0);
+  if (v >= P->num_vertices) return;
+  PmrVertex r = pmr_verts[v];
+  r.x0 += view * r.dx;
+  r.dx = 0;
+  out[v] = r;
+}

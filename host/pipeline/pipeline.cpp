@@ -10,15 +10,24 @@ namespace pmr {
 
 namespace {
 
-// RAII for the profiling events of one frame.
+enum Stage { kVertex, kSetup, kBin, kFine, kEncode, kStages };
+
+// RAII for the profiling events of one frame, each tagged with its stage.
 struct Events {
-  std::vector<cl_event> all;
-  cl_event add(cl_event e) {
-    all.push_back(e);
+  std::vector<std::pair<Stage, cl_event>> all;
+  cl_event add(Stage s, cl_event e) {
+    all.push_back({s, e});
     return e;
   }
+  // Adds up the device time per stage (after the queue has finished).
+  void collect(StageTimes& t) const {
+    double ms[kStages] = {};
+    for (const auto& se : all) ms[se.first] += event_ms(se.second);
+    t.vertex = ms[kVertex], t.setup = ms[kSetup], t.bin = ms[kBin], t.fine = ms[kFine], t.encode = ms[kEncode];
+    if (!all.empty()) t.device_total = event_span_ms(all.front().second, all.back().second);
+  }
   ~Events() {
-    for (cl_event e : all) clReleaseEvent(e);
+    for (const auto& se : all) clReleaseEvent(se.second);
   }
 };
 
@@ -41,16 +50,17 @@ size_t bytes_of(const std::vector<T>& v) {
 struct Pipeline::Impl {
   const ClRuntime& rt;
   cl_program program = nullptr;
-  ClKernel k_vertex, k_setup, k_bin_count, k_bin_fill, k_fine, k_encode;
+  ClKernel k_vertex, k_vertex_select, k_setup, k_bin_count, k_bin_fill, k_fine, k_encode;
 
   // scene
   uint32_t num_vertices = 0, num_triangles = 0;
   ClBuffer positions, attrs, tris, materials, textures, texels, lut;
   // frame
   PmrParams params{};
+  Rig rig;
   PmrEncodeParams encode_params{};
   bool encode = false;
-  ClBuffer params_buf, encode_buf, vertices, mtas, mta_counter;
+  ClBuffer params_buf, encode_buf, vertices, pmr_vertices, mtas, mta_counter;
   uint32_t mta_capacity = 0;
   bool mta_capacity_fixed = false;
   ClBuffer tile_counts, tile_offsets, tile_queue;
@@ -62,22 +72,38 @@ struct Pipeline::Impl {
 
   explicit Impl(const ClRuntime& r) : rt(r) {}
 
-  // Stage 5: interleaves the view volume into the display image.
-  cl_event launch_encode(Events& ev) {
-    rt.write(encode_buf, &encode_params, sizeof encode_params);
-    k_encode.arg(0, encode_buf);
-    k_encode.arg(1, volume);
-    k_encode.arg(2, display);
-    return ev.add(rt.launch(k_encode, size_t(encode_params.display_w) * encode_params.display_h, 0));
-  }
+  // Each stage enqueues its kernel(s) for the parameters P (written to params_buf here).
+  void vertex_stage(const PmrParams& P, Events& ev);
+  void select_view_stage(const PmrParams& P, int view, Events& ev);
+  void setup_stage(PmrParams& P, Events& ev, StageTimes& t);
+  void bin_stage(const PmrParams& P, Events& ev, StageTimes& t);
+  void fine_stage(const PmrParams& P, const int tile[3], Events& ev);
+  void encode_stage(Events& ev);
   ~Impl() {
     if (program) clReleaseProgram(program);
   }
 };
 
+Method parse_method(const std::string& name) {
+  if (name == "pmr") return Method::Pmr;
+  if (name == "multipass") return Method::Multipass;
+  if (name == "duplicate") return Method::Duplicate;
+  throw Error("unknown method '" + name + "' (expected pmr, multipass or duplicate)");
+}
+
+const char* to_string(Method m) {
+  switch (m) {
+    case Method::Multipass: return "multipass";
+    case Method::Duplicate: return "duplicate";
+    default: return "pmr";
+  }
+}
+
 Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
     : impl_(new Impl(runtime)), config_(config) {
-  const int tx = config.tile_x, ty = config.tile_y, tv = config.tile_v;
+  tile_[0] = config.tile_x, tile_[1] = config.tile_y, tile_[2] = config.tile_v;
+  if (config.method != Method::Pmr && config.tile_v != 1) tile_[0] = 8, tile_[1] = 8, tile_[2] = 1;
+  const int tx = tile_[0], ty = tile_[1], tv = tile_[2];
   if (tx < 1 || ty < 1 || tv < 1 || tx > 64 || ty > 64 || tv > 64)
     throw Error("invalid --tile: each tile side must be 1..64");
   if (size_t(tx) * ty * tv > runtime.max_work_group_size())
@@ -90,6 +116,7 @@ Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
   Impl& m = *impl_;
   m.program = runtime.build_program({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl"}, options);
   m.k_vertex = ClKernel(m.program, "vertex_transform");
+  m.k_vertex_select = ClKernel(m.program, "vertex_select_view");
   m.k_setup = ClKernel(m.program, "setup_triangles");
   m.k_bin_count = ClKernel(m.program, "bin_count");
   m.k_bin_fill = ClKernel(m.program, "bin_fill");
@@ -143,6 +170,8 @@ void Pipeline::set_scene(const Scene& scene) {
   m.texels = rt.buffer(texels.size(), "texels", CL_MEM_READ_ONLY);
   rt.write(m.texels, texels.data(), texels.size());
   m.vertices = rt.buffer(size_t(m.num_vertices) * sizeof(PmrVertex), "transformed vertices");
+  if (config_.method == Method::Multipass && config_.multipass_snapped)
+    m.pmr_vertices = rt.buffer(size_t(m.num_vertices) * sizeof(PmrVertex), "PMR vertices");
   if (!m.mta_capacity_fixed || m.mta_capacity == 0) {
     // Most triangles become one MTA; clipping and double-sided orientation splits add a few.
     m.mta_capacity = std::max<uint32_t>(1024, m.num_triangles + m.num_triangles / 4);
@@ -163,9 +192,12 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   Impl& m = *impl_;
   const ClRuntime& rt = m.rt;
   m.params = make_params(rig);
-  tiles_x_ = (rig.view_w + config_.tile_x - 1) / config_.tile_x;
-  tiles_y_ = (rig.view_h + config_.tile_y - 1) / config_.tile_y;
-  tiles_v_ = (rig.views + config_.tile_v - 1) / config_.tile_v;
+  m.rig = rig;
+  tiles_x_ = (rig.view_w + tile_[0] - 1) / tile_[0];
+  tiles_y_ = (rig.view_h + tile_[1] - 1) / tile_[1];
+  // multipass rasterizes one view per pass, so its tile grid is one view deep
+  const int pass_views = config_.method == Method::Multipass ? 1 : rig.views;
+  tiles_v_ = (pass_views + tile_[2] - 1) / tile_[2];
   m.num_tiles = uint64_t(tiles_x_) * tiles_y_ * tiles_v_;
   if (m.num_tiles >= (uint64_t(1) << 32)) throw Error("too many tiles; use larger --tile");
   m.encode = display != nullptr;
@@ -201,16 +233,113 @@ void Pipeline::set_mta_capacity(uint32_t capacity) {
   impl_->mtas = ClBuffer();
 }
 
+void Pipeline::Impl::vertex_stage(const PmrParams& P, Events& ev) {
+  rt.write(params_buf, &P, sizeof P);
+  k_vertex.arg(0, params_buf);
+  k_vertex.arg(1, positions);
+  k_vertex.arg(2, vertices);
+  ev.add(kVertex, rt.launch(k_vertex, num_vertices, 0));
+}
+
+void Pipeline::Impl::select_view_stage(const PmrParams& P, int view, Events& ev) {
+  rt.write(params_buf, &P, sizeof P);
+  k_vertex_select.arg(0, params_buf);
+  k_vertex_select.arg(1, pmr_vertices);
+  k_vertex_select.arg(2, view);
+  k_vertex_select.arg(3, vertices);
+  ev.add(kVertex, rt.launch(k_vertex_select, num_vertices, 0));
+}
+
+// Primitive setup, redone with a larger MTA queue until everything fits (never drops work).
+void Pipeline::Impl::setup_stage(PmrParams& P, Events& ev, StageTimes& t) {
+  for (;;) {
+    if (!mtas.get()) mtas = rt.buffer(size_t(mta_capacity) * sizeof(PmrMta), "MTA queue");
+    P.mta_capacity = mta_capacity;
+    rt.write(params_buf, &P, sizeof P);
+    const uint32_t zero = 0;
+    rt.write(mta_counter, &zero, sizeof zero);
+    k_setup.arg(0, params_buf);
+    k_setup.arg(1, tris);
+    k_setup.arg(2, vertices);
+    k_setup.arg(3, materials);
+    k_setup.arg(4, mtas);
+    k_setup.arg(5, mta_counter);
+    ev.add(kSetup, rt.launch(k_setup, num_triangles, 0));
+    rt.read(mta_counter, &last_mtas, sizeof last_mtas);
+    if (last_mtas <= mta_capacity) break;
+    const uint64_t grown = uint64_t(last_mtas) + last_mtas / 4 + 64;
+    if (grown * sizeof(PmrMta) > rt.max_alloc_bytes())
+      throw Error("the scene produces " + std::to_string(last_mtas) + " multi-view triangles, more than the device can hold");
+    mta_capacity = uint32_t(std::min<uint64_t>(grown, 0xffffffffu));
+    mtas = ClBuffer();
+    ++t.retries;
+  }
+  t.mtas += last_mtas;
+}
+
+// Tile raster: count entries per tile, exclusive scan on the host (sizes the queue), fill.
+void Pipeline::Impl::bin_stage(const PmrParams& P, Events& ev, StageTimes& t) {
+  (void)P;
+  k_bin_count.arg(0, params_buf);
+  k_bin_count.arg(1, mtas);
+  k_bin_count.arg(2, last_mtas);
+  k_bin_count.arg(3, tile_counts);
+  ev.add(kBin, rt.launch(k_bin_count, last_mtas, 0));
+  std::vector<uint32_t> counts(num_tiles + 1);
+  rt.read(tile_counts, counts.data(), size_t(num_tiles) * 4);
+  uint64_t total = 0;
+  for (uint64_t i = 0; i < num_tiles; ++i) {
+    const uint32_t c = counts[i];
+    counts[i] = uint32_t(total);
+    total += c;
+    if (total >= 0xffffffffull) throw Error("the tile queues would exceed 4 G entries; use larger --tile or fewer views");
+  }
+  counts[num_tiles] = uint32_t(total);
+  rt.write(tile_offsets, counts.data(), bytes_of(counts));
+  if (total > tile_queue_capacity) {
+    const size_t grown = size_t(total) + size_t(total) / 4;
+    if (grown * 4 > rt.max_alloc_bytes())
+      throw Error("the tile queues need " + std::to_string((total * 4) >> 20) + " MiB, more than the device can hold; use larger --tile");
+    tile_queue = ClBuffer();
+    tile_queue = rt.buffer(grown * 4, "tile queues");
+    tile_queue_capacity = grown;
+  }
+  t.bin_entries += total;
+  k_bin_fill.arg(0, params_buf);
+  k_bin_fill.arg(1, mtas);
+  k_bin_fill.arg(2, last_mtas);
+  k_bin_fill.arg(3, tile_counts);
+  k_bin_fill.arg(4, tile_offsets);
+  k_bin_fill.arg(5, tile_queue);
+  ev.add(kBin, rt.launch(k_bin_fill, last_mtas, 0));
+}
+
+void Pipeline::Impl::fine_stage(const PmrParams& P, const int tile[3], Events& ev) {
+  (void)P;
+  const size_t group = size_t(tile[0]) * tile[1] * tile[2];
+  cl_uint a = 0;
+  for (const ClBuffer* b : {&params_buf, &mtas, &tile_offsets, &tile_queue, &tris, &attrs, &materials, &textures,
+                            &texels, &lut, &volume, &dbg_key, &dbg_depth, &dbg_count})
+    k_fine.arg(a++, *b);
+  ev.add(kFine, rt.launch(k_fine, size_t(num_tiles) * group, group));
+}
+
+void Pipeline::Impl::encode_stage(Events& ev) {
+  rt.write(encode_buf, &encode_params, sizeof encode_params);
+  k_encode.arg(0, encode_buf);
+  k_encode.arg(1, volume);
+  k_encode.arg(2, display);
+  ev.add(kEncode, rt.launch(k_encode, size_t(encode_params.display_w) * encode_params.display_h, 0));
+}
+
 StageTimes Pipeline::render(const Rig& rig) {
   Impl& m = *impl_;
-  const ClRuntime& rt = m.rt;
   const auto t_start = std::chrono::steady_clock::now();
   if (!m.volume.get()) throw Error("internal error: Pipeline::render before configure");
   StageTimes times;
   Events ev;
-
-  PmrParams& P = m.params;
-  const PmrParams fresh = make_params(rig);
+  PmrParams P = m.params;
+  const PmrParams fresh = make_params(rig);  // the camera may move between frames
   std::copy(fresh.view, fresh.view + 16, P.view);
   std::copy(fresh.light_world, fresh.light_world + 4, P.light_world);
   P.tiles_x = tiles_x_;
@@ -219,106 +348,42 @@ StageTimes Pipeline::render(const Rig& rig) {
   P.num_vertices = m.num_vertices;
   P.num_triangles = m.num_triangles;
   P.debug_outputs = config_.debug_outputs ? 1u : 0u;
+  P.setup_mode = config_.method == Method::Duplicate ? PMR_SETUP_DUPLICATE : PMR_SETUP_MTA;
 
-  // 1. vertex transform
-  rt.write(m.params_buf, &P, sizeof P);
-  m.k_vertex.arg(0, m.params_buf);
-  m.k_vertex.arg(1, m.positions);
-  m.k_vertex.arg(2, m.vertices);
-  cl_event e_vertex = ev.add(rt.launch(m.k_vertex, m.num_vertices, 0));
-
-  // 2. primitive setup, redone with a larger MTA queue until everything fits
-  uint32_t produced = 0;
-  cl_event e_setup = nullptr;
-  for (;;) {
-    if (!m.mtas.get()) m.mtas = rt.buffer(size_t(m.mta_capacity) * sizeof(PmrMta), "MTA queue");
-    P.mta_capacity = m.mta_capacity;
-    rt.write(m.params_buf, &P, sizeof P);
-    const uint32_t zero = 0;
-    rt.write(m.mta_counter, &zero, sizeof zero);
-    m.k_setup.arg(0, m.params_buf);
-    m.k_setup.arg(1, m.tris);
-    m.k_setup.arg(2, m.vertices);
-    m.k_setup.arg(3, m.materials);
-    m.k_setup.arg(4, m.mtas);
-    m.k_setup.arg(5, m.mta_counter);
-    e_setup = ev.add(rt.launch(m.k_setup, m.num_triangles, 0));
-    rt.read(m.mta_counter, &produced, sizeof produced);
-    if (produced <= m.mta_capacity) break;
-    const uint64_t grown = uint64_t(produced) + produced / 4 + 64;
-    if (grown * sizeof(PmrMta) > rt.max_alloc_bytes())
-      throw Error("the scene produces " + std::to_string(produced) + " multi-view triangles, more than the device can hold");
-    m.mta_capacity = uint32_t(std::min<uint64_t>(grown, 0xffffffffu));
-    m.mtas = ClBuffer();
-    ++times.retries;
+  if (config_.method != Method::Multipass) {
+    m.vertex_stage(P, ev);
+    m.setup_stage(P, ev, times);
+    m.bin_stage(P, ev, times);
+    m.fine_stage(P, tile_, ev);
+  } else {
+    if (config_.multipass_snapped) {  // test mode: PMR's vertex records, computed once
+      m.vertex_stage(P, ev);
+      std::swap(m.vertices, m.pmr_vertices);
+    }
+    // One conventional pass per view with view i's own view matrix and off-axis projection:
+    // x_ndc = (D / a) x_view / w + s_i / a in camera i's view space.
+    const double a = rig.aspect * rig.focal * std::tan(rig.yfov / 2.0);
+    for (int i = 0; i < rig.views; ++i) {
+      PmrParams Q = P;
+      const glm::dmat4 V = rig.view_matrix(i);
+      std::copy(&V[0][0], &V[0][0] + 16, Q.view);
+      Q.views = 1;
+      Q.disparity_k = 0.0;
+      Q.ndc_offset_x = rig.camera_offset(i) / a;
+      Q.view_base = uint32_t(i);
+      if (config_.multipass_snapped)
+        m.select_view_stage(Q, i, ev);
+      else
+        m.vertex_stage(Q, ev);
+      m.setup_stage(Q, ev, times);
+      m.bin_stage(Q, ev, times);
+      m.fine_stage(Q, tile_, ev);
+    }
+    if (config_.multipass_snapped) std::swap(m.vertices, m.pmr_vertices);
   }
-  m.last_mtas = produced;
-  times.mtas = produced;
-
-  // 3. tile raster: count, scan on the host, fill
-  m.k_bin_count.arg(0, m.params_buf);
-  m.k_bin_count.arg(1, m.mtas);
-  m.k_bin_count.arg(2, produced);
-  m.k_bin_count.arg(3, m.tile_counts);
-  cl_event e_bin0 = ev.add(rt.launch(m.k_bin_count, produced, 0));
-  std::vector<uint32_t> counts(m.num_tiles + 1);
-  rt.read(m.tile_counts, counts.data(), size_t(m.num_tiles) * 4);
-  uint64_t total = 0;
-  for (uint64_t t = 0; t < m.num_tiles; ++t) {
-    const uint32_t c = counts[t];
-    counts[t] = uint32_t(total);
-    total += c;
-    if (total >= 0xffffffffull)
-      throw Error("the tile queues would exceed 4 G entries; use larger --tile or fewer views");
-  }
-  counts[m.num_tiles] = uint32_t(total);
-  rt.write(m.tile_offsets, counts.data(), bytes_of(counts));
-  if (total > m.tile_queue_capacity) {
-    const size_t grown = size_t(total) + size_t(total) / 4;
-    if (grown * 4 > rt.max_alloc_bytes())
-      throw Error("the tile queues need " + std::to_string((total * 4) >> 20) + " MiB, more than the device can hold; use larger --tile");
-    m.tile_queue = ClBuffer();
-    m.tile_queue = rt.buffer(grown * 4, "tile queues");
-    m.tile_queue_capacity = grown;
-  }
-  times.bin_entries = total;
-  m.k_bin_fill.arg(0, m.params_buf);
-  m.k_bin_fill.arg(1, m.mtas);
-  m.k_bin_fill.arg(2, produced);
-  m.k_bin_fill.arg(3, m.tile_counts);
-  m.k_bin_fill.arg(4, m.tile_offsets);
-  m.k_bin_fill.arg(5, m.tile_queue);
-  cl_event e_bin1 = ev.add(rt.launch(m.k_bin_fill, produced, 0));
-
-  // 4. fine raster
-  const size_t group = size_t(config_.tile_x) * config_.tile_y * config_.tile_v;
-  int a = 0;
-  m.k_fine.arg(a++, m.params_buf);
-  m.k_fine.arg(a++, m.mtas);
-  m.k_fine.arg(a++, m.tile_offsets);
-  m.k_fine.arg(a++, m.tile_queue);
-  m.k_fine.arg(a++, m.tris);
-  m.k_fine.arg(a++, m.attrs);
-  m.k_fine.arg(a++, m.materials);
-  m.k_fine.arg(a++, m.textures);
-  m.k_fine.arg(a++, m.texels);
-  m.k_fine.arg(a++, m.lut);
-  m.k_fine.arg(a++, m.volume);
-  m.k_fine.arg(a++, m.dbg_key);
-  m.k_fine.arg(a++, m.dbg_depth);
-  m.k_fine.arg(a++, m.dbg_count);
-  cl_event e_fine = ev.add(rt.launch(m.k_fine, size_t(m.num_tiles) * group, group));
-
-  // 5. pixel encoding
-  cl_event e_last = e_fine;
-  if (m.encode) e_last = m.launch_encode(ev);
-  rt.finish();
-  if (m.encode) times.encode = event_ms(e_last);
-  times.vertex = event_ms(e_vertex);
-  times.setup = event_ms(e_setup);
-  times.bin = event_ms(e_bin0) + event_ms(e_bin1);
-  times.fine = event_ms(e_fine);
-  times.device_total = event_span_ms(e_vertex, e_last);
+  if (m.encode) m.encode_stage(ev);
+  m.rt.finish();
+  ev.collect(times);
   times.wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
   return times;
 }
@@ -329,10 +394,10 @@ StageTimes Pipeline::encode_volume(const std::vector<uint16_t>& volume) {
   if (volume.size() * 2 != volume_bytes()) throw Error("internal error: volume size mismatch");
   m.rt.write(m.volume, volume.data(), volume_bytes());
   Events ev;
-  cl_event e = m.launch_encode(ev);
+  m.encode_stage(ev);
   m.rt.finish();
   StageTimes t;
-  t.encode = event_ms(e);
+  ev.collect(t);
   return t;
 }
 
@@ -356,6 +421,16 @@ void Pipeline::read_debug(std::vector<uint32_t>& keys, std::vector<float>& depth
   impl_->rt.read(impl_->dbg_key, keys.data(), n * 4);
   impl_->rt.read(impl_->dbg_depth, depth.data(), n * 4);
   impl_->rt.read(impl_->dbg_count, count.data(), n * 4);
+}
+
+size_t Pipeline::device_bytes() const {
+  const Impl& m = *impl_;
+  size_t total = 0;
+  for (const ClBuffer* b : {&m.positions, &m.attrs, &m.tris, &m.materials, &m.textures, &m.texels, &m.lut, &m.params_buf,
+                            &m.encode_buf, &m.vertices, &m.pmr_vertices, &m.mtas, &m.mta_counter, &m.tile_counts,
+                            &m.tile_offsets, &m.tile_queue, &m.volume, &m.display, &m.dbg_key, &m.dbg_depth, &m.dbg_count})
+    total += b->get() ? b->size() : 0;
+  return total;
 }
 
 std::vector<PmrMta> Pipeline::read_mtas() const {

@@ -15,9 +15,22 @@
 
 namespace pmr {
 
+// How the N views are rasterized. All three produce the same images (see tests/test_methods.cpp).
+enum class Method {
+  Pmr,        // multi-view triangles over (x, y, view): the paper's method
+  Multipass,  // one conventional single-view pass per view, each with that view's own matrices
+  Duplicate,  // every triangle duplicated once per view by setup, 2D tiles over the view atlas
+};
+Method parse_method(const std::string& name);  // "pmr", "multipass", "duplicate"
+const char* to_string(Method m);
+
 struct PipelineConfig {
-  int tile_x = 4, tile_y = 4, tile_v = 4;  // 3D tile (voxels over x, y, view) = one fine work-group
-  bool debug_outputs = false;              // fine raster also writes per-voxel key, depth, count
+  Method method = Method::Pmr;
+  // PMR: the 3D tile (voxels over x, y, view) of one fine work-group. The single-view baselines use
+  // 2D tiles: this tile if its V is 1, else 8x8x1 (the same 64 voxels as the default 4x4x4).
+  int tile_x = 4, tile_y = 4, tile_v = 4;
+  bool debug_outputs = false;      // fine raster also writes per-voxel key, depth, count
+  bool multipass_snapped = false;  // test mode: multipass fed PMR's snapped per-view positions
 };
 
 struct StageTimes {  // milliseconds
@@ -43,6 +56,8 @@ class Pipeline {
   StageTimes render(const Rig& rig);
 
   const PipelineConfig& config() const { return config_; }
+  // Bytes of device buffers currently allocated.
+  size_t device_bytes() const;
   int tiles_x() const { return tiles_x_; }
   int tiles_y() const { return tiles_y_; }
   int tiles_v() const { return tiles_v_; }
@@ -65,11 +80,13 @@ class Pipeline {
   // The MTA queue capacity (for tests of the grow-and-redo path).
   void set_mta_capacity(uint32_t capacity);
 
+ struct Impl;
+
  private:
-  struct Impl;
   std::unique_ptr<Impl> impl_;
   PipelineConfig config_;
   int tiles_x_ = 0, tiles_y_ = 0, tiles_v_ = 0;
+  int tile_[3] = {4, 4, 4};  // effective tile for the method
 };
 
 }  // namespace pmr

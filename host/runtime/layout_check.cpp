@@ -5,9 +5,9 @@
 
 #include "pmr/shared.h"
 
-static_assert(sizeof(PmrParams) == 16 * 8 + 8 * 8 + 16 + 12 * 4, "PmrParams layout");
-static_assert(offsetof(PmrParams, light_world) == 192, "PmrParams layout");
-static_assert(offsetof(PmrParams, view_w) == 208, "PmrParams layout");
+static_assert(sizeof(PmrParams) == 16 * 8 + 9 * 8 + 16 + 12 * 4, "PmrParams layout");
+static_assert(offsetof(PmrParams, light_world) == 200, "PmrParams layout");
+static_assert(offsetof(PmrParams, view_w) == 216, "PmrParams layout");
 static_assert(sizeof(PmrVertex) == 64 && offsetof(PmrVertex, x0) == 32 && offsetof(PmrVertex, z) == 48, "PmrVertex layout");
 static_assert(sizeof(PmrMta) == 27 * 4, "PmrMta layout");
 static_assert(offsetof(PmrMta, bary) == 60 && offsetof(PmrMta, tri) == 84 && offsetof(PmrMta, flags) == 104, "PmrMta layout");

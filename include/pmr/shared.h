@@ -72,6 +72,11 @@ typedef int64_t pmr_i64;
 #define PMR_MTA_BACK 1u   /* back-facing in its view range (double-sided): shading flips the normal */
 #define PMR_MTA_MASK 2u   /* material uses alphaMode MASK: visibility must evaluate alpha */
 
+/* PmrParams.setup_mode: one MTA per orientation range (PMR), or one single-view MTA per view
+ * (the geometry-duplication baseline). */
+#define PMR_SETUP_MTA 0u
+#define PMR_SETUP_DUPLICATE 1u
+
 /* Frame parameters, one copy per frame, read by every stage. Producer: host/pipeline. */
 typedef struct {
   double view[16];        /* center camera view matrix, column-major (world -> center view space) */
@@ -83,6 +88,7 @@ typedef struct {
   double far;             /* far plane                                                      */
   double guard_ndc_x;     /* guard band half-width in NDC x: PMR_GUARD_PX / (W / 2)         */
   double guard_ndc_y;     /* guard band half-height in NDC y                                */
+  double ndc_offset_x;    /* added to x_ndc: s_i / a for a multipass view, 0 for PMR        */
   float light_world[4];   /* unit vector toward the light, world space (xyz, w unused)      */
   pmr_i32 view_w, view_h; /* view raster size (px)                                          */
   pmr_i32 views;          /* N                                                              */
@@ -90,7 +96,8 @@ typedef struct {
   pmr_u32 num_vertices, num_triangles;
   pmr_u32 mta_capacity;   /* size of the MTA queue; setup counts past it and stops writing   */
   pmr_u32 debug_outputs;  /* 1: fine raster writes per-voxel key, depth and coverage count   */
-  pmr_u32 pad0, pad1;
+  pmr_u32 view_base;      /* volume slice of local view 0 (multipass renders one view a pass) */
+  pmr_u32 setup_mode;     /* PMR_SETUP_MTA or PMR_SETUP_DUPLICATE                            */
 } PmrParams;
 
 /* Vertex-stage output, one per scene vertex. Producer: cl/vertex.cl. */

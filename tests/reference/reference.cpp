@@ -14,7 +14,7 @@ PmrVertex project(const PmrParams& P, double xv, double yv, double zv) {
   PmrVertex out{};
   const double w = -zv;
   const double kk = P.disparity_k / double(P.view_w);
-  const double xc = P.ndc_scale_x * xv;
+  const double xc = P.ndc_scale_x * xv + P.ndc_offset_x * w;
   const double xfirst = xc - kk * (w - P.focal), xlast = xc + kk * (w - P.focal);
   const double yc = P.ndc_scale_y * yv;
   const double gx = P.guard_ndc_x * w, gy = P.guard_ndc_y * w;
@@ -57,7 +57,7 @@ PmrVertex project(const PmrParams& P, double xv, double yv, double zv) {
 double plane_value(const PmrParams& P, int k, const double* p) {
   const double w = -p[2];
   const double kk = P.disparity_k / double(P.view_w);
-  const double xc = P.ndc_scale_x * p[0];
+  const double xc = P.ndc_scale_x * p[0] + P.ndc_offset_x * w;
   switch (k) {
     case 0: return w - P.near_eff;
     case 1: return P.far - w;

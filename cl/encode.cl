@@ -4,17 +4,10 @@
  * coverage of the three sampled voxels. */
 #include "common.h"
 
-/* View v at the sampling position of subpixel k of display pixel (j, i), all four channels. */
-inline float4 sample_view(global const PmrEncodeParams* E, global const half* volume, int v, int k, int j, int i) {
+/* Bilinear sample of view v at normalized position (u, t), all four channels. */
+inline float4 sample_bilinear(global const PmrEncodeParams* E, global const half* volume, int v, float u, float t) {
   const size_t plane = (size_t)v * (size_t)E->view_h * (size_t)E->view_w;
-  if (!E->bilinear) {
-    /* exact nearest pixel: floor((j + (k + 0.5) / 3) / W_d * W) = floor((6j + 2k + 1) W / (6 W_d)) */
-    const uint px = ((uint)(6 * j + 2 * k + 1) * (uint)E->view_w) / (6u * (uint)E->display_w);
-    const uint py = ((uint)(2 * i + 1) * (uint)E->view_h) / (2u * (uint)E->display_h);
-    return vload_half4(plane + (size_t)py * E->view_w + px, volume);
-  }
-  const float fx = ((float)j + ((float)k + 0.5f) / 3.0f) / (float)E->display_w * (float)E->view_w - 0.5f;
-  const float fy = ((float)i + 0.5f) / (float)E->display_h * (float)E->view_h - 0.5f;
+  const float fx = u * (float)E->view_w - 0.5f, fy = t * (float)E->view_h - 0.5f;
   const float x0f = floor(fx), y0f = floor(fy);
   const float ax = fx - x0f, ay = fy - y0f;
   const int x0 = clamp((int)x0f, 0, E->view_w - 1), x1 = clamp((int)x0f + 1, 0, E->view_w - 1);
@@ -27,19 +20,66 @@ inline float4 sample_view(global const PmrEncodeParams* E, global const half* vo
   return top + (bottom - top) * ay;
 }
 
+/* One work-item encodes PMR_ENCODE_RUN consecutive pixels of one display row. Along a row the
+ * subpixel index s = 3j + k grows by one per subpixel, so both the view index floor(N t) mod N (N t
+ * grows by num_jk / den) and the nearest view column floor((2s + 1) W / (6 W_d)) are stepped with
+ * integer additions, after one division each at the start of the run. */
+#define PMR_ENCODE_RUN 32
+
 kernel void encode_display(global const PmrEncodeParams* E, global const half* volume, global half* display) {
+  const int runs = (E->display_w + PMR_ENCODE_RUN - 1) / PMR_ENCODE_RUN;
   const uint gid = get_global_id(0);
-  if (gid >= (uint)E->display_w * (uint)E->display_h) return;
-  const int j = (int)(gid % (uint)E->display_w), i = (int)(gid / (uint)E->display_w);
-  const long row = E->num_i * (long)i + E->num_0;
-  float rgb[3], alpha = 0.0f;
-  for (int k = 0; k < 3; ++k) {
-    long v = floor_div_l(E->num_jk * (long)(3 * j + k) - row, E->den) % E->views;
-    if (v < 0) v += E->views;
-    if (E->reversed) v = E->views - 1 - v;
-    const float4 c = sample_view(E, volume, (int)v, k, j, i);
-    rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
-    alpha += c.w;
+  if (gid >= (uint)runs * (uint)E->display_h) return;
+  const int i = (int)(gid / (uint)runs);
+  const int j0 = (int)(gid % (uint)runs) * PMR_ENCODE_RUN;
+  const int j1 = min(j0 + PMR_ENCODE_RUN, E->display_w);
+  const int N = E->views;
+
+  /* N t = (num_jk s - row) / den = q + r / den, 0 <= r < den */
+  const long num = E->num_jk * (long)(3 * j0) - (E->num_i * (long)i + E->num_0);
+  long q = floor_div_l(num, E->den);
+  long r = num - q * E->den;
+  const long step_q = E->num_jk / E->den, step_r = E->num_jk % E->den; /* num_jk > 0 */
+  int v = (int)(q % N);
+  if (v < 0) v += N;
+  const int step_v = (int)(step_q % N);
+
+  /* nearest column: (2s + 1) W = cx * 6 W_d + cr */
+  const long six_wd = 6L * E->display_w;
+  const long cnum = (long)(6 * j0 + 1) * E->view_w;
+  int cx = (int)(cnum / six_wd);
+  long cr = cnum - (long)cx * six_wd;
+  const long cstep = 2L * E->view_w;
+  const int py = (int)(((long)(2 * i + 1) * E->view_h) / (2L * E->display_h));
+  const size_t plane = (size_t)E->view_h * (size_t)E->view_w;
+  const size_t row_off = (size_t)py * (size_t)E->view_w;
+  const float t = ((float)i + 0.5f) / (float)E->display_h;
+
+  for (int j = j0; j < j1; ++j) {
+    float rgb[3], alpha = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+      const int view = E->reversed ? N - 1 - v : v;
+      float4 c;
+      if (!E->bilinear)
+        c = vload_half4((size_t)view * plane + row_off + (size_t)cx, volume);
+      else
+        c = sample_bilinear(E, volume, view, ((float)j + ((float)k + 0.5f) / 3.0f) / (float)E->display_w, t);
+      rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
+      alpha += c.w;
+      /* next subpixel */
+      r += step_r;
+      v += step_v;
+      if (r >= E->den) {
+        r -= E->den;
+        ++v;
+      }
+      if (v >= N) v -= N;
+      cr += cstep;
+      while (cr >= six_wd) {
+        cr -= six_wd;
+        ++cx;
+      }
+    }
+    vstore_half4((float4)(rgb[0], rgb[1], rgb[2], alpha / 3.0f), (size_t)i * E->display_w + j, display);
   }
-  vstore_half4((float4)(rgb[0], rgb[1], rgb[2], alpha / 3.0f), gid, display);
 }

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/bench_command.h"
 #include "cli/options.h"
 #include "cli/render_command.h"
 #include "pmr/error.h"
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
     const std::string cmd = args[0];
     args.erase(args.begin());
     if (cmd == "render") return pmr::run_render(args);
+    if (cmd == "bench") return pmr::run_bench(args);
     if (cmd == "info") {
       for (const auto& line : pmr::describe_opencl_devices()) std::printf("%s\n", line.c_str());
       return 0;

@@ -95,6 +95,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     } else if (a == "--compression") o.compression = value();
     else if (a == "--frame") o.frame = parse_int(value(), a, 0, 9999);
     else if (a == "--verbose" || a == "-v") o.verbose = true;
+    else if (a == "--method") o.pipeline.method = parse_method(value());
     else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see pmr render --help)");
     else if (o.scene.empty()) o.scene = a;
     else throw Error("more than one scene given ('" + o.scene + "' and '" + a + "')");
@@ -115,6 +116,7 @@ std::string main_help() {
          "\n"
          "usage:\n"
          "  pmr render [SCENE.gltf|SCENE.glb] [options]   render N views and the encoded display image\n"
+         "  pmr bench [SCENE] [options]                  performance sweeps over view count and method\n"
          "  pmr info                                     list OpenCL platforms and devices\n"
          "  pmr --help | pmr render --help\n";
 }
@@ -152,6 +154,8 @@ std::string render_help() {
          "  --bilinear             sample views bilinearly (default nearest)\n"
          "pipeline:\n"
          "  --tile XxYxV           3D tile of the tile/fine raster, voxels over x, y, view (default 4x4x4)\n"
+         "  --method M             pmr (default), multipass (one conventional pass per view) or duplicate\n"
+         "                         (every triangle copied per view into a 2D-tiled view atlas)\n"
          "  --verbose              per-stage device times and queue sizes\n"
          "Environment: PMR_DEVICE=substring selects the OpenCL device by name (default: first CPU device).\n";
 }

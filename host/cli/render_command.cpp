@@ -115,6 +115,7 @@ int run_render(const std::vector<std::string>& args) {
   info.tile_x = o.pipeline.tile_x;
   info.tile_y = o.pipeline.tile_y;
   info.tile_v = o.pipeline.tile_v;
+  info.method = to_string(o.pipeline.method);
   info.camera = o.rig.camera;
   info.has_bounds = true;
   info.bounds_lo = lo;

@@ -10,6 +10,9 @@ namespace pmr {
 
 namespace {
 
+// Display pixels one encode work-item handles (PMR_ENCODE_RUN in cl/encode.cl).
+constexpr size_t kEncodeRun = 32;
+
 enum Stage { kVertex, kSetup, kBin, kFine, kEncode, kStages };
 
 // RAII for the profiling events of one frame, each tagged with its stage.
@@ -329,7 +332,8 @@ void Pipeline::Impl::encode_stage(Events& ev) {
   k_encode.arg(0, encode_buf);
   k_encode.arg(1, volume);
   k_encode.arg(2, display);
-  ev.add(kEncode, rt.launch(k_encode, size_t(encode_params.display_w) * encode_params.display_h, 0));
+  const size_t runs = (size_t(encode_params.display_w) + kEncodeRun - 1) / kEncodeRun;
+  ev.add(kEncode, rt.launch(k_encode, runs * encode_params.display_h, 0));
 }
 
 StageTimes Pipeline::render(const Rig& rig) {

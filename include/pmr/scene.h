@@ -49,3 +49,10 @@ Scene load_scene(const std::string& path);
 void scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi);
 
 }  // namespace pmr
+
+namespace pmr {
+// A procedural scene of about `triangles` triangles (1k to 1M): UV spheres of ~200 triangles with
+// random sizes and colours spread through a 4 x 2 x 3 box, so they cover the whole depth range in
+// front of and behind the focal plane. Deterministic for a given seed. For performance sweeps.
+Scene make_synthetic_scene(size_t triangles, uint32_t seed = 1);
+}  // namespace pmr

@@ -1,0 +1,242 @@
+#include "cli/bench_command.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "cli/options.h"
+#include "cli/render_command.h"
+#include "pipeline/pipeline.h"
+#include "pmr/error.h"
+#include "pmr/output.h"
+#include "pmr/scene.h"
+#include "runtime/cl_runtime.h"
+
+namespace pmr {
+
+namespace {
+
+struct BenchOptions {
+  std::string scene;
+  size_t synthetic = 0;
+  std::vector<int> views = {1, 2, 4, 8, 16, 32, 48, 64, 96};
+  std::vector<Method> methods = {Method::Pmr, Method::Multipass, Method::Duplicate};
+  int frames = 5;
+  std::string csv;
+  std::string keep = "view";
+  int view_w = 1024, view_h = 512;  // per-view raster at N = 96 (keep total) or always (keep view)
+  Display display;
+  int tile[3] = {4, 4, 4};
+  bool check = true;
+  bool help = false;
+};
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string w;
+  while (std::getline(ss, w, ',')) out.push_back(w);
+  return out;
+}
+
+BenchOptions parse(const std::vector<std::string>& args) {
+  BenchOptions o;
+  std::vector<std::string> rest;  // options shared with render go through its parser
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= args.size()) throw Error("option " + a + " needs a value (see pmr bench --help)");
+      return args[++i];
+    };
+    if (a == "-h" || a == "--help") o.help = true;
+    else if (a == "--views") {
+      o.views.clear();
+      for (const auto& v : split(value())) {
+        const RenderOptions r = parse_render_options({"--views", v});
+        o.views.push_back(r.rig.views);
+      }
+    } else if (a == "--method") {
+      o.methods.clear();
+      for (const auto& m : split(value())) o.methods.push_back(parse_method(m));
+    } else if (a == "--frames") {
+      const std::string v = value();
+      o.frames = std::atoi(v.c_str());
+      if (o.frames < 1 || o.frames > 1000) throw Error("invalid --frames '" + v + "': expected 1..1000");
+    } else if (a == "--csv") o.csv = value();
+    else if (a == "--keep") {
+      o.keep = value();
+      if (o.keep != "view" && o.keep != "total") throw Error("invalid --keep '" + o.keep + "': expected view or total");
+    } else if (a == "--synthetic") {
+      const std::string v = value();
+      char* end = nullptr;
+      const double n = std::strtod(v.c_str(), &end);
+      if (*end != '\0' || !(n >= 1 && n <= 5e7)) throw Error("invalid --synthetic '" + v + "': expected a triangle count");
+      o.synthetic = size_t(n);
+    } else if (a == "--no-check") o.check = false;
+    else if (a == "--view-size" || a == "--display" || a == "--tile" || a == "--lens-pitch" || a == "--tan-slant" ||
+             a == "--offset" || a == "--cone" || a == "--yfov" || a == "--display-size") {
+      rest.push_back(a);
+      rest.push_back(value());
+    } else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see pmr bench --help)");
+    else if (o.scene.empty()) o.scene = a;
+    else throw Error("more than one scene given");
+  }
+  RenderOptions r = parse_render_options(rest);
+  o.view_w = r.rig.view_w, o.view_h = r.rig.view_h;
+  o.display = r.display;
+  o.tile[0] = r.pipeline.tile_x, o.tile[1] = r.pipeline.tile_y, o.tile[2] = r.pipeline.tile_v;
+  if (o.methods.empty() || o.views.empty()) throw Error("nothing to measure");
+  return o;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Device copy bandwidth in bytes per second (best of a few 256 MiB copies).
+double copy_bandwidth(const ClRuntime& rt) {
+  const size_t bytes = size_t(256) << 20;
+  ClBuffer a = rt.buffer(bytes, "bandwidth probe"), b = rt.buffer(bytes, "bandwidth probe");
+  rt.fill_zero(a);
+  rt.fill_zero(b);
+  rt.finish();
+  double best = 0;
+  for (int k = 0; k < 4; ++k) {
+    cl_event e = nullptr;
+    cl_check(clEnqueueCopyBuffer(rt.queue(), a.get(), b.get(), 0, 0, bytes, 0, nullptr, &e), "clEnqueueCopyBuffer");
+    clWaitForEvents(1, &e);
+    const double ms = event_ms(e);
+    clReleaseEvent(e);
+    if (ms > 0) best = std::max(best, 2.0 * double(bytes) / (ms * 1e-3));  // read + write
+  }
+  return best;
+}
+
+// Fraction of voxels whose coverage (alpha != 0) differs between two volumes.
+double coverage_mismatch(const std::vector<uint16_t>& a, const std::vector<uint16_t>& b) {
+  if (a.size() != b.size() || a.empty()) return 1.0;
+  size_t diff = 0;
+  for (size_t i = 3; i < a.size(); i += 4) diff += (a[i] != 0) != (b[i] != 0);
+  return double(diff) / double(a.size() / 4);
+}
+
+}  // namespace
+
+std::string bench_help() {
+  return "usage: pmr bench [SCENE] [options]\n"
+         "Times whole frames (render + encode, no file I/O) per view count and method.\n"
+         "  --views LIST        view counts (default 1,2,4,8,16,32,48,64,96)\n"
+         "  --method LIST       pmr, multipass, duplicate (default all three)\n"
+         "  --frames K          timed frames per point after one warm-up frame (default 5)\n"
+         "  --csv FILE          write one row per point\n"
+         "  --keep view|total   view: every view is --view-size (default 1024x512); total: the total voxel\n"
+         "                      count of 96 views of --view-size is held fixed (the paper's Fig. 15)\n"
+         "  --synthetic TRIS    a procedural scene of about TRIS triangles instead of SCENE\n"
+         "  --no-check          skip comparing the methods' images\n"
+         "  --view-size, --display, --tile and the display options are as for pmr render.\n"
+         "Per point it prints the frame time, the per-stage device times, and the floor: the bytes a frame\n"
+         "must move (each voxel written once, the display image written once) at the measured copy bandwidth.\n";
+}
+
+int run_bench(const std::vector<std::string>& args) {
+  BenchOptions o = parse(args);
+  if (o.help) {
+    std::fputs(bench_help().c_str(), stdout);
+    return 0;
+  }
+  std::unique_ptr<std::ofstream> csv;
+  if (!o.csv.empty()) {
+    csv.reset(new std::ofstream(o.csv));
+    if (!*csv) throw Error("cannot write " + o.csv);
+  }
+  Scene scene;
+  std::string scene_name;
+  if (o.synthetic) {
+    scene = make_synthetic_scene(o.synthetic);
+    scene_name = "synthetic-" + std::to_string(o.synthetic);
+  } else {
+    const std::string path = o.scene.empty() ? default_scene_path() : o.scene;
+    scene = load_scene(path);
+    scene_name = path.substr(path.rfind('/') + 1);
+  }
+  glm::dvec3 lo, hi;
+  scene_bounds(scene, lo, hi);
+  ClRuntime rt;
+  const double bw = copy_bandwidth(rt);
+  std::printf("# %s: %zu triangles; device %s; copy bandwidth %.1f GB/s\n", scene_name.c_str(), scene.triangles.size(),
+              rt.device_name().c_str(), bw * 1e-9);
+  if (csv)
+    *csv << "scene,method,views,view_w,view_h,display_w,display_h,triangles,frames,ms_median,ms_min,ms_setup,ms_tile,"
+            "ms_fine,ms_encode,mvoxels_per_s,peak_mem_mb,floor_ms,x_floor,coverage_mismatch\n";
+  std::printf("%-10s %5s %9s %9s %9s %8s %8s %8s %8s %9s %7s %8s\n", "method", "views", "view", "ms_median", "ms_min",
+              "setup", "tile", "fine", "encode", "Mvox/s", "xfloor", "mismatch");
+  const double total_voxels = 96.0 * o.view_w * o.view_h;
+  for (int N : o.views) {
+    RigConfig rc;
+    rc.views = N;
+    rc.view_w = o.view_w, rc.view_h = o.view_h;
+    if (o.keep == "total") {  // same total voxels, aspect 2:1, multiples of 4
+      const double h = std::sqrt(total_voxels / N / 2.0);
+      rc.view_h = std::max(4, std::min(PMR_MAX_RASTER / 2, int(std::lround(h / 4.0)) * 4));
+      rc.view_w = 2 * rc.view_h;
+    }
+    Display display = o.display;
+    display.offset = parse_rational(std::to_string(-display.lens_pitch.num) + "/" +
+                                        std::to_string(2 * display.lens_pitch.den * N), "offset");
+    const Rig rig = make_rig(rc, display, lo, hi);
+    const double voxels = double(N) * rig.view_w * rig.view_h;
+    const double floor_ms = (voxels * 8.0 + double(display.width) * display.height * 8.0) / bw * 1e3;
+    std::vector<uint16_t> reference;
+    for (Method method : o.methods) {
+      PipelineConfig pc;
+      pc.method = method;
+      pc.tile_x = o.tile[0], pc.tile_y = o.tile[1], pc.tile_v = o.tile[2];
+      Pipeline p(rt, pc);
+      p.set_scene(scene);
+      p.configure(rig, &display);
+      p.render(rig);  // warm-up: first-touch of buffers, queue growth
+      std::vector<double> wall, setup, tile, fine, encode;
+      for (int f = 0; f < o.frames; ++f) {
+        const StageTimes t = p.render(rig);
+        wall.push_back(t.wall);
+        setup.push_back(t.vertex + t.setup);
+        tile.push_back(t.bin);
+        fine.push_back(t.fine);
+        encode.push_back(t.encode);
+      }
+      double mismatch = 0.0;
+      if (o.check) {
+        std::vector<uint16_t> volume;
+        p.read_volume(volume);
+        if (reference.empty()) reference.swap(volume);
+        else mismatch = coverage_mismatch(reference, volume);
+        if (mismatch > 0.001)
+          std::fprintf(stderr, "pmr: warning: %s at N = %d differs from %s on %.3f%% of voxels\n", to_string(method), N,
+                       to_string(o.methods[0]), 100.0 * mismatch);
+      }
+      const double med = median(wall), mn = *std::min_element(wall.begin(), wall.end());
+      const double mvox = voxels / (med * 1e-3) * 1e-6;
+      const double mem_mb = double(p.device_bytes()) / (1 << 20);
+      char view[32];
+      std::snprintf(view, sizeof view, "%dx%d", rig.view_w, rig.view_h);
+      std::printf("%-10s %5d %9s %9.1f %9.1f %8.1f %8.1f %8.1f %8.1f %9.0f %7.1f %8.5f\n", to_string(method), N, view,
+                  med, mn, median(setup), median(tile), median(fine), median(encode), mvox, med / floor_ms, mismatch);
+      std::fflush(stdout);
+      if (csv)
+        *csv << scene_name << ',' << to_string(method) << ',' << N << ',' << rig.view_w << ',' << rig.view_h << ','
+             << display.width << ',' << display.height << ',' << scene.triangles.size() << ',' << o.frames << ',' << med
+             << ',' << mn << ',' << median(setup) << ',' << median(tile) << ',' << median(fine) << ','
+             << median(encode) << ',' << mvox << ',' << mem_mb << ',' << floor_ms << ',' << med / floor_ms << ','
+             << mismatch << '\n';
+    }
+  }
+  return 0;
+}
+
+}  // namespace pmr

@@ -10,9 +10,6 @@ namespace pmr {
 
 namespace {
 
-// Display pixels one encode work-item handles (PMR_ENCODE_RUN in cl/encode.cl).
-constexpr size_t kEncodeRun = 32;
-
 enum Stage { kVertex, kSetup, kBin, kFine, kEncode, kStages };
 
 // RAII for the profiling events of one frame, each tagged with its stage.
@@ -68,7 +65,7 @@ struct Pipeline::Impl {
   bool mta_capacity_fixed = false;
   ClBuffer tile_counts, tile_offsets, tile_queue;
   size_t tile_queue_capacity = 0;
-  ClBuffer volume, display;
+  ClBuffer volume, display, encode_columns, encode_rows;
   ClBuffer dbg_key, dbg_depth, dbg_count;
   uint32_t last_mtas = 0;
   uint64_t num_tiles = 0;
@@ -204,7 +201,16 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   m.num_tiles = uint64_t(tiles_x_) * tiles_y_ * tiles_v_;
   if (m.num_tiles >= (uint64_t(1) << 32)) throw Error("too many tiles; use larger --tile");
   m.encode = display != nullptr;
-  if (display) m.encode_params = make_encode_params(*display, rig.views, rig.view_w, rig.view_h);
+  if (display) {
+    m.encode_params = make_encode_params(*display, rig.views, rig.view_w, rig.view_h);
+    std::vector<PmrEncodeColumn> columns;
+    std::vector<PmrEncodeRow> rows;
+    make_encode_tables(m.encode_params, columns, rows);
+    m.encode_columns = rt.buffer(bytes_of(columns), "encoder columns", CL_MEM_READ_ONLY);
+    rt.write(m.encode_columns, columns.data(), bytes_of(columns));
+    m.encode_rows = rt.buffer(bytes_of(rows), "encoder rows", CL_MEM_READ_ONLY);
+    rt.write(m.encode_rows, rows.data(), bytes_of(rows));
+  }
 
   const size_t vol = volume_bytes();
   const size_t disp = display_bytes();
@@ -330,10 +336,11 @@ void Pipeline::Impl::fine_stage(const PmrParams& P, const int tile[3], Events& e
 void Pipeline::Impl::encode_stage(Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
   k_encode.arg(0, encode_buf);
-  k_encode.arg(1, volume);
-  k_encode.arg(2, display);
-  const size_t runs = (size_t(encode_params.display_w) + kEncodeRun - 1) / kEncodeRun;
-  ev.add(kEncode, rt.launch(k_encode, runs * encode_params.display_h, 0));
+  k_encode.arg(1, encode_columns);
+  k_encode.arg(2, encode_rows);
+  k_encode.arg(3, volume);
+  k_encode.arg(4, display);
+  ev.add(kEncode, rt.launch_2d(k_encode, size_t(encode_params.display_w), size_t(encode_params.display_h), 64, 1));
 }
 
 StageTimes Pipeline::render(const Rig& rig) {
@@ -432,7 +439,7 @@ size_t Pipeline::device_bytes() const {
   size_t total = 0;
   for (const ClBuffer* b : {&m.positions, &m.attrs, &m.tris, &m.materials, &m.textures, &m.texels, &m.lut, &m.params_buf,
                             &m.encode_buf, &m.vertices, &m.pmr_vertices, &m.mtas, &m.mta_counter, &m.tile_counts,
-                            &m.tile_offsets, &m.tile_queue, &m.volume, &m.display, &m.dbg_key, &m.dbg_depth, &m.dbg_count})
+                            &m.tile_offsets, &m.tile_queue, &m.volume, &m.display, &m.encode_columns, &m.encode_rows, &m.dbg_key, &m.dbg_depth, &m.dbg_count})
     total += b->get() ? b->size() : 0;
   return total;
 }

@@ -94,7 +94,7 @@ PmrEncodeParams make_encode_params(const Display& display, int views, int view_w
   const i128 den = i128(L.num) * T.den * O.den;
   const i128 a_i = num_i < 0 ? -num_i : num_i, a_0 = num_0 < 0 ? -num_0 : num_0;
   const i128 worst = num_jk * (3 * i128(display.width) + 3) + a_i * display.height + a_0;
-  if (worst >= (i128(1) << 62) || den >= (i128(1) << 62))
+  if (worst >= (i128(1) << 62) || den >= (i128(1) << 31))
     throw Error("display parameters need too many digits for exact subpixel evaluation; use simpler fractions");
   PmrEncodeParams p{};
   p.num_jk = int64_t(num_jk);
@@ -109,6 +109,29 @@ PmrEncodeParams make_encode_params(const Display& display, int views, int view_w
   p.reversed = display.reversed ? 1 : 0;
   p.bilinear = display.bilinear ? 1 : 0;
   return p;
+}
+
+void make_encode_tables(const PmrEncodeParams& p, std::vector<PmrEncodeColumn>& columns, std::vector<PmrEncodeRow>& rows) {
+  columns.resize(size_t(3) * p.display_w);
+  for (size_t s = 0; s < columns.size(); ++s) {
+    const i128 n = i128(p.num_jk) * i128(s);
+    const i128 a = floor_div(n, p.den);
+    PmrEncodeColumn& c = columns[s];
+    c.a_mod_n = int32_t(((a % p.views) + p.views) % p.views);
+    c.b = int32_t(n - a * p.den);
+    c.px = int32_t((i128(2 * s + 1) * p.view_w) / (i128(6) * p.display_w));
+    c.pad = 0;
+  }
+  rows.resize(size_t(p.display_h));
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const i128 n = i128(p.num_i) * i128(i) + p.num_0;
+    const i128 q = floor_div(n, p.den);
+    PmrEncodeRow& r = rows[i];
+    r.q_mod_n = int32_t(((q % p.views) + p.views) % p.views);
+    r.s = int32_t(n - q * p.den);
+    r.py = int32_t((i128(2 * i + 1) * p.view_h) / (i128(2) * p.display_h));
+    r.pad = 0;
+  }
 }
 
 int encode_view_index(const Display& display, int views, int j, int i, int k) {

@@ -276,6 +276,14 @@ cl_event ClRuntime::launch(const ClKernel& k, size_t global, size_t local) const
   return e;
 }
 
+cl_event ClRuntime::launch_2d(const ClKernel& k, size_t gx, size_t gy, size_t lx, size_t ly) const {
+  cl_event e = nullptr;
+  const size_t global[2] = {(gx + lx - 1) / lx * lx, (gy + ly - 1) / ly * ly}, local[2] = {lx, ly};
+  cl_check(clEnqueueNDRangeKernel(queue_, k.get(), 2, nullptr, global, local, 0, nullptr, &e),
+           "launching kernel " + k.name() + " (2D " + std::to_string(global[0]) + "x" + std::to_string(global[1]) + ")");
+  return e;
+}
+
 void ClRuntime::finish() const { cl_check(clFinish(queue_), "clFinish"); }
 
 double event_ms(cl_event e) { return event_span_ms(e, e); }

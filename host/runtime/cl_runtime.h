@@ -84,6 +84,8 @@ class ClRuntime {
   void fill_zero(const ClBuffer& b) const;
   // Launches a kernel; returns its event (caller releases) for profiling.
   cl_event launch(const ClKernel& k, size_t global, size_t local) const;
+  // 2D launch; the global size is rounded up to a multiple of the local size.
+  cl_event launch_2d(const ClKernel& k, size_t gx, size_t gy, size_t lx, size_t ly) const;
   void finish() const;
 
  private:

@@ -71,6 +71,9 @@ PmrParams make_params(const Rig& rig);
 // Encoder parameters with exact integer coefficients. Throws pmr::Error if they could overflow.
 PmrEncodeParams make_encode_params(const Display& display, int views, int view_w, int view_h);
 
+// The encoder's per-subpixel-column and per-row tables (see PmrEncodeColumn in shared.h).
+void make_encode_tables(const PmrEncodeParams& p, std::vector<PmrEncodeColumn>& columns, std::vector<PmrEncodeRow>& rows);
+
 // Direct evaluation of DESIGN section 5 in exact rational arithmetic: the view of subpixel k of
 // display pixel (j, i). The reference the encoder kernel is tested against.
 int encode_view_index(const Display& display, int views, int j, int i, int k);

@@ -175,4 +175,22 @@ typedef struct {
   pmr_i32 pad0;
 } PmrEncodeParams;
 
+/* Encoder tables, computed once per configuration by the host (host/rig/display.cpp). With
+ * num_jk * s = A_s * den + B_s (s = 3j + k, 0 <= B_s < den) and num_i * i + num_0 = Q_i * den + S_i
+ * (0 <= S_i < den): floor(N t) = A_s - Q_i - (B_s < S_i), so the view of a subpixel needs no division:
+ * v = (A_s mod N) - (Q_i mod N) - (B_s < S_i), plus N if negative. */
+typedef struct {
+  pmr_i32 a_mod_n;        /* A_s mod N                                                      */
+  pmr_i32 b;              /* B_s (den < 2^31 is checked by the host)                         */
+  pmr_i32 px;             /* nearest view column: floor((2s + 1) W / (6 W_d))                 */
+  pmr_i32 pad;
+} PmrEncodeColumn;
+
+typedef struct {
+  pmr_i32 q_mod_n;        /* Q_i mod N                                                      */
+  pmr_i32 s;              /* S_i                                                            */
+  pmr_i32 py;             /* nearest view row: floor((2i + 1) H / (2 H_d))                    */
+  pmr_i32 pad;
+} PmrEncodeRow;
+
 #endif /* PMR_SHARED_H */

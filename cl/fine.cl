@@ -13,14 +13,9 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
                         global const uchar4* texels, global const float* srgb_lut,
                         global half* volume, global uint* debug_key, global float* debug_depth,
                         global uint* debug_count) {
-  const uint tile = get_group_id(0);
-  const uint lid = get_local_id(0);
-  const int tx = (int)(tile % (uint)P->tiles_x);
-  const int ty = (int)((tile / (uint)P->tiles_x) % (uint)P->tiles_y);
-  const int tv = (int)(tile / ((uint)P->tiles_x * (uint)P->tiles_y));
-  const int px = tx * PMR_TILE_X + (int)(lid % PMR_TILE_X);
-  const int py = ty * PMR_TILE_Y + (int)((lid / PMR_TILE_X) % PMR_TILE_Y);
-  const int view = tv * PMR_TILE_V + (int)(lid / (PMR_TILE_X * PMR_TILE_Y));
+  /* 3D range: x, y, view; one work-group is one tile (no divisions per work-item) */
+  const int px = (int)get_global_id(0), py = (int)get_global_id(1), view = (int)get_global_id(2);
+  const uint tile = ((uint)get_group_id(2) * (uint)P->tiles_y + (uint)get_group_id(1)) * (uint)P->tiles_x + (uint)get_group_id(0);
   const bool valid = px < P->view_w && py < P->view_h && view < P->views;
   const long X = (long)px * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
 
@@ -59,12 +54,12 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
   if (!valid) return;
 
   const size_t voxel = ((size_t)(view + (int)P->view_base) * (size_t)P->view_h + (size_t)py) * (size_t)P->view_w + (size_t)px;
-  float4 color = (float4)(0.0f);
   if (best_key != PMR_NO_KEY) {
     const PmrMta m = mtas[best_mta];
-    color = shade(&in, P, m.tri, source_barycentrics(&m, best_e), (m.flags & PMR_MTA_BACK) != 0);
+    vstore_half4(shade(&in, P, m.tri, source_barycentrics(&m, best_e), (m.flags & PMR_MTA_BACK) != 0), voxel, volume);
+  } else {
+    vstore4((ushort4)(0), voxel, (global ushort*)volume); /* background; PoCL converts halves in software */
   }
-  vstore_half4(color, voxel, volume);
   if (P->debug_outputs) {
     debug_key[voxel] = best_key;
     debug_depth[voxel] = best_depth;

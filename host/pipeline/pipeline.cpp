@@ -328,9 +328,11 @@ void Pipeline::Impl::fine_stage(const PmrParams& P, const int tile[3], Events& e
   for (const ClBuffer* b : {&params_buf, &mtas, &tile_offsets, &tile_queue, &tris, &attrs, &materials, &textures,
                             &texels, &lut, &volume, &dbg_key, &dbg_depth, &dbg_count})
     k_fine.arg(a++, *b);
-  const size_t global[3] = {size_t(P.tiles_x) * tile[0], size_t(P.tiles_y) * tile[1], size_t(P.tiles_v) * tile[2]};
-  const size_t local[3] = {size_t(tile[0]), size_t(tile[1]), size_t(tile[2])};
-  ev.add(kFine, rt.launch_3d(k_fine, global, local));
+  (void)P;
+  (void)tile;
+  // one work-item per tile; small work-groups keep the two cores balanced
+  const size_t group = 8;
+  ev.add(kFine, rt.launch(k_fine, (size_t(num_tiles) + group - 1) / group * group, group));
 }
 
 void Pipeline::Impl::encode_stage(Events& ev) {

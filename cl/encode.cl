@@ -21,46 +21,52 @@ inline float4 sample_bilinear(global const PmrEncodeParams* E, global const half
   return top + (bottom - top) * ay;
 }
 
+/* Display pixels per work-item: amortizes the per-work-item cost of the device. */
+#define PMR_ENCODE_RUN 16
+
 kernel void encode_display(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
                            global const PmrEncodeRow* rows, global const half* volume, global half* display) {
-  const int j = (int)get_global_id(0), i = (int)get_global_id(1);
-  if (j >= E->display_w || i >= E->display_h) return;
+  const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
+  if (j0 >= E->display_w || i >= E->display_h) return;
+  const int j1 = min(j0 + PMR_ENCODE_RUN, E->display_w);
   const int N = E->views;
   const PmrEncodeRow row = rows[i];
   const size_t plane = (size_t)E->view_h * (size_t)E->view_w;
   const size_t row_off = (size_t)row.py * (size_t)E->view_w;
-  const size_t out = (size_t)i * E->display_w + j;
-  int view[3];
-  for (int k = 0; k < 3; ++k) {
-    const PmrEncodeColumn col = columns[3 * j + k];
-    int v = col.a_mod_n - row.q_mod_n - (col.b < row.s ? 1 : 0);
-    v = v < 0 ? v + N : v;
-    view[k] = E->reversed ? N - 1 - v : v;
-  }
-  if (E->bilinear) {
-    const float t = ((float)i + 0.5f) / (float)E->display_h;
-    float rgb[3], alpha = 0.0f;
-    for (int k = 0; k < 3; ++k) {
-      const float4 c = sample_bilinear(E, volume, view[k], ((float)j + ((float)k + 0.5f) / 3.0f) / (float)E->display_w, t);
-      rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
-      alpha += c.w;
-    }
-    vstore_half4((float4)(rgb[0], rgb[1], rgb[2], alpha / 3.0f), out, display);
-    return;
-  }
-  /* Nearest: copy the half bits (PoCL converts halves in software, which would dominate the stage). */
   global const ushort* bits = (global const ushort*)volume;
-  ushort rgb[3], a[3];
-  for (int k = 0; k < 3; ++k) {
-    const ushort4 c = vload4((size_t)view[k] * plane + row_off + (size_t)columns[3 * j + k].px, bits);
-    rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
-    a[k] = c.w;
+  for (int j = j0; j < j1; ++j) {
+    const size_t out = (size_t)i * E->display_w + j;
+    int view[3];
+    for (int k = 0; k < 3; ++k) {
+      const PmrEncodeColumn col = columns[3 * j + k];
+      int v = col.a_mod_n - row.q_mod_n - (col.b < row.s ? 1 : 0);
+      v = v < 0 ? v + N : v;
+      view[k] = E->reversed ? N - 1 - v : v;
+    }
+    if (E->bilinear) {
+      const float t = ((float)i + 0.5f) / (float)E->display_h;
+      float rgb[3], alpha = 0.0f;
+      for (int k = 0; k < 3; ++k) {
+        const float4 c = sample_bilinear(E, volume, view[k], ((float)j + ((float)k + 0.5f) / 3.0f) / (float)E->display_w, t);
+        rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
+        alpha += c.w;
+      }
+      vstore_half4((float4)(rgb[0], rgb[1], rgb[2], alpha / 3.0f), out, display);
+      continue;
+    }
+    /* Nearest: copy the half bits (PoCL converts halves in software, which would dominate the stage). */
+    ushort rgb[3], a[3];
+    for (int k = 0; k < 3; ++k) {
+      const ushort4 c = vload4((size_t)view[k] * plane + row_off + (size_t)columns[3 * j + k].px, bits);
+      rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
+      a[k] = c.w;
+    }
+    /* alpha = mean coverage; the mean of three equal halves is that half exactly, the common case */
+    ushort alpha = a[0];
+    if (a[1] != a[0] || a[2] != a[0]) {
+      const float mean = (vload_half(0, (const half*)a) + vload_half(1, (const half*)a) + vload_half(2, (const half*)a)) / 3.0f;
+      vstore_half(mean, 0, (half*)&alpha);
+    }
+    vstore4((ushort4)(rgb[0], rgb[1], rgb[2], alpha), out, (global ushort*)display);
   }
-  /* alpha = mean coverage; the mean of three equal halves is that half exactly, the common case */
-  ushort alpha = a[0];
-  if (a[1] != a[0] || a[2] != a[0]) {
-    const float m = (vload_half(0, (const half*)a) + vload_half(1, (const half*)a) + vload_half(2, (const half*)a)) / 3.0f;
-    vstore_half(m, 0, (half*)&alpha);
-  }
-  vstore4((ushort4)(rgb[0], rgb[1], rgb[2], alpha), out, (global ushort*)display);
 }

@@ -10,6 +10,9 @@ namespace pmr {
 
 namespace {
 
+// Display pixels per encode work-item (PMR_ENCODE_RUN in cl/encode.cl).
+constexpr size_t kEncodeRun = 16;
+
 enum Stage { kVertex, kSetup, kBin, kFine, kEncode, kStages };
 
 // RAII for the profiling events of one frame, each tagged with its stage.
@@ -342,7 +345,8 @@ void Pipeline::Impl::encode_stage(Events& ev) {
   k_encode.arg(2, encode_rows);
   k_encode.arg(3, volume);
   k_encode.arg(4, display);
-  ev.add(kEncode, rt.launch_2d(k_encode, size_t(encode_params.display_w), size_t(encode_params.display_h), 64, 1));
+  const size_t runs = (size_t(encode_params.display_w) + kEncodeRun - 1) / kEncodeRun;
+  ev.add(kEncode, rt.launch_2d(k_encode, runs, size_t(encode_params.display_h), 8, 1));
 }
 
 StageTimes Pipeline::render(const Rig& rig) {

@@ -27,8 +27,9 @@ const char* to_string(Method m);
 struct PipelineConfig {
   Method method = Method::Pmr;
   // PMR: the 3D tile (voxels over x, y, view) of one fine work-group. The single-view baselines use
-  // 2D tiles: this tile if its V is 1, else 8x8x1 (the same 64 voxels as the default 4x4x4).
-  int tile_x = 4, tile_y = 4, tile_v = 4;
+  // 2D tiles: this tile if its V is 1, else 8x8x1 (measured best of 8x8, 16x4, 32x2, 16x8).
+  // Default 16x2x4: best of 13 shapes measured with pmr bench --synthetic 100000 at N = 96.
+  int tile_x = 16, tile_y = 2, tile_v = 4;
   bool debug_outputs = false;      // fine raster also writes per-voxel key, depth, count
   bool multipass_snapped = false;  // test mode: multipass fed PMR's snapped per-view positions
 };

@@ -24,49 +24,59 @@ inline float4 sample_bilinear(global const PmrEncodeParams* E, global const half
 /* Display pixels per work-item: amortizes the per-work-item cost of the device. */
 #define PMR_ENCODE_RUN 16
 
-kernel void encode_display(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
+/* The view index of subpixel k of pixel j in a row (see PmrEncodeColumn). */
+inline int encode_view(global const PmrEncodeParams* E, const PmrEncodeColumn* col, const PmrEncodeRow* row) {
+  int v = col->a_mod_n - row->q_mod_n - (col->b < row->s ? 1 : 0);
+  v = v < 0 ? v + E->views : v;
+  return E->reversed ? E->views - 1 - v : v;
+}
+
+/* Nearest sampling copies the colour's half bits: PoCL converts halves in software, and the
+ * conversions would dominate the stage. Separate kernels for nearest and bilinear sampling, because
+ * a branch between them would be flattened when the kernel is vectorized across work-items. */
+kernel void encode_nearest(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
                            global const PmrEncodeRow* rows, global const half* volume, global half* display) {
   const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
   if (j0 >= E->display_w || i >= E->display_h) return;
   const int j1 = min(j0 + PMR_ENCODE_RUN, E->display_w);
-  const int N = E->views;
   const PmrEncodeRow row = rows[i];
   const size_t plane = (size_t)E->view_h * (size_t)E->view_w;
   const size_t row_off = (size_t)row.py * (size_t)E->view_w;
   global const ushort* bits = (global const ushort*)volume;
   for (int j = j0; j < j1; ++j) {
-    const size_t out = (size_t)i * E->display_w + j;
-    int view[3];
-    for (int k = 0; k < 3; ++k) {
-      const PmrEncodeColumn col = columns[3 * j + k];
-      int v = col.a_mod_n - row.q_mod_n - (col.b < row.s ? 1 : 0);
-      v = v < 0 ? v + N : v;
-      view[k] = E->reversed ? N - 1 - v : v;
-    }
-    if (E->bilinear) {
-      const float t = ((float)i + 0.5f) / (float)E->display_h;
-      float rgb[3], alpha = 0.0f;
-      for (int k = 0; k < 3; ++k) {
-        const float4 c = sample_bilinear(E, volume, view[k], ((float)j + ((float)k + 0.5f) / 3.0f) / (float)E->display_w, t);
-        rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
-        alpha += c.w;
-      }
-      vstore_half4((float4)(rgb[0], rgb[1], rgb[2], alpha / 3.0f), out, display);
-      continue;
-    }
-    /* Nearest: copy the half bits (PoCL converts halves in software, which would dominate the stage). */
-    ushort rgb[3], a[3];
-    for (int k = 0; k < 3; ++k) {
-      const ushort4 c = vload4((size_t)view[k] * plane + row_off + (size_t)columns[3 * j + k].px, bits);
-      rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
-      a[k] = c.w;
-    }
+    /* the three subpixels unrolled into scalars: small private arrays written by element and read
+     * back as a vector stall the CPU's store forwarding, which cost more than all the rest */
+    const PmrEncodeColumn c0 = columns[3 * j], c1 = columns[3 * j + 1], c2 = columns[3 * j + 2];
+    const ushort4 s0 = vload4((size_t)encode_view(E, &c0, &row) * plane + row_off + (size_t)c0.px, bits);
+    const ushort4 s1 = vload4((size_t)encode_view(E, &c1, &row) * plane + row_off + (size_t)c1.px, bits);
+    const ushort4 s2 = vload4((size_t)encode_view(E, &c2, &row) * plane + row_off + (size_t)c2.px, bits);
     /* alpha = mean coverage; the mean of three equal halves is that half exactly, the common case */
-    ushort alpha = a[0];
-    if (a[1] != a[0] || a[2] != a[0]) {
+    ushort alpha = s0.w;
+    if (s1.w != s0.w || s2.w != s0.w) {
+      const ushort a[3] = {s0.w, s1.w, s2.w};
       const float mean = (vload_half(0, (const half*)a) + vload_half(1, (const half*)a) + vload_half(2, (const half*)a)) / 3.0f;
       vstore_half(mean, 0, (half*)&alpha);
     }
-    vstore4((ushort4)(rgb[0], rgb[1], rgb[2], alpha), out, (global ushort*)display);
+    vstore4((ushort4)(s0.x, s1.y, s2.z, alpha), (size_t)i * E->display_w + j, (global ushort*)display);
+  }
+}
+
+kernel void encode_bilinear(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
+                            global const PmrEncodeRow* rows, global const half* volume, global half* display) {
+  const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
+  if (j0 >= E->display_w || i >= E->display_h) return;
+  const int j1 = min(j0 + PMR_ENCODE_RUN, E->display_w);
+  const PmrEncodeRow row = rows[i];
+  const float t = ((float)i + 0.5f) / (float)E->display_h;
+  for (int j = j0; j < j1; ++j) {
+    float rgb[3], alpha = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+      const PmrEncodeColumn col = columns[3 * j + k];
+      const float4 c = sample_bilinear(E, volume, encode_view(E, &col, &row),
+                                       ((float)j + ((float)k + 0.5f) / 3.0f) / (float)E->display_w, t);
+      rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
+      alpha += c.w;
+    }
+    vstore_half4((float4)(rgb[0], rgb[1], rgb[2], alpha / 3.0f), (size_t)i * E->display_w + j, display);
   }
 }

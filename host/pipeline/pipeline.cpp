@@ -53,7 +53,7 @@ size_t bytes_of(const std::vector<T>& v) {
 struct Pipeline::Impl {
   const ClRuntime& rt;
   cl_program program = nullptr;
-  ClKernel k_vertex, k_vertex_select, k_setup, k_bin_count, k_bin_fill, k_fine, k_encode;
+  ClKernel k_vertex, k_vertex_select, k_setup, k_bin_count, k_bin_fill, k_fine, k_encode, k_encode_bilinear;
 
   // scene
   uint32_t num_vertices = 0, num_triangles = 0;
@@ -124,7 +124,8 @@ Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
   m.k_bin_count = ClKernel(m.program, "bin_count");
   m.k_bin_fill = ClKernel(m.program, "bin_fill");
   m.k_fine = ClKernel(m.program, "fine_raster");
-  m.k_encode = ClKernel(m.program, "encode_display");
+  m.k_encode = ClKernel(m.program, "encode_nearest");
+  m.k_encode_bilinear = ClKernel(m.program, "encode_bilinear");
   m.params_buf = runtime.buffer(sizeof(PmrParams), "frame parameters", CL_MEM_READ_ONLY);
   m.encode_buf = runtime.buffer(sizeof(PmrEncodeParams), "encoder parameters", CL_MEM_READ_ONLY);
   m.mta_counter = runtime.buffer(sizeof(uint32_t), "MTA counter");
@@ -340,13 +341,14 @@ void Pipeline::Impl::fine_stage(const PmrParams& P, const int tile[3], Events& e
 
 void Pipeline::Impl::encode_stage(Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
-  k_encode.arg(0, encode_buf);
-  k_encode.arg(1, encode_columns);
-  k_encode.arg(2, encode_rows);
-  k_encode.arg(3, volume);
-  k_encode.arg(4, display);
+  ClKernel& k = encode_params.bilinear ? k_encode_bilinear : k_encode;
+  k.arg(0, encode_buf);
+  k.arg(1, encode_columns);
+  k.arg(2, encode_rows);
+  k.arg(3, volume);
+  k.arg(4, display);
   const size_t runs = (size_t(encode_params.display_w) + kEncodeRun - 1) / kEncodeRun;
-  ev.add(kEncode, rt.launch_2d(k_encode, runs, size_t(encode_params.display_h), 8, 1));
+  ev.add(kEncode, rt.launch_2d(k, runs, size_t(encode_params.display_h), 8, 1));
 }
 
 StageTimes Pipeline::render(const Rig& rig) {

@@ -1,0 +1,61 @@
+// `pmr bench` at a tiny configuration: the CSV has the documented columns, one row per point, and the
+// methods' images agree; the synthetic scene has about the requested triangle count.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "test_util.h"
+
+namespace pmr {
+namespace {
+
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> out;
+  std::stringstream ss(line);
+  std::string f;
+  while (std::getline(ss, f, ',')) out.push_back(f);
+  return out;
+}
+
+TEST(Bench, WritesCsvWithOneRowPerPoint) {
+  const std::string csv = ::testing::TempDir() + "pmr_bench_test.csv";
+  const std::string cmd = std::string(PMR_BINARY) +
+                          " bench --synthetic 2000 --views 1,3,8 --method pmr,multipass,duplicate --frames 1"
+                          " --view-size 64x32 --display 320x180 --csv " + csv + " > /dev/null 2>&1";
+  const int st = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << cmd;
+  std::ifstream in(csv);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header.rfind("scene,method,views,view_w,view_h,display_w,display_h,triangles,frames,ms_median,ms_min,"
+                         "ms_setup,ms_tile,ms_fine,ms_encode,mvoxels_per_s,peak_mem_mb", 0),
+            0u)
+      << header;
+  const auto cols = split_csv(header);
+  std::string line;
+  int rows = 0;
+  while (std::getline(in, line)) {
+    const auto f = split_csv(line);
+    ASSERT_EQ(f.size(), cols.size()) << line;
+    EXPECT_GT(std::stod(f[9]), 0.0) << "ms_median";
+    EXPECT_LE(std::stod(f[10]), std::stod(f[9])) << "ms_min <= ms_median";
+    EXPECT_LT(std::stod(f.back()), 0.001) << "coverage mismatch between methods: " << line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 9);
+}
+
+TEST(Bench, SyntheticSceneHasAboutTheRequestedTriangles) {
+  for (size_t n : {1000u, 100000u}) {
+    const Scene s = make_synthetic_scene(n);
+    EXPECT_NEAR(double(s.triangles.size()), double(n), 0.02 * n + 200);
+    glm::dvec3 lo, hi;
+    scene_bounds(s, lo, hi);
+    EXPECT_GT(hi.z - lo.z, 2.5) << "spread through the depth range";
+  }
+}
+
+}  // namespace
+}  // namespace pmr

@@ -86,13 +86,16 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
     }
   }
 
+  /* frame constants in registers: stores through the output pointers could alias P */
+  const bool debug = P->debug_outputs != 0;
+  const size_t W = (size_t)P->view_w, H = (size_t)P->view_h, view_base = (size_t)P->view_base;
+  const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
   for (int lv = 0; lv < nv; ++lv)
     for (int ly = 0; ly < ny; ++ly)
       for (int lx = 0; lx < nx; ++lx) {
         const int k = (lv * PMR_TILE_Y + ly) * PMR_TILE_X + lx;
         const int view = v0 + lv, px = x0 + lx, py = y0 + ly;
-        const size_t voxel =
-            ((size_t)(view + (int)P->view_base) * (size_t)P->view_h + (size_t)py) * (size_t)P->view_w + (size_t)px;
+        const size_t voxel = (((size_t)view + view_base) * H + (size_t)py) * W + (size_t)px;
         if (best_key[k] != PMR_NO_KEY) {
           const PmrMta m = mtas[best_mta[k]];
           /* the winner's edge functions at this voxel, for its barycentrics */
@@ -100,11 +103,11 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
           e[0] = m.sign * mta_edge(&m, 1, 2, (long)px * PMR_X_ONE + PMR_HALF_X, (long)py * PMR_Y_ONE + PMR_HALF_Y, view);
           e[1] = m.sign * mta_edge(&m, 2, 0, (long)px * PMR_X_ONE + PMR_HALF_X, (long)py * PMR_Y_ONE + PMR_HALF_Y, view);
           e[2] = m.sign * mta_edge(&m, 0, 1, (long)px * PMR_X_ONE + PMR_HALF_X, (long)py * PMR_Y_ONE + PMR_HALF_Y, view);
-          vstore_half4(shade(&in, P, m.tri, source_barycentrics(&m, e), (m.flags & PMR_MTA_BACK) != 0), voxel, volume);
+          vstore_half4(shade(&in, light, m.tri, source_barycentrics(&m, e), (m.flags & PMR_MTA_BACK) != 0), voxel, volume);
         } else {
           vstore4((ushort4)(0), voxel, (global ushort*)volume); /* background */
         }
-        if (P->debug_outputs) {
+        if (debug) {
           debug_key[voxel] = best_key[k];
           debug_depth[voxel] = best_depth[k];
           debug_count[voxel] = covered[k];

@@ -77,7 +77,7 @@ inline float4 base_color(const ShadeInputs* in, uint tri, float3 b) {
 }
 
 /* Lit colour; alpha is coverage (1). */
-inline float4 shade(const ShadeInputs* in, global const PmrParams* P, uint tri, float3 b, bool back) {
+inline float4 shade(const ShadeInputs* in, float3 light, uint tri, float3 b, bool back) {
   const PmrTriangle t = in->tris[tri];
   float3 n;
   if (t.has_normals) {
@@ -89,8 +89,7 @@ inline float4 shade(const ShadeInputs* in, global const PmrParams* P, uint tri, 
     n = vload3(0, t.face_normal);
   }
   if (back) n = -n;
-  const float3 l = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
-  const float lambert = 0.2f + 0.8f * max(0.0f, dot(n, l));
+  const float lambert = 0.2f + 0.8f * max(0.0f, dot(n, light));
   const float4 c = base_color(in, tri, b);
   return (float4)(c.x * lambert, c.y * lambert, c.z * lambert, 1.0f);
 }

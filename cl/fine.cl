@@ -45,7 +45,12 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
     const long bias[3] = {mta_edge_bias(&m, 1, 2), mta_edge_bias(&m, 2, 0), mta_edge_bias(&m, 0, 1)};
     const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
     const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
+    /* the tile's pixel-center box, to skip views in which the (sheared) prism misses the tile */
+    const long tile_x_lo = X0, tile_x_hi = X0 + (long)(nx - 1) * PMR_X_ONE;
     for (int i = i_lo; i <= i_hi; ++i) {
+      const long xa = (long)m.x0[0] + (long)i * m.dx[0], xb = (long)m.x0[1] + (long)i * m.dx[1];
+      const long xc = (long)m.x0[2] + (long)i * m.dx[2];
+      if (max(xa, max(xb, xc)) < tile_x_lo || min(xa, min(xb, xc)) > tile_x_hi) continue;
       long row[3], step_x[3], step_y[3];
       for (int e = 0; e < 3; ++e) {
         const int a = ea[e], b = eb[e];

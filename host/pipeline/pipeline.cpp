@@ -79,8 +79,8 @@ struct Pipeline::Impl {
   void vertex_stage(const PmrParams& P, Events& ev);
   void select_view_stage(const PmrParams& P, int view, Events& ev);
   void setup_stage(PmrParams& P, Events& ev, StageTimes& t);
-  void bin_stage(const PmrParams& P, Events& ev, StageTimes& t);
-  void fine_stage(const PmrParams& P, const int tile[3], Events& ev);
+  void bin_stage(Events& ev, StageTimes& t);
+  void fine_stage(Events& ev);
   void encode_stage(Events& ev);
   ~Impl() {
     if (program) clReleaseProgram(program);
@@ -291,8 +291,7 @@ void Pipeline::Impl::setup_stage(PmrParams& P, Events& ev, StageTimes& t) {
 }
 
 // Tile raster: count entries per tile, exclusive scan on the host (sizes the queue), fill.
-void Pipeline::Impl::bin_stage(const PmrParams& P, Events& ev, StageTimes& t) {
-  (void)P;
+void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
   k_bin_count.arg(0, params_buf);
   k_bin_count.arg(1, mtas);
   k_bin_count.arg(2, last_mtas);
@@ -327,13 +326,11 @@ void Pipeline::Impl::bin_stage(const PmrParams& P, Events& ev, StageTimes& t) {
   ev.add(kBin, rt.launch(k_bin_fill, last_mtas, 0));
 }
 
-void Pipeline::Impl::fine_stage(const PmrParams& P, const int tile[3], Events& ev) {
+void Pipeline::Impl::fine_stage(Events& ev) {
   cl_uint a = 0;
   for (const ClBuffer* b : {&params_buf, &mtas, &tile_offsets, &tile_queue, &tris, &attrs, &materials, &textures,
                             &texels, &lut, &volume, &dbg_key, &dbg_depth, &dbg_count})
     k_fine.arg(a++, *b);
-  (void)P;
-  (void)tile;
   // one work-item per tile; small work-groups keep the two cores balanced
   const size_t group = 8;
   ev.add(kFine, rt.launch(k_fine, (size_t(num_tiles) + group - 1) / group * group, group));
@@ -372,8 +369,8 @@ StageTimes Pipeline::render(const Rig& rig) {
   if (config_.method != Method::Multipass) {
     m.vertex_stage(P, ev);
     m.setup_stage(P, ev, times);
-    m.bin_stage(P, ev, times);
-    m.fine_stage(P, tile_, ev);
+    m.bin_stage(ev, times);
+    m.fine_stage(ev);
   } else {
     if (config_.multipass_snapped) {  // test mode: PMR's vertex records, computed once
       m.vertex_stage(P, ev);
@@ -395,8 +392,8 @@ StageTimes Pipeline::render(const Rig& rig) {
       else
         m.vertex_stage(Q, ev);
       m.setup_stage(Q, ev, times);
-      m.bin_stage(Q, ev, times);
-      m.fine_stage(Q, tile_, ev);
+      m.bin_stage(ev, times);
+      m.fine_stage(ev);
     }
     if (config_.multipass_snapped) std::swap(m.vertices, m.pmr_vertices);
   }

@@ -284,18 +284,6 @@ cl_event ClRuntime::launch_2d(const ClKernel& k, size_t gx, size_t gy, size_t lx
   return e;
 }
 
-cl_event ClRuntime::launch_3d(const ClKernel& k, const size_t global[3], const size_t local[3]) const {
-  cl_event e = nullptr;
-  if (global[0] * global[1] * global[2] == 0) {
-    cl_check(clEnqueueMarkerWithWaitList(queue_, 0, nullptr, &e), "clEnqueueMarkerWithWaitList");
-    return e;
-  }
-  cl_check(clEnqueueNDRangeKernel(queue_, k.get(), 3, nullptr, global, local, 0, nullptr, &e),
-           "launching kernel " + k.name() + " (3D " + std::to_string(global[0]) + "x" + std::to_string(global[1]) + "x" +
-               std::to_string(global[2]) + ")");
-  return e;
-}
-
 void ClRuntime::finish() const { cl_check(clFinish(queue_), "clFinish"); }
 
 double event_ms(cl_event e) { return event_span_ms(e, e); }

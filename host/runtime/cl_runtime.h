@@ -86,8 +86,6 @@ class ClRuntime {
   cl_event launch(const ClKernel& k, size_t global, size_t local) const;
   // 2D launch; the global size is rounded up to a multiple of the local size.
   cl_event launch_2d(const ClKernel& k, size_t gx, size_t gy, size_t lx, size_t ly) const;
-  // 3D launch with exact global sizes (multiples of the local sizes).
-  cl_event launch_3d(const ClKernel& k, const size_t global[3], const size_t local[3]) const;
   void finish() const;
 
  private:

@@ -13,11 +13,7 @@ const ClRuntime& runtime() {
 
 Scene empty_scene(bool double_sided) {
   Scene s;
-  PmrMaterial m{};
-  for (int c = 0; c < 4; ++c) m.base_color[c] = 1.0f;
-  m.texture = -1;
-  m.alpha_mode = PMR_ALPHA_OPAQUE;
-  m.alpha_cutoff = 0.5f;
+  PmrMaterial m = default_material();
   m.double_sided = double_sided ? 1u : 0u;
   s.materials.push_back(m);
   return s;

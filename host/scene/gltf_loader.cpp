@@ -285,15 +285,6 @@ int scene_texture(Loader& L, int texture) {
   return result = int(L.scene.textures.size() - 1);
 }
 
-PmrMaterial default_material() {
-  PmrMaterial m{};
-  for (float& c : m.base_color) c = 1.0f;
-  m.texture = -1;
-  m.alpha_mode = PMR_ALPHA_OPAQUE;
-  m.alpha_cutoff = 0.5f;
-  m.double_sided = 0;
-  return m;
-}
 
 // Scene::materials[0] is the default material; glTF material i is Scene::materials[i + 1].
 void build_materials(Loader& L) {
@@ -656,20 +647,5 @@ Scene load_scene(const std::string& path) {
   return scene;
 }
 
-void scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi) {
-  lo = glm::dvec3(std::numeric_limits<double>::infinity());
-  hi = -lo;
-  bool any = false;
-  for (const PmrTriangle& t : scene.triangles) {
-    for (uint32_t v : t.v) {
-      if (v >= scene.positions.size()) throw Error("scene_bounds: triangle vertex index out of range");
-      const glm::dvec3 p(scene.positions[v]);
-      lo = glm::min(lo, p);
-      hi = glm::max(hi, p);
-      any = true;
-    }
-  }
-  if (!any) throw Error("scene_bounds: the scene has no triangles");
-}
 
 }  // namespace pmr

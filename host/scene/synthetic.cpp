@@ -13,12 +13,7 @@ Scene make_synthetic_scene(size_t triangles, uint32_t seed) {
   const size_t per_sphere = size_t(2 * slices * (stacks - 1));
   const size_t spheres = std::max<size_t>(1, (triangles + per_sphere / 2) / per_sphere);
   Scene s;
-  PmrMaterial m{};
-  for (int c = 0; c < 4; ++c) m.base_color[c] = 1.0f;
-  m.texture = -1;
-  m.alpha_mode = PMR_ALPHA_OPAQUE;
-  m.alpha_cutoff = 0.5f;
-  s.materials.push_back(m);
+  s.materials.push_back(default_material());
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   // radius shrinks with the count so that the spheres keep a similar total screen coverage

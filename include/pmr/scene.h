@@ -51,6 +51,9 @@ void scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi);
 }  // namespace pmr
 
 namespace pmr {
+// The glTF default material: white, opaque, single-sided (used when a primitive has none).
+PmrMaterial default_material();
+
 // A procedural scene of about `triangles` triangles (1k to 1M): UV spheres of ~200 triangles with
 // random sizes and colours spread through a 4 x 2 x 3 box, so they cover the whole depth range in
 // front of and behind the focal plane. Deterministic for a given seed. For performance sweeps.

@@ -21,9 +21,6 @@ inline float4 sample_bilinear(global const PmrEncodeParams* E, global const half
   return top + (bottom - top) * ay;
 }
 
-/* Display pixels per work-item: amortizes the per-work-item cost of the device. */
-#define PMR_ENCODE_RUN 16
-
 /* The view index of subpixel k of pixel j in a row (see PmrEncodeColumn). */
 inline int encode_view(global const PmrEncodeParams* E, const PmrEncodeColumn* col, const PmrEncodeRow* row) {
   int v = col->a_mod_n - row->q_mod_n - (col->b < row->s ? 1 : 0);

@@ -10,9 +10,6 @@ namespace pmr {
 
 namespace {
 
-// Display pixels per encode work-item (PMR_ENCODE_RUN in cl/encode.cl).
-constexpr size_t kEncodeRun = 16;
-
 enum Stage { kVertex, kSetup, kBin, kFine, kEncode, kStages };
 
 // RAII for the profiling events of one frame, each tagged with its stage.
@@ -60,7 +57,6 @@ struct Pipeline::Impl {
   ClBuffer positions, attrs, tris, materials, textures, texels, lut;
   // frame
   PmrParams params{};
-  Rig rig;
   PmrEncodeParams encode_params{};
   bool encode = false;
   ClBuffer params_buf, encode_buf, vertices, pmr_vertices, mtas, mta_counter;
@@ -196,7 +192,6 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   Impl& m = *impl_;
   const ClRuntime& rt = m.rt;
   m.params = make_params(rig);
-  m.rig = rig;
   tiles_x_ = (rig.view_w + tile_[0] - 1) / tile_[0];
   tiles_y_ = (rig.view_h + tile_[1] - 1) / tile_[1];
   // multipass rasterizes one view per pass, so its tile grid is one view deep
@@ -248,18 +243,13 @@ void Pipeline::set_mta_capacity(uint32_t capacity) {
 
 void Pipeline::Impl::vertex_stage(const PmrParams& P, Events& ev) {
   rt.write(params_buf, &P, sizeof P);
-  k_vertex.arg(0, params_buf);
-  k_vertex.arg(1, positions);
-  k_vertex.arg(2, vertices);
+  k_vertex.args(params_buf, positions, vertices);
   ev.add(kVertex, rt.launch(k_vertex, num_vertices, 0));
 }
 
 void Pipeline::Impl::select_view_stage(const PmrParams& P, int view, Events& ev) {
   rt.write(params_buf, &P, sizeof P);
-  k_vertex_select.arg(0, params_buf);
-  k_vertex_select.arg(1, pmr_vertices);
-  k_vertex_select.arg(2, view);
-  k_vertex_select.arg(3, vertices);
+  k_vertex_select.args(params_buf, pmr_vertices, view, vertices);
   ev.add(kVertex, rt.launch(k_vertex_select, num_vertices, 0));
 }
 
@@ -271,12 +261,7 @@ void Pipeline::Impl::setup_stage(PmrParams& P, Events& ev, StageTimes& t) {
     rt.write(params_buf, &P, sizeof P);
     const uint32_t zero = 0;
     rt.write(mta_counter, &zero, sizeof zero);
-    k_setup.arg(0, params_buf);
-    k_setup.arg(1, tris);
-    k_setup.arg(2, vertices);
-    k_setup.arg(3, materials);
-    k_setup.arg(4, mtas);
-    k_setup.arg(5, mta_counter);
+    k_setup.args(params_buf, tris, vertices, materials, mtas, mta_counter);
     ev.add(kSetup, rt.launch(k_setup, num_triangles, 0));
     rt.read(mta_counter, &last_mtas, sizeof last_mtas);
     if (last_mtas <= mta_capacity) break;
@@ -292,10 +277,7 @@ void Pipeline::Impl::setup_stage(PmrParams& P, Events& ev, StageTimes& t) {
 
 // Tile raster: count entries per tile, exclusive scan on the host (sizes the queue), fill.
 void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
-  k_bin_count.arg(0, params_buf);
-  k_bin_count.arg(1, mtas);
-  k_bin_count.arg(2, last_mtas);
-  k_bin_count.arg(3, tile_counts);
+  k_bin_count.args(params_buf, mtas, last_mtas, tile_counts);
   ev.add(kBin, rt.launch(k_bin_count, last_mtas, 0));
   std::vector<uint32_t> counts(num_tiles + 1);
   rt.read(tile_counts, counts.data(), size_t(num_tiles) * 4);
@@ -317,20 +299,13 @@ void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
     tile_queue_capacity = grown;
   }
   t.bin_entries += total;
-  k_bin_fill.arg(0, params_buf);
-  k_bin_fill.arg(1, mtas);
-  k_bin_fill.arg(2, last_mtas);
-  k_bin_fill.arg(3, tile_counts);
-  k_bin_fill.arg(4, tile_offsets);
-  k_bin_fill.arg(5, tile_queue);
+  k_bin_fill.args(params_buf, mtas, last_mtas, tile_counts, tile_offsets, tile_queue);
   ev.add(kBin, rt.launch(k_bin_fill, last_mtas, 0));
 }
 
 void Pipeline::Impl::fine_stage(Events& ev) {
-  cl_uint a = 0;
-  for (const ClBuffer* b : {&params_buf, &mtas, &tile_offsets, &tile_queue, &tris, &attrs, &materials, &textures,
-                            &texels, &lut, &volume, &dbg_key, &dbg_depth, &dbg_count})
-    k_fine.arg(a++, *b);
+  k_fine.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, volume,
+              dbg_key, dbg_depth, dbg_count);
   // one work-item per tile; small work-groups keep the two cores balanced
   const size_t group = 8;
   ev.add(kFine, rt.launch(k_fine, (size_t(num_tiles) + group - 1) / group * group, group));
@@ -339,12 +314,8 @@ void Pipeline::Impl::fine_stage(Events& ev) {
 void Pipeline::Impl::encode_stage(Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
   ClKernel& k = encode_params.bilinear ? k_encode_bilinear : k_encode;
-  k.arg(0, encode_buf);
-  k.arg(1, encode_columns);
-  k.arg(2, encode_rows);
-  k.arg(3, volume);
-  k.arg(4, display);
-  const size_t runs = (size_t(encode_params.display_w) + kEncodeRun - 1) / kEncodeRun;
+  k.args(encode_buf, encode_columns, encode_rows, volume, display);
+  const size_t runs = (size_t(encode_params.display_w) + PMR_ENCODE_RUN - 1) / PMR_ENCODE_RUN;
   ev.add(kEncode, rt.launch_2d(k, runs, size_t(encode_params.display_h), 8, 1));
 }
 

@@ -49,6 +49,12 @@ class ClKernel {
   template <typename T>
   void arg(cl_uint index, const T& value) { set(index, sizeof(T), &value); }
   void arg(cl_uint index, const ClBuffer& b) { cl_mem m = b.get(); set(index, sizeof(cl_mem), &m); }
+  // Sets arguments 0, 1, 2, ... in order.
+  template <typename... Args>
+  void args(const Args&... values) {
+    cl_uint index = 0;
+    (arg(index++, values), ...);
+  }
 
  private:
   void set(cl_uint index, size_t size, const void* value);

@@ -58,6 +58,9 @@ typedef int64_t pmr_i64;
 #define PMR_CULL_NEAR   (1u << 12)  /* same as PMR_CLIP_NEAR, kept in the cull set */
 #define PMR_CULL_FAR    (1u << 13)
 
+/* Display pixels one encoder work-item handles (amortizes the device's per-work-item cost). */
+#define PMR_ENCODE_RUN 16
+
 /* Material alpha modes (glTF). */
 #define PMR_ALPHA_OPAQUE 0
 #define PMR_ALPHA_MASK 1

@@ -95,4 +95,40 @@ inline long mta_edge_bias(const PmrMta* m, int a, int b) {
   return (dy > 0 || (dy == 0 && dx < 0)) ? 0 : 1;
 }
 
+/* Depth plane of an MTA in view i. Depth is linear in screen space (DESIGN section 3); it is
+ * evaluated per voxel as a plane anchored at vertex 0's pixel (pr, qr), so that a row of voxels costs
+ * one float multiply-add per voxel and the value depends on the MTA, the view and the voxel alone
+ * (never on the tile that computes it):
+ *   depth(px, py) = (float)(zr + gy * (double)(py - qr)) + gx * (float)(px - pr)
+ * The gradients come from the exact integer vertex positions of view i (twice the signed area A is
+ * non-zero in every view of an MTA). The C++ reference (tests/reference) evaluates the same
+ * expression in the same order. */
+typedef struct {
+  double zr;  /* depth at the center of pixel (pr, qr) */
+  double gy;  /* depth per pixel row */
+  float gx;   /* depth per pixel column */
+  int pr, qr; /* vertex 0's pixel */
+} DepthPlane;
+
+inline DepthPlane depth_plane(const PmrMta* m, int i) {
+  const long x0 = (long)m->x0[0] + (long)i * m->dx[0];
+  const long x1 = (long)m->x0[1] + (long)i * m->dx[1];
+  const long x2 = (long)m->x0[2] + (long)i * m->dx[2];
+  const long y0 = m->y[0], y1 = m->y[1], y2 = m->y[2];
+  const long area = (y1 - y0) * (x2 - x0) - (x1 - x0) * (y2 - y0);
+  const double inv = 1.0 / (double)area;
+  const double dz1 = (double)m->z[1] - (double)m->z[0], dz2 = (double)m->z[2] - (double)m->z[0];
+  const double gx = (dz1 * (double)(y0 - y2) + dz2 * (double)(y1 - y0)) * (double)PMR_X_ONE * inv;
+  const double gy = (dz1 * (double)(x2 - x0) - dz2 * (double)(x1 - x0)) * (double)PMR_Y_ONE * inv;
+  DepthPlane d;
+  d.pr = (int)(x0 >> PMR_X_FRAC_BITS); /* arithmetic shifts: floor division */
+  d.qr = (int)(y0 >> PMR_Y_FRAC_BITS);
+  const double ox = (double)((long)d.pr * PMR_X_ONE + PMR_HALF_X - x0) / (double)PMR_X_ONE;
+  const double oy = (double)((long)d.qr * PMR_Y_ONE + PMR_HALF_Y - y0) / (double)PMR_Y_ONE;
+  d.zr = (double)m->z[0] + gx * ox + gy * oy;
+  d.gy = gy;
+  d.gx = (float)gx;
+  return d;
+}
+
 #endif

@@ -109,9 +109,11 @@ Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
     throw Error("invalid --tile " + std::to_string(tx) + "x" + std::to_string(ty) + "x" + std::to_string(tv) +
                 ": " + std::to_string(tx * ty * tv) + " voxels exceed the device's work-group limit of " +
                 std::to_string(runtime.max_work_group_size()));
+  // fine raster vectors: the smallest of 4, 8, 16 lanes that holds a tile row (wider rows take several)
+  const int lanes = tx <= 4 ? 4 : (tx <= 8 ? 8 : 16);
   const std::string options = "-cl-std=CL1.2 -cl-fp32-correctly-rounded-divide-sqrt -DPMR_TILE_X=" +
                               std::to_string(tx) + " -DPMR_TILE_Y=" + std::to_string(ty) +
-                              " -DPMR_TILE_V=" + std::to_string(tv);
+                              " -DPMR_TILE_V=" + std::to_string(tv) + " -DPMR_VW=" + std::to_string(lanes);
   Impl& m = *impl_;
   m.program = runtime.build_program({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl"}, options);
   m.k_vertex = ClKernel(m.program, "vertex_transform");

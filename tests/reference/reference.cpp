@@ -70,6 +70,23 @@ double plane_value(const PmrParams& P, int k, const double* p) {
   }
 }
 
+// Depth of a triangle at pixel (px, py) of a view, given the view's snapped vertex positions: the
+// plane anchored at vertex 0's pixel, evaluated exactly as cl/common.h's depth_plane and the fine
+// raster do (same operations, same order, no contraction).
+float depth_at(const int64_t* x, const int64_t* y, const ClippedTriangle& c, int64_t px, int64_t py) {
+  const int64_t area = (y[1] - y[0]) * (x[2] - x[0]) - (x[1] - x[0]) * (y[2] - y[0]);
+  const double inv = 1.0 / double(area);
+  const double dz1 = double(c.v[1].z) - double(c.v[0].z), dz2 = double(c.v[2].z) - double(c.v[0].z);
+  const double gx = (dz1 * double(y[0] - y[2]) + dz2 * double(y[1] - y[0])) * double(PMR_X_ONE) * inv;
+  const double gy = (dz1 * double(x[2] - x[0]) - dz2 * double(x[1] - x[0])) * double(PMR_Y_ONE) * inv;
+  const int64_t pr = x[0] >> PMR_X_FRAC_BITS, qr = y[0] >> PMR_Y_FRAC_BITS;
+  const double ox = double(pr * PMR_X_ONE + PMR_X_ONE / 2 - x[0]) / double(PMR_X_ONE);
+  const double oy = double(qr * PMR_Y_ONE + PMR_Y_ONE / 2 - y[0]) / double(PMR_Y_ONE);
+  const double zr = double(c.v[0].z) + gx * ox + gy * oy;
+  const float zrow = float(zr + gy * double(int32_t(py - qr)));
+  return zrow + float(gx) * float(int32_t(px - pr));
+}
+
 struct CV {
   double p[3], b[2];
   int src;
@@ -230,8 +247,7 @@ RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& t
           if (!inside) continue;
           const size_t vox = (i * H + py) * W + px;
           ++r.count[vox];
-          const float depth = (float(e[0]) * c.v[0].z + float(e[1]) * c.v[1].z + float(e[2]) * c.v[2].z) /
-                              float(e[0] + e[1] + e[2]);
+          const float depth = depth_at(x, y, c, int64_t(px), int64_t(py));
           if (depth < r.depth[vox] || (depth == r.depth[vox] && c.key < r.key[vox])) {
             r.depth[vox] = depth;
             r.key[vox] = c.key;

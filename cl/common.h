@@ -131,4 +131,25 @@ inline DepthPlane depth_plane(const PmrMta* m, int i) {
   return d;
 }
 
+/* The view shown by a display subpixel (DESIGN section 5), exact and division-free from the
+ * per-column and per-row encoder tables (see PmrEncodeColumn). */
+inline int encode_view(int views, int reversed, const PmrEncodeColumn* col, const PmrEncodeRow* row) {
+  int v = col->a_mod_n - row->q_mod_n - (col->b < row->s ? 1 : 0);
+  v = v < 0 ? v + views : v;
+  return reversed ? views - 1 - v : v;
+}
+
+/* A display pixel from the half-RGBA bits of the view pixels its three subpixels sample: channel k
+ * from subpixel k, alpha the mean coverage (the mean of three equal halves is that half exactly, the
+ * common case). */
+inline ushort4 encode_pixel(ushort4 s0, ushort4 s1, ushort4 s2) {
+  ushort alpha = s0.w;
+  if (s1.w != s0.w || s2.w != s0.w) {
+    const ushort a[3] = {s0.w, s1.w, s2.w};
+    const float mean = (vload_half(0, (const half*)a) + vload_half(1, (const half*)a) + vload_half(2, (const half*)a)) / 3.0f;
+    vstore_half(mean, 0, (half*)&alpha);
+  }
+  return (ushort4)(s0.x, s1.y, s2.z, alpha);
+}
+
 #endif

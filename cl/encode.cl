@@ -21,13 +21,6 @@ inline float4 sample_bilinear(global const PmrEncodeParams* E, global const half
   return top + (bottom - top) * ay;
 }
 
-/* The view index of subpixel k of pixel j in a row (see PmrEncodeColumn). */
-inline int encode_view(global const PmrEncodeParams* E, const PmrEncodeColumn* col, const PmrEncodeRow* row) {
-  int v = col->a_mod_n - row->q_mod_n - (col->b < row->s ? 1 : 0);
-  v = v < 0 ? v + E->views : v;
-  return E->reversed ? E->views - 1 - v : v;
-}
-
 /* Nearest sampling copies the colour's half bits: PoCL converts halves in software, and the
  * conversions would dominate the stage. Separate kernels for nearest and bilinear sampling, because
  * a branch between them would be flattened when the kernel is vectorized across work-items. */
@@ -44,17 +37,10 @@ kernel void encode_nearest(global const PmrEncodeParams* E, global const PmrEnco
     /* the three subpixels unrolled into scalars: small private arrays written by element and read
      * back as a vector stall the CPU's store forwarding, which cost more than all the rest */
     const PmrEncodeColumn c0 = columns[3 * j], c1 = columns[3 * j + 1], c2 = columns[3 * j + 2];
-    const ushort4 s0 = vload4((size_t)encode_view(E, &c0, &row) * plane + row_off + (size_t)c0.px, bits);
-    const ushort4 s1 = vload4((size_t)encode_view(E, &c1, &row) * plane + row_off + (size_t)c1.px, bits);
-    const ushort4 s2 = vload4((size_t)encode_view(E, &c2, &row) * plane + row_off + (size_t)c2.px, bits);
-    /* alpha = mean coverage; the mean of three equal halves is that half exactly, the common case */
-    ushort alpha = s0.w;
-    if (s1.w != s0.w || s2.w != s0.w) {
-      const ushort a[3] = {s0.w, s1.w, s2.w};
-      const float mean = (vload_half(0, (const half*)a) + vload_half(1, (const half*)a) + vload_half(2, (const half*)a)) / 3.0f;
-      vstore_half(mean, 0, (half*)&alpha);
-    }
-    vstore4((ushort4)(s0.x, s1.y, s2.z, alpha), (size_t)i * E->display_w + j, (global ushort*)display);
+    const ushort4 s0 = vload4((size_t)encode_view(E->views, E->reversed, &c0, &row) * plane + row_off + (size_t)c0.px, bits);
+    const ushort4 s1 = vload4((size_t)encode_view(E->views, E->reversed, &c1, &row) * plane + row_off + (size_t)c1.px, bits);
+    const ushort4 s2 = vload4((size_t)encode_view(E->views, E->reversed, &c2, &row) * plane + row_off + (size_t)c2.px, bits);
+    vstore4(encode_pixel(s0, s1, s2), (size_t)i * E->display_w + j, (global ushort*)display);
   }
 }
 
@@ -69,7 +55,7 @@ kernel void encode_bilinear(global const PmrEncodeParams* E, global const PmrEnc
     float rgb[3], alpha = 0.0f;
     for (int k = 0; k < 3; ++k) {
       const PmrEncodeColumn col = columns[3 * j + k];
-      const float4 c = sample_bilinear(E, volume, encode_view(E, &col, &row),
+      const float4 c = sample_bilinear(E, volume, encode_view(E->views, E->reversed, &col, &row),
                                        ((float)j + ((float)k + 0.5f) / 3.0f) / (float)E->display_w, t);
       rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
       alpha += c.w;

@@ -118,7 +118,7 @@ double copy_bandwidth(const ClRuntime& rt) {
   return best;
 }
 
-// Fraction of voxels whose coverage (alpha != 0) differs between two volumes.
+// Fraction of display pixels whose coverage (alpha != 0) differs between two encoded images.
 double coverage_mismatch(const std::vector<uint16_t>& a, const std::vector<uint16_t>& b) {
   if (a.size() != b.size() || a.empty()) return 1.0;
   size_t diff = 0;
@@ -203,6 +203,7 @@ int run_bench(const std::vector<std::string>& args) {
       PipelineConfig pc;
       pc.method = method;
       pc.tile_x = o.tile[0], pc.tile_y = o.tile[1], pc.tile_v = o.tile[2];
+      pc.fuse_encode = true;  // the encoded-only job, as pmr render runs it
       Pipeline p(rt, pc);
       p.set_scene(scene);
       p.configure(rig, &display);
@@ -218,12 +219,12 @@ int run_bench(const std::vector<std::string>& args) {
       }
       double mismatch = 0.0;
       if (o.check) {
-        std::vector<uint16_t> volume;
-        p.read_volume(volume);
-        if (reference.empty()) reference.swap(volume);
-        else mismatch = coverage_mismatch(reference, volume);
+        std::vector<uint16_t> image;
+        p.read_display(image);
+        if (reference.empty()) reference.swap(image);
+        else mismatch = coverage_mismatch(reference, image);
         if (mismatch > 0.001)
-          std::fprintf(stderr, "pmr: warning: %s at N = %d differs from %s on %.3f%% of voxels\n", to_string(method), N,
+          std::fprintf(stderr, "pmr: warning: %s at N = %d differs from %s on %.3f%% of display pixels\n", to_string(method), N,
                        to_string(o.methods[0]), 100.0 * mismatch);
       }
       const double med = median(wall), mn = *std::min_element(wall.begin(), wall.end());

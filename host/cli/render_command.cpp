@@ -93,7 +93,9 @@ int run_render(const std::vector<std::string>& args) {
                scene.triangles.size(), rig.views, rig.view_w, rig.view_h, o.display.width, o.display.height);
   ClRuntime runtime;
   const auto t_build = std::chrono::steady_clock::now();
-  Pipeline pipeline(runtime, o.pipeline);
+  PipelineConfig pc = o.pipeline;
+  pc.fuse_encode = !o.write_views;  // the volume is only kept when the views are written
+  Pipeline pipeline(runtime, pc);
   if (o.verbose)
     std::fprintf(stderr, "pmr: device %s; kernels built in %.2f s\n", runtime.device_name().c_str(), seconds_since(t_build));
   pipeline.set_scene(scene);

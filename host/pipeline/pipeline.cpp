@@ -12,6 +12,10 @@ namespace {
 
 enum Stage { kVertex, kSetup, kBin, kFine, kEncode, kStages };
 
+// Private memory one fused work-item may use for its visibility state and colours (20 bytes per
+// voxel of a screen tile over all views); larger configurations use the unfused path.
+constexpr size_t kFusedPrivateBudget = size_t(256) << 10;
+
 // RAII for the profiling events of one frame, each tagged with its stage.
 struct Events {
   std::vector<std::pair<Stage, cl_event>> all;
@@ -66,6 +70,13 @@ struct Pipeline::Impl {
   size_t tile_queue_capacity = 0;
   ClBuffer volume, display, encode_columns, encode_rows;
   ClBuffer dbg_key, dbg_depth, dbg_count;
+  // fused raster + encode (cl/fine_encode.cl), built per view count
+  cl_program fused_program = nullptr;
+  int fused_views = 0;
+  ClKernel k_fine_encode, k_straddle_alpha;
+  bool fused = false;
+  ClBuffer column_start, row_start, straddle_slot, straddle_columns, straddle_cov;
+  uint32_t straddle_slots = 0;
   uint32_t last_mtas = 0;
   uint64_t num_tiles = 0;
 
@@ -78,8 +89,12 @@ struct Pipeline::Impl {
   void bin_stage(Events& ev, StageTimes& t);
   void fine_stage(Events& ev);
   void encode_stage(Events& ev);
+  void fused_stage(const PmrParams& P, Events& ev);
+  void configure_fused(const std::string& options, int views, int tile_x, const std::vector<PmrEncodeColumn>& columns,
+                       const std::vector<PmrEncodeRow>& rows);
   ~Impl() {
     if (program) clReleaseProgram(program);
+    if (fused_program) clReleaseProgram(fused_program);
   }
 };
 
@@ -115,6 +130,7 @@ Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
                               std::to_string(tx) + " -DPMR_TILE_Y=" + std::to_string(ty) +
                               " -DPMR_TILE_V=" + std::to_string(tv) + " -DPMR_VW=" + std::to_string(lanes);
   Impl& m = *impl_;
+  build_options_ = options;
   m.program = runtime.build_program({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl"}, options);
   m.k_vertex = ClKernel(m.program, "vertex_transform");
   m.k_vertex_select = ClKernel(m.program, "vertex_select_view");
@@ -202,25 +218,29 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   m.num_tiles = uint64_t(tiles_x_) * tiles_y_ * tiles_v_;
   if (m.num_tiles >= (uint64_t(1) << 32)) throw Error("too many tiles; use larger --tile");
   m.encode = display != nullptr;
+  const size_t fused_private = size_t(tile_[0] + 15) / 16 * 16 * tile_[1] * rig.views * 20;
+  m.fused = config_.fuse_encode && display && !display->bilinear && config_.method == Method::Pmr &&
+            !config_.debug_outputs && fused_private <= kFusedPrivateBudget;
   if (display) {
     m.encode_params = make_encode_params(*display, rig.views, rig.view_w, rig.view_h);
     std::vector<PmrEncodeColumn> columns;
     std::vector<PmrEncodeRow> rows;
     make_encode_tables(m.encode_params, columns, rows);
+    if (m.fused) m.configure_fused(build_options_, rig.views, tile_[0], columns, rows);
     m.encode_columns = rt.buffer(bytes_of(columns), "encoder columns", CL_MEM_READ_ONLY);
     rt.write(m.encode_columns, columns.data(), bytes_of(columns));
     m.encode_rows = rt.buffer(bytes_of(rows), "encoder rows", CL_MEM_READ_ONLY);
     rt.write(m.encode_rows, rows.data(), bytes_of(rows));
   }
 
-  const size_t vol = volume_bytes();
+  const size_t vol = m.fused ? 0 : volume_bytes();
   const size_t disp = display_bytes();
   const size_t dbg = config_.debug_outputs ? size_t(rig.views) * rig.view_w * rig.view_h * 12 : 0;
   if (vol + disp + dbg > rt.global_mem_bytes())
     throw Error("the view volume (" + std::to_string(vol >> 20) + " MiB) and display image (" +
                 std::to_string(disp >> 20) + " MiB) do not fit in the device's memory (" +
                 std::to_string(rt.global_mem_bytes() >> 20) + " MiB)");
-  m.volume = rt.buffer(vol, "view volume");
+  m.volume = rt.buffer(std::max<size_t>(vol, 16), "view volume");
   m.display = rt.buffer(std::max<size_t>(disp, 16), "display image");
   m.tile_counts = rt.buffer(size_t(m.num_tiles + 1) * sizeof(uint32_t), "tile counters");
   rt.fill_zero(m.tile_counts);
@@ -321,6 +341,58 @@ void Pipeline::Impl::encode_stage(Events& ev) {
   ev.add(kEncode, rt.launch_2d(k, runs, size_t(encode_params.display_h), 8, 1));
 }
 
+// Tables of the fused path: the first subpixel of every view column and the first display row of every
+// view row (the encoder's maps are monotone), and the display columns whose three subpixels belong to
+// different screen tiles, each with a slot in the coverage buffer their alpha is computed from.
+void Pipeline::Impl::configure_fused(const std::string& options, int views, int tile_x,
+                                     const std::vector<PmrEncodeColumn>& columns, const std::vector<PmrEncodeRow>& rows) {
+  if (fused_views != views) {
+    if (fused_program) clReleaseProgram(fused_program);
+    fused_program = rt.build_program({"fine_encode.cl"}, options + " -DPMR_FUSED_VIEWS=" + std::to_string(views));
+    fused_views = views;
+    k_fine_encode = ClKernel(fused_program, "fine_encode");
+    k_straddle_alpha = ClKernel(fused_program, "encode_straddle_alpha");
+  }
+  const PmrEncodeParams& E = encode_params;
+  std::vector<int32_t> col_start(size_t(E.view_w) + 1), row_first(size_t(E.view_h) + 1);
+  for (int px = 0, s = 0; px <= E.view_w; ++px) {
+    while (s < int(columns.size()) && columns[size_t(s)].px < px) ++s;
+    col_start[size_t(px)] = s;
+  }
+  for (int py = 0, i = 0; py <= E.view_h; ++py) {
+    while (i < int(rows.size()) && rows[size_t(i)].py < py) ++i;
+    row_first[size_t(py)] = i;
+  }
+  std::vector<int32_t> slot(size_t(E.display_w), -1), straddling;
+  for (int j = 0; j < E.display_w; ++j) {
+    if (columns[size_t(3 * j)].px / tile_x == columns[size_t(3 * j + 2)].px / tile_x) continue;
+    slot[size_t(j)] = int32_t(straddling.size());
+    straddling.push_back(j);
+  }
+  straddle_slots = uint32_t(straddling.size());
+  auto upload = [&](ClBuffer& b, const std::vector<int32_t>& v, const char* name) {
+    b = rt.buffer(std::max<size_t>(bytes_of(v), 16), name, CL_MEM_READ_ONLY);
+    rt.write(b, v.data(), bytes_of(v));
+  };
+  upload(column_start, col_start, "fused column starts");
+  upload(row_start, row_first, "fused row starts");
+  upload(straddle_slot, slot, "fused straddle slots");
+  upload(straddle_columns, straddling, "fused straddle columns");
+  straddle_cov = rt.buffer(std::max<size_t>(size_t(straddle_slots) * E.display_h * 3, 16), "fused straddle coverage");
+}
+
+void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
+  rt.write(encode_buf, &encode_params, sizeof encode_params);
+  k_fine_encode.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut,
+                     encode_buf, encode_columns, encode_rows, column_start, row_start, straddle_slot, straddle_slots,
+                     straddle_cov, display);
+  const size_t screen_tiles = size_t(P.tiles_x) * P.tiles_y;
+  ev.add(kFine, rt.launch(k_fine_encode, screen_tiles, 1));
+  if (straddle_slots == 0) return;
+  k_straddle_alpha.args(encode_buf, straddle_columns, straddle_slots, straddle_cov, display);
+  ev.add(kEncode, rt.launch_2d(k_straddle_alpha, straddle_slots, size_t(encode_params.display_h), 1, 8));
+}
+
 StageTimes Pipeline::render(const Rig& rig) {
   Impl& m = *impl_;
   const auto t_start = std::chrono::steady_clock::now();
@@ -343,7 +415,10 @@ StageTimes Pipeline::render(const Rig& rig) {
     m.vertex_stage(P, ev);
     m.setup_stage(P, ev, times);
     m.bin_stage(ev, times);
-    m.fine_stage(ev);
+    if (m.fused)
+      m.fused_stage(P, ev);
+    else
+      m.fine_stage(ev);
   } else {
     if (config_.multipass_snapped) {  // test mode: PMR's vertex records, computed once
       m.vertex_stage(P, ev);
@@ -370,7 +445,7 @@ StageTimes Pipeline::render(const Rig& rig) {
     }
     if (config_.multipass_snapped) std::swap(m.vertices, m.pmr_vertices);
   }
-  if (m.encode) m.encode_stage(ev);
+  if (m.encode && !m.fused) m.encode_stage(ev);
   m.rt.finish();
   ev.collect(times);
   times.wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
@@ -379,7 +454,7 @@ StageTimes Pipeline::render(const Rig& rig) {
 
 StageTimes Pipeline::encode_volume(const std::vector<uint16_t>& volume) {
   Impl& m = *impl_;
-  if (!m.encode) throw Error("internal error: no display configured");
+  if (!m.encode || m.fused) throw Error("internal error: no display configured, or fused path");
   if (volume.size() * 2 != volume_bytes()) throw Error("internal error: volume size mismatch");
   m.rt.write(m.volume, volume.data(), volume_bytes());
   Events ev;
@@ -390,7 +465,10 @@ StageTimes Pipeline::encode_volume(const std::vector<uint16_t>& volume) {
   return t;
 }
 
+bool Pipeline::fused() const { return impl_->fused; }
+
 void Pipeline::read_volume(std::vector<uint16_t>& out) const {
+  if (impl_->fused) throw Error("internal error: the fused path keeps no view volume");
   out.resize(volume_bytes() / 2);
   impl_->rt.read(impl_->volume, out.data(), volume_bytes());
 }

@@ -31,6 +31,11 @@ struct PipelineConfig {
   // Default 16x2x4: best of 13 shapes measured with pmr bench --synthetic 100000 at N = 96.
   int tile_x = 16, tile_y = 2, tile_v = 4;
   bool debug_outputs = false;      // fine raster also writes per-voxel key, depth, count
+  // The encoded-only job: fine raster writes the display image directly (cl/fine_encode.cl) and the
+  // view volume is never allocated. Applies to PMR with a display, nearest sampling and no debug
+  // outputs, when one screen tile's state for all views fits a work-item's private memory;
+  // otherwise the volume is rendered and encoded as usual. read_volume() needs it off.
+  bool fuse_encode = false;
   bool multipass_snapped = false;  // test mode: multipass fed PMR's snapped per-view positions
 };
 
@@ -63,6 +68,7 @@ class Pipeline {
   int tiles_y() const { return tiles_y_; }
   int tiles_v() const { return tiles_v_; }
   size_t volume_bytes() const;
+  bool fused() const;  // the last configure() chose the fused raster + encode path
   size_t display_bytes() const;
 
   // Read-back of the last frame. Volume: [view][y][x][RGBA] halves. Display: [y][x][RGBA] halves.
@@ -88,6 +94,7 @@ class Pipeline {
   PipelineConfig config_;
   int tiles_x_ = 0, tiles_y_ = 0, tiles_v_ = 0;
   int tile_[3] = {4, 4, 4};  // effective tile for the method
+  std::string build_options_;  // kernel build options (the fused program is built per view count)
 };
 
 }  // namespace pmr

@@ -1,0 +1,109 @@
+/* Stages 4 and 5 fused, for the encoded-only job with nearest sampling: one work-item per screen tile
+ * (PMR_TILE_X x PMR_TILE_Y pixels) and ALL PMR_FUSED_VIEWS views. It rasterizes the queues of the
+ * tile's view slabs (fine_raster.h) into one private visibility state, shades the winners, and writes
+ * the display pixels whose subpixels sample these voxels, with the same map as encode.cl (DESIGN
+ * section 5). The view volume (403 MB at paper-8k) is never written nor read, and the display image is
+ * bit-identical to fine.cl followed by encode.cl.
+ *
+ * Ownership: display subpixel s belongs to the tile holding its view column px(s), display row i to the
+ * tile holding its view row py(i) (both maps are monotone; column_start / row_start give each view
+ * column's and row's first subpixel and display row). A display pixel whose three subpixels belong to
+ * different tiles ("straddling", a column property the host lists) gets each colour channel from the
+ * subpixel's owner and its alpha, the mean coverage, from encode_straddle_alpha once all tiles are
+ * done: the owners leave one coverage byte per subpixel in straddle_cov. */
+#include "fine_raster.h"
+
+#define FUSED_ROWS (PMR_TILE_Y * PMR_FUSED_VIEWS * FINE_CHUNKS)
+
+/* Index of voxel (view, ly, lx) in the visibility state and colour arrays. */
+inline int fused_voxel(int view, int ly, int lx) {
+  return ((view * PMR_TILE_Y + ly) * FINE_CHUNKS + lx / VW) * VW + lx % VW;
+}
+
+kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
+                        global const uint* tile_offsets, global const uint* tile_queue,
+                        global const PmrTriangle* tris, global const PmrVertexAttr* attrs,
+                        global const PmrMaterial* materials, global const PmrTexture* textures,
+                        global const uchar4* texels, global const float* srgb_lut,
+                        global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
+                        global const PmrEncodeRow* rows, global const int* column_start,
+                        global const int* row_start, global const int* straddle_slot, uint straddle_slots,
+                        global uchar* straddle_cov, global half* display) {
+  const uint tile_xy = get_global_id(0);
+  const uint tiles_x = (uint)P->tiles_x, tiles_y = (uint)P->tiles_y;
+  if (tile_xy >= tiles_x * tiles_y) return;
+  const int x0 = (int)(tile_xy % tiles_x) * PMR_TILE_X, y0 = (int)(tile_xy / tiles_x) * PMR_TILE_Y;
+  const int nx = min(PMR_TILE_X, P->view_w - x0), ny = min(PMR_TILE_Y, P->view_h - y0);
+  const int views = P->views;
+
+  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut};
+  vfloat best_depth[FUSED_ROWS];
+  vuint best_key[FUSED_ROWS], best_mta[FUSED_ROWS];
+  fine_clear_state(FUSED_ROWS, best_depth, best_key, best_mta);
+  for (int tv = 0; tv < P->tiles_v; ++tv) {
+    const uint tile = ((uint)tv * tiles_y) * tiles_x + tile_xy;
+    const int v0 = tv * PMR_TILE_V;
+    fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], &in, tris, materials, x0, y0,
+                      v0, nx, ny, min(PMR_TILE_V, views - v0), 0, best_depth, best_key, best_mta, 0);
+  }
+
+  /* the winners' colours as half bits, background zero */
+  const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
+  const uint* key_of = (const uint*)best_key;
+  const uint* mta_of = (const uint*)best_mta;
+  ushort4 colour[FUSED_ROWS * VW];
+  for (int view = 0; view < views; ++view)
+    for (int ly = 0; ly < ny; ++ly)
+      for (int lx = 0; lx < nx; ++lx) {
+        const int k = fused_voxel(view, ly, lx);
+        if (key_of[k] != PMR_NO_KEY)
+          vstore_half4(fine_shade_winner(&in, mtas, mta_of[k], light, x0 + lx, y0 + ly, view), k, (half*)colour);
+        else
+          colour[k] = (ushort4)(0);
+      }
+
+  /* the display pixels this tile owns, whole or in part */
+  const int width = E->display_w, reversed = E->reversed;
+  const int s_lo = column_start[x0], s_hi = column_start[x0 + nx];
+  const int i_lo = row_start[y0], i_hi = row_start[y0 + ny];
+  global ushort* bits = (global ushort*)display;
+  for (int i = i_lo; i < i_hi; ++i) {
+    const PmrEncodeRow row = rows[i];
+    const int ly = row.py - y0;
+    for (int j = s_lo / 3; 3 * j < s_hi; ++j) {
+      const size_t pixel = (size_t)i * (size_t)width + (size_t)j;
+      if (3 * j >= s_lo && 3 * j + 3 <= s_hi) {
+        const PmrEncodeColumn c0 = columns[3 * j], c1 = columns[3 * j + 1], c2 = columns[3 * j + 2];
+        const ushort4 a = colour[fused_voxel(encode_view(views, reversed, &c0, &row), ly, c0.px - x0)];
+        const ushort4 b = colour[fused_voxel(encode_view(views, reversed, &c1, &row), ly, c1.px - x0)];
+        const ushort4 c = colour[fused_voxel(encode_view(views, reversed, &c2, &row), ly, c2.px - x0)];
+        vstore4(encode_pixel(a, b, c), pixel, bits);
+        continue;
+      }
+      const size_t slot = ((size_t)i * straddle_slots + (size_t)straddle_slot[j]) * 3;
+      for (int k = 0; k < 3; ++k) {
+        const int s = 3 * j + k;
+        if (s < s_lo || s >= s_hi) continue;
+        const PmrEncodeColumn col = columns[s];
+        const ushort4 a = colour[fused_voxel(encode_view(views, reversed, &col, &row), ly, col.px - x0)];
+        bits[pixel * 4 + (size_t)k] = k == 0 ? a.x : (k == 1 ? a.y : a.z);
+        straddle_cov[slot + (size_t)k] = a.w != 0 ? 1 : 0;
+      }
+    }
+  }
+}
+
+/* Alpha of the straddling display pixels (see the head of this file): the mean coverage of their three
+ * subpixels, computed exactly as encode_pixel does from the views' alpha (0 or 1). 2D range: x = slot,
+ * y = display row. */
+kernel void encode_straddle_alpha(global const PmrEncodeParams* E, global const int* straddle_columns,
+                                  uint straddle_slots, global const uchar* straddle_cov, global half* display) {
+  const uint slot = get_global_id(0), i = get_global_id(1);
+  if (slot >= straddle_slots || i >= (uint)E->display_h) return;
+  global const uchar* c = straddle_cov + ((size_t)i * straddle_slots + slot) * 3;
+  const ushort one = 0x3c00; /* 1.0 as a half */
+  const ushort4 a = (ushort4)(0, 0, 0, c[0] ? one : 0), b = (ushort4)(0, 0, 0, c[1] ? one : 0);
+  const ushort4 d = (ushort4)(0, 0, 0, c[2] ? one : 0);
+  const size_t pixel = (size_t)i * (size_t)E->display_w + (size_t)straddle_columns[slot];
+  ((global ushort*)display)[pixel * 4 + 3] = encode_pixel(a, b, d).w;
+}

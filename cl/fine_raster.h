@@ -1,0 +1,160 @@
+#ifndef PMR_CL_FINE_RASTER_H
+#define PMR_CL_FINE_RASTER_H
+/* The fine raster's inner loop, shared by the stage kernels that write the view volume (fine.cl)
+ * and that write the display image directly (fine_encode.cl).
+ *
+ * A work-item walks a tile's queue once. Per MTA and view it sets up the exact edge functions at
+ * the tile's first pixel center in 64-bit integers, and per tile row it turns each edge into a 32-bit
+ * threshold on the lane index, so that coverage of a whole row of pixels is a few 32-bit vector
+ * compares (explicit OpenCL vectors of PMR_VW lanes: PoCL does not vectorize a work-item loop around
+ * a queue loop, but it does compile vector types to SIMD). Depth is a plane per (MTA, view) (see
+ * depth_plane in common.h), one float multiply-add per voxel. The closest fragment per voxel is kept in
+ * private memory, so the volume needs no depth buffer and no clear. Visibility is a total order on
+ * (depth, key), so the result does not depend on queue order, tile size or thread count. Only the
+ * winners are shaded (except for alphaMode MASK, whose alpha decides visibility).
+ *
+ * Why the thresholds are exact. For edge e, the inside test at pixel lx of a row chunk is
+ *   F + s dy 2^16 lx >= bias     (F = sign * E at the chunk's first pixel center, 2^-24 px^2 units)
+ * and since s dy 2^16 lx is a multiple of 2^8 this is equivalent to
+ *   G lx >= T,   G = s dy 2^8,   T = ceil((bias - F) / 2^8).
+ * When |G| (PMR_VW - 1) < 2^31 - 1 ("narrow" edges: up to ~2000 px tall at 16 lanes), G lx fits in
+ * 32 bits and T can be clamped to 32 bits without changing the outcome; taller edges use an exact
+ * 64-bit division per row instead. */
+#include "shade.h"
+
+#define PMR_CAT_(a, b) a##b
+#define PMR_CAT(a, b) PMR_CAT_(a, b)
+#define VW PMR_VW
+typedef PMR_CAT(int, PMR_VW) vint;
+typedef PMR_CAT(uint, PMR_VW) vuint;
+typedef PMR_CAT(float, PMR_VW) vfloat;
+#define vload_vint PMR_CAT(vload, PMR_VW)
+#define vstore_vint PMR_CAT(vstore, PMR_VW)
+#define convert_vfloat PMR_CAT(convert_float, PMR_VW)
+
+/* A tile row is FINE_CHUNKS vectors; the private visibility state is FINE_ROWS vectors per array. */
+#define FINE_CHUNKS ((PMR_TILE_X + VW - 1) / VW)
+#define FINE_ROWS (PMR_TILE_Y * PMR_TILE_V * FINE_CHUNKS)
+
+constant int fine_lane_index[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+
+/* Lanes of a row chunk inside one edge: G lx >= T (see the head of this file). */
+inline vint edge_lanes(long F, long bias, long G, vint ramp, bool narrow, vint lane) {
+  const long T = (bias - F + 255) >> 8; /* ceil((bias - F) / 2^8) */
+  if (narrow) return ramp >= (vint)((int)clamp(T, (long)INT_MIN, (long)INT_MAX));
+  if (G > 0) return lane >= (vint)((int)clamp(floor_div_l(T + G - 1, G), 0L, (long)VW));
+  if (G < 0) return lane <= (vint)((int)clamp(floor_div_l(-T, -G), -1L, (long)VW));
+  return (vint)(T <= 0 ? -1 : 0);
+}
+
+/* alphaMode MASK: of the lanes in `win`, those whose base colour alpha passes the cutoff. Rare path,
+ * one lane at a time with the exact edge functions. */
+inline vint mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, vint win, long X, long Y, int i, float cutoff) {
+  int w[VW];
+  vstore_vint(win, 0, w);
+  for (int k = 0; k < VW; ++k) {
+    if (!w[k]) continue;
+    const long Xk = X + (long)k * PMR_X_ONE;
+    const long e[3] = {m->sign * mta_edge(m, 1, 2, Xk, Y, i), m->sign * mta_edge(m, 2, 0, Xk, Y, i),
+                       m->sign * mta_edge(m, 0, 1, Xk, Y, i)};
+    if (!(base_color(in, m->tri, source_barycentrics(m, e)).w >= cutoff)) w[k] = 0;
+  }
+  return vload_vint(0, w);
+}
+
+/* Rasterizes the queue entries [q0, q1) of the 3D tile at (x0, y0, v0) (nx x ny x nv voxels inside
+ * the raster) into the visibility state: per voxel the closest (depth, key) and the winning MTA, and,
+ * if `covered` is not null, the number of MTAs covering it. State row r = ((view - vbase) *
+ * PMR_TILE_Y + ly) * FINE_CHUNKS + chunk holds VW lanes. */
+inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile_queue, uint q0, uint q1,
+                              const ShadeInputs* in, global const PmrTriangle* tris,
+                              global const PmrMaterial* materials, int x0, int y0, int v0, int nx, int ny,
+                              int nv, int vbase, vfloat* best_depth, vuint* best_key, vuint* best_mta,
+                              vint* covered) {
+  const long X0 = (long)x0 * PMR_X_ONE + PMR_HALF_X, Y0 = (long)y0 * PMR_Y_ONE + PMR_HALF_Y;
+  const vint lane = vload_vint(0, fine_lane_index);
+  vint in_tile[FINE_CHUNKS]; /* lanes inside the raster (edge tiles are narrower) */
+  for (int c = 0; c < FINE_CHUNKS; ++c) in_tile[c] = (lane + c * VW) < (vint)(nx);
+  for (uint q = q0; q < q1; ++q) {
+    const uint id = tile_queue[q];
+    const PmrMta m = mtas[id];
+    const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
+    long bias[3], G[3];
+    bool narrow[3];
+    vint ramp[3];
+    for (int e = 0; e < 3; ++e) {
+      bias[e] = mta_edge_bias(&m, ea[e], eb[e]);
+      G[e] = (long)m.sign * (long)(m.y[eb[e]] - m.y[ea[e]]) * PMR_Y_ONE;
+      narrow[e] = (G[e] < 0 ? -G[e] : G[e]) * (VW - 1) < (long)INT_MAX;
+      ramp[e] = narrow[e] ? (vint)((int)G[e]) * lane : (vint)(0);
+    }
+    /* the tile rows whose centers lie within the MTA's y extent (the same in every view) */
+    const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));
+    const int ly0 = (int)max(0L, -floor_div_l(Y0 - ylo, PMR_Y_ONE));
+    const int ly1 = (int)min((long)ny - 1, floor_div_l(yhi - Y0, PMR_Y_ONE));
+    const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
+    const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
+    /* the tile's pixel-center box, to skip views in which the (sheared) prism misses the tile */
+    const long tile_x_lo = X0, tile_x_hi = X0 + (long)(nx - 1) * PMR_X_ONE;
+    for (int i = i_lo; i <= i_hi && ly0 <= ly1; ++i) {
+      const long xa = (long)m.x0[0] + (long)i * m.dx[0], xb = (long)m.x0[1] + (long)i * m.dx[1];
+      const long xc = (long)m.x0[2] + (long)i * m.dx[2];
+      if (max(xa, max(xb, xc)) < tile_x_lo || min(xa, min(xb, xc)) > tile_x_hi) continue;
+      long row[3], step_y[3], step_c[3];
+      const long Yfirst = Y0 + (long)ly0 * PMR_Y_ONE;
+      for (int e = 0; e < 3; ++e) {
+        const int a = ea[e], b = eb[e];
+        const long xa = (long)m.x0[a] + (long)i * m.dx[a], xb = (long)m.x0[b] + (long)i * m.dx[b];
+        const long dy = (long)(m.y[b] - m.y[a]), dx = xb - xa;
+        row[e] = m.sign * (dy * (X0 - xa) - dx * (Yfirst - (long)m.y[a]));
+        step_y[e] = -m.sign * dx * PMR_Y_ONE;
+        step_c[e] = m.sign * dy * ((long)PMR_X_ONE * VW);
+      }
+      const DepthPlane dp = depth_plane(&m, i);
+      for (int ly = ly0; ly <= ly1; ++ly) {
+        const float zrow = (float)(dp.zr + dp.gy * (double)(y0 + ly - dp.qr));
+        for (int c = 0; c < FINE_CHUNKS; ++c) {
+          vint hit = in_tile[c];
+          hit &= edge_lanes(row[0] + c * step_c[0], bias[0], G[0], ramp[0], narrow[0], lane);
+          hit &= edge_lanes(row[1] + c * step_c[1], bias[1], G[1], ramp[1], narrow[1], lane);
+          hit &= edge_lanes(row[2] + c * step_c[2], bias[2], G[2], ramp[2], narrow[2], lane);
+          if (!any(hit)) continue;
+          const vfloat z = (vfloat)(zrow) + (vfloat)(dp.gx) * convert_vfloat(lane + (x0 + c * VW - dp.pr));
+          const int r = ((i - vbase) * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
+          if (covered) covered[r] -= hit;
+          vint win = hit & ((z < best_depth[r]) | ((z == best_depth[r]) & ((vuint)(m.key) < best_key[r])));
+          if ((m.flags & PMR_MTA_MASK) && any(win))
+            win = mask_alpha_lanes(in, &m, win, X0 + (long)c * VW * PMR_X_ONE, Y0 + (long)ly * PMR_Y_ONE, i, cutoff);
+          best_depth[r] = select(best_depth[r], z, win);
+          best_key[r] = select(best_key[r], (vuint)(m.key), win);
+          best_mta[r] = select(best_mta[r], (vuint)(id), win);
+        }
+        row[0] += step_y[0];
+        row[1] += step_y[1];
+        row[2] += step_y[2];
+      }
+    }
+  }
+}
+
+/* Lit colour of the winning MTA `id` at voxel (px, py, view): barycentrics from its exact edge
+ * functions there. */
+inline float4 fine_shade_winner(const ShadeInputs* in, global const PmrMta* mtas, uint id, float3 light, int px,
+                                int py, int view) {
+  const PmrMta m = mtas[id];
+  const long X = (long)px * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
+  const long e[3] = {m.sign * mta_edge(&m, 1, 2, X, Y, view), m.sign * mta_edge(&m, 2, 0, X, Y, view),
+                     m.sign * mta_edge(&m, 0, 1, X, Y, view)};
+  return shade(in, light, m.tri, source_barycentrics(&m, e), (m.flags & PMR_MTA_BACK) != 0);
+}
+
+/* Initial visibility state: nothing drawn. */
+inline void fine_clear_state(int rows, vfloat* best_depth, vuint* best_key, vuint* best_mta) {
+  for (int r = 0; r < rows; ++r) {
+    best_depth[r] = (vfloat)(INFINITY);
+    best_key[r] = (vuint)(PMR_NO_KEY);
+    best_mta[r] = (vuint)(0);
+  }
+}
+
+#endif

@@ -30,7 +30,7 @@ struct BenchOptions {
   std::string keep = "view";
   int view_w = 1024, view_h = 512;  // per-view raster at N = 96 (keep total) or always (keep view)
   Display display;
-  int tile[3] = {16, 2, 4};
+  int tile[3] = {16, 2, 16};
   bool check = true;
   bool help = false;
 };

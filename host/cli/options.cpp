@@ -153,7 +153,7 @@ std::string render_help() {
          "  --reverse-views        use view N-1-v instead of v\n"
          "  --bilinear             sample views bilinearly (default nearest)\n"
          "pipeline:\n"
-         "  --tile XxYxV           3D tile of the tile/fine raster, voxels over x, y, view (default 16x2x4)\n"
+         "  --tile XxYxV           3D tile of the tile/fine raster, voxels over x, y, view (default 16x2x16)\n"
          "  --method M             pmr (default), multipass (one conventional pass per view) or duplicate\n"
          "                         (every triangle copied per view into a 2D-tiled view atlas)\n"
          "  --verbose              per-stage device times and queue sizes\n"

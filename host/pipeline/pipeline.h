@@ -28,8 +28,9 @@ struct PipelineConfig {
   Method method = Method::Pmr;
   // PMR: the 3D tile (voxels over x, y, view) of one fine work-group. The single-view baselines use
   // 2D tiles: this tile if its V is 1, else 8x8x1 (measured best of 8x8, 16x4, 32x2, 16x8).
-  // Default 16x2x4: best of 13 shapes measured with pmr bench --synthetic 100000 at N = 96.
-  int tile_x = 16, tile_y = 2, tile_v = 4;
+  // Default 16x2x16: best of the shapes measured with the fused path at N = 96 (pmr bench on
+  // AnisotropyStrengthTest, TransmissionTest, --synthetic 100000; docs/PERFORMANCE.md).
+  int tile_x = 16, tile_y = 2, tile_v = 16;
   bool debug_outputs = false;      // fine raster also writes per-voxel key, depth, count
   // The encoded-only job: fine raster writes the display image directly (cl/fine_encode.cl) and the
   // view volume is never allocated. Applies to PMR with a display, nearest sampling and no debug

@@ -78,7 +78,7 @@ struct SidecarInfo {
   std::string scene;            // the scene file as given (empty = the bundled default scene)
   int frame = 0;
   std::string method = "pmr";   // "pmr" or the baseline's name
-  int tile_x = 16, tile_y = 2, tile_v = 4;
+  int tile_x = 16, tile_y = 2, tile_v = 16;
   int camera = -1;              // glTF camera index, -1 = the default framing of the bounding sphere
   bool has_bounds = false;      // world bounds of the scene the default framing used
   glm::dvec3 bounds_lo{0.0}, bounds_hi{0.0};

@@ -103,9 +103,15 @@ int run_render(const std::vector<std::string>& args) {
   const StageTimes t = pipeline.render(rig);
   std::fprintf(stderr, "pmr: rendered in %.1f ms (device %.1f ms)\n", t.wall, t.device_total);
   if (o.verbose) {
-    std::fprintf(stderr,
-                 "pmr: stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, fine raster %.2f, encode %.2f\n",
-                 t.vertex, t.setup, t.bin, t.fine, t.encode);
+    if (pipeline.fused())
+      std::fprintf(stderr,
+                   "pmr: stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, fine raster + encode (fused) "
+                   "%.2f, straddling alpha %.2f\n",
+                   t.vertex, t.setup, t.bin, t.fine, t.encode);
+    else
+      std::fprintf(stderr,
+                   "pmr: stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, fine raster %.2f, encode %.2f\n",
+                   t.vertex, t.setup, t.bin, t.fine, t.encode);
     std::fprintf(stderr, "pmr: %u MTAs, %llu tile-queue entries, %d queue regrowth(s)\n", t.mtas,
                  (unsigned long long)t.bin_entries, t.retries);
   }

@@ -16,6 +16,10 @@ enum Stage { kVertex, kSetup, kBin, kFine, kEncode, kStages };
 // voxel of a screen tile over all views); larger configurations use the unfused path.
 constexpr size_t kFusedPrivateBudget = size_t(256) << 10;
 
+// Fine raster vector width (PMR_VW): the smallest of 4, 8, 16 lanes that holds a tile row (wider rows
+// take several vectors).
+int fine_lanes(int tile_x) { return tile_x <= 4 ? 4 : (tile_x <= 8 ? 8 : 16); }
+
 // RAII for the profiling events of one frame, each tagged with its stage.
 struct Events {
   std::vector<std::pair<Stage, cl_event>> all;
@@ -124,11 +128,9 @@ Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
     throw Error("invalid --tile " + std::to_string(tx) + "x" + std::to_string(ty) + "x" + std::to_string(tv) +
                 ": " + std::to_string(tx * ty * tv) + " voxels exceed the device's work-group limit of " +
                 std::to_string(runtime.max_work_group_size()));
-  // fine raster vectors: the smallest of 4, 8, 16 lanes that holds a tile row (wider rows take several)
-  const int lanes = tx <= 4 ? 4 : (tx <= 8 ? 8 : 16);
   const std::string options = "-cl-std=CL1.2 -cl-fp32-correctly-rounded-divide-sqrt -DPMR_TILE_X=" +
                               std::to_string(tx) + " -DPMR_TILE_Y=" + std::to_string(ty) +
-                              " -DPMR_TILE_V=" + std::to_string(tv) + " -DPMR_VW=" + std::to_string(lanes);
+                              " -DPMR_TILE_V=" + std::to_string(tv) + " -DPMR_VW=" + std::to_string(fine_lanes(tx));
   Impl& m = *impl_;
   build_options_ = options;
   m.program = runtime.build_program({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl"}, options);
@@ -218,7 +220,8 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   m.num_tiles = uint64_t(tiles_x_) * tiles_y_ * tiles_v_;
   if (m.num_tiles >= (uint64_t(1) << 32)) throw Error("too many tiles; use larger --tile");
   m.encode = display != nullptr;
-  const size_t fused_private = size_t(tile_[0] + 15) / 16 * 16 * tile_[1] * rig.views * 20;
+  const int lanes = fine_lanes(tile_[0]);
+  const size_t fused_private = size_t(tile_[0] + lanes - 1) / lanes * lanes * tile_[1] * rig.views * 20;
   m.fused = config_.fuse_encode && display && !display->bilinear && config_.method == Method::Pmr &&
             !config_.debug_outputs && fused_private <= kFusedPrivateBudget;
   if (display) {

@@ -22,7 +22,9 @@ namespace {
 
 struct BenchOptions {
   std::string scene;
-  size_t synthetic = 0;
+  std::string generator;                // "synthetic" or "objects": procedural scenes instead of SCENE
+  std::vector<size_t> triangle_counts;  // one generated scene per count (the triangle sweep)
+  std::string save_scene;               // write the generated scene as .glb and exit
   std::vector<int> views = {1, 2, 4, 8, 16, 32, 48, 64, 96};
   std::vector<Method> methods = {Method::Pmr, Method::Multipass, Method::Duplicate};
   int frames = 5;
@@ -70,13 +72,19 @@ BenchOptions parse(const std::vector<std::string>& args) {
     else if (a == "--keep") {
       o.keep = value();
       if (o.keep != "view" && o.keep != "total") throw Error("invalid --keep '" + o.keep + "': expected view or total");
-    } else if (a == "--synthetic") {
-      const std::string v = value();
-      char* end = nullptr;
-      const double n = std::strtod(v.c_str(), &end);
-      if (*end != '\0' || !(n >= 1 && n <= 5e7)) throw Error("invalid --synthetic '" + v + "': expected a triangle count");
-      o.synthetic = size_t(n);
-    } else if (a == "--no-check") o.check = false;
+    } else if (a == "--synthetic" || a == "--objects") {
+      if (!o.generator.empty()) throw Error("give one of --synthetic and --objects, once");
+      o.generator = a.substr(2);
+      for (const auto& v : split(value())) {
+        char* end = nullptr;
+        const double n = std::strtod(v.c_str(), &end);
+        if (v.empty() || *end != '\0' || !(n >= 1 && n <= 5e7))
+          throw Error("invalid " + a + " '" + v + "': expected triangle counts (1 to 5e7), comma-separated");
+        o.triangle_counts.push_back(size_t(n));
+      }
+      if (o.triangle_counts.empty()) throw Error("invalid " + a + ": expected triangle counts");
+    } else if (a == "--save-scene") o.save_scene = value();
+    else if (a == "--no-check") o.check = false;
     else if (a == "--view-size" || a == "--display" || a == "--tile" || a == "--lens-pitch" || a == "--tan-slant" ||
              a == "--offset" || a == "--cone" || a == "--yfov" || a == "--display-size") {
       rest.push_back(a);
@@ -90,6 +98,9 @@ BenchOptions parse(const std::vector<std::string>& args) {
   o.display = r.display;
   o.tile[0] = r.pipeline.tile_x, o.tile[1] = r.pipeline.tile_y, o.tile[2] = r.pipeline.tile_v;
   if (o.methods.empty() || o.views.empty()) throw Error("nothing to measure");
+  if (!o.generator.empty() && !o.scene.empty()) throw Error("give a SCENE or a generator (--synthetic, --objects), not both");
+  if (!o.save_scene.empty() && o.triangle_counts.size() != 1)
+    throw Error("--save-scene needs exactly one generated scene (--synthetic TRIS or --objects TRIS)");
   return o;
 }
 
@@ -126,55 +137,13 @@ double coverage_mismatch(const std::vector<uint16_t>& a, const std::vector<uint1
   return double(diff) / double(a.size() / 4);
 }
 
-}  // namespace
-
-std::string bench_help() {
-  return "usage: pmr bench [SCENE] [options]\n"
-         "Times whole frames (render + encode, no file I/O) per view count and method.\n"
-         "  --views LIST        view counts (default 1,2,4,8,16,32,48,64,96)\n"
-         "  --method LIST       pmr, multipass, duplicate (default all three)\n"
-         "  --frames K          timed frames per point after one warm-up frame (default 5)\n"
-         "  --csv FILE          write one row per point\n"
-         "  --keep view|total   view: every view is --view-size (default 1024x512); total: the total voxel\n"
-         "                      count of 96 views of --view-size is held fixed (the paper's Fig. 15; views\n"
-         "                      are capped at 4096x2048)\n"
-         "  --synthetic TRIS    a procedural scene of about TRIS triangles instead of SCENE\n"
-         "  --no-check          skip comparing the methods' images\n"
-         "  --view-size, --display, --tile and the display options are as for pmr render.\n"
-         "Per point it prints the frame time, the per-stage device times, and the floor: the bytes a frame\n"
-         "must move (each voxel written once, the display image written once) at the measured copy bandwidth.\n";
-}
-
-int run_bench(const std::vector<std::string>& args) {
-  BenchOptions o = parse(args);
-  if (o.help) {
-    std::fputs(bench_help().c_str(), stdout);
-    return 0;
-  }
-  std::unique_ptr<std::ofstream> csv;
-  if (!o.csv.empty()) {
-    csv.reset(new std::ofstream(o.csv));
-    if (!*csv) throw Error("cannot write " + o.csv);
-  }
-  Scene scene;
-  std::string scene_name;
-  if (o.synthetic) {
-    scene = make_synthetic_scene(o.synthetic);
-    scene_name = "synthetic-" + std::to_string(o.synthetic);
-  } else {
-    const std::string path = o.scene.empty() ? default_scene_path() : o.scene;
-    scene = load_scene(path);
-    scene_name = path.substr(path.rfind('/') + 1);
-  }
+// One scene: every view count and method of the options, a table row (and CSV row) per point.
+void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Scene& scene,
+                 const std::string& scene_name, std::ofstream* csv) {
   glm::dvec3 lo, hi;
   scene_bounds(scene, lo, hi);
-  ClRuntime rt;
-  const double bw = copy_bandwidth(rt);
   std::printf("# %s: %zu triangles; device %s; copy bandwidth %.1f GB/s\n", scene_name.c_str(), scene.triangles.size(),
               rt.device_name().c_str(), bw * 1e-9);
-  if (csv)
-    *csv << "scene,method,views,view_w,view_h,display_w,display_h,triangles,frames,ms_median,ms_min,ms_setup,ms_tile,"
-            "ms_fine,ms_encode,mvoxels_per_s,peak_mem_mb,floor_mb,floor_ms,x_floor,coverage_mismatch\n";
   std::printf("%-10s %5s %9s %9s %9s %8s %8s %8s %8s %9s %8s %7s %8s\n", "method", "views", "view", "ms_median",
               "ms_min", "setup", "tile", "fine", "encode", "Mvox/s", "floor_MB", "xfloor", "mismatch");
   const double total_voxels = 96.0 * o.view_w * o.view_h;
@@ -244,6 +213,64 @@ int run_bench(const std::vector<std::string>& args) {
              << med / floor_ms << ',' << mismatch << '\n';
     }
   }
+}
+
+Scene generate(const std::string& generator, size_t triangles) {
+  return generator == "objects" ? make_objects_scene(triangles) : make_synthetic_scene(triangles);
+}
+
+}  // namespace
+
+std::string bench_help() {
+  return "usage: pmr bench [SCENE] [options]\n"
+         "Times whole frames (render + encode, no file I/O) per view count and method.\n"
+         "  --views LIST        view counts (default 1,2,4,8,16,32,48,64,96)\n"
+         "  --method LIST       pmr, multipass, duplicate (default all three)\n"
+         "  --frames K          timed frames per point after one warm-up frame (default 5)\n"
+         "  --csv FILE          write one row per point\n"
+         "  --keep view|total   view: every view is --view-size (default 1024x512); total: the total voxel\n"
+         "                      count of 96 views of --view-size is held fixed (the paper's Fig. 15; views\n"
+         "                      are capped at 4096x2048)\n"
+         "  --synthetic LIST    procedural scenes of about these triangle counts instead of SCENE (a sweep:\n"
+         "                      1000,10000,100000): UV spheres of ~200 triangles in a 4 x 2 x 3 box\n"
+         "  --objects LIST      the same with a CAD-like scene: 100 closed double-sided tori and rounded\n"
+         "                      boxes at different depths, tiny triangles at 1M (1e6 is accepted)\n"
+         "  --save-scene FILE   write the one generated scene to FILE (.glb) and exit: `pmr bench FILE` on\n"
+         "                      any build then renders the very same triangles\n"
+         "  --no-check          skip comparing the methods' images\n"
+         "  --view-size, --display, --tile and the display options are as for pmr render.\n"
+         "Per point it prints the frame time, the per-stage device times, and the floor: the bytes a frame\n"
+         "must move (each voxel written once, the display image written once) at the measured copy bandwidth.\n";
+}
+
+int run_bench(const std::vector<std::string>& args) {
+  BenchOptions o = parse(args);
+  if (o.help) {
+    std::fputs(bench_help().c_str(), stdout);
+    return 0;
+  }
+  if (!o.save_scene.empty()) {
+    const Scene scene = generate(o.generator, o.triangle_counts[0]);
+    save_glb(scene, o.save_scene);
+    std::printf("wrote %s: %zu triangles\n", o.save_scene.c_str(), scene.triangles.size());
+    return 0;
+  }
+  std::unique_ptr<std::ofstream> csv;
+  if (!o.csv.empty()) {
+    csv.reset(new std::ofstream(o.csv));
+    if (!*csv) throw Error("cannot write " + o.csv);
+  }
+  ClRuntime rt;
+  const double bw = copy_bandwidth(rt);
+  if (csv)
+    *csv << "scene,method,views,view_w,view_h,display_w,display_h,triangles,frames,ms_median,ms_min,ms_setup,ms_tile,"
+            "ms_fine,ms_encode,mvoxels_per_s,peak_mem_mb,floor_mb,floor_ms,x_floor,coverage_mismatch\n";
+  if (o.generator.empty()) {
+    const std::string path = o.scene.empty() ? default_scene_path() : o.scene;
+    bench_scene(o, rt, bw, load_scene(path), path.substr(path.rfind('/') + 1), csv.get());
+  }
+  for (size_t n : o.triangle_counts)
+    bench_scene(o, rt, bw, generate(o.generator, n), o.generator + "-" + std::to_string(n), csv.get());
   return 0;
 }
 

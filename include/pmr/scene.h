@@ -58,4 +58,17 @@ PmrMaterial default_material();
 // random sizes and colours spread through a 4 x 2 x 3 box, so they cover the whole depth range in
 // front of and behind the focal plane. Deterministic for a given seed. For performance sweeps.
 Scene make_synthetic_scene(size_t triangles, uint32_t seed = 1);
+
+// A procedural scene built like a detailed CAD assembly: about `triangles` triangles over 100 closed
+// objects (fewer below 10,000 triangles), tori and superquadrics (rounded boxes to ellipsoids) with
+// smooth normals, random rotations, anisotropic sizes and colours, each its own double-sided material,
+// spread through the same 4 x 2 x 3 box. At 1M triangles most triangles cover under a pixel of a
+// 1024 x 512 view. Deterministic for a given seed. For performance sweeps.
+Scene make_objects_scene(size_t triangles, uint32_t seed = 1);
+
+// Writes a scene without textures as a binary glTF (.glb): one mesh per material with POSITION,
+// NORMAL and COLOR_0, uint32 indices, the materials' base colour, alpha mode and sidedness. Loading
+// the file gives the same positions, triangles and materials (load_scene adds its default material
+// at index 0). Written atomically; throws pmr::Error on failure or on a scene with textures.
+void save_glb(const Scene& scene, const std::string& path);
 }  // namespace pmr

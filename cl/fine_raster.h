@@ -36,6 +36,9 @@ typedef PMR_CAT(float, PMR_VW) vfloat;
 #define FINE_CHUNKS ((PMR_TILE_X + VW - 1) / VW)
 #define FINE_ROWS (PMR_TILE_Y * PMR_TILE_V * FINE_CHUNKS)
 
+/* Queue entries between an MTA's prefetch and its use. */
+#define FINE_PREFETCH 4
+
 constant int fine_lane_index[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
 
 /* Lanes of a row chunk inside one edge: G lx >= T (see the head of this file). */
@@ -76,6 +79,13 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
   vint in_tile[FINE_CHUNKS]; /* lanes inside the raster (edge tiles are narrower) */
   for (int c = 0; c < FINE_CHUNKS; ++c) in_tile[c] = (lane + c * VW) < (vint)(nx);
   for (uint q = q0; q < q1; ++q) {
+    /* The queue visits MTAs in no memory order and a 1M-triangle frame's MTAs (150 MB) do not stay in
+     * cache: ask for an MTA a few entries ahead, so its cache misses overlap this entry's work. */
+    if (q + FINE_PREFETCH < q1) {
+      global const char* ahead = (global const char*)&mtas[tile_queue[q + FINE_PREFETCH]];
+      __builtin_prefetch(ahead);
+      __builtin_prefetch(ahead + sizeof(PmrMta) - 1);
+    }
     const uint id = tile_queue[q];
     const PmrMta m = mtas[id];
     const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
@@ -96,42 +106,61 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
     /* the tile's pixel-center box, to skip views in which the (sheared) prism misses the tile */
     const long tile_x_lo = X0, tile_x_hi = X0 + (long)(nx - 1) * PMR_X_ONE;
-    for (int i = i_lo; i <= i_hi && ly0 <= ly1; ++i) {
-      const long xa = (long)m.x0[0] + (long)i * m.dx[0], xb = (long)m.x0[1] + (long)i * m.dx[1];
-      const long xc = (long)m.x0[2] + (long)i * m.dx[2];
-      if (max(xa, max(xb, xc)) < tile_x_lo || min(xa, min(xb, xc)) > tile_x_hi) continue;
-      long row[3], step_y[3], step_c[3];
-      const long Yfirst = Y0 + (long)ly0 * PMR_Y_ONE;
-      for (int e = 0; e < 3; ++e) {
-        const int a = ea[e], b = eb[e];
-        const long xa = (long)m.x0[a] + (long)i * m.dx[a], xb = (long)m.x0[b] + (long)i * m.dx[b];
-        const long dy = (long)(m.y[b] - m.y[a]), dx = xb - xa;
-        row[e] = m.sign * (dy * (X0 - xa) - dx * (Yfirst - (long)m.y[a]));
-        step_y[e] = -m.sign * dx * PMR_Y_ONE;
-        step_c[e] = m.sign * dy * ((long)PMR_X_ONE * VW);
-      }
-      const DepthPlane dp = depth_plane(&m, i);
-      for (int ly = ly0; ly <= ly1; ++ly) {
-        const float zrow = (float)(dp.zr + dp.gy * (double)(y0 + ly - dp.qr));
-        for (int c = 0; c < FINE_CHUNKS; ++c) {
-          vint hit = in_tile[c];
-          hit &= edge_lanes(row[0] + c * step_c[0], bias[0], G[0], ramp[0], narrow[0], lane);
-          hit &= edge_lanes(row[1] + c * step_c[1], bias[1], G[1], ramp[1], narrow[1], lane);
-          hit &= edge_lanes(row[2] + c * step_c[2], bias[2], G[2], ramp[2], narrow[2], lane);
-          if (!any(hit)) continue;
-          const vfloat z = (vfloat)(zrow) + (vfloat)(dp.gx) * convert_vfloat(lane + (x0 + c * VW - dp.pr));
-          const int r = ((i - vbase) * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
-          if (covered) covered[r] -= hit;
-          vint win = hit & ((z < best_depth[r]) | ((z == best_depth[r]) & ((vuint)(m.key) < best_key[r])));
-          if ((m.flags & PMR_MTA_MASK) && any(win))
-            win = mask_alpha_lanes(in, &m, win, X0 + (long)c * VW * PMR_X_ONE, Y0 + (long)ly * PMR_Y_ONE, i, cutoff);
-          best_depth[r] = select(best_depth[r], z, win);
-          best_key[r] = select(best_key[r], (vuint)(m.key), win);
-          best_mta[r] = select(best_mta[r], (vuint)(id), win);
+    if (ly0 > ly1 || i_lo > i_hi) continue;
+    /* Every per-view quantity is linear in the view index i (x_k(i) = x0_k + i dx_k), so the setup at
+     * view i_lo is stepped by exact integer increments from view to view: the edge functions at the
+     * tile's first row (row), their row step (step_y), the vertices' x (for the box test). */
+    const long Yfirst = Y0 + (long)ly0 * PMR_Y_ONE;
+    long row_v[3], drow_v[3], step_y_v[3], dstep_y[3], step_c[3];
+    for (int e = 0; e < 3; ++e) {
+      const int a = ea[e], b = eb[e];
+      const long xa = (long)m.x0[a] + (long)i_lo * m.dx[a], xb = (long)m.x0[b] + (long)i_lo * m.dx[b];
+      const long dy = (long)(m.y[b] - m.y[a]), ddx = (long)m.dx[b] - (long)m.dx[a];
+      row_v[e] = m.sign * (dy * (X0 - xa) - (xb - xa) * (Yfirst - (long)m.y[a]));
+      drow_v[e] = -m.sign * (dy * (long)m.dx[a] + ddx * (Yfirst - (long)m.y[a]));
+      step_y_v[e] = -m.sign * (xb - xa) * PMR_Y_ONE;
+      dstep_y[e] = -m.sign * ddx * PMR_Y_ONE;
+      step_c[e] = m.sign * dy * ((long)PMR_X_ONE * VW);
+    }
+    long xv[3] = {(long)m.x0[0] + (long)i_lo * m.dx[0], (long)m.x0[1] + (long)i_lo * m.dx[1],
+                  (long)m.x0[2] + (long)i_lo * m.dx[2]};
+    for (int i = i_lo; i <= i_hi; ++i) {
+      /* skip views in which the (sheared) prism misses the tile's pixel-center columns */
+      const bool overlaps = max(xv[0], max(xv[1], xv[2])) >= tile_x_lo && min(xv[0], min(xv[1], xv[2])) <= tile_x_hi;
+      if (overlaps) {
+        long row[3] = {row_v[0], row_v[1], row_v[2]};
+        DepthPlane dp;
+        bool have_plane = false; /* set up on the first covered voxel: tiny MTAs often cover none */
+        for (int ly = ly0; ly <= ly1; ++ly) {
+          float zrow = 0.0f;
+          bool have_zrow = false;
+          for (int c = 0; c < FINE_CHUNKS; ++c) {
+            vint hit = in_tile[c];
+            hit &= edge_lanes(row[0] + c * step_c[0], bias[0], G[0], ramp[0], narrow[0], lane);
+            hit &= edge_lanes(row[1] + c * step_c[1], bias[1], G[1], ramp[1], narrow[1], lane);
+            hit &= edge_lanes(row[2] + c * step_c[2], bias[2], G[2], ramp[2], narrow[2], lane);
+            if (!any(hit)) continue;
+            if (!have_plane) dp = depth_plane(&m, i), have_plane = true;
+            if (!have_zrow) zrow = (float)(dp.zr + dp.gy * (double)(y0 + ly - dp.qr)), have_zrow = true;
+            const vfloat z = (vfloat)(zrow) + (vfloat)(dp.gx) * convert_vfloat(lane + (x0 + c * VW - dp.pr));
+            const int r = ((i - vbase) * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
+            if (covered) covered[r] -= hit;
+            vint win = hit & ((z < best_depth[r]) | ((z == best_depth[r]) & ((vuint)(m.key) < best_key[r])));
+            if ((m.flags & PMR_MTA_MASK) && any(win))
+              win = mask_alpha_lanes(in, &m, win, X0 + (long)c * VW * PMR_X_ONE, Y0 + (long)ly * PMR_Y_ONE, i, cutoff);
+            best_depth[r] = select(best_depth[r], z, win);
+            best_key[r] = select(best_key[r], (vuint)(m.key), win);
+            best_mta[r] = select(best_mta[r], (vuint)(id), win);
+          }
+          row[0] += step_y_v[0];
+          row[1] += step_y_v[1];
+          row[2] += step_y_v[2];
         }
-        row[0] += step_y[0];
-        row[1] += step_y[1];
-        row[2] += step_y[2];
+      }
+      for (int e = 0; e < 3; ++e) {
+        row_v[e] += drow_v[e];
+        step_y_v[e] += dstep_y[e];
+        xv[e] += m.dx[e];
       }
     }
   }

@@ -104,8 +104,6 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     const int ly1 = (int)min((long)ny - 1, floor_div_l(yhi - Y0, PMR_Y_ONE));
     const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
     const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
-    /* the tile's pixel-center box, to skip views in which the (sheared) prism misses the tile */
-    const long tile_x_lo = X0, tile_x_hi = X0 + (long)(nx - 1) * PMR_X_ONE;
     if (ly0 > ly1 || i_lo > i_hi) continue;
     /* Every per-view quantity is linear in the view index i (x_k(i) = x0_k + i dx_k), so the setup at
      * view i_lo is stepped by exact integer increments from view to view: the edge functions at the
@@ -125,9 +123,11 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     long xv[3] = {(long)m.x0[0] + (long)i_lo * m.dx[0], (long)m.x0[1] + (long)i_lo * m.dx[1],
                   (long)m.x0[2] + (long)i_lo * m.dx[2]};
     for (int i = i_lo; i <= i_hi; ++i) {
-      /* skip views in which the (sheared) prism misses the tile's pixel-center columns */
-      const bool overlaps = max(xv[0], max(xv[1], xv[2])) >= tile_x_lo && min(xv[0], min(xv[1], xv[2])) <= tile_x_hi;
-      if (overlaps) {
+      /* skip views in which no pixel-center column of the tile lies within the triangle's x extent (a
+       * sub-pixel triangle misses most of them; arithmetic shifts are floor divisions) */
+      const long kmax = (max(xv[0], max(xv[1], xv[2])) - X0) >> PMR_X_FRAC_BITS;
+      const long kmin = -((X0 - min(xv[0], min(xv[1], xv[2]))) >> PMR_X_FRAC_BITS);
+      if (max(kmin, 0L) <= min(kmax, (long)nx - 1)) {
         long row[3] = {row_v[0], row_v[1], row_v[2]};
         DepthPlane dp;
         bool have_plane = false; /* set up on the first covered voxel: tiny MTAs often cover none */

@@ -26,6 +26,7 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
                         global const PmrMaterial* materials, global const PmrTexture* textures,
                         global const uchar4* texels, global const float* srgb_lut,
                         global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
+                        global const int* column_soa,
                         global const PmrEncodeRow* rows, global const int* column_start,
                         global const int* row_start, global const int* straddle_slot, uint straddle_slots,
                         global uchar* straddle_cov, global half* display) {
@@ -67,22 +68,54 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
   const int s_lo = column_start[x0], s_hi = column_start[x0 + nx];
   const int i_lo = row_start[y0], i_hi = row_start[y0 + ny];
   global ushort* bits = (global ushort*)display;
+  /* colour[] index of voxel (view, ly, lx) = view * VIEW_STRIDE + ly * ROW_STRIDE + lx (fused_voxel) */
+  const int ROW_STRIDE = FINE_CHUNKS * VW, VIEW_STRIDE = PMR_TILE_Y * FINE_CHUNKS * VW;
+  const ulong* colour_bits = (const ulong*)colour;
+  /* display pixels wholly owned: j in [j_a, j_b) */
+  const int j_a = (s_lo + 2) / 3, j_b = s_hi / 3;
   for (int i = i_lo; i < i_hi; ++i) {
     const PmrEncodeRow row = rows[i];
     const int ly = row.py - y0;
-    for (int j = s_lo / 3; 3 * j < s_hi; ++j) {
-      const size_t pixel = (size_t)i * (size_t)width + (size_t)j;
-      if (3 * j >= s_lo && 3 * j + 3 <= s_hi) {
-        const PmrEncodeColumn c0 = columns[3 * j], c1 = columns[3 * j + 1], c2 = columns[3 * j + 2];
+    global ulong* row_bits = (global ulong*)display + (size_t)i * (size_t)width;
+    /* Eight wholly owned pixels at a time: the view and colour index of each subpixel as 8-lane vector
+     * arithmetic on the column tables' planes (column_soa[(field * 3 + k) * width + j], fields a_mod_n,
+     * b, px), then the colours fetched one by one. Same map as encode_view. */
+    const int8 q = (int8)(row.q_mod_n), srow = (int8)(row.s), base = (int8)(ly * ROW_STRIDE - x0);
+    int j = j_a;
+    for (; j + 8 <= j_b; j += 8) {
+      int idx[3][8];
+      for (int k = 0; k < 3; ++k) {
+        const int8 a = vload8(0, column_soa + (size_t)(0 * 3 + k) * width + j);
+        const int8 b = vload8(0, column_soa + (size_t)(1 * 3 + k) * width + j);
+        const int8 px = vload8(0, column_soa + (size_t)(2 * 3 + k) * width + j);
+        int8 v = a - q + (b < srow); /* a true comparison is -1 */
+        v = select(v, v + views, v < 0);
+        if (reversed) v = (int8)(views - 1) - v;
+        vstore8(v * VIEW_STRIDE + base + px, 0, idx[k]);
+      }
+      for (int l = 0; l < 8; ++l) {
+        const ulong c0 = colour_bits[idx[0][l]], c1 = colour_bits[idx[1][l]], c2 = colour_bits[idx[2][l]];
+        /* channel k from subpixel k; alpha (bits 48..63) the mean coverage, exact when all agree */
+        ulong p = (c0 & 0xffffUL) | (c1 & 0xffff0000UL) | (c2 & 0xffff00000000UL) | (c0 & 0xffff000000000000UL);
+        if ((c0 ^ c1) >> 48 || (c0 ^ c2) >> 48)
+          p = as_ulong(encode_pixel(as_ushort4(c0), as_ushort4(c1), as_ushort4(c2)));
+        row_bits[j + l] = p;
+      }
+    }
+    for (int jj = s_lo / 3; 3 * jj < s_hi; ++jj) {
+      if (jj >= j_a && jj < j) continue; /* done above */
+      const size_t pixel = (size_t)i * (size_t)width + (size_t)jj;
+      if (3 * jj >= s_lo && 3 * jj + 3 <= s_hi) {
+        const PmrEncodeColumn c0 = columns[3 * jj], c1 = columns[3 * jj + 1], c2 = columns[3 * jj + 2];
         const ushort4 a = colour[fused_voxel(encode_view(views, reversed, &c0, &row), ly, c0.px - x0)];
         const ushort4 b = colour[fused_voxel(encode_view(views, reversed, &c1, &row), ly, c1.px - x0)];
         const ushort4 c = colour[fused_voxel(encode_view(views, reversed, &c2, &row), ly, c2.px - x0)];
         vstore4(encode_pixel(a, b, c), pixel, bits);
         continue;
       }
-      const size_t slot = ((size_t)i * straddle_slots + (size_t)straddle_slot[j]) * 3;
+      const size_t slot = ((size_t)i * straddle_slots + (size_t)straddle_slot[jj]) * 3;
       for (int k = 0; k < 3; ++k) {
-        const int s = 3 * j + k;
+        const int s = 3 * jj + k;
         if (s < s_lo || s >= s_hi) continue;
         const PmrEncodeColumn col = columns[s];
         const ushort4 a = colour[fused_voxel(encode_view(views, reversed, &col, &row), ly, col.px - x0)];

@@ -79,7 +79,7 @@ struct Pipeline::Impl {
   int fused_views = 0;
   ClKernel k_fine_encode, k_straddle_alpha;
   bool fused = false;
-  ClBuffer column_start, row_start, straddle_slot, straddle_columns, straddle_cov;
+  ClBuffer column_start, column_soa, row_start, straddle_slot, straddle_columns, straddle_cov;
   uint32_t straddle_slots = 0;
   uint32_t last_mtas = 0;
   uint64_t num_tiles = 0;
@@ -373,11 +373,20 @@ void Pipeline::Impl::configure_fused(const std::string& options, int views, int 
     straddling.push_back(j);
   }
   straddle_slots = uint32_t(straddling.size());
+  // the column table as planes for 8-pixel vector loads: [field (a_mod_n, b, px)][subpixel k][pixel j]
+  const size_t W = size_t(E.display_w);
+  std::vector<int32_t> soa(9 * W);
+  for (size_t j = 0; j < W; ++j)
+    for (size_t k = 0; k < 3; ++k) {
+      const PmrEncodeColumn& c = columns[3 * j + k];
+      soa[(0 + k) * W + j] = c.a_mod_n, soa[(3 + k) * W + j] = c.b, soa[(6 + k) * W + j] = c.px;
+    }
   auto upload = [&](ClBuffer& b, const std::vector<int32_t>& v, const char* name) {
     b = rt.buffer(std::max<size_t>(bytes_of(v), 16), name, CL_MEM_READ_ONLY);
     rt.write(b, v.data(), bytes_of(v));
   };
   upload(column_start, col_start, "fused column starts");
+  upload(column_soa, soa, "fused column planes");
   upload(row_start, row_first, "fused row starts");
   upload(straddle_slot, slot, "fused straddle slots");
   upload(straddle_columns, straddling, "fused straddle columns");
@@ -387,7 +396,7 @@ void Pipeline::Impl::configure_fused(const std::string& options, int views, int 
 void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
   k_fine_encode.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut,
-                     encode_buf, encode_columns, encode_rows, column_start, row_start, straddle_slot, straddle_slots,
+                     encode_buf, encode_columns, column_soa, encode_rows, column_start, row_start, straddle_slot, straddle_slots,
                      straddle_cov, display);
   const size_t screen_tiles = size_t(P.tiles_x) * P.tiles_y;
   ev.add(kFine, rt.launch(k_fine_encode, screen_tiles, 1));

@@ -102,8 +102,12 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
         row_bits[j + l] = p;
       }
     }
+    /* the rest one at a time: a partly owned pixel at each end, wholly owned ones after the last eight */
     for (int jj = s_lo / 3; 3 * jj < s_hi; ++jj) {
-      if (jj >= j_a && jj < j) continue; /* done above */
+      if (jj == j_a && j > j_a) { /* skip the pixels done eight at a time */
+        jj = j - 1;
+        continue;
+      }
       const size_t pixel = (size_t)i * (size_t)width + (size_t)jj;
       if (3 * jj >= s_lo && 3 * jj + 3 <= s_hi) {
         const PmrEncodeColumn c0 = columns[3 * jj], c1 = columns[3 * jj + 1], c2 = columns[3 * jj + 2];

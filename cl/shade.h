@@ -6,6 +6,7 @@
 #include "common.h"
 
 inline int wrap_texel(int c, int size, int mode) {
+  if ((uint)c < (uint)size) return c; /* inside: every mode leaves it (and skips a division) */
   if (mode == PMR_WRAP_CLAMP) return clamp(c, 0, size - 1);
   if (mode == PMR_WRAP_MIRROR) {
     const int period = 2 * size;
@@ -41,8 +42,8 @@ inline float4 sample_texture(global const uchar4* texels, global const float* sr
  * corrected, non-negative) edge functions opposite MTA vertex k. */
 inline float3 source_barycentrics(const PmrMta* m, const long* e) {
   const float pa = (float)e[0] * m->inv_w[0], pb = (float)e[1] * m->inv_w[1], pc = (float)e[2] * m->inv_w[2];
-  const float s = pa + pb + pc;
-  const float la = pa / s, lb = pb / s, lc = pc / s;
+  const float inv = 1.0f / (pa + pb + pc);
+  const float la = pa * inv, lb = pb * inv, lc = pc * inv;
   const float b1 = la * m->bary[0][0] + lb * m->bary[1][0] + lc * m->bary[2][0];
   const float b2 = la * m->bary[0][1] + lb * m->bary[1][1] + lc * m->bary[2][1];
   return (float3)(1.0f - b1 - b2, b1, b2);
@@ -84,7 +85,7 @@ inline float4 shade(const ShadeInputs* in, float3 light, uint tri, float3 b, boo
     n = b.x * vload3(0, in->attrs[t.v[0]].normal) + b.y * vload3(0, in->attrs[t.v[1]].normal) +
         b.z * vload3(0, in->attrs[t.v[2]].normal);
     const float len = length(n);
-    n = len > 0.0f ? n / len : vload3(0, t.face_normal);
+    n = len > 0.0f ? n * (1.0f / len) : vload3(0, t.face_normal);
   } else {
     n = vload3(0, t.face_normal);
   }

@@ -65,6 +65,32 @@ inline vint mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, vint win, l
   return vload_vint(0, w);
 }
 
+/* Bit l set: in view ib + l (l < count) some pixel-center column of the tile (first center X0, nx
+ * columns) lies within the MTA's x extent. Views failing it cannot hold a covered voxel; a sub-pixel
+ * MTA passes in an irregular part of the views, so testing 16 views at once (lanes = views) replaces
+ * 16 unpredictable branches. Vertex x relative to X0 in 32 bits when that provably fits, else every
+ * view is passed on (the edge tests decide exactly either way). Arithmetic shifts floor. */
+inline uint view_pass_mask(const PmrMta* m, int ib, int count, long X0, int nx) {
+  const uint all = count >= 32 ? ~0u : (1u << count) - 1u;
+  long base[3];
+  bool fits = true;
+  for (int k = 0; k < 3; ++k) {
+    base[k] = (long)m->x0[k] + (long)ib * m->dx[k] - X0;
+    fits = fits && base[k] > -(1L << 29) && base[k] < (1L << 29) && abs(m->dx[k]) < (1 << 25);
+  }
+  if (!fits) return all;
+  const int16 l = vload16(0, fine_lane_index);
+  const int16 xa = (int16)((int)base[0]) + l * m->dx[0], xb = (int16)((int)base[1]) + l * m->dx[1];
+  const int16 xc = (int16)((int)base[2]) + l * m->dx[2];
+  const int16 kmax = max(xa, max(xb, xc)) >> PMR_X_FRAC_BITS;
+  const int16 kmin = -((-min(xa, min(xb, xc))) >> PMR_X_FRAC_BITS);
+  const int16 bits = select((int16)(0), (int16)(1) << l, max(kmin, 0) <= min(kmax, nx - 1));
+  int8 r8 = bits.lo | bits.hi;
+  int4 r4 = r8.lo | r8.hi;
+  int2 r2 = r4.lo | r4.hi;
+  return (uint)(r2.x | r2.y) & all;
+}
+
 /* Rasterizes the queue entries [q0, q1) of the 3D tile at (x0, y0, v0) (nx x ny x nv voxels inside
  * the raster) into the visibility state: per voxel the closest (depth, key) and the winning MTA, and,
  * if `covered` is not null, the number of MTAs covering it. State row r = ((view - vbase) *
@@ -105,9 +131,9 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
     const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
     if (ly0 > ly1 || i_lo > i_hi) continue;
-    /* Every per-view quantity is linear in the view index i (x_k(i) = x0_k + i dx_k), so the setup at
-     * view i_lo is stepped by exact integer increments from view to view: the edge functions at the
-     * tile's first row (row), their row step (step_y), the vertices' x (for the box test). */
+    /* Every per-view quantity is linear in the view index i (x_k(i) = x0_k + i dx_k): the edge
+     * functions at the tile's first row (row) and their row step (step_y) at view i are those at view
+     * i_lo plus (i - i_lo) exact integer increments. */
     const long Yfirst = Y0 + (long)ly0 * PMR_Y_ONE;
     long row_v[3], drow_v[3], step_y_v[3], dstep_y[3], step_c[3];
     for (int e = 0; e < 3; ++e) {
@@ -120,15 +146,15 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
       dstep_y[e] = -m.sign * ddx * PMR_Y_ONE;
       step_c[e] = m.sign * dy * ((long)PMR_X_ONE * VW);
     }
-    long xv[3] = {(long)m.x0[0] + (long)i_lo * m.dx[0], (long)m.x0[1] + (long)i_lo * m.dx[1],
-                  (long)m.x0[2] + (long)i_lo * m.dx[2]};
-    for (int i = i_lo; i <= i_hi; ++i) {
-      /* skip views in which no pixel-center column of the tile lies within the triangle's x extent (a
-       * sub-pixel triangle misses most of them; arithmetic shifts are floor divisions) */
-      const long kmax = (max(xv[0], max(xv[1], xv[2])) - X0) >> PMR_X_FRAC_BITS;
-      const long kmin = -((X0 - min(xv[0], min(xv[1], xv[2]))) >> PMR_X_FRAC_BITS);
-      if (max(kmin, 0L) <= min(kmax, (long)nx - 1)) {
-        long row[3] = {row_v[0], row_v[1], row_v[2]};
+    for (int ib = i_lo; ib <= i_hi; ib += 16) {
+      uint pass = view_pass_mask(&m, ib, min(i_hi - ib + 1, 16), X0, nx);
+      while (pass != 0) { /* the passing views, lowest first */
+        const int i = ib + (31 - (int)clz(pass & (0u - pass)));
+        pass &= pass - 1u;
+        const long di = (long)(i - i_lo);
+        long row[3] = {row_v[0] + di * drow_v[0], row_v[1] + di * drow_v[1], row_v[2] + di * drow_v[2]};
+        const long step_y[3] = {step_y_v[0] + di * dstep_y[0], step_y_v[1] + di * dstep_y[1],
+                                step_y_v[2] + di * dstep_y[2]};
         DepthPlane dp;
         bool have_plane = false; /* set up on the first covered voxel: tiny MTAs often cover none */
         for (int ly = ly0; ly <= ly1; ++ly) {
@@ -152,15 +178,10 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
             best_key[r] = select(best_key[r], (vuint)(m.key), win);
             best_mta[r] = select(best_mta[r], (vuint)(id), win);
           }
-          row[0] += step_y_v[0];
-          row[1] += step_y_v[1];
-          row[2] += step_y_v[2];
+          row[0] += step_y[0];
+          row[1] += step_y[1];
+          row[2] += step_y[2];
         }
-      }
-      for (int e = 0; e < 3; ++e) {
-        row_v[e] += drow_v[e];
-        step_y_v[e] += dstep_y[e];
-        xv[e] += m.dx[e];
       }
     }
   }

@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """Plots a `pmr bench` CSV: frames per second against view count per method, and stacked per-stage
-device times per method (the analogue of the paper's Fig. 14).
+device times per method (the analogue of the paper's Fig. 14). A triangle sweep (one view count,
+several generated scenes: `pmr bench --objects 1000,...,1000000`) is plotted as frame time against
+triangle count instead, with the same stacked stages.
 
-usage: scripts/plot_sweep.py SWEEP.csv [OUT_PREFIX]   -> OUT_PREFIX_fps.png, OUT_PREFIX_stages.png
+usage: scripts/plot_sweep.py SWEEP.csv [OUT_PREFIX]   -> OUT_PREFIX_fps.png (or _ms.png), OUT_PREFIX_stages.png
 Uses Debian's python3-matplotlib (run with /usr/bin/python3 if another python3 comes first in PATH).
 """
 import csv
@@ -22,9 +24,29 @@ def load(path):
     by_method = {}
     for r in rows:
         by_method.setdefault(r["method"], []).append(r)
+    sweep = "triangles" if len({r["triangles"] for r in rows}) > 1 else "views"
     for m in by_method.values():
-        m.sort(key=lambda r: int(r["views"]))
-    return rows, by_method
+        m.sort(key=lambda r: int(r[sweep]))
+    return rows, by_method, sweep
+
+
+def triangle_sweep(rows, by_method, prefix):
+    r0 = rows[0]
+    title = (f"{r0['scene'].rsplit('-', 1)[0]} scenes, {r0['views']} views of {r0['view_w']}x{r0['view_h']} "
+             f"-> display {r0['display_w']}x{r0['display_h']}")
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for method, rs in by_method.items():
+        ax.plot([int(r["triangles"]) for r in rs], [float(r["ms_median"]) for r in rs], "o-", label=method)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("triangles")
+    ax.set_ylabel("ms per frame (render + encode)")
+    ax.set_title(title, fontsize=8)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(prefix + "_ms.png", dpi=110)
+    return title
 
 
 def main():
@@ -32,11 +54,18 @@ def main():
         sys.exit(__doc__)
     path = sys.argv[1]
     prefix = sys.argv[2] if len(sys.argv) > 2 else path.rsplit(".", 1)[0]
-    rows, by_method = load(path)
+    rows, by_method, sweep = load(path)
     r0 = rows[0]
-    title = (f"{r0['scene']} ({r0['triangles']} triangles), display {r0['display_w']}x{r0['display_h']}, "
-             f"views of {r0['view_w']}x{r0['view_h']}")
+    if sweep == "triangles":
+        title = triangle_sweep(rows, by_method, prefix)
+    else:
+        title = (f"{r0['scene']} ({r0['triangles']} triangles), display {r0['display_w']}x{r0['display_h']}, "
+                 f"views of {r0['view_w']}x{r0['view_h']}")
+        fps_plot(by_method, title, prefix)
+    stages_plot(by_method, sweep, title, prefix)
 
+
+def fps_plot(by_method, title, prefix):
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for method, rs in by_method.items():
         ax.plot([int(r["views"]) for r in rs], [1000.0 / float(r["ms_median"]) for r in rs], "o-", label=method)
@@ -49,7 +78,9 @@ def main():
     fig.tight_layout()
     fig.savefig(prefix + "_fps.png", dpi=110)
 
-    stages = [("ms_setup", "vertex + setup"), ("ms_tile", "tile raster"), ("ms_fine", "fine raster"),
+
+def stages_plot(by_method, sweep, title, prefix):
+    stages = [("ms_setup", "vertex + setup"), ("ms_tile", "tile raster"), ("ms_fine", "fine raster (+ encode if fused)"),
               ("ms_encode", "encode")]
     methods = list(by_method)
     fig, axes = plt.subplots(1, len(methods), figsize=(4.2 * len(methods), 4.2), sharey=True, squeeze=False)
@@ -62,8 +93,8 @@ def main():
             ax.bar(xs, vals, bottom=bottom, label=label)
             bottom = [b + v for b, v in zip(bottom, vals)]
         ax.set_xticks(xs)
-        ax.set_xticklabels([r["views"] for r in rs])
-        ax.set_xlabel("views N")
+        ax.set_xticklabels([r[sweep] for r in rs], rotation=30 if sweep == "triangles" else 0)
+        ax.set_xlabel("views N" if sweep == "views" else "triangles")
         ax.set_title(method)
         ax.grid(True, axis="y", alpha=0.3)
     axes[0][0].set_ylabel("device time per frame (ms)")

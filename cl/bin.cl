@@ -30,25 +30,31 @@ inline bool edge_may_pass(const PmrMta* m, int a, int b, long X0, long X1, long 
   return best >= bias;
 }
 
+/* The MTA's x extent in view i reaches the pixel-center range [X0, X1]. */
+inline bool in_view(const PmrMta* m, int i, long X0, long X1) {
+  const long xa = (long)m->x0[0] + (long)i * m->dx[0], xb = (long)m->x0[1] + (long)i * m->dx[1];
+  const long xc = (long)m->x0[2] + (long)i * m->dx[2];
+  return max3l(xa, xb, xc) >= X0 && min3l(xa, xb, xc) <= X1;
+}
+
 /* Calls BIN_EMIT(tile) for every tile the MTA may cover. */
 #define BIN_ENUMERATE(P, m)                                                                          \
   for (int tv = (m).view_lo / PMR_TILE_V; tv <= (m).view_hi / PMR_TILE_V; ++tv) {                   \
     const int i0 = max((m).view_lo, tv * PMR_TILE_V);                                                \
     const int i1 = min((m).view_hi, tv * PMR_TILE_V + PMR_TILE_V - 1);                               \
-    /* x range per view (the prism is sheared: each view's range moves with its disparity) */      \
-    long vxlo[PMR_TILE_V], vxhi[PMR_TILE_V];                                                         \
+    /* x range over the slab: each vertex's x is linear in the view, so the extremes are at its end \
+     * views; per view only when the views are more than a tile apart (in_view below) */             \
     long xlo = LONG_MAX, xhi = LONG_MIN;                                                             \
-    for (int i = i0; i <= i1; ++i) {                                                                 \
-      const long xa = (long)(m).x0[0] + (long)i * (m).dx[0];                                         \
-      const long xb = (long)(m).x0[1] + (long)i * (m).dx[1];                                         \
-      const long xc = (long)(m).x0[2] + (long)i * (m).dx[2];                                         \
-      vxlo[i - i0] = min(xa, min(xb, xc));                                                           \
-      vxhi[i - i0] = max(xa, max(xb, xc));                                                           \
-      xlo = min(xlo, vxlo[i - i0]);                                                                  \
-      xhi = max(xhi, vxhi[i - i0]);                                                                  \
+    for (int k = 0; k < 3; ++k) {                                                                    \
+      const long xa = (long)(m).x0[k] + (long)i0 * (m).dx[k], xb = (long)(m).x0[k] + (long)i1 * (m).dx[k]; \
+      xlo = min(xlo, min(xa, xb));                                                                   \
+      xhi = max(xhi, max(xa, xb));                                                                   \
     }                                                                                                \
-    /* only worth testing per view when the views of the slab are more than a tile apart */        \
-    const bool sheared = (xhi - xlo) - (vxhi[0] - vxlo[0]) > (long)PMR_TILE_X * PMR_X_ONE;           \
+    const long w0 = max3l((m).x0[0] + (long)i0 * (m).dx[0], (m).x0[1] + (long)i0 * (m).dx[1],       \
+                          (m).x0[2] + (long)i0 * (m).dx[2]) -                                        \
+                    min3l((m).x0[0] + (long)i0 * (m).dx[0], (m).x0[1] + (long)i0 * (m).dx[1],       \
+                          (m).x0[2] + (long)i0 * (m).dx[2]);                                         \
+    const bool sheared = (xhi - xlo) - w0 > (long)PMR_TILE_X * PMR_X_ONE;                           \
     const long ylo = min3l((m).y[0], (m).y[1], (m).y[2]), yhi = max3l((m).y[0], (m).y[1], (m).y[2]); \
     /* pixels whose centers lie inside the box */                                                   \
     const int px0 = (int)max(0L, -floor_div_l(PMR_HALF_X - xlo, PMR_X_ONE));                        \
@@ -63,7 +69,7 @@ inline bool edge_may_pass(const PmrMta* m, int a, int b, long X0, long X1, long 
         const long X1 = (long)min(px1, tx * PMR_TILE_X + PMR_TILE_X - 1) * PMR_X_ONE + PMR_HALF_X;   \
         bool in_some_view = !sheared;                                                                \
         for (int i = i0; i <= i1 && !in_some_view; ++i)                                              \
-          in_some_view = vxhi[i - i0] >= X0 && vxlo[i - i0] <= X1;                                   \
+          in_some_view = in_view(&(m), i, X0, X1);                                                   \
         if (in_some_view &&                                                                          \
             edge_may_pass(&(m), 1, 2, X0, X1, Y0, Y1, i0, i1) &&                                     \
             edge_may_pass(&(m), 2, 0, X0, X1, Y0, Y1, i0, i1) &&                                     \

@@ -698,6 +698,52 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
       {"glTF 1.0", [](GltfFile& g) { g.doc["asset"]["version"] = "1.0"; }, "glTF version 1.0 is not supported"},
       {"no asset", [](GltfFile& g) { g.doc.erase("asset"); }, "asset.version is missing"},
       {"accessor without componentType", [](GltfFile& g) { g.doc["accessors"][0].erase("componentType"); }, "not a valid glTF file"},
+      // the schema's minimums, which tinygltf would coerce (gltf_schema.cpp)
+      {"negative bufferView byteOffset", [](GltfFile& g) { g.doc["bufferViews"][1]["byteOffset"] = -4; },
+       "bufferView 1 byteOffset is -4, which the glTF schema does not allow (minimum 0)"},
+      {"negative accessor byteOffset", [](GltfFile& g) { g.doc["accessors"][1]["byteOffset"] = -12; },
+       "accessor 1 byteOffset is -12"},
+      {"zero accessor count", [](GltfFile& g) { g.doc["accessors"][0]["count"] = 0; }, "accessor 0 count is 0"},
+      {"zero bufferView byteLength", [](GltfFile& g) { g.doc["bufferViews"][0]["byteLength"] = 0; },
+       "bufferView 0 byteLength is 0"},
+      {"byteStride not a multiple of 4", [](GltfFile& g) { g.doc["bufferViews"][0]["byteStride"] = 14; },
+       "bufferView 0 byteStride is 14"},
+      {"byteStride above 252", [](GltfFile& g) { g.doc["bufferViews"][0]["byteStride"] = 256; }, "from 4 to 252"},
+      {"fractional index", [](GltfFile& g) { g.doc["nodes"][0]["mesh"] = 0.5; }, "node 0 mesh is not an integer"},
+      {"negative mesh index", [](GltfFile& g) { g.doc["nodes"][0]["mesh"] = -1; }, "node 0 mesh is -1"},
+      {"negative attribute accessor", [](GltfFile& g) { g.doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = -2; },
+       "mesh 0 primitive 0 attribute NORMAL is -2"},
+      {"animation sampler out of range",
+       [](GltfFile& g) {
+         g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":1,"target":{"node":0,"path":"translation"}}]}])");
+       },
+       "animation 0 channel 0 sampler refers to sampler 1, but the file has 1"},
+      {"animation target node out of range",
+       [](GltfFile& g) {
+         g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":0,"target":{"node":9,"path":"rotation"}}]}])");
+       },
+       "animation 0 channel 0 target node refers to node 9"},
+      {"animation path unknown",
+       [](GltfFile& g) {
+         g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":0,"target":{"node":0,"path":"colour"}}]}])");
+       },
+       "animation 0 channel 0 target path is 'colour'; the glTF schema allows translation, rotation, scale, weights"},
+      {"animation interpolation unknown",
+       [](GltfFile& g) {
+         g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":0,"output":0,"interpolation":"CUBIC"}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])");
+       },
+       "animation 0 sampler 0 interpolation is 'CUBIC'"},
+      {"animation input accessor out of range",
+       [](GltfFile& g) {
+         g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":30,"output":0}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])");
+       },
+       "animation 0 sampler 0 input refers to accessor 30"},
+      {"animation without channels",
+       [](GltfFile& g) { g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":0,"output":0}]}])"); },
+       "animation 0 has no channels"},
+      {"skin joint out of range", [](GltfFile& g) { g.doc["skins"] = nlohmann::json::parse(R"([{"joints":[0,5]}])"); },
+       "skin 0 joints refers to node 5"},
+      {"node skin out of range", [](GltfFile& g) { g.doc["nodes"][0]["skin"] = 2; }, "node 0 skin refers to skin 2"},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.name);

@@ -1,6 +1,7 @@
 // Private to host/scene: the glTF loader, split by concern.
 //   gltf_validate.cpp   the file before tinygltf sees it (reading, GLB container, JSON pre-checks) and
 //                       the structure after (reference ranges, bufferView bounds, node hierarchy)
+//   gltf_schema.cpp     the schema's minimums and the animation / skin structure on the raw JSON
 //   gltf_accessors.cpp  bounds-checked typed reads of accessors (stride, normalization, sparse)
 //   gltf_loader.cpp     the tinygltf call, materials and textures, the scene walk, flattening
 //
@@ -43,6 +44,15 @@ struct SourceFile {
   std::vector<std::string> ignored_extensions;  // in extensionsUsed, not required, not implemented
 };
 SourceFile read_source(const std::string& path);
+
+// A member of a JSON object, nullptr when absent or when `object` is not an object.
+const nlohmann::json* member(const nlohmann::json& object, const char* key);
+
+// ---- gltf_schema.cpp: the schema's ranges on the raw JSON (called by read_source) -------------------
+
+// Indices, offsets, lengths, counts and strides against the glTF 2.0 schema's minimums, and animations
+// and skins completely (references, enums). Throws pmr::Error naming the file and the element.
+void check_schema(const std::string& path, const nlohmann::json& doc);
 
 // Percent-decodes a relative URI the way tinygltf does and joins it to base_dir.
 std::string resolve_uri(const std::string& base_dir, const std::string& uri);

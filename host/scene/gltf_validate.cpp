@@ -118,12 +118,6 @@ int json_depth(const std::string& text) {
   return max_depth;
 }
 
-const json* member(const json& object, const char* key) {
-  if (!object.is_object()) return nullptr;
-  auto it = object.find(key);
-  return it == object.end() ? nullptr : &*it;
-}
-
 // An index-like JSON value (non-negative integer); -1 when absent or of another type.
 int64_t json_index(const json* v) {
   if (!v || !v->is_number_integer()) return -1;
@@ -218,6 +212,13 @@ std::string base_dir_of(const std::string& path) {
 
 }  // namespace
 
+const json* member(const json& object, const char* key) {
+  if (!object.is_object()) return nullptr;
+  auto it = object.find(key);
+  return it == object.end() ? nullptr : &*it;
+}
+
+
 std::string resolve_uri(const std::string& base_dir, const std::string& uri) {
   // Same decoding as tinygltf's dlib::urldecode ('+' is a space, %XX a byte), so that the file checked
   // here is the file tinygltf then opens.
@@ -268,6 +269,7 @@ SourceFile read_source(const std::string& path) {
   if (!version || !version->is_string()) fail(path, "not a glTF file: asset.version is missing");
   const std::string v = version->get<std::string>();
   if (v.rfind("2.", 0) != 0) fail(path, "glTF version " + v + " is not supported (2.x only)");
+  check_schema(path, doc);
   check_extensions(path, doc, src);
   check_buffers(path, doc, src, bin_length);
   src.base_color_images = base_color_images(doc);

@@ -562,6 +562,11 @@ TEST_F(SceneLoaderTest, NonFinitePositionsSkipTheirTriangles) {
 
 // ---- malformed files: each must throw pmr::Error with a specific message -----------------------------
 
+// An edit that replaces the file's animations with `text` (JSON).
+std::function<void(GltfFile&)> set_animations(const char* text) {
+  return [text](GltfFile& g) { g.doc["animations"] = nlohmann::json::parse(text); };
+}
+
 struct BadCase {
   const char* name;
   std::function<void(GltfFile&)> edit;  // applied to a valid one-triangle file
@@ -714,32 +719,22 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
       {"negative attribute accessor", [](GltfFile& g) { g.doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = -2; },
        "mesh 0 primitive 0 attribute NORMAL is -2"},
       {"animation sampler out of range",
-       [](GltfFile& g) {
-         g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":1,"target":{"node":0,"path":"translation"}}]}])");
-       },
+       set_animations(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":1,"target":{"node":0,"path":"translation"}}]}])"),
        "animation 0 channel 0 sampler refers to sampler 1, but the file has 1"},
       {"animation target node out of range",
-       [](GltfFile& g) {
-         g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":0,"target":{"node":9,"path":"rotation"}}]}])");
-       },
+       set_animations(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":0,"target":{"node":9,"path":"rotation"}}]}])"),
        "animation 0 channel 0 target node refers to node 9"},
       {"animation path unknown",
-       [](GltfFile& g) {
-         g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":0,"target":{"node":0,"path":"colour"}}]}])");
-       },
+       set_animations(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":0,"target":{"node":0,"path":"colour"}}]}])"),
        "animation 0 channel 0 target path is 'colour'; the glTF schema allows translation, rotation, scale, weights"},
       {"animation interpolation unknown",
-       [](GltfFile& g) {
-         g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":0,"output":0,"interpolation":"CUBIC"}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])");
-       },
+       set_animations(R"([{"samplers":[{"input":0,"output":0,"interpolation":"CUBIC"}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
        "animation 0 sampler 0 interpolation is 'CUBIC'"},
       {"animation input accessor out of range",
-       [](GltfFile& g) {
-         g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":30,"output":0}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])");
-       },
+       set_animations(R"([{"samplers":[{"input":30,"output":0}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
        "animation 0 sampler 0 input refers to accessor 30"},
       {"animation without channels",
-       [](GltfFile& g) { g.doc["animations"] = nlohmann::json::parse(R"([{"samplers":[{"input":0,"output":0}]}])"); },
+       set_animations(R"([{"samplers":[{"input":0,"output":0}]}])"),
        "animation 0 has no channels"},
       {"skin joint out of range", [](GltfFile& g) { g.doc["skins"] = nlohmann::json::parse(R"([{"joints":[0,5]}])"); },
        "skin 0 joints refers to node 5"},

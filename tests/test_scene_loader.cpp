@@ -562,9 +562,13 @@ TEST_F(SceneLoaderTest, NonFinitePositionsSkipTheirTriangles) {
 
 // ---- malformed files: each must throw pmr::Error with a specific message -----------------------------
 
-// An edit that replaces the file's animations with `text` (JSON).
+// An edit that replaces the file's animations with `text` (JSON), after adding accessors 3 (2 float
+// key times), 4 (2 VEC3) and 5 (2 VEC4) for it to use (no bufferView: implicit zeros).
 std::function<void(GltfFile&)> set_animations(const char* text) {
-  return [text](GltfFile& g) { g.doc["animations"] = nlohmann::json::parse(text); };
+  return [text](GltfFile& g) {
+    for (const char* type : {"SCALAR", "VEC3", "VEC4"}) g.accessor(-1, kFloat, type, 2);
+    g.doc["animations"] = nlohmann::json::parse(text);
+  };
 }
 
 struct BadCase {
@@ -719,23 +723,35 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
       {"negative attribute accessor", [](GltfFile& g) { g.doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = -2; },
        "mesh 0 primitive 0 attribute NORMAL is -2"},
       {"animation sampler out of range",
-       set_animations(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":1,"target":{"node":0,"path":"translation"}}]}])"),
+       set_animations(R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":1,"target":{"node":0,"path":"translation"}}]}])"),
        "animation 0 channel 0 sampler refers to sampler 1, but the file has 1"},
       {"animation target node out of range",
-       set_animations(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":0,"target":{"node":9,"path":"rotation"}}]}])"),
+       set_animations(R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":0,"target":{"node":9,"path":"translation"}}]}])"),
        "animation 0 channel 0 target node refers to node 9"},
       {"animation path unknown",
-       set_animations(R"([{"samplers":[{"input":0,"output":0}],"channels":[{"sampler":0,"target":{"node":0,"path":"colour"}}]}])"),
+       set_animations(R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"colour"}}]}])"),
        "animation 0 channel 0 target path is 'colour'; the glTF schema allows translation, rotation, scale, weights"},
       {"animation interpolation unknown",
-       set_animations(R"([{"samplers":[{"input":0,"output":0,"interpolation":"CUBIC"}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
+       set_animations(R"([{"samplers":[{"input":3,"output":4,"interpolation":"CUBIC"}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
        "animation 0 sampler 0 interpolation is 'CUBIC'"},
       {"animation input accessor out of range",
-       set_animations(R"([{"samplers":[{"input":30,"output":0}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
+       set_animations(R"([{"samplers":[{"input":30,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
        "animation 0 sampler 0 input refers to accessor 30"},
       {"animation without channels",
-       set_animations(R"([{"samplers":[{"input":0,"output":0}]}])"),
+       set_animations(R"([{"samplers":[{"input":3,"output":4}]}])"),
        "animation 0 has no channels"},
+      {"animation input not float scalars",
+       set_animations(R"([{"samplers":[{"input":4,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
+       "animation 0 sampler 0 input (accessor 4) must hold float scalars"},
+      {"animation output type for the path",
+       set_animations(R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"rotation"}}]}])"),
+       "animates rotation but its sampler's output (accessor 4) has type VEC3, VEC4 expected"},
+      {"animation CUBICSPLINE key count",
+       set_animations(R"([{"samplers":[{"input":3,"output":5,"interpolation":"CUBICSPLINE"}],"channels":[{"sampler":0,"target":{"node":0,"path":"rotation"}}]}])"),
+       "sampler 0 has 2 key times but 2 output elements (6 expected)"},
+      {"animated weights without morph targets",
+       set_animations(R"([{"samplers":[{"input":3,"output":3}],"channels":[{"sampler":0,"target":{"node":0,"path":"weights"}}]}])"),
+       "animates weights of a node without morph targets"},
       {"skin joint out of range", [](GltfFile& g) { g.doc["skins"] = nlohmann::json::parse(R"([{"joints":[0,5]}])"); },
        "skin 0 joints refers to node 5"},
       {"node skin out of range", [](GltfFile& g) { g.doc["nodes"][0]["skin"] = 2; }, "node 0 skin refers to skin 2"},

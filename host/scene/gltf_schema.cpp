@@ -5,6 +5,7 @@
 // (gltf_validate.cpp); animations and skins are checked here completely, since nothing else reads them
 // yet and a file must be refused before any frame renders.
 #include <string>
+#include <vector>
 
 #include "scene/gltf_internal.h"
 
@@ -116,6 +117,40 @@ void check_texture_info(const SchemaCheck& c, const json& material, const std::s
     for (const char* n : in_pbr) check(member(*pbr, n), n);
 }
 
+// An accessor's count, type and componentType as written (count -1, type "" when absent or invalid;
+// their own checks report that).
+struct AccessorShape {
+  int64_t count = -1;
+  std::string type;
+  int64_t component = -1;
+};
+
+AccessorShape accessor_shape(const SchemaCheck& c, int64_t index) {
+  AccessorShape a;
+  const json* all = member(c.doc(), "accessors");
+  if (!all || !all->is_array() || index < 0 || index >= int64_t(all->size())) return a;
+  const json& acc = (*all)[size_t(index)];
+  if (const json* n = member(acc, "count"); n && n->is_number_unsigned() && n->get<uint64_t>() <= uint64_t(INT64_MAX))
+    a.count = int64_t(n->get<uint64_t>());
+  if (const json* t = member(acc, "type"); t && t->is_string()) a.type = t->get<std::string>();
+  if (const json* k = member(acc, "componentType"); k && k->is_number_integer()) a.component = k->get<int64_t>();
+  return a;
+}
+
+// Morph targets of node `node`'s mesh (that of its first primitive), -1 when it has no mesh.
+int64_t node_morph_targets(const SchemaCheck& c, int64_t node) {
+  const json* nodes = member(c.doc(), "nodes");
+  const json* meshes = member(c.doc(), "meshes");
+  if (!nodes || !meshes || !nodes->is_array() || !meshes->is_array() || node < 0 || node >= int64_t(nodes->size()))
+    return -1;
+  const json* mesh = member((*nodes)[size_t(node)], "mesh");
+  if (!mesh || !mesh->is_number_unsigned() || mesh->get<uint64_t>() >= meshes->size()) return -1;
+  const json* prims = member((*meshes)[mesh->get<size_t>()], "primitives");
+  if (!prims || !prims->is_array() || prims->empty()) return -1;
+  const json* targets = member((*prims)[0], "targets");
+  return targets && targets->is_array() ? int64_t(targets->size()) : 0;
+}
+
 void check_animations(const SchemaCheck& c) {
   const int64_t accessors = c.count("accessors"), nodes = c.count("nodes");
   c.each("animations", "animation", [&](const json& anim, const std::string& where) {
@@ -123,21 +158,46 @@ void check_animations(const SchemaCheck& c) {
     const json* channels = member(anim, "channels");
     if (!samplers || !samplers->is_array() || samplers->empty()) fail(c.path(), where + " has no samplers");
     if (!channels || !channels->is_array() || channels->empty()) fail(c.path(), where + " has no channels");
+    std::vector<std::string> interpolation;
     for (size_t s = 0; s < samplers->size(); ++s) {
       const std::string w = where + " sampler " + std::to_string(s);
-      c.required_integer((*samplers)[s], "input", w, 0, accessors, "accessor");
+      const int64_t input = c.required_integer((*samplers)[s], "input", w, 0, accessors, "accessor");
       c.required_integer((*samplers)[s], "output", w, 0, accessors, "accessor");
-      c.one_of((*samplers)[s], "interpolation", w, {"LINEAR", "STEP", "CUBICSPLINE"}, "LINEAR");
+      interpolation.push_back(c.one_of((*samplers)[s], "interpolation", w, {"LINEAR", "STEP", "CUBICSPLINE"}, "LINEAR"));
+      const AccessorShape in = accessor_shape(c, input);
+      if (in.type != "SCALAR" || in.component != 5126)
+        fail(c.path(), w + " input (accessor " + std::to_string(input) + ") must hold float scalars (key times)");
     }
     for (size_t k = 0; k < channels->size(); ++k) {
       const std::string w = where + " channel " + std::to_string(k);
       const json& ch = (*channels)[k];
-      c.required_integer(ch, "sampler", w, 0, int64_t(samplers->size()), "sampler");
+      const int64_t s = c.required_integer(ch, "sampler", w, 0, int64_t(samplers->size()), "sampler");
       const json* target = member(ch, "target");
       if (!target || !target->is_object()) fail(c.path(), w + " has no target");
-      c.integer(*target, "node", w + " target", 0, nodes, "node");
+      const int64_t node = c.integer(*target, "node", w + " target", 0, nodes, "node");
       if (!member(*target, "path")) fail(c.path(), w + " target has no path");
-      c.one_of(*target, "path", w + " target", {"translation", "rotation", "scale", "weights"}, "");
+      const std::string path = c.one_of(*target, "path", w + " target", {"translation", "rotation", "scale", "weights"}, "");
+      if (node < 0) continue;  // the animated object is defined by an extension: nothing here reads it
+      // the output must fit the path: VEC3 for translation and scale, VEC4 for rotation, one scalar per
+      // morph target for weights; key count x 3 for CUBICSPLINE (in-tangent, value, out-tangent)
+      const json& smp = (*samplers)[size_t(s)];
+      const AccessorShape in = accessor_shape(c, member(smp, "input")->get<int64_t>());
+      const int64_t output = member(smp, "output")->get<int64_t>();
+      const AccessorShape out = accessor_shape(c, output);
+      const char* want = path == "rotation" ? "VEC4" : path == "weights" ? "SCALAR" : "VEC3";
+      if (out.type != want)
+        fail(c.path(), w + " animates " + path + " but its sampler's output (accessor " + std::to_string(output) +
+                           ") has type " + (out.type.empty() ? "?" : out.type) + ", " + want + " expected");
+      int64_t per_key = interpolation[size_t(s)] == "CUBICSPLINE" ? 3 : 1;
+      if (path == "weights") {
+        const int64_t targets = node >= 0 ? node_morph_targets(c, node) : -1;
+        if (targets <= 0) fail(c.path(), w + " animates weights of a node without morph targets");
+        per_key *= targets;
+      }
+      if (in.count >= 0 && out.count >= 0 && out.count != in.count * per_key)
+        fail(c.path(), w + ": sampler " + std::to_string(s) + " has " + std::to_string(in.count) + " key times but " +
+                           std::to_string(out.count) + " output elements (" + std::to_string(in.count * per_key) +
+                           " expected)");
     }
   });
 }

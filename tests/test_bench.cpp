@@ -2,6 +2,7 @@
 // methods' images agree; the synthetic scene has about the requested triangle count.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <fstream>
 #include <sstream>
@@ -20,7 +21,7 @@ std::vector<std::string> split_csv(const std::string& line) {
 }
 
 TEST(Bench, WritesCsvWithOneRowPerPoint) {
-  const std::string csv = ::testing::TempDir() + "pmr_bench_test.csv";
+  const std::string csv = ::testing::TempDir() + "pmr_bench_test_" + std::to_string(getpid()) + ".csv";
   const std::string cmd = std::string(PMR_BINARY) +
                           " bench --synthetic 2000 --views 1,3,8 --method pmr,multipass,duplicate --frames 1"
                           " --view-size 64x32 --display 320x180 --csv " + csv + " > /dev/null 2>&1";

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <Imath/half.h>
 
@@ -35,8 +36,9 @@ CliRun run(const std::string& args) {
   return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
 }
 
+// A fresh folder per test and process, so that two test runs on one machine cannot meet.
 std::string temp_dir(const std::string& name) {
-  const std::string d = ::testing::TempDir() + "pmr_cli_" + name;
+  const std::string d = ::testing::TempDir() + "pmr_cli_" + name + "_" + std::to_string(getpid());
   std::system(("rm -rf '" + d + "'").c_str());
   return d;
 }

@@ -3,6 +3,7 @@
 // and a saved .glb loads back to the same triangles and renders the same image.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstring>
@@ -48,7 +49,7 @@ TEST(Generators, ObjectsSceneIsClosedDoubleSidedObjectsAtDifferentDepths) {
 
 TEST(Generators, SavedGlbLoadsBackToTheSameTrianglesAndImage) {
   const Scene s = make_objects_scene(4000, 7);
-  const std::string path = ::testing::TempDir() + "pmr_objects_test.glb";
+  const std::string path = ::testing::TempDir() + "pmr_objects_test_" + std::to_string(getpid()) + ".glb";
   save_glb(s, path);
   const Scene l = load_scene(path);
   ASSERT_EQ(l.triangles.size(), s.triangles.size());
@@ -79,7 +80,7 @@ TEST(Generators, SavedGlbLoadsBackToTheSameTrianglesAndImage) {
 }
 
 TEST(Generators, BenchSavesTheGeneratedSceneAndRefusesAmbiguousRequests) {
-  const std::string path = ::testing::TempDir() + "pmr_bench_saved.glb";
+  const std::string path = ::testing::TempDir() + "pmr_bench_saved_" + std::to_string(getpid()) + ".glb";
   auto run = [](const std::string& args) {
     const int st = std::system((std::string(PMR_BINARY) + " bench " + args + " > /dev/null 2>&1").c_str());
     return WIFEXITED(st) ? WEXITSTATUS(st) : -1;

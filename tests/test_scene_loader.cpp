@@ -752,6 +752,14 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
       {"animated weights without morph targets",
        set_animations(R"([{"samplers":[{"input":3,"output":3}],"channels":[{"sampler":0,"target":{"node":0,"path":"weights"}}]}])"),
        "animates weights of a node without morph targets"},
+      {"animation key times not increasing",
+       [](GltfFile& g) {
+         const int times = g.data<float>({0.0f, 0.5f, 0.5f}, kFloat, "SCALAR");
+         const int values = g.data<float>(std::vector<float>(9, 1.0f), kFloat, "VEC3");
+         g.doc["animations"] = {{{"samplers", {{{"input", times}, {"output", values}}}},
+                                 {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}}}};
+       },
+       "animation 0 sampler 0 key times are not strictly increasing (key 2: 0.500000 after 0.500000)"},
       {"skin joint out of range", [](GltfFile& g) { g.doc["skins"] = nlohmann::json::parse(R"([{"joints":[0,5]}])"); },
        "skin 0 joints refers to node 5"},
       {"node skin out of range", [](GltfFile& g) { g.doc["nodes"][0]["skin"] = 2; }, "node 0 skin refers to skin 2"},
@@ -774,6 +782,22 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
     EXPECT_TRUE(contains(error, c.message)) << "error: " << error << "\nexpected: " << c.message;
     EXPECT_TRUE(contains(error, path)) << "the message names the file: " << error;
   }
+}
+
+// A well-formed animation passes every check (and is ignored for now, with a warning).
+TEST_F(SceneLoaderTest, ValidAnimationLoads) {
+  GltfFile g = unit_triangle();
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  const int times = g.data<float>({0.0f, 0.5f, 1.0f}, kFloat, "SCALAR");
+  const int values = g.data<float>(std::vector<float>(9, 1.0f), kFloat, "VEC3");
+  g.doc["animations"] = {{{"samplers", {{{"input", times}, {"output", values}, {"interpolation", "STEP"}}}},
+                          {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "scale"}}}}}}}};
+  const Scene s = load_scene(g.write(dir_, "animated"));
+  EXPECT_EQ(s.triangles.size(), 1u);
+  bool warned = false;
+  for (const std::string& w : s.warnings) warned |= w.find("animations ignored") != std::string::npos;
+  EXPECT_TRUE(warned);
 }
 
 // Broken files and containers that never reach the glTF structure.

@@ -43,6 +43,12 @@ const Rule kTexcoord{"TEXCOORD", 1u << 2,
                          combo(kShort, true) | combo(kUShort, false)};
 const Rule kColor{"COLOR", 1u << 3 | 1u << 4, combo(kFloat, false) | combo(kUByte, true) | combo(kUShort, true)};
 const Rule kIndices{"indices", 1u << 1, combo(kUByte, false) | combo(kUShort, false) | combo(kUInt, false)};
+// Animation samplers: key times are float scalars; outputs float or normalized integers (rotations and
+// weights may be quantized), scalar (weights), VEC3 (translation, scale) or VEC4 (rotation).
+const Rule kKeyTimes{"animation input", 1u << 1, combo(kFloat, false)};
+const Rule kAnimationOutput{"animation output", 1u << 1 | 1u << 3 | 1u << 4,
+                            combo(kFloat, false) | combo(kByte, true) | combo(kUByte, true) | combo(kShort, true) |
+                                combo(kUShort, true)};
 
 size_t component_size(int type) {
   switch (type) {
@@ -210,6 +216,8 @@ const Rule& rule_for(Semantic semantic) {
     case Semantic::Normal: return kNormal;
     case Semantic::Texcoord: return kTexcoord;
     case Semantic::Color: return kColor;
+    case Semantic::KeyTimes: return kKeyTimes;
+    case Semantic::AnimationOutput: return kAnimationOutput;
     default: return kIndices;
   }
 }

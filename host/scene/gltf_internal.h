@@ -74,7 +74,7 @@ glm::dmat4 node_local_matrix(const tinygltf::Node& node, int index, const std::s
 
 // ---- gltf_accessors.cpp ----------------------------------------------------------------------------
 
-enum class Semantic { Position, Normal, Texcoord, Color, Indices };
+enum class Semantic { Position, Normal, Texcoord, Color, Indices, KeyTimes, AnimationOutput };
 
 // One vertex attribute, decoded to float (normalized integers mapped per the glTF spec), sparse
 // substitutions applied. values.size() == count * components.

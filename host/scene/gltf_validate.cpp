@@ -392,12 +392,32 @@ std::vector<int> check_nodes(const tinygltf::Model& m, const std::string& file) 
   return parent;
 }
 
+// The samplers' data (their structure was checked on the JSON, gltf_schema.cpp): key times finite and
+// strictly increasing, as the specification requires; outputs readable within their buffers.
+void check_animation_data(const tinygltf::Model& m, const std::string& file) {
+  for (size_t a = 0; a < m.animations.size(); ++a)
+    for (size_t s = 0; s < m.animations[a].samplers.size(); ++s) {
+      const tinygltf::AnimationSampler& smp = m.animations[a].samplers[s];
+      const std::string where = "animation " + std::to_string(a) + " sampler " + std::to_string(s);
+      const AttributeData t = read_attribute(m, smp.input, Semantic::KeyTimes, "input of " + where, file);
+      for (size_t k = 0; k < t.values.size(); ++k) {
+        if (!std::isfinite(t.values[k]))
+          fail(file, where + " key time " + std::to_string(k) + " is not a finite number");
+        if (k > 0 && !(t.values[k] > t.values[k - 1]))
+          fail(file, where + " key times are not strictly increasing (key " + std::to_string(k) + ": " +
+                         std::to_string(t.values[k]) + " after " + std::to_string(t.values[k - 1]) + ")");
+      }
+      check_accessor(m, smp.output, Semantic::AnimationOutput, "output of " + where, file);
+    }
+}
+
 }  // namespace
 
 std::vector<int> validate_model(const tinygltf::Model& model, const std::string& file) {
   check_buffer_views(model, file);
   check_meshes(model, file);
   check_materials(model, file);
+  check_animation_data(model, file);
   return check_nodes(model, file);
 }
 

@@ -30,11 +30,19 @@ inline bool edge_may_pass(const PmrMta* m, int a, int b, long X0, long X1, long 
   return best >= bias;
 }
 
-/* The MTA's x extent in view i reaches the pixel-center range [X0, X1]. */
-inline bool in_view(const PmrMta* m, int i, long X0, long X1) {
+/* The MTA's x extent [lo, hi] in view i. */
+inline void x_extent(const PmrMta* m, int i, long* lo, long* hi) {
   const long xa = (long)m->x0[0] + (long)i * m->dx[0], xb = (long)m->x0[1] + (long)i * m->dx[1];
   const long xc = (long)m->x0[2] + (long)i * m->dx[2];
-  return max3l(xa, xb, xc) >= X0 && min3l(xa, xb, xc) <= X1;
+  *lo = min3l(xa, xb, xc);
+  *hi = max3l(xa, xb, xc);
+}
+
+/* The MTA's x extent in view i reaches the pixel-center range [X0, X1]. */
+inline bool in_view(const PmrMta* m, int i, long X0, long X1) {
+  long lo, hi;
+  x_extent(m, i, &lo, &hi);
+  return hi >= X0 && lo <= X1;
 }
 
 /* Calls BIN_EMIT(tile) for every tile the MTA may cover. */
@@ -44,17 +52,11 @@ inline bool in_view(const PmrMta* m, int i, long X0, long X1) {
     const int i1 = min((m).view_hi, tv * PMR_TILE_V + PMR_TILE_V - 1);                               \
     /* x range over the slab: each vertex's x is linear in the view, so the extremes are at its end \
      * views; per view only when the views are more than a tile apart (in_view below) */             \
-    long xlo = LONG_MAX, xhi = LONG_MIN;                                                             \
-    for (int k = 0; k < 3; ++k) {                                                                    \
-      const long xa = (long)(m).x0[k] + (long)i0 * (m).dx[k], xb = (long)(m).x0[k] + (long)i1 * (m).dx[k]; \
-      xlo = min(xlo, min(xa, xb));                                                                   \
-      xhi = max(xhi, max(xa, xb));                                                                   \
-    }                                                                                                \
-    const long w0 = max3l((m).x0[0] + (long)i0 * (m).dx[0], (m).x0[1] + (long)i0 * (m).dx[1],       \
-                          (m).x0[2] + (long)i0 * (m).dx[2]) -                                        \
-                    min3l((m).x0[0] + (long)i0 * (m).dx[0], (m).x0[1] + (long)i0 * (m).dx[1],       \
-                          (m).x0[2] + (long)i0 * (m).dx[2]);                                         \
-    const bool sheared = (xhi - xlo) - w0 > (long)PMR_TILE_X * PMR_X_ONE;                           \
+    long lo0, hi0, lo1, hi1;                                                                         \
+    x_extent(&(m), i0, &lo0, &hi0);                                                                  \
+    x_extent(&(m), i1, &lo1, &hi1);                                                                  \
+    const long xlo = min(lo0, lo1), xhi = max(hi0, hi1);                                             \
+    const bool sheared = (xhi - xlo) - (hi0 - lo0) > (long)PMR_TILE_X * PMR_X_ONE;                   \
     const long ylo = min3l((m).y[0], (m).y[1], (m).y[2]), yhi = max3l((m).y[0], (m).y[1], (m).y[2]); \
     /* pixels whose centers lie inside the box */                                                   \
     const int px0 = (int)max(0L, -floor_div_l(PMR_HALF_X - xlo, PMR_X_ONE));                        \

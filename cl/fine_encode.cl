@@ -15,6 +15,17 @@
 
 #define FUSED_ROWS (PMR_TILE_Y * PMR_FUSED_VIEWS * FINE_CHUNKS)
 
+/* Subpixel s's entry of the encoder column table, from its planes (see the display scan below). */
+inline PmrEncodeColumn soa_column(global const int* column_soa, int width, int s) {
+  const int j = s / 3, k = s % 3;
+  PmrEncodeColumn c;
+  c.a_mod_n = column_soa[k * width + j];
+  c.b = column_soa[(3 + k) * width + j];
+  c.px = column_soa[(6 + k) * width + j];
+  c.pad = 0;
+  return c;
+}
+
 /* Index of voxel (view, ly, lx) in the visibility state and colour arrays. */
 inline int fused_voxel(int view, int ly, int lx) {
   return ((view * PMR_TILE_Y + ly) * FINE_CHUNKS + lx / VW) * VW + lx % VW;
@@ -25,8 +36,7 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
                         global const PmrTriangle* tris, global const PmrVertexAttr* attrs,
                         global const PmrMaterial* materials, global const PmrTexture* textures,
                         global const uchar4* texels, global const float* srgb_lut,
-                        global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
-                        global const int* column_soa,
+                        global const PmrEncodeParams* E, global const int* column_soa,
                         global const PmrEncodeRow* rows, global const int* column_start,
                         global const int* row_start, global const int* straddle_slot, uint straddle_slots,
                         global uchar* straddle_cov, global half* display) {
@@ -95,11 +105,7 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
       }
       for (int l = 0; l < 8; ++l) {
         const ulong c0 = colour_bits[idx[0][l]], c1 = colour_bits[idx[1][l]], c2 = colour_bits[idx[2][l]];
-        /* channel k from subpixel k; alpha (bits 48..63) the mean coverage, exact when all agree */
-        ulong p = (c0 & 0xffffUL) | (c1 & 0xffff0000UL) | (c2 & 0xffff00000000UL) | (c0 & 0xffff000000000000UL);
-        if ((c0 ^ c1) >> 48 || (c0 ^ c2) >> 48)
-          p = as_ulong(encode_pixel(as_ushort4(c0), as_ushort4(c1), as_ushort4(c2)));
-        row_bits[j + l] = p;
+        row_bits[j + l] = as_ulong(encode_pixel(as_ushort4(c0), as_ushort4(c1), as_ushort4(c2)));
       }
     }
     /* the rest one at a time: a partly owned pixel at each end, wholly owned ones after the last eight */
@@ -110,7 +116,9 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
       }
       const size_t pixel = (size_t)i * (size_t)width + (size_t)jj;
       if (3 * jj >= s_lo && 3 * jj + 3 <= s_hi) {
-        const PmrEncodeColumn c0 = columns[3 * jj], c1 = columns[3 * jj + 1], c2 = columns[3 * jj + 2];
+        const PmrEncodeColumn c0 = soa_column(column_soa, width, 3 * jj);
+        const PmrEncodeColumn c1 = soa_column(column_soa, width, 3 * jj + 1);
+        const PmrEncodeColumn c2 = soa_column(column_soa, width, 3 * jj + 2);
         const ushort4 a = colour[fused_voxel(encode_view(views, reversed, &c0, &row), ly, c0.px - x0)];
         const ushort4 b = colour[fused_voxel(encode_view(views, reversed, &c1, &row), ly, c1.px - x0)];
         const ushort4 c = colour[fused_voxel(encode_view(views, reversed, &c2, &row), ly, c2.px - x0)];
@@ -121,7 +129,7 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
       for (int k = 0; k < 3; ++k) {
         const int s = 3 * jj + k;
         if (s < s_lo || s >= s_hi) continue;
-        const PmrEncodeColumn col = columns[s];
+        const PmrEncodeColumn col = soa_column(column_soa, width, s);
         const ushort4 a = colour[fused_voxel(encode_view(views, reversed, &col, &row), ly, col.px - x0)];
         bits[pixel * 4 + (size_t)k] = k == 0 ? a.x : (k == 1 ? a.y : a.z);
         straddle_cov[slot + (size_t)k] = a.w != 0 ? 1 : 0;

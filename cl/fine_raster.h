@@ -71,7 +71,7 @@ inline vint mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, vint win, l
  * 16 unpredictable branches. Vertex x relative to X0 in 32 bits when that provably fits, else every
  * view is passed on (the edge tests decide exactly either way). Arithmetic shifts floor. */
 inline uint view_pass_mask(const PmrMta* m, int ib, int count, long X0, int nx) {
-  const uint all = count >= 32 ? ~0u : (1u << count) - 1u;
+  const uint all = (1u << count) - 1u; /* count <= 16 */
   long base[3];
   bool fits = true;
   for (int k = 0; k < 3; ++k) {
@@ -129,8 +129,8 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     const int ly0 = (int)max(0L, -floor_div_l(Y0 - ylo, PMR_Y_ONE));
     const int ly1 = (int)min((long)ny - 1, floor_div_l(yhi - Y0, PMR_Y_ONE));
     const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
-    const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
     if (ly0 > ly1 || i_lo > i_hi) continue;
+    const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
     /* Every per-view quantity is linear in the view index i (x_k(i) = x0_k + i dx_k): the edge
      * functions at the tile's first row (row) and their row step (step_y) at view i are those at view
      * i_lo plus (i - i_lo) exact integer increments. */

@@ -30,23 +30,21 @@ def load(path):
     return rows, by_method, sweep
 
 
-def triangle_sweep(rows, by_method, prefix):
-    r0 = rows[0]
-    title = (f"{r0['scene'].rsplit('-', 1)[0]} scenes, {r0['views']} views of {r0['view_w']}x{r0['view_h']} "
-             f"-> display {r0['display_w']}x{r0['display_h']}")
+def line_plot(by_method, x_key, y_of, xlabel, ylabel, logy, title, path):
+    """One line per method: y_of(row) against row[x_key] on a log x axis."""
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for method, rs in by_method.items():
-        ax.plot([int(r["triangles"]) for r in rs], [float(r["ms_median"]) for r in rs], "o-", label=method)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("triangles")
-    ax.set_ylabel("ms per frame (render + encode)")
+        ax.plot([int(r[x_key]) for r in rs], [y_of(r) for r in rs], "o-", label=method)
+    ax.set_xscale("log", base=2 if x_key == "views" else 10)
+    if logy:
+        ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=8)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    fig.savefig(prefix + "_ms.png", dpi=110)
-    return title
+    fig.savefig(path, dpi=110)
 
 
 def main():
@@ -57,26 +55,16 @@ def main():
     rows, by_method, sweep = load(path)
     r0 = rows[0]
     if sweep == "triangles":
-        title = triangle_sweep(rows, by_method, prefix)
+        title = (f"{r0['scene'].rsplit('-', 1)[0]} scenes, {r0['views']} views of {r0['view_w']}x{r0['view_h']} "
+                 f"-> display {r0['display_w']}x{r0['display_h']}")
+        line_plot(by_method, "triangles", lambda r: float(r["ms_median"]), "triangles",
+                  "ms per frame (render + encode)", True, title, prefix + "_ms.png")
     else:
         title = (f"{r0['scene']} ({r0['triangles']} triangles), display {r0['display_w']}x{r0['display_h']}, "
                  f"views of {r0['view_w']}x{r0['view_h']}")
-        fps_plot(by_method, title, prefix)
+        line_plot(by_method, "views", lambda r: 1000.0 / float(r["ms_median"]), "views N",
+                  "frames per second (render + encode)", False, title, prefix + "_fps.png")
     stages_plot(by_method, sweep, title, prefix)
-
-
-def fps_plot(by_method, title, prefix):
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    for method, rs in by_method.items():
-        ax.plot([int(r["views"]) for r in rs], [1000.0 / float(r["ms_median"]) for r in rs], "o-", label=method)
-    ax.set_xscale("log", base=2)
-    ax.set_xlabel("views N")
-    ax.set_ylabel("frames per second (render + encode)")
-    ax.set_title(title, fontsize=8)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(prefix + "_fps.png", dpi=110)
 
 
 def stages_plot(by_method, sweep, title, prefix):

@@ -373,7 +373,7 @@ void Pipeline::Impl::configure_fused(const std::string& options, int views, int 
     straddling.push_back(j);
   }
   straddle_slots = uint32_t(straddling.size());
-  // the column table as planes for 8-pixel vector loads: [field (a_mod_n, b, px)][subpixel k][pixel j]
+  // the fused kernel's column table, as planes for 8-pixel vector loads: [field (a_mod_n, b, px)][subpixel k][pixel j]
   const size_t W = size_t(E.display_w);
   std::vector<int32_t> soa(9 * W);
   for (size_t j = 0; j < W; ++j)
@@ -396,7 +396,7 @@ void Pipeline::Impl::configure_fused(const std::string& options, int views, int 
 void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
   k_fine_encode.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut,
-                     encode_buf, encode_columns, column_soa, encode_rows, column_start, row_start, straddle_slot, straddle_slots,
+                     encode_buf, column_soa, encode_rows, column_start, row_start, straddle_slot, straddle_slots,
                      straddle_cov, display);
   const size_t screen_tiles = size_t(P.tiles_x) * P.tiles_y;
   ev.add(kFine, rt.launch(k_fine_encode, screen_tiles, 1));

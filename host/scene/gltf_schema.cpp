@@ -31,16 +31,19 @@ class SchemaCheck {
   int64_t integer(const json& obj, const char* key, const std::string& where, int64_t lo, int64_t hi = -1,
                   const char* what = nullptr) const {
     const json* v = member(obj, key);
-    if (!v) return -1;
-    const std::string name = where + " " + key;
-    if (!v->is_number_integer()) fail(path_, name + " is not an integer");
-    if (v->is_number_unsigned()) {
-      const uint64_t u = v->get<uint64_t>();
+    return v ? value(*v, where + " " + key, lo, hi, what) : -1;
+  }
+
+  // An integer JSON value >= lo (and < hi when hi >= 0), `name` naming it in messages.
+  int64_t value(const json& v, const std::string& name, int64_t lo, int64_t hi = -1, const char* what = nullptr) const {
+    if (!v.is_number_integer()) fail(path_, name + " is not an integer");
+    if (v.is_number_unsigned()) {
+      const uint64_t u = v.get<uint64_t>();
       if (lo > 0 && u < uint64_t(lo)) below(name, std::to_string(u), lo);
       if (hi >= 0 && u >= uint64_t(hi)) out_of_range(name, std::to_string(u), hi, what);
       return u > uint64_t(INT64_MAX) ? INT64_MAX : int64_t(u);
     }
-    const int64_t s = v->get<int64_t>();
+    const int64_t s = v.get<int64_t>();
     if (s < lo) below(name, std::to_string(s), lo);
     if (hi >= 0 && s >= hi) out_of_range(name, std::to_string(s), hi, what);
     return s;
@@ -59,10 +62,7 @@ class SchemaCheck {
     if (!a) return;
     if (!a->is_array()) fail(path_, where + " " + key + " is not an array");
     if (a->size() < min_items) fail(path_, where + " " + key + " is empty");
-    for (size_t i = 0; i < a->size(); ++i) {
-      json one = {{key, (*a)[i]}};
-      integer(one, key, where, 0, hi, what);
-    }
+    for (const json& v : *a) value(v, where + " " + key, 0, hi, what);
   }
 
   // An optional string property that must be one of `allowed`.
@@ -159,10 +159,12 @@ void check_animations(const SchemaCheck& c) {
     if (!samplers || !samplers->is_array() || samplers->empty()) fail(c.path(), where + " has no samplers");
     if (!channels || !channels->is_array() || channels->empty()) fail(c.path(), where + " has no channels");
     std::vector<std::string> interpolation;
+    std::vector<int64_t> inputs, outputs;
     for (size_t s = 0; s < samplers->size(); ++s) {
       const std::string w = where + " sampler " + std::to_string(s);
       const int64_t input = c.required_integer((*samplers)[s], "input", w, 0, accessors, "accessor");
-      c.required_integer((*samplers)[s], "output", w, 0, accessors, "accessor");
+      inputs.push_back(input);
+      outputs.push_back(c.required_integer((*samplers)[s], "output", w, 0, accessors, "accessor"));
       interpolation.push_back(c.one_of((*samplers)[s], "interpolation", w, {"LINEAR", "STEP", "CUBICSPLINE"}, "LINEAR"));
       const AccessorShape in = accessor_shape(c, input);
       if (in.type != "SCALAR" || in.component != 5126)
@@ -180,9 +182,8 @@ void check_animations(const SchemaCheck& c) {
       if (node < 0) continue;  // the animated object is defined by an extension: nothing here reads it
       // the output must fit the path: VEC3 for translation and scale, VEC4 for rotation, one scalar per
       // morph target for weights; key count x 3 for CUBICSPLINE (in-tangent, value, out-tangent)
-      const json& smp = (*samplers)[size_t(s)];
-      const AccessorShape in = accessor_shape(c, member(smp, "input")->get<int64_t>());
-      const int64_t output = member(smp, "output")->get<int64_t>();
+      const AccessorShape in = accessor_shape(c, inputs[size_t(s)]);
+      const int64_t output = outputs[size_t(s)];
       const AccessorShape out = accessor_shape(c, output);
       const char* want = path == "rotation" ? "VEC4" : path == "weights" ? "SCALAR" : "VEC3";
       if (out.type != want)
@@ -251,16 +252,12 @@ void check_schema(const std::string& path, const json& doc) {
       c.integer(prim, "indices", w, 0);
       c.integer(prim, "material", w, 0);
       if (const json* attrs = member(prim, "attributes"))
-        for (auto it = attrs->begin(); attrs->is_object() && it != attrs->end(); ++it) {
-          const json one = {{it.key(), it.value()}};
-          c.integer(one, it.key().c_str(), w + " attribute", 0);
-        }
+        for (auto it = attrs->begin(); attrs->is_object() && it != attrs->end(); ++it)
+          c.value(it.value(), w + " attribute " + it.key(), 0);
       if (const json* targets = member(prim, "targets"); targets && targets->is_array())
         for (size_t t = 0; t < targets->size(); ++t)
-          for (auto it = (*targets)[t].begin(); (*targets)[t].is_object() && it != (*targets)[t].end(); ++it) {
-            const json one = {{it.key(), it.value()}};
-            c.integer(one, it.key().c_str(), w + " morph target " + std::to_string(t), 0);
-          }
+          for (auto it = (*targets)[t].begin(); (*targets)[t].is_object() && it != (*targets)[t].end(); ++it)
+            c.value(it.value(), w + " morph target " + std::to_string(t) + " " + it.key(), 0);
     }
   });
   c.each("nodes", "node", [&](const json& n, const std::string& where) {

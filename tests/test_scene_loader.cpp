@@ -694,8 +694,6 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
        },
        "triangles; the renderer supports at most 134217727"},
       {"primitive mode 9", [](GltfFile& g) { g.doc["meshes"][0]["primitives"][0]["mode"] = 9; }, "mode 9"},
-      {"empty scene", [](GltfFile& g) { g.scene({}); }, "the scene has no triangles to render"},
-      {"only lines", [](GltfFile& g) { g.doc["meshes"][0]["primitives"][0]["mode"] = 1; }, "the scene has no triangles to render"},
       {"Draco required",
        [](GltfFile& g) {
          g.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
@@ -784,20 +782,48 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
   }
 }
 
-// A well-formed animation passes every check (and is ignored for now, with a warning).
+// A scene with nothing to draw loads with a warning: a sequence must not stop on it (its frames are
+// transparent).
+TEST_F(SceneLoaderTest, SceneWithoutTrianglesLoadsWithWarning) {
+  for (int lines = 0; lines < 2; ++lines) {
+    GltfFile g = unit_triangle();
+    g.add("nodes", {{"mesh", 0}});
+    if (lines) g.doc["meshes"][0]["primitives"][0]["mode"] = 1, g.scene({0});
+    else g.scene({});
+    const Scene s = load_scene(g.write(dir_, "empty"));
+    EXPECT_TRUE(s.triangles.empty());
+    bool warned = false;
+    for (const std::string& w : s.warnings) warned |= w.find("no triangles to render") != std::string::npos;
+    EXPECT_TRUE(warned) << lines;
+    glm::dvec3 lo, hi;
+    EXPECT_FALSE(scene_bounds(s, lo, hi));
+  }
+}
+
+// A well-formed animation passes every check and drives its node: STEP scale keys 1, 2, 3 at t = 0, 0.5, 1.
 TEST_F(SceneLoaderTest, ValidAnimationLoads) {
   GltfFile g = unit_triangle();
   g.add("nodes", {{"mesh", 0}});
   g.scene({0});
   const int times = g.data<float>({0.0f, 0.5f, 1.0f}, kFloat, "SCALAR");
-  const int values = g.data<float>(std::vector<float>(9, 1.0f), kFloat, "VEC3");
-  g.doc["animations"] = {{{"samplers", {{{"input", times}, {"output", values}, {"interpolation", "STEP"}}}},
+  const int values = g.data<float>({1, 1, 1, 2, 2, 2, 3, 3, 3}, kFloat, "VEC3");
+  g.doc["animations"] = {{{"name", "grow"},
+                          {"samplers", {{{"input", times}, {"output", values}, {"interpolation", "STEP"}}}},
                           {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "scale"}}}}}}}};
   const Scene s = load_scene(g.write(dir_, "animated"));
   EXPECT_EQ(s.triangles.size(), 1u);
-  bool warned = false;
-  for (const std::string& w : s.warnings) warned |= w.find("animations ignored") != std::string::npos;
-  EXPECT_TRUE(warned);
+  ASSERT_EQ(s.animations.size(), 1u);
+  EXPECT_EQ(s.animations[0].name, "grow");
+  EXPECT_EQ(s.animations[0].start, 0.0);
+  EXPECT_EQ(s.animations[0].end, 1.0);
+  PoseRequest r;
+  r.animation = 0;
+  for (const auto& [t, scale] : std::vector<std::pair<double, float>>{{0.3, 1.0f}, {0.6, 2.0f}, {7.0, 3.0f}}) {
+    r.time = t;
+    Scene p;
+    EXPECT_TRUE(pose_scene(s, r, p));
+    for (size_t v = 0; v < s.positions.size(); ++v) EXPECT_EQ(p.positions[v], s.positions[v] * scale) << t;
+  }
 }
 
 // Broken files and containers that never reach the glTF structure.

@@ -49,6 +49,14 @@ const Rule kKeyTimes{"animation input", 1u << 1, combo(kFloat, false)};
 const Rule kAnimationOutput{"animation output", 1u << 1 | 1u << 3 | 1u << 4,
                             combo(kFloat, false) | combo(kByte, true) | combo(kUByte, true) | combo(kShort, true) |
                                 combo(kUShort, true)};
+// Skins: JOINTS_n are unsigned byte / short indices, WEIGHTS_n float or normalized unsigned integers,
+// inverse bind matrices float MAT4. Morph target deltas: float, or (KHR_mesh_quantization) integers.
+const Rule kJoints{"JOINTS", 1u << 4, combo(kUByte, false) | combo(kUShort, false)};
+const Rule kWeights{"WEIGHTS", 1u << 4, combo(kFloat, false) | combo(kUByte, true) | combo(kUShort, true)};
+const Rule kInverseBind{"inverseBindMatrices", 1u << 16, combo(kFloat, false)};
+const Rule kMorphDelta{"morph target", 1u << 3,
+                       combo(kFloat, false) | combo(kByte, false) | combo(kByte, true) | combo(kShort, false) |
+                           combo(kShort, true)};
 
 size_t component_size(int type) {
   switch (type) {
@@ -65,7 +73,8 @@ int component_count(int type) {
     case TINYGLTF_TYPE_VEC2: return 2;
     case TINYGLTF_TYPE_VEC3: return 3;
     case TINYGLTF_TYPE_VEC4: return 4;
-    default: return 0;  // matrices are never vertex attributes we read
+    case TINYGLTF_TYPE_MAT4: return 16;  // float MAT4 columns are 16 bytes: no padding (spec, "Data Alignment")
+    default: return 0;  // MAT2 / MAT3 are never read
   }
 }
 
@@ -218,6 +227,10 @@ const Rule& rule_for(Semantic semantic) {
     case Semantic::Color: return kColor;
     case Semantic::KeyTimes: return kKeyTimes;
     case Semantic::AnimationOutput: return kAnimationOutput;
+    case Semantic::Joints: return kJoints;
+    case Semantic::Weights: return kWeights;
+    case Semantic::InverseBind: return kInverseBind;
+    case Semantic::MorphDelta: return kMorphDelta;
     default: return kIndices;
   }
 }

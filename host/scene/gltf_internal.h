@@ -22,6 +22,8 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
+#include "scene/motion.h"
+
 namespace pmr::gltf {
 
 // Throws pmr::Error("<file>: <what>").
@@ -69,12 +71,24 @@ std::vector<int> validate_model(const tinygltf::Model& model, const std::string&
 std::vector<int> scene_roots(const tinygltf::Model& model, const std::vector<int>& parent,
                              const std::string& file);
 
-// The node's local transform (matrix, or T * R * S), checked for size and finiteness.
-glm::dmat4 node_local_matrix(const tinygltf::Node& node, int index, const std::string& file);
+// The node's rest transform (matrix, or T, R, S with R normalized), checked for size and finiteness.
+// Morph weights are not filled in.
+MotionNode node_transform(const tinygltf::Node& node, int index, const std::string& file);
+
+// ---- gltf_motion.cpp ---------------------------------------------------------------------------------
+
+// Nodes (rest transforms, default morph weights, parents before children), clips and skins. Camera
+// nodes and deformable instances are filled in by the loader's walk.
+std::shared_ptr<SceneMotion> read_motion(const tinygltf::Model& model, const std::vector<int>& parent,
+                                         const std::string& file);
+// Per node: whether some clip's translation, rotation or scale channel moves it or an ancestor.
+std::vector<bool> moving_nodes(const SceneMotion& motion);
 
 // ---- gltf_accessors.cpp ----------------------------------------------------------------------------
 
-enum class Semantic { Position, Normal, Texcoord, Color, Indices, KeyTimes, AnimationOutput };
+enum class Semantic {
+  Position, Normal, Texcoord, Color, Indices, KeyTimes, AnimationOutput, Joints, Weights, InverseBind, MorphDelta
+};
 
 // One vertex attribute, decoded to float (normalized integers mapped per the glTF spec), sparse
 // substitutions applied. values.size() == count * components.

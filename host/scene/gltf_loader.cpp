@@ -156,7 +156,11 @@ struct Loader {
   std::map<int, int> scene_texture_of;   // glTF texture -> Scene::textures index (-1: unusable)
   std::set<int> used_materials;          // glTF materials of emitted primitives
   size_t point_line_primitives = 0, skipped_triangles = 0, nonfinite_attributes = 0, leftover_indices = 0;
-  bool skinned = false, morphed = false;
+  std::shared_ptr<SceneMotion> motion;   // always built; kept in the scene when a clip moves something
+  std::vector<glm::dmat4> rest_world;     // per node
+  std::vector<std::vector<glm::dmat4>> rest_joints;  // per skin: joint matrices at rest
+  std::vector<bool> moving, weights_animated;        // per node
+  std::set<int> skins_without_joints;                // meshes: skinned nodes whose mesh lacks JOINTS_0
 
   void warn(const std::string& line) {
     if (seen.insert(line).second) scene.warnings.push_back(file + ": " + one_line(line));
@@ -316,43 +320,37 @@ void build_materials(Loader& L) {
 
 struct Instance {
   int mesh;
-  glm::dmat4 world;
+  int node;
 };
 
-bool finite(const glm::dmat4& m) {
-  for (int c = 0; c < 4; ++c)
-    for (int r = 0; r < 4; ++r)
-      if (!std::isfinite(m[c][r])) return false;
-  return true;
-}
-
-// Pre-order walk, children in their listed order. The hierarchy is a checked forest, so each node is
-// visited once and the walk ends.
+// Pre-order walk, children in their listed order: the instances in the order they are emitted, and
+// which node places each camera (the first in this order).
 std::vector<Instance> walk(Loader& L, const std::vector<int>& roots) {
   std::vector<Instance> instances;
-  std::vector<std::pair<int, glm::dmat4>> stack;
-  for (auto r = roots.rbegin(); r != roots.rend(); ++r) stack.push_back({*r, glm::dmat4(1.0)});
+  std::vector<int> stack(roots.rbegin(), roots.rend());
   while (!stack.empty()) {
-    const auto [index, parent] = stack.back();
+    const int index = stack.back();
     stack.pop_back();
     const tinygltf::Node& node = L.model.nodes[size_t(index)];
-    const glm::dmat4 world = parent * node_local_matrix(node, index, L.file);
-    if (!finite(world)) fail(L.file, "node " + std::to_string(index) + " has a world matrix that overflows");
-    if (node.mesh >= 0) instances.push_back({node.mesh, world});
-    if (node.skin >= 0) L.skinned = true;
+    const glm::dmat4& world = L.rest_world[size_t(index)];
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r)
+        if (!std::isfinite(world[c][r])) fail(L.file, "node " + std::to_string(index) + " has a world matrix that overflows");
+    if (node.mesh >= 0) instances.push_back({node.mesh, index});
     if (node.camera >= 0 && !L.scene.cameras[size_t(node.camera)].placed) {
       L.scene.cameras[size_t(node.camera)].placed = true;
       L.scene.cameras[size_t(node.camera)].world_from_camera = world;
+      L.motion->camera_node[size_t(node.camera)] = index;
     }
-    for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back({*c, world});
+    for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back(*c);
   }
   return instances;
 }
 
 // One primitive decoded in its mesh's space, shared by all instances of the mesh.
 struct Decoded {
-  size_t vertices = 0;
-  std::vector<float> pos, nrm, uv, col;  // nrm, uv, col empty when the attribute is absent
+  std::shared_ptr<DeformSource> geo;     // positions, normals, morph targets, joints and weights
+  std::vector<float> uv, col;            // empty when the attribute is absent
   std::vector<uint32_t> tris;            // 3 local vertex indices per triangle, as authored (CCW front)
   uint32_t material = 0;                 // Scene::materials index
 };
@@ -376,27 +374,56 @@ Decoded decode_primitive(Loader& L, int mesh, int index) {
     L.warn(where + " has no POSITION attribute; skipped");
     return d;
   }
-  if (!p.targets.empty()) L.morphed = true;
   if (p.material >= 0) L.used_materials.insert(p.material);
   d.material = p.material >= 0 ? uint32_t(p.material + 1) : 0u;
   AttributeData pos = read_attribute(L.model, *position, Semantic::Position, "POSITION of " + where, L.file);
-  d.vertices = pos.count;
-  d.pos = std::move(pos.values);
-  auto read = [&](const std::string& name, Semantic semantic) -> std::vector<float> {
-    const int* a = attribute(p, name);
-    if (!a) return {};
-    AttributeData data = read_attribute(L.model, *a, semantic, name + " of " + where, L.file);
-    if (data.count != d.vertices)
-      fail(L.file, "accessor " + std::to_string(*a) + " (" + name + " of " + where + ") has " + std::to_string(data.count) +
-                       " elements but POSITION has " + std::to_string(d.vertices));
-    if (semantic == Semantic::Color && data.components == 3) {  // RGB -> RGBA, alpha 1
-      std::vector<float> rgba(d.vertices * 4, 1.0f);
-      for (size_t v = 0; v < d.vertices; ++v) std::copy_n(&data.values[3 * v], 3, &rgba[4 * v]);
-      return rgba;
-    }
+  d.geo = std::make_shared<DeformSource>();
+  DeformSource& geo = *d.geo;
+  geo.vertices = pos.count;
+  geo.pos = std::move(pos.values);
+  auto read_from = [&](const std::map<std::string, int>& attributes, const std::string& name, Semantic semantic,
+                       const std::string& label) -> std::vector<float> {
+    const auto it = attributes.find(name);
+    if (it == attributes.end()) return {};
+    const int a = it->second;
+    AttributeData data = read_attribute(L.model, a, semantic, label, L.file);
+    if (data.count != geo.vertices)
+      fail(L.file, "accessor " + std::to_string(a) + " (" + label + ") has " + std::to_string(data.count) +
+                       " elements but POSITION has " + std::to_string(geo.vertices));
     return std::move(data.values);
   };
-  d.nrm = read("NORMAL", Semantic::Normal);
+  auto read = [&](const std::string& name, Semantic semantic) -> std::vector<float> {
+    std::vector<float> values = read_from(p.attributes, name, semantic, name + " of " + where);
+    if (values.empty()) return values;
+    if (semantic == Semantic::Color && values.size() == geo.vertices * 3) {  // RGB -> RGBA, alpha 1
+      std::vector<float> rgba(geo.vertices * 4, 1.0f);
+      for (size_t v = 0; v < geo.vertices; ++v) std::copy_n(&values[3 * v], 3, &rgba[4 * v]);
+      return rgba;
+    }
+    return values;
+  };
+  geo.nrm = read("NORMAL", Semantic::Normal);
+  for (size_t k = 0; k < p.targets.size(); ++k) {
+    const std::string t = " of " + where + " morph target " + std::to_string(k);
+    geo.target_pos.push_back(read_from(p.targets[k], "POSITION", Semantic::MorphDelta, "POSITION" + t));
+    geo.target_nrm.push_back(read_from(p.targets[k], "NORMAL", Semantic::MorphDelta, "NORMAL" + t));
+  }
+  for (int set = 0; set < 2; ++set) {  // JOINTS_0 / WEIGHTS_0, then _1: four influences each
+    const std::string n = std::to_string(set);
+    std::vector<float> joints = read("JOINTS_" + n, Semantic::Joints), weights = read("WEIGHTS_" + n, Semantic::Weights);
+    if (joints.empty() || weights.empty()) break;
+    const int k = geo.influences + 4;
+    std::vector<uint16_t> j(geo.vertices * size_t(k));
+    std::vector<float> w(geo.vertices * size_t(k));
+    for (size_t v = 0; v < geo.vertices; ++v)
+      for (int i = 0; i < k; ++i) {
+        const bool old = i < geo.influences;
+        j[v * size_t(k) + size_t(i)] = old ? geo.joints[v * size_t(geo.influences) + size_t(i)] : uint16_t(joints[4 * v + size_t(i - geo.influences)]);
+        const float wv = old ? geo.weights[v * size_t(geo.influences) + size_t(i)] : weights[4 * v + size_t(i - geo.influences)];
+        w[v * size_t(k) + size_t(i)] = std::isfinite(wv) && wv > 0.0f ? wv : 0.0f;
+      }
+    geo.joints = std::move(j), geo.weights = std::move(w), geo.influences = k;
+  }
   const MaterialUv uv = p.material >= 0 ? L.material_uv[size_t(p.material)] : MaterialUv{};
   d.uv = read("TEXCOORD_" + std::to_string(uv.set), Semantic::Texcoord);
   if (uv.transform.active) {
@@ -414,11 +441,11 @@ Decoded decode_primitive(Loader& L, int mesh, int index) {
     const std::string what = "indices of " + where;
     indices = read_indices(L.model, p.indices, what, L.file);
     for (uint32_t i : indices)
-      if (i >= d.vertices)
+      if (i >= geo.vertices)
         fail(L.file, "accessor " + std::to_string(p.indices) + " (" + what + ") reads index " + std::to_string(i) +
-                         " but POSITION has " + std::to_string(d.vertices) + " vertices");
+                         " but POSITION has " + std::to_string(geo.vertices) + " vertices");
   }
-  const size_t n = p.indices >= 0 ? indices.size() : d.vertices;
+  const size_t n = p.indices >= 0 ? indices.size() : geo.vertices;
   auto at = [&](size_t k) { return p.indices >= 0 ? indices[k] : uint32_t(k); };
   const size_t triangles = mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : n >= 3 ? n - 2 : 0;  // < 2^27: check_totals
   d.tris.reserve(3 * triangles);
@@ -437,44 +464,38 @@ Decoded decode_primitive(Loader& L, int mesh, int index) {
   return d;
 }
 
-glm::vec3 face_normal(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
-  const glm::dvec3 n = glm::cross(glm::dvec3(b) - glm::dvec3(a), glm::dvec3(c) - glm::dvec3(a));
-  const double len = glm::length(n);
-  if (!(len > 0.0) || !std::isfinite(len)) return {0.0f, 0.0f, 1.0f};  // zero area
-  return glm::vec3(n / len);
-}
-
-bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-// Appends one instance: positions to world space, normals by the inverse transpose, winding reversed
-// under a mirroring matrix so that counter-clockwise stays the front face.
-void emit(Loader& L, const Decoded& d, const glm::dmat4& world) {
+// Appends one instance at its rest pose: morph targets with the node's default weights, then the skin at
+// its skeleton's rest transforms or the node's world matrix; winding reversed under a mirroring matrix
+// so that counter-clockwise stays the front face. Records the instance as deformable when a clip can
+// move it.
+void emit(Loader& L, const Decoded& d, const Instance& inst) {
   Scene& s = L.scene;
   const size_t ntri = d.tris.size() / 3;
   if (ntri == 0) return;  // (totals were checked by check_totals)
-  const glm::dmat3 m3(world);
-  const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(m3));
-  const bool mirrored = glm::determinant(m3) < 0.0;
+  const DeformSource& geo = *d.geo;
+  int skin = L.model.nodes[size_t(inst.node)].skin;
+  if (skin >= 0 && geo.influences == 0) {
+    L.skins_without_joints.insert(inst.mesh);
+    skin = -1;
+  }
+  if (skin >= 0) {
+    const size_t joints = L.motion->skins[size_t(skin)].joints.size();
+    for (uint16_t j : geo.joints)
+      if (j >= joints)
+        fail(L.file, "mesh " + std::to_string(inst.mesh) + " has a JOINTS value " + std::to_string(j) + " but skin " +
+                         std::to_string(skin) + " has " + std::to_string(joints) + " joints");
+  }
+  const glm::dmat4& world = L.rest_world[size_t(inst.node)];
+  const bool mirrored = skin < 0 && glm::determinant(glm::dmat3(world)) < 0.0;
   const uint32_t base = uint32_t(s.positions.size());
-  std::vector<uint8_t> bad_position(d.vertices, 0), bad_normal(d.vertices, 0);
-  for (size_t v = 0; v < d.vertices; ++v) {
-    const glm::dvec4 p = world * glm::dvec4(d.pos[3 * v], d.pos[3 * v + 1], d.pos[3 * v + 2], 1.0);
-    glm::vec3 pf(p);
-    if (!finite(pf)) {  // NaN in the data, or beyond float range
-      bad_position[v] = 1;
-      pf = glm::vec3(0.0f);
-    }
-    s.positions.push_back(pf);
-    PmrVertexAttr a{};
-    if (!d.nrm.empty()) {
-      const glm::dvec3 n = normal_matrix * glm::dvec3(d.nrm[3 * v], d.nrm[3 * v + 1], d.nrm[3 * v + 2]);
-      const double len = glm::length(n);
-      if (len > 0.0 && std::isfinite(len)) {
-        for (int c = 0; c < 3; ++c) a.normal[c] = float(n[c] / len);
-      } else {
-        bad_normal[v] = 1;
-      }
-    }
+  const uint32_t first_triangle = uint32_t(s.triangles.size());
+  s.positions.resize(base + geo.vertices);
+  s.attributes.resize(base + geo.vertices);
+  std::vector<uint8_t> bad_position(geo.vertices, 0), bad_normal(geo.vertices, 0);
+  deform(geo, L.motion->nodes[size_t(inst.node)].weights, skin >= 0 ? L.rest_joints[size_t(skin)].data() : nullptr,
+         world, &s.positions[base], &s.attributes[base], bad_position.data(), bad_normal.data());
+  for (size_t v = 0; v < geo.vertices; ++v) {
+    PmrVertexAttr& a = s.attributes[base + v];
     for (int c = 0; c < 2; ++c) {
       a.uv[c] = d.uv.empty() ? 0.0f : d.uv[2 * v + size_t(c)];
       if (!std::isfinite(a.uv[c])) a.uv[c] = 0.0f, ++L.nonfinite_attributes;
@@ -483,7 +504,6 @@ void emit(Loader& L, const Decoded& d, const glm::dmat4& world) {
       a.color[c] = d.col.empty() ? 1.0f : d.col[4 * v + size_t(c)];
       if (!std::isfinite(a.color[c])) a.color[c] = 1.0f, ++L.nonfinite_attributes;
     }
-    s.attributes.push_back(a);
   }
   for (size_t t = 0; t < ntri; ++t) {
     uint32_t v[3] = {d.tris[3 * t], d.tris[3 * t + 1], d.tris[3 * t + 2]};
@@ -497,8 +517,22 @@ void emit(Loader& L, const Decoded& d, const glm::dmat4& world) {
     tri.material = d.material;
     const glm::vec3 n = face_normal(s.positions[tri.v[0]], s.positions[tri.v[1]], s.positions[tri.v[2]]);
     tri.face_normal[0] = n.x, tri.face_normal[1] = n.y, tri.face_normal[2] = n.z;
-    tri.has_normals = !d.nrm.empty() && !bad_normal[v[0]] && !bad_normal[v[1]] && !bad_normal[v[2]];
+    tri.has_normals = !geo.nrm.empty() && !bad_normal[v[0]] && !bad_normal[v[1]] && !bad_normal[v[2]];
     s.triangles.push_back(tri);
+  }
+  bool moves = L.weights_animated[size_t(inst.node)] || (skin < 0 && L.moving[size_t(inst.node)]);
+  if (skin >= 0)
+    for (int j : L.motion->skins[size_t(skin)].joints) moves = moves || L.moving[size_t(j)];
+  if (moves) {
+    Deformable dm;
+    dm.node = inst.node;
+    dm.skin = skin;
+    dm.source = d.geo;
+    dm.vertex_begin = base;
+    dm.triangle_begin = first_triangle;
+    dm.triangle_end = uint32_t(s.triangles.size());
+    dm.rest_mirrored = mirrored;
+    L.motion->deformables.push_back(std::move(dm));
   }
 }
 
@@ -561,9 +595,15 @@ void emit_instances(Loader& L, const std::vector<Instance>& instances) {
       std::vector<Decoded> prims;
       const size_t count = L.model.meshes[size_t(inst.mesh)].primitives.size();
       for (size_t p = 0; p < count; ++p) prims.push_back(decode_primitive(L, inst.mesh, int(p)));
+      const auto& mp = L.model.meshes[size_t(inst.mesh)].primitives;
+      for (size_t p = 1; p < count; ++p)
+        if (mp[p].targets.size() != mp[0].targets.size())
+          fail(L.file, "mesh " + std::to_string(inst.mesh) + " primitive " + std::to_string(p) + " has " +
+                           std::to_string(mp[p].targets.size()) + " morph targets but primitive 0 has " +
+                           std::to_string(mp[0].targets.size()));
       it = cache.emplace(inst.mesh, std::move(prims)).first;
     }
-    for (const Decoded& d : it->second) emit(L, d, inst.world);
+    for (const Decoded& d : it->second) emit(L, d, inst);
     if (--remaining[inst.mesh] == 0) cache.erase(it);
   }
 }
@@ -608,9 +648,8 @@ std::string join(const std::vector<std::string>& items) {
 void summary_warnings(Loader& L, const SourceFile& src) {
   if (!src.ignored_extensions.empty())
     L.warn("extensions used but not implemented, ignored: " + join(src.ignored_extensions));
-  if (!L.model.animations.empty()) L.warn("animations ignored: the static pose is rendered");
-  if (L.skinned) L.warn("skins ignored: skinned meshes are drawn in their bind pose");
-  if (L.morphed) L.warn("morph targets ignored: meshes are drawn with their base shape");
+  for (int mesh : L.skins_without_joints)
+    L.warn("mesh " + std::to_string(mesh) + " is skinned but has no JOINTS_0 / WEIGHTS_0: drawn unskinned");
   if (L.point_line_primitives)
     L.warn(std::to_string(L.point_line_primitives) + " point or line primitive(s) skipped: only triangles are drawn");
   if (L.leftover_indices) L.warn("TRIANGLES primitive(s) with a vertex count not divisible by 3: extra vertices ignored");
@@ -638,12 +677,23 @@ Scene load_scene(const std::string& path) {
 
   Scene scene;
   Loader L(model, path, images, scene);
+  L.motion = read_motion(model, parent, path);
+  L.rest_world = world_matrices(*L.motion, rest_local_matrices(*L.motion));
+  for (const MotionSkin& skin : L.motion->skins) L.rest_joints.push_back(joint_matrices(skin, L.rest_world));
+  L.moving = moving_nodes(*L.motion);
+  L.weights_animated.assign(model.nodes.size(), false);
+  for (const MotionClip& clip : L.motion->clips)
+    for (const MotionChannel& ch : clip.channels)
+      if (ch.path == ChannelPath::Weights) L.weights_animated[size_t(ch.node)] = true;
   build_materials(L);
   build_cameras(L);
   emit_instances(L, walk(L, roots));
   check_cameras(L);
   summary_warnings(L, src);
-  if (scene.triangles.empty()) fail(path, "the scene has no triangles to render");
+  if (scene.triangles.empty())
+    L.warn("the scene has no triangles to render: every frame will be a transparent image");
+  for (const MotionClip& clip : L.motion->clips) scene.animations.push_back({clip.name, clip.start, clip.end});
+  if (!L.motion->clips.empty()) scene.motion = L.motion;
   return scene;
 }
 

@@ -445,20 +445,21 @@ std::vector<int> scene_roots(const tinygltf::Model& m, const std::vector<int>& p
   return roots;
 }
 
-glm::dmat4 node_local_matrix(const tinygltf::Node& n, int index, const std::string& file) {
+MotionNode node_transform(const tinygltf::Node& n, int index, const std::string& file) {
   const std::string name = "node " + std::to_string(index);
   auto finite = [](const std::vector<double>& v) {
     for (double x : v)
       if (!std::isfinite(x)) return false;
     return true;
   };
+  MotionNode out;
   if (!n.matrix.empty()) {
     if (n.matrix.size() != 16) fail(file, name + " has a matrix of " + std::to_string(n.matrix.size()) + " values (16 expected)");
     if (!finite(n.matrix)) fail(file, name + " has a non-finite matrix");
-    glm::dmat4 m;
+    out.has_matrix = true;
     for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[size_t(c * 4 + r)];  // glTF is column-major, like glm
-    return m;
+      for (int r = 0; r < 4; ++r) out.matrix[c][r] = n.matrix[size_t(c * 4 + r)];  // glTF is column-major, like glm
+    return out;
   }
   auto check = [&](const std::vector<double>& v, size_t size, const char* what) {
     if (!v.empty() && v.size() != size)
@@ -468,25 +469,16 @@ glm::dmat4 node_local_matrix(const tinygltf::Node& n, int index, const std::stri
   check(n.translation, 3, "translation");
   check(n.rotation, 4, "rotation");
   check(n.scale, 3, "scale");
-  const glm::dvec3 t = n.translation.empty() ? glm::dvec3(0.0) : glm::dvec3(n.translation[0], n.translation[1], n.translation[2]);
-  const glm::dvec3 s = n.scale.empty() ? glm::dvec3(1.0) : glm::dvec3(n.scale[0], n.scale[1], n.scale[2]);
-  double x = 0, y = 0, z = 0, w = 1;
+  if (!n.translation.empty()) out.translation = glm::dvec3(n.translation[0], n.translation[1], n.translation[2]);
+  if (!n.scale.empty()) out.scale = glm::dvec3(n.scale[0], n.scale[1], n.scale[2]);
   if (!n.rotation.empty()) {
-    x = n.rotation[0], y = n.rotation[1], z = n.rotation[2], w = n.rotation[3];
+    const glm::dvec4 q(n.rotation[0], n.rotation[1], n.rotation[2], n.rotation[3]);
     // The spec wants unit quaternions; exporters write them rounded to a few digits, so normalize.
-    const double len = std::sqrt(x * x + y * y + z * z + w * w);
+    const double len = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
     if (!(len > 0.0) || !std::isfinite(len)) fail(file, name + " has a zero-length rotation quaternion");
-    x /= len, y /= len, z /= len, w /= len;
+    out.rotation = q / len;
   }
-  // Rotation matrix of the unit quaternion (x, y, z, w); glm matrices are indexed [column][row].
-  glm::dmat3 r;
-  r[0] = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w)};
-  r[1] = {2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w)};
-  r[2] = {2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y)};
-  glm::dmat4 m(1.0);
-  for (int c = 0; c < 3; ++c) m[c] = glm::dvec4(r[c] * s[c], 0.0);
-  m[3] = glm::dvec4(t, 1.0);
-  return m;
+  return out;
 }
 
 }  // namespace pmr::gltf

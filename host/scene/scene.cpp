@@ -16,20 +16,20 @@ PmrMaterial default_material() {
   return m;
 }
 
-void scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi) {
-  lo = glm::dvec3(std::numeric_limits<double>::infinity());
-  hi = -lo;
+bool scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi) {
+  glm::dvec3 l(std::numeric_limits<double>::infinity()), h = -l;
   bool any = false;
   for (const PmrTriangle& t : scene.triangles) {
     for (uint32_t v : t.v) {
       if (v >= scene.positions.size()) throw Error("scene_bounds: triangle vertex index out of range");
       const glm::dvec3 p(scene.positions[v]);
-      lo = glm::min(lo, p);
-      hi = glm::max(hi, p);
+      l = glm::min(l, p);
+      h = glm::max(h, p);
       any = true;
     }
   }
-  if (!any) throw Error("scene_bounds: the scene has no triangles");
+  if (any) lo = l, hi = h;
+  return any;
 }
 
 }  // namespace pmr

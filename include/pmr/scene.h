@@ -2,6 +2,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,14 @@ struct SceneCamera {
   bool placed = false;                // true: a node of the scene places it (world_from_camera valid)
 };
 
+struct SceneMotion;  // node hierarchy, clips, skins, moving instances (host/scene/motion.h)
+
+// A glTF animation as the CLI lists and selects it.
+struct SceneAnimation {
+  std::string name;               // as in the file ("" when unnamed)
+  double start = 0.0, end = 0.0;  // first and last key time, seconds
+};
+
 struct Scene {
   std::vector<glm::vec3> positions;       // world space, one per vertex
   std::vector<PmrVertexAttr> attributes;  // one per vertex (normal in world space)
@@ -39,14 +48,44 @@ struct Scene {
   std::vector<SceneTexture> textures;     // referenced by PmrMaterial::texture
   std::vector<SceneCamera> cameras;       // one per glTF camera, same order (see SceneCamera::placed)
   std::vector<std::string> warnings;      // non-fatal problems, one line each
+  // The arrays above hold the rest pose: no animation applied, default morph weights, skins bound to
+  // their skeleton's rest transforms. pose_scene() places a frame.
+  std::vector<SceneAnimation> animations;
+  std::shared_ptr<const SceneMotion> motion;  // null when no animation can move anything
 };
+
+constexpr int kNoAnimation = -1, kAllAnimations = -2;
+
+// One frame's pose (DESIGN section 7).
+struct PoseRequest {
+  double time = 0.0;                // seconds
+  int animation = kNoAnimation;     // index into Scene::animations, kNoAnimation or kAllAnimations
+  bool turntable = false;           // turn the geometry by turntable_deg about +Y through pivot
+  double turntable_deg = 0.0;       // counter-clockwise seen from above (right-hand rule about +Y)
+  glm::dvec3 pivot{0.0};
+};
+
+// Writes the posed geometry (positions, attributes, triangles) and cameras of `rest` into `out`.
+// `out` starts as anything: its arrays are sized and filled from `rest` on first use and rewritten
+// where the pose differs, so a pose depends only on the request, never on earlier frames. Materials
+// and textures of `out` are left alone. Returns true when some geometry differs from the rest pose's
+// arrays (so the renderer must upload it).
+bool pose_scene(const Scene& rest, const PoseRequest& request, Scene& out);
+
+// True if the request can move any vertex or camera (an animation that targets something, or a
+// turntable). A static request's frames are the rest scene.
+bool pose_moves(const Scene& rest, const PoseRequest& request);
+
+// The turntable angle of frame f for DEG:FRAMES, in [0, 360), exact for whole multiples of 360.
+double turntable_angle(long frame, double degrees, long frames);
 
 // Loads a .gltf or .glb file (detected by content, not by extension) and validates it completely
 // before returning. Throws pmr::Error with one clear line on anything that cannot be rendered.
 Scene load_scene(const std::string& path);
 
-// World-space axis-aligned bounds of all vertices referenced by triangles. Throws if there are none.
-void scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi);
+// World-space axis-aligned bounds of all vertices referenced by triangles. Returns false (lo, hi
+// untouched) when there are none.
+bool scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi);
 
 }  // namespace pmr
 

@@ -133,7 +133,9 @@ TEST(PoseTest, CorpusAnimationsPoseWithPlausibleBounds) {
         moved |= s.positions[v] != rest.positions[v];
         const float* n = s.attributes[v].normal;
         const double len = std::sqrt(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2]);
-        if (len != 0.0) ASSERT_NEAR(len, 1.0, 1e-5) << "vertex " << v << " t = " << t;
+        if (len != 0.0) {
+          ASSERT_NEAR(len, 1.0, 1e-5) << "vertex " << v << " t = " << t;
+        }
       }
     }
     // AnimatedTriangle etc. move their node; every model here moves some vertex at some time

@@ -1,7 +1,9 @@
 #include "cli/options.h"
 
 #include <cerrno>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 
@@ -93,7 +95,26 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
         else throw Error("invalid --write '" + w + "': expected encoded, views or encoded,views");
       }
     } else if (a == "--compression") o.compression = value();
-    else if (a == "--frame") o.frame = parse_int(value(), a, 0, 9999);
+    else if (a == "--frame" || a == "--frames") o.frames = value();
+    else if (a == "--fps") {
+      o.fps = parse_double(value(), a);
+      if (!(o.fps > 0.0) || o.fps > 10000.0) throw Error("invalid --fps: must be in (0, 10000]");
+    } else if (a == "--animation") {
+      o.animation = value();
+      if (o.animation.empty()) throw Error("invalid --animation '': expected a name, an index or all");
+    } else if (a == "--name") {
+      o.name = value();
+      check_name_pattern(o.name);
+    } else if (a == "--turntable") {
+      const std::string v = value();
+      const auto colon = v.find(':');
+      if (colon == std::string::npos) throw Error("invalid --turntable '" + v + "': expected DEG:FRAMES, e.g. 360:96");
+      o.turntable = true;
+      o.turntable_deg = parse_double(v.substr(0, colon), a);
+      o.turntable_frames = parse_int(v.substr(colon + 1), a, 1, 1 << 30);
+    } else if (a == "--resume") o.resume = true;
+    else if (a == "--overwrite") o.overwrite = true;
+    else if (a == "--quiet" || a == "-q") o.quiet = true;
     else if (a == "--verbose" || a == "-v") o.verbose = true;
     else if (a == "--method") o.pipeline.method = parse_method(value());
     else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see pmr render --help)");
@@ -101,6 +122,36 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     else throw Error("more than one scene given ('" + o.scene + "' and '" + a + "')");
   }
   return o;
+}
+
+void check_name_pattern(const std::string& p) {
+  int conversions = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    if (p[i] == '/') throw Error("invalid --name '" + p + "': a file stem cannot contain '/'");
+    if (p[i] != '%') continue;
+    if (i + 1 < p.size() && p[i + 1] == '%') {
+      ++i;
+      continue;
+    }
+    size_t j = i + 1;
+    if (j < p.size() && p[j] == '0') ++j;
+    size_t digits = 0;
+    while (j < p.size() && std::isdigit((unsigned char)p[j])) ++j, ++digits;
+    if (j >= p.size() || p[j] != 'd' || digits > 2)
+      throw Error("invalid --name '" + p + "': only %d, %Nd or %0Nd (and %% for a percent sign) are allowed");
+    ++conversions;
+    i = j;
+  }
+  if (conversions != 1)
+    throw Error("invalid --name '" + p + "': it needs exactly one frame number conversion such as %04d");
+  if (frame_stem(p, 0).empty() || frame_stem(p, 0)[0] == '.')
+    throw Error("invalid --name '" + p + "': the file stem would be empty or hidden");
+}
+
+std::string frame_stem(const std::string& pattern, long frame) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf, pattern.c_str(), int(frame));  // checked by check_name_pattern
+  return buf;
 }
 
 void finalize_render_options(RenderOptions& o) {
@@ -132,8 +183,18 @@ std::string render_help() {
          "  --write LIST           encoded, views or encoded,views (default: encoded). DIR/frame_NNNN.exr is\n"
          "                         the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view;\n"
          "                         DIR/frame_NNNN.json (rig, display, every view's matrices) is always written\n"
-         "  --frame N              frame number used in the file names (default 0)\n"
+         "  --name PATTERN         file stem, printf-style with one integer (default frame_%04d)\n"
          "  --compression C        EXR compression: none, zip, piz, rle (default zip)\n"
+         "sequences (an animated glTF plays; frame f samples time f / fps):\n"
+         "  --frames LIST          frames to render: N, A:B (inclusive), A:B:STEP, a comma list of these\n"
+         "                         (0:99,120,130:140), or all = the animation's time range (default 0)\n"
+         "  --fps F                frames per second (default 24)\n"
+         "  --animation A          NAME, INDEX or all (every animation at once); default: the first one\n"
+         "  --turntable DEG:FRAMES turn the scene DEG degrees every FRAMES frames about the vertical axis\n"
+         "                         through its framing center (360:96 loops every 96 frames)\n"
+         "  --resume               skip frames whose files are all present; refuse a changed configuration\n"
+         "  --overwrite            with --resume: re-render frames of another configuration instead\n"
+         "  --quiet                no progress output (errors and the summary still print)\n"
          "rig:\n"
          "  --preset NAME          paper-8k (the only preset; also the default)\n"
          "  --views N              number of views (default 96)\n"

@@ -18,13 +18,27 @@ struct RenderOptions {
   bool write_encoded = true;
   bool write_views = false;
   std::string compression = "zip";
-  int frame = 0;
+  // Sequences (DESIGN section 7)
+  std::string frames = "0";       // --frames LIST, or "all"
+  double fps = 24.0;
+  std::string animation;          // --animation NAME|INDEX|all; empty = the first animation
+  std::string name = "frame_%04d";  // --name: printf-style stem, one integer conversion
+  bool turntable = false;
+  double turntable_deg = 0.0;
+  long turntable_frames = 0;
+  bool resume = false, overwrite = false, quiet = false;
   bool verbose = false;
   bool help = false;
 };
 
 // Parses the arguments after `render`. Throws pmr::Error with one line on bad input.
 RenderOptions parse_render_options(const std::vector<std::string>& args);
+// Checks a --name pattern: exactly one integer conversion (%d, %4d, %04d), %% for a literal percent,
+// no '/'. Throws pmr::Error otherwise.
+void check_name_pattern(const std::string& pattern);
+// The file stem of a frame under the pattern.
+std::string frame_stem(const std::string& pattern, long frame);
+
 // Fills in derived defaults (the encoder offset) once all options are known.
 void finalize_render_options(RenderOptions& options);
 std::string render_help();

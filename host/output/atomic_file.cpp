@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <system_error>
 
+#include "output/interrupt.h"
 #include "pmr/error.h"
 #include "pmr/output.h"
 
@@ -51,9 +52,11 @@ AtomicFile::AtomicFile(std::string final_path) : final_path_(std::move(final_pat
     temp_path_.clear();
     throw Error("cannot write " + final_path_ + ": cannot create a file in its folder: " + reason);
   }
+  slot_ = register_temp_file(temp_path_);
 }
 
 AtomicFile::~AtomicFile() {
+  unregister_temp_file(slot_);
   if (!committed_ && !temp_path_.empty()) ::unlink(temp_path_.c_str());
 }
 
@@ -63,6 +66,8 @@ void AtomicFile::commit() {
     throw Error("cannot write " + final_path_ + ": cannot rename the finished temporary file " + temp_path_ +
                 " into place: " + std::strerror(errno));
   committed_ = true;
+  unregister_temp_file(slot_);
+  slot_ = -1;
 }
 
 void prepare_output_dir(const std::string& dir) {

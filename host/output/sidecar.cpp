@@ -81,6 +81,17 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   for (const auto& [kind, file] : info.outputs) outputs[kind] = file;
   j["outputs"] = outputs;
   j["warnings"] = info.warnings;
+  j["time"] = info.time;
+  j["fps"] = info.fps;
+  if (info.animation == -1) j["animation"] = nullptr;
+  else j["animation"] = {{"index", info.animation}, {"name", info.animation_name}};
+  if (info.turntable)
+    j["turntable"] = {{"degrees", info.turntable_deg},
+                      {"frames", info.turntable_frames},
+                      {"angle_deg", info.turntable_angle},
+                      {"pivot", vec3_json(info.pivot)},
+                      {"axis", vec3_json(glm::dvec3(0, 1, 0))}};
+  else j["turntable"] = nullptr;
 
   json d;
   d["width"] = display.width;
@@ -150,6 +161,32 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   std::string text;
   emit(j, 0, text);
   return text + "\n";
+}
+
+std::string sidecar_config_difference(const std::string& existing, const std::string& expected) {
+  const json b = json::parse(expected);
+  json a;
+  try {
+    a = json::parse(existing);
+  } catch (const std::exception&) {
+    return "unreadable";
+  }
+  if (!a.is_object()) return "unreadable";
+  for (const char* key : {"format", "scene", "method", "tile", "camera", "display", "fps", "animation"})
+    if (!a.contains(key) || a[key] != b[key]) return key;
+  // the turntable without this frame's angle
+  auto turn = [](json t) {
+    if (t.is_object()) t.erase("angle_deg");
+    return t;
+  };
+  if (!a.contains("turntable") || turn(a["turntable"]) != turn(b["turntable"])) return "turntable";
+  // the rig as configured (an animated camera moves the focal plane from frame to frame)
+  if (!a.contains("rig") || !a["rig"].is_object()) return "rig";
+  for (const char* key : {"views", "view_width", "view_height", "cone_deg", "yfov_deg", "aspect"})
+    if (!a["rig"].contains(key) || a["rig"][key] != b["rig"][key]) return std::string("rig.") + key;
+  // the framing (it follows from the scene file's content and the animation)
+  if (!a.contains("scene_bounds") || a["scene_bounds"] != b["scene_bounds"]) return "scene_bounds";
+  return "";
 }
 
 void write_sidecar(const std::string& path, const Rig& rig, const Display& display, const SidecarInfo& info) {

@@ -199,6 +199,17 @@ void Pipeline::set_scene(const Scene& scene) {
   }
 }
 
+void Pipeline::update_geometry(const Scene& posed) {
+  Impl& m = *impl_;
+  if (posed.positions.size() != m.num_vertices || posed.triangles.size() != m.num_triangles ||
+      posed.attributes.size() != posed.positions.size())
+    throw Error("update_geometry: the posed scene does not match the scene given to set_scene");
+  if (posed.triangles.empty()) return;
+  m.rt.write(m.positions, posed.positions.data(), bytes_of(posed.positions));
+  m.rt.write(m.attrs, posed.attributes.data(), bytes_of(posed.attributes));
+  m.rt.write(m.tris, posed.triangles.data(), bytes_of(posed.triangles));
+}
+
 size_t Pipeline::volume_bytes() const {
   const PmrParams& p = impl_->params;
   return size_t(p.views) * p.view_w * p.view_h * 4 * sizeof(uint16_t);

@@ -56,6 +56,9 @@ class Pipeline {
 
   // Uploads geometry, materials and textures. Call again to switch scenes.
   void set_scene(const Scene& scene);
+  // Replaces positions, attributes and triangles (a posed frame of the scene given to set_scene: same
+  // counts, same materials and textures). Only a copy: no buffer is reallocated.
+  void update_geometry(const Scene& posed);
   // Allocates the per-configuration buffers (view volume, tile queues, display image). The display
   // may be null when only the view volume is needed.
   void configure(const Rig& rig, const Display* display);

@@ -43,6 +43,7 @@ class AtomicFile {
  private:
   std::string final_path_, temp_path_;
   bool committed_ = false;
+  int slot_ = -1;  // registration with the interrupt handler (output/interrupt.h)
 };
 
 // Half RGBA EXR (scanline, one part), row 0 at the top (data window (0,0)-(width-1,height-1)).
@@ -86,10 +87,26 @@ struct SidecarInfo {
   // Files written for this frame, as (kind, file name) pairs, e.g. {"encoded", "frame_0000.exr"}.
   std::vector<std::pair<std::string, std::string>> outputs;
   std::vector<std::string> warnings;   // e.g. "near plane raised ..."
+  // The frame's place in a sequence (DESIGN section 7), so any frame can be reproduced alone.
+  double time = 0.0;                   // seconds: frame / fps
+  double fps = 24.0;
+  int animation = -1;                  // glTF animation index, -1 none, -2 all
+  std::string animation_name;          // its name ("all" for every animation)
+  bool turntable = false;
+  double turntable_deg = 0.0;          // DEG:FRAMES as requested
+  long turntable_frames = 0;
+  double turntable_angle = 0.0;        // this frame's angle, degrees
+  glm::dvec3 pivot{0.0};               // the turntable axis passes through it (along +Y)
 };
 
 // The sidecar's JSON text (pretty printed, doubles with round-trip precision).
 std::string sidecar_json(const Rig& rig, const Display& display, const SidecarInfo& info);
+// Compares the configuration that decides a frame's pixels (scene, method, tile, camera, display, rig,
+// framing, fps, animation, turntable; not the frame, its time or the outputs) of two sidecars' JSON
+// texts. Returns "" when they agree, else the first differing key (or "unreadable" when `existing` does
+// not parse).
+std::string sidecar_config_difference(const std::string& existing, const std::string& expected);
+
 // Writes the JSON sidecar (DESIGN section 6) atomically. Matrices are 16 numbers, column-major.
 void write_sidecar(const std::string& path, const Rig& rig, const Display& display, const SidecarInfo& info);
 

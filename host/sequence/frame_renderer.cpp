@@ -1,0 +1,167 @@
+#include "sequence/frame_renderer.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "pmr/error.h"
+#include "scene/motion.h"
+
+namespace pmr {
+
+void select_animation(const Scene& scene, const std::string& choice, SequenceSpec& spec) {
+  const auto& a = scene.animations;
+  auto label = [&](size_t i) { return a[i].name.empty() ? "#" + std::to_string(i) : a[i].name; };
+  if (choice.empty()) {
+    spec.animation = a.empty() ? kNoAnimation : 0;
+    spec.animation_label = a.empty() ? "" : label(0);
+    return;
+  }
+  if (choice == "all") {
+    spec.animation = a.empty() ? kNoAnimation : kAllAnimations;
+    spec.animation_label = a.empty() ? "" : "all";
+    if (a.empty()) throw Error("--animation all: the scene has no animations");
+    return;
+  }
+  for (size_t i = 0; i < a.size(); ++i)
+    if (a[i].name == choice) {
+      spec.animation = int(i), spec.animation_label = label(i);
+      return;
+    }
+  char* end = nullptr;
+  const long index = std::strtol(choice.c_str(), &end, 10);
+  if (!choice.empty() && *end == '\0' && index >= 0 && size_t(index) < a.size()) {
+    spec.animation = int(index), spec.animation_label = label(size_t(index));
+    return;
+  }
+  std::string known;
+  for (size_t i = 0; i < a.size(); ++i) known += (known.empty() ? "" : ", ") + std::to_string(i) + " '" + a[i].name + "'";
+  throw Error("--animation '" + choice + "': " +
+              (a.empty() ? std::string("the scene has no animations") : "no such animation (the scene has " + known + ")"));
+}
+
+namespace {
+
+// Clip key range of the selection (empty selection: false).
+bool key_range(const Scene& scene, int animation, double& start, double& end) {
+  bool any = false;
+  for (size_t i = 0; i < scene.animations.size(); ++i) {
+    if (animation != kAllAnimations && animation != int(i)) continue;
+    start = any ? std::min(start, scene.animations[i].start) : scene.animations[i].start;
+    end = any ? std::max(end, scene.animations[i].end) : scene.animations[i].end;
+    any = true;
+  }
+  return any;
+}
+
+double ms_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+void animation_frame_range(const Scene& scene, const SequenceSpec& spec, long& first, long& last) {
+  double start = 0, end = 0;
+  if (spec.animation != kNoAnimation && key_range(scene, spec.animation, start, end)) {
+    // A tolerance keeps 1.0000001 s at 24 fps from adding a frame.
+    first = std::max(0L, long(std::floor(start * spec.fps + 1e-6)));
+    last = std::max(first, long(std::ceil(end * spec.fps - 1e-6)));
+    return;
+  }
+  first = 0;
+  last = spec.turntable ? std::max(0L, spec.turntable_frames - 1) : 0;
+}
+
+PoseRequest FrameRenderer::request(long frame) const {
+  PoseRequest r;
+  r.time = double(frame) / spec_.fps;
+  r.animation = spec_.animation;
+  r.turntable = spec_.turntable;
+  r.turntable_deg = spec_.turntable ? turntable_angle(frame, spec_.turntable_deg, spec_.turntable_frames) : 0.0;
+  r.pivot = pivot();
+  return r;
+}
+
+FrameRenderer::FrameRenderer(const Scene& rest, const SequenceSpec& spec, const RigConfig& rig_config,
+                             const Display& display, std::vector<std::string>* warnings)
+    : rest_(rest), spec_(spec), rig_config_(rig_config), display_(display) {
+  if (!(spec.fps > 0.0) || !std::isfinite(spec.fps)) throw Error("invalid --fps: must be a positive number");
+  if (rig_config.camera >= 0) {
+    if (rig_config.camera >= int(rest.cameras.size()))
+      throw Error("--camera " + std::to_string(rig_config.camera) + ": the scene has " +
+                  std::to_string(rest.cameras.size()) + " camera(s)");
+    const SceneCamera& cam = rest.cameras[size_t(rig_config.camera)];
+    if (!cam.perspective || !cam.placed)
+      throw Error("--camera " + std::to_string(rig_config.camera) + " is not a perspective camera placed in the scene");
+  }
+  // Framing: the union of the bounds of every frame of the animation's range, without the turntable
+  // (its sphere is centered on the pivot, so turning does not change it).
+  SequenceSpec still = spec;
+  still.turntable = false;
+  bool any = false;
+  glm::dvec3 lo, hi;
+  if (pose_moves(rest, PoseRequest{0.0, spec.animation})) {
+    long first = 0, last = 0;
+    animation_frame_range(rest, still, first, last);
+    Scene posed;
+    for (long f = first; f <= last; ++f) {
+      PoseRequest r;
+      r.time = double(f) / spec.fps;
+      r.animation = spec.animation;
+      pose_scene(rest, r, posed);
+      glm::dvec3 l, h;
+      if (scene_bounds(posed, l, h)) {
+        lo = any ? glm::min(lo, l) : l;
+        hi = any ? glm::max(hi, h) : h;
+        any = true;
+      }
+    }
+  } else {
+    any = scene_bounds(rest, lo, hi);
+  }
+  if (any) lo_ = lo, hi_ = hi;
+  else if (warnings) warnings->push_back("nothing to frame (no triangles): framing a unit cube at the origin");
+  moves_ = pose_moves(rest, request(0));
+  camera_moves_ = rig_config.camera >= 0 && spec.animation != kNoAnimation && rest.motion &&
+                  size_t(rig_config.camera) < rest.motion->camera_node.size() &&
+                  rest.motion->camera_node[size_t(rig_config.camera)] >= 0;
+  rig_ = rig_for(rest, warnings);
+}
+
+Rig FrameRenderer::rig_for(const Scene& posed, std::vector<std::string>* warnings) const {
+  const glm::dmat4* pose = nullptr;
+  double yfov = 0.0;
+  if (rig_config_.camera >= 0) {
+    pose = &posed.cameras[size_t(rig_config_.camera)].world_from_camera;
+    yfov = posed.cameras[size_t(rig_config_.camera)].yfov;
+  }
+  return make_rig(rig_config_, display_, lo_, hi_, pose, yfov, warnings);
+}
+
+void FrameRenderer::attach(Pipeline& pipeline, const Display* encode_display) {
+  pipeline_ = &pipeline;
+  if (rest_.triangles.empty()) return;  // every frame is transparent: the pipeline is never run
+  pipeline.set_scene(rest_);
+  pipeline.configure(rig_, encode_display);
+}
+
+FrameRenderer::Frame FrameRenderer::render(long frame) {
+  if (!pipeline_) throw Error("FrameRenderer::render before attach");
+  Frame out;
+  out.number = frame;
+  const PoseRequest r = request(frame);
+  out.time = r.time;
+  out.angle = r.turntable_deg;
+  out.rig = rig_;
+  if (rest_.triangles.empty()) return out;
+  const auto t0 = std::chrono::steady_clock::now();
+  if (moves_) {
+    if (pose_scene(rest_, r, posed_)) pipeline_->update_geometry(posed_);
+    if (camera_moves_) out.rig = rig_for(posed_, nullptr);
+  }
+  out.pose_ms = ms_since(t0);
+  out.times = pipeline_->render(out.rig);
+  out.visible = out.times.mtas > 0;
+  return out;
+}
+
+}  // namespace pmr

@@ -1,0 +1,78 @@
+// One frame of a sequence, the same for `pmr render` and `pmr bench`: the scene posed at the frame's
+// time (animation) and angle (turntable), uploaded if it moved, the rig (fixed, or following an animated
+// glTF camera), and the pipeline run. The framing is computed once over the chosen animation's whole
+// time range (DESIGN section 7), so any frame renders the same alone as inside a longer sequence.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "pipeline/pipeline.h"
+#include "pmr/rig.h"
+#include "pmr/scene.h"
+
+namespace pmr {
+
+struct SequenceSpec {
+  int animation = kNoAnimation;  // Scene::animations index, kAllAnimations or kNoAnimation
+  std::string animation_label;   // what the sidecar records: the clip's name (or "#index"), "all" or ""
+  double fps = 24.0;
+  bool turntable = false;
+  double turntable_deg = 0.0;     // DEG of DEG:FRAMES
+  long turntable_frames = 1;      // FRAMES of DEG:FRAMES
+};
+
+// Resolves --animation (NAME, INDEX or all; empty = the first animation if there is one) against the
+// scene's clips. Throws pmr::Error naming the known animations when nothing matches.
+void select_animation(const Scene& scene, const std::string& choice, SequenceSpec& spec);
+
+// The frames covering the chosen animation's key range at the frame rate: floor(start * fps) to
+// ceil(end * fps) (so the last pose is included). Without animation: frame 0 alone, or one turn
+// 0..FRAMES-1 with a turntable.
+void animation_frame_range(const Scene& scene, const SequenceSpec& spec, long& first, long& last);
+
+class FrameRenderer {
+ public:
+  // Computes the framing (the union of the posed bounds over every frame of the animation's range;
+  // without triangles anywhere a unit cube at the origin, with a warning) and the rig. `warnings`
+  // receives the rig's and the framing's warnings.
+  FrameRenderer(const Scene& rest, const SequenceSpec& spec, const RigConfig& rig_config, const Display& display,
+                std::vector<std::string>* warnings);
+
+  // Uploads the scene and configures the pipeline (display may be null: views only).
+  void attach(Pipeline& pipeline, const Display* encode_display);
+
+  struct Frame {
+    long number = 0;
+    double time = 0.0;   // seconds: number / fps
+    double angle = 0.0;  // turntable degrees
+    Rig rig;
+    StageTimes times;
+    double pose_ms = 0.0;    // posing and upload on the host
+    bool visible = false;    // some MTA was produced (false: a transparent image)
+  };
+  Frame render(long frame);
+
+  const Rig& rig() const { return rig_; }
+  const glm::dvec3& bounds_lo() const { return lo_; }
+  const glm::dvec3& bounds_hi() const { return hi_; }
+  glm::dvec3 pivot() const { return 0.5 * (lo_ + hi_); }
+  const SequenceSpec& spec() const { return spec_; }
+  bool has_geometry() const { return !rest_.triangles.empty(); }
+
+ private:
+  Rig rig_for(const Scene& posed, std::vector<std::string>* warnings) const;
+  PoseRequest request(long frame) const;
+
+  const Scene& rest_;
+  SequenceSpec spec_;
+  RigConfig rig_config_;
+  Display display_;
+  glm::dvec3 lo_{-1.0}, hi_{1.0};
+  Rig rig_;
+  bool moves_ = false;         // posing changes something
+  bool camera_moves_ = false;  // the selected glTF camera's node is animated
+  Scene posed_;
+  Pipeline* pipeline_ = nullptr;
+};
+
+}  // namespace pmr

@@ -1,0 +1,164 @@
+#include "sequence/frame_writer.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "output/interrupt.h"
+#include "pmr/error.h"
+
+namespace pmr {
+
+namespace {
+
+void write_text_file(const std::string& path, const std::string& text) {
+  AtomicFile file(path);
+  {
+    std::ofstream out(file.temp_path(), std::ios::binary | std::ios::trunc);
+    if (out) out.write(text.data(), std::streamsize(text.size()));
+    if (out) out.close();
+    if (!out) throw Error("cannot write " + path + ": " + std::strerror(errno) + " (disk full?)");
+  }
+  file.commit();
+}
+
+uint64_t file_size(const std::string& path) {
+  std::error_code ec;
+  const auto n = std::filesystem::file_size(path, ec);
+  return ec ? 0 : uint64_t(n);
+}
+
+// Thrown inside write() when an interrupt arrives between two files of a frame.
+struct Abandoned {};
+
+}  // namespace
+
+FrameWriter::FrameWriter(int exr_threads) : exr_threads_(exr_threads), thread_([this] { run(); }) {}
+
+FrameWriter::~FrameWriter() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+    queue_.clear();
+  }
+  changed_.notify_all();
+  thread_.join();
+}
+
+void FrameWriter::rethrow() {
+  if (error_) std::rethrow_exception(error_);
+}
+
+void FrameWriter::submit(FrameFiles&& frame) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  changed_.wait(lock, [&] { return queue_.empty() || error_; });
+  rethrow();
+  queue_.push_back(std::move(frame));
+  changed_.notify_all();
+}
+
+void FrameWriter::finish() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  changed_.wait(lock, [&] { return (queue_.empty() && !busy_) || error_; });
+  rethrow();
+}
+
+long FrameWriter::frames_written() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return written_;
+}
+double FrameWriter::write_seconds() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return seconds_;
+}
+uint64_t FrameWriter::bytes_written() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return bytes_;
+}
+
+void FrameWriter::run() {
+  for (;;) {
+    FrameFiles f;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      changed_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+      if (stop_ || error_) return;
+      f = std::move(queue_.front());
+      queue_.pop_front();
+      busy_ = true;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    std::exception_ptr error;
+    uint64_t bytes = 0;
+    bool done = false;
+    try {
+      write(f);
+      done = true;
+      for (const std::string* p : {&f.sidecar_path, &f.encoded_path, &f.views_path})
+        if (!p->empty()) bytes += file_size(*p);
+    } catch (const Abandoned&) {
+    } catch (...) {
+      error = std::current_exception();
+    }
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      busy_ = false;
+      if (error && !error_) error_ = error;
+      if (interrupt_signal()) queue_.clear();  // nothing more is written after an interrupt
+      if (done) ++written_, seconds_ += s, bytes_ += bytes;
+    }
+    changed_.notify_all();
+  }
+}
+
+void FrameWriter::write(FrameFiles& f) {
+  std::vector<std::string> committed;
+  // Until the frame is whole its committed files are registered like temporaries, so that a second
+  // signal (immediate exit) removes them too.
+  std::vector<int> slots;
+  struct Unregister {
+    std::vector<int>& s;
+    ~Unregister() {
+      for (int i : s) unregister_temp_file(i);
+    }
+  } unregister{slots};
+  auto roll_back = [&] {
+    for (const std::string& p : committed) ::unlink(p.c_str());
+  };
+  auto check = [&] {
+    if (interrupt_signal()) {
+      roll_back();
+      throw Abandoned{};
+    }
+  };
+  try {
+    check();
+    write_text_file(f.sidecar_path, f.sidecar_text);
+    committed.push_back(f.sidecar_path);
+    slots.push_back(register_temp_file(f.sidecar_path));
+    if (!f.encoded_path.empty()) {
+      check();
+      write_rgba_exr(f.encoded_path, f.display_w, f.display_h, f.display.data(), f.compression, exr_threads_);
+      committed.push_back(f.encoded_path);
+      slots.push_back(register_temp_file(f.encoded_path));
+    }
+    if (!f.views_path.empty()) {
+      check();
+      write_views_exr(f.views_path, f.view_w, f.view_h, f.views, f.volume.data(), nullptr, f.compression, exr_threads_,
+                      f.pixel_aspect);
+      committed.push_back(f.views_path);
+    }
+  } catch (const Abandoned&) {
+    throw;
+  } catch (...) {
+    roll_back();  // a frame is complete or absent: no sidecar without its images
+    throw;
+  }
+}
+
+}  // namespace pmr

@@ -1,0 +1,66 @@
+// Writes finished frames on a background thread while the next frame renders: a bounded queue of one
+// frame (so memory stays at two or three frames) feeding one writer thread, which lets OpenEXR
+// compress with its own thread pool. Per frame the sidecar is committed first, then the images, each
+// through AtomicFile, so an image never exists without its sidecar. An interrupt (output/interrupt.h)
+// abandons the frame being written and removes what of it was already committed, so a frame is either
+// complete or absent. The first error stops the writer; the next submit() or finish() rethrows it.
+#pragma once
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pmr/output.h"
+#include "pmr/rig.h"
+
+namespace pmr {
+
+struct FrameFiles {
+  long frame = 0;
+  std::string sidecar_path, sidecar_text;  // the JSON, prepared by the frame loop
+  std::string encoded_path;                // empty: not requested
+  std::vector<uint16_t> display;           // half RGBA, display_w x display_h
+  int display_w = 0, display_h = 0;
+  std::string views_path;                  // empty: not requested
+  std::vector<uint16_t> volume;            // half RGBA, views x view_h x view_w
+  int view_w = 0, view_h = 0, views = 0;
+  float pixel_aspect = 1.0f;
+  ExrCompression compression = ExrCompression::Zip;
+};
+
+class FrameWriter {
+ public:
+  explicit FrameWriter(int exr_threads);
+  ~FrameWriter();  // abandons whatever is queued (the frame being written finishes or is rolled back)
+
+  // Queues a frame; blocks while the queue is full. Rethrows an earlier write error.
+  void submit(FrameFiles&& frame);
+  // Waits until every queued frame is written (or abandoned on interrupt). Rethrows a write error.
+  void finish();
+
+  long frames_written() const;
+  double write_seconds() const;  // summed time the writer spent on frames
+  uint64_t bytes_written() const;
+
+ private:
+  void run();
+  void write(FrameFiles& f);
+  void rethrow();
+
+  int exr_threads_;
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<FrameFiles> queue_;
+  bool busy_ = false, stop_ = false;
+  std::exception_ptr error_;
+  long written_ = 0;
+  double seconds_ = 0.0;
+  uint64_t bytes_ = 0;
+  std::thread thread_;
+};
+
+}  // namespace pmr

@@ -1,0 +1,230 @@
+// The sequence job: load, frame, skip what --resume finds complete, then render frame after frame while
+// the writer thread compresses and writes the previous one; progress, clean interruption, a summary.
+#include "sequence/sequence_job.h"
+
+#include <csignal>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "output/interrupt.h"
+#include "pmr/error.h"
+#include "pmr/output.h"
+#include "runtime/cl_runtime.h"
+#include "sequence/frame_list.h"
+#include "sequence/frame_renderer.h"
+#include "sequence/frame_writer.h"
+#include "sequence/progress.h"
+
+namespace pmr {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct FramePaths {
+  std::string sidecar, encoded, views;
+};
+
+FramePaths paths_of(const RenderOptions& o, long frame) {
+  const std::string base = (fs::path(o.out_dir) / frame_stem(o.name, frame)).string();
+  FramePaths p;
+  p.sidecar = base + ".json";
+  if (o.write_encoded) p.encoded = base + ".exr";
+  if (o.write_views) p.views = base + ".views.exr";
+  return p;
+}
+
+bool exists(const std::string& p) {
+  std::error_code ec;
+  return !p.empty() && fs::is_regular_file(p, ec);
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::string base_name(const std::string& path) { return fs::path(path).filename().string(); }
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+int run_sequence(const RenderOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const ExrCompression compression = parse_exr_compression(o.compression);
+  if (o.overwrite && !o.resume) throw Error("--overwrite only applies with --resume");
+  std::vector<long> frames;
+  if (o.frames != "all") frames = parse_frame_list(o.frames);  // before the long work: fail early
+  // Everything that can be checked cheaply is checked before the long work starts.
+  prepare_output_dir(o.out_dir);
+  make_encode_params(o.display, o.rig.views, o.rig.view_w, o.rig.view_h);
+
+  const Scene scene = load_scene(o.scene);
+  for (const auto& w : scene.warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
+  SequenceSpec spec;
+  select_animation(scene, o.animation, spec);
+  spec.fps = o.fps;
+  spec.turntable = o.turntable;
+  spec.turntable_deg = o.turntable_deg;
+  spec.turntable_frames = o.turntable ? o.turntable_frames : 1;
+  if (o.frames == "all") {
+    long first = 0, last = 0;
+    animation_frame_range(scene, spec, first, last);
+    for (long f = first; f <= last; ++f) frames.push_back(f);
+  }
+  std::vector<std::string> warnings;
+  FrameRenderer renderer(scene, spec, o.rig, o.display, &warnings);
+  for (const auto& w : warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
+  const Rig& rig = renderer.rig();
+
+  SidecarInfo info;
+  info.scene = o.scene;
+  info.tile_x = o.pipeline.tile_x;
+  info.tile_y = o.pipeline.tile_y;
+  info.tile_v = o.pipeline.tile_v;
+  info.method = to_string(o.pipeline.method);
+  info.camera = o.rig.camera;
+  info.has_bounds = true;
+  info.bounds_lo = renderer.bounds_lo();
+  info.bounds_hi = renderer.bounds_hi();
+  info.compression = to_string(compression);
+  info.warnings = scene.warnings;
+  info.warnings.insert(info.warnings.end(), warnings.begin(), warnings.end());
+  info.fps = spec.fps;
+  info.animation = spec.animation;
+  info.animation_name = spec.animation_label;
+  info.turntable = spec.turntable;
+  info.turntable_deg = spec.turntable_deg;
+  info.turntable_frames = spec.turntable ? spec.turntable_frames : 0;
+  info.pivot = renderer.pivot();
+  auto frame_info = [&](long frame, const FramePaths& p, double angle) {
+    SidecarInfo i = info;
+    i.frame = int(frame);
+    i.time = double(frame) / spec.fps;
+    i.turntable_angle = angle;
+    if (!p.encoded.empty()) i.outputs.push_back({"encoded", base_name(p.encoded)});
+    if (!p.views.empty()) i.outputs.push_back({"views", base_name(p.views)});
+    return i;
+  };
+
+  // --resume: a frame is complete when all its requested files exist (they appear only whole: atomic
+  // renames, sidecar first); its sidecar must show the same configuration.
+  std::vector<long> todo;
+  long skipped = 0;
+  for (long f : frames) {
+    const FramePaths p = paths_of(o, f);
+    if (o.resume && exists(p.sidecar) && (p.encoded.empty() || exists(p.encoded)) && (p.views.empty() || exists(p.views))) {
+      const std::string expected = sidecar_json(rig, o.display, frame_info(f, p, 0.0));
+      const std::string diff = sidecar_config_difference(read_text(p.sidecar), expected);
+      if (diff.empty()) {
+        ++skipped;
+        continue;
+      }
+      if (!o.overwrite)
+        throw Error("--resume: " + p.sidecar + " was rendered with a different configuration (" + diff +
+                    " differs); use --overwrite to re-render such frames, or another --out folder");
+    }
+    todo.push_back(f);
+  }
+  const long total = long(todo.size());
+  std::fprintf(stderr, "pmr: %s: %zu triangles, %d views of %dx%d -> %dx%d display; %ld frame(s)%s\n",
+               o.scene.c_str(), scene.triangles.size(), rig.views, rig.view_w, rig.view_h, o.display.width,
+               o.display.height, total, skipped ? (", " + std::to_string(skipped) + " already complete").c_str() : "");
+  if (todo.empty()) {
+    std::fprintf(stderr, "pmr: nothing to do\n");
+    return 0;
+  }
+
+  ClRuntime runtime;
+  const auto t_build = std::chrono::steady_clock::now();
+  PipelineConfig pc = o.pipeline;
+  pc.fuse_encode = !o.write_views;  // the volume is only kept when the views are written
+  Pipeline pipeline(runtime, pc);
+  renderer.attach(pipeline, o.write_encoded ? &o.display : nullptr);
+  if (o.verbose)
+    std::fprintf(stderr, "pmr: device %s; kernels built in %.2f s\n", runtime.device_name().c_str(), seconds_since(t_build));
+
+  install_interrupt_handlers();
+  FrameWriter writer(2);
+  Progress progress(total, o.quiet);
+  double render_s = 0.0, pose_s = 0.0;
+  long rendered = 0;
+  const auto t_loop = std::chrono::steady_clock::now();
+  for (long f : todo) {
+    if (interrupt_signal()) break;
+    const FramePaths p = paths_of(o, f);
+    const FrameRenderer::Frame fr = renderer.render(f);
+    if (interrupt_signal()) break;  // the frame in flight is abandoned
+    render_s += fr.times.wall / 1000.0;
+    pose_s += fr.pose_ms / 1000.0;
+    if (!fr.visible) progress.message("pmr: warning: frame " + std::to_string(f) + ": nothing visible, written as a transparent image");
+    if (o.verbose) {
+      char line[320];
+      std::snprintf(line, sizeof line,
+                    "pmr: frame %ld: pose + upload %.2f ms; stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, "
+                    "fine raster%s %.2f, %s %.2f; %u MTAs, %llu tile-queue entries, %d queue regrowth(s)",
+                    f, fr.pose_ms, fr.times.vertex, fr.times.setup, fr.times.bin, pipeline.fused() ? " + encode (fused)" : "",
+                    fr.times.fine, pipeline.fused() ? "straddling alpha" : "encode", fr.times.encode, fr.times.mtas,
+                    (unsigned long long)fr.times.bin_entries, fr.times.retries);
+      progress.message(line);
+    }
+    FrameFiles files;
+    files.frame = f;
+    files.compression = compression;
+    files.sidecar_path = p.sidecar;
+    files.sidecar_text = sidecar_json(fr.rig, o.display, frame_info(f, p, fr.angle));
+    if (o.write_encoded) {
+      files.encoded_path = p.encoded;
+      files.display_w = o.display.width, files.display_h = o.display.height;
+      if (renderer.has_geometry()) pipeline.read_display(files.display);
+      else files.display.assign(size_t(o.display.width) * o.display.height * 4, 0);
+    }
+    if (o.write_views) {
+      files.views_path = p.views;
+      files.view_w = rig.view_w, files.view_h = rig.view_h, files.views = rig.views;
+      // pixels of a view are non-square: the view spans the display's aspect A
+      files.pixel_aspect = float(rig.aspect * rig.view_h / rig.view_w);
+      if (renderer.has_geometry()) pipeline.read_volume(files.volume);
+      else files.volume.assign(size_t(rig.views) * rig.view_w * rig.view_h * 4, 0);
+    }
+    writer.submit(std::move(files));
+    ++rendered;
+    progress.frame_done(rendered, f, fr.times.wall);
+  }
+  try {
+    writer.finish();
+  } catch (...) {
+    progress.close();
+    throw;
+  }
+  progress.close();
+  const long written = writer.frames_written();
+  if (const int sig = interrupt_signal()) {
+    std::fprintf(stderr, "pmr: interrupted by %s: %ld of %ld frame(s) written (%ld already complete); nothing partial "
+                 "was left: rerun with --resume to finish\n",
+                 sig == SIGTERM ? "SIGTERM" : "SIGINT", written, total, skipped);
+    return 128 + sig;
+  }
+  const double wall = seconds_since(t_loop);
+  const double n = double(std::max(1L, rendered));
+  std::fprintf(stderr,
+               "pmr: %ld frame(s) in %.2f s (%.2f s/frame; %ld skipped): render %.0f ms/frame (pose %.1f), write %.0f "
+               "ms/frame on the writer thread (%s, %.1f MB/frame); total %.2f s\n",
+               rendered, wall, wall / n, skipped, 1000.0 * render_s / n, 1000.0 * pose_s / n,
+               1000.0 * writer.write_seconds() / n, to_string(compression), double(writer.bytes_written()) / n / 1e6,
+               seconds_since(t0));
+  if (!o.quiet && rendered == 1)
+    for (const std::string& path : {paths_of(o, todo[0]).encoded, paths_of(o, todo[0]).views, paths_of(o, todo[0]).sidecar})
+      if (!path.empty()) std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());
+  return 0;
+}
+
+}  // namespace pmr

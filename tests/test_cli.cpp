@@ -20,51 +20,12 @@
 namespace pmr {
 namespace {
 
-struct CliRun {
-  int status;
-  std::string output;
-};
-
-CliRun run(const std::string& args) {
-  const std::string cmd = std::string(PMR_BINARY) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
-}
-
-// A fresh folder per test and process, so that two test runs on one machine cannot meet.
-std::string temp_dir(const std::string& name) {
-  const std::string d = ::testing::TempDir() + "pmr_cli_" + name + "_" + std::to_string(getpid());
-  std::system(("rm -rf '" + d + "'").c_str());
-  return d;
-}
-
-bool exists(const std::string& p) {
-  struct stat st;
-  return stat(p.c_str(), &st) == 0;
-}
-
-size_t count_entries(const std::string& dir) {
-  FILE* p = popen(("ls -A '" + dir + "' 2>/dev/null | wc -l").c_str(), "r");
-  size_t n = 0;
-  if (fscanf(p, "%zu", &n) != 1) n = 0;
-  pclose(p);
-  return n;
-}
-
-// The error is one line starting with "pmr: error:" (warnings may precede it).
-void expect_one_error_line(const CliRun& r, const std::string& fragment) {
-  EXPECT_EQ(r.status, 1) << r.output;
-  const auto at = r.output.find("pmr: error: ");
-  ASSERT_NE(at, std::string::npos) << r.output;
-  const std::string line = r.output.substr(at);
-  EXPECT_EQ(line.find('\n'), line.size() - 1) << "exactly one error line: " << r.output;
-  EXPECT_NE(line.find(fragment), std::string::npos) << "expected '" << fragment << "' in: " << line;
-}
+using test::CliRun;
+using test::count_entries;
+using test::exists;
+using test::expect_one_error_line;
+using test::run;
+using test::temp_dir;
 
 TEST(Cli, HelpAndInfo) {
   EXPECT_EQ(run("").status, 2);

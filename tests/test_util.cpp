@@ -1,6 +1,12 @@
 #include "test_util.h"
 
+#include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
 
 #include <memory>
 
@@ -103,6 +109,49 @@ PmrParams params_for(const Rig& rig, int tx, int ty, int tv) {
   P.tiles_y = (rig.view_h + ty - 1) / ty;
   P.tiles_v = (rig.views + tv - 1) / tv;
   return P;
+}
+
+}  // namespace pmr::test
+
+namespace pmr::test {
+
+CliRun run(const std::string& args) {
+  const std::string cmd = std::string(PMR_BINARY) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+std::string temp_dir(const std::string& name) {
+  const std::string d = ::testing::TempDir() + "pmr_cli_" + name + "_" + std::to_string(getpid());
+  std::system(("rm -rf '" + d + "'").c_str());
+  return d;
+}
+
+bool exists(const std::string& p) {
+  struct stat st;
+  return stat(p.c_str(), &st) == 0;
+}
+
+size_t count_entries(const std::string& dir) {
+  FILE* p = popen(("ls -A '" + dir + "' 2>/dev/null | wc -l").c_str(), "r");
+  size_t n = 0;
+  if (fscanf(p, "%zu", &n) != 1) n = 0;
+  pclose(p);
+  return n;
+}
+
+void expect_one_error_line(const CliRun& r, const std::string& fragment) {
+  EXPECT_EQ(r.status, 1) << r.output;
+  const auto at = r.output.find("pmr: error: ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const std::string line = r.output.substr(at);
+  EXPECT_EQ(line.find('\n'), line.size() - 1) << "exactly one error line: " << r.output;
+  EXPECT_NE(line.find(fragment), std::string::npos) << "expected '" << fragment << "' in: " << line;
 }
 
 }  // namespace pmr::test

@@ -49,3 +49,18 @@ glm::vec3 focal_point(const Rig& rig, double x, double y);
 // Parameters the kernels see for this rig and tile size.
 PmrParams params_for(const Rig& rig, int tx = 4, int ty = 4, int tv = 4);
 }  // namespace pmr::test
+
+namespace pmr::test {
+// The pmr binary run with `args` (stderr merged into output).
+struct CliRun {
+  int status;  // exit code, -1 if killed by a signal
+  std::string output;
+};
+CliRun run(const std::string& args);
+// A fresh folder per test and process, so that two test runs on one machine cannot meet.
+std::string temp_dir(const std::string& name);
+bool exists(const std::string& path);
+size_t count_entries(const std::string& dir);  // including hidden ones
+// The error is one line starting with "pmr: error:" (warnings may precede it), exit code 1.
+void expect_one_error_line(const CliRun& r, const std::string& fragment);
+}  // namespace pmr::test

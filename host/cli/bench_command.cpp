@@ -15,6 +15,7 @@
 #include "pmr/output.h"
 #include "pmr/scene.h"
 #include "runtime/cl_runtime.h"
+#include "sequence/frame_renderer.h"
 
 namespace pmr {
 
@@ -35,6 +36,12 @@ struct BenchOptions {
   int tile[3] = {16, 2, 16};
   bool check = true;
   bool help = false;
+  // Timed frames are frames 0..K-1 of this sequence (animation and turntable as for pmr render).
+  std::string animation;
+  double fps = 24.0;
+  bool turntable = false;
+  double turntable_deg = 0.0;
+  long turntable_frames = 1;
 };
 
 std::vector<std::string> split(const std::string& s) {
@@ -86,7 +93,8 @@ BenchOptions parse(const std::vector<std::string>& args) {
     } else if (a == "--save-scene") o.save_scene = value();
     else if (a == "--no-check") o.check = false;
     else if (a == "--view-size" || a == "--display" || a == "--tile" || a == "--lens-pitch" || a == "--tan-slant" ||
-             a == "--offset" || a == "--cone" || a == "--yfov" || a == "--display-size") {
+             a == "--offset" || a == "--cone" || a == "--yfov" || a == "--display-size" || a == "--animation" ||
+             a == "--fps" || a == "--turntable") {
       rest.push_back(a);
       rest.push_back(value());
     } else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see pmr bench --help)");
@@ -97,6 +105,8 @@ BenchOptions parse(const std::vector<std::string>& args) {
   o.view_w = r.rig.view_w, o.view_h = r.rig.view_h;
   o.display = r.display;
   o.tile[0] = r.pipeline.tile_x, o.tile[1] = r.pipeline.tile_y, o.tile[2] = r.pipeline.tile_v;
+  o.animation = r.animation, o.fps = r.fps;
+  o.turntable = r.turntable, o.turntable_deg = r.turntable_deg, o.turntable_frames = r.turntable ? r.turntable_frames : 1;
   if (o.methods.empty() || o.views.empty()) throw Error("nothing to measure");
   if (!o.generator.empty() && !o.scene.empty()) throw Error("give a SCENE or a generator (--synthetic, --objects), not both");
   if (!o.save_scene.empty() && o.triangle_counts.size() != 1)
@@ -140,8 +150,10 @@ double coverage_mismatch(const std::vector<uint16_t>& a, const std::vector<uint1
 // One scene: every view count and method of the options, a table row (and CSV row) per point.
 void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Scene& scene,
                  const std::string& scene_name, std::ofstream* csv) {
-  glm::dvec3 lo, hi;
-  scene_bounds(scene, lo, hi);
+  SequenceSpec spec;
+  select_animation(scene, o.animation, spec);
+  spec.fps = o.fps;
+  spec.turntable = o.turntable, spec.turntable_deg = o.turntable_deg, spec.turntable_frames = o.turntable_frames;
   std::printf("# %s: %zu triangles; device %s; copy bandwidth %.1f GB/s\n", scene_name.c_str(), scene.triangles.size(),
               rt.device_name().c_str(), bw * 1e-9);
   std::printf("%-10s %5s %9s %9s %9s %8s %8s %8s %8s %9s %8s %7s %8s\n", "method", "views", "view", "ms_median",
@@ -162,7 +174,8 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
     Display display = o.display;
     display.offset = parse_rational(std::to_string(-display.lens_pitch.num) + "/" +
                                         std::to_string(2 * display.lens_pitch.den * N), "offset");
-    const Rig rig = make_rig(rc, display, lo, hi);
+    FrameRenderer renderer(scene, spec, rc, display, nullptr);
+    const Rig& rig = renderer.rig();
     const double voxels = double(N) * rig.view_w * rig.view_h;
     // the least a frame must move: every voxel written once, the display image written once (half RGBA)
     const double floor_bytes = voxels * 8.0 + double(display.width) * display.height * 8.0;
@@ -174,13 +187,14 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       pc.tile_x = o.tile[0], pc.tile_y = o.tile[1], pc.tile_v = o.tile[2];
       pc.fuse_encode = true;  // the encoded-only job, as pmr render runs it
       Pipeline p(rt, pc);
-      p.set_scene(scene);
-      p.configure(rig, &display);
-      p.render(rig);  // warm-up: first-touch of buffers, queue growth
-      std::vector<double> wall, setup, tile, fine, encode;
+      renderer.attach(p, &display);
+      renderer.render(0);  // warm-up: first-touch of buffers, queue growth
+      std::vector<double> wall, setup, tile, fine, encode, pose;
       for (int f = 0; f < o.frames; ++f) {
-        const StageTimes t = p.render(rig);
+        const FrameRenderer::Frame fr = renderer.render(f);
+        const StageTimes& t = fr.times;
         wall.push_back(t.wall);
+        pose.push_back(fr.pose_ms);
         setup.push_back(t.vertex + t.setup);
         tile.push_back(t.bin);
         fine.push_back(t.fine);
@@ -204,6 +218,7 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       std::printf("%-10s %5d %9s %9.1f %9.1f %8.1f %8.1f %8.1f %8.1f %9.0f %8.0f %7.1f %8.5f\n", to_string(method), N,
                   view, med, mn, median(setup), median(tile), median(fine), median(encode), mvox, floor_bytes / 1e6,
                   med / floor_ms, mismatch);
+      if (median(pose) > 0.0) std::printf("#   host pose + upload per frame (not in ms_median): %.2f ms\n", median(pose));
       std::fflush(stdout);
       if (csv)
         *csv << scene_name << ',' << to_string(method) << ',' << N << ',' << rig.view_w << ',' << rig.view_h << ','
@@ -238,7 +253,8 @@ std::string bench_help() {
          "  --save-scene FILE   write the one generated scene to FILE (.glb) and exit: `pmr bench FILE` on\n"
          "                      any build then renders the very same triangles\n"
          "  --no-check          skip comparing the methods' images\n"
-         "  --view-size, --display, --tile and the display options are as for pmr render.\n"
+         "  --view-size, --display, --tile and the display options are as for pmr render, and so are\n"
+         "  --animation, --fps and --turntable: the timed frames are then frames 0..K-1 of that sequence.\n"
          "Per point it prints the frame time, the per-stage device times, and the floor: the bytes a frame\n"
          "must move (each voxel written once, the display image written once) at the measured copy bandwidth.\n";
 }

@@ -102,8 +102,8 @@ struct FileAsFolder {
   FileAsFolder() { write_text(file, "not a folder"); }
 };
 
-const ExrCompression kAllCompressions[] = {ExrCompression::None, ExrCompression::Zip, ExrCompression::Piz,
-                                           ExrCompression::Rle};
+const ExrCompression kAllCompressions[] = {ExrCompression::None, ExrCompression::Zip, ExrCompression::ZipFast,
+                                           ExrCompression::Piz, ExrCompression::Rle};
 
 // ---------------------------------------------------------------------------------------------------
 TEST(Output, ParseExrCompression) {
@@ -111,6 +111,7 @@ TEST(Output, ParseExrCompression) {
   EXPECT_EQ(parse_exr_compression("zip"), ExrCompression::Zip);
   EXPECT_EQ(parse_exr_compression("piz"), ExrCompression::Piz);
   EXPECT_EQ(parse_exr_compression("rle"), ExrCompression::Rle);
+  EXPECT_EQ(parse_exr_compression("zip-fast"), ExrCompression::ZipFast);
   for (ExrCompression c : kAllCompressions) EXPECT_EQ(parse_exr_compression(to_string(c)), c);
   EXPECT_THROW(parse_exr_compression("zips"), Error);
   EXPECT_THROW(parse_exr_compression(""), Error);
@@ -138,7 +139,7 @@ TEST(Output, RgbaRoundTripIsBitExact) {
     }
   }
   // Only finished files remain, no temporaries.
-  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"img_none.exr", "img_piz.exr", "img_rle.exr", "img_zip.exr"}));
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"img_none.exr", "img_piz.exr", "img_rle.exr", "img_zip-fast.exr", "img_zip.exr"}));
 }
 
 // Row 0 of the caller's buffer is EXR's top scanline (y = dataWindow.min.y), checked with OpenEXR

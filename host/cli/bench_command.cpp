@@ -189,12 +189,13 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       Pipeline p(rt, pc);
       renderer.attach(p, &display);
       renderer.render(0);  // warm-up: first-touch of buffers, queue growth
-      std::vector<double> wall, setup, tile, fine, encode, pose;
+      std::vector<double> wall, setup, tile, fine, encode, pose, upload;
       for (int f = 0; f < o.frames; ++f) {
         const FrameRenderer::Frame fr = renderer.render(f);
         const StageTimes& t = fr.times;
         wall.push_back(t.wall);
         pose.push_back(fr.pose_ms);
+        upload.push_back(fr.upload_ms);
         setup.push_back(t.vertex + t.setup);
         tile.push_back(t.bin);
         fine.push_back(t.fine);
@@ -218,7 +219,9 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       std::printf("%-10s %5d %9s %9.1f %9.1f %8.1f %8.1f %8.1f %8.1f %9.0f %8.0f %7.1f %8.5f\n", to_string(method), N,
                   view, med, mn, median(setup), median(tile), median(fine), median(encode), mvox, floor_bytes / 1e6,
                   med / floor_ms, mismatch);
-      if (median(pose) > 0.0) std::printf("#   host pose + upload per frame (not in ms_median): %.2f ms\n", median(pose));
+      if (median(pose) > 0.0)
+        std::printf("#   on the host per frame (not in ms_median): pose %.2f ms, upload %.2f ms\n", median(pose),
+                    median(upload));
       std::fflush(stdout);
       if (csv)
         *csv << scene_name << ',' << to_string(method) << ',' << N << ',' << rig.view_w << ',' << rig.view_h << ','

@@ -5,6 +5,7 @@
 // scene bit for bit.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -84,6 +85,10 @@ std::vector<glm::dmat4> rest_local_matrices(const SceneMotion& m);
 // The joint matrices of a skin: world(joint) * inverseBind, one per joint.
 std::vector<glm::dmat4> joint_matrices(const MotionSkin& skin, const std::vector<glm::dmat4>& world);
 
+// Runs fn(begin, end) over [0, n) split into contiguous chunks on up to hardware_concurrency threads
+// (serially below `grain` items per thread).
+void parallel_for(size_t n, size_t grain, const std::function<void(size_t, size_t)>& fn);
+
 // Places src's vertices: morph targets with `morph_weights` (may be empty), then the skin's joint
 // matrices if `joints` is not null, else the rigid `world`. Writes positions and unit normals (normal
 // left zero when absent or degenerate, so shading falls back to the face normal). Vertices whose
@@ -91,6 +96,10 @@ std::vector<glm::dmat4> joint_matrices(const MotionSkin& skin, const std::vector
 void deform(const DeformSource& src, const std::vector<float>& morph_weights, const glm::dmat4* joints,
             const glm::dmat4& world, glm::vec3* positions, PmrVertexAttr* attributes,
             uint8_t* bad_position = nullptr, uint8_t* bad_normal = nullptr);
+// The same for vertices [begin, end) only (the output pointers still address vertex 0).
+void deform_range(const DeformSource& src, const std::vector<float>& morph_weights, const glm::dmat4* joints,
+                  const glm::dmat4& world, size_t begin, size_t end, glm::vec3* positions, PmrVertexAttr* attributes,
+                  uint8_t* bad_position, uint8_t* bad_normal);
 
 // Unit normal of a triangle, +Z when it has no area.
 glm::vec3 face_normal(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);

@@ -61,13 +61,15 @@ void deform_instances(const Scene& rest, const SceneMotion& m, const PoseRequest
     const glm::dmat4* jm = d.skin >= 0 ? joints[size_t(d.skin)].data() : nullptr;
     deform(*d.source, weights[size_t(d.node)], jm, w, &out.positions[d.vertex_begin], &out.attributes[d.vertex_begin]);
     const bool mirrored = d.skin < 0 && glm::determinant(glm::dmat3(w)) < 0.0;
-    for (uint32_t t = d.triangle_begin; t < d.triangle_end; ++t) {
-      PmrTriangle tri = rest.triangles[t];
-      if (mirrored != d.rest_mirrored) std::swap(tri.v[1], tri.v[2]);
-      const glm::vec3 n = face_normal(out.positions[tri.v[0]], out.positions[tri.v[1]], out.positions[tri.v[2]]);
-      tri.face_normal[0] = n.x, tri.face_normal[1] = n.y, tri.face_normal[2] = n.z;
-      out.triangles[t] = tri;
-    }
+    parallel_for(d.triangle_end - d.triangle_begin, 32768, [&](size_t b, size_t e) {
+      for (size_t t = d.triangle_begin + b; t < d.triangle_begin + e; ++t) {
+        PmrTriangle tri = rest.triangles[t];
+        if (mirrored != d.rest_mirrored) std::swap(tri.v[1], tri.v[2]);
+        const glm::vec3 n = face_normal(out.positions[tri.v[0]], out.positions[tri.v[1]], out.positions[tri.v[2]]);
+        tri.face_normal[0] = n.x, tri.face_normal[1] = n.y, tri.face_normal[2] = n.z;
+        out.triangles[t] = tri;
+      }
+    });
   }
   for (size_t c = 0; c < out.cameras.size() && c < m.camera_node.size(); ++c)
     if (m.camera_node[c] >= 0 && out.cameras[c].placed) out.cameras[c].world_from_camera = world[size_t(m.camera_node[c])];

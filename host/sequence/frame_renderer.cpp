@@ -155,10 +155,13 @@ FrameRenderer::Frame FrameRenderer::render(long frame) {
   if (rest_.triangles.empty()) return out;
   const auto t0 = std::chrono::steady_clock::now();
   if (moves_) {
-    if (pose_scene(rest_, r, posed_)) pipeline_->update_geometry(posed_);
+    const bool changed = pose_scene(rest_, r, posed_);
     if (camera_moves_) out.rig = rig_for(posed_, nullptr);
+    out.pose_ms = ms_since(t0);
+    const auto t1 = std::chrono::steady_clock::now();
+    if (changed) pipeline_->update_geometry(posed_);
+    out.upload_ms = ms_since(t1);
   }
-  out.pose_ms = ms_since(t0);
   out.times = pipeline_->render(out.rig);
   out.visible = out.times.mtas > 0;
   return out;

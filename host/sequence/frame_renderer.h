@@ -47,7 +47,8 @@ class FrameRenderer {
     double angle = 0.0;  // turntable degrees
     Rig rig;
     StageTimes times;
-    double pose_ms = 0.0;    // posing and upload on the host
+    double pose_ms = 0.0;    // posing (animation sampling, morphing, skinning, turntable) on the host
+    double upload_ms = 0.0;  // copying the posed geometry to the device
     bool visible = false;    // some MTA was produced (false: a transparent image)
   };
   Frame render(long frame);

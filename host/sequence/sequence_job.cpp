@@ -155,7 +155,7 @@ int run_sequence(const RenderOptions& o) {
   install_interrupt_handlers();
   FrameWriter writer(2);
   Progress progress(total, o.quiet);
-  double render_s = 0.0, pose_s = 0.0;
+  double render_s = 0.0, pose_s = 0.0, upload_s = 0.0;
   long rendered = 0;
   const auto t_loop = std::chrono::steady_clock::now();
   for (long f : todo) {
@@ -165,13 +165,14 @@ int run_sequence(const RenderOptions& o) {
     if (interrupt_signal()) break;  // the frame in flight is abandoned
     render_s += fr.times.wall / 1000.0;
     pose_s += fr.pose_ms / 1000.0;
+    upload_s += fr.upload_ms / 1000.0;
     if (!fr.visible) progress.message("pmr: warning: frame " + std::to_string(f) + ": nothing visible, written as a transparent image");
     if (o.verbose) {
       char line[320];
       std::snprintf(line, sizeof line,
-                    "pmr: frame %ld: pose + upload %.2f ms; stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, "
+                    "pmr: frame %ld: pose %.2f ms, upload %.2f ms; stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, "
                     "fine raster%s %.2f, %s %.2f; %u MTAs, %llu tile-queue entries, %d queue regrowth(s)",
-                    f, fr.pose_ms, fr.times.vertex, fr.times.setup, fr.times.bin, pipeline.fused() ? " + encode (fused)" : "",
+                    f, fr.pose_ms, fr.upload_ms, fr.times.vertex, fr.times.setup, fr.times.bin, pipeline.fused() ? " + encode (fused)" : "",
                     fr.times.fine, pipeline.fused() ? "straddling alpha" : "encode", fr.times.encode, fr.times.mtas,
                     (unsigned long long)fr.times.bin_entries, fr.times.retries);
       progress.message(line);
@@ -216,9 +217,9 @@ int run_sequence(const RenderOptions& o) {
   const double wall = seconds_since(t_loop);
   const double n = double(std::max(1L, rendered));
   std::fprintf(stderr,
-               "pmr: %ld frame(s) in %.2f s (%.2f s/frame; %ld skipped): render %.0f ms/frame (pose %.1f), write %.0f "
+               "pmr: %ld frame(s) in %.2f s (%.2f s/frame; %ld skipped): render %.0f ms/frame (+ pose %.1f, upload %.1f), write %.0f "
                "ms/frame on the writer thread (%s, %.1f MB/frame); total %.2f s\n",
-               rendered, wall, wall / n, skipped, 1000.0 * render_s / n, 1000.0 * pose_s / n,
+               rendered, wall, wall / n, skipped, 1000.0 * render_s / n, 1000.0 * pose_s / n, 1000.0 * upload_s / n,
                1000.0 * writer.write_seconds() / n, to_string(compression), double(writer.bytes_written()) / n / 1e6,
                seconds_since(t0));
   if (!o.quiet && rendered == 1)

@@ -67,6 +67,14 @@ void FrameWriter::finish() {
   rethrow();
 }
 
+std::vector<uint16_t> FrameWriter::spare_buffer() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (spare_.empty()) return {};
+  std::vector<uint16_t> b = std::move(spare_.back());
+  spare_.pop_back();
+  return b;
+}
+
 long FrameWriter::frames_written() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return written_;
@@ -111,6 +119,8 @@ void FrameWriter::run() {
       if (error && !error_) error_ = error;
       if (interrupt_signal()) queue_.clear();  // nothing more is written after an interrupt
       if (done) ++written_, seconds_ += s, bytes_ += bytes;
+      for (std::vector<uint16_t>* b : {&f.display, &f.volume})
+        if (!b->empty() && spare_.size() < 4) spare_.push_back(std::move(*b));
     }
     changed_.notify_all();
   }

@@ -185,6 +185,7 @@ int run_sequence(const RenderOptions& o) {
     if (o.write_encoded) {
       files.encoded_path = p.encoded;
       files.display_w = o.display.width, files.display_h = o.display.height;
+      files.display = writer.spare_buffer();
       if (renderer.has_geometry()) pipeline.read_display(files.display);
       else files.display.assign(size_t(o.display.width) * o.display.height * 4, 0);
     }
@@ -193,6 +194,7 @@ int run_sequence(const RenderOptions& o) {
       files.view_w = rig.view_w, files.view_h = rig.view_h, files.views = rig.views;
       // pixels of a view are non-square: the view spans the display's aspect A
       files.pixel_aspect = float(rig.aspect * rig.view_h / rig.view_w);
+      files.volume = writer.spare_buffer();
       if (renderer.has_geometry()) pipeline.read_volume(files.volume);
       else files.volume.assign(size_t(rig.views) * rig.view_w * rig.view_h * 4, 0);
     }

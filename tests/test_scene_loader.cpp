@@ -532,6 +532,41 @@ TEST_F(SceneLoaderTest, CamerasArePlacedByTheirNodes) {
   EXPECT_DOUBLE_EQ(s.cameras[2].aspect, 2.0);
 }
 
+// Animated nodes: a camera node moving (LINEAR translation) is followed by the pose; a mesh whose scale
+// steps to (-1, 1, 1) is mirrored in that frame and keeps counter-clockwise front faces (winding
+// reversed, face normal still +Z, vertex normals by the inverse transpose: (0, 0, 1) stays).
+TEST_F(SceneLoaderTest, AnimatedCameraAndMirroringScale) {
+  GltfFile g = unit_triangle();
+  g.add("cameras", {{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}});
+  g.add("nodes", {{"mesh", 0}});
+  g.add("nodes", {{"camera", 0}, {"translation", {0, 0, 5}}});
+  g.scene({0, 1});
+  const int times = g.data<float>({0.0f, 1.0f}, kFloat, "SCALAR");
+  const int scales = g.data<float>({1, 1, 1, -1, 1, 1}, kFloat, "VEC3");
+  const int moves = g.data<float>({0, 0, 5, 2, 0, 5}, kFloat, "VEC3");
+  g.doc["animations"] = {{{"samplers", {{{"input", times}, {"output", scales}, {"interpolation", "STEP"}},
+                                        {{"input", times}, {"output", moves}}}},
+                          {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "scale"}}}},
+                                        {{"sampler", 1}, {"target", {{"node", 1}, {"path", "translation"}}}}}}}};
+  const Scene s = load_scene(g.write(dir_, "animated_camera"));
+  PoseRequest r;
+  r.animation = 0;
+  r.time = 0.5;
+  Scene p;
+  pose_scene(s, r, p);
+  EXPECT_EQ(p.cameras[0].world_from_camera[3], glm::dvec4(1, 0, 5, 1));
+  EXPECT_EQ(p.triangles[0].v[1], s.triangles[0].v[1]) << "not mirrored before t = 1";
+  r.time = 2.0;
+  pose_scene(s, r, p);
+  EXPECT_EQ(p.cameras[0].world_from_camera[3], glm::dvec4(2, 0, 5, 1));
+  EXPECT_EQ(p.positions[1], glm::vec3(-1, 0, 0));
+  EXPECT_EQ(p.triangles[0].v[1], s.triangles[0].v[2]) << "winding reversed under the mirror";
+  EXPECT_EQ(p.triangles[0].v[2], s.triangles[0].v[1]);
+  EXPECT_EQ(glm::vec3(p.triangles[0].face_normal[0], p.triangles[0].face_normal[1], p.triangles[0].face_normal[2]),
+            glm::vec3(0, 0, 1));
+  EXPECT_EQ(glm::vec3(p.attributes[0].normal[0], p.attributes[0].normal[1], p.attributes[0].normal[2]), glm::vec3(0, 0, 1));
+}
+
 // Without scenes, every root node is drawn (with its children).
 TEST_F(SceneLoaderTest, NoScenesDrawsAllRootNodes) {
   GltfFile g = unit_triangle();

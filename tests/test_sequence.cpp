@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -184,6 +185,29 @@ TEST(Sequence, EmptySceneRendersTransparentFrames) {
   for (uint16_t v : pixels(out + "/frame_0001.exr")) ASSERT_EQ(v, 0u);
   EXPECT_EQ(read_exr_part_names(out + "/frame_0001.views.exr").size(), 4u);
   fs::remove(scene);
+}
+
+// A full disk stops the job with one line and exit code 1; the frames before stay whole and the frame
+// that did not fit leaves nothing (not even its sidecar). Needs a small tmpfs: skipped where mounting
+// is not allowed.
+TEST(Sequence, FullDiskStopsCleanly) {
+  const std::string mnt = temp_dir("seq_full");
+  fs::create_directories(mnt);
+  if (std::system(("mount -t tmpfs -o size=600k tmpfs '" + mnt + "' 2>/dev/null").c_str()) != 0) {
+    fs::remove_all(mnt);
+    GTEST_SKIP() << "cannot mount a small tmpfs here: skipped";
+  }
+  const CliRun r = run("render --frames 0:9 --views 8 --view-size 128x64 --display 960x540 --out " + mnt + "/o");
+  const std::set<std::string> names = listing(mnt + "/o");
+  std::system(("umount '" + mnt + "'").c_str());
+  fs::remove_all(mnt);
+  expect_one_error_line(r, "No space left on device");
+  EXPECT_GE(names.size(), 2u);
+  for (const std::string& n : names) {
+    EXPECT_NE(n[0], '.') << "temporary file left: " << n;
+    const std::string stem = n.substr(0, n.find('.'));
+    EXPECT_TRUE(names.count(stem + ".exr") && names.count(stem + ".json")) << "partial frame: " << n;
+  }
 }
 
 TEST(Sequence, BadSequenceOptionsFailWithOneLine) {

@@ -15,6 +15,7 @@
 
 #include "pmr/output.h"
 #include "pmr/rig.h"
+#include "pmr/scene.h"
 #include "test_util.h"
 
 namespace pmr {
@@ -35,6 +36,24 @@ TEST(Cli, HelpAndInfo) {
   const CliRun info = run("info");
   EXPECT_EQ(info.status, 0);
   EXPECT_NE(info.output.find("device 0"), std::string::npos) << info.output;
+}
+
+// pmr info SCENE: what the scene holds, without OpenCL; CesiumMan (corpus README: 19 joints, one
+// animation) when the corpus is there.
+TEST(Cli, InfoDescribesAScene) {
+  const CliRun r = run("info " + std::string(PMR_SOURCE_DIR) + "/data/default_scene.glb");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const Scene s = load_scene(std::string(PMR_SOURCE_DIR) + "/data/default_scene.glb");
+  EXPECT_NE(r.output.find("triangles: " + std::to_string(s.triangles.size()) + ","), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("animations: 0"), std::string::npos) << r.output;
+  expect_one_error_line(run("info /nonexistent/x.gltf"), "file not found");
+  const std::string dir = test::corpus_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/gltf not found: CesiumMan part skipped";
+  const CliRun c = run("info '" + dir + "/CesiumMan/glTF/CesiumMan.gltf'");
+  ASSERT_EQ(c.status, 0) << c.output;
+  EXPECT_NE(c.output.find("animations: 1"), std::string::npos) << c.output;
+  EXPECT_NE(c.output.find("19 joint(s)"), std::string::npos) << c.output;
+  EXPECT_NE(c.output.find("to 2.000 s; --frames all at 24 fps: "), std::string::npos) << c.output;  // keys end at 2 s
 }
 
 TEST(Cli, BadOptionsFailWithOneLine) {

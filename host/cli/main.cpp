@@ -5,10 +5,10 @@
 #include <vector>
 
 #include "cli/bench_command.h"
+#include "cli/info_command.h"
 #include "cli/options.h"
 #include "cli/render_command.h"
 #include "pmr/error.h"
-#include "runtime/cl_runtime.h"
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
@@ -21,10 +21,7 @@ int main(int argc, char** argv) {
     args.erase(args.begin());
     if (cmd == "render") return pmr::run_render(args);
     if (cmd == "bench") return pmr::run_bench(args);
-    if (cmd == "info") {
-      for (const auto& line : pmr::describe_opencl_devices()) std::printf("%s\n", line.c_str());
-      return 0;
-    }
+    if (cmd == "info") return pmr::run_info(args);
     throw pmr::Error("unknown command '" + cmd + "' (try pmr --help)");
   } catch (const pmr::Error& e) {
     std::fprintf(stderr, "pmr: error: %s\n", e.what());

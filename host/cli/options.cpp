@@ -169,6 +169,7 @@ std::string main_help() {
          "  pmr render [SCENE.gltf|SCENE.glb] [options]   render N views and the encoded display image\n"
          "  pmr bench [SCENE] [options]                  performance sweeps over view count and method\n"
          "  pmr info                                     list OpenCL platforms and devices\n"
+         "  pmr info SCENE                               what a scene holds (cameras, animations, ...)\n"
          "  pmr --help | pmr render --help\n";
 }
 

@@ -347,6 +347,18 @@ std::vector<Instance> walk(Loader& L, const std::vector<int>& roots) {
   return instances;
 }
 
+size_t walk_count(const Loader& L, const std::vector<int>& roots) {
+  size_t n = 0;
+  std::vector<int> stack(roots.begin(), roots.end());
+  while (!stack.empty()) {
+    const tinygltf::Node& node = L.model.nodes[size_t(stack.back())];
+    stack.pop_back();
+    n += node.mesh >= 0;
+    stack.insert(stack.end(), node.children.begin(), node.children.end());
+  }
+  return n;
+}
+
 // One primitive decoded in its mesh's space, shared by all instances of the mesh.
 struct Decoded {
   std::shared_ptr<DeformSource> geo;     // positions, normals, morph targets, joints and weights
@@ -665,6 +677,20 @@ void summary_warnings(Loader& L, const SourceFile& src) {
   }
 }
 
+void describe_structure(Loader& L, const std::vector<int>& roots) {
+  SceneStructure& d = L.scene.structure;
+  d.nodes = L.model.nodes.size();
+  d.meshes = L.model.meshes.size();
+  d.mesh_instances = walk_count(L, roots);
+  for (size_t m = 0; m < L.model.meshes.size(); ++m) {
+    const auto& prims = L.model.meshes[m].primitives;
+    d.primitives += prims.size();
+    if (!prims.empty() && !prims[0].targets.empty()) d.morph_meshes.push_back({int(m), prims[0].targets.size()});
+  }
+  for (const tinygltf::Skin& skin : L.model.skins) d.skin_joints.push_back(skin.joints.size());
+  d.generator = L.model.asset.generator;
+}
+
 }  // namespace
 
 Scene load_scene(const std::string& path) {
@@ -692,7 +718,9 @@ Scene load_scene(const std::string& path) {
   summary_warnings(L, src);
   if (scene.triangles.empty())
     L.warn("the scene has no triangles to render: every frame will be a transparent image");
-  for (const MotionClip& clip : L.motion->clips) scene.animations.push_back({clip.name, clip.start, clip.end});
+  for (const MotionClip& clip : L.motion->clips)
+    scene.animations.push_back({clip.name, clip.start, clip.end, clip.channels.size()});
+  describe_structure(L, roots);
   if (!L.motion->clips.empty()) scene.motion = L.motion;
   return scene;
 }

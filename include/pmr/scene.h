@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -37,6 +38,15 @@ struct SceneMotion;  // node hierarchy, clips, skins, moving instances (host/sce
 struct SceneAnimation {
   std::string name;               // as in the file ("" when unnamed)
   double start = 0.0, end = 0.0;  // first and last key time, seconds
+  size_t channels = 0;
+};
+
+// What the file holds beyond the flattened arrays, for `pmr info SCENE`.
+struct SceneStructure {
+  size_t nodes = 0, meshes = 0, mesh_instances = 0, primitives = 0;
+  std::vector<size_t> skin_joints;                    // per skin: its joint count
+  std::vector<std::pair<int, size_t>> morph_meshes;   // (mesh index, morph target count) per mesh with targets
+  std::string generator;                              // asset.generator
 };
 
 struct Scene {
@@ -51,7 +61,8 @@ struct Scene {
   // The arrays above hold the rest pose: no animation applied, default morph weights, skins bound to
   // their skeleton's rest transforms. pose_scene() places a frame.
   std::vector<SceneAnimation> animations;
-  std::shared_ptr<const SceneMotion> motion;  // null when no animation can move anything
+  std::shared_ptr<const SceneMotion> motion;
+  SceneStructure structure;  // null when no animation can move anything
 };
 
 constexpr int kNoAnimation = -1, kAllAnimations = -2;

@@ -86,15 +86,23 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
       o.pipeline.tile_x = d[0], o.pipeline.tile_y = d[1], o.pipeline.tile_v = d[2];
     } else if (a == "--camera") o.rig.camera = parse_int(value(), a, 0, 1 << 30);
     else if (a == "--write") {
-      o.write_encoded = o.write_views = false;
+      o.write_encoded = o.write_views = o.write_quilt = o.write_depth = false;
       std::stringstream ss(value());
       std::string w;
       while (std::getline(ss, w, ',')) {
         if (w == "encoded") o.write_encoded = true;
         else if (w == "views") o.write_views = true;
-        else throw Error("invalid --write '" + w + "': expected encoded, views or encoded,views");
+        else if (w == "quilt") o.write_quilt = true;
+        else if (w == "depth") o.write_depth = true;
+        else throw Error("invalid --write '" + w + "': expected a list of encoded, views, quilt, depth");
       }
+      if (!o.write_encoded && !o.write_views && !o.write_quilt)
+        throw Error("invalid --write: nothing to write (depth is a channel of views or quilt)");
+      if (o.write_depth && !o.write_views && !o.write_quilt)
+        throw Error("invalid --write: depth is a channel of the views or quilt EXR: add views or quilt");
     } else if (a == "--compression") o.compression = value();
+    else if (a == "--quilt") o.quilt = value();
+    else if (a == "--preview") o.preview = true;
     else if (a == "--frame" || a == "--frames") o.frames = value();
     else if (a == "--fps") {
       o.fps = parse_double(value(), a);
@@ -181,9 +189,14 @@ std::string render_help() {
          "\n"
          "output:\n"
          "  --out DIR              output folder (created if missing; default: out)\n"
-         "  --write LIST           encoded, views or encoded,views (default: encoded). DIR/frame_NNNN.exr is\n"
-         "                         the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view;\n"
-         "                         DIR/frame_NNNN.json (rig, display, every view's matrices) is always written\n"
+         "  --write LIST           any of encoded, views, quilt, depth (default: encoded). DIR/frame_NNNN.exr is\n"
+         "                         the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view,\n"
+         "                         DIR/frame_NNNN_qsCxRaA.exr the views as a Looking Glass quilt (view 0 bottom\n"
+         "                         left), depth a float Z channel (view-space depth, +inf where empty) in the\n"
+         "                         views and quilt files; DIR/frame_NNNN.json (rig, display, every view's\n"
+         "                         matrices) is always written\n"
+         "  --quilt CxR            quilt layout in tiles (default: the most square layout, e.g. 8x6 for 48)\n"
+         "  --preview              also 8-bit sRGB PNGs: the encoded image, the center view (N / 2) and the quilt\n"
          "  --name PATTERN         file stem, printf-style with one integer (default frame_%04d)\n"
          "  --compression C        EXR compression: none, zip, zip-fast (ZIP at deflate level 1: about 35%\n"
          "                         less CPU, 15% larger), piz, rle (default zip)\n"

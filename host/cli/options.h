@@ -17,6 +17,10 @@ struct RenderOptions {
   PipelineConfig pipeline;
   bool write_encoded = true;
   bool write_views = false;
+  bool write_quilt = false;     // Looking Glass quilt (EXR)
+  bool write_depth = false;     // a Z channel in the views and quilt EXRs
+  std::string quilt;            // --quilt CxR; empty = chosen from the view count and size
+  bool preview = false;         // PNG previews of the encoded image, the center view and the quilt
   std::string compression = "zip";
   // Sequences (DESIGN section 7)
   std::string frames = "0";       // --frames LIST, or "all"

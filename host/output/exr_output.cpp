@@ -5,6 +5,7 @@
 #include <ImfInputPart.h>
 #include <ImfMultiPartInputFile.h>
 #include <ImfMultiPartOutputFile.h>
+#include <ImfOutputFile.h>
 #include <ImfOutputPart.h>
 #include <ImfPartType.h>
 #include <ImfRgbaFile.h>
@@ -130,13 +131,28 @@ std::string view_part_name(int i, int views) {
 }
 
 void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half,
-                    ExrCompression c, int threads) {
+                    ExrCompression c, int threads, const float* depth, float pixel_aspect) {
   check_image(path, width, height, 1, rgba_half);
+  if (!(pixel_aspect > 0.0f) || !std::isfinite(pixel_aspect))
+    throw Error("cannot write " + path + ": invalid pixel aspect ratio " + std::to_string(pixel_aspect));
   AtomicFile file(path);
   guarded("cannot write", path, file.temp_path(), [&] {
     set_threads(threads);
-    Imf::Header header(width, height);  // display and data window (0,0)-(w-1,h-1), INCREASING_Y
+    // display and data window (0,0)-(w-1,h-1), INCREASING_Y
+    Imf::Header header(width, height, pixel_aspect);
     set_compression(header, c, path);
+    if (depth) {  // half RGBA plus a float Z channel: the general interface
+      for (const char* ch : {"R", "G", "B", "A"}) header.channels().insert(ch, Imf::Channel(Imf::HALF));
+      header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+      Imf::OutputFile out(file.temp_path().c_str(), header);
+      Imf::FrameBuffer fb;
+      insert_half_rgba(fb, rgba_half, width);
+      char* z = const_cast<char*>(reinterpret_cast<const char*>(depth));
+      fb.insert("Z", Imf::Slice(Imf::FLOAT, z, sizeof(float), sizeof(float) * size_t(width)));
+      out.setFrameBuffer(fb);
+      out.writePixels(height);
+      return;
+    }
     Imf::RgbaOutputFile out(file.temp_path().c_str(), header, Imf::WRITE_RGBA);
     // Pixel (x, y) at base + x + y * width: the caller's memory, row 0 = EXR's top scanline.
     out.setFrameBuffer(reinterpret_cast<const Imf::Rgba*>(rgba_half), 1, size_t(width));

@@ -80,6 +80,15 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   json outputs = json::object();
   for (const auto& [kind, file] : info.outputs) outputs[kind] = file;
   j["outputs"] = outputs;
+  if (info.quilt_columns > 0)
+    j["quilt"] = {{"columns", info.quilt_columns},
+                  {"rows", info.quilt_rows},
+                  {"aspect", rig.aspect},
+                  {"tile_width", rig.view_w},
+                  {"tile_height", rig.view_h},
+                  {"order", "view 0 in the bottom-left tile, then left to right, then upward"}};
+  if (info.center_view >= 0) j["preview_center_view"] = info.center_view;
+  j["depth_channel"] = info.depth;
   j["warnings"] = info.warnings;
   j["time"] = info.time;
   j["fps"] = info.fps;
@@ -149,7 +158,8 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
                 "view = T(-s_i, 0, 0) * center_view; views[i] is part view_NNN of the views EXR"},
       {"matrices", "4x4, 16 numbers column-major as glTF stores them (element 4 * c + r is row r of column c); "
                    "clip = proj * view * (x, y, z, 1); OpenGL clip space, NDC z in [-1, 1]"},
-      {"depth", "the Z channel of the views EXR (when written) is window depth in [0, 1]: (z_ndc + 1) / 2"},
+      {"depth", "the Z channel of the views and quilt EXRs (when written) is the view-space depth w: the distance "
+                "along the view's axis, positive in front of the camera; +infinity where nothing was drawn"},
       {"color", "linear-light RGB; alpha = coverage; background (0, 0, 0, 0)"},
       {"light", "directional, toward the light, fixed in the center camera's view space; "
                 "color = base * (0.2 + 0.8 * max(0, dot(n, l)))"},

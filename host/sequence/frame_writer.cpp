@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <cstdio>
 #include <filesystem>
@@ -106,7 +107,8 @@ void FrameWriter::run() {
     try {
       write(f);
       done = true;
-      for (const std::string* p : {&f.sidecar_path, &f.encoded_path, &f.views_path})
+      for (const std::string* p : {&f.sidecar_path, &f.encoded_path, &f.views_path, &f.quilt_path, &f.encoded_png,
+                                   &f.center_png, &f.quilt_png})
         if (!p->empty()) bytes += file_size(*p);
     } catch (const Abandoned&) {
     } catch (...) {
@@ -146,22 +148,58 @@ void FrameWriter::write(FrameFiles& f) {
       throw Abandoned{};
     }
   };
+  auto done = [&](const std::string& path) {
+    committed.push_back(path);
+    slots.push_back(register_temp_file(path));
+  };
   try {
     check();
     write_text_file(f.sidecar_path, f.sidecar_text);
-    committed.push_back(f.sidecar_path);
-    slots.push_back(register_temp_file(f.sidecar_path));
+    done(f.sidecar_path);
     if (!f.encoded_path.empty()) {
       check();
       write_rgba_exr(f.encoded_path, f.display_w, f.display_h, f.display.data(), f.compression, exr_threads_);
-      committed.push_back(f.encoded_path);
-      slots.push_back(register_temp_file(f.encoded_path));
+      done(f.encoded_path);
     }
+    if (!f.depth.empty()) {
+      // window depth -> view-space depth (DESIGN section 6); +infinity stays
+      const double n = f.near, fa = f.far;
+      for (float& z : f.depth)
+        if (std::isfinite(z)) z = float(fa * n / (fa - double(z) * (fa - n)));
+    }
+    const float* depth = f.depth.empty() ? nullptr : f.depth.data();
     if (!f.views_path.empty()) {
       check();
-      write_views_exr(f.views_path, f.view_w, f.view_h, f.views, f.volume.data(), nullptr, f.compression, exr_threads_,
+      write_views_exr(f.views_path, f.view_w, f.view_h, f.views, f.volume.data(), depth, f.compression, exr_threads_,
                       f.pixel_aspect);
-      committed.push_back(f.views_path);
+      done(f.views_path);
+    }
+    std::vector<uint16_t> quilt;
+    std::vector<float> quilt_depth;
+    if (!f.quilt_path.empty() || !f.quilt_png.empty())
+      assemble_quilt(f.quilt, f.views, f.view_w, f.view_h, f.volume.data(), depth, quilt, depth ? &quilt_depth : nullptr);
+    const int qw = f.quilt.columns * f.view_w, qh = f.quilt.rows * f.view_h;
+    if (!f.quilt_path.empty()) {
+      check();
+      write_rgba_exr(f.quilt_path, qw, qh, quilt.data(), f.compression, exr_threads_,
+                     depth ? quilt_depth.data() : nullptr, f.pixel_aspect);
+      done(f.quilt_path);
+    }
+    if (!f.encoded_png.empty()) {
+      check();
+      write_png_preview(f.encoded_png, f.display_w, f.display_h, f.display.data());
+      done(f.encoded_png);
+    }
+    if (!f.center_png.empty()) {
+      check();
+      const size_t plane = size_t(f.view_w) * size_t(f.view_h) * 4;
+      write_png_preview(f.center_png, f.view_w, f.view_h, f.volume.data() + size_t(f.center_view) * plane);
+      done(f.center_png);
+    }
+    if (!f.quilt_png.empty()) {
+      check();
+      write_png_preview(f.quilt_png, qw, qh, quilt.data());
+      done(f.quilt_png);
     }
   } catch (const Abandoned&) {
     throw;

@@ -15,20 +15,29 @@
 #include <vector>
 
 #include "pmr/output.h"
+#include "pmr/quilt.h"
 #include "pmr/rig.h"
 
 namespace pmr {
 
+// One frame's products. A path left empty is not written. The quilt and the previews are assembled
+// and encoded on the writer thread, the depth converted there too.
 struct FrameFiles {
   long frame = 0;
   std::string sidecar_path, sidecar_text;  // the JSON, prepared by the frame loop
-  std::string encoded_path;                // empty: not requested
+  std::string encoded_path, encoded_png;
   std::vector<uint16_t> display;           // half RGBA, display_w x display_h
   int display_w = 0, display_h = 0;
-  std::string views_path;                  // empty: not requested
+  std::string views_path, quilt_path, quilt_png, center_png;
   std::vector<uint16_t> volume;            // half RGBA, views x view_h x view_w
   int view_w = 0, view_h = 0, views = 0;
-  float pixel_aspect = 1.0f;
+  float pixel_aspect = 1.0f;               // of a view's pixels (A h / w)
+  QuiltLayout quilt;
+  int center_view = 0;
+  // Window depth per voxel from the pipeline (INFINITY where empty), or empty: no depth requested.
+  // Written as view-space depth w = f n / (f - z (f - n)) with the rig's near (used) and far planes.
+  std::vector<float> depth;
+  double near = 0.0, far = 0.0;
   ExrCompression compression = ExrCompression::Zip;
 };
 

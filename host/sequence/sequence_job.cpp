@@ -3,7 +3,9 @@
 #include "sequence/sequence_job.h"
 
 #include <csignal>
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +14,7 @@
 #include "output/interrupt.h"
 #include "pmr/error.h"
 #include "pmr/output.h"
+#include "pmr/quilt.h"
 #include "runtime/cl_runtime.h"
 #include "sequence/frame_list.h"
 #include "sequence/frame_renderer.h"
@@ -24,16 +27,31 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Every file of a frame; empty = not requested.
 struct FramePaths {
-  std::string sidecar, encoded, views;
+  std::string sidecar, encoded, views, quilt, encoded_png, center_png, quilt_png;
+  std::vector<std::string> images() const {
+    std::vector<std::string> all;
+    for (const std::string* p : {&encoded, &views, &quilt, &encoded_png, &center_png, &quilt_png})
+      if (!p->empty()) all.push_back(*p);
+    return all;
+  }
 };
 
-FramePaths paths_of(const RenderOptions& o, long frame) {
-  const std::string base = (fs::path(o.out_dir) / frame_stem(o.name, frame)).string();
+FramePaths paths_of(const RenderOptions& o, long frame, const QuiltLayout& quilt, double aspect) {
+  const std::string stem = frame_stem(o.name, frame);
+  const std::string base = (fs::path(o.out_dir) / stem).string();
   FramePaths p;
   p.sidecar = base + ".json";
   if (o.write_encoded) p.encoded = base + ".exr";
   if (o.write_views) p.views = base + ".views.exr";
+  const std::string quilt_base = (fs::path(o.out_dir) / quilt_stem(stem, quilt, aspect)).string();
+  if (o.write_quilt) p.quilt = quilt_base + ".exr";
+  if (o.preview) {
+    if (o.write_encoded) p.encoded_png = base + ".png";
+    p.center_png = base + ".center.png";
+    if (o.write_quilt) p.quilt_png = quilt_base + ".png";
+  }
   return p;
 }
 
@@ -84,6 +102,15 @@ int run_sequence(const RenderOptions& o) {
   FrameRenderer renderer(scene, spec, o.rig, o.display, &warnings);
   for (const auto& w : warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
   const Rig& rig = renderer.rig();
+  const bool need_volume = o.write_views || o.write_quilt || o.preview;
+  QuiltLayout quilt;
+  if (o.write_quilt)
+    quilt = o.quilt.empty() ? choose_quilt_layout(rig.views, rig.view_w, rig.view_h)
+                            : parse_quilt_layout(o.quilt, rig.views, rig.view_w, rig.view_h);
+  else if (!o.quilt.empty())
+    throw Error("--quilt needs --write quilt");
+  const int center_view = rig.views / 2;
+  auto paths = [&](long f) { return paths_of(o, f, quilt, rig.aspect); };
 
   SidecarInfo info;
   info.scene = o.scene;
@@ -110,8 +137,14 @@ int run_sequence(const RenderOptions& o) {
     i.frame = int(frame);
     i.time = double(frame) / spec.fps;
     i.turntable_angle = angle;
-    if (!p.encoded.empty()) i.outputs.push_back({"encoded", base_name(p.encoded)});
-    if (!p.views.empty()) i.outputs.push_back({"views", base_name(p.views)});
+    const std::pair<const char*, const std::string*> kinds[] = {
+        {"encoded", &p.encoded}, {"views", &p.views}, {"quilt", &p.quilt}, {"preview_encoded", &p.encoded_png},
+        {"preview_center", &p.center_png}, {"preview_quilt", &p.quilt_png}};
+    for (const auto& [kind, path] : kinds)
+      if (!path->empty()) i.outputs.push_back({kind, base_name(*path)});
+    if (o.write_quilt) i.quilt_columns = quilt.columns, i.quilt_rows = quilt.rows;
+    if (o.preview) i.center_view = center_view;
+    i.depth = o.write_depth;
     return i;
   };
 
@@ -120,8 +153,9 @@ int run_sequence(const RenderOptions& o) {
   std::vector<long> todo;
   long skipped = 0;
   for (long f : frames) {
-    const FramePaths p = paths_of(o, f);
-    if (o.resume && exists(p.sidecar) && (p.encoded.empty() || exists(p.encoded)) && (p.views.empty() || exists(p.views))) {
+    const FramePaths p = paths(f);
+    const std::vector<std::string> images = p.images();
+    if (o.resume && exists(p.sidecar) && std::all_of(images.begin(), images.end(), exists)) {
       const std::string expected = sidecar_json(rig, o.display, frame_info(f, p, 0.0));
       const std::string diff = sidecar_config_difference(read_text(p.sidecar), expected);
       if (diff.empty()) {
@@ -146,7 +180,8 @@ int run_sequence(const RenderOptions& o) {
   ClRuntime runtime;
   const auto t_build = std::chrono::steady_clock::now();
   PipelineConfig pc = o.pipeline;
-  pc.fuse_encode = !o.write_views;  // the volume is only kept when the views are written
+  pc.fuse_encode = !need_volume;  // the volume is only kept when a product needs it
+  pc.debug_outputs = o.write_depth;  // per-voxel depth
   Pipeline pipeline(runtime, pc);
   renderer.attach(pipeline, o.write_encoded ? &o.display : nullptr);
   if (o.verbose)
@@ -160,7 +195,7 @@ int run_sequence(const RenderOptions& o) {
   const auto t_loop = std::chrono::steady_clock::now();
   for (long f : todo) {
     if (interrupt_signal()) break;
-    const FramePaths p = paths_of(o, f);
+    const FramePaths p = paths(f);
     const FrameRenderer::Frame fr = renderer.render(f);
     if (interrupt_signal()) break;  // the frame in flight is abandoned
     render_s += fr.times.wall / 1000.0;
@@ -189,14 +224,26 @@ int run_sequence(const RenderOptions& o) {
       if (renderer.has_geometry()) pipeline.read_display(files.display);
       else files.display.assign(size_t(o.display.width) * o.display.height * 4, 0);
     }
-    if (o.write_views) {
+    files.encoded_png = p.encoded_png;
+    if (need_volume) {
       files.views_path = p.views;
+      files.quilt_path = p.quilt;
+      files.quilt_png = p.quilt_png;
+      files.center_png = p.center_png;
+      files.quilt = quilt;
+      files.center_view = center_view;
       files.view_w = rig.view_w, files.view_h = rig.view_h, files.views = rig.views;
       // pixels of a view are non-square: the view spans the display's aspect A
       files.pixel_aspect = float(rig.aspect * rig.view_h / rig.view_w);
       files.volume = writer.spare_buffer();
       if (renderer.has_geometry()) pipeline.read_volume(files.volume);
       else files.volume.assign(size_t(rig.views) * rig.view_w * rig.view_h * 4, 0);
+      if (o.write_depth) {
+        files.near = fr.rig.near_eff, files.far = fr.rig.far;
+        std::vector<uint32_t> keys, count;
+        if (renderer.has_geometry()) pipeline.read_debug(keys, files.depth, count);
+        else files.depth.assign(size_t(rig.views) * rig.view_w * rig.view_h, std::numeric_limits<float>::infinity());
+      }
     }
     writer.submit(std::move(files));
     ++rendered;
@@ -225,8 +272,8 @@ int run_sequence(const RenderOptions& o) {
                1000.0 * writer.write_seconds() / n, to_string(compression), double(writer.bytes_written()) / n / 1e6,
                seconds_since(t0));
   if (!o.quiet && rendered == 1)
-    for (const std::string& path : {paths_of(o, todo[0]).encoded, paths_of(o, todo[0]).views, paths_of(o, todo[0]).sidecar})
-      if (!path.empty()) std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());
+    for (const std::string& path : paths(todo[0]).images()) std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());
+  if (!o.quiet && rendered == 1) std::fprintf(stderr, "pmr: wrote %s\n", paths(todo[0]).sidecar.c_str());
   return 0;
 }
 

@@ -49,8 +49,11 @@ class AtomicFile {
 // Half RGBA EXR (scanline, one part), row 0 at the top (data window (0,0)-(width-1,height-1)).
 // rgba_half: width*height*4 uint16 (IEEE half bits), row-major, RGBA, read in place (no copy).
 // threads > 0 sets OpenEXR's global thread count used for compression (Imf::setGlobalThreadCount).
+// depth (optional, [y][x] floats) adds a FLOAT channel "Z"; pixel_aspect is the header's
+// pixelAspectRatio (a quilt of non-square view pixels).
 void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half,
-                    ExrCompression c, int threads = 0);
+                    ExrCompression c, int threads = 0, const float* depth = nullptr, float pixel_aspect = 1.0f);
+
 
 // The name of part i of a views file with `views` parts: view_000, view_001, ... with 3 digits, or as
 // many as views - 1 needs (view_0000 .. view_1000 for 1001 views) so names sort in view order.
@@ -73,6 +76,15 @@ std::vector<std::string> read_exr_part_names(const std::string& path);
 // ([y][x]), or is cleared if the part has no "Z" channel.
 void read_views_exr_part(const std::string& path, int part, int& width, int& height,
                          std::vector<uint16_t>& rgba_half, std::vector<float>* depth = nullptr);
+
+// An 8-bit sRGB PNG with alpha for a person to look at: the linear half RGBA values (row 0 at the top)
+// encoded with the sRGB transfer curve, clamped to [0, 1] and rounded; alpha linear. Written atomically,
+// fast deflate (a preview, not an archive).
+void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half);
+// Reads an 8-bit RGBA (or RGB, gray: expanded) PNG, row 0 at the top (for the tests).
+void read_png_rgba8(const std::string& path, int& width, int& height, std::vector<uint8_t>& rgba);
+// The sRGB transfer curve (IEC 61966-2-1) of a linear value, clamped to [0, 1].
+double srgb_encode(double linear);
 
 // What the sidecar records besides the rig and the display.
 struct SidecarInfo {
@@ -97,6 +109,9 @@ struct SidecarInfo {
   long turntable_frames = 0;
   double turntable_angle = 0.0;        // this frame's angle, degrees
   glm::dvec3 pivot{0.0};               // the turntable axis passes through it (along +Y)
+  int quilt_columns = 0, quilt_rows = 0;  // of the quilt output (0: none)
+  int center_view = -1;                // the view of the center preview (-1: none)
+  bool depth = false;                  // Z channels in the views / quilt files
 };
 
 // The sidecar's JSON text (pretty printed, doubles with round-trip precision).

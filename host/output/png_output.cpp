@@ -1,0 +1,105 @@
+// PNG previews through libpng: 8-bit sRGB, written row by row into an AtomicFile.
+#include <png.h>
+
+#include <Imath/half.h>
+
+#include <cerrno>
+#include <cmath>
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+
+#include "pmr/error.h"
+#include "pmr/output.h"
+
+namespace pmr {
+
+double srgb_encode(double x) {
+  if (!(x > 0.0)) return 0.0;  // also NaN
+  if (x >= 1.0) return 1.0;
+  return x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1.0 / 2.4) - 0.055;
+}
+
+namespace {
+
+// libpng reports errors through longjmp; the message is kept for one clear line.
+struct PngError {
+  char message[256] = "";
+};
+
+void on_error(png_structp png, png_const_charp msg) {
+  auto* e = static_cast<PngError*>(png_get_error_ptr(png));
+  std::snprintf(e->message, sizeof e->message, "%s", msg);
+  png_longjmp(png, 1);
+}
+void on_warning(png_structp, png_const_charp) {}
+
+uint8_t to_byte(double v) { return uint8_t(std::lround(std::min(1.0, std::max(0.0, v)) * 255.0)); }
+
+}  // namespace
+
+void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half) {
+  if (width < 1 || height < 1 || !rgba_half) throw Error("cannot write " + path + ": empty image");
+  // sRGB lookup for every half value: the curve is applied once per distinct input, not per pixel
+  static uint8_t lut[65536];
+  static bool lut_ready = false;
+  if (!lut_ready) {
+    for (uint32_t h = 0; h < 65536; ++h) {
+      half v;
+      v.setBits(uint16_t(h));
+      lut[h] = to_byte(srgb_encode(double(float(v))));
+    }
+    lut_ready = true;
+  }
+  AtomicFile file(path);
+  FILE* f = std::fopen(file.temp_path().c_str(), "wb");
+  if (!f) throw Error("cannot write " + path + ": " + std::strerror(errno));
+  PngError err;
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, on_error, on_warning);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  std::vector<uint8_t> row(size_t(width) * 4);
+  bool ok = png && info;
+  if (ok && setjmp(png_jmpbuf(png)) == 0) {
+    png_init_io(png, f);
+    png_set_compression_level(png, 1);
+    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_write_info(png, info);
+    for (int y = 0; y < height; ++y) {
+      const uint16_t* src = rgba_half + size_t(y) * size_t(width) * 4;
+      for (size_t x = 0; x < size_t(width); ++x) {
+        for (int c = 0; c < 3; ++c) row[4 * x + size_t(c)] = lut[src[4 * x + size_t(c)]];
+        half a;
+        a.setBits(src[4 * x + 3]);
+        row[4 * x + 3] = to_byte(double(float(a)));
+      }
+      png_write_row(png, row.data());
+    }
+    png_write_end(png, info);
+  } else {
+    ok = false;
+  }
+  png_destroy_write_struct(png ? &png : nullptr, info ? &info : nullptr);
+  const bool closed = std::fclose(f) == 0;
+  if (!ok || !closed)
+    throw Error("cannot write " + path + ": " + (err.message[0] ? err.message : std::strerror(errno)));
+  file.commit();
+}
+
+void read_png_rgba8(const std::string& path, int& width, int& height, std::vector<uint8_t>& rgba) {
+  png_image image;
+  std::memset(&image, 0, sizeof image);
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, path.c_str()))
+    throw Error("cannot read " + path + ": " + image.message);
+  image.format = PNG_FORMAT_RGBA;
+  rgba.assign(PNG_IMAGE_SIZE(image), 0);
+  if (!png_image_finish_read(&image, nullptr, rgba.data(), 0, nullptr)) {
+    png_image_free(&image);
+    throw Error("cannot read " + path + ": " + image.message);
+  }
+  width = int(image.width), height = int(image.height);
+}
+
+}  // namespace pmr

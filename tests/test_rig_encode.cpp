@@ -144,6 +144,87 @@ void check_encoder(const Display& display, int views, int vw, int vh, bool all_v
   for (int v = 0; v < views && all_views_shown; ++v) EXPECT_TRUE(views_seen[size_t(v)]) << "view " << v << " never shown";
 }
 
+TEST(Encode, ParsesCalibrationPrecisionExactly) {
+  const Rational l = parse_rational("18.6578963681", "L");
+  EXPECT_EQ(l.num, 186578963681);
+  EXPECT_EQ(l.den, 10000000000);
+  const Rational t = parse_rational("-0.138666843675", "T");
+  EXPECT_EQ(t.num, -5546673747);  // -138666843675 / 10^12 reduced by 25
+  EXPECT_EQ(t.den, 40000000000);
+  EXPECT_EQ(parse_rational("1.5e-3", "x").num, 3);
+  EXPECT_EQ(parse_rational("1.5e-3", "x").den, 2000);
+  EXPECT_EQ(parse_rational("2E2", "x").num, 200);
+  const Rational r18 = parse_rational("0.123456789012345678", "x");  // 18 significant digits, exact
+  EXPECT_EQ((__int128)r18.num * 1000000000000000000, (__int128)123456789012345678 * r18.den);
+  EXPECT_THROW(parse_rational("0.000123456789012345678", "x"), Error);  // denominator 10^21
+  EXPECT_THROW(parse_rational("1.2345678901234567890", "x"), Error);  // 20 significant digits
+  EXPECT_THROW(parse_rational("1e-30", "x"), Error);
+  EXPECT_THROW(parse_rational("1e", "x"), Error);
+}
+
+// The view of every subpixel from the host tables (the kernels' formula) for a real Looking Glass
+// Portrait calibration in DESIGN terms, on the whole 1536 x 2048 panel, against an independent long
+// double evaluation of floor(frac(t) N): they must agree wherever N t is not within 1e-9 of an integer
+// (long double carries ~19 digits; N t < 10^5). Rounding the calibration to 4 significant digits
+// instead moves a large part of the subpixels to another view: the reason for exactness.
+TEST(Encode, RealCalibrationIsExactOnTheWholePanel) {
+  Display d;
+  d.width = 1536, d.height = 2048;
+  d.lens_pitch = parse_rational("18.6578963681", "L");
+  d.tan_slant = parse_rational("-0.138666843675", "T");
+  d.offset = parse_rational("18.1706630397", "O");
+  const int views = 48;
+  const PmrEncodeParams p = make_encode_params(d, views, 420, 560);
+  std::vector<PmrEncodeColumn> cols;
+  std::vector<PmrEncodeRow> rows;
+  make_encode_tables(d, p, cols, rows);
+  const long double L = 18.6578963681L, T = -0.138666843675L, O = 18.1706630397L;
+  const long double L4 = 18.66L, T4 = -0.1387L, O4 = 18.17L;
+  size_t ambiguous = 0, rounded_wrong = 0, total = 0;
+  for (int i = 0; i < d.height; ++i)
+    for (int s = 0; s < 3 * d.width; ++s) {
+      const PmrEncodeColumn& c = cols[size_t(s)];
+      const PmrEncodeRow& r = rows[size_t(i)];
+      int v = c.a_mod_n - r.q_mod_n - (c.b < r.s ? 1 : 0);
+      if (v < 0) v += views;
+      if (v < 0) v += views;
+      const long double nt = views * (s - 3.0L * i * T - O) / L;
+      const long double f = nt - views * std::floor(nt / views);
+      const long double near = std::abs(f - std::round(f));
+      if (near < 1e-9L) {
+        ++ambiguous;
+      } else {
+        ASSERT_EQ(v, int(std::floor(f))) << "subpixel column " << s << " row " << i;
+      }
+      const long double nt4 = views * (s - 3.0L * i * T4 - O4) / L4;
+      rounded_wrong += int(nt4 - views * std::floor(nt4 / views)) != v;
+      ++total;
+    }
+  EXPECT_EQ(ambiguous, 0u);
+  std::printf("4-digit calibration: %zu of %zu subpixels (%.1f%%) on another view\n", rounded_wrong, total,
+              100.0 * double(rounded_wrong) / double(total));
+  // the issue measured about half; anything over a tenth shows the point
+  EXPECT_GT(double(rounded_wrong) / double(total), 0.1) << rounded_wrong << " of " << total;
+  // the direct wide evaluation agrees on a sample of subpixels
+  for (int i = 0; i < d.height; i += 97)
+    for (int j = 0; j < d.width; j += 31)
+      for (int k = 0; k < 3; ++k) {
+        const PmrEncodeColumn& c = cols[size_t(3 * j + k)];
+        int v = c.a_mod_n - rows[size_t(i)].q_mod_n - (c.b < rows[size_t(i)].s ? 1 : 0);
+        v = (v + 2 * views) % views;
+        ASSERT_EQ(encode_view_index(d, views, j, i, k), v) << j << "," << i << "," << k;
+      }
+}
+
+TEST(Encode, KernelMatchesDirectEvaluationPortraitCalibration) {
+  Display d;
+  d.width = 384, d.height = 256;  // a real Portrait calibration on a smaller panel
+  d.lens_pitch = parse_rational("18.6578963681", "L");
+  d.tan_slant = parse_rational("-0.138666843675", "T");
+  d.offset = parse_rational("18.1706630397", "O");
+  check_encoder(d, 48, 42, 56);
+}
+
 TEST(Encode, KernelMatchesDirectEvaluationPaperParameters) {
   Display d;
   d.width = 960, d.height = 540;  // the paper-8k lens parameters on a smaller panel

@@ -172,8 +172,7 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       rc.view_w = 2 * rc.view_h;
     }
     Display display = o.display;
-    display.offset = parse_rational(std::to_string(-display.lens_pitch.num) + "/" +
-                                        std::to_string(2 * display.lens_pitch.den * N), "offset");
+    display.offset = default_offset(display.lens_pitch, N);
     FrameRenderer renderer(scene, spec, rc, display, nullptr);
     const Rig& rig = renderer.rig();
     const double voxels = double(N) * rig.view_w * rig.view_h;

@@ -164,9 +164,7 @@ std::string frame_stem(const std::string& pattern, long frame) {
 
 void finalize_render_options(RenderOptions& o) {
   if (!o.offset_given) {
-    // offset = -L / (2N): N t lands half-way between view boundaries (DESIGN section 5).
-    const Rational& L = o.display.lens_pitch;
-    o.display.offset = parse_rational(std::to_string(-L.num) + "/" + std::to_string(2 * L.den * o.rig.views), "offset");
+    o.display.offset = default_offset(o.display.lens_pitch, o.rig.views);
   }
 }
 

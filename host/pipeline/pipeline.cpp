@@ -239,7 +239,7 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
     m.encode_params = make_encode_params(*display, rig.views, rig.view_w, rig.view_h);
     std::vector<PmrEncodeColumn> columns;
     std::vector<PmrEncodeRow> rows;
-    make_encode_tables(m.encode_params, columns, rows);
+    make_encode_tables(*display, m.encode_params, columns, rows);
     if (m.fused) m.configure_fused(build_options_, rig.views, tile_[0], columns, rows);
     m.encode_columns = rt.buffer(bytes_of(columns), "encoder columns", CL_MEM_READ_ONLY);
     rt.write(m.encode_columns, columns.data(), bytes_of(columns));

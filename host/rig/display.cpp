@@ -1,8 +1,15 @@
-// The display's subpixel-to-view map (DESIGN section 5) in exact rational arithmetic.
+// The display's subpixel-to-view map (DESIGN section 5), exact for any display parameters given as
+// decimals (up to 18 significant digits, optional exponent) or fractions.
 //
 // A literal float evaluation of floor(frac(t) * N) picks the wrong view wherever t * N is an integer
-// (a third of all subpixels for some presets), so every display parameter is kept as an exact
-// fraction and the kernel evaluates N t = (num_jk (3j + k) - num_i i - num_0) / den in int64.
+// (a third of all subpixels for some presets), and a real panel's calibration (L = 18.6578963681 ...)
+// accumulates any rounding over hundreds of lenses. So with L = a/b, tan(alpha) = c/d, offset = e/f:
+//   N t = (P_s - R_i) / Den,  Den = a d f,  P_s = N b d f s (s = 3j + k),  R_i = N b (3 i c f + e d),
+// all exact integers (WideInt: up to ~220 bits). With P_s = qP Den + rP and R_i = qR Den + rR
+// (0 <= r < Den): floor(N t) = qP - qR - (rP < rR). The tables hold qP, qR mod N and, instead of the
+// wide remainders, their ranks among all column and row remainders: equal remainders get equal ranks,
+// so the kernels' 32-bit comparison decides every subpixel exactly as the wide one would, ties included.
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <limits>
@@ -10,6 +17,7 @@
 
 #include "pmr/error.h"
 #include "pmr/rig.h"
+#include "rig/wide_int.h"
 
 namespace pmr {
 
@@ -27,41 +35,61 @@ Rational reduced(i128 num, i128 den, const std::string& what) {
     b = t;
   }
   if (a > 1) num /= a, den /= a;
-  const i128 lim = i128(1) << 40;
+  const i128 lim = i128(1) << 62;
   if (num > lim || -num > lim || den > lim)
-    throw Error("invalid " + what + ": too many digits for an exact fraction");
+    throw Error("invalid " + what + ": too many digits for an exact fraction (at most 18 significant digits)");
   return Rational{int64_t(num), int64_t(den)};
 }
 
-// Parses an optionally signed decimal ("16", "-0.0833", ".5") as an exact fraction.
+// Parses an optionally signed decimal with an optional exponent ("16", "-0.0833", ".5", "1.5e-3") as an
+// exact fraction num / den. At most 18 significant digits; the exponent moves the point.
 bool parse_decimal(const std::string& s, i128& num, i128& den) {
   size_t i = 0;
   bool neg = false;
   if (i < s.size() && (s[i] == '+' || s[i] == '-')) neg = s[i++] == '-';
   num = 0;
   den = 1;
-  int digits = 0;
-  bool frac = false;
-  for (; i < s.size(); ++i) {
+  int digits = 0, scale = 0;  // value = num * 10^-scale
+  bool frac = false, any = false;
+  for (; i < s.size() && s[i] != 'e' && s[i] != 'E'; ++i) {
     if (s[i] == '.' && !frac) {
       frac = true;
       continue;
     }
     if (!std::isdigit(static_cast<unsigned char>(s[i]))) return false;
-    if (++digits > 15) return false;
+    any = true;
+    if (num == 0 && s[i] == '0') {  // leading zeros are not significant
+      if (frac) ++scale;
+      continue;
+    }
+    if (++digits > 18) return false;
     num = num * 10 + (s[i] - '0');
-    if (frac) den *= 10;
+    if (frac) ++scale;
   }
-  if (digits == 0) return false;
+  if (!any) return false;
+  if (i < s.size()) {  // exponent
+    ++i;
+    bool eneg = false;
+    if (i < s.size() && (s[i] == '+' || s[i] == '-')) eneg = s[i++] == '-';
+    if (i >= s.size()) return false;
+    int e = 0;
+    for (; i < s.size(); ++i) {
+      if (!std::isdigit(static_cast<unsigned char>(s[i])) || e > 100) return false;
+      e = e * 10 + (s[i] - '0');
+    }
+    scale += eneg ? e : -e;
+  }
+  // num and den below 2^62 (products of two stay inside 128 bits; the encoder's wide integers hold
+  // three of them)
+  const i128 lim = i128(1) << 62;
+  for (; scale > 0; --scale)
+    if ((den *= 10) >= lim) return false;
+  for (; scale < 0; ++scale)
+    if ((num *= 10) >= lim) return false;
   if (neg) num = -num;
   return true;
 }
 
-i128 floor_div(i128 a, i128 b) {  // b > 0
-  i128 q = a / b;
-  if ((a % b != 0) && (a < 0)) --q;
-  return q;
-}
 
 }  // namespace
 
@@ -72,35 +100,49 @@ Rational parse_rational(const std::string& text, const std::string& what) {
                       ? parse_decimal(text, n1, d1)
                       : parse_decimal(text.substr(0, slash), n1, d1) &&
                             parse_decimal(text.substr(slash + 1), n2, d2);
-  if (!ok) throw Error("invalid " + what + " '" + text + "': expected a number or a fraction like 1/18");
+  if (!ok)
+    throw Error("invalid " + what + " '" + text +
+                "': expected a number (at most 18 significant digits) or a fraction like 1/18");
   return reduced(n1 * d2, d1 * n2, what);
+}
+
+Rational default_offset(const Rational& lens_pitch, int views) {
+  // -L / (2N): N t lands half-way between view boundaries (DESIGN section 5)
+  return reduced(-i128(lens_pitch.num), i128(2) * lens_pitch.den * views, "offset");
 }
 
 std::string to_string(const Rational& r) {
   return r.den == 1 ? std::to_string(r.num) : std::to_string(r.num) + "/" + std::to_string(r.den);
 }
 
+namespace {
+
+// The exact integers of the header comment.
+struct Phase {
+  WideInt den, p1, r0, dr;  // Den, P_1 (P_s = s P_1), R_0, R_{i+1} - R_i
+};
+
+Phase phase_of(const Display& display, int views) {
+  const Rational &L = display.lens_pitch, &T = display.tan_slant, &O = display.offset;
+  Phase ph;
+  ph.den = WideInt(L.num) * T.den * O.den;
+  ph.p1 = WideInt(views) * L.den * T.den * O.den;
+  ph.r0 = WideInt(views) * L.den * O.num * T.den;
+  ph.dr = WideInt(3) * views * L.den * T.num * O.den;
+  return ph;
+}
+
+int mod_n(int64_t q, int n) { return int(((q % n) + n) % n); }
+
+}  // namespace
+
 PmrEncodeParams make_encode_params(const Display& display, int views, int view_w, int view_h) {
   if (display.width < 1 || display.height < 1 || display.width > 16384 || display.height > 16384)  // encode.cl indexes in 32 bits
     throw Error("invalid --display: each side must be 1..16384");
   if (display.lens_pitch.num <= 0) throw Error("invalid --lens-pitch: must be positive");
-  const Rational& L = display.lens_pitch;
-  const Rational& T = display.tan_slant;
-  const Rational& O = display.offset;
-  // N t = N (3j + k - 3 i T - O) / L = (num_jk (3j+k) - num_i i - num_0) / den
-  const i128 num_jk = i128(views) * L.den * T.den * O.den;
-  const i128 num_i = i128(3) * views * L.den * T.num * O.den;
-  const i128 num_0 = i128(views) * L.den * O.num * T.den;
-  const i128 den = i128(L.num) * T.den * O.den;
-  const i128 a_i = num_i < 0 ? -num_i : num_i, a_0 = num_0 < 0 ? -num_0 : num_0;
-  const i128 worst = num_jk * (3 * i128(display.width) + 3) + a_i * display.height + a_0;
-  if (worst >= (i128(1) << 62) || den >= (i128(1) << 31))
-    throw Error("display parameters need too many digits for exact subpixel evaluation; use simpler fractions");
+  for (const Rational* r : {&display.lens_pitch, &display.tan_slant, &display.offset})
+    if (r->den <= 0) throw Error("internal error: display fraction with a non-positive denominator");
   PmrEncodeParams p{};
-  p.num_jk = int64_t(num_jk);
-  p.num_i = int64_t(num_i);
-  p.num_0 = int64_t(num_0);
-  p.den = int64_t(den);
   p.display_w = display.width;
   p.display_h = display.height;
   p.views = views;
@@ -111,38 +153,66 @@ PmrEncodeParams make_encode_params(const Display& display, int views, int view_w
   return p;
 }
 
-void make_encode_tables(const PmrEncodeParams& p, std::vector<PmrEncodeColumn>& columns, std::vector<PmrEncodeRow>& rows) {
+void make_encode_tables(const Display& display, const PmrEncodeParams& p, std::vector<PmrEncodeColumn>& columns,
+                        std::vector<PmrEncodeRow>& rows) {
+  const Phase ph = phase_of(display, p.views);
   columns.resize(size_t(3) * p.display_w);
-  for (size_t s = 0; s < columns.size(); ++s) {
-    const i128 n = i128(p.num_jk) * i128(s);
-    const i128 a = floor_div(n, p.den);
-    PmrEncodeColumn& c = columns[s];
-    c.a_mod_n = int32_t(((a % p.views) + p.views) % p.views);
-    c.b = int32_t(n - a * p.den);
-    c.px = int32_t((i128(2 * s + 1) * p.view_w) / (i128(6) * p.display_w));
-    c.pad = 0;
-  }
   rows.resize(size_t(p.display_h));
+  // Remainders of every column and row, stepped exactly (one wide division each for the steps).
+  std::vector<std::pair<WideInt, int>> rems;  // (remainder, +column index or -(row index) - 1)
+  rems.reserve(columns.size() + rows.size());
+  WideInt q1, r1, q, r;
+  ph.p1.floor_divmod(ph.den, q1, r1);
+  const int64_t q1n = q1.to_int64();
+  int64_t qp = 0;
+  WideInt rp(0);
+  for (size_t s = 0; s < columns.size(); ++s) {
+    if (s > 0) {
+      qp += q1n;
+      rp = rp + r1;
+      if (rp >= ph.den) rp = rp - ph.den, ++qp;
+    }
+    PmrEncodeColumn& c = columns[s];
+    c.a_mod_n = mod_n(qp, p.views);
+    c.px = int32_t((int64_t(2 * s + 1) * p.view_w) / (int64_t(6) * p.display_w));
+    c.pad = 0;
+    rems.push_back({rp, int(s)});
+  }
+  WideInt qd, rd;
+  ph.dr.floor_divmod(ph.den, qd, rd);
+  ph.r0.floor_divmod(ph.den, q, r);
+  const int64_t qdn = qd.to_int64();
+  int64_t qr = q.to_int64();
   for (size_t i = 0; i < rows.size(); ++i) {
-    const i128 n = i128(p.num_i) * i128(i) + p.num_0;
-    const i128 q = floor_div(n, p.den);
-    PmrEncodeRow& r = rows[i];
-    r.q_mod_n = int32_t(((q % p.views) + p.views) % p.views);
-    r.s = int32_t(n - q * p.den);
-    r.py = int32_t((i128(2 * i + 1) * p.view_h) / (i128(2) * p.display_h));
-    r.pad = 0;
+    if (i > 0) {
+      qr += qdn;
+      r = r + rd;
+      if (r >= ph.den) r = r - ph.den, ++qr;
+    }
+    PmrEncodeRow& row = rows[i];
+    row.q_mod_n = mod_n(qr, p.views);
+    row.py = int32_t((int64_t(2 * i + 1) * p.view_h) / (int64_t(2) * p.display_h));
+    row.pad = 0;
+    rems.push_back({r, -int(i) - 1});
+  }
+  // Ranks of the remainders (equal remainders, equal ranks).
+  std::sort(rems.begin(), rems.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  int32_t rank = 0;
+  for (size_t k = 0; k < rems.size(); ++k) {
+    if (k > 0 && rems[k - 1].first < rems[k].first) ++rank;
+    const int idx = rems[k].second;
+    if (idx >= 0) columns[size_t(idx)].b = rank;
+    else rows[size_t(-idx - 1)].s = rank;
   }
 }
 
 int encode_view_index(const Display& display, int views, int j, int i, int k) {
-  // t = (3j + k - 3 i tan(alpha) - offset) / L as one fraction p / q, then v = floor(frac(t) N).
-  const Rational &L = display.lens_pitch, &T = display.tan_slant, &O = display.offset;
-  const i128 q0 = i128(T.den) * O.den;  // common denominator of the bracket
-  const i128 p0 = (i128(3) * j + k) * q0 - i128(3) * i * T.num * O.den - i128(O.num) * T.den;
-  const i128 p = p0 * L.den, q = q0 * L.num;  // divide by L = L.num / L.den
-  const i128 frac_num = p - floor_div(p, q) * q;  // frac(t) = frac_num / q, in [0, 1)
-  int v = int(floor_div(frac_num * views, q));
-  if (v > views - 1) v = views - 1;
+  // Direct: N t = (P_s - R_i) / Den as one wide fraction, v = floor(N t) mod N.
+  const Phase ph = phase_of(display, views);
+  const WideInt num = ph.p1 * (3 * int64_t(j) + k) - (ph.r0 + ph.dr * i);
+  WideInt q, r;
+  num.floor_divmod(ph.den, q, r);
+  int v = mod_n(q.to_int64(), views);
   if (display.reversed) v = views - 1 - v;
   return v;
 }

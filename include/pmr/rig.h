@@ -19,6 +19,8 @@ struct Rational {
 // Parses "16", "-0.0833", "1/18", "-1/12". Throws pmr::Error naming `what` on bad input.
 Rational parse_rational(const std::string& text, const std::string& what);
 std::string to_string(const Rational& r);
+// The default encoder offset -L / (2N), exact.
+Rational default_offset(const Rational& lens_pitch, int views);
 
 struct Display {
   int width = 7680, height = 4320;   // pixels
@@ -68,14 +70,16 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
 // Frame parameters for the kernels (tile grid and capacities are filled in by the pipeline).
 PmrParams make_params(const Rig& rig);
 
-// Encoder parameters with exact integer coefficients. Throws pmr::Error if they could overflow.
+// Encoder parameters (sizes and flags). Throws pmr::Error on an unusable display.
 PmrEncodeParams make_encode_params(const Display& display, int views, int view_w, int view_h);
 
-// The encoder's per-subpixel-column and per-row tables (see PmrEncodeColumn in shared.h).
-void make_encode_tables(const PmrEncodeParams& p, std::vector<PmrEncodeColumn>& columns, std::vector<PmrEncodeRow>& rows);
+// The encoder's per-subpixel-column and per-row tables (see PmrEncodeColumn in shared.h), computed in
+// exact wide integer arithmetic from the display's fractions.
+void make_encode_tables(const Display& display, const PmrEncodeParams& p, std::vector<PmrEncodeColumn>& columns,
+                        std::vector<PmrEncodeRow>& rows);
 
-// Direct evaluation of DESIGN section 5 in exact rational arithmetic: the view of subpixel k of
-// display pixel (j, i). The reference the encoder kernel is tested against.
+// Direct evaluation of DESIGN section 5 in exact arithmetic (one wide division per subpixel): the view
+// of subpixel k of display pixel (j, i). The reference the encoder kernels are tested against.
 int encode_view_index(const Display& display, int views, int j, int i, int k);
 
 }  // namespace pmr

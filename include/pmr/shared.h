@@ -162,14 +162,9 @@ typedef struct {
   pmr_u32 pad0, pad1, pad2;
 } PmrTexture;
 
-/* Encoder parameters (DESIGN section 5), exact rational arithmetic. For subpixel (j, i, k):
- *   N * t = (num_jk * (3j + k) - num_i * i - num_0) / den
- * and v = floor(N t) mod N. Producer: host/display. */
+/* Encoder parameters (DESIGN section 5): sizes and flags. The subpixel-to-view map itself is in the
+ * tables below, computed exactly by the host (host/rig/display.cpp). */
 typedef struct {
-  pmr_i64 num_jk;         /* see above; the host checks that nothing overflows               */
-  pmr_i64 num_i;
-  pmr_i64 num_0;
-  pmr_i64 den;                  /* > 0                                                             */
   pmr_i32 display_w, display_h;
   pmr_i32 views;
   pmr_i32 view_w, view_h;
@@ -179,19 +174,20 @@ typedef struct {
 } PmrEncodeParams;
 
 /* Encoder tables, computed once per configuration by the host (host/rig/display.cpp). With
- * num_jk * s = A_s * den + B_s (s = 3j + k, 0 <= B_s < den) and num_i * i + num_0 = Q_i * den + S_i
- * (0 <= S_i < den): floor(N t) = A_s - Q_i - (B_s < S_i), so the view of a subpixel needs no division:
- * v = (A_s mod N) - (Q_i mod N) - (B_s < S_i), plus N if negative. */
+ * N t = (P_s - R_i) / Den exactly (s = 3j + k), P_s = A_s Den + rP_s and R_i = Q_i Den + rR_i
+ * (0 <= r < Den): floor(N t) = A_s - Q_i - (rP_s < rR_i), so the view of a subpixel needs no division:
+ * v = (A_s mod N) - (Q_i mod N) - (B_s < S_i), plus N if negative, where B_s and S_i are the ranks of
+ * the wide remainders rP_s and rR_i among all of them (same order, ties kept). */
 typedef struct {
   pmr_i32 a_mod_n;        /* A_s mod N                                                      */
-  pmr_i32 b;              /* B_s (den < 2^31 is checked by the host)                         */
+  pmr_i32 b;              /* B_s: rank of the column's remainder                             */
   pmr_i32 px;             /* nearest view column: floor((2s + 1) W / (6 W_d))                 */
   pmr_i32 pad;
 } PmrEncodeColumn;
 
 typedef struct {
   pmr_i32 q_mod_n;        /* Q_i mod N                                                      */
-  pmr_i32 s;              /* S_i                                                            */
+  pmr_i32 s;              /* S_i: rank of the row's remainder                                */
   pmr_i32 py;             /* nearest view row: floor((2i + 1) H / (2 H_d))                    */
   pmr_i32 pad;
 } PmrEncodeRow;

@@ -1,5 +1,7 @@
 #include "test_util.h"
 
+#include <Imath/half.h>
+
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -152,6 +154,53 @@ void expect_one_error_line(const CliRun& r, const std::string& fragment) {
   const std::string line = r.output.substr(at);
   EXPECT_EQ(line.find('\n'), line.size() - 1) << "exactly one error line: " << r.output;
   EXPECT_NE(line.find(fragment), std::string::npos) << "expected '" << fragment << "' in: " << line;
+}
+
+}  // namespace pmr::test
+
+namespace pmr::test {
+
+std::vector<int> encoded_view_indices(const Display& display, int views, int view_w, int view_h) {
+  RigConfig rc;
+  rc.views = views, rc.view_w = view_w, rc.view_h = view_h;
+  const Rig rig = make_rig(rc, display, glm::dvec3(-1), glm::dvec3(1));
+  Pipeline p(runtime(), PipelineConfig{});
+  p.set_scene(random_scene(1, 1, false));
+  p.configure(rig, &display);
+  const size_t plane = size_t(view_w) * view_h;
+  std::vector<uint16_t> vol(plane * views * 4), enc;
+  for (int v = 0; v < views; ++v) {
+    const uint16_t h = half(float(v)).bits();
+    for (size_t x = 0; x < plane * 4; ++x) vol[size_t(v) * plane * 4 + x] = h;
+  }
+  p.encode_volume(vol);
+  p.read_display(enc);
+  std::vector<int> out(size_t(display.width) * display.height * 3);
+  for (size_t px = 0; px < size_t(display.width) * display.height; ++px)
+    for (int k = 0; k < 3; ++k) {
+      half h;
+      h.setBits(enc[px * 4 + size_t(k)]);
+      out[px * 3 + size_t(k)] = int(float(h));
+    }
+  return out;
+}
+
+std::vector<int> table_view_indices(const Display& display, int views) {
+  const PmrEncodeParams p = make_encode_params(display, views, 1, 1);
+  std::vector<PmrEncodeColumn> cols;
+  std::vector<PmrEncodeRow> rows;
+  make_encode_tables(display, p, cols, rows);
+  std::vector<int> out(size_t(display.width) * display.height * 3);
+  for (int i = 0; i < display.height; ++i)
+    for (int s = 0; s < 3 * display.width; ++s) {
+      const PmrEncodeColumn& c = cols[size_t(s)];
+      const PmrEncodeRow& r = rows[size_t(i)];
+      int v = c.a_mod_n - r.q_mod_n - (c.b < r.s ? 1 : 0);
+      v = (v + 2 * views) % views;
+      if (display.reversed) v = views - 1 - v;
+      out[size_t(i) * 3 * display.width + size_t(s)] = v;
+    }
+  return out;
 }
 
 }  // namespace pmr::test

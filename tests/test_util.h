@@ -64,3 +64,11 @@ size_t count_entries(const std::string& dir);  // including hidden ones
 // The error is one line starting with "pmr: error:" (warnings may precede it), exit code 1.
 void expect_one_error_line(const CliRun& r, const std::string& fragment);
 }  // namespace pmr::test
+
+namespace pmr::test {
+// The view index each display subpixel shows, from the encode kernel (a volume whose every channel
+// holds its view's index, encoded by the pipeline): [i][j][k], display rows from the top.
+std::vector<int> encoded_view_indices(const Display& display, int views, int view_w, int view_h);
+// The same from the host tables alone (the kernels' formula, no device): for whole-panel checks.
+std::vector<int> table_view_indices(const Display& display, int views);
+}  // namespace pmr::test

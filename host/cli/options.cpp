@@ -1,6 +1,7 @@
 #include "cli/options.h"
 
 #include <cerrno>
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -45,8 +46,62 @@ std::vector<int> parse_dims(const std::string& text, const std::string& opt, siz
 
 }  // namespace
 
+namespace {
+
+// The rig a Looking Glass panel's serial prefix recommends (the preset of that model), or 48 views of the
+// panel's aspect for an unknown one.
+RigConfig rig_for_serial(const LookingGlassCalibration& c, std::string& quilt) {
+  const std::pair<const char*, const char*> models[] = {{"LKG-P", "lg-portrait"}, {"LKG-E", "lg-go"},
+                                                        {"LKG-J", "lg-16"},       {"LKG-H", "lg-16-portrait"},
+                                                        {"LKG-L", "lg-32"},       {"LKG-K", "lg-32-portrait"},
+                                                        {"LKG-A", "lg-16-gen2"},  {"LKG-B", "lg-32-gen2"}};
+  for (const auto& [prefix, preset] : models)
+    if (c.serial.rfind(prefix, 0) == 0) {
+      const DisplayPreset& p = find_display_preset(preset);
+      quilt = p.quilt;
+      RigConfig r = p.rig;
+      r.cone_deg = c.view_cone;
+      return r;
+    }
+  RigConfig r;
+  r.views = 48;
+  r.view_h = 560;
+  r.view_w = std::max(1, int(std::lround(560.0 * c.screen_w / c.screen_h)));
+  r.cone_deg = c.view_cone;
+  return r;
+}
+
+// --preset and --display-config set the defaults that every other option then overrides.
+void apply_display_source(RenderOptions& o, const std::vector<std::string>& args) {
+  for (size_t i = 0; i + 1 < args.size(); ++i) {
+    if (args[i] == "--preset") {
+      if (args[i + 1] == "help") {
+        o.preset_help = true;
+        return;
+      }
+      const DisplayPreset& p = find_display_preset(args[i + 1]);
+      o.display = p.display;
+      o.rig = p.rig;
+      o.display_source = "preset " + p.name;
+    } else if (args[i] == "--display-config") {
+      o.calibration = read_looking_glass_calibration(args[i + 1], &o.option_warnings);
+      o.has_calibration = true;
+      o.display = display_from_calibration(o.calibration);
+      std::string quilt;
+      o.rig = rig_for_serial(o.calibration, quilt);
+      o.display_source = "calibration " + args[i + 1];
+    }
+  }
+  int sources = 0;
+  for (const std::string& a : args) sources += a == "--preset" || a == "--display-config";
+  if (sources > 1) throw Error("give one of --preset and --display-config, once");
+}
+
+}  // namespace
+
 RenderOptions parse_render_options(const std::vector<std::string>& args) {
   RenderOptions o;
+  apply_display_source(o, args);
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> std::string {
@@ -55,10 +110,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     };
     if (a == "-h" || a == "--help") o.help = true;
     else if (a == "--out" || a == "-o") o.out_dir = value();
-    else if (a == "--preset") {
-      const std::string p = value();
-      if (p != "paper-8k") throw Error("unknown --preset '" + p + "' (known: paper-8k)");
-    } else if (a == "--views") o.rig.views = parse_int(value(), a, 1, 4096);
+    else if (a == "--preset" || a == "--display-config") value();  // applied first (apply_display_source)
+    else if (a == "--views") o.rig.views = parse_int(value(), a, 1, 4096);
     else if (a == "--view-size") {
       const auto d = parse_dims(value(), a, 2, PMR_MAX_RASTER);
       o.rig.view_w = d[0], o.rig.view_h = d[1];
@@ -209,7 +262,10 @@ std::string render_help() {
          "  --overwrite            with --resume: re-render frames of another configuration instead\n"
          "  --quiet                no progress output (errors and the summary still print)\n"
          "rig:\n"
-         "  --preset NAME          paper-8k (the only preset; also the default)\n"
+         "  --preset NAME          a display: paper-8k (default), lg-portrait, lg-go, lg-16, lg-32, ...\n"
+         "                         (--preset help lists them); other options override its values\n"
+         "  --display-config F     a Looking Glass panel's own calibration file (visual.json): display,\n"
+         "                         encoder and the model's recommended views (docs/DISPLAYS.md)\n"
          "  --views N              number of views (default 96)\n"
          "  --view-size WxH        view raster in pixels (default 1024x512; each side <= 8192)\n"
          "  --cone DEG             view cone (default 80)\n"

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "pipeline/pipeline.h"
+#include "pmr/display_presets.h"
 #include "pmr/rig.h"
 
 namespace pmr {
@@ -13,6 +14,10 @@ struct RenderOptions {
   std::string out_dir = "out";
   RigConfig rig;
   Display display;
+  std::string display_source = "preset paper-8k";  // what the display came from (sidecar)
+  bool has_calibration = false;                     // --display-config: the file's values
+  LookingGlassCalibration calibration;
+  std::vector<std::string> option_warnings;         // e.g. calibration fields read but ignored
   bool offset_given = false;    // else offset = -L / (2N), which centres every subpixel in its view
   PipelineConfig pipeline;
   bool write_encoded = true;
@@ -33,6 +38,7 @@ struct RenderOptions {
   bool resume = false, overwrite = false, quiet = false;
   bool verbose = false;
   bool help = false;
+  bool preset_help = false;  // --preset help
 };
 
 // Parses the arguments after `render`. Throws pmr::Error with one line on bad input.

@@ -47,6 +47,10 @@ int run_render(const std::vector<std::string>& args) {
     std::fputs(render_help().c_str(), stdout);
     return 0;
   }
+  if (o.preset_help) {
+    std::fputs(display_presets_help().c_str(), stdout);
+    return 0;
+  }
   finalize_render_options(o);
   if (o.scene.empty()) o.scene = default_scene_path();
   return run_sequence(o);

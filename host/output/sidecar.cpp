@@ -115,6 +115,15 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   d["offset"] = display.offset.value();
   d["offset_fraction"] = to_string(display.offset);
   d["reversed"] = display.reversed;
+  d["phase_sign"] = display.phase_sign;
+  d["subpixel_order"] = display.subpixel_bgr ? "bgr" : "rgb";
+  if (!info.display_source.empty()) d["source"] = info.display_source;
+  if (!info.calibration.empty()) {
+    json cal = json::object();
+    cal["serial"] = info.calibration_serial;
+    for (const auto& [key, value] : info.calibration) cal[key] = value;
+    d["calibration"] = cal;
+  }
   d["sampling"] = display.bilinear ? "bilinear" : "nearest";
   j["display"] = d;
 
@@ -164,9 +173,9 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
       {"light", "directional, toward the light, fixed in the center camera's view space; "
                 "color = base * (0.2 + 0.8 * max(0, dot(n, l)))"},
       {"encoding", "display pixel (j, i), row 0 at the top, subpixel k in {0,1,2} (R,G,B left to right): "
-                   "t = (3 j + k - 3 i tan_slant - offset) / lens_pitch, v = floor(frac(t) * views) evaluated "
-                   "exactly, v -> views - 1 - v if reversed; channel k of view v sampled at "
-                   "((j + (k + 0.5) / 3) / width, (i + 0.5) / height)"},
+                   "t = (3 j + k' - 3 i tan_slant - offset) / lens_pitch with k' = k (subpixel_order rgb) or 2 - k "
+                   "(bgr), v = floor(frac(phase_sign * t) * views) evaluated exactly, v -> views - 1 - v if "
+                   "reversed; channel k of view v sampled at ((j + (k + 0.5) / 3) / width, (i + 0.5) / height)"},
   };
   std::string text;
   emit(j, 0, text);

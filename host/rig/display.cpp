@@ -129,10 +129,19 @@ Phase phase_of(const Display& display, int views) {
   ph.p1 = WideInt(views) * L.den * T.den * O.den;
   ph.r0 = WideInt(views) * L.den * O.num * T.den;
   ph.dr = WideInt(3) * views * L.den * T.num * O.den;
+  if (display.phase_sign < 0) {  // N (-t) = (-P_s + R_i) / Den
+    ph.p1 = WideInt(0) - ph.p1;
+    ph.r0 = WideInt(0) - ph.r0;
+    ph.dr = WideInt(0) - ph.dr;
+  }
   return ph;
 }
 
 int mod_n(int64_t q, int n) { return int(((q % n) + n) % n); }
+
+// The phase position of subpixel column s = 3j + k: s itself, or 3j + 2 - k on a BGR panel. The map
+// is its own inverse.
+size_t phase_position(const Display& display, size_t s) { return display.subpixel_bgr ? s - s % 3 + (2 - s % 3) : s; }
 
 }  // namespace
 
@@ -142,6 +151,7 @@ PmrEncodeParams make_encode_params(const Display& display, int views, int view_w
   if (display.lens_pitch.num <= 0) throw Error("invalid --lens-pitch: must be positive");
   for (const Rational* r : {&display.lens_pitch, &display.tan_slant, &display.offset})
     if (r->den <= 0) throw Error("internal error: display fraction with a non-positive denominator");
+  if (display.phase_sign != 1 && display.phase_sign != -1) throw Error("internal error: phase sign must be +1 or -1");
   PmrEncodeParams p{};
   p.display_w = display.width;
   p.display_h = display.height;
@@ -159,24 +169,25 @@ void make_encode_tables(const Display& display, const PmrEncodeParams& p, std::v
   columns.resize(size_t(3) * p.display_w);
   rows.resize(size_t(p.display_h));
   // Remainders of every column and row, stepped exactly (one wide division each for the steps).
-  std::vector<std::pair<WideInt, int>> rems;  // (remainder, +column index or -(row index) - 1)
+  std::vector<std::pair<WideInt, int>> rems(columns.size());  // (remainder, +column index or -(row index) - 1)
   rems.reserve(columns.size() + rows.size());
   WideInt q1, r1, q, r;
   ph.p1.floor_divmod(ph.den, q1, r1);
   const int64_t q1n = q1.to_int64();
   int64_t qp = 0;
   WideInt rp(0);
-  for (size_t s = 0; s < columns.size(); ++s) {
-    if (s > 0) {
+  for (size_t pos = 0; pos < columns.size(); ++pos) {  // phase positions in order
+    if (pos > 0) {
       qp += q1n;
       rp = rp + r1;
       if (rp >= ph.den) rp = rp - ph.den, ++qp;
     }
+    const size_t s = phase_position(display, pos);  // the subpixel whose phase sits there (an involution)
     PmrEncodeColumn& c = columns[s];
     c.a_mod_n = mod_n(qp, p.views);
     c.px = int32_t((int64_t(2 * s + 1) * p.view_w) / (int64_t(6) * p.display_w));
     c.pad = 0;
-    rems.push_back({rp, int(s)});
+    rems[s] = {rp, int(s)};
   }
   WideInt qd, rd;
   ph.dr.floor_divmod(ph.den, qd, rd);
@@ -209,7 +220,7 @@ void make_encode_tables(const Display& display, const PmrEncodeParams& p, std::v
 int encode_view_index(const Display& display, int views, int j, int i, int k) {
   // Direct: N t = (P_s - R_i) / Den as one wide fraction, v = floor(N t) mod N.
   const Phase ph = phase_of(display, views);
-  const WideInt num = ph.p1 * (3 * int64_t(j) + k) - (ph.r0 + ph.dr * i);
+  const WideInt num = ph.p1 * int64_t(phase_position(display, 3 * size_t(j) + size_t(k))) - (ph.r0 + ph.dr * i);
   WideInt q, r;
   num.floor_divmod(ph.den, q, r);
   int v = mod_n(q.to_int64(), views);

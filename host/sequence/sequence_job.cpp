@@ -85,6 +85,7 @@ int run_sequence(const RenderOptions& o) {
   prepare_output_dir(o.out_dir);
   make_encode_params(o.display, o.rig.views, o.rig.view_w, o.rig.view_h);
 
+  for (const auto& w : o.option_warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
   const Scene scene = load_scene(o.scene);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
   SequenceSpec spec;
@@ -132,6 +133,15 @@ int run_sequence(const RenderOptions& o) {
   info.turntable_deg = spec.turntable_deg;
   info.turntable_frames = spec.turntable ? spec.turntable_frames : 0;
   info.pivot = renderer.pivot();
+  info.display_source = o.display_source;
+  if (o.has_calibration) {
+    const LookingGlassCalibration& c = o.calibration;
+    info.calibration_serial = c.serial;
+    info.calibration = {{"pitch", c.pitch},         {"slope", c.slope},       {"center", c.center},
+                        {"DPI", c.dpi},             {"screenW", c.screen_w},  {"screenH", c.screen_h},
+                        {"viewCone", c.view_cone},  {"fringe", c.fringe},     {"flipImageX", c.flip_x},
+                        {"flipImageY", c.flip_y},   {"flipSubp", c.flip_subp}, {"invView", c.inv_view}};
+  }
   auto frame_info = [&](long frame, const FramePaths& p, double angle) {
     SidecarInfo i = info;
     i.frame = int(frame);

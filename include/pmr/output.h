@@ -112,6 +112,9 @@ struct SidecarInfo {
   int quilt_columns = 0, quilt_rows = 0;  // of the quilt output (0: none)
   int center_view = -1;                // the view of the center preview (-1: none)
   bool depth = false;                  // Z channels in the views / quilt files
+  std::string display_source;          // "preset NAME" or "calibration FILE"
+  std::vector<std::pair<std::string, double>> calibration;  // the calibration file's values, as read
+  std::string calibration_serial;
 };
 
 // The sidecar's JSON text (pretty printed, doubles with round-trip precision).

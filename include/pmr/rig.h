@@ -29,6 +29,12 @@ struct Display {
   Rational tan_slant{1, 18};         // tan(alpha)
   Rational offset{-1, 12};           // subpixels
   bool reversed = false;             // v -> N - 1 - v
+  // Extensions for real panels (docs/DISPLAYS.md): the Looking Glass shader takes its view from
+  // 1 - frac(t), i.e. from frac(-t) (phase_sign -1), and on BGR panels (or a flipped image) subpixel k
+  // of pixel j sits at phase position 3j + 2 - k instead of 3j + k (subpixel_bgr). The position each
+  // subpixel samples its view at stays its own (DESIGN section 5).
+  int phase_sign = 1;
+  bool subpixel_bgr = false;
   bool bilinear = false;             // sample views bilinearly instead of nearest
   double aspect() const { return size_w_cm / size_h_cm; }
 };

@@ -1,0 +1,120 @@
+// Looking Glass calibration files (visual.json) and their mapping onto DESIGN section 5 (derivation in
+// docs/DISPLAYS.md).
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "pmr/display_presets.h"
+#include "pmr/error.h"
+
+namespace pmr {
+
+namespace {
+
+using json = nlohmann::json;
+
+// A field stored as {"value": x} (or, leniently, as a bare number).
+double number_field(const json& doc, const char* key, const std::string& path, bool required, double fallback) {
+  if (!doc.contains(key)) {
+    if (required) throw Error(path + ": calibration field '" + key + "' is missing");
+    return fallback;
+  }
+  const json& f = doc[key];
+  const json* v = f.is_object() && f.contains("value") ? &f["value"] : &f;
+  if (!v->is_number()) throw Error(path + ": calibration field '" + key + "' is not a number");
+  const double x = v->get<double>();
+  if (!std::isfinite(x)) throw Error(path + ": calibration field '" + key + "' is not finite");
+  return x;
+}
+
+// An exact decimal for a long double computed from the calibration: 17 decimals below 1, fewer above,
+// so that numerator and denominator stay below 2^62 (parse_rational's limit); the rounding (below
+// 1e-16 subpixels) is far below the double precision of the shader's own inputs.
+Rational exact_decimal(long double x, const std::string& what) {
+  int decimals = 17;
+  for (long double a = std::fabs(x); a >= 1.0L && decimals > 0; a /= 10.0L) --decimals;
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*Lf", decimals, x);
+  return parse_rational(buf, what);
+}
+
+}  // namespace
+
+LookingGlassCalibration read_looking_glass_calibration(const std::string& path, std::vector<std::string>* warnings) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot open the calibration file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  json doc;
+  try {
+    doc = json::parse(ss.str());
+  } catch (const std::exception& e) {
+    throw Error(path + ": not a JSON calibration file (" + std::string(e.what()).substr(0, 120) + ")");
+  }
+  if (!doc.is_object()) throw Error(path + ": not a JSON calibration file (expected an object)");
+  LookingGlassCalibration c;
+  if (doc.contains("serial") && doc["serial"].is_string()) c.serial = doc["serial"].get<std::string>();
+  if (doc.contains("configVersion") && doc["configVersion"].is_string()) c.config_version = doc["configVersion"].get<std::string>();
+  c.pitch = number_field(doc, "pitch", path, true, 0);
+  c.slope = number_field(doc, "slope", path, true, 0);
+  c.center = number_field(doc, "center", path, true, 0);
+  c.dpi = number_field(doc, "DPI", path, true, 0);
+  c.view_cone = number_field(doc, "viewCone", path, false, 40.0);
+  c.fringe = number_field(doc, "fringe", path, false, 0.0);
+  const double w = number_field(doc, "screenW", path, true, 0), h = number_field(doc, "screenH", path, true, 0);
+  c.flip_x = number_field(doc, "flipImageX", path, false, 0.0) >= 0.5;
+  c.flip_y = number_field(doc, "flipImageY", path, false, 0.0) >= 0.5;
+  c.flip_subp = number_field(doc, "flipSubp", path, false, 0.0) >= 0.5;
+  c.inv_view = number_field(doc, "invView", path, false, 1.0) >= 0.5;
+  auto absurd = [&](const char* field, const std::string& why) { throw Error(path + ": calibration field '" + field + "' " + why); };
+  if (!(c.pitch > 0.0)) absurd("pitch", "must be positive (lenticules per inch)");
+  if (c.slope == 0.0 || std::fabs(c.slope) > 1e6) absurd("slope", "must be non-zero");
+  if (!(c.dpi > 0.0)) absurd("DPI", "must be positive");
+  if (!(w >= 1 && w <= 16384 && w == std::floor(w))) absurd("screenW", "must be a whole number of pixels in 1..16384");
+  if (!(h >= 1 && h <= 16384 && h == std::floor(h))) absurd("screenH", "must be a whole number of pixels in 1..16384");
+  if (!(c.view_cone > 0.0 && c.view_cone < 180.0)) absurd("viewCone", "must be in (0, 180) degrees");
+  c.screen_w = int(w), c.screen_h = int(h);
+  if (doc.contains("subpixelCells") && doc["subpixelCells"].is_array() && !doc["subpixelCells"].empty())
+    throw Error(path + ": calibration field 'subpixelCells' (per-channel subpixel cells of the gen3 OLED panels) is "
+                       "not supported yet");
+  if (warnings) {
+    if (!c.inv_view) warnings->push_back(path + ": invView = 0 ignored, as Looking Glass's current shader (webxr 0.6) does");
+    if (c.flip_y) warnings->push_back(path + ": flipImageY ignored, as Looking Glass's current shader does");
+    if (c.fringe != 0.0) warnings->push_back(path + ": fringe ignored, as Looking Glass's current shader does");
+  }
+  return c;
+}
+
+Display display_from_calibration(const LookingGlassCalibration& c) {
+  // The shader's uniforms, in double as LookingGlassConfig.ts computes them.
+  const double W = c.screen_w, H = c.screen_h;
+  const double sign = c.flip_x ? -1.0 : 1.0;
+  const double pitch_px = c.pitch * W / c.dpi * std::cos(std::atan(1.0 / c.slope));
+  const double tilt = H / (W * c.slope) * sign;
+  if (!(pitch_px > 0.0) || !std::isfinite(pitch_px) || !std::isfinite(tilt))
+    throw Error("the calibration gives no usable lens pitch");
+  // DESIGN section 5 (derivation in docs/DISPLAYS.md).
+  const long double L = 3.0L * W / (long double)pitch_px;
+  const long double T = (long double)W * tilt / H;
+  const long double O = -1.5L + (c.flip_x ? 2.0L : 0.0L) - 3.0L * W * (long double)tilt * (H - 0.5L) / H +
+                        (long double)c.center * L;
+  Display d;
+  d.width = c.screen_w;
+  d.height = c.screen_h;
+  d.size_w_cm = W / c.dpi * 2.54;
+  d.size_h_cm = H / c.dpi * 2.54;
+  // Looking Glass software renders with a 14 degree vertical field of view (webxr's fovy default): the
+  // viewing distance that gives it.
+  d.viewing_distance_cm = 0.5 * d.size_h_cm / std::tan(7.0 * 3.14159265358979323846 / 180.0);
+  d.lens_pitch = exact_decimal(L, "lens pitch (from the calibration)");
+  d.tan_slant = exact_decimal(T, "slant (from the calibration)");
+  d.offset = exact_decimal(O, "offset (from the calibration)");
+  d.phase_sign = -1;
+  d.subpixel_bgr = c.flip_subp != c.flip_x;
+  return d;
+}
+
+}  // namespace pmr

@@ -44,6 +44,35 @@ kernel void encode_nearest(global const PmrEncodeParams* E, global const PmrEnco
   }
 }
 
+/* View blending (Looking Glass webxr 0.6's filter mode 1): subpixel k shows views v and v + 1 (the
+ * last view stands in for v + 1 = N) mixed by the fraction of the phase, N t - floor(N t), sampled at
+ * its own position. The fraction comes from the tables' float remainders: a weight, not a decision. */
+kernel void encode_blend(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
+                         global const PmrEncodeRow* rows, global const half* volume, global half* display) {
+  const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
+  if (j0 >= E->display_w || i >= E->display_h) return;
+  const int j1 = min(j0 + PMR_ENCODE_RUN, E->display_w);
+  const PmrEncodeRow row = rows[i];
+  const size_t plane = (size_t)E->view_h * (size_t)E->view_w;
+  const size_t row_off = (size_t)row.py * (size_t)E->view_w;
+  for (int j = j0; j < j1; ++j) {
+    float rgb[3], alpha = 0.0f;
+    for (int k = 0; k < 3; ++k) {
+      const PmrEncodeColumn col = columns[3 * j + k];
+      const int v0 = encode_view(E->views, 0, &col, &row), v1 = min(v0 + 1, E->views - 1);
+      float w = col.phase_frac - row.phase_frac;
+      w = w < 0.0f ? w + 1.0f : w;
+      const int a = E->reversed ? E->views - 1 - v0 : v0, b = E->reversed ? E->views - 1 - v1 : v1;
+      const float4 c0 = vload_half4((size_t)a * plane + row_off + (size_t)col.px, volume);
+      const float4 c1 = vload_half4((size_t)b * plane + row_off + (size_t)col.px, volume);
+      const float4 c = c0 + (c1 - c0) * w;
+      rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
+      alpha += c.w;
+    }
+    vstore_half4((float4)(rgb[0], rgb[1], rgb[2], alpha / 3.0f), (size_t)i * E->display_w + j, display);
+  }
+}
+
 kernel void encode_bilinear(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
                             global const PmrEncodeRow* rows, global const half* volume, global half* display) {
   const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);

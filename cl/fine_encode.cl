@@ -22,7 +22,7 @@ inline PmrEncodeColumn soa_column(global const int* column_soa, int width, int s
   c.a_mod_n = column_soa[k * width + j];
   c.b = column_soa[(3 + k) * width + j];
   c.px = column_soa[(6 + k) * width + j];
-  c.pad = 0;
+  c.phase_frac = 0.0f;  /* (only view blending reads it; the fused path does not blend) */
   return c;
 }
 

@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <Imath/half.h>
+
 #include "pmr/display_presets.h"
 #include "pmr/error.h"
 #include "test_util.h"
@@ -85,6 +87,49 @@ TEST(Displays, CalibrationMatchesTheLookingGlassShaderSubpixelBySubpixel) {
     EXPECT_EQ(ties, 0u);
     EXPECT_EQ(checked, size_t(d.width) * d.height * 3);
   }
+}
+
+// --blend-views: with every channel of view v holding v, each subpixel shows v + w (w the phase's
+// fraction), i.e. the shader's continuous view coordinate a N, up to half precision (the last view
+// stands in for view N).
+TEST(Displays, BlendedViewsFollowTheContinuousPhase) {
+  const LookingGlassCalibration cal = small_panel(-7.134567737579346, false, true);
+  Display d = display_from_calibration(cal);
+  d.blend_views = true;
+  const int views = 48;
+  RigConfig rc;
+  rc.views = views, rc.view_w = 16, rc.view_h = 12;
+  const Rig rig = make_rig(rc, d, glm::dvec3(-1), glm::dvec3(1));
+  Pipeline p(test::runtime(), PipelineConfig{});
+  p.set_scene(test::random_scene(1, 1, false));
+  p.configure(rig, &d);
+  const size_t plane = size_t(16) * 12;
+  std::vector<uint16_t> vol(plane * views * 4), enc;
+  for (int v = 0; v < views; ++v)
+    for (size_t x = 0; x < plane * 4; ++x) vol[size_t(v) * plane * 4 + x] = half(float(v)).bits();
+  p.encode_volume(vol);
+  p.read_display(enc);
+  size_t blended = 0;
+  for (int py = 0; py < d.height; ++py)
+    for (int px = 0; px < d.width; ++px)
+      for (int c = 0; c < 3; ++c) {
+        const int v = shader_view(cal, views, px, py, c);
+        if (v < 0) continue;
+        // the shader's continuous coordinate, recomputed as in shader_view
+        const double W = cal.screen_w, H = cal.screen_h;
+        const double pitch = cal.pitch * W / cal.dpi * std::cos(std::atan(1.0 / cal.slope));
+        const double tilt = H / (W * cal.slope);
+        const long double u = (px + 0.5L) / W, vv = (H - 1 - py + 0.5L) / H;
+        const int offset = cal.flip_subp ? 2 - c : c;
+        const long double phase = (u + offset / (3.0L * W) + vv * (long double)tilt) * (long double)pitch - cal.center;
+        const long double z = (1.0L - (phase - std::floor(phase))) * views;
+        half h;
+        h.setBits(enc[(size_t(py) * d.width + px) * 4 + size_t(c)]);
+        const double want = v == views - 1 ? double(views - 1) : double(z);
+        ASSERT_NEAR(float(h), want, 0.04) << "pixel " << px << "," << py << " channel " << c;
+        blended += std::fabs(want - v) > 0.1;
+      }
+  EXPECT_GT(blended, size_t(d.width) * d.height);  // most subpixels really mix two views
 }
 
 TEST(Displays, EveryPresetShowsEveryView) {

@@ -134,6 +134,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
       o.offset_given = true;
     } else if (a == "--reverse-views") o.display.reversed = true;
     else if (a == "--bilinear") o.display.bilinear = true;
+    else if (a == "--blend-views") o.display.blend_views = true;
     else if (a == "--tile") {
       const auto d = parse_dims(value(), a, 3, 64);
       o.pipeline.tile_x = d[0], o.pipeline.tile_y = d[1], o.pipeline.tile_v = d[2];
@@ -282,6 +283,8 @@ std::string render_help() {
          "                         (L, T, O accept decimals or fractions like 1/18; evaluated exactly)\n"
          "  --reverse-views        use view N-1-v instead of v\n"
          "  --bilinear             sample views bilinearly (default nearest)\n"
+         "  --blend-views          blend the two nearest views by the lens phase, as Looking Glass's\n"
+         "                         webxr shader does by default (default: one view per subpixel)\n"
          "pipeline:\n"
          "  --tile XxYxV           3D tile of the tile/fine raster, voxels over x, y, view (default 16x2x16)\n"
          "  --method M             pmr (default), multipass (one conventional pass per view) or duplicate\n"

@@ -125,6 +125,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
     d["calibration"] = cal;
   }
   d["sampling"] = display.bilinear ? "bilinear" : "nearest";
+  d["view_blend"] = display.blend_views;
   j["display"] = d;
 
   json r;

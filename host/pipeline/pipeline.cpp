@@ -58,7 +58,7 @@ size_t bytes_of(const std::vector<T>& v) {
 struct Pipeline::Impl {
   const ClRuntime& rt;
   cl_program program = nullptr;
-  ClKernel k_vertex, k_vertex_select, k_setup, k_bin_count, k_bin_fill, k_fine, k_encode, k_encode_bilinear;
+  ClKernel k_vertex, k_vertex_select, k_setup, k_bin_count, k_bin_fill, k_fine, k_encode, k_encode_bilinear, k_encode_blend;
 
   // scene
   uint32_t num_vertices = 0, num_triangles = 0;
@@ -142,6 +142,7 @@ Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
   m.k_fine = ClKernel(m.program, "fine_raster");
   m.k_encode = ClKernel(m.program, "encode_nearest");
   m.k_encode_bilinear = ClKernel(m.program, "encode_bilinear");
+  m.k_encode_blend = ClKernel(m.program, "encode_blend");
   m.params_buf = runtime.buffer(sizeof(PmrParams), "frame parameters", CL_MEM_READ_ONLY);
   m.encode_buf = runtime.buffer(sizeof(PmrEncodeParams), "encoder parameters", CL_MEM_READ_ONLY);
   m.mta_counter = runtime.buffer(sizeof(uint32_t), "MTA counter");
@@ -233,7 +234,7 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   m.encode = display != nullptr;
   const int lanes = fine_lanes(tile_[0]);
   const size_t fused_private = size_t(tile_[0] + lanes - 1) / lanes * lanes * tile_[1] * rig.views * 20;
-  m.fused = config_.fuse_encode && display && !display->bilinear && config_.method == Method::Pmr &&
+  m.fused = config_.fuse_encode && display && !display->bilinear && !display->blend_views && config_.method == Method::Pmr &&
             !config_.debug_outputs && fused_private <= kFusedPrivateBudget;
   if (display) {
     m.encode_params = make_encode_params(*display, rig.views, rig.view_w, rig.view_h);
@@ -349,7 +350,7 @@ void Pipeline::Impl::fine_stage(Events& ev) {
 
 void Pipeline::Impl::encode_stage(Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
-  ClKernel& k = encode_params.bilinear ? k_encode_bilinear : k_encode;
+  ClKernel& k = encode_params.blend ? k_encode_blend : encode_params.bilinear ? k_encode_bilinear : k_encode;
   k.args(encode_buf, encode_columns, encode_rows, volume, display);
   const size_t runs = (size_t(encode_params.display_w) + PMR_ENCODE_RUN - 1) / PMR_ENCODE_RUN;
   ev.add(kEncode, rt.launch_2d(k, runs, size_t(encode_params.display_h), 8, 1));

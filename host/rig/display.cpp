@@ -160,12 +160,15 @@ PmrEncodeParams make_encode_params(const Display& display, int views, int view_w
   p.view_h = view_h;
   p.reversed = display.reversed ? 1 : 0;
   p.bilinear = display.bilinear ? 1 : 0;
+  p.blend = display.blend_views ? 1 : 0;
+  if (display.blend_views && display.bilinear) throw Error("--blend-views and --bilinear cannot be combined");
   return p;
 }
 
 void make_encode_tables(const Display& display, const PmrEncodeParams& p, std::vector<PmrEncodeColumn>& columns,
                         std::vector<PmrEncodeRow>& rows) {
   const Phase ph = phase_of(display, p.views);
+  const double den_d = ph.den.to_double();
   columns.resize(size_t(3) * p.display_w);
   rows.resize(size_t(p.display_h));
   // Remainders of every column and row, stepped exactly (one wide division each for the steps).
@@ -186,7 +189,7 @@ void make_encode_tables(const Display& display, const PmrEncodeParams& p, std::v
     PmrEncodeColumn& c = columns[s];
     c.a_mod_n = mod_n(qp, p.views);
     c.px = int32_t((int64_t(2 * s + 1) * p.view_w) / (int64_t(6) * p.display_w));
-    c.pad = 0;
+    c.phase_frac = float(rp.to_double() / den_d);
     rems[s] = {rp, int(s)};
   }
   WideInt qd, rd;
@@ -203,7 +206,7 @@ void make_encode_tables(const Display& display, const PmrEncodeParams& p, std::v
     PmrEncodeRow& row = rows[i];
     row.q_mod_n = mod_n(qr, p.views);
     row.py = int32_t((int64_t(2 * i + 1) * p.view_h) / (int64_t(2) * p.display_h));
-    row.pad = 0;
+    row.phase_frac = float(r.to_double() / den_d);
     rems.push_back({r, -int(i) - 1});
   }
   // Ranks of the remainders (equal remainders, equal ranks).

@@ -86,6 +86,12 @@ WideInt WideInt::operator*(int64_t m) const {
   return r;
 }
 
+double WideInt::to_double() const {
+  double x = 0.0;
+  for (int i = kLimbs - 1; i >= 0; --i) x = x * 18446744073709551616.0 + double(mag_[i]);
+  return negative() ? -x : x;
+}
+
 int64_t WideInt::to_int64() const {
   for (int i = 1; i < kLimbs; ++i)
     if (mag_[i]) overflow();

@@ -22,6 +22,8 @@ class WideInt {
   bool negative() const { return neg_ && !zero(); }
   bool zero() const;
   int compare(const WideInt& o) const;
+  // The value as a double (rounded).
+  double to_double() const;
   // The value as int64; throws when it does not fit.
   int64_t to_int64() const;
 

@@ -35,6 +35,9 @@ struct Display {
   // subpixel samples its view at stays its own (DESIGN section 5).
   int phase_sign = 1;
   bool subpixel_bgr = false;
+  // Blend views v and v + 1 by the phase's fraction (Looking Glass's webxr 0.6 default filter); off by
+  // default, so that every subpixel shows exactly one view.
+  bool blend_views = false;
   bool bilinear = false;             // sample views bilinearly instead of nearest
   double aspect() const { return size_w_cm / size_h_cm; }
 };

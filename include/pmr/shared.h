@@ -170,7 +170,8 @@ typedef struct {
   pmr_i32 view_w, view_h;
   pmr_i32 reversed;       /* 1: v -> N - 1 - v                                                 */
   pmr_i32 bilinear;       /* 1: bilinear sampling of the view, 0: nearest                     */
-  pmr_i32 pad0;
+  pmr_i32 blend;          /* 1: blend views v and v + 1 by the phase's fraction (Looking Glass's
+                             webxr filter mode 1), 0: one view per subpixel                     */
 } PmrEncodeParams;
 
 /* Encoder tables, computed once per configuration by the host (host/rig/display.cpp). With
@@ -182,14 +183,14 @@ typedef struct {
   pmr_i32 a_mod_n;        /* A_s mod N                                                      */
   pmr_i32 b;              /* B_s: rank of the column's remainder                             */
   pmr_i32 px;             /* nearest view column: floor((2s + 1) W / (6 W_d))                 */
-  pmr_i32 pad;
+  float phase_frac;       /* rP_s / Den as a float: the phase's fraction, for view blending    */
 } PmrEncodeColumn;
 
 typedef struct {
   pmr_i32 q_mod_n;        /* Q_i mod N                                                      */
   pmr_i32 s;              /* S_i: rank of the row's remainder                                */
   pmr_i32 py;             /* nearest view row: floor((2i + 1) H / (2 H_d))                    */
-  pmr_i32 pad;
+  float phase_frac;       /* rR_i / Den as a float                                           */
 } PmrEncodeRow;
 
 #endif /* PMR_SHARED_H */

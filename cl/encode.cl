@@ -21,13 +21,21 @@ inline float4 sample_bilinear(global const PmrEncodeParams* E, global const half
   return top + (bottom - top) * ay;
 }
 
+/* The column table of row i: with subpixel cells one block per row class (PmrEncodeParams). */
+inline global const PmrEncodeColumn* row_columns(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
+                                                 int i) {
+  const int cls = E->cell_rows > 1 ? (E->display_h - 1 - i) % E->cell_rows : 0;
+  return columns + (size_t)cls * 3 * (size_t)E->display_w;
+}
+
 /* Nearest sampling copies the colour's half bits: PoCL converts halves in software, and the
  * conversions would dominate the stage. Separate kernels for nearest and bilinear sampling, because
  * a branch between them would be flattened when the kernel is vectorized across work-items. */
-kernel void encode_nearest(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
+kernel void encode_nearest(global const PmrEncodeParams* E, global const PmrEncodeColumn* all_columns,
                            global const PmrEncodeRow* rows, global const half* volume, global half* display) {
   const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
   if (j0 >= E->display_w || i >= E->display_h) return;
+  global const PmrEncodeColumn* columns = row_columns(E, all_columns, i);
   const int j1 = min(j0 + PMR_ENCODE_RUN, E->display_w);
   const PmrEncodeRow row = rows[i];
   const size_t plane = (size_t)E->view_h * (size_t)E->view_w;
@@ -47,10 +55,11 @@ kernel void encode_nearest(global const PmrEncodeParams* E, global const PmrEnco
 /* View blending (Looking Glass webxr 0.6's filter mode 1): subpixel k shows views v and v + 1 (the
  * last view stands in for v + 1 = N) mixed by the fraction of the phase, N t - floor(N t), sampled at
  * its own position. The fraction comes from the tables' float remainders: a weight, not a decision. */
-kernel void encode_blend(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
+kernel void encode_blend(global const PmrEncodeParams* E, global const PmrEncodeColumn* all_columns,
                          global const PmrEncodeRow* rows, global const half* volume, global half* display) {
   const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
   if (j0 >= E->display_w || i >= E->display_h) return;
+  global const PmrEncodeColumn* columns = row_columns(E, all_columns, i);
   const int j1 = min(j0 + PMR_ENCODE_RUN, E->display_w);
   const PmrEncodeRow row = rows[i];
   const size_t plane = (size_t)E->view_h * (size_t)E->view_w;
@@ -73,10 +82,11 @@ kernel void encode_blend(global const PmrEncodeParams* E, global const PmrEncode
   }
 }
 
-kernel void encode_bilinear(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
+kernel void encode_bilinear(global const PmrEncodeParams* E, global const PmrEncodeColumn* all_columns,
                             global const PmrEncodeRow* rows, global const half* volume, global half* display) {
   const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
   if (j0 >= E->display_w || i >= E->display_h) return;
+  global const PmrEncodeColumn* columns = row_columns(E, all_columns, i);
   const int j1 = min(j0 + PMR_ENCODE_RUN, E->display_w);
   const PmrEncodeRow row = rows[i];
   const float t = ((float)i + 0.5f) / (float)E->display_h;

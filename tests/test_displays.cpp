@@ -12,6 +12,7 @@
 
 #include "pmr/display_presets.h"
 #include "pmr/error.h"
+#include "pmr/output.h"
 #include "test_util.h"
 
 namespace pmr {
@@ -31,8 +32,24 @@ int shader_view(const LookingGlassCalibration& cal, int views, int px, int py, i
   // the fragment's texture coordinate: texel center, v from the bottom
   const long double u = (px + 0.5L) / W, v = (H - 1 - py + 0.5L) / H;
   // BGR panels: red takes the phase of subpixel offset 2 and blue of offset 0 (ri, bi = 2, 0)
-  const int offset = cal.flip_subp ? 2 - c : c;
-  const long double phase = (u + offset * subp + v * (long double)tilt) * (long double)pitch - cal.center;
+  long double phase;
+  if (cal.cells.empty()) {
+    const int offset = cal.flip_subp ? 2 - c : c;
+    phase = (u + offset * subp + v * (long double)tilt) * (long double)pitch - cal.center;
+  } else {  // GetCellForPixel and GetSubpixelViews with subpixel cells (pattern from the calibration)
+    const int x = px, y = cal.screen_h - 1 - py;
+    int cell = 0;
+    switch (cal.cell_pattern) {
+      case 1: cell = ((y % 2 == 0 && x % 2 == 0) || (y % 2 != 0 && x % 2 != 0)) ? 0 : 1; break;
+      case 2: cell = x % 2; break;
+      case 3: cell = (y + (x % 2) * 2) % 4; break;
+      case 4: cell = y % 2; break;
+      default: cell = 0;
+    }
+    const std::array<double, 6>& off = cal.cells[size_t(cell) % cal.cells.size()];
+    const long double du = off[size_t(2 * c)] / W, dv = off[size_t(2 * c + 1)] / H;
+    phase = ((u + du) + (v + dv) * (long double)tilt) * (long double)pitch - cal.center;
+  }
   long double a = 1.0L - (phase - std::floor(phase));
   a = std::min(std::max(a, 0.00001L), 0.999999L);
   const long double z = a * views;
@@ -48,6 +65,20 @@ LookingGlassCalibration small_panel(double slope, bool flip_x, bool flip_subp) {
   c.slope = slope;
   c.center = 0.5658454895019531;
   c.flip_x = flip_x, c.flip_subp = flip_subp;
+  return c;
+}
+
+// A gen3 panel's calibration (the 16" Spatial's cells as Looking Glass Bridge stores them) on a small
+// screen.
+LookingGlassCalibration gen3_panel(int pattern, bool flip_x) {
+  LookingGlassCalibration c = small_panel(-6.874565686767793, flip_x, false);
+  c.pitch = 44.75058319896644;
+  c.dpi = 283;
+  c.center = 0.16935753461833172;
+  c.cells = {{-0.3100000023841858, 0.25, 0.2800000011920929, 0.25, 0.0, -0.25},
+             {-0.3100000023841858, -0.25, 0.2800000011920929, -0.25, 0.0, 0.25}};
+  if (pattern == 3) c.cells.push_back({0.1, 0.2, -0.2, 0.1, 0.3, -0.1}), c.cells.push_back({0.0, 0.0, 0.1, 0.1, -0.1, 0.2});
+  c.cell_pattern = pattern;
   return c;
 }
 
@@ -67,6 +98,10 @@ TEST(Displays, CalibrationMatchesTheLookingGlassShaderSubpixelBySubpixel) {
       {"BGR (flipSubp)", small_panel(-7.134567737579346, false, true), 48},
       {"flipped BGR", small_panel(-7.134567737579346, true, true), 45},
       {"positive slope", small_panel(6.3, false, false), 66},
+      {"gen3 cells, pattern 2", gen3_panel(2, false), 49},
+      {"gen3 cells, pattern 1 (checkerboard)", gen3_panel(1, false), 49},
+      {"gen3 cells, pattern 3, flipped", gen3_panel(3, true), 66},
+      {"gen3 cells, pattern 4", gen3_panel(4, false), 66},
   };
   for (const Case& t : cases) {
     SCOPED_TRACE(t.name);
@@ -168,7 +203,8 @@ TEST(Displays, MalformedCalibrationFilesFailNamingTheField) {
       {with(R"("screenW": {"value": 1536})", R"("screenW": {"value": 0})"), "'screenW'"},
       {with(R"("screenH": {"value": 2048})", R"("screenH": {"value": 20.5})"), "'screenH'"},
       {with(R"("center": {"value": 0.56})", R"("center": {"value": NaN})"), "not a JSON"},
-      {with(R"("serial": "LKG-P0",)", R"("subpixelCells": [{"ROffsetX": 0.1}],)"), "'subpixelCells'"},
+      {with(R"("serial": "LKG-P0",)", R"("subpixelCells": [{"ROffsetX": 0.1}],)"), "'subpixelCells' needs a number"},
+      {with(R"("serial": "LKG-P0",)", R"("CellPatternMode": {"value": 7}, "subpixelCells": [],)"), "'CellPatternMode'"},
       {"[1, 2]", "expected an object"},
   };
   for (const auto& [text, fragment] : bad) {
@@ -205,6 +241,39 @@ TEST(Displays, CliRendersForALookingGlassPanel) {
   test::expect_one_error_line(test::run("render --preset lg-99 --out " + dir + "/o"), "lg-portrait");
   test::expect_one_error_line(
       test::run("render --preset lg-portrait --display-config " + dir + "/visual.json --out " + dir + "/o"), "once");
+}
+
+}  // namespace pmr
+
+namespace pmr {
+
+// A gen3 calibration whose cells depend on the column only (pattern 2) keeps the fused raster+encode
+// path; its image equals the separate raster-then-encode path's bit for bit. Pattern 1 (row classes)
+// falls back to the separate path and renders too.
+TEST(Displays, Gen3CalibrationRendersFusedAndSeparateAlike) {
+  const std::string dir = test::temp_dir("lg_gen3");
+  fs::create_directories(dir);
+  for (int pattern : {2, 1}) {
+    const std::string cal = dir + "/visual" + std::to_string(pattern) + ".json";
+    write_file(cal, R"({"configVersion": "3.0", "serial": "LKG-J00332", "pitch": {"value": 44.75058319896644},
+      "slope": {"value": -6.874565686767793}, "center": {"value": 0.16935753461833172}, "viewCone": {"value": 50.0},
+      "DPI": {"value": 283.0}, "screenW": {"value": 384.0}, "screenH": {"value": 216.0}, "flipImageX": {"value": 0.0},
+      "CellPatternMode": {"value": )" + std::to_string(pattern) + R"(.0}, "subpixelCells": [
+        {"ROffsetX": -0.31, "ROffsetY": 0.25, "GOffsetX": 0.28, "GOffsetY": 0.25, "BOffsetX": 0.0, "BOffsetY": -0.25},
+        {"ROffsetX": -0.31, "ROffsetY": -0.25, "GOffsetX": 0.28, "GOffsetY": -0.25, "BOffsetX": 0.0, "BOffsetY": 0.25}]})");
+    const std::string a = dir + "/fused" + std::to_string(pattern), b = dir + "/separate" + std::to_string(pattern);
+    const std::string common = " --display-config " + cal + " --view-size 96x96 ";
+    ASSERT_EQ(test::run("render" + common + "--out " + a).status, 0);
+    ASSERT_EQ(test::run("render" + common + "--write encoded,views --out " + b).status, 0);
+    int w = 0, h = 0;
+    std::vector<uint16_t> x, y;
+    read_rgba_exr(a + "/frame_0000.exr", w, h, x);
+    read_rgba_exr(b + "/frame_0000.exr", w, h, y);
+    EXPECT_EQ(x, y) << "pattern " << pattern;
+    size_t covered = 0;
+    for (size_t i = 3; i < x.size(); i += 4) covered += x[i] != 0;
+    EXPECT_GT(covered, x.size() / 4 / 20) << "pattern " << pattern;
+  }
 }
 
 }  // namespace pmr

@@ -234,7 +234,7 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   m.encode = display != nullptr;
   const int lanes = fine_lanes(tile_[0]);
   const size_t fused_private = size_t(tile_[0] + lanes - 1) / lanes * lanes * tile_[1] * rig.views * 20;
-  m.fused = config_.fuse_encode && display && !display->bilinear && !display->blend_views && config_.method == Method::Pmr &&
+  m.fused = config_.fuse_encode && display && !display->bilinear && !display->blend_views && display->cell_rows <= 1 && config_.method == Method::Pmr &&
             !config_.debug_outputs && fused_private <= kFusedPrivateBudget;
   if (display) {
     m.encode_params = make_encode_params(*display, rig.views, rig.view_w, rig.view_h);

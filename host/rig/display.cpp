@@ -117,24 +117,45 @@ std::string to_string(const Rational& r) {
 
 namespace {
 
-// The exact integers of the header comment.
+// The exact integers of the header comment. With subpixel cells the offset moves to the column side:
+// t = (3j - o/G - 3 i c/d) / (a/b) with G = 10^14, so Den = a d G, P = N b d (3j G - o), R_i = 3 N b c G i.
 struct Phase {
   WideInt den, p1, r0, dr;  // Den, P_1 (P_s = s P_1), R_0, R_{i+1} - R_i
+  bool cells = false;
+  WideInt cell_scale;       // N b d (cells: P = cell_scale (3j G - o))
 };
+
+constexpr int64_t kCellDenominator = 100000000000000;  // 10^14
 
 Phase phase_of(const Display& display, int views) {
   const Rational &L = display.lens_pitch, &T = display.tan_slant, &O = display.offset;
   Phase ph;
-  ph.den = WideInt(L.num) * T.den * O.den;
-  ph.p1 = WideInt(views) * L.den * T.den * O.den;
-  ph.r0 = WideInt(views) * L.den * O.num * T.den;
-  ph.dr = WideInt(3) * views * L.den * T.num * O.den;
+  if (!display.cell_offsets.empty()) {
+    ph.cells = true;
+    ph.den = WideInt(L.num) * T.den * kCellDenominator;
+    ph.cell_scale = WideInt(views) * L.den * T.den;
+    ph.p1 = ph.cell_scale * 3 * kCellDenominator;  // per pixel j (3 subpixels)
+    ph.r0 = WideInt(0);
+    ph.dr = WideInt(3) * views * L.den * T.num * kCellDenominator;
+  } else {
+    ph.den = WideInt(L.num) * T.den * O.den;
+    ph.p1 = WideInt(views) * L.den * T.den * O.den;
+    ph.r0 = WideInt(views) * L.den * O.num * T.den;
+    ph.dr = WideInt(3) * views * L.den * T.num * O.den;
+  }
   if (display.phase_sign < 0) {  // N (-t) = (-P_s + R_i) / Den
     ph.p1 = WideInt(0) - ph.p1;
     ph.r0 = WideInt(0) - ph.r0;
     ph.dr = WideInt(0) - ph.dr;
+    ph.cell_scale = WideInt(0) - ph.cell_scale;
   }
   return ph;
+}
+
+// With cells: P for pixel column j, subpixel k in row class c.
+WideInt cell_column_value(const Display& display, const Phase& ph, int j, int k, int c) {
+  const int64_t o = display.cell_offsets[size_t((c * 2 + j % 2) * 3 + k)];
+  return ph.cell_scale * (3 * int64_t(j)) * kCellDenominator - ph.cell_scale * o;
 }
 
 int mod_n(int64_t q, int n) { return int(((q % n) + n) % n); }
@@ -161,6 +182,10 @@ PmrEncodeParams make_encode_params(const Display& display, int views, int view_w
   p.reversed = display.reversed ? 1 : 0;
   p.bilinear = display.bilinear ? 1 : 0;
   p.blend = display.blend_views ? 1 : 0;
+  p.cell_rows = display.cell_offsets.empty() ? 1 : display.cell_rows;
+  if (!display.cell_offsets.empty() &&
+      (display.cell_rows < 1 || display.cell_rows > 4 || display.cell_offsets.size() != size_t(display.cell_rows) * 6))
+    throw Error("internal error: subpixel cell offsets do not match their row classes");
   if (display.blend_views && display.bilinear) throw Error("--blend-views and --bilinear cannot be combined");
   return p;
 }
@@ -169,7 +194,8 @@ void make_encode_tables(const Display& display, const PmrEncodeParams& p, std::v
                         std::vector<PmrEncodeRow>& rows) {
   const Phase ph = phase_of(display, p.views);
   const double den_d = ph.den.to_double();
-  columns.resize(size_t(3) * p.display_w);
+  const size_t width3 = size_t(3) * p.display_w;
+  columns.resize(width3 * size_t(p.cell_rows));
   rows.resize(size_t(p.display_h));
   // Remainders of every column and row, stepped exactly (one wide division each for the steps).
   std::vector<std::pair<WideInt, int>> rems(columns.size());  // (remainder, +column index or -(row index) - 1)
@@ -179,7 +205,7 @@ void make_encode_tables(const Display& display, const PmrEncodeParams& p, std::v
   const int64_t q1n = q1.to_int64();
   int64_t qp = 0;
   WideInt rp(0);
-  for (size_t pos = 0; pos < columns.size(); ++pos) {  // phase positions in order
+  for (size_t pos = 0; pos < (ph.cells ? 0 : columns.size()); ++pos) {  // phase positions in order
     if (pos > 0) {
       qp += q1n;
       rp = rp + r1;
@@ -191,6 +217,18 @@ void make_encode_tables(const Display& display, const PmrEncodeParams& p, std::v
     c.px = int32_t((int64_t(2 * s + 1) * p.view_w) / (int64_t(6) * p.display_w));
     c.phase_frac = float(rp.to_double() / den_d);
     rems[s] = {rp, int(s)};
+  }
+  if (ph.cells) {  // every column of every row class on its own (one wide division each)
+    for (size_t e = 0; e < columns.size(); ++e) {
+      const int c = int(e / width3), s = int(e % width3), j = s / 3, k = s % 3;
+      WideInt qc, rc;
+      cell_column_value(display, ph, j, k, c).floor_divmod(ph.den, qc, rc);
+      PmrEncodeColumn& col = columns[e];
+      col.a_mod_n = mod_n(qc.to_int64(), p.views);
+      col.px = int32_t((int64_t(2 * s + 1) * p.view_w) / (int64_t(6) * p.display_w));
+      col.phase_frac = float(rc.to_double() / den_d);
+      rems[e] = {rc, int(e)};
+    }
   }
   WideInt qd, rd;
   ph.dr.floor_divmod(ph.den, qd, rd);
@@ -223,7 +261,9 @@ void make_encode_tables(const Display& display, const PmrEncodeParams& p, std::v
 int encode_view_index(const Display& display, int views, int j, int i, int k) {
   // Direct: N t = (P_s - R_i) / Den as one wide fraction, v = floor(N t) mod N.
   const Phase ph = phase_of(display, views);
-  const WideInt num = ph.p1 * int64_t(phase_position(display, 3 * size_t(j) + size_t(k))) - (ph.r0 + ph.dr * i);
+  const WideInt column = ph.cells ? cell_column_value(display, ph, j, k, (display.height - 1 - i) % display.cell_rows)
+                                  : ph.p1 * int64_t(phase_position(display, 3 * size_t(j) + size_t(k)));
+  const WideInt num = column - (ph.r0 + ph.dr * i);
   WideInt q, r;
   num.floor_divmod(ph.den, q, r);
   int v = mod_n(q.to_int64(), views);

@@ -77,9 +77,26 @@ LookingGlassCalibration read_looking_glass_calibration(const std::string& path, 
   if (!(h >= 1 && h <= 16384 && h == std::floor(h))) absurd("screenH", "must be a whole number of pixels in 1..16384");
   if (!(c.view_cone > 0.0 && c.view_cone < 180.0)) absurd("viewCone", "must be in (0, 180) degrees");
   c.screen_w = int(w), c.screen_h = int(h);
-  if (doc.contains("subpixelCells") && doc["subpixelCells"].is_array() && !doc["subpixelCells"].empty())
-    throw Error(path + ": calibration field 'subpixelCells' (per-channel subpixel cells of the gen3 OLED panels) is "
-                       "not supported yet");
+  if (doc.contains("subpixelCells") && !doc["subpixelCells"].is_null()) {
+    const json& cells = doc["subpixelCells"];
+    if (!cells.is_array() || cells.size() > 4) absurd("subpixelCells", "must be a list of at most 4 cells");
+    const char* keys[6] = {"ROffsetX", "ROffsetY", "GOffsetX", "GOffsetY", "BOffsetX", "BOffsetY"};
+    for (const json& cell : cells) {
+      std::array<double, 6> v{};
+      for (int k = 0; k < 6; ++k) {
+        if (!cell.is_object() || !cell.contains(keys[k]) || !cell[keys[k]].is_number())
+          absurd("subpixelCells", std::string("needs a number ") + keys[k] + " in every cell");
+        v[size_t(k)] = cell[keys[k]].get<double>();
+        if (!std::isfinite(v[size_t(k)]) || std::fabs(v[size_t(k)]) > 4.0) absurd("subpixelCells", "has an offset beyond 4 pixels");
+      }
+      c.cells.push_back(v);
+    }
+    // CellPatternMode as the Unity plugin reads it (capital C, else cellPatternMode)
+    const char* mode_key = doc.contains("CellPatternMode") ? "CellPatternMode" : "cellPatternMode";
+    const double mode = number_field(doc, mode_key, path, false, 0.0);
+    if (!(mode >= 0 && mode <= 4 && mode == std::floor(mode))) absurd("CellPatternMode", "must be 0, 1, 2, 3 or 4");
+    c.cell_pattern = int(mode);
+  }
   if (warnings) {
     if (!c.inv_view) warnings->push_back(path + ": invView = 0 ignored, as Looking Glass's current shader (webxr 0.6) does");
     if (c.flip_y) warnings->push_back(path + ": flipImageY ignored, as Looking Glass's current shader does");
@@ -114,6 +131,34 @@ Display display_from_calibration(const LookingGlassCalibration& c) {
   d.offset = exact_decimal(O, "offset (from the calibration)");
   d.phase_sign = -1;
   d.subpixel_bgr = c.flip_subp != c.flip_x;
+  if (!c.cells.empty()) {
+    // Gen3: no per-channel subp term; channel k of a pixel in cell m sits at
+    // ((j + 1/2 + dX) / W, (H - 1 - i + 1/2 + dY) / H), so its phase position is 3j and its offset
+    // -3/2 - 3 dX - 3 W tilt (H - 1/2 + dY) / H + center L, as exact numerators over 10^14.
+    static const int kRows[5] = {1, 2, 1, 4, 2};
+    d.cell_rows = kRows[c.cell_pattern];
+    d.subpixel_bgr = false;
+    for (int row_class = 0; row_class < d.cell_rows; ++row_class)
+      for (int xpar = 0; xpar < 2; ++xpar) {
+        int cell = 0;  // GetCellForPixel with y mod cell_rows = row_class (y from the bottom), x mod 2 = xpar
+        switch (c.cell_pattern) {
+          case 1: cell = (xpar + row_class) % 2; break;
+          case 2: cell = xpar; break;
+          case 3: cell = (row_class + 2 * xpar) % 4; break;
+          case 4: cell = row_class % 2; break;
+          default: cell = 0;
+        }
+        const std::array<double, 6>& off = c.cells[size_t(cell) % c.cells.size()];
+        for (int k = 0; k < 3; ++k) {
+          const long double dx = off[size_t(2 * k)], dy = off[size_t(2 * k + 1)];
+          const long double o = -1.5L - 3.0L * dx - 3.0L * W * (long double)tilt * (H - 0.5L + dy) / H +
+                                (long double)c.center * L;
+          const long double scaled = std::round(o * 1e14L);
+          if (!(std::fabs(scaled) < 9.0e18L)) throw Error("the calibration's offsets are too large for exact evaluation");
+          d.cell_offsets.push_back(int64_t(scaled));
+        }
+      }
+  }
   return d;
 }
 

@@ -15,5 +15,5 @@ static_assert(sizeof(PmrVertexAttr) == 36, "PmrVertexAttr layout");
 static_assert(sizeof(PmrTriangle) == 32, "PmrTriangle layout");
 static_assert(sizeof(PmrMaterial) == 32, "PmrMaterial layout");
 static_assert(sizeof(PmrTexture) == 32, "PmrTexture layout");
-static_assert(sizeof(PmrEncodeParams) == 32 && offsetof(PmrEncodeParams, display_w) == 0, "PmrEncodeParams layout");
+static_assert(sizeof(PmrEncodeParams) == 48 && offsetof(PmrEncodeParams, display_w) == 0, "PmrEncodeParams layout");
 static_assert(sizeof(PmrEncodeColumn) == 16 && sizeof(PmrEncodeRow) == 16, "encoder table layout");

@@ -1,6 +1,7 @@
 // Real displays (docs/DISPLAYS.md): the paper's 8K panel and Looking Glass panels, as presets and from a
 // Looking Glass calibration file ("visual.json"), mapped onto DESIGN section 5's encoder.
 #pragma once
+#include <array>
 #include <string>
 #include <vector>
 
@@ -14,11 +15,15 @@ struct LookingGlassCalibration {
   double pitch = 0, slope = 0, center = 0, dpi = 0, view_cone = 0, fringe = 0;
   int screen_w = 0, screen_h = 0;
   bool flip_x = false, flip_y = false, flip_subp = false, inv_view = true;
+  // Gen3 panels: subpixel cells, each {R, G, B} x {X, Y} offsets in pixels, and the pattern that
+  // assigns a cell to each pixel (CellPatternMode 0..4).
+  std::vector<std::array<double, 6>> cells;
+  int cell_pattern = 0;
 };
 
 // Reads and checks a visual.json: one clear pmr::Error naming the file and the field on anything
 // missing, non-numeric or absurd (zero DPI or slope, NaN, non-positive or huge screen size), and on
-// per-channel subpixel cells (the gen3 OLED panels), which the encoder does not express yet.
+// (subpixelCells with CellPatternMode are read for the gen3 panels).
 // `warnings` receives what is read but ignored (invView = 0, flipImageY, fringe, verticalAngle).
 LookingGlassCalibration read_looking_glass_calibration(const std::string& path, std::vector<std::string>* warnings);
 

@@ -38,6 +38,12 @@ struct Display {
   // Blend views v and v + 1 by the phase's fraction (Looking Glass's webxr 0.6 default filter); off by
   // default, so that every subpixel shows exactly one view.
   bool blend_views = false;
+  // Gen3 Looking Glass panels' subpixel cells (docs/DISPLAYS.md): when cell_offsets is not empty, every
+  // subpixel's phase position is 3j (no k) and its offset, instead of `offset`, is
+  // cell_offsets[(c * 2 + j % 2) * 3 + k] / 10^14 for row class c = (height - 1 - i) % cell_rows
+  // (exact numerators over a common denominator, so the encoder stays exact).
+  int cell_rows = 1;
+  std::vector<int64_t> cell_offsets;
   bool bilinear = false;             // sample views bilinearly instead of nearest
   double aspect() const { return size_w_cm / size_h_cm; }
 };

@@ -172,6 +172,9 @@ typedef struct {
   pmr_i32 bilinear;       /* 1: bilinear sampling of the view, 0: nearest                     */
   pmr_i32 blend;          /* 1: blend views v and v + 1 by the phase's fraction (Looking Glass's
                              webxr filter mode 1), 0: one view per subpixel                     */
+  pmr_i32 cell_rows;      /* subpixel cells: the column table has one block of 3 W_d entries per
+                             row class (H_d - 1 - i) mod cell_rows; 1 without cells            */
+  pmr_i32 pad0, pad1, pad2;
 } PmrEncodeParams;
 
 /* Encoder tables, computed once per configuration by the host (host/rig/display.cpp). With

@@ -117,6 +117,10 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   d["reversed"] = display.reversed;
   d["phase_sign"] = display.phase_sign;
   d["subpixel_order"] = display.subpixel_bgr ? "bgr" : "rgb";
+  if (!display.cell_offsets.empty()) {
+    d["cell_rows"] = display.cell_rows;
+    d["cell_offsets_1e14"] = display.cell_offsets;  // [(row class * 2 + j % 2) * 3 + k]
+  }
   if (!info.display_source.empty()) d["source"] = info.display_source;
   if (!info.calibration.empty()) {
     json cal = json::object();
@@ -176,7 +180,9 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
       {"encoding", "display pixel (j, i), row 0 at the top, subpixel k in {0,1,2} (R,G,B left to right): "
                    "t = (3 j + k' - 3 i tan_slant - offset) / lens_pitch with k' = k (subpixel_order rgb) or 2 - k "
                    "(bgr), v = floor(frac(phase_sign * t) * views) evaluated exactly, v -> views - 1 - v if "
-                   "reversed; channel k of view v sampled at ((j + (k + 0.5) / 3) / width, (i + 0.5) / height)"},
+                   "reversed; with subpixel cells (display.cell_rows) k' = 0 and the offset of the pixel's cell and "
+                   "channel (display.cell_offsets_1e14 / 10^14); channel k of view v sampled at "
+                   "((j + (k + 0.5) / 3) / width, (i + 0.5) / height)"},
   };
   std::string text;
   emit(j, 0, text);

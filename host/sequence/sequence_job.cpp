@@ -140,7 +140,8 @@ int run_sequence(const RenderOptions& o) {
     info.calibration = {{"pitch", c.pitch},         {"slope", c.slope},       {"center", c.center},
                         {"DPI", c.dpi},             {"screenW", c.screen_w},  {"screenH", c.screen_h},
                         {"viewCone", c.view_cone},  {"fringe", c.fringe},     {"flipImageX", c.flip_x},
-                        {"flipImageY", c.flip_y},   {"flipSubp", c.flip_subp}, {"invView", c.inv_view}};
+                        {"flipImageY", c.flip_y},   {"flipSubp", c.flip_subp}, {"invView", c.inv_view},
+                        {"CellPatternMode", c.cell_pattern}, {"subpixelCells", double(c.cells.size())}};
   }
   auto frame_info = [&](long frame, const FramePaths& p, double angle) {
     SidecarInfo i = info;

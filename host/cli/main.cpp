@@ -8,6 +8,7 @@
 #include "cli/info_command.h"
 #include "cli/options.h"
 #include "cli/render_command.h"
+#include "cli/verify_command.h"
 #include "pmr/error.h"
 
 int main(int argc, char** argv) {
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
     if (cmd == "render") return pmr::run_render(args);
     if (cmd == "bench") return pmr::run_bench(args);
     if (cmd == "info") return pmr::run_info(args);
+    if (cmd == "verify") return pmr::run_verify(args);
     throw pmr::Error("unknown command '" + cmd + "' (try pmr --help)");
   } catch (const pmr::Error& e) {
     std::fprintf(stderr, "pmr: error: %s\n", e.what());

@@ -174,7 +174,10 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
       o.turntable = true;
       o.turntable_deg = parse_double(v.substr(0, colon), a);
       o.turntable_frames = parse_int(v.substr(colon + 1), a, 1, 1 << 30);
-    } else if (a == "--resume") o.resume = true;
+    } else if (a == "--shard") o.shard = value();
+    else if (a == "--shard-count") o.shard_count = parse_int(value(), a, 1, 1 << 30);
+    else if (a == "--shard-first") o.shard_first = parse_int(value(), a, 0, 1 << 30);
+    else if (a == "--resume") o.resume = true;
     else if (a == "--overwrite") o.overwrite = true;
     else if (a == "--quiet" || a == "-q") o.quiet = true;
     else if (a == "--verbose" || a == "-v") o.verbose = true;
@@ -230,6 +233,7 @@ std::string main_help() {
          "  pmr bench [SCENE] [options]                  performance sweeps over view count and method\n"
          "  pmr info                                     list OpenCL platforms and devices\n"
          "  pmr info SCENE                               what a scene holds (cameras, animations, ...)\n"
+         "  pmr verify DIR --frames LIST                 which frames of a sequence are missing or broken\n"
          "  pmr --help | pmr render --help\n";
 }
 
@@ -262,6 +266,10 @@ std::string render_help() {
          "  --resume               skip frames whose files are all present; refuse a changed configuration\n"
          "  --overwrite            with --resume: re-render frames of another configuration instead\n"
          "  --quiet                no progress output (errors and the summary still print)\n"
+         "  --shard K/N|auto       render only task K's share of the frames (interleaved: positions K, K+N,\n"
+         "                         ...); auto reads a Slurm, Kubernetes, AWS Batch, PBS, SGE or LSF array index\n"
+         "                         (--shard-count N where the environment lacks the count, --shard-first F\n"
+         "                         for PBS arrays not starting at 0); see docs/farm/README.md\n"
          "rig:\n"
          "  --preset NAME          a display: paper-8k (default), lg-portrait, lg-go, lg-16, lg-32, ...\n"
          "                         (--preset help lists them); other options override its values\n"

@@ -36,6 +36,8 @@ struct RenderOptions {
   double turntable_deg = 0.0;
   long turntable_frames = 0;
   bool resume = false, overwrite = false, quiet = false;
+  std::string shard;              // --shard K/N or auto; empty = every frame
+  long shard_count = 0, shard_first = 0;
   bool verbose = false;
   bool help = false;
   bool preset_help = false;  // --preset help

@@ -197,6 +197,34 @@ void write_views_exr(const std::string& path, int width, int height, int views, 
   file.commit();
 }
 
+bool exr_is_complete(const std::string& path) {
+  try {
+    Imf::MultiPartInputFile in(path.c_str());
+    for (int p = 0; p < in.parts(); ++p) {
+      Imf::InputPart part(in, p);
+      if (!part.isComplete()) return false;
+      // isComplete() only reads the offset table: decode every chunk too (every line into one scratch
+      // line per channel: y stride 0), so that a file cut short or damaged in its data is caught.
+      const Imath::Box2i dw = part.header().dataWindow();
+      const size_t width = size_t(int64_t(dw.max.x) - dw.min.x + 1);
+      size_t channels = 0;
+      for (auto c = part.header().channels().begin(); c != part.header().channels().end(); ++c) ++channels;
+      std::vector<float> scratch(width * channels);
+      Imf::FrameBuffer fb;
+      size_t k = 0;
+      for (auto c = part.header().channels().begin(); c != part.header().channels().end(); ++c, ++k) {
+        char* line = reinterpret_cast<char*>(scratch.data() + k * width) - size_t(dw.min.x) * sizeof(float);
+        fb.insert(c.name(), Imf::Slice(Imf::FLOAT, line, sizeof(float), 0));
+      }
+      part.setFrameBuffer(fb);
+      part.readPixels(dw.min.y, dw.max.y);
+    }
+    return in.parts() > 0;
+  } catch (...) {
+    return false;
+  }
+}
+
 void read_rgba_exr(const std::string& path, int& width, int& height, std::vector<uint16_t>& rgba_half) {
   guarded("cannot read", path, "", [&] {
     Imf::RgbaInputFile in(path.c_str());

@@ -5,6 +5,7 @@
 #include <csignal>
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <limits>
 #include <cstdio>
 #include <filesystem>
@@ -16,56 +17,18 @@
 #include "pmr/output.h"
 #include "pmr/quilt.h"
 #include "runtime/cl_runtime.h"
+#include "sequence/frame_files.h"
 #include "sequence/frame_list.h"
 #include "sequence/frame_renderer.h"
 #include "sequence/frame_writer.h"
 #include "sequence/progress.h"
+#include "sequence/shard.h"
 
 namespace pmr {
 
 namespace {
 
 namespace fs = std::filesystem;
-
-// Every file of a frame; empty = not requested.
-struct FramePaths {
-  std::string sidecar, encoded, views, quilt, encoded_png, center_png, quilt_png;
-  std::vector<std::string> images() const {
-    std::vector<std::string> all;
-    for (const std::string* p : {&encoded, &views, &quilt, &encoded_png, &center_png, &quilt_png})
-      if (!p->empty()) all.push_back(*p);
-    return all;
-  }
-};
-
-FramePaths paths_of(const RenderOptions& o, long frame, const QuiltLayout& quilt, double aspect) {
-  const std::string stem = frame_stem(o.name, frame);
-  const std::string base = (fs::path(o.out_dir) / stem).string();
-  FramePaths p;
-  p.sidecar = base + ".json";
-  if (o.write_encoded) p.encoded = base + ".exr";
-  if (o.write_views) p.views = base + ".views.exr";
-  const std::string quilt_base = (fs::path(o.out_dir) / quilt_stem(stem, quilt, aspect)).string();
-  if (o.write_quilt) p.quilt = quilt_base + ".exr";
-  if (o.preview) {
-    if (o.write_encoded) p.encoded_png = base + ".png";
-    p.center_png = base + ".center.png";
-    if (o.write_quilt) p.quilt_png = quilt_base + ".png";
-  }
-  return p;
-}
-
-bool exists(const std::string& p) {
-  std::error_code ec;
-  return !p.empty() && fs::is_regular_file(p, ec);
-}
-
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 std::string base_name(const std::string& path) { return fs::path(path).filename().string(); }
 
@@ -99,6 +62,13 @@ int run_sequence(const RenderOptions& o) {
     animation_frame_range(scene, spec, first, last);
     for (long f = first; f <= last; ++f) frames.push_back(f);
   }
+  if (!o.shard.empty()) {
+    const Shard shard = parse_shard(o.shard, o.shard_count, o.shard_first, [](const char* n) { return std::getenv(n); });
+    const size_t all = frames.size();
+    frames = shard_frames(frames, shard);
+    std::fprintf(stderr, "pmr: %s: shard %ld of %ld, %zu of %zu frame(s)\n", shard.source.c_str(), shard.index,
+                 shard.count, frames.size(), all);
+  }
   std::vector<std::string> warnings;
   FrameRenderer renderer(scene, spec, o.rig, o.display, &warnings);
   for (const auto& w : warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
@@ -111,7 +81,7 @@ int run_sequence(const RenderOptions& o) {
   else if (!o.quilt.empty())
     throw Error("--quilt needs --write quilt");
   const int center_view = rig.views / 2;
-  auto paths = [&](long f) { return paths_of(o, f, quilt, rig.aspect); };
+  auto paths = [&](long f) { return frame_paths(o, f, quilt, rig.aspect); };
 
   SidecarInfo info;
   info.scene = o.scene;
@@ -165,10 +135,11 @@ int run_sequence(const RenderOptions& o) {
   long skipped = 0;
   for (long f : frames) {
     const FramePaths p = paths(f);
-    const std::vector<std::string> images = p.images();
-    if (o.resume && exists(p.sidecar) && std::all_of(images.begin(), images.end(), exists)) {
+    // complete = every file present and readable (a node may have died during a rename on a network
+    // file system); anything less is rendered again
+    if (o.resume && frame_problem(p.sidecar, p.images()).empty()) {
       const std::string expected = sidecar_json(rig, o.display, frame_info(f, p, 0.0));
-      const std::string diff = sidecar_config_difference(read_text(p.sidecar), expected);
+      const std::string diff = sidecar_config_difference(read_text_file(p.sidecar), expected);
       if (diff.empty()) {
         ++skipped;
         continue;

@@ -67,6 +67,10 @@ std::string view_part_name(int i, int views);
 void write_views_exr(const std::string& path, int width, int height, int views, const uint16_t* volume,
                      const float* depth, ExrCompression c, int threads = 0, float pixel_aspect = 1.0f);
 
+// True when the EXR file opens and every part has all its pixel data (a truncated file is not
+// complete). Never throws.
+bool exr_is_complete(const std::string& path);
+
 // Readers (used by the tests). They return the data window's size and the pixels row 0 at the top,
 // RGBA half bits; a missing alpha channel reads as 1.0, missing colour channels as 0.
 void read_rgba_exr(const std::string& path, int& width, int& height, std::vector<uint16_t>& rgba_half);

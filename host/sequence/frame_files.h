@@ -1,0 +1,27 @@
+// A frame's files on disk: their names (from the options) and whether they make a complete frame.
+// Shared by the sequence job (--resume) and `pmr verify`.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "cli/options.h"
+#include "pmr/quilt.h"
+
+namespace pmr {
+
+// Every file of a frame; empty = not requested.
+struct FramePaths {
+  std::string sidecar, encoded, views, quilt, encoded_png, center_png, quilt_png;
+  std::vector<std::string> images() const;  // the non-empty ones besides the sidecar
+};
+
+FramePaths frame_paths(const RenderOptions& o, long frame, const QuiltLayout& quilt, double aspect);
+
+// "" when the frame is whole (the sidecar parses as a JSON object, every EXR is complete, every PNG
+// decodes), else what is wrong with it, e.g. "frame_0003.exr is missing", "frame_0003.exr is truncated
+// or unreadable".
+std::string frame_problem(const std::string& sidecar, const std::vector<std::string>& images);
+
+std::string read_text_file(const std::string& path);
+
+}  // namespace pmr

@@ -1,0 +1,140 @@
+// Render-farm pieces that need no scheduler: the shard arithmetic for every scheduler's array
+// environment (each frame to exactly one task), and `pmr verify` on broken folders.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include "pmr/error.h"
+#include "sequence/frame_list.h"
+#include "sequence/shard.h"
+#include "test_util.h"
+
+namespace pmr {
+namespace {
+
+namespace fs = std::filesystem;
+
+using Env = std::map<std::string, std::string>;
+
+Environment from(const Env& env) {
+  return [env](const char* name) -> const char* {
+    auto it = env.find(name);
+    return it == env.end() ? nullptr : it->second.c_str();
+  };
+}
+
+// Every task of an array (ids as the scheduler numbers them) with its environment: the union of their
+// shares is every frame exactly once, in interleaved order.
+void expect_partition(const std::vector<Env>& tasks, const std::vector<long>& frames, long count = 0, long first = 0) {
+  std::map<long, int> seen;
+  for (const Env& env : tasks) {
+    const Shard s = parse_shard("auto", count, first, from(env));
+    EXPECT_EQ(s.count, long(tasks.size()));
+    for (long f : shard_frames(frames, s)) ++seen[f];
+  }
+  ASSERT_EQ(seen.size(), frames.size());
+  for (const auto& [f, n] : seen) EXPECT_EQ(n, 1) << "frame " << f;
+}
+
+std::vector<long> range(long a, long b) {
+  std::vector<long> v;
+  for (long f = a; f <= b; ++f) v.push_back(f);
+  return v;
+}
+
+}  // namespace
+
+TEST(Shard, ExplicitSharesAreInterleaved) {
+  const std::vector<long> frames = parse_frame_list("10:19");
+  EXPECT_EQ(shard_frames(frames, parse_shard("1/3", 0, 0, from({}))), (std::vector<long>{11, 14, 17}));
+  EXPECT_TRUE(shard_frames({1, 2}, parse_shard("4/5", 0, 0, from({}))).empty());  // more shards than frames
+  for (const char* bad : {"3/3", "-1/2", "1", "a/b", "1/0", "2/"}) EXPECT_THROW(parse_shard(bad, 0, 0, from({})), Error) << bad;
+}
+
+TEST(Shard, EverySchedulersArrayCoversEveryFrameOnce) {
+  const std::vector<long> frames = range(0, 16);  // 17 frames over 4 tasks: uneven shares
+  std::vector<Env> slurm, slurm_step, k8s, aws, sge, lsf, pbs, torque;
+  for (int t = 0; t < 4; ++t) {
+    // Slurm --array=3-6 (first index other than 0 or 1), and --array=0-12:4 with a step
+    slurm.push_back({{"SLURM_ARRAY_TASK_ID", std::to_string(3 + t)}, {"SLURM_ARRAY_TASK_MIN", "3"},
+                     {"SLURM_ARRAY_TASK_MAX", "6"}, {"SLURM_ARRAY_TASK_COUNT", "4"}});
+    slurm_step.push_back({{"SLURM_ARRAY_TASK_ID", std::to_string(4 * t)}, {"SLURM_ARRAY_TASK_MIN", "0"},
+                          {"SLURM_ARRAY_TASK_MAX", "12"}, {"SLURM_ARRAY_TASK_STEP", "4"}});
+    k8s.push_back({{"JOB_COMPLETION_INDEX", std::to_string(t)}});
+    aws.push_back({{"AWS_BATCH_JOB_ARRAY_INDEX", std::to_string(t)}, {"AWS_BATCH_JOB_ARRAY_SIZE", "4"}});
+    sge.push_back({{"SGE_TASK_ID", std::to_string(2 + 3 * t)}, {"SGE_TASK_FIRST", "2"}, {"SGE_TASK_LAST", "11"},
+                   {"SGE_TASK_STEPSIZE", "3"}});
+    lsf.push_back({{"LSB_JOBINDEX", std::to_string(1 + t)}, {"LSB_JOBINDEX_END", "4"}});
+    pbs.push_back({{"PBS_ARRAY_INDEX", std::to_string(1 + t)}});
+    torque.push_back({{"PBS_ARRAYID", std::to_string(t)}});
+  }
+  expect_partition(slurm, frames);
+  expect_partition(slurm_step, frames);
+  expect_partition(k8s, frames, 4);
+  expect_partition(aws, frames);
+  expect_partition(sge, frames);
+  expect_partition(lsf, frames);
+  expect_partition(pbs, frames, 4, 1);
+  expect_partition(torque, frames, 4, 0);
+  // more tasks than frames: every frame still once, some tasks idle
+  expect_partition(aws, range(0, 1));
+}
+
+TEST(Shard, BadEnvironmentsFailWithOneLine) {
+  auto msg = [](const Env& env, long count = 0) {
+    try {
+      parse_shard("auto", count, 0, from(env));
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(accepted)");
+  };
+  EXPECT_NE(msg({}).find("no array job in the environment"), std::string::npos);
+  EXPECT_NE(msg({{"JOB_COMPLETION_INDEX", "2"}}).find("--shard-count"), std::string::npos);  // k8s has no count
+  EXPECT_NE(msg({{"PBS_ARRAY_INDEX", "2"}}).find("--shard-count"), std::string::npos);
+  EXPECT_NE(msg({{"JOB_COMPLETION_INDEX", "5"}}, 4).find("outside"), std::string::npos);
+  EXPECT_NE(msg({{"AWS_BATCH_JOB_ARRAY_INDEX", "1"}, {"AWS_BATCH_JOB_ARRAY_SIZE", "4"}}, 3).find("disagrees"),
+            std::string::npos);
+  EXPECT_NE(msg({{"SLURM_ARRAY_TASK_ID", "5"}, {"SLURM_ARRAY_TASK_MIN", "0"}, {"SLURM_ARRAY_TASK_STEP", "4"},
+                 {"SLURM_ARRAY_TASK_MAX", "12"}})
+                .find("not on the array's range"),
+            std::string::npos);
+  EXPECT_NE(msg({{"SLURM_ARRAY_TASK_ID", "x"}}).find("not a whole number"), std::string::npos);
+  // SGE outside an array job, LSF index 0: not an array
+  EXPECT_NE(msg({{"SGE_TASK_ID", "undefined"}, {"LSB_JOBINDEX", "0"}}).find("no array job"), std::string::npos);
+}
+
+// pmr verify on a sequence folder: complete, then with a frame missing, an EXR cut short, a sidecar
+// from another configuration; the printed list is what to resubmit, and --resume redoes exactly those.
+TEST(Verify, ReportsMissingAndBrokenFramesAsAFramesList) {
+  const std::string out = test::temp_dir("verify");
+  const std::string args = " --turntable 360:8 --views 4 --view-size 64x32 --display 240x135 --out " + out;
+  ASSERT_EQ(test::run("render --frames 0:7 -q" + args).status, 0);
+  test::CliRun v = test::run("verify " + out + " --frames 0:7");
+  EXPECT_EQ(v.status, 0) << v.output;
+  EXPECT_NE(v.output.find("8 of 8 frame(s) complete"), std::string::npos) << v.output;
+  fs::remove(out + "/frame_0002.exr");
+  {  // truncate frame 4's image
+    const std::string p = out + "/frame_0004.exr";
+    const auto size = fs::file_size(p);
+    fs::resize_file(p, size / 2);
+  }
+  // frame 6 rendered again at another fps: another configuration
+  ASSERT_EQ(test::run("render --frames 6 -q --fps 30" + args).status, 0);
+  v = test::run("verify " + out + " --frames 0:7");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("2:6:2\n"), std::string::npos) << v.output;  // frames 2, 4, 6
+  EXPECT_NE(v.output.find("frame 4: frame_0004.exr is truncated"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("another configuration"), std::string::npos) << v.output;
+  // --resume redoes the missing and truncated frames (the other configuration needs --overwrite)
+  test::CliRun r = test::run("render --frames 0:7 --resume --overwrite" + args);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("3 frame(s) in"), std::string::npos) << r.output;
+  EXPECT_EQ(test::run("verify " + out + " --frames 0:7").status, 0);
+  test::expect_one_error_line(test::run("verify " + out), "--frames");
+  test::expect_one_error_line(test::run("verify /nonexistent --frames 0"), "not a folder");
+}
+
+}  // namespace pmr

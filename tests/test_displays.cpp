@@ -277,3 +277,58 @@ TEST(Displays, Gen3CalibrationRendersFusedAndSeparateAlike) {
 }
 
 }  // namespace pmr
+
+namespace pmr {
+
+// Angular camera spacing (the Looking Glass convention): the offsets are D tan(cone ((i + 1/2) / N -
+// 1/2)), and every rendered view (multipass: each view with its own matrices) puts a small square
+// where that view's sidecar matrices project it, in front of and behind the focal plane.
+TEST(Displays, AngularSpacingViewsMatchTheirMatrices) {
+  Scene s = test::empty_scene(true);
+  const float h = 0.1f;
+  for (const auto& [x, z] : std::vector<std::pair<float, float>>{{-0.5f, 0.6f}, {0.5f, -0.6f}}) {
+    test::add_triangle(s, {x - h, -h, z}, {x + h, -h, z}, {x + h, h, z});
+    test::add_triangle(s, {x - h, -h, z}, {x + h, h, z}, {x - h, h, z});
+  }
+  RigConfig rc;
+  rc.views = 8, rc.view_w = 256, rc.view_h = 128;
+  rc.cone_deg = 40;
+  rc.angular_spacing = true;
+  const Display d;
+  const Rig rig = make_rig(rc, d, glm::dvec3(-1), glm::dvec3(1));
+  for (int i = 0; i < rig.views; ++i)
+    EXPECT_DOUBLE_EQ(rig.camera_offset(i), rig.focal * std::tan(rig.cone * ((i + 0.5) / 8.0 - 0.5)));
+  EXPECT_THROW(test::render(s, rig), Error);  // PMR itself needs evenly spaced views (for now)
+  PipelineConfig pc;
+  pc.method = Method::Multipass;
+  Pipeline p(test::runtime(), pc);
+  p.set_scene(s);
+  p.configure(rig, nullptr);
+  p.render(rig);
+  std::vector<uint16_t> vol;
+  p.read_volume(vol);
+  const size_t plane = size_t(rig.view_w) * rig.view_h;
+  double first_px[2] = {0, 0}, shift = 0;
+  for (int i = 0; i < rig.views; ++i)
+    for (const float x : {-0.5f, 0.5f}) {
+      const float z = x < 0 ? 0.6f : -0.6f;
+      const glm::dvec4 c = rig.projection(i) * rig.view_matrix(i) * glm::dvec4(x, 0, z, 1);
+      const double px = (c.x / c.w + 1) / 2 * rig.view_w, py = (1 - c.y / c.w) / 2 * rig.view_h;
+      // centroid of the covered pixels near the expected position
+      double sx = 0, sy = 0, n = 0;
+      for (int y = 0; y < rig.view_h; ++y)
+        for (int xx = 0; xx < rig.view_w; ++xx) {
+          if (std::abs(xx + 0.5 - px) > 16 || std::abs(y + 0.5 - py) > 16) continue;
+          if (vol[(size_t(i) * plane + size_t(y) * rig.view_w + size_t(xx)) * 4 + 3] == 0) continue;
+          sx += xx + 0.5, sy += y + 0.5, n += 1;
+        }
+      ASSERT_GT(n, 4) << "view " << i << " square " << x;
+      EXPECT_NEAR(sx / n, px, 0.5) << "view " << i << " square " << x;
+      EXPECT_NEAR(sy / n, py, 0.5) << "view " << i << " square " << x;
+      if (i == 0) first_px[x > 0] = px;
+      if (i == rig.views - 1) shift += std::abs(px - first_px[x > 0]);
+    }
+  EXPECT_GT(shift, 1.0);  // the squares off the focal plane do move between views
+}
+
+}  // namespace pmr

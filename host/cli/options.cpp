@@ -82,6 +82,7 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
       const DisplayPreset& p = find_display_preset(args[i + 1]);
       o.display = p.display;
       o.rig = p.rig;
+      o.rig.angular_spacing = p.name != "paper-8k";  // Looking Glass software spaces its cameras angularly
       o.display_source = "preset " + p.name;
     } else if (args[i] == "--display-config") {
       o.calibration = read_looking_glass_calibration(args[i + 1], &o.option_warnings);
@@ -89,6 +90,7 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
       o.display = display_from_calibration(o.calibration);
       std::string quilt;
       o.rig = rig_for_serial(o.calibration, quilt);
+      o.rig.angular_spacing = true;
       o.display_source = "calibration " + args[i + 1];
     }
   }
@@ -181,7 +183,12 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     else if (a == "--overwrite") o.overwrite = true;
     else if (a == "--quiet" || a == "-q") o.quiet = true;
     else if (a == "--verbose" || a == "-v") o.verbose = true;
-    else if (a == "--method") o.pipeline.method = parse_method(value());
+    else if (a == "--method") o.pipeline.method = parse_method(value()), o.method_given = true;
+    else if (a == "--camera-spacing") {
+      const std::string v = value();
+      if (v != "linear" && v != "angular") throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
+      o.rig.angular_spacing = v == "angular";
+    }
     else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see pmr render --help)");
     else if (o.scene.empty()) o.scene = a;
     else throw Error("more than one scene given ('" + o.scene + "' and '" + a + "')");
@@ -220,6 +227,12 @@ std::string frame_stem(const std::string& pattern, long frame) {
 }
 
 void finalize_render_options(RenderOptions& o) {
+  if (o.rig.angular_spacing && !o.method_given) {
+    // PMR needs evenly spaced views; one conventional pass per view takes any spacing
+    o.pipeline.method = Method::Multipass;
+    o.option_warnings.push_back("angular camera spacing (the Looking Glass convention): rendering with --method "
+                                "multipass; --camera-spacing linear renders with PMR, several times faster");
+  }
   if (!o.offset_given) {
     o.display.offset = default_offset(o.display.lens_pitch, o.rig.views);
   }
@@ -279,6 +292,9 @@ std::string render_help() {
          "  --view-size WxH        view raster in pixels (default 1024x512; each side <= 8192)\n"
          "  --cone DEG             view cone (default 80)\n"
          "  --yfov DEG             vertical field of view (default from the display: 2 atan(46.5 / 200))\n"
+         "  --camera-spacing S     linear (DESIGN, default for paper-8k) or angular (Looking Glass: D tan(cone\n"
+         "                         ((i + 1/2) / N - 1/2)), default for the Looking Glass presets; angular\n"
+         "                         renders with --method multipass for now\n"
          "  --camera K             use the scene's glTF camera K (pose and field of view) instead of framing\n"
          "                         the scene's bounding sphere\n"
          "display:\n"

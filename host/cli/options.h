@@ -41,6 +41,7 @@ struct RenderOptions {
   bool verbose = false;
   bool help = false;
   bool preset_help = false;  // --preset help
+  bool method_given = false;   // --method was on the command line
 };
 
 // Parses the arguments after `render`. Throws pmr::Error with one line on bad input.

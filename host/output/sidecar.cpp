@@ -143,6 +143,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   r["aspect"] = rig.aspect;
   r["focal_distance"] = rig.focal;
   r["baseline"] = rig.baseline();
+  r["camera_spacing"] = rig.angular ? "angular" : "linear";
   r["near"] = rig.near;
   r["near_used"] = rig.near_eff;
   r["far"] = rig.far;

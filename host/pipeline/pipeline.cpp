@@ -222,6 +222,9 @@ size_t Pipeline::display_bytes() const {
 
 void Pipeline::configure(const Rig& rig, const Display* display) {
   Impl& m = *impl_;
+  if (rig.angular && config_.method != Method::Multipass)
+    throw Error("angular camera spacing renders with --method multipass for now: PMR's multi-view triangles "
+                "need evenly spaced views (or use --camera-spacing linear)");
   const ClRuntime& rt = m.rt;
   m.params = make_params(rig);
   tiles_x_ = (rig.view_w + tile_[0] - 1) / tile_[0];

@@ -12,6 +12,7 @@ namespace pmr {
 double Rig::baseline() const { return 2.0 * focal * std::tan(cone / 2.0); }
 
 double Rig::camera_offset(int i) const {
+  if (angular) return focal * std::tan(cone * ((double(i) + 0.5) / double(views) - 0.5));
   if (views <= 1) return 0.0;
   return (double(i) / double(views - 1) - 0.5) * baseline();
 }
@@ -74,6 +75,7 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
   rig.view_h = config.view_h;
   rig.aspect = display.aspect();
   rig.cone = glm::radians(config.cone_deg);
+  rig.angular = config.angular_spacing;
   rig.yfov = config.yfov_deg > 0.0 ? glm::radians(config.yfov_deg)
                                    : 2.0 * std::atan(0.5 * display.size_h_cm / display.viewing_distance_cm);
   if (camera_pose && camera_yfov > 0.0 && !(config.yfov_deg > 0.0)) rig.yfov = camera_yfov;

@@ -54,6 +54,9 @@ struct RigConfig {
   double cone_deg = 80.0;
   double yfov_deg = 0.0;   // 0 = from the display: 2 atan(size_h / 2 / viewing_distance)
   int camera = -1;         // glTF camera index, -1 = frame the scene's bounding sphere
+  // Camera spacing along the baseline: linear (DESIGN section 2, PMR's evenly spaced views) or
+  // angular as Looking Glass software places them, D tan(cone ((i + 1/2) / N - 1/2)).
+  bool angular_spacing = false;
 };
 
 // The resolved rig of one frame.
@@ -64,10 +67,11 @@ struct Rig {
   double focal = 0;               // D
   double near = 0, far = 0;       // the planes as requested (default or camera)
   double near_eff = 0;            // near raised (if needed) to keep disparity inside the guard band
+  bool angular = false;           // camera spacing (RigConfig::angular_spacing)
   glm::dmat4 center_view{1.0};    // world -> center view space
 
   double baseline() const;                    // B = 2 D tan(theta / 2)
-  double camera_offset(int i) const;          // s_i
+  double camera_offset(int i) const;          // s_i (linear or angular spacing)
   glm::dmat4 view_matrix(int i) const;        // V_i = T(-s_i, 0, 0) V
   glm::dmat4 projection(int i) const;         // glFrustum(l_i, r_i, b, t, near_eff, far)
   double disparity_k() const;                 // W tan(theta/2) / (A tan(phi/2))

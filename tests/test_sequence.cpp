@@ -19,6 +19,7 @@
 #include "pmr/error.h"
 #include "pmr/output.h"
 #include "sequence/frame_list.h"
+#include "sequence/frame_renderer.h"
 #include "test_util.h"
 
 namespace pmr {
@@ -210,6 +211,25 @@ TEST(Sequence, FullDiskStopsCleanly) {
     const std::string stem = n.substr(0, n.find('.'));
     EXPECT_TRUE(names.count(stem + ".exr") && names.count(stem + ".json")) << "partial frame: " << n;
   }
+}
+
+// Key times near float's maximum (a malformed but schema-valid file) or hours of animation: one clear
+// error instead of posing billions of frames for the framing.
+TEST(Sequence, AbsurdAnimationRangesAreRefused) {
+  Scene s;
+  s.animations = {{"long", 0.0, 1e30, 1}, {"ok", 0.5, 2.0, 1}};
+  SequenceSpec spec;
+  long first = 0, last = 0;
+  spec.animation = 0;
+  EXPECT_THROW(animation_frame_range(s, spec, first, last), Error);
+  spec.animation = 1;
+  animation_frame_range(s, spec, first, last);
+  EXPECT_EQ(first, 12);
+  EXPECT_EQ(last, 48);
+  spec.animation = kAllAnimations;
+  EXPECT_THROW(animation_frame_range(s, spec, first, last), Error);
+  expect_one_error_line(run("render --turntable 360:100000000 --frames all" + kSmall + "--out " + temp_dir("seq_long")),
+                        "give a range");
 }
 
 TEST(Sequence, BadSequenceOptionsFailWithOneLine) {

@@ -44,9 +44,15 @@ void describe_scene(const std::string& path) {
     SequenceSpec spec;  // what --frames all renders at the default fps
     spec.animation = int(i);
     long first = 0, last = 0;
-    animation_frame_range(s, spec, first, last);
-    std::printf("  %zu %s: %zu channel(s), keys %.3f to %.3f s; --frames all at 24 fps: %ld:%ld\n", i,
-                quoted(a.name).c_str(), a.channels, a.start, a.end, first, last);
+    std::string frames;
+    try {
+      animation_frame_range(s, spec, first, last);
+      frames = std::to_string(first) + ":" + std::to_string(last);
+    } catch (const Error&) {
+      frames = "too long to render";
+    }
+    std::printf("  %zu %s: %zu channel(s), keys %.3f to %.3f s; --frames all at 24 fps: %s\n", i,
+                quoted(a.name).c_str(), a.channels, a.start, a.end, frames.c_str());
   }
   std::printf("skins: %zu\n", d.skin_joints.size());
   for (size_t i = 0; i < d.skin_joints.size(); ++i) std::printf("  %zu: %zu joint(s)\n", i, d.skin_joints[i]);

@@ -63,8 +63,14 @@ void animation_frame_range(const Scene& scene, const SequenceSpec& spec, long& f
   double start = 0, end = 0;
   if (spec.animation != kNoAnimation && key_range(scene, spec.animation, start, end)) {
     // A tolerance keeps 1.0000001 s at 24 fps from adding a frame.
-    first = std::max(0L, long(std::floor(start * spec.fps + 1e-6)));
-    last = std::max(first, long(std::ceil(end * spec.fps - 1e-6)));
+    const double a = std::floor(start * spec.fps + 1e-6), b = std::ceil(end * spec.fps - 1e-6);
+    // The framing poses every frame of the range: refuse absurd ranges (key times near float's
+    // maximum, hours of animation) with one line instead of working for days or overflowing.
+    if (!(b - std::max(a, 0.0) < double(kMaxAnimationFrames)))
+      throw Error("the animation's keys span " + std::to_string(start) + " to " + std::to_string(end) + " s, over " +
+                  std::to_string(kMaxAnimationFrames) + " frames at " + std::to_string(spec.fps) + " fps");
+    first = std::max(0L, long(a));
+    last = std::max(first, long(b));
     return;
   }
   first = 0;

@@ -27,7 +27,8 @@ void select_animation(const Scene& scene, const std::string& choice, SequenceSpe
 
 // The frames covering the chosen animation's key range at the frame rate: floor(start * fps) to
 // ceil(end * fps) (so the last pose is included). Without animation: frame 0 alone, or one turn
-// 0..FRAMES-1 with a turntable.
+// 0..FRAMES-1 with a turntable. Throws pmr::Error when the range exceeds kMaxAnimationFrames.
+constexpr long kMaxAnimationFrames = 1000000;
 void animation_frame_range(const Scene& scene, const SequenceSpec& spec, long& first, long& last);
 
 class FrameRenderer {

@@ -60,6 +60,7 @@ int run_sequence(const RenderOptions& o) {
   if (o.frames == "all") {
     long first = 0, last = 0;
     animation_frame_range(scene, spec, first, last);
+    if (last - first >= 10000000) throw Error("--frames all would be " + std::to_string(last - first + 1) + " frames; give a range");
     for (long f = first; f <= last; ++f) frames.push_back(f);
   }
   if (!o.shard.empty()) {

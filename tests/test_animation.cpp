@@ -84,3 +84,18 @@ TEST(Animation, MalformedSamplersAreRefused) {
 
 }  // namespace
 }  // namespace pmr
+
+// A time just below the last key that rounds to it as a float (1.2 < 1.2f) stays inside the key arrays.
+TEST(Animation, TimeJustBelowTheLastKeyStaysInRange) {
+  pmr::AnimationSampler s;
+  s.interpolation = pmr::Interpolation::Linear;
+  s.width = 1;
+  s.times = {0.0f, 1.2f};
+  s.values = {0.0f, 10.0f};
+  ASSERT_LT(1.2, double(1.2f));
+  const std::vector<float> v = pmr::sample(s, 1.2);
+  ASSERT_EQ(v.size(), 1u);
+  EXPECT_NEAR(v[0], 10.0f, 1e-5f);
+  s.interpolation = pmr::Interpolation::Step;
+  EXPECT_EQ(pmr::sample(s, 1.2)[0], 0.0f);  // still the first key's interval
+}

@@ -234,6 +234,15 @@ TEST(Displays, CliRendersForALookingGlassPanel) {
   const test::CliRun r = test::run("render --display-config " + dir + "/visual.json --view-size 42x56 --write encoded,quilt --out " + dir + "/o");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("invView = 0 ignored"), std::string::npos) << r.output;
+  // the calibration's offset reaches the encoder (not the generic -L / 2N)
+  const Display want = display_from_calibration(read_looking_glass_calibration(dir + "/visual.json", nullptr));
+  const std::string sidecar = test::read_file(dir + "/o/frame_0000.json");
+  EXPECT_NE(sidecar.find("\"offset_fraction\": \"" + to_string(want.offset) + "\""), std::string::npos) << sidecar;
+  const test::CliRun pr = test::run("render --preset lg-portrait --view-size 42x56 --out " + dir + "/p");
+  ASSERT_EQ(pr.status, 0) << pr.output;
+  EXPECT_NE(test::read_file(dir + "/p/frame_0000.json")
+                .find("\"offset_fraction\": \"" + to_string(find_display_preset("lg-portrait").display.offset) + "\""),
+            std::string::npos);
   EXPECT_TRUE(test::exists(dir + "/o/frame_0000_qs8x6a0.75.exr")) << r.output;
   const test::CliRun h = test::run("render --preset help");
   EXPECT_EQ(h.status, 0);

@@ -55,7 +55,7 @@ TEST(Shard, ExplicitSharesAreInterleaved) {
 
 TEST(Shard, EverySchedulersArrayCoversEveryFrameOnce) {
   const std::vector<long> frames = range(0, 16);  // 17 frames over 4 tasks: uneven shares
-  std::vector<Env> slurm, slurm_step, k8s, aws, sge, lsf, pbs, torque;
+  std::vector<Env> slurm, slurm_step, k8s, aws, sge, lsf, lsf5, pbs, torque;
   for (int t = 0; t < 4; ++t) {
     // Slurm --array=3-6 (first index other than 0 or 1), and --array=0-12:4 with a step
     slurm.push_back({{"SLURM_ARRAY_TASK_ID", std::to_string(3 + t)}, {"SLURM_ARRAY_TASK_MIN", "3"},
@@ -67,6 +67,7 @@ TEST(Shard, EverySchedulersArrayCoversEveryFrameOnce) {
     sge.push_back({{"SGE_TASK_ID", std::to_string(2 + 3 * t)}, {"SGE_TASK_FIRST", "2"}, {"SGE_TASK_LAST", "11"},
                    {"SGE_TASK_STEPSIZE", "3"}});
     lsf.push_back({{"LSB_JOBINDEX", std::to_string(1 + t)}, {"LSB_JOBINDEX_END", "4"}});
+    lsf5.push_back({{"LSB_JOBINDEX", std::to_string(5 + t)}, {"LSB_JOBINDEX_END", "8"}});
     pbs.push_back({{"PBS_ARRAY_INDEX", std::to_string(1 + t)}});
     torque.push_back({{"PBS_ARRAYID", std::to_string(t)}});
   }
@@ -76,6 +77,7 @@ TEST(Shard, EverySchedulersArrayCoversEveryFrameOnce) {
   expect_partition(aws, frames);
   expect_partition(sge, frames);
   expect_partition(lsf, frames);
+  expect_partition(lsf5, frames, 0, 5);  // bsub -J "r[5-8]": --shard-first 5
   expect_partition(pbs, frames, 4, 1);
   expect_partition(torque, frames, 4, 0);
   // more tasks than frames: every frame still once, some tasks idle
@@ -121,6 +123,12 @@ TEST(Verify, ReportsMissingAndBrokenFramesAsAFramesList) {
     const auto size = fs::file_size(p);
     fs::resize_file(p, size / 2);
   }
+  // a damaged but parseable sidecar (frame 1): reported, not a crash
+  std::ofstream(out + "/frame_0001.json") << R"({"frame": 1, "fps": 24, "time": 0.041666666666666664})";
+  v = test::run("verify " + out + " --frames 0:7");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frame 1: frame_0001.json was rendered with another configuration"), std::string::npos) << v.output;
+  ASSERT_EQ(test::run("render --frames 1 -q" + args).status, 0);
   // frame 6 rendered again at another fps: another configuration
   ASSERT_EQ(test::run("render --frames 6 -q --fps 30" + args).status, 0);
   v = test::run("verify " + out + " --frames 0:7");

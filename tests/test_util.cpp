@@ -8,6 +8,8 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <cstdlib>
 
 #include <memory>
@@ -132,6 +134,11 @@ std::string temp_dir(const std::string& name) {
   const std::string d = ::testing::TempDir() + "pmr_cli_" + name + "_" + std::to_string(getpid());
   std::system(("rm -rf '" + d + "'").c_str());
   return d;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 bool exists(const std::string& p) {

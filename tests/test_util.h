@@ -60,6 +60,7 @@ CliRun run(const std::string& args);
 // A fresh folder per test and process, so that two test runs on one machine cannot meet.
 std::string temp_dir(const std::string& name);
 bool exists(const std::string& path);
+std::string read_file(const std::string& path);
 size_t count_entries(const std::string& dir);  // including hidden ones
 // The error is one line starting with "pmr: error:" (warnings may precede it), exit code 1.
 void expect_one_error_line(const CliRun& r, const std::string& fragment);

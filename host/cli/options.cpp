@@ -81,6 +81,7 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
       }
       const DisplayPreset& p = find_display_preset(args[i + 1]);
       o.display = p.display;
+      o.offset_given = p.name != "paper-8k";  // a panel's offset comes from its calibration
       o.rig = p.rig;
       o.rig.angular_spacing = p.name != "paper-8k";  // Looking Glass software spaces its cameras angularly
       o.display_source = "preset " + p.name;
@@ -88,6 +89,7 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
       o.calibration = read_looking_glass_calibration(args[i + 1], &o.option_warnings);
       o.has_calibration = true;
       o.display = display_from_calibration(o.calibration);
+      o.offset_given = true;  // the calibration's center decides it
       std::string quilt;
       o.rig = rig_for_serial(o.calibration, quilt);
       o.rig.angular_spacing = true;

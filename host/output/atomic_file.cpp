@@ -44,15 +44,19 @@ AtomicFile::AtomicFile(std::string final_path) : final_path_(std::move(final_pat
   int err = 0;
   for (int attempt = 0; attempt < 100; ++attempt) {
     temp_path_ = temp_name(p);
+    slot_ = register_temp_file(temp_path_);  // before it exists: a signal in between cannot leak it
     err = create_exclusive(temp_path_);
     if (err != EEXIST) break;
+    unregister_temp_file(slot_);  // someone else's file of that name: not ours to remove
+    slot_ = -1;
   }
   if (err != 0) {
+    unregister_temp_file(slot_);
+    slot_ = -1;
     const std::string reason = std::strerror(err);
     temp_path_.clear();
     throw Error("cannot write " + final_path_ + ": cannot create a file in its folder: " + reason);
   }
-  slot_ = register_temp_file(temp_path_);
 }
 
 AtomicFile::~AtomicFile() {

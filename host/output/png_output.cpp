@@ -41,16 +41,15 @@ uint8_t to_byte(double v) { return uint8_t(std::lround(std::min(1.0, std::max(0.
 void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half) {
   if (width < 1 || height < 1 || !rgba_half) throw Error("cannot write " + path + ": empty image");
   // sRGB lookup for every half value: the curve is applied once per distinct input, not per pixel
-  static uint8_t lut[65536];
-  static bool lut_ready = false;
-  if (!lut_ready) {
+  static const std::vector<uint8_t> lut = [] {  // thread-safe initialization
+    std::vector<uint8_t> t(65536);
     for (uint32_t h = 0; h < 65536; ++h) {
       half v;
       v.setBits(uint16_t(h));
-      lut[h] = to_byte(srgb_encode(double(float(v))));
+      t[h] = to_byte(srgb_encode(double(float(v))));
     }
-    lut_ready = true;
-  }
+    return t;
+  }();
   AtomicFile file(path);
   FILE* f = std::fopen(file.temp_path().c_str(), "wb");
   if (!f) throw Error("cannot write " + path + ": " + std::strerror(errno));

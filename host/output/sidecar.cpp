@@ -198,21 +198,24 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   } catch (const std::exception&) {
     return "unreadable";
   }
-  if (!a.is_object()) return "unreadable";
-  for (const char* key : {"format", "scene", "method", "tile", "camera", "display", "fps", "animation"})
-    if (!a.contains(key) || a[key] != b[key]) return key;
+  if (!a.is_object() || !b.is_object()) return "unreadable";
+  // a member of either side, null when absent (so a damaged sidecar compares unequal, never crashes)
+  auto get = [](const json& o, const char* key) { return o.is_object() && o.contains(key) ? o[key] : json(); };
+  for (const char* key : {"format", "scene", "method", "tile", "camera", "display", "fps", "animation", "depth_channel"})
+    if (!a.contains(key) || get(a, key) != get(b, key)) return key;
   // the turntable without this frame's angle
   auto turn = [](json t) {
     if (t.is_object()) t.erase("angle_deg");
     return t;
   };
-  if (!a.contains("turntable") || turn(a["turntable"]) != turn(b["turntable"])) return "turntable";
+  if (!a.contains("turntable") || turn(get(a, "turntable")) != turn(get(b, "turntable"))) return "turntable";
   // the rig as configured (an animated camera moves the focal plane from frame to frame)
-  if (!a.contains("rig") || !a["rig"].is_object()) return "rig";
-  for (const char* key : {"views", "view_width", "view_height", "cone_deg", "yfov_deg", "aspect"})
-    if (!a["rig"].contains(key) || a["rig"][key] != b["rig"][key]) return std::string("rig.") + key;
+  const json ra = get(a, "rig"), rb = get(b, "rig");
+  if (!ra.is_object()) return "rig";
+  for (const char* key : {"views", "view_width", "view_height", "cone_deg", "yfov_deg", "aspect", "camera_spacing"})
+    if (!ra.contains(key) || get(ra, key) != get(rb, key)) return std::string("rig.") + key;
   // the framing (it follows from the scene file's content and the animation)
-  if (!a.contains("scene_bounds") || a["scene_bounds"] != b["scene_bounds"]) return "scene_bounds";
+  if (!a.contains("scene_bounds") || get(a, "scene_bounds") != get(b, "scene_bounds")) return "scene_bounds";
   return "";
 }
 

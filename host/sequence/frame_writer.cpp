@@ -148,10 +148,12 @@ void FrameWriter::write(FrameFiles& f) {
       throw Abandoned{};
     }
   };
-  auto done = [&](const std::string& path) {
-    committed.push_back(path);
-    slots.push_back(register_temp_file(path));
-  };
+  // Every final path of the frame is registered before its file is written: a second signal between a
+  // rename and its registration would otherwise leave that file behind.
+  for (const std::string* p : {&f.sidecar_path, &f.encoded_path, &f.views_path, &f.quilt_path, &f.encoded_png,
+                               &f.center_png, &f.quilt_png})
+    if (!p->empty()) slots.push_back(register_temp_file(*p));
+  auto done = [&](const std::string& path) { committed.push_back(path); };
   try {
     check();
     write_text_file(f.sidecar_path, f.sidecar_text);

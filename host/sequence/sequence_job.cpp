@@ -61,6 +61,8 @@ int run_sequence(const RenderOptions& o) {
     long first = 0, last = 0;
     animation_frame_range(scene, spec, first, last);
     if (last - first >= 10000000) throw Error("--frames all would be " + std::to_string(last - first + 1) + " frames; give a range");
+    if (last > kMaxFrame)
+      throw Error("--frames all would reach frame " + std::to_string(last) + ", beyond " + std::to_string(kMaxFrame));
     for (long f = first; f <= last; ++f) frames.push_back(f);
   }
   if (!o.shard.empty()) {
@@ -240,7 +242,7 @@ int run_sequence(const RenderOptions& o) {
   }
   progress.close();
   const long written = writer.frames_written();
-  if (const int sig = interrupt_signal()) {
+  if (const int sig = interrupt_signal(); sig && written < total) {
     std::fprintf(stderr, "pmr: interrupted by %s: %ld of %ld frame(s) written (%ld already complete); nothing partial "
                  "was left: rerun with --resume to finish\n",
                  sig == SIGTERM ? "SIGTERM" : "SIGINT", written, total, skipped);

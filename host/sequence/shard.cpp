@@ -106,7 +106,10 @@ Shard parse_shard(const std::string& text, long shard_count, long shard_first, c
     const long step = env_long(env, "LSB_JOBINDEX_STEP", hs);
     if (!h2) throw Error(src + ": LSB_JOBINDEX_END is not set");
     const long st = hs ? step : 1;
-    return with_count(position(lsf, 1, st, src), (end - 1) / st + 1, true, src);
+    // LSF does not tell where the array starts: 1 unless --shard-first says otherwise ("r[5-20]")
+    const long first = shard_first > 0 ? shard_first : 1;
+    return with_count(position(lsf, first, st, src + " (first index " + std::to_string(first) + ")"),
+                      (end - first) / st + 1, true, src);
   }
   // PBS Pro (PBS_ARRAY_INDEX) / Torque (PBS_ARRAYID): neither tells the range
   for (const char* name : {"PBS_ARRAY_INDEX", "PBS_ARRAYID"}) {

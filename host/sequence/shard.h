@@ -22,7 +22,7 @@ using Environment = std::function<const char*(const char*)>;
 // Kubernetes Indexed Jobs, AWS Batch, PBS Pro / Torque, SGE / UGE, LSF). shard_count (> 0 when given
 // by --shard-count) supplies the count where the environment has none (Kubernetes, PBS) and must
 // agree with it elsewhere; shard_first (--shard-first) is the first array index where the environment
-// does not say it (PBS, default 0). Throws pmr::Error with one line when nothing fits.
+// does not say it (PBS: default 0; LSF: default 1). Throws pmr::Error with one line when nothing fits.
 Shard parse_shard(const std::string& text, long shard_count, long shard_first, const Environment& env);
 
 // The frames of `frames` (in their order) that belong to the shard.

@@ -22,8 +22,8 @@ struct LookingGlassCalibration {
 };
 
 // Reads and checks a visual.json: one clear pmr::Error naming the file and the field on anything
-// missing, non-numeric or absurd (zero DPI or slope, NaN, non-positive or huge screen size), and on
-// (subpixelCells with CellPatternMode are read for the gen3 panels).
+// missing, non-numeric or absurd (zero DPI or slope, NaN, non-positive or huge screen size, malformed
+// subpixelCells or CellPatternMode, which gen3 panels carry).
 // `warnings` receives what is read but ignored (invView = 0, flipImageY, fringe, verticalAngle).
 LookingGlassCalibration read_looking_glass_calibration(const std::string& path, std::vector<std::string>* warnings);
 

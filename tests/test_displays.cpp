@@ -23,7 +23,8 @@ namespace fs = std::filesystem;
 // The shader, written from its GLSL (not from the encoder's derivation): for display pixel (px, py),
 // py from the top, and output channel c, the view index it picks with filter_mode 0. Returns -1 where
 // (1 - fract) * N lies within 1e-9 of a whole number (a tie that float evaluation cannot settle).
-int shader_view(const LookingGlassCalibration& cal, int views, int px, int py, int c) {
+// The shader's phase for output channel c of display pixel (px, py), py from the top.
+long double shader_phase(const LookingGlassCalibration& cal, int px, int py, int c) {
   const double W = cal.screen_w, H = cal.screen_h;
   // LookingGlassConfig.ts, in double
   const double pitch = cal.pitch * W / cal.dpi * std::cos(std::atan(1.0 / cal.slope));
@@ -31,28 +32,39 @@ int shader_view(const LookingGlassCalibration& cal, int views, int px, int py, i
   const long double subp = 1.0L / (W * 3.0L) * (cal.flip_x ? -1 : 1);
   // the fragment's texture coordinate: texel center, v from the bottom
   const long double u = (px + 0.5L) / W, v = (H - 1 - py + 0.5L) / H;
-  // BGR panels: red takes the phase of subpixel offset 2 and blue of offset 0 (ri, bi = 2, 0)
-  long double phase;
   if (cal.cells.empty()) {
+    // BGR panels: red takes the phase of subpixel offset 2 and blue of offset 0 (ri, bi = 2, 0)
     const int offset = cal.flip_subp ? 2 - c : c;
-    phase = (u + offset * subp + v * (long double)tilt) * (long double)pitch - cal.center;
-  } else {  // GetCellForPixel and GetSubpixelViews with subpixel cells (pattern from the calibration)
-    const int x = px, y = cal.screen_h - 1 - py;
-    int cell = 0;
-    switch (cal.cell_pattern) {
-      case 1: cell = ((y % 2 == 0 && x % 2 == 0) || (y % 2 != 0 && x % 2 != 0)) ? 0 : 1; break;
-      case 2: cell = x % 2; break;
-      case 3: cell = (y + (x % 2) * 2) % 4; break;
-      case 4: cell = y % 2; break;
-      default: cell = 0;
-    }
-    const std::array<double, 6>& off = cal.cells[size_t(cell) % cal.cells.size()];
-    const long double du = off[size_t(2 * c)] / W, dv = off[size_t(2 * c + 1)] / H;
-    phase = ((u + du) + (v + dv) * (long double)tilt) * (long double)pitch - cal.center;
+    return (u + offset * subp + v * (long double)tilt) * (long double)pitch - cal.center;
   }
+  // GetCellForPixel and GetSubpixelViews with subpixel cells (pattern from the calibration)
+  const int x = px, y = cal.screen_h - 1 - py;
+  int cell = 0;
+  switch (cal.cell_pattern) {
+    case 1: cell = ((y % 2 == 0 && x % 2 == 0) || (y % 2 != 0 && x % 2 != 0)) ? 0 : 1; break;
+    case 2: cell = x % 2; break;
+    case 3: cell = (y + (x % 2) * 2) % 4; break;
+    case 4: cell = y % 2; break;
+    default: cell = 0;
+  }
+  const std::array<double, 6>& off = cal.cells[size_t(cell) % cal.cells.size()];
+  const long double du = off[size_t(2 * c)] / W, dv = off[size_t(2 * c + 1)] / H;
+  return ((u + du) + (v + dv) * (long double)tilt) * (long double)pitch - cal.center;
+}
+
+// The shader's continuous view coordinate a N, a = 1 - fract(phase) clamped as the shader clamps it.
+long double shader_view_coordinate(const LookingGlassCalibration& cal, int views, int px, int py, int c) {
+  const long double phase = shader_phase(cal, px, py, c);
   long double a = 1.0L - (phase - std::floor(phase));
   a = std::min(std::max(a, 0.00001L), 0.999999L);
-  const long double z = a * views;
+  return a * views;
+}
+
+// The shader, written from its GLSL (not from the encoder's derivation): the view index it picks with
+// filter_mode 0 for display pixel (px, py), py from the top, and output channel c. Returns -1 where
+// (1 - fract) * N lies within 1e-9 of a whole number (a tie that float evaluation cannot settle).
+int shader_view(const LookingGlassCalibration& cal, int views, int px, int py, int c) {
+  const long double z = shader_view_coordinate(cal, views, px, py, c);
   if (std::fabs(z - std::round(z)) < 1e-9L) return -1;
   return int(std::floor(z));
 }
@@ -150,14 +162,7 @@ TEST(Displays, BlendedViewsFollowTheContinuousPhase) {
       for (int c = 0; c < 3; ++c) {
         const int v = shader_view(cal, views, px, py, c);
         if (v < 0) continue;
-        // the shader's continuous coordinate, recomputed as in shader_view
-        const double W = cal.screen_w, H = cal.screen_h;
-        const double pitch = cal.pitch * W / cal.dpi * std::cos(std::atan(1.0 / cal.slope));
-        const double tilt = H / (W * cal.slope);
-        const long double u = (px + 0.5L) / W, vv = (H - 1 - py + 0.5L) / H;
-        const int offset = cal.flip_subp ? 2 - c : c;
-        const long double phase = (u + offset / (3.0L * W) + vv * (long double)tilt) * (long double)pitch - cal.center;
-        const long double z = (1.0L - (phase - std::floor(phase))) * views;
+        const long double z = shader_view_coordinate(cal, views, px, py, c);
         half h;
         h.setBits(enc[(size_t(py) * d.width + px) * 4 + size_t(c)]);
         const double want = v == views - 1 ? double(views - 1) : double(z);

@@ -162,32 +162,31 @@ TEST(Encode, ParsesCalibrationPrecisionExactly) {
   EXPECT_THROW(parse_rational("1e", "x"), Error);
 }
 
+// A real Looking Glass Portrait's calibration in DESIGN terms, on a panel of the given size.
+Display portrait_calibration(int width, int height) {
+  Display d;
+  d.width = width, d.height = height;
+  d.lens_pitch = parse_rational("18.6578963681", "L");
+  d.tan_slant = parse_rational("-0.138666843675", "T");
+  d.offset = parse_rational("18.1706630397", "O");
+  return d;
+}
+
 // The view of every subpixel from the host tables (the kernels' formula) for a real Looking Glass
 // Portrait calibration in DESIGN terms, on the whole 1536 x 2048 panel, against an independent long
 // double evaluation of floor(frac(t) N): they must agree wherever N t is not within 1e-9 of an integer
 // (long double carries ~19 digits; N t < 10^5). Rounding the calibration to 4 significant digits
 // instead moves a large part of the subpixels to another view: the reason for exactness.
 TEST(Encode, RealCalibrationIsExactOnTheWholePanel) {
-  Display d;
-  d.width = 1536, d.height = 2048;
-  d.lens_pitch = parse_rational("18.6578963681", "L");
-  d.tan_slant = parse_rational("-0.138666843675", "T");
-  d.offset = parse_rational("18.1706630397", "O");
+  const Display d = portrait_calibration(1536, 2048);
   const int views = 48;
-  const PmrEncodeParams p = make_encode_params(d, views, 420, 560);
-  std::vector<PmrEncodeColumn> cols;
-  std::vector<PmrEncodeRow> rows;
-  make_encode_tables(d, p, cols, rows);
+  const std::vector<int> table = test::table_view_indices(d, views);
   const long double L = 18.6578963681L, T = -0.138666843675L, O = 18.1706630397L;
   const long double L4 = 18.66L, T4 = -0.1387L, O4 = 18.17L;
   size_t ambiguous = 0, rounded_wrong = 0, total = 0;
   for (int i = 0; i < d.height; ++i)
     for (int s = 0; s < 3 * d.width; ++s) {
-      const PmrEncodeColumn& c = cols[size_t(s)];
-      const PmrEncodeRow& r = rows[size_t(i)];
-      int v = c.a_mod_n - r.q_mod_n - (c.b < r.s ? 1 : 0);
-      if (v < 0) v += views;
-      if (v < 0) v += views;
+      const int v = table[size_t(i) * 3 * d.width + size_t(s)];
       const long double nt = views * (s - 3.0L * i * T - O) / L;
       const long double f = nt - views * std::floor(nt / views);
       const long double near = std::abs(f - std::round(f));
@@ -208,21 +207,13 @@ TEST(Encode, RealCalibrationIsExactOnTheWholePanel) {
   // the direct wide evaluation agrees on a sample of subpixels
   for (int i = 0; i < d.height; i += 97)
     for (int j = 0; j < d.width; j += 31)
-      for (int k = 0; k < 3; ++k) {
-        const PmrEncodeColumn& c = cols[size_t(3 * j + k)];
-        int v = c.a_mod_n - rows[size_t(i)].q_mod_n - (c.b < rows[size_t(i)].s ? 1 : 0);
-        v = (v + 2 * views) % views;
-        ASSERT_EQ(encode_view_index(d, views, j, i, k), v) << j << "," << i << "," << k;
-      }
+      for (int k = 0; k < 3; ++k)
+        ASSERT_EQ(encode_view_index(d, views, j, i, k), table[(size_t(i) * d.width + size_t(j)) * 3 + size_t(k)])
+            << j << "," << i << "," << k;
 }
 
 TEST(Encode, KernelMatchesDirectEvaluationPortraitCalibration) {
-  Display d;
-  d.width = 384, d.height = 256;  // a real Portrait calibration on a smaller panel
-  d.lens_pitch = parse_rational("18.6578963681", "L");
-  d.tan_slant = parse_rational("-0.138666843675", "T");
-  d.offset = parse_rational("18.1706630397", "O");
-  check_encoder(d, 48, 42, 56);
+  check_encoder(portrait_calibration(384, 256), 48, 42, 56);  // on a smaller panel
 }
 
 TEST(Encode, KernelMatchesDirectEvaluationPaperParameters) {

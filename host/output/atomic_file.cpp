@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <system_error>
 
 #include "output/interrupt.h"
@@ -72,6 +73,17 @@ void AtomicFile::commit() {
   committed_ = true;
   unregister_temp_file(slot_);
   slot_ = -1;
+}
+
+void write_text_atomic(const std::string& path, const std::string& text) {
+  AtomicFile file(path);
+  {
+    std::ofstream out(file.temp_path(), std::ios::binary | std::ios::trunc);
+    if (out) out.write(text.data(), std::streamsize(text.size()));
+    if (out) out.close();
+    if (!out) throw Error("cannot write " + path + ": " + std::strerror(errno));
+  }
+  file.commit();
 }
 
 void prepare_output_dir(const std::string& dir) {

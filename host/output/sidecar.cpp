@@ -1,7 +1,4 @@
 // The per-frame JSON sidecar (DESIGN section 6): everything needed to reproduce or check a frame.
-#include <cerrno>
-#include <cstring>
-#include <fstream>
 
 #include <glm/gtc/constants.hpp>
 #include <nlohmann/json.hpp>
@@ -228,14 +225,7 @@ void write_sidecar(const std::string& path, const Rig& rig, const Display& displ
   } catch (const std::exception& e) {  // e.g. nlohmann::json::type_error on a name that is not UTF-8
     throw Error("cannot write " + path + ": " + e.what());
   }
-  AtomicFile file(path);
-  {
-    std::ofstream out(file.temp_path(), std::ios::binary | std::ios::trunc);
-    if (out) out.write(text.data(), std::streamsize(text.size()));
-    if (out) out.close();
-    if (!out) throw Error("cannot write " + path + ": " + std::strerror(errno));
-  }
-  file.commit();
+  write_text_atomic(path, text);
 }
 
 }  // namespace pmr

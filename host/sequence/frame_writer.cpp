@@ -7,7 +7,6 @@
 #include <cstring>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 
 #include "output/interrupt.h"
 #include "pmr/error.h"
@@ -15,17 +14,6 @@
 namespace pmr {
 
 namespace {
-
-void write_text_file(const std::string& path, const std::string& text) {
-  AtomicFile file(path);
-  {
-    std::ofstream out(file.temp_path(), std::ios::binary | std::ios::trunc);
-    if (out) out.write(text.data(), std::streamsize(text.size()));
-    if (out) out.close();
-    if (!out) throw Error("cannot write " + path + ": " + std::strerror(errno) + " (disk full?)");
-  }
-  file.commit();
-}
 
 uint64_t file_size(const std::string& path) {
   std::error_code ec;
@@ -156,7 +144,7 @@ void FrameWriter::write(FrameFiles& f) {
   auto done = [&](const std::string& path) { committed.push_back(path); };
   try {
     check();
-    write_text_file(f.sidecar_path, f.sidecar_text);
+    write_text_atomic(f.sidecar_path, f.sidecar_text);
     done(f.sidecar_path);
     if (!f.encoded_path.empty()) {
       check();

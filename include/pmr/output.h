@@ -46,6 +46,10 @@ class AtomicFile {
   int slot_ = -1;  // registration with the interrupt handler (output/interrupt.h)
 };
 
+// Writes `text` to `path` through an AtomicFile. Throws pmr::Error naming the file (and the reason:
+// a full disk shows here) on failure.
+void write_text_atomic(const std::string& path, const std::string& text);
+
 // Half RGBA EXR (scanline, one part), row 0 at the top (data window (0,0)-(width-1,height-1)).
 // rgba_half: width*height*4 uint16 (IEEE half bits), row-major, RGBA, read in place (no copy).
 // threads > 0 sets OpenEXR's global thread count used for compression (Imf::setGlobalThreadCount).

@@ -1,8 +1,9 @@
 /* Stage 3, tile raster: one work-item per MTA bins it into the 3D tiles (PMR_TILE_X x PMR_TILE_Y
  * pixels x PMR_TILE_V views) it may cover. Per view slab it takes the MTA's exact bounding box over
  * those views, then tests every tile of the box with the 8-corner test: the edge functions are
- * multilinear in (x, y, view), so their maximum over a box of voxel centers is at one of its 8
- * corners, and a tile is rejected exactly when some edge fails at all 8 (found with two evaluations,
+ * multilinear in (x, y, view), so their maximum over a box of samples (voxel centers, or with
+ * --sampling subpixel every point of the tile's pixels) is at one of its 8 corners, and a tile is
+ * rejected exactly when some edge fails at all 8 (found with two evaluations,
  * see edge_may_pass).
  *
  * The queues are built in two passes that enumerate identically: bin_count counts entries per tile,
@@ -38,7 +39,7 @@ inline void x_extent(const PmrMta* m, int i, long* lo, long* hi) {
   *hi = max3l(xa, xb, xc);
 }
 
-/* The MTA's x extent in view i reaches the pixel-center range [X0, X1]. */
+/* The MTA's x extent in view i reaches the sample range [X0, X1]. */
 inline bool in_view(const PmrMta* m, int i, long X0, long X1) {
   long lo, hi;
   x_extent(m, i, &lo, &hi);
@@ -58,17 +59,21 @@ inline bool in_view(const PmrMta* m, int i, long X0, long X1) {
     const long xlo = min(lo0, lo1), xhi = max(hi0, hi1);                                             \
     const bool sheared = (xhi - xlo) - (hi0 - lo0) > (long)PMR_TILE_X * PMR_X_ONE;                   \
     const long ylo = min3l((m).y[0], (m).y[1], (m).y[2]), yhi = max3l((m).y[0], (m).y[1], (m).y[2]); \
-    /* pixels whose centers lie inside the box */                                                   \
-    const int px0 = (int)max(0L, -floor_div_l(PMR_HALF_X - xlo, PMR_X_ONE));                        \
-    const int px1 = (int)min((long)(P)->view_w - 1, floor_div_l(xhi - PMR_HALF_X, PMR_X_ONE));      \
-    const int py0 = (int)max(0L, -floor_div_l(PMR_HALF_Y - ylo, PMR_Y_ONE));                        \
-    const int py1 = (int)min((long)(P)->view_h - 1, floor_div_l(yhi - PMR_HALF_Y, PMR_Y_ONE));      \
+    /* a pixel's samples lie in [X + slo_x, X + shi_x] x [Y + slo_y, Y + shi_y] (X, Y its corner): its \
+     * center, or the whole pixel with --sampling subpixel; the pixels whose samples meet the box */  \
+    const bool whole = (P)->sample_area == PMR_SAMPLES_PIXEL;                                        \
+    const long slo_x = whole ? 0 : PMR_HALF_X, shi_x = whole ? PMR_X_ONE - 1 : PMR_HALF_X;           \
+    const long slo_y = whole ? 0 : PMR_HALF_Y, shi_y = whole ? PMR_Y_ONE - 1 : PMR_HALF_Y;           \
+    const int px0 = (int)max(0L, -floor_div_l(shi_x - xlo, PMR_X_ONE));                             \
+    const int px1 = (int)min((long)(P)->view_w - 1, floor_div_l(xhi - slo_x, PMR_X_ONE));           \
+    const int py0 = (int)max(0L, -floor_div_l(shi_y - ylo, PMR_Y_ONE));                             \
+    const int py1 = (int)min((long)(P)->view_h - 1, floor_div_l(yhi - slo_y, PMR_Y_ONE));           \
     for (int ty = py0 / PMR_TILE_Y; py0 <= py1 && ty <= py1 / PMR_TILE_Y; ++ty) {                  \
-      const long Y0 = (long)max(py0, ty * PMR_TILE_Y) * PMR_Y_ONE + PMR_HALF_Y;                      \
-      const long Y1 = (long)min(py1, ty * PMR_TILE_Y + PMR_TILE_Y - 1) * PMR_Y_ONE + PMR_HALF_Y;     \
+      const long Y0 = (long)max(py0, ty * PMR_TILE_Y) * PMR_Y_ONE + slo_y;                           \
+      const long Y1 = (long)min(py1, ty * PMR_TILE_Y + PMR_TILE_Y - 1) * PMR_Y_ONE + shi_y;          \
       for (int tx = px0 / PMR_TILE_X; px0 <= px1 && tx <= px1 / PMR_TILE_X; ++tx) {                \
-        const long X0 = (long)max(px0, tx * PMR_TILE_X) * PMR_X_ONE + PMR_HALF_X;                    \
-        const long X1 = (long)min(px1, tx * PMR_TILE_X + PMR_TILE_X - 1) * PMR_X_ONE + PMR_HALF_X;   \
+        const long X0 = (long)max(px0, tx * PMR_TILE_X) * PMR_X_ONE + slo_x;                         \
+        const long X1 = (long)min(px1, tx * PMR_TILE_X + PMR_TILE_X - 1) * PMR_X_ONE + shi_x;        \
         bool in_some_view = !sheared;                                                                \
         for (int i = i0; i <= i1 && !in_some_view; ++i)                                              \
           in_some_view = in_view(&(m), i, X0, X1);                                                   \

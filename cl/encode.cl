@@ -22,12 +22,6 @@ inline float4 sample_bilinear(global const PmrEncodeParams* E, global const half
 }
 
 /* The column table of row i: with subpixel cells one block per row class (PmrEncodeParams). */
-inline global const PmrEncodeColumn* row_columns(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
-                                                 int i) {
-  const int cls = E->cell_rows > 1 ? (E->display_h - 1 - i) % E->cell_rows : 0;
-  return columns + (size_t)cls * 3 * (size_t)E->display_w;
-}
-
 /* Nearest sampling copies the colour's half bits: PoCL converts halves in software, and the
  * conversions would dominate the stage. Separate kernels for nearest and bilinear sampling, because
  * a branch between them would be flattened when the kernel is vectorized across work-items. */

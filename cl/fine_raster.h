@@ -187,15 +187,10 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
   }
 }
 
-/* Lit colour of the winning MTA `id` at voxel (px, py, view): barycentrics from its exact edge
- * functions there. */
+/* Lit colour of the winning MTA `id` at voxel (px, py, view), sampled at the pixel center. */
 inline float4 fine_shade_winner(const ShadeInputs* in, global const PmrMta* mtas, uint id, float3 light, int px,
                                 int py, int view) {
-  const PmrMta m = mtas[id];
-  const long X = (long)px * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
-  const long e[3] = {m.sign * mta_edge(&m, 1, 2, X, Y, view), m.sign * mta_edge(&m, 2, 0, X, Y, view),
-                     m.sign * mta_edge(&m, 0, 1, X, Y, view)};
-  return shade(in, light, m.tri, source_barycentrics(&m, e), (m.flags & PMR_MTA_BACK) != 0);
+  return shade_mta_at(in, mtas, id, light, (long)px * PMR_X_ONE + PMR_HALF_X, (long)py * PMR_Y_ONE + PMR_HALF_Y, view);
 }
 
 /* Initial visibility state: nothing drawn. */

@@ -95,4 +95,14 @@ inline float4 shade(const ShadeInputs* in, float3 light, uint tri, float3 b, boo
   return (float4)(c.x * lambert, c.y * lambert, c.z * lambert, 1.0f);
 }
 
+/* Lit colour of MTA `id` at raster point (X, Y) (16.16 / 24.8) of view `view`: barycentrics from its
+ * exact edge functions there. */
+inline float4 shade_mta_at(const ShadeInputs* in, global const PmrMta* mtas, uint id, float3 light, long X, long Y,
+                           int view) {
+  const PmrMta m = mtas[id];
+  const long e[3] = {m.sign * mta_edge(&m, 1, 2, X, Y, view), m.sign * mta_edge(&m, 2, 0, X, Y, view),
+                     m.sign * mta_edge(&m, 0, 1, X, Y, view)};
+  return shade(in, light, m.tri, source_barycentrics(&m, e), (m.flags & PMR_MTA_BACK) != 0);
+}
+
 #endif

@@ -200,7 +200,8 @@ std::vector<int> table_view_indices(const Display& display, int views) {
   std::vector<int> out(size_t(display.width) * display.height * 3);
   for (int i = 0; i < display.height; ++i)
     for (int s = 0; s < 3 * display.width; ++s) {
-      const PmrEncodeColumn& c = cols[size_t(s)];
+      const int cls = p.cell_rows > 1 ? (display.height - 1 - i) % p.cell_rows : 0;
+      const PmrEncodeColumn& c = cols[size_t(cls) * 3 * display.width + size_t(s)];
       const PmrEncodeRow& r = rows[size_t(i)];
       int v = c.a_mod_n - r.q_mod_n - (c.b < r.s ? 1 : 0);
       v = (v + 2 * views) % views;

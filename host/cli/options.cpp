@@ -186,6 +186,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     else if (a == "--quiet" || a == "-q") o.quiet = true;
     else if (a == "--verbose" || a == "-v") o.verbose = true;
     else if (a == "--method") o.pipeline.method = parse_method(value()), o.method_given = true;
+    else if (a == "--sampling") o.pipeline.sampling = parse_sampling(value());
     else if (a == "--camera-spacing") {
       const std::string v = value();
       if (v != "linear" && v != "angular") throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
@@ -229,6 +230,8 @@ std::string frame_stem(const std::string& pattern, long frame) {
 }
 
 void finalize_render_options(RenderOptions& o) {
+  if (o.rig.angular_spacing && o.pipeline.sampling == Sampling::Subpixel)
+    throw Error("--sampling subpixel rasterizes with PMR, which needs evenly spaced views: add --camera-spacing linear");
   if (o.rig.angular_spacing && !o.method_given) {
     // PMR needs evenly spaced views; one conventional pass per view takes any spacing
     o.pipeline.method = Method::Multipass;
@@ -315,6 +318,9 @@ std::string render_help() {
          "  --tile XxYxV           3D tile of the tile/fine raster, voxels over x, y, view (default 16x2x16)\n"
          "  --method M             pmr (default), multipass (one conventional pass per view) or duplicate\n"
          "                         (every triangle copied per view into a 2D-tiled view atlas)\n"
+         "  --sampling S           view (default): the views rendered on their grids, each subpixel reading\n"
+         "                         its view's nearest pixel; subpixel: every display subpixel rasterized at\n"
+         "                         its own sample in its own view (docs/SAMPLING.md)\n"
          "  --verbose              per-stage device times and queue sizes\n"
          "Environment: PMR_DEVICE=substring selects the OpenCL device by name (default: first CPU device).\n";
 }

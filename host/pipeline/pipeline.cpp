@@ -1,5 +1,7 @@
 #include "pipeline/pipeline.h"
 
+#include "pipeline/tile_tables.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -81,6 +83,15 @@ struct Pipeline::Impl {
   bool fused = false;
   ClBuffer column_start, column_soa, row_start, straddle_slot, straddle_columns, straddle_cov;
   uint32_t straddle_slots = 0;
+  // --sampling subpixel (cl/fine_subpixel.cl), built per view count; shares the straddle buffers
+  cl_program subpixel_program = nullptr;
+  int subpixel_views = 0;
+  ClKernel k_fine_subpixel, k_subpixel_straddle;
+  bool subpixel = false, keep_volume = true;
+  bool subpixel_debug = false;  // debug outputs per display subpixel (when no view volume is rendered)
+  ClBuffer chunks;
+  uint32_t num_chunks = 0;
+  size_t debug_entries = 1;
   uint32_t last_mtas = 0;
   uint64_t num_tiles = 0;
 
@@ -94,11 +105,17 @@ struct Pipeline::Impl {
   void fine_stage(Events& ev);
   void encode_stage(Events& ev);
   void fused_stage(const PmrParams& P, Events& ev);
+  void subpixel_stage(Events& ev);
+  void straddle_alpha_stage(ClKernel& k, Events& ev);
   void configure_fused(const std::string& options, int views, int tile_x, const std::vector<PmrEncodeColumn>& columns,
                        const std::vector<PmrEncodeRow>& rows);
+  void configure_subpixel(const std::string& options, int views, const int* tile,
+                          const std::vector<PmrEncodeColumn>& columns, const std::vector<PmrEncodeRow>& rows);
+  void upload_straddles(const TileOwnership& own);
   ~Impl() {
     if (program) clReleaseProgram(program);
     if (fused_program) clReleaseProgram(fused_program);
+    if (subpixel_program) clReleaseProgram(subpixel_program);
   }
 };
 
@@ -116,6 +133,14 @@ const char* to_string(Method m) {
     default: return "pmr";
   }
 }
+
+Sampling parse_sampling(const std::string& name) {
+  if (name == "view") return Sampling::View;
+  if (name == "subpixel") return Sampling::Subpixel;
+  throw Error("unknown sampling '" + name + "' (expected view or subpixel)");
+}
+
+const char* to_string(Sampling s) { return s == Sampling::Subpixel ? "subpixel" : "view"; }
 
 Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
     : impl_(new Impl(runtime)), config_(config) {
@@ -235,25 +260,39 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   m.num_tiles = uint64_t(tiles_x_) * tiles_y_ * tiles_v_;
   if (m.num_tiles >= (uint64_t(1) << 32)) throw Error("too many tiles; use larger --tile");
   m.encode = display != nullptr;
+  m.subpixel = config_.sampling == Sampling::Subpixel;
+  if (m.subpixel) {
+    if (!display) throw Error("--sampling subpixel samples a display's subpixels: it needs a display");
+    if (config_.method != Method::Pmr) throw Error("--sampling subpixel renders with --method pmr");
+    if (display->bilinear || display->blend_views)
+      throw Error("--sampling subpixel computes every subpixel at its own sample: --bilinear and --blend-views "
+                  "apply to --sampling view only");
+  }
   const int lanes = fine_lanes(tile_[0]);
   const size_t fused_private = size_t(tile_[0] + lanes - 1) / lanes * lanes * tile_[1] * rig.views * 20;
-  m.fused = config_.fuse_encode && display && !display->bilinear && !display->blend_views && display->cell_rows <= 1 && config_.method == Method::Pmr &&
-            !config_.debug_outputs && fused_private <= kFusedPrivateBudget;
+  m.fused = !m.subpixel && config_.fuse_encode && display && !display->bilinear && !display->blend_views &&
+            display->cell_rows <= 1 && config_.method == Method::Pmr && !config_.debug_outputs &&
+            fused_private <= kFusedPrivateBudget;
+  m.keep_volume = !m.fused && !(m.subpixel && config_.fuse_encode);
+  m.subpixel_debug = m.subpixel && !m.keep_volume && config_.debug_outputs;
   if (display) {
     m.encode_params = make_encode_params(*display, rig.views, rig.view_w, rig.view_h);
     std::vector<PmrEncodeColumn> columns;
     std::vector<PmrEncodeRow> rows;
     make_encode_tables(*display, m.encode_params, columns, rows);
     if (m.fused) m.configure_fused(build_options_, rig.views, tile_[0], columns, rows);
+    if (m.subpixel) m.configure_subpixel(build_options_, rig.views, tile_, columns, rows);
     m.encode_columns = rt.buffer(bytes_of(columns), "encoder columns", CL_MEM_READ_ONLY);
     rt.write(m.encode_columns, columns.data(), bytes_of(columns));
     m.encode_rows = rt.buffer(bytes_of(rows), "encoder rows", CL_MEM_READ_ONLY);
     rt.write(m.encode_rows, rows.data(), bytes_of(rows));
   }
 
-  const size_t vol = m.fused ? 0 : volume_bytes();
+  const size_t vol = m.keep_volume ? volume_bytes() : 0;
   const size_t disp = display_bytes();
-  const size_t dbg = config_.debug_outputs ? size_t(rig.views) * rig.view_w * rig.view_h * 12 : 0;
+  const size_t voxels = size_t(rig.views) * rig.view_w * rig.view_h;
+  m.debug_entries = !config_.debug_outputs ? 1 : m.keep_volume ? voxels : size_t(3) * display->width * display->height;
+  const size_t dbg = config_.debug_outputs ? m.debug_entries * 12 : 0;
   if (vol + disp + dbg > rt.global_mem_bytes())
     throw Error("the view volume (" + std::to_string(vol >> 20) + " MiB) and display image (" +
                 std::to_string(disp >> 20) + " MiB) do not fit in the device's memory (" +
@@ -263,11 +302,9 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   m.tile_counts = rt.buffer(size_t(m.num_tiles + 1) * sizeof(uint32_t), "tile counters");
   rt.fill_zero(m.tile_counts);
   m.tile_offsets = rt.buffer(size_t(m.num_tiles + 1) * sizeof(uint32_t), "tile offsets");
-  const size_t voxels = size_t(rig.views) * rig.view_w * rig.view_h;
-  const size_t dbg_n = config_.debug_outputs ? voxels : 1;
-  m.dbg_key = rt.buffer(dbg_n * 4, "debug keys");
-  m.dbg_depth = rt.buffer(dbg_n * 4, "debug depth");
-  m.dbg_count = rt.buffer(dbg_n * 4, "debug counts");
+  m.dbg_key = rt.buffer(m.debug_entries * 4, "debug keys");
+  m.dbg_depth = rt.buffer(m.debug_entries * 4, "debug depth");
+  m.dbg_count = rt.buffer(m.debug_entries * 4, "debug counts");
   if (m.tile_queue_capacity == 0) {
     m.tile_queue_capacity = std::max<size_t>(4096, size_t(m.mta_capacity) * 8);
     m.tile_queue = rt.buffer(m.tile_queue_capacity * sizeof(uint32_t), "tile queues");
@@ -366,28 +403,14 @@ void Pipeline::Impl::configure_fused(const std::string& options, int views, int 
                                      const std::vector<PmrEncodeColumn>& columns, const std::vector<PmrEncodeRow>& rows) {
   if (fused_views != views) {
     if (fused_program) clReleaseProgram(fused_program);
-    fused_program = rt.build_program({"fine_encode.cl"}, options + " -DPMR_FUSED_VIEWS=" + std::to_string(views));
+    fused_program = rt.build_program({"fine_encode.cl", "straddle_alpha.cl"}, options + " -DPMR_FUSED_VIEWS=" + std::to_string(views));
     fused_views = views;
     k_fine_encode = ClKernel(fused_program, "fine_encode");
     k_straddle_alpha = ClKernel(fused_program, "encode_straddle_alpha");
   }
   const PmrEncodeParams& E = encode_params;
-  std::vector<int32_t> col_start(size_t(E.view_w) + 1), row_first(size_t(E.view_h) + 1);
-  for (int px = 0, s = 0; px <= E.view_w; ++px) {
-    while (s < int(columns.size()) && columns[size_t(s)].px < px) ++s;
-    col_start[size_t(px)] = s;
-  }
-  for (int py = 0, i = 0; py <= E.view_h; ++py) {
-    while (i < int(rows.size()) && rows[size_t(i)].py < py) ++i;
-    row_first[size_t(py)] = i;
-  }
-  std::vector<int32_t> slot(size_t(E.display_w), -1), straddling;
-  for (int j = 0; j < E.display_w; ++j) {
-    if (columns[size_t(3 * j)].px / tile_x == columns[size_t(3 * j + 2)].px / tile_x) continue;
-    slot[size_t(j)] = int32_t(straddling.size());
-    straddling.push_back(j);
-  }
-  straddle_slots = uint32_t(straddling.size());
+  const TileOwnership own = tile_ownership(E, columns, rows, tile_x);
+  upload_straddles(own);
   // the fused kernel's column table, as planes for 8-pixel vector loads: [field (a_mod_n, b, px)][subpixel k][pixel j]
   const size_t W = size_t(E.display_w);
   std::vector<int32_t> soa(9 * W);
@@ -396,16 +419,61 @@ void Pipeline::Impl::configure_fused(const std::string& options, int views, int 
       const PmrEncodeColumn& c = columns[3 * j + k];
       soa[(0 + k) * W + j] = c.a_mod_n, soa[(3 + k) * W + j] = c.b, soa[(6 + k) * W + j] = c.px;
     }
+  column_soa = rt.buffer(bytes_of(soa), "fused column planes", CL_MEM_READ_ONLY);
+  rt.write(column_soa, soa.data(), bytes_of(soa));
+}
+
+// Ownership tables and the straddling pixels' coverage slots (fused and subpixel paths).
+void Pipeline::Impl::upload_straddles(const TileOwnership& own) {
   auto upload = [&](ClBuffer& b, const std::vector<int32_t>& v, const char* name) {
     b = rt.buffer(std::max<size_t>(bytes_of(v), 16), name, CL_MEM_READ_ONLY);
     rt.write(b, v.data(), bytes_of(v));
   };
-  upload(column_start, col_start, "fused column starts");
-  upload(column_soa, soa, "fused column planes");
-  upload(row_start, row_first, "fused row starts");
-  upload(straddle_slot, slot, "fused straddle slots");
-  upload(straddle_columns, straddling, "fused straddle columns");
-  straddle_cov = rt.buffer(std::max<size_t>(size_t(straddle_slots) * E.display_h * 3, 16), "fused straddle coverage");
+  upload(column_start, own.column_start, "column starts");
+  upload(row_start, own.row_start, "row starts");
+  upload(straddle_slot, own.straddle_slot, "straddle slots");
+  upload(straddle_columns, own.straddling, "straddle columns");
+  straddle_slots = uint32_t(own.straddling.size());
+  straddle_cov = rt.buffer(std::max<size_t>(size_t(straddle_slots) * encode_params.display_h * 3, 16), "straddle coverage");
+}
+
+// The subpixel program (per view count: its private per-view arrays) and the chunk list.
+void Pipeline::Impl::configure_subpixel(const std::string& options, int views, const int* tile,
+                                        const std::vector<PmrEncodeColumn>& columns,
+                                        const std::vector<PmrEncodeRow>& rows) {
+  const int capacity = subpixel_chunk_capacity(views);
+  if (subpixel_views != views) {
+    if (subpixel_program) clReleaseProgram(subpixel_program);
+    subpixel_program = nullptr;
+    subpixel_program = rt.build_program({"fine_subpixel.cl", "straddle_alpha.cl"},
+                                        options + " -DPMR_SUBPIXEL_VIEWS=" + std::to_string(views) +
+                                            " -DPMR_SUBPIXEL_CAP=" + std::to_string(capacity) +
+                                            " -DPMR_SUBPIXEL_SLOTS=" + std::to_string(kSubpixelSlots));
+    subpixel_views = views;
+    k_fine_subpixel = ClKernel(subpixel_program, "fine_subpixel");
+    k_subpixel_straddle = ClKernel(subpixel_program, "encode_straddle_alpha");
+  }
+  const TileOwnership own = tile_ownership(encode_params, columns, rows, tile[0]);
+  upload_straddles(own);
+  const std::vector<PmrSampleChunk> list = subpixel_chunks(own, tile[0], tile[1], capacity);
+  num_chunks = uint32_t(list.size());
+  chunks = rt.buffer(std::max<size_t>(bytes_of(list), 16), "subpixel chunks", CL_MEM_READ_ONLY);
+  rt.write(chunks, list.data(), bytes_of(list));
+}
+
+void Pipeline::Impl::straddle_alpha_stage(ClKernel& k, Events& ev) {
+  if (straddle_slots == 0) return;
+  k.args(encode_buf, straddle_columns, straddle_slots, straddle_cov, display);
+  ev.add(kEncode, rt.launch_2d(k, straddle_slots, size_t(encode_params.display_h), 1, 8));
+}
+
+void Pipeline::Impl::subpixel_stage(Events& ev) {
+  rt.write(encode_buf, &encode_params, sizeof encode_params);
+  k_fine_subpixel.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut,
+                       encode_buf, encode_columns, encode_rows, chunks, num_chunks, straddle_slot, straddle_slots,
+                       straddle_cov, display, cl_uint(subpixel_debug), dbg_key, dbg_depth);
+  ev.add(kFine, rt.launch(k_fine_subpixel, num_chunks, 1));
+  straddle_alpha_stage(k_subpixel_straddle, ev);
 }
 
 void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
@@ -415,9 +483,7 @@ void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
                      straddle_cov, display);
   const size_t screen_tiles = size_t(P.tiles_x) * P.tiles_y;
   ev.add(kFine, rt.launch(k_fine_encode, screen_tiles, 1));
-  if (straddle_slots == 0) return;
-  k_straddle_alpha.args(encode_buf, straddle_columns, straddle_slots, straddle_cov, display);
-  ev.add(kEncode, rt.launch_2d(k_straddle_alpha, straddle_slots, size_t(encode_params.display_h), 1, 8));
+  straddle_alpha_stage(k_straddle_alpha, ev);
 }
 
 StageTimes Pipeline::render(const Rig& rig) {
@@ -437,15 +503,15 @@ StageTimes Pipeline::render(const Rig& rig) {
   P.num_triangles = m.num_triangles;
   P.debug_outputs = config_.debug_outputs ? 1u : 0u;
   P.setup_mode = config_.method == Method::Duplicate ? PMR_SETUP_DUPLICATE : PMR_SETUP_MTA;
+  P.sample_area = m.subpixel ? PMR_SAMPLES_PIXEL : PMR_SAMPLES_CENTER;
 
   if (config_.method != Method::Multipass) {
     m.vertex_stage(P, ev);
     m.setup_stage(P, ev, times);
     m.bin_stage(ev, times);
-    if (m.fused)
-      m.fused_stage(P, ev);
-    else
-      m.fine_stage(ev);
+    if (m.fused) m.fused_stage(P, ev);
+    if (m.keep_volume) m.fine_stage(ev);
+    if (m.subpixel) m.subpixel_stage(ev);
   } else {
     if (config_.multipass_snapped) {  // test mode: PMR's vertex records, computed once
       m.vertex_stage(P, ev);
@@ -472,7 +538,7 @@ StageTimes Pipeline::render(const Rig& rig) {
     }
     if (config_.multipass_snapped) std::swap(m.vertices, m.pmr_vertices);
   }
-  if (m.encode && !m.fused) m.encode_stage(ev);
+  if (m.encode && !m.fused && !m.subpixel) m.encode_stage(ev);
   m.rt.finish();
   ev.collect(times);
   times.wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
@@ -481,7 +547,7 @@ StageTimes Pipeline::render(const Rig& rig) {
 
 StageTimes Pipeline::encode_volume(const std::vector<uint16_t>& volume) {
   Impl& m = *impl_;
-  if (!m.encode || m.fused) throw Error("internal error: no display configured, or fused path");
+  if (!m.encode || m.fused || m.subpixel) throw Error("internal error: no display configured, or a path without an encoder");
   if (volume.size() * 2 != volume_bytes()) throw Error("internal error: volume size mismatch");
   m.rt.write(m.volume, volume.data(), volume_bytes());
   Events ev;
@@ -493,9 +559,10 @@ StageTimes Pipeline::encode_volume(const std::vector<uint16_t>& volume) {
 }
 
 bool Pipeline::fused() const { return impl_->fused; }
+bool Pipeline::has_volume() const { return impl_->keep_volume; }
 
 void Pipeline::read_volume(std::vector<uint16_t>& out) const {
-  if (impl_->fused) throw Error("internal error: the fused path keeps no view volume");
+  if (!impl_->keep_volume) throw Error("internal error: this configuration keeps no view volume");
   out.resize(volume_bytes() / 2);
   impl_->rt.read(impl_->volume, out.data(), volume_bytes());
 }
@@ -508,7 +575,7 @@ void Pipeline::read_display(std::vector<uint16_t>& out) const {
 
 void Pipeline::read_debug(std::vector<uint32_t>& keys, std::vector<float>& depth, std::vector<uint32_t>& count) const {
   if (!config_.debug_outputs) throw Error("internal error: debug outputs are off");
-  const size_t n = size_t(impl_->params.views) * impl_->params.view_w * impl_->params.view_h;
+  const size_t n = impl_->debug_entries;
   keys.resize(n);
   depth.resize(n);
   count.resize(n);

@@ -24,6 +24,14 @@ enum class Method {
 Method parse_method(const std::string& name);  // "pmr", "multipass", "duplicate"
 const char* to_string(Method m);
 
+// Where the display's subpixels take their colours from.
+enum class Sampling {
+  View,      // the views rendered on their W x H grids, each subpixel reading its view's nearest pixel
+  Subpixel,  // every subpixel rasterized at its own sample in its own view (cl/fine_subpixel.cl)
+};
+Sampling parse_sampling(const std::string& name);  // "view", "subpixel"
+const char* to_string(Sampling s);
+
 struct PipelineConfig {
   Method method = Method::Pmr;
   // PMR: the 3D tile (voxels over x, y, view) of one fine work-group. The single-view baselines use
@@ -38,6 +46,10 @@ struct PipelineConfig {
   // otherwise the volume is rendered and encoded as usual. read_volume() needs it off.
   bool fuse_encode = false;
   bool multipass_snapped = false;  // test mode: multipass fed PMR's snapped per-view positions
+  // Subpixel needs a display and --method pmr. The views are rendered on their grids as well only when
+  // fuse_encode is off (a product needs them); debug outputs are per voxel of those views, or without
+  // them per display subpixel ([row][3 * column + k]).
+  Sampling sampling = Sampling::View;
 };
 
 struct StageTimes {  // milliseconds
@@ -73,12 +85,14 @@ class Pipeline {
   int tiles_v() const { return tiles_v_; }
   size_t volume_bytes() const;
   bool fused() const;  // the last configure() chose the fused raster + encode path
+  bool has_volume() const;  // the last configure() renders the view volume (read_volume works)
   size_t display_bytes() const;
 
   // Read-back of the last frame. Volume: [view][y][x][RGBA] halves. Display: [y][x][RGBA] halves.
   void read_volume(std::vector<uint16_t>& out) const;
   void read_display(std::vector<uint16_t>& out) const;
-  // Requires debug_outputs: per voxel the winning key (PMR_NO_KEY if empty), depth and coverage count.
+  // Requires debug_outputs: per voxel the winning key (PMR_NO_KEY if empty), depth and coverage count
+  // (with --sampling subpixel and no view volume: per display subpixel, and no count).
   void read_debug(std::vector<uint32_t>& keys, std::vector<float>& depth, std::vector<uint32_t>& count) const;
   // The MTAs of the last frame, in queue order (arbitrary), and the tile queues (offsets has one entry
   // per tile plus one; queue[offsets[t] .. offsets[t+1]) are MTA indices).

@@ -80,6 +80,12 @@ typedef int64_t pmr_i64;
 #define PMR_SETUP_MTA 0u
 #define PMR_SETUP_DUPLICATE 1u
 
+/* PmrParams.sample_area: where the samples of a raster pixel lie, for the tile raster's conservative
+ * tests. --sampling view samples pixel centers; --sampling subpixel samples each display subpixel at
+ * its own position, anywhere in [px, px + 1) x [py, py + 1) of its view's raster. */
+#define PMR_SAMPLES_CENTER 0u
+#define PMR_SAMPLES_PIXEL 1u
+
 /* Frame parameters, one copy per frame, read by every stage. Producer: host/pipeline. */
 typedef struct {
   double view[16];        /* center camera view matrix, column-major (world -> center view space) */
@@ -101,6 +107,8 @@ typedef struct {
   pmr_u32 debug_outputs;  /* 1: fine raster writes per-voxel key, depth and coverage count   */
   pmr_u32 view_base;      /* volume slice of local view 0 (multipass renders one view a pass) */
   pmr_u32 setup_mode;     /* PMR_SETUP_MTA or PMR_SETUP_DUPLICATE                            */
+  pmr_u32 sample_area;    /* PMR_SAMPLES_CENTER or PMR_SAMPLES_PIXEL                          */
+  pmr_u32 pad_params;
 } PmrParams;
 
 /* Vertex-stage output, one per scene vertex. Producer: cl/vertex.cl. */
@@ -195,5 +203,16 @@ typedef struct {
   pmr_i32 py;             /* nearest view row: floor((2i + 1) H / (2 H_d))                    */
   float phase_frac;       /* rR_i / Den as a float                                           */
 } PmrEncodeRow;
+
+/* --sampling subpixel: a block of display subpixels whose samples all lie in one screen tile (the
+ * view raster's PMR_TILE_X x PMR_TILE_Y pixels, over all views): columns s = 3j + k in [s0, s1), display
+ * rows [i0, i1). Blocks split a tile's subpixels at display-pixel boundaries, so a display pixel is cut
+ * only where its subpixels' samples fall in different tiles. Producer: host/pipeline. */
+typedef struct {
+  pmr_i32 tile;           /* screen tile index ty * tiles_x + tx                              */
+  pmr_i32 s0, s1;         /* subpixel columns                                                */
+  pmr_i32 i0, i1;         /* display rows                                                    */
+  pmr_i32 pad0, pad1, pad2;
+} PmrSampleChunk;
 
 #endif /* PMR_SHARED_H */

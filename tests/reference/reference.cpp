@@ -259,6 +259,54 @@ RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& t
   return r;
 }
 
+SubpixelResult rasterize_subpixels(const PmrParams& P, const std::vector<ClippedTriangle>& tris,
+                                   const std::vector<int>& view_of, int display_w, int display_h) {
+  const size_t n = size_t(3) * display_w * display_h;
+  SubpixelResult r;
+  r.key.assign(n, PMR_NO_KEY);
+  r.depth.assign(n, INFINITY);
+  r.x.resize(n);
+  r.y.resize(n);
+  for (int i = 0; i < display_h; ++i)
+    for (int s = 0; s < 3 * display_w; ++s) {
+      const size_t at = size_t(i) * 3 * display_w + size_t(s);
+      // floor((s + 1/2) / (3 W_d) * W * 2^16) and floor((i + 1/2) / H_d * H * 2^8), in integers
+      const int64_t X = (int64_t(2 * s + 1) * P.view_w * PMR_X_ONE) / (int64_t(6) * display_w);
+      const int64_t Y = (int64_t(2 * i + 1) * P.view_h * PMR_Y_ONE) / (int64_t(2) * display_h);
+      r.x[at] = X, r.y[at] = Y;
+      const int64_t v = view_of[at];
+      for (const ClippedTriangle& c : tris) {
+        int64_t x[3], y[3];
+        for (int k = 0; k < 3; ++k) {
+          x[k] = int64_t(c.v[k].x0) + v * c.v[k].dx;
+          y[k] = c.v[k].y;
+        }
+        const int64_t area = (y[1] - y[0]) * (x[2] - x[0]) - (x[1] - x[0]) * (y[2] - y[0]);
+        if (area == 0 || (area < 0 && !c.double_sided)) continue;
+        const int64_t sg = area > 0 ? 1 : -1;
+        const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
+        bool inside = true;
+        for (int k = 0; k < 3 && inside; ++k) {
+          const int a = ea[k], b = eb[k];
+          const int64_t dx = sg * (x[b] - x[a]), dy = sg * (y[b] - y[a]);
+          const int64_t bias = (dy > 0 || (dy == 0 && dx < 0)) ? 0 : 1;
+          inside = sg * ((y[b] - y[a]) * (X - x[a]) - (x[b] - x[a]) * (Y - y[a])) >= bias;
+        }
+        if (!inside) continue;
+        const double inv = 1.0 / double(area);
+        const double dz1 = double(c.v[1].z) - double(c.v[0].z), dz2 = double(c.v[2].z) - double(c.v[0].z);
+        const double gx = (dz1 * double(y[0] - y[2]) + dz2 * double(y[1] - y[0])) * inv;
+        const double gy = (dz1 * double(x[2] - x[0]) - dz2 * double(x[1] - x[0])) * inv;
+        const float depth = float(double(c.v[0].z) + (gx * double(X - x[0]) + gy * double(Y - y[0])));
+        if (depth < r.depth[at] || (depth == r.depth[at] && c.key < r.key[at])) {
+          r.depth[at] = depth;
+          r.key[at] = c.key;
+        }
+      }
+    }
+  return r;
+}
+
 RasterResult render(const PmrParams& P, const Scene& scene) {
   std::vector<PmrVertex> verts;
   for (const auto& p : scene.positions) verts.push_back(transform_vertex(P, &p.x));

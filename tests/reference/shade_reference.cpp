@@ -25,12 +25,16 @@ glm::dvec4 texel(const SceneTexture& t, int x, int y) {
 }  // namespace
 
 glm::dvec3 source_barycentrics(const PmrMta& m, int px, int py, int view) {
+  return source_barycentrics_at(m, int64_t(px) * PMR_X_ONE + PMR_X_ONE / 2, int64_t(py) * PMR_Y_ONE + PMR_Y_ONE / 2, view);
+}
+
+glm::dvec3 source_barycentrics_at(const PmrMta& m, int64_t sample_x, int64_t sample_y, int view) {
   double x[3], y[3];
   for (int k = 0; k < 3; ++k) {
     x[k] = (double(m.x0[k]) + double(view) * m.dx[k]) / PMR_X_ONE;
     y[k] = double(m.y[k]) / PMR_Y_ONE;
   }
-  const double X = px + 0.5, Y = py + 0.5;
+  const double X = double(sample_x) / PMR_X_ONE, Y = double(sample_y) / PMR_Y_ONE;
   // screen-space barycentrics of the MTA from signed sub-areas
   double l[3];
   const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};

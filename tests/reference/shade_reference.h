@@ -1,5 +1,7 @@
 // Double-precision reference of DESIGN section 4 (shading) for one voxel.
 #pragma once
+#include <cstdint>
+
 #include <glm/glm.hpp>
 
 #include "pmr/scene.h"
@@ -9,6 +11,8 @@ namespace pmr::ref {
 
 // Perspective-correct barycentrics of voxel (px, py, view) in the MTA's SOURCE triangle.
 glm::dvec3 source_barycentrics(const PmrMta& m, int px, int py, int view);
+// The same at raster point (X, Y) in fixed point (16.16, 24.8): a --sampling subpixel sample.
+glm::dvec3 source_barycentrics_at(const PmrMta& m, int64_t sample_x, int64_t sample_y, int view);
 // Unlit base colour (factor * texture * COLOR_0) at source barycentrics b of triangle `tri`.
 glm::dvec4 base_color(const Scene& scene, uint32_t tri, const glm::dvec3& b);
 // Lit colour (alpha = 1) with the light direction `light` (world space, unit).

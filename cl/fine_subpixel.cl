@@ -1,0 +1,229 @@
+/* Stage 4 with --sampling subpixel: every display subpixel rasterized at its own sample in its own view
+ * (DESIGN section 5's sample position, in the view the encoder maps it to), shaded, and written straight
+ * into the display image. No view volume.
+ *
+ * One work-item per sample chunk (PmrSampleChunk): a block of display subpixels whose samples all lie in
+ * one screen tile, so the tile queues the tile raster built (with PMR_SAMPLES_PIXEL: whole-pixel boxes)
+ * hold every MTA that can cover them. The chunk first sorts its samples by view (a counting sort; each
+ * view's run padded to whole vectors), then walks the tile's queues: per MTA and view, the run of that
+ * view's samples is tested SP_LANES at a time.
+ *
+ * Why the double-precision edge test is exact. Relative to the chunk's first sample (Xc, Yc), a sample
+ * is (Xc + x, Yc + y) with 0 <= x < 2^22 (a tile is at most 64 px wide, 16.16) and 0 <= y < 2^14
+ * (24.8). The exact test sign * E(X, Y, v) >= bias becomes
+ *   (sign dy) x - (sign dx_ab(v)) y >= bias - sign * E(Xc, Yc, v) = T
+ * with |dy| < 2^24 and |dx_ab| < 2^32 (the guard band), so both products are integers below 2^46 and
+ * their difference below 2^47: every double operation on the left is exact, and T, clamped to
+ * +-2^48 (beyond which the comparison cannot change), converts exactly. So the outcome is the integer
+ * one, bit for bit, in 4-wide vector doubles.
+ *
+ * Depth at a sample: the plane through the MTA's three vertices in view v, in double and anchored at
+ * vertex 0, z = (float)(z_0 + (g_x (X - x_0) + g_y (Y - y_0))): a function of the MTA, the view and the
+ * sample alone, so the result does not depend on chunks, tiles or threads. Visibility is the (depth,
+ * key) order as everywhere. */
+#include "shade.h"
+
+#define SP_LANES 8
+#define SP_SLOTS PMR_SUBPIXEL_SLOTS /* the host keeps area + (SP_LANES - 1) * min(views, area) within */
+
+constant int sp_lane_index[SP_LANES] = {0, 1, 2, 3, 4, 5, 6, 7};
+
+/* alphaMode MASK: of the lanes in `win`, those whose base colour alpha passes the cutoff (rare path, one
+ * lane at a time with the exact edge functions). */
+inline int8 sp_mask_alpha(const ShadeInputs* in, const PmrMta* m, int8 win, const int* sx, const int* sy, long Xc,
+                          long Yc, int v, float cutoff) {
+  int w[SP_LANES];
+  vstore8(win, 0, w);
+  for (int l = 0; l < SP_LANES; ++l) {
+    if (!w[l]) continue;
+    const long X = Xc + sx[l], Y = Yc + sy[l];
+    const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, v), m->sign * mta_edge(m, 2, 0, X, Y, v),
+                       m->sign * mta_edge(m, 0, 1, X, Y, v)};
+    if (!(base_color(in, m->tri, source_barycentrics(m, e)).w >= cutoff)) w[l] = 0;
+  }
+  return vload8(0, w);
+}
+
+kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, global const uint* tile_offsets,
+                          global const uint* tile_queue, global const PmrTriangle* tris,
+                          global const PmrVertexAttr* attrs, global const PmrMaterial* materials,
+                          global const PmrTexture* textures, global const uchar4* texels,
+                          global const float* srgb_lut, global const PmrEncodeParams* E,
+                          global const PmrEncodeColumn* all_columns, global const PmrEncodeRow* rows,
+                          global const PmrSampleChunk* chunks, uint num_chunks, global const int* straddle_slot,
+                          uint straddle_slots, global uchar* straddle_cov, global half* display,
+                          uint debug, global uint* dbg_key, global float* dbg_depth) {
+  const uint chunk = get_global_id(0);
+  if (chunk >= num_chunks) return;
+  const PmrSampleChunk ch = chunks[chunk];
+  const int views = P->views, width = ch.s1 - ch.s0;
+  const int W = P->view_w, H = P->view_h, Wd = E->display_w, Hd = E->display_h;
+  const long Xc = subpixel_sample_x(ch.s0, W, Wd), Yc = subpixel_sample_y(ch.i0, H, Hd);
+  const long Xl = subpixel_sample_x(ch.s1 - 1, W, Wd), Yl = subpixel_sample_y(ch.i1 - 1, H, Hd);
+
+  /* 1. The samples by view: run v holds count[v] samples from first[v], padded to whole vectors. */
+  int first[PMR_SUBPIXEL_VIEWS + 1], count[PMR_SUBPIXEL_VIEWS];
+  for (int v = 0; v < views; ++v) count[v] = 0;
+  for (int i = ch.i0; i < ch.i1; ++i) {
+    global const PmrEncodeColumn* cols = row_columns(E, all_columns, i);
+    const PmrEncodeRow row = rows[i];
+    for (int s = ch.s0; s < ch.s1; ++s) {
+      const PmrEncodeColumn c = cols[s];
+      ++count[encode_view(views, E->reversed, &c, &row)];
+    }
+  }
+  int run = 0;
+  for (int v = 0; v < views; ++v) {
+    first[v] = run;
+    run += (count[v] + SP_LANES - 1) / SP_LANES * SP_LANES;
+  }
+  first[views] = run;
+  int sx[SP_SLOTS], sy[SP_SLOTS];     /* sample offsets from (Xc, Yc), fixed point */
+  ushort sid[SP_SLOTS];               /* sample index (i - i0) * width + (s - s0) */
+  float best_depth[SP_SLOTS];
+  uint best_key[SP_SLOTS], best_mta[SP_SLOTS];
+  for (int k = 0; k < run; ++k) {
+    sx[k] = sy[k] = 0;
+    sid[k] = 0;
+    best_depth[k] = INFINITY;
+    best_key[k] = PMR_NO_KEY;
+    best_mta[k] = 0;
+  }
+  {
+    int fill[PMR_SUBPIXEL_VIEWS];
+    for (int v = 0; v < views; ++v) fill[v] = first[v];
+    for (int i = ch.i0; i < ch.i1; ++i) {
+      global const PmrEncodeColumn* cols = row_columns(E, all_columns, i);
+      const PmrEncodeRow row = rows[i];
+      const int y = (int)(subpixel_sample_y(i, H, Hd) - Yc);
+      for (int s = ch.s0; s < ch.s1; ++s) {
+        const PmrEncodeColumn c = cols[s];
+        const int k = fill[encode_view(views, E->reversed, &c, &row)]++;
+        sx[k] = (int)(subpixel_sample_x(s, W, Wd) - Xc);
+        sy[k] = y;
+        sid[k] = (ushort)((i - ch.i0) * width + (s - ch.s0));
+      }
+    }
+  }
+
+  /* 2. Visibility: the tile's queues, every view slab. */
+  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut};
+  const int8 lane = vload8(0, sp_lane_index);
+  const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
+  for (int tv = 0; tv < P->tiles_v; ++tv) {
+    const int v0 = tv * PMR_TILE_V, v1 = min(views, v0 + PMR_TILE_V) - 1;
+    if (first[v1 + 1] == first[v0]) continue; /* no sample of the chunk shows these views */
+    const uint tile = ((uint)tv * (uint)P->tiles_y) * (uint)P->tiles_x + (uint)ch.tile;
+    const uint q1 = tile_offsets[tile + 1];
+    for (uint q = tile_offsets[tile]; q < q1; ++q) {
+      const uint id = tile_queue[q];
+      const PmrMta m = mtas[id];
+      const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));
+      if (yhi < Yc || ylo > Yl) continue;
+      const int i_lo = max(v0, m.view_lo), i_hi = min(v1, m.view_hi);
+      const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
+      long bias[3];
+      double dy[3];
+      for (int e = 0; e < 3; ++e) {
+        bias[e] = mta_edge_bias(&m, ea[e], eb[e]);
+        dy[e] = (double)((long)m.sign * (long)(m.y[eb[e]] - m.y[ea[e]]));
+      }
+      for (int v = i_lo; v <= i_hi; ++v) {
+        const int k0 = first[v], k1 = k0 + count[v];
+        if (k0 == k1) continue;
+        long xv[3];
+        for (int k = 0; k < 3; ++k) xv[k] = (long)m.x0[k] + (long)v * (long)m.dx[k];
+        if (max(xv[0], max(xv[1], xv[2])) < Xc || min(xv[0], min(xv[1], xv[2])) > Xl) continue;
+        double dx[3], T[3];
+        for (int e = 0; e < 3; ++e) {
+          const long t = bias[e] - (long)m.sign * mta_edge(&m, ea[e], eb[e], Xc, Yc, v);
+          T[e] = (double)clamp(t, -(1L << 48), 1L << 48);
+          dx[e] = (double)(-(long)m.sign * (xv[eb[e]] - xv[ea[e]]));
+        }
+        bool have_plane = false;
+        double z0 = 0.0, gx = 0.0, gy = 0.0, bx = 0.0, by = 0.0;
+        for (int k = k0; k < k1; k += SP_LANES) {
+          const double8 x = convert_double8(vload8(0, sx + k)), y = convert_double8(vload8(0, sy + k));
+          long8 hit = convert_long8(lane < (int8)(k1 - k));
+          hit &= (double8)(dy[0]) * x + (double8)(dx[0]) * y >= (double8)(T[0]);
+          hit &= (double8)(dy[1]) * x + (double8)(dx[1]) * y >= (double8)(T[1]);
+          hit &= (double8)(dy[2]) * x + (double8)(dx[2]) * y >= (double8)(T[2]);
+          if (!any(hit)) continue;
+          if (!have_plane) { /* set up on the first covered sample: tiny MTAs often cover none */
+            const long y0 = m.y[0], y1 = m.y[1], y2 = m.y[2];
+            const long area = (y1 - y0) * (xv[2] - xv[0]) - (xv[1] - xv[0]) * (y2 - y0);
+            const double inv = 1.0 / (double)area;
+            const double dz1 = (double)m.z[1] - (double)m.z[0], dz2 = (double)m.z[2] - (double)m.z[0];
+            gx = (dz1 * (double)(y0 - y2) + dz2 * (double)(y1 - y0)) * inv;
+            gy = (dz1 * (double)(xv[2] - xv[0]) - dz2 * (double)(xv[1] - xv[0])) * inv;
+            z0 = (double)m.z[0];
+            bx = (double)(Xc - xv[0]);
+            by = (double)(Yc - y0);
+            have_plane = true;
+          }
+          const float8 z = convert_float8((double8)(z0) + ((double8)(gx) * ((double8)(bx) + x) +
+                                                           (double8)(gy) * ((double8)(by) + y)));
+          const float8 bd = vload8(0, best_depth + k);
+          const uint8 bk = vload8(0, best_key + k);
+          int8 win = convert_int8(hit) & ((z < bd) | ((z == bd) & ((uint8)(m.key) < bk)));
+          if ((m.flags & PMR_MTA_MASK) && any(win)) win = sp_mask_alpha(&in, &m, win, sx + k, sy + k, Xc, Yc, v, cutoff);
+          vstore8(select(bd, z, win), 0, best_depth + k);
+          vstore8(select(bk, (uint8)(m.key), as_uint8(win)), 0, best_key + k);
+          vstore8(select(vload8(0, best_mta + k), (uint8)(id), as_uint8(win)), 0, best_mta + k);
+        }
+      }
+    }
+  }
+
+  /* 3. The winners shaded at their samples: channel k of subpixel s = 3j + k, half bits, by sample. */
+  const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
+  ushort value[PMR_SUBPIXEL_CAP];
+  uchar covered[PMR_SUBPIXEL_CAP];
+  for (int v = 0; v < views; ++v)
+    for (int k = first[v]; k < first[v] + count[v]; ++k) {
+      const int n = sid[k], s = ch.s0 + n % width;
+      if (debug) {
+        const size_t at = (size_t)(ch.i0 + n / width) * (size_t)(3 * Wd) + (size_t)s;
+        dbg_key[at] = best_key[k];
+        dbg_depth[at] = best_depth[k];
+      }
+      if (best_key[k] == PMR_NO_KEY) {
+        value[n] = 0;
+        covered[n] = 0;
+        continue;
+      }
+      const float4 c = shade_mta_at(&in, mtas, best_mta[k], light, Xc + sx[k], Yc + sy[k], v);
+      const int channel = s % 3;
+      ushort h;
+      vstore_half(channel == 0 ? c.x : (channel == 1 ? c.y : c.z), 0, (half*)&h);
+      value[n] = h;
+      covered[n] = 1;
+    }
+
+  /* 4. The display pixels: whole ones with their alpha (the three subpixels' mean coverage, as
+   * encode_pixel computes it), cut ones (their subpixels in other tiles too) channel by channel with
+   * their coverage left for encode_straddle_alpha. */
+  global ushort* bits = (global ushort*)display;
+  const ushort one = 0x3c00; /* 1.0 as a half */
+  for (int i = ch.i0; i < ch.i1; ++i) {
+    const int r = (i - ch.i0) * width - ch.s0;
+    for (int j = ch.s0 / 3; 3 * j < ch.s1; ++j) {
+      const size_t pixel = (size_t)i * (size_t)Wd + (size_t)j;
+      if (3 * j >= ch.s0 && 3 * j + 3 <= ch.s1) {
+        const int n = r + 3 * j;
+        const ushort4 a = (ushort4)(value[n], 0, 0, covered[n] ? one : 0);
+        const ushort4 b = (ushort4)(0, value[n + 1], 0, covered[n + 1] ? one : 0);
+        const ushort4 c = (ushort4)(0, 0, value[n + 2], covered[n + 2] ? one : 0);
+        vstore4(encode_pixel(a, b, c), pixel, bits);
+        continue;
+      }
+      const size_t slot = ((size_t)i * straddle_slots + (size_t)straddle_slot[j]) * 3;
+      for (int k = 0; k < 3; ++k) {
+        const int s = 3 * j + k;
+        if (s < ch.s0 || s >= ch.s1) continue;
+        bits[pixel * 4 + (size_t)k] = value[r + s];
+        straddle_cov[slot + (size_t)k] = covered[r + s];
+      }
+    }
+  }
+}

@@ -1,0 +1,33 @@
+// Tables of the paths that write the display image from screen tiles (the fused raster + encode, and
+// --sampling subpixel): which screen tile owns which display subpixels, and how --sampling subpixel cuts
+// a tile's subpixels into chunks of bounded size.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "pmr/shared.h"
+
+namespace pmr {
+
+// Ownership: display subpixel column s belongs to the screen tile holding its view column px(s), display
+// row i to the one holding its view row py(i) (both maps are monotone).
+struct TileOwnership {
+  std::vector<int32_t> column_start;   // per view column px (and W): its first subpixel column
+  std::vector<int32_t> row_start;      // per view row py (and H): its first display row
+  std::vector<int32_t> straddle_slot;  // per display column: its slot in `straddling`, or -1
+  std::vector<int32_t> straddling;     // display columns whose three subpixels lie in different tiles
+};
+// `columns` may hold several blocks (subpixel cells): px is the same in every block, the first is read.
+TileOwnership tile_ownership(const PmrEncodeParams& E, const std::vector<PmrEncodeColumn>& columns,
+                             const std::vector<PmrEncodeRow>& rows, int tile_x);
+
+// --sampling subpixel. A chunk's samples sorted by view, each view's run padded to whole vectors, must fit
+// the kernel's PMR_SUBPIXEL_SLOTS private slots: the chunk capacity leaves room for the padding.
+constexpr int kSubpixelSlots = 4096;
+constexpr int kSubpixelLanes = 8;  // SP_LANES in cl/fine_subpixel.cl
+int subpixel_chunk_capacity(int views);
+// Every display subpixel in exactly one chunk; a chunk lies in one screen tile, holds at most
+// `capacity` subpixels and is cut from its neighbours in the same tile at display-pixel boundaries.
+std::vector<PmrSampleChunk> subpixel_chunks(const TileOwnership& own, int tile_x, int tile_y, int capacity);
+
+}  // namespace pmr

@@ -1,0 +1,214 @@
+// --sampling subpixel (cl/fine_subpixel.cl) against a direct per-subpixel evaluation: for random
+// triangles and random display parameters (lens pitches and slants with many digits, offsets, reversed
+// views, subpixel cells, view rasters larger and smaller than the display, tile shapes whose tiles cut
+// display pixels), every subpixel's winning key and depth equal the C++ reference rasterizer evaluated
+// at that one sample in that one view, bit for bit; its colour channel equals the double-precision
+// shading reference at that sample within the half-float tolerance of test_shading.cpp; its alpha is
+// the exact mean coverage. The display image does not depend on the tile shape.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <random>
+
+#include <Imath/half.h>
+
+#include "pmr/rig.h"
+#include "reference/reference.h"
+#include "reference/shade_reference.h"
+#include "test_util.h"
+
+namespace pmr {
+namespace {
+
+using Imath::half;
+
+struct SubpixelRender {
+  std::vector<uint16_t> display;
+  std::vector<uint32_t> key, count;
+  std::vector<float> depth;
+  std::vector<PmrMta> mtas;
+};
+
+SubpixelRender render_subpixels(const Scene& scene, const Rig& rig, const Display& d, const int* tile) {
+  PipelineConfig pc;
+  pc.tile_x = tile[0], pc.tile_y = tile[1], pc.tile_v = tile[2];
+  pc.sampling = Sampling::Subpixel;
+  pc.fuse_encode = true;  // no view volume: debug outputs per display subpixel
+  pc.debug_outputs = true;
+  Pipeline p(test::runtime(), pc);
+  p.set_scene(scene);
+  p.configure(rig, &d);
+  p.render(rig);
+  EXPECT_FALSE(p.has_volume());
+  SubpixelRender r;
+  p.read_display(r.display);
+  p.read_debug(r.key, r.depth, r.count);
+  r.mtas = p.read_mtas();
+  return r;
+}
+
+// A decimal with `digits` fractional digits in [lo, hi).
+std::string random_decimal(std::mt19937& rng, double lo, double hi, int digits) {
+  std::uniform_real_distribution<double> u(lo, hi);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, u(rng));
+  return buf;
+}
+
+TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
+  std::mt19937 rng(20261123);
+  const int tiles[][3] = {{16, 2, 16}, {4, 4, 4}, {8, 3, 5}, {3, 1, 2}, {32, 8, 1}};
+  size_t covered_total = 0, straddles_seen = 0;
+  for (int trial = 0; trial < 10; ++trial) {
+    std::uniform_int_distribution<int> views_d(1, 40), vw(6, 90), vh(4, 60), dw(10, 130), dh(6, 80);
+    Display d;
+    d.width = dw(rng), d.height = dh(rng);
+    d.lens_pitch = parse_rational(random_decimal(rng, 2.0, 24.0, 10), "L");
+    d.tan_slant = parse_rational(random_decimal(rng, -0.4, 0.4, 12), "T");
+    d.offset = parse_rational(random_decimal(rng, -30.0, 30.0, 9), "O");
+    d.reversed = trial % 3 == 1;
+    RigConfig rc;
+    rc.views = trial == 0 ? 1 : views_d(rng);
+    rc.view_w = vw(rng), rc.view_h = vh(rng);
+    if (trial == 4) {  // Looking Glass conventions: gen3 subpixel cells (the column map changes with the
+                       // row class), the shader's 1 - fract phase, BGR subpixel order
+      d.cell_rows = 2;
+      d.cell_offsets.clear();
+      for (int k = 0; k < 12; ++k) d.cell_offsets.push_back(int64_t(std::uniform_int_distribution<int>(-300, 300)(rng)) * 10000000000000LL / 100);
+      d.phase_sign = -1;
+      d.subpixel_bgr = true;
+    }
+    if (trial == 5) rc.view_w = 3 * d.width, rc.view_h = 2 * d.height;  // views larger than the display
+    const Rig rig = make_rig(rc, d, glm::dvec3(-1.0), glm::dvec3(1.0));
+    const Scene scene = test::random_scene(150, 900u + unsigned(trial), trial % 2 == 0);
+    const int* tile = tiles[trial % 5];
+    SCOPED_TRACE("trial " + std::to_string(trial) + ": " + std::to_string(rc.views) + " views of " +
+                 std::to_string(rc.view_w) + "x" + std::to_string(rc.view_h) + ", display " + std::to_string(d.width) +
+                 "x" + std::to_string(d.height) + ", tile " + std::to_string(tile[0]) + "x" + std::to_string(tile[1]) +
+                 "x" + std::to_string(tile[2]));
+    const SubpixelRender got = render_subpixels(scene, rig, d, tile);
+
+    const PmrParams P = test::params_for(rig);
+    std::vector<PmrVertex> verts;
+    for (const auto& p : scene.positions) verts.push_back(ref::transform_vertex(P, &p.x));
+    const std::vector<int> view_of = test::table_view_indices(d, rc.views);
+    const ref::SubpixelResult want =
+        ref::rasterize_subpixels(P, ref::clip_triangles(P, scene, verts), view_of, d.width, d.height);
+    ASSERT_EQ(got.key.size(), want.key.size());
+    size_t key_bad = 0, depth_bad = 0, colour_bad = 0, alpha_bad = 0;
+    std::multimap<uint32_t, const PmrMta*> by_key;
+    for (const PmrMta& m : got.mtas) by_key.emplace(m.key, &m);
+    const glm::dvec3 light = rig.light_world();
+    for (size_t at = 0; at < want.key.size(); ++at) {
+      if (got.key[at] != want.key[at] && ++key_bad <= 5)
+        ADD_FAILURE() << "subpixel " << at << ": key " << got.key[at] << ", reference " << want.key[at];
+      if (std::memcmp(&got.depth[at], &want.depth[at], sizeof(float)) != 0 && ++depth_bad <= 5)
+        ADD_FAILURE() << "subpixel " << at << ": depth " << got.depth[at] << ", reference " << want.depth[at];
+      half value;
+      value.setBits(got.display[(at / 3) * 4 + at % 3]);
+      if (want.key[at] == PMR_NO_KEY) {
+        if (value.bits() != 0 && ++colour_bad <= 5) ADD_FAILURE() << "background subpixel " << at << " is " << float(value);
+        continue;
+      }
+      ++covered_total;
+      const int view = view_of[at];
+      const PmrMta* m = nullptr;
+      auto range = by_key.equal_range(want.key[at]);
+      for (auto it = range.first; it != range.second; ++it)
+        if (view >= it->second->view_lo && view <= it->second->view_hi) m = it->second;
+      if (!m) {
+        ADD_FAILURE() << "no MTA for key " << want.key[at];
+        continue;
+      }
+      const glm::dvec3 b = ref::source_barycentrics_at(*m, want.x[at], want.y[at], view);
+      const double c = ref::shade(scene, m->tri, b, (m->flags & PMR_MTA_BACK) != 0, light)[int(at % 3)];
+      if (std::abs(double(float(value)) - c) > std::ldexp(std::abs(c), -10) + 1e-4 && ++colour_bad <= 5)
+        ADD_FAILURE() << "subpixel " << at << ": " << float(value) << ", reference " << c;
+    }
+    // alpha: the mean coverage of the pixel's three subpixels, computed as the encoder does
+    for (size_t px = 0; px < size_t(d.width) * d.height; ++px) {
+      const half a[3] = {half(want.key[3 * px] != PMR_NO_KEY ? 1.0f : 0.0f),
+                         half(want.key[3 * px + 1] != PMR_NO_KEY ? 1.0f : 0.0f),
+                         half(want.key[3 * px + 2] != PMR_NO_KEY ? 1.0f : 0.0f)};
+      const half alpha((float(a[0]) + float(a[1]) + float(a[2])) / 3.0f);
+      if (got.display[px * 4 + 3] != alpha.bits() && ++alpha_bad <= 5)
+        ADD_FAILURE() << "display pixel " << px << ": alpha bits " << got.display[px * 4 + 3] << ", want " << alpha.bits();
+      const int a0 = int(a[0]), a1 = int(a[1]), a2 = int(a[2]);
+      straddles_seen += (a0 + a1 + a2) % 3 != 0;
+    }
+    EXPECT_EQ(key_bad + depth_bad + colour_bad + alpha_bad, 0u);
+
+    // the same image from another tile shape (other chunks, other straddling pixels)
+    const int* other = tiles[(trial + 2) % 5];
+    EXPECT_EQ(render_subpixels(scene, rig, d, other).display, got.display)
+        << "tile " << other[0] << "x" << other[1] << "x" << other[2] << " gives another image";
+  }
+  EXPECT_GT(covered_total, 10000u) << "too few covered subpixels for the test to mean much";
+  EXPECT_GT(straddles_seen, 100u) << "too few partly covered display pixels";
+}
+
+// The fill rule at samples lying exactly on edges: a grid mesh on the focal plane (the same in every
+// view) whose vertices sit on sample positions, so that its horizontal and vertical edges pass through
+// whole rows and columns of samples. Neighbouring triangles are coplanar: a sample owned by both (or by
+// neither) would show in the keys. Sizes are chosen so that the samples are exact in fixed point: with
+// W / W_d = 3/2 sample x = (2s + 1) / 4 px, with H / H_d = 2 sample y = 2i + 1 px.
+TEST(SubpixelSampling, SamplesOnEdgesFollowTheTopLeftRule) {
+  Display d;
+  d.width = 64, d.height = 32;
+  RigConfig rc;
+  rc.views = 8, rc.view_w = 96, rc.view_h = 64;
+  const Rig rig = make_rig(rc, d, glm::dvec3(-1.0), glm::dvec3(1.0));
+  Scene scene = test::empty_scene(false);
+  // grid lines through sample columns s = 9c + 4 and sample rows i = 4r + 2
+  auto corner = [&](int c, int r) { return test::focal_point(rig, (2.0 * (9 * c + 4) + 1.0) / 4.0, 2.0 * (4 * r + 2) + 1.0); };
+  for (int r = 0; r + 1 < 7; ++r)
+    for (int c = 0; c + 1 < 20; ++c) {
+      const glm::vec3 a = corner(c, r), b = corner(c + 1, r), e = corner(c + 1, r + 1), f = corner(c, r + 1);
+      // counter-clockwise seen from the camera (raster y points down), the first vertex rotated so
+      // that each of the kernel's three edges meets every kind of edge (top, left, right, bottom)
+      const glm::vec3 t[2][3] = {{a, f, (r + c) % 2 ? b : e}, {(r + c) % 2 ? f : a, e, b}};
+      for (int k = 0; k < 2; ++k) {
+        const int rot = (c + 2 * r + k) % 3;
+        test::add_triangle(scene, t[k][rot], t[k][(rot + 1) % 3], t[k][(rot + 2) % 3]);
+      }
+    }
+  const PmrParams P = test::params_for(rig);
+  std::vector<PmrVertex> verts;
+  for (const auto& p : scene.positions) verts.push_back(ref::transform_vertex(P, &p.x));
+  const auto clipped = ref::clip_triangles(P, scene, verts);
+  const std::vector<int> view_of = test::table_view_indices(d, rc.views);
+  const ref::SubpixelResult want = ref::rasterize_subpixels(P, clipped, view_of, d.width, d.height);
+  // how many samples lie exactly on an edge of some triangle (the point of this test)
+  size_t on_edge = 0;
+  for (size_t at = 0; at < want.key.size(); ++at)
+    for (const ref::ClippedTriangle& c : clipped) {
+      const int64_t v = view_of[at];
+      const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
+      for (int k = 0; k < 3; ++k) {
+        const int64_t xa = int64_t(c.v[ea[k]].x0) + v * c.v[ea[k]].dx, xb = int64_t(c.v[eb[k]].x0) + v * c.v[eb[k]].dx;
+        const int64_t ya = c.v[ea[k]].y, yb = c.v[eb[k]].y;
+        const bool between = std::min(ya, yb) <= want.y[at] && want.y[at] <= std::max(ya, yb) &&
+                             std::min(xa, xb) <= want.x[at] && want.x[at] <= std::max(xa, xb);
+        on_edge += between && (yb - ya) * (want.x[at] - xa) - (xb - xa) * (want.y[at] - ya) == 0;
+      }
+    }
+  EXPECT_GT(on_edge, 1000u) << "the grid's edges should pass through many samples";
+  const int tiles[2][3] = {{16, 2, 16}, {5, 3, 3}};
+  for (const auto& tile : tiles) {
+    const SubpixelRender got = render_subpixels(scene, rig, d, tile);
+    size_t bad = 0, covered = 0;
+    for (size_t at = 0; at < want.key.size(); ++at) {
+      covered += want.key[at] != PMR_NO_KEY;
+      if (got.key[at] != want.key[at] && ++bad <= 5)
+        ADD_FAILURE() << "subpixel " << at << " (sample " << want.x[at] << ", " << want.y[at] << "): key " << got.key[at]
+                      << ", reference " << want.key[at];
+    }
+    EXPECT_EQ(bad, 0u);
+    EXPECT_GT(covered, 3000u);
+  }
+}
+
+}  // namespace
+}  // namespace pmr

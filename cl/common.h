@@ -139,16 +139,6 @@ inline int encode_view(int views, int reversed, const PmrEncodeColumn* col, cons
   return reversed ? views - 1 - v : v;
 }
 
-/* --sampling subpixel: the sample of display subpixel column s = 3j + k and of display row i in the view
- * raster, ((s + 1/2) / (3 W_d) W, (i + 1/2) / H_d H) (DESIGN section 5), truncated to the raster's fixed
- * point (16.16 and 24.8): the truncation keeps each sample in the pixel the encoder tables name. */
-inline long subpixel_sample_x(int s, int view_w, int display_w) {
-  return ((long)(2 * s + 1) * (long)view_w << PMR_X_FRAC_BITS) / (6L * (long)display_w);
-}
-inline long subpixel_sample_y(int i, int view_h, int display_h) {
-  return ((long)(2 * i + 1) * (long)view_h << PMR_Y_FRAC_BITS) / (2L * (long)display_h);
-}
-
 /* The column table of display row i: with subpixel cells, one block of 3 W_d columns per row class. */
 inline global const PmrEncodeColumn* row_columns(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
                                                  int i) {

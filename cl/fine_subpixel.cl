@@ -44,12 +44,36 @@ inline int8 sp_mask_alpha(const ShadeInputs* in, const PmrMta* m, int8 win, cons
   return vload8(0, w);
 }
 
+/* Bit l set: in view ib + l (l < n <= 16) the MTA's x extent reaches the chunk's samples, [0, span]
+ * relative to the chunk's first sample. Vertex x in 32 bits when that provably fits, else every view
+ * passes (the edge tests decide exactly either way). */
+inline uint sp_view_mask(const PmrMta* m, int ib, int n, long Xc, long span) {
+  const uint all = (1u << n) - 1u;
+  long base[3];
+  bool fits = span < (1L << 29);
+  for (int k = 0; k < 3; ++k) {
+    base[k] = (long)m->x0[k] + (long)ib * m->dx[k] - Xc;
+    fits = fits && base[k] > -(1L << 29) && base[k] < (1L << 29) && abs(m->dx[k]) < (1 << 25);
+  }
+  if (!fits) return all;
+  const int16 l = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  const int16 xa = (int16)((int)base[0]) + l * m->dx[0], xb = (int16)((int)base[1]) + l * m->dx[1];
+  const int16 xc = (int16)((int)base[2]) + l * m->dx[2];
+  const int16 pass = (max(xa, max(xb, xc)) >= (int16)(0)) & (min(xa, min(xb, xc)) <= (int16)((int)span));
+  const int16 bits = select((int16)(0), (int16)(1) << l, pass);
+  const int8 r8 = bits.lo | bits.hi;
+  const int4 r4 = r8.lo | r8.hi;
+  const int2 r2 = r4.lo | r4.hi;
+  return (uint)(r2.x | r2.y) & all;
+}
+
 kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, global const uint* tile_offsets,
                           global const uint* tile_queue, global const PmrTriangle* tris,
                           global const PmrVertexAttr* attrs, global const PmrMaterial* materials,
                           global const PmrTexture* textures, global const uchar4* texels,
                           global const float* srgb_lut, global const PmrEncodeParams* E,
                           global const PmrEncodeColumn* all_columns, global const PmrEncodeRow* rows,
+                          global const int* sample_x, global const int* sample_y,
                           global const PmrSampleChunk* chunks, uint num_chunks, global const int* straddle_slot,
                           uint straddle_slots, global uchar* straddle_cov, global half* display,
                           uint debug, global uint* dbg_key, global float* dbg_depth) {
@@ -57,19 +81,21 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
   if (chunk >= num_chunks) return;
   const PmrSampleChunk ch = chunks[chunk];
   const int views = P->views, width = ch.s1 - ch.s0;
-  const int W = P->view_w, H = P->view_h, Wd = E->display_w, Hd = E->display_h;
-  const long Xc = subpixel_sample_x(ch.s0, W, Wd), Yc = subpixel_sample_y(ch.i0, H, Hd);
-  const long Xl = subpixel_sample_x(ch.s1 - 1, W, Wd), Yl = subpixel_sample_y(ch.i1 - 1, H, Hd);
+  const int Wd = E->display_w;
+  const long Xc = sample_x[ch.s0], Yc = sample_y[ch.i0], Xl = sample_x[ch.s1 - 1], Yl = sample_y[ch.i1 - 1];
 
   /* 1. The samples by view: run v holds count[v] samples from first[v], padded to whole vectors. */
   int first[PMR_SUBPIXEL_VIEWS + 1], count[PMR_SUBPIXEL_VIEWS];
+  ushort view_of[PMR_SUBPIXEL_CAP];
   for (int v = 0; v < views; ++v) count[v] = 0;
-  for (int i = ch.i0; i < ch.i1; ++i) {
+  for (int i = ch.i0, n = 0; i < ch.i1; ++i) {
     global const PmrEncodeColumn* cols = row_columns(E, all_columns, i);
     const PmrEncodeRow row = rows[i];
-    for (int s = ch.s0; s < ch.s1; ++s) {
+    for (int s = ch.s0; s < ch.s1; ++s, ++n) {
       const PmrEncodeColumn c = cols[s];
-      ++count[encode_view(views, E->reversed, &c, &row)];
+      const int v = encode_view(views, E->reversed, &c, &row);
+      view_of[n] = (ushort)v;
+      ++count[v];
     }
   }
   int run = 0;
@@ -92,19 +118,27 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
   {
     int fill[PMR_SUBPIXEL_VIEWS];
     for (int v = 0; v < views; ++v) fill[v] = first[v];
-    for (int i = ch.i0; i < ch.i1; ++i) {
-      global const PmrEncodeColumn* cols = row_columns(E, all_columns, i);
-      const PmrEncodeRow row = rows[i];
-      const int y = (int)(subpixel_sample_y(i, H, Hd) - Yc);
-      for (int s = ch.s0; s < ch.s1; ++s) {
-        const PmrEncodeColumn c = cols[s];
-        const int k = fill[encode_view(views, E->reversed, &c, &row)]++;
-        sx[k] = (int)(subpixel_sample_x(s, W, Wd) - Xc);
-        sy[k] = y;
-        sid[k] = (ushort)((i - ch.i0) * width + (s - ch.s0));
+    /* column by column: a vector's samples then lie close together in x (all rows of a few columns),
+     * which the bounding boxes below exploit */
+    for (int s = ch.s0; s < ch.s1; ++s) {
+      const int x = (int)(sample_x[s] - Xc);
+      for (int i = ch.i0, n = s - ch.s0; i < ch.i1; ++i, n += width) {
+        const int k = fill[view_of[n]]++;
+        sx[k] = x;
+        sy[k] = (int)(sample_y[i] - Yc);
+        sid[k] = (ushort)n;
       }
     }
   }
+  /* each vector's bounding box (x0, x1, y0, y1): an MTA skips the vectors it cannot reach */
+  int4 box[SP_SLOTS / SP_LANES];
+  for (int v = 0; v < views; ++v)
+    for (int k = first[v]; k < first[v] + count[v]; k += SP_LANES) {
+      int4 b = (int4)(sx[k], sx[k], sy[k], sy[k]);
+      for (int l = 1; l < min(SP_LANES, first[v] + count[v] - k); ++l)
+        b = (int4)(min(b.x, sx[k + l]), max(b.y, sx[k + l]), min(b.z, sy[k + l]), max(b.w, sy[k + l]));
+      box[k / SP_LANES] = b;
+    }
 
   /* 2. Visibility: the tile's queues, every view slab. */
   ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut};
@@ -122,27 +156,41 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
       if (yhi < Yc || ylo > Yl) continue;
       const int i_lo = max(v0, m.view_lo), i_hi = min(v1, m.view_hi);
       const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
-      long bias[3];
+      /* per edge: sign * dy, and bias - sign * E(Xc, Yc, v) and -sign * dx_ab(v) at view i_lo with their
+       * exact per-view increments (both are linear in v) */
+      long t_lo[3], dt[3], dx_lo[3], ddx[3];
       double dy[3];
       for (int e = 0; e < 3; ++e) {
-        bias[e] = mta_edge_bias(&m, ea[e], eb[e]);
-        dy[e] = (double)((long)m.sign * (long)(m.y[eb[e]] - m.y[ea[e]]));
+        const int a = ea[e], b = eb[e];
+        const long sg = m.sign, d_y = (long)(m.y[b] - m.y[a]), d_dx = (long)m.dx[b] - (long)m.dx[a];
+        t_lo[e] = mta_edge_bias(&m, a, b) - sg * mta_edge(&m, a, b, Xc, Yc, i_lo);
+        dt[e] = sg * (d_y * (long)m.dx[a] + d_dx * (Yc - (long)m.y[a]));
+        dx_lo[e] = -sg * ((long)m.x0[b] - (long)m.x0[a] + (long)i_lo * d_dx);
+        ddx[e] = -sg * d_dx;
+        dy[e] = (double)(sg * d_y);
       }
-      for (int v = i_lo; v <= i_hi; ++v) {
+      const long my0 = ylo - Yc, my1 = yhi - Yc;
+      for (int ib = i_lo; ib <= i_hi; ib += 16) {
+      uint pass = sp_view_mask(&m, ib, min(i_hi - ib + 1, 16), Xc, Xl - Xc);
+      while (pass != 0) { /* the passing views, lowest first */
+        const int v = ib + (31 - (int)clz(pass & (0u - pass)));
+        pass &= pass - 1u;
         const int k0 = first[v], k1 = k0 + count[v];
         if (k0 == k1) continue;
         long xv[3];
         for (int k = 0; k < 3; ++k) xv[k] = (long)m.x0[k] + (long)v * (long)m.dx[k];
-        if (max(xv[0], max(xv[1], xv[2])) < Xc || min(xv[0], min(xv[1], xv[2])) > Xl) continue;
+        const long mx0 = min(xv[0], min(xv[1], xv[2])) - Xc, mx1 = max(xv[0], max(xv[1], xv[2])) - Xc;
         double dx[3], T[3];
+        const long di = (long)(v - i_lo);
         for (int e = 0; e < 3; ++e) {
-          const long t = bias[e] - (long)m.sign * mta_edge(&m, ea[e], eb[e], Xc, Yc, v);
-          T[e] = (double)clamp(t, -(1L << 48), 1L << 48);
-          dx[e] = (double)(-(long)m.sign * (xv[eb[e]] - xv[ea[e]]));
+          T[e] = (double)clamp(t_lo[e] + di * dt[e], -(1L << 48), 1L << 48);
+          dx[e] = (double)(dx_lo[e] + di * ddx[e]);
         }
         bool have_plane = false;
         double z0 = 0.0, gx = 0.0, gy = 0.0, bx = 0.0, by = 0.0;
         for (int k = k0; k < k1; k += SP_LANES) {
+          const int4 b = box[k / SP_LANES];
+          if (b.y < mx0 || b.x > mx1 || b.w < my0 || b.z > my1) continue;
           const double8 x = convert_double8(vload8(0, sx + k)), y = convert_double8(vload8(0, sy + k));
           long8 hit = convert_long8(lane < (int8)(k1 - k));
           hit &= (double8)(dy[0]) * x + (double8)(dx[0]) * y >= (double8)(T[0]);
@@ -171,6 +219,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
           vstore8(select(bk, (uint8)(m.key), as_uint8(win)), 0, best_key + k);
           vstore8(select(vload8(0, best_mta + k), (uint8)(id), as_uint8(win)), 0, best_mta + k);
         }
+      }
       }
     }
   }

@@ -28,10 +28,13 @@ struct BenchOptions {
   std::string save_scene;               // write the generated scene as .glb and exit
   std::vector<int> views = {1, 2, 4, 8, 16, 32, 48, 64, 96};
   std::vector<Method> methods = {Method::Pmr, Method::Multipass, Method::Duplicate};
+  std::vector<Sampling> samplings = {Sampling::View};  // subpixel applies to pmr only
+  bool views_given = false;
   int frames = 5;
   std::string csv;
   std::string keep = "view";
   int view_w = 1024, view_h = 512;  // per-view raster at N = 96 (keep total) or always (keep view)
+  RigConfig rig;                    // cone, field of view (views and sizes come from the options above)
   Display display;
   int tile[3] = {16, 2, 16};
   bool check = true;
@@ -63,6 +66,7 @@ BenchOptions parse(const std::vector<std::string>& args) {
     };
     if (a == "-h" || a == "--help") o.help = true;
     else if (a == "--views") {
+      o.views_given = true;
       o.views.clear();
       for (const auto& v : split(value())) {
         const RenderOptions r = parse_render_options({"--views", v});
@@ -71,6 +75,9 @@ BenchOptions parse(const std::vector<std::string>& args) {
     } else if (a == "--method") {
       o.methods.clear();
       for (const auto& m : split(value())) o.methods.push_back(parse_method(m));
+    } else if (a == "--sampling") {
+      o.samplings.clear();
+      for (const auto& m : split(value())) o.samplings.push_back(parse_sampling(m));
     } else if (a == "--frames") {
       const std::string v = value();
       o.frames = std::atoi(v.c_str());
@@ -94,20 +101,25 @@ BenchOptions parse(const std::vector<std::string>& args) {
     else if (a == "--no-check") o.check = false;
     else if (a == "--view-size" || a == "--display" || a == "--tile" || a == "--lens-pitch" || a == "--tan-slant" ||
              a == "--offset" || a == "--cone" || a == "--yfov" || a == "--display-size" || a == "--animation" ||
-             a == "--fps" || a == "--turntable") {
+             a == "--fps" || a == "--turntable" || a == "--preset") {
       rest.push_back(a);
       rest.push_back(value());
+    } else if (a == "--bilinear" || a == "--reverse-views") {
+      rest.push_back(a);
     } else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see pmr bench --help)");
     else if (o.scene.empty()) o.scene = a;
     else throw Error("more than one scene given");
   }
   RenderOptions r = parse_render_options(rest);
   o.view_w = r.rig.view_w, o.view_h = r.rig.view_h;
+  o.rig = r.rig;
+  o.rig.angular_spacing = false;  // PMR renders evenly spaced views
+  if (!o.views_given && std::find(rest.begin(), rest.end(), "--preset") != rest.end()) o.views = {r.rig.views};
   o.display = r.display;
   o.tile[0] = r.pipeline.tile_x, o.tile[1] = r.pipeline.tile_y, o.tile[2] = r.pipeline.tile_v;
   o.animation = r.animation, o.fps = r.fps;
   o.turntable = r.turntable, o.turntable_deg = r.turntable_deg, o.turntable_frames = r.turntable ? r.turntable_frames : 1;
-  if (o.methods.empty() || o.views.empty()) throw Error("nothing to measure");
+  if (o.methods.empty() || o.views.empty() || o.samplings.empty()) throw Error("nothing to measure");
   if (!o.generator.empty() && !o.scene.empty()) throw Error("give a SCENE or a generator (--synthetic, --objects), not both");
   if (!o.save_scene.empty() && o.triangle_counts.size() != 1)
     throw Error("--save-scene needs exactly one generated scene (--synthetic TRIS or --objects TRIS)");
@@ -156,11 +168,12 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
   spec.turntable = o.turntable, spec.turntable_deg = o.turntable_deg, spec.turntable_frames = o.turntable_frames;
   std::printf("# %s: %zu triangles; device %s; copy bandwidth %.1f GB/s\n", scene_name.c_str(), scene.triangles.size(),
               rt.device_name().c_str(), bw * 1e-9);
-  std::printf("%-10s %5s %9s %9s %9s %8s %8s %8s %8s %9s %8s %7s %8s\n", "method", "views", "view", "ms_median",
-              "ms_min", "setup", "tile", "fine", "encode", "Mvox/s", "floor_MB", "xfloor", "mismatch");
+  std::printf("%-10s %-8s %5s %9s %9s %9s %9s %8s %8s %8s %8s %9s %8s %7s %8s\n", "method", "sampling", "views", "view",
+              "Msamples", "ms_median", "ms_min", "setup", "tile", "fine", "encode", "Msmp/s", "floor_MB", "xfloor",
+              "mismatch");
   const double total_voxels = 96.0 * o.view_w * o.view_h;
   for (int N : o.views) {
-    RigConfig rc;
+    RigConfig rc = o.rig;
     rc.views = N;
     rc.view_w = o.view_w, rc.view_h = o.view_h;
     if (o.keep == "total") {
@@ -176,13 +189,19 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
     FrameRenderer renderer(scene, spec, rc, display, nullptr);
     const Rig& rig = renderer.rig();
     const double voxels = double(N) * rig.view_w * rig.view_h;
-    // the least a frame must move: every voxel written once, the display image written once (half RGBA)
-    const double floor_bytes = voxels * 8.0 + double(display.width) * display.height * 8.0;
-    const double floor_ms = floor_bytes / bw * 1e3;
-    std::vector<uint16_t> reference;
-    for (Method method : o.methods) {
+    const double subpixels = 3.0 * display.width * display.height;
+    std::vector<uint16_t> reference[2];  // per sampling: the first method's image
+    for (Method method : o.methods)
+      for (Sampling sampling : o.samplings) {
+      if (sampling == Sampling::Subpixel && method != Method::Pmr) continue;  // PMR only
+      // samples per frame: the voxels, or each display subpixel once
+      const double samples = sampling == Sampling::Subpixel ? subpixels : voxels;
+      // the least a frame must move: every sample written once, the display image written once (half RGBA)
+      const double floor_bytes = (sampling == Sampling::Subpixel ? 0.0 : voxels * 8.0) + double(display.width) * display.height * 8.0;
+      const double floor_ms = floor_bytes / bw * 1e3;
       PipelineConfig pc;
       pc.method = method;
+      pc.sampling = sampling;
       pc.tile_x = o.tile[0], pc.tile_y = o.tile[1], pc.tile_v = o.tile[2];
       pc.fuse_encode = true;  // the encoded-only job, as pmr render runs it
       Pipeline p(rt, pc);
@@ -204,20 +223,21 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       if (o.check) {
         std::vector<uint16_t> image;
         p.read_display(image);
-        if (reference.empty()) reference.swap(image);
-        else mismatch = coverage_mismatch(reference, image);
+        std::vector<uint16_t>& first = reference[sampling == Sampling::Subpixel];
+        if (first.empty()) first.swap(image);
+        else mismatch = coverage_mismatch(first, image);
         if (mismatch > 0.001)
           std::fprintf(stderr, "pmr: warning: %s at N = %d differs from %s on %.3f%% of display pixels\n", to_string(method), N,
                        to_string(o.methods[0]), 100.0 * mismatch);
       }
       const double med = median(wall), mn = *std::min_element(wall.begin(), wall.end());
-      const double mvox = voxels / (med * 1e-3) * 1e-6;
+      const double msmp = samples / (med * 1e-3) * 1e-6;
       const double mem_mb = double(p.device_bytes()) / (1 << 20);
       char view[32];
       std::snprintf(view, sizeof view, "%dx%d", rig.view_w, rig.view_h);
-      std::printf("%-10s %5d %9s %9.1f %9.1f %8.1f %8.1f %8.1f %8.1f %9.0f %8.0f %7.1f %8.5f\n", to_string(method), N,
-                  view, med, mn, median(setup), median(tile), median(fine), median(encode), mvox, floor_bytes / 1e6,
-                  med / floor_ms, mismatch);
+      std::printf("%-10s %-8s %5d %9s %9.2f %9.1f %9.1f %8.1f %8.1f %8.1f %8.1f %9.0f %8.0f %7.1f %8.5f\n",
+                  to_string(method), to_string(sampling), N, view, samples * 1e-6, med, mn, median(setup), median(tile),
+                  median(fine), median(encode), msmp, floor_bytes / 1e6, med / floor_ms, mismatch);
       if (median(pose) > 0.0)
         std::printf("#   on the host per frame (not in ms_median): pose %.2f ms, upload %.2f ms\n", median(pose),
                     median(upload));
@@ -225,10 +245,10 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       if (csv)
         *csv << scene_name << ',' << to_string(method) << ',' << N << ',' << rig.view_w << ',' << rig.view_h << ','
              << display.width << ',' << display.height << ',' << scene.triangles.size() << ',' << o.frames << ',' << med
-             << ',' << mn << ',' << median(setup) << ',' << median(tile) << ',' << median(fine) << ','
-             << median(encode) << ',' << mvox << ',' << mem_mb << ',' << floor_bytes / 1e6 << ',' << floor_ms << ','
-             << med / floor_ms << ',' << mismatch << '\n';
-    }
+             << ',' << mn << ',' << median(setup) << ',' << median(tile) << ',' << median(fine) << ',' << median(encode)
+             << ',' << voxels / (med * 1e-3) * 1e-6 << ',' << mem_mb << ',' << floor_bytes / 1e6 << ',' << floor_ms << ','
+             << med / floor_ms << ',' << mismatch << ',' << to_string(sampling) << ',' << samples << ',' << msmp << '\n';
+      }
   }
 }
 
@@ -243,6 +263,8 @@ std::string bench_help() {
          "Times whole frames (render + encode, no file I/O) per view count and method.\n"
          "  --views LIST        view counts (default 1,2,4,8,16,32,48,64,96)\n"
          "  --method LIST       pmr, multipass, duplicate (default all three)\n"
+         "  --sampling LIST     view, subpixel (default view; subpixel with pmr only): samples per frame are\n"
+         "                      the voxels, or each display subpixel once\n"
          "  --frames K          timed frames per point after one warm-up frame (default 5)\n"
          "  --csv FILE          write one row per point\n"
          "  --keep view|total   view: every view is --view-size (default 1024x512); total: the total voxel\n"
@@ -255,7 +277,8 @@ std::string bench_help() {
          "  --save-scene FILE   write the one generated scene to FILE (.glb) and exit: `pmr bench FILE` on\n"
          "                      any build then renders the very same triangles\n"
          "  --no-check          skip comparing the methods' images\n"
-         "  --view-size, --display, --tile and the display options are as for pmr render, and so are\n"
+         "  --preset, --view-size, --display, --tile and the display options are as for pmr render (a\n"
+         "  preset's view count unless --views; views evenly spaced), and so are\n"
          "  --animation, --fps and --turntable: the timed frames are then frames 0..K-1 of that sequence.\n"
          "Per point it prints the frame time, the per-stage device times, and the floor: the bytes a frame\n"
          "must move (each voxel written once, the display image written once) at the measured copy bandwidth.\n";
@@ -282,7 +305,8 @@ int run_bench(const std::vector<std::string>& args) {
   const double bw = copy_bandwidth(rt);
   if (csv)
     *csv << "scene,method,views,view_w,view_h,display_w,display_h,triangles,frames,ms_median,ms_min,ms_setup,ms_tile,"
-            "ms_fine,ms_encode,mvoxels_per_s,peak_mem_mb,floor_mb,floor_ms,x_floor,coverage_mismatch\n";
+            "ms_fine,ms_encode,mvoxels_per_s,peak_mem_mb,floor_mb,floor_ms,x_floor,coverage_mismatch,sampling,samples,"
+            "msamples_per_s\n";
   if (o.generator.empty()) {
     const std::string path = o.scene.empty() ? default_scene_path() : o.scene;
     bench_scene(o, rt, bw, load_scene(path), path.substr(path.rfind('/') + 1), csv.get());

@@ -89,7 +89,7 @@ struct Pipeline::Impl {
   ClKernel k_fine_subpixel, k_subpixel_straddle;
   bool subpixel = false, keep_volume = true;
   bool subpixel_debug = false;  // debug outputs per display subpixel (when no view volume is rendered)
-  ClBuffer chunks;
+  ClBuffer chunks, sample_x, sample_y;
   uint32_t num_chunks = 0;
   size_t debug_entries = 1;
   uint32_t last_mtas = 0;
@@ -112,6 +112,10 @@ struct Pipeline::Impl {
   void configure_subpixel(const std::string& options, int views, const int* tile,
                           const std::vector<PmrEncodeColumn>& columns, const std::vector<PmrEncodeRow>& rows);
   void upload_straddles(const TileOwnership& own);
+  void upload_table(ClBuffer& b, const std::vector<int32_t>& v, const char* name) {
+    b = rt.buffer(std::max<size_t>(bytes_of(v), 16), name, CL_MEM_READ_ONLY);
+    rt.write(b, v.data(), bytes_of(v));
+  }
   ~Impl() {
     if (program) clReleaseProgram(program);
     if (fused_program) clReleaseProgram(fused_program);
@@ -425,14 +429,10 @@ void Pipeline::Impl::configure_fused(const std::string& options, int views, int 
 
 // Ownership tables and the straddling pixels' coverage slots (fused and subpixel paths).
 void Pipeline::Impl::upload_straddles(const TileOwnership& own) {
-  auto upload = [&](ClBuffer& b, const std::vector<int32_t>& v, const char* name) {
-    b = rt.buffer(std::max<size_t>(bytes_of(v), 16), name, CL_MEM_READ_ONLY);
-    rt.write(b, v.data(), bytes_of(v));
-  };
-  upload(column_start, own.column_start, "column starts");
-  upload(row_start, own.row_start, "row starts");
-  upload(straddle_slot, own.straddle_slot, "straddle slots");
-  upload(straddle_columns, own.straddling, "straddle columns");
+  upload_table(column_start, own.column_start, "column starts");
+  upload_table(row_start, own.row_start, "row starts");
+  upload_table(straddle_slot, own.straddle_slot, "straddle slots");
+  upload_table(straddle_columns, own.straddling, "straddle columns");
   straddle_slots = uint32_t(own.straddling.size());
   straddle_cov = rt.buffer(std::max<size_t>(size_t(straddle_slots) * encode_params.display_h * 3, 16), "straddle coverage");
 }
@@ -455,6 +455,8 @@ void Pipeline::Impl::configure_subpixel(const std::string& options, int views, c
   }
   const TileOwnership own = tile_ownership(encode_params, columns, rows, tile[0]);
   upload_straddles(own);
+  upload_table(sample_x, subpixel_sample_columns(encode_params), "subpixel sample columns");
+  upload_table(sample_y, subpixel_sample_rows(encode_params), "subpixel sample rows");
   const std::vector<PmrSampleChunk> list = subpixel_chunks(own, tile[0], tile[1], capacity);
   num_chunks = uint32_t(list.size());
   chunks = rt.buffer(std::max<size_t>(bytes_of(list), 16), "subpixel chunks", CL_MEM_READ_ONLY);
@@ -470,7 +472,7 @@ void Pipeline::Impl::straddle_alpha_stage(ClKernel& k, Events& ev) {
 void Pipeline::Impl::subpixel_stage(Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
   k_fine_subpixel.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut,
-                       encode_buf, encode_columns, encode_rows, chunks, num_chunks, straddle_slot, straddle_slots,
+                       encode_buf, encode_columns, encode_rows, sample_x, sample_y, chunks, num_chunks, straddle_slot, straddle_slots,
                        straddle_cov, display, cl_uint(subpixel_debug), dbg_key, dbg_depth);
   ev.add(kFine, rt.launch(k_fine_subpixel, num_chunks, 1));
   straddle_alpha_stage(k_subpixel_straddle, ev);

@@ -27,6 +27,20 @@ TileOwnership tile_ownership(const PmrEncodeParams& E, const std::vector<PmrEnco
   return t;
 }
 
+std::vector<int32_t> subpixel_sample_columns(const PmrEncodeParams& E) {
+  std::vector<int32_t> x(size_t(3) * E.display_w);
+  for (int s = 0; s < 3 * E.display_w; ++s)
+    x[size_t(s)] = int32_t((int64_t(2 * s + 1) * E.view_w * PMR_X_ONE) / (int64_t(6) * E.display_w));
+  return x;
+}
+
+std::vector<int32_t> subpixel_sample_rows(const PmrEncodeParams& E) {
+  std::vector<int32_t> y(size_t(E.display_h));
+  for (int i = 0; i < E.display_h; ++i)
+    y[size_t(i)] = int32_t((int64_t(2 * i + 1) * E.view_h * PMR_Y_ONE) / (int64_t(2) * E.display_h));
+  return y;
+}
+
 int subpixel_chunk_capacity(int views) {
   // area + (lanes - 1) * min(views, area) <= slots
   const int area = kSubpixelSlots - (kSubpixelLanes - 1) * views;

@@ -21,9 +21,15 @@ struct TileOwnership {
 TileOwnership tile_ownership(const PmrEncodeParams& E, const std::vector<PmrEncodeColumn>& columns,
                              const std::vector<PmrEncodeRow>& rows, int tile_x);
 
-// --sampling subpixel. A chunk's samples sorted by view, each view's run padded to whole vectors, must fit
+// --sampling subpixel: the sample of display subpixel column s = 3j + k and of display row i in the view
+// raster, ((s + 1/2) / (3 W_d) W, (i + 1/2) / H_d H) (DESIGN section 5), truncated to the raster's fixed
+// point (16.16 and 24.8): the truncation keeps each sample in the pixel the encoder tables name.
+std::vector<int32_t> subpixel_sample_columns(const PmrEncodeParams& E);  // 3 W_d entries, 16.16
+std::vector<int32_t> subpixel_sample_rows(const PmrEncodeParams& E);     // H_d entries, 24.8
+
+// A chunk's samples sorted by view, each view's run padded to whole vectors, must fit
 // the kernel's PMR_SUBPIXEL_SLOTS private slots: the chunk capacity leaves room for the padding.
-constexpr int kSubpixelSlots = 4096;
+constexpr int kSubpixelSlots = 8192;
 constexpr int kSubpixelLanes = 8;  // SP_LANES in cl/fine_subpixel.cl
 int subpixel_chunk_capacity(int views);
 // Every display subpixel in exactly one chunk; a chunk lies in one screen tile, holds at most

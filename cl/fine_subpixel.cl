@@ -72,7 +72,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
                           global const PmrVertexAttr* attrs, global const PmrMaterial* materials,
                           global const PmrTexture* textures, global const uchar4* texels,
                           global const float* srgb_lut, global const PmrEncodeParams* E,
-                          global const PmrEncodeColumn* all_columns, global const PmrEncodeRow* rows,
+                          global const int* column_a, global const int* column_b, global const PmrEncodeRow* rows,
                           global const int* sample_x, global const int* sample_y,
                           global const PmrSampleChunk* chunks, uint num_chunks, global const int* straddle_slot,
                           uint straddle_slots, global uchar* straddle_cov, global half* display,
@@ -86,18 +86,21 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
 
   /* 1. The samples by view: run v holds count[v] samples from first[v], padded to whole vectors. */
   int first[PMR_SUBPIXEL_VIEWS + 1], count[PMR_SUBPIXEL_VIEWS];
-  ushort view_of[PMR_SUBPIXEL_CAP];
+  ushort view_of[PMR_SUBPIXEL_CAP + 8];
   for (int v = 0; v < views; ++v) count[v] = 0;
   for (int i = ch.i0, n = 0; i < ch.i1; ++i) {
-    global const PmrEncodeColumn* cols = row_columns(E, all_columns, i);
+    /* encode_view for 8 columns at a time from the column table's planes (a_mod_n, b) */
+    const size_t block = (size_t)(E->cell_rows > 1 ? (E->display_h - 1 - i) % E->cell_rows : 0) * (size_t)(3 * Wd);
     const PmrEncodeRow row = rows[i];
-    for (int s = ch.s0; s < ch.s1; ++s, ++n) {
-      const PmrEncodeColumn c = cols[s];
-      const int v = encode_view(views, E->reversed, &c, &row);
-      view_of[n] = (ushort)v;
-      ++count[v];
+    for (int s = ch.s0; s < ch.s1; s += 8, n += 8) {
+      int8 v = vload8(0, column_a + block + s) - (int8)(row.q_mod_n) + (vload8(0, column_b + block + s) < (int8)(row.s));
+      v = select(v, v + (int8)(views), v < (int8)(0));
+      if (E->reversed) v = (int8)(views - 1) - v;
+      vstore8(convert_ushort8(v), 0, view_of + n);
     }
+    n -= (8 - width % 8) % 8; /* the last vector's lanes past the chunk are overwritten by the next row */
   }
+  for (int n = 0; n < width * (ch.i1 - ch.i0); ++n) ++count[view_of[n]];
   int run = 0;
   for (int v = 0; v < views; ++v) {
     first[v] = run;
@@ -106,14 +109,14 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
   first[views] = run;
   int sx[SP_SLOTS], sy[SP_SLOTS];     /* sample offsets from (Xc, Yc), fixed point */
   ushort sid[SP_SLOTS];               /* sample index (i - i0) * width + (s - s0) */
+  uchar channel[SP_SLOTS];            /* k of the sample's subpixel s = 3j + k */
   float best_depth[SP_SLOTS];
-  uint best_key[SP_SLOTS], best_mta[SP_SLOTS];
-  for (int k = 0; k < run; ++k) {
-    sx[k] = sy[k] = 0;
-    sid[k] = 0;
-    best_depth[k] = INFINITY;
-    best_key[k] = PMR_NO_KEY;
-    best_mta[k] = 0;
+  uint best_key[SP_SLOTS], best_mta[SP_SLOTS]; /* best_mta is read only where best_key says drawn */
+  for (int k = 0; k < run; k += 8) {
+    vstore8((float8)(INFINITY), 0, best_depth + k);
+    vstore8((uint8)(PMR_NO_KEY), 0, best_key + k);
+    vstore8((int8)(0), 0, sx + k); /* padding lanes: any value, masked by the run's length */
+    vstore8((int8)(0), 0, sy + k);
   }
   {
     int fill[PMR_SUBPIXEL_VIEWS];
@@ -122,27 +125,30 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
      * which the bounding boxes below exploit */
     for (int s = ch.s0; s < ch.s1; ++s) {
       const int x = (int)(sample_x[s] - Xc);
+      const uchar c = (uchar)(s % 3);
       for (int i = ch.i0, n = s - ch.s0; i < ch.i1; ++i, n += width) {
         const int k = fill[view_of[n]]++;
         sx[k] = x;
         sy[k] = (int)(sample_y[i] - Yc);
         sid[k] = (ushort)n;
+        channel[k] = c;
       }
     }
   }
   /* each vector's bounding box (x0, x1, y0, y1): an MTA skips the vectors it cannot reach */
   int4 box[SP_SLOTS / SP_LANES];
+  const int8 lane = vload8(0, sp_lane_index);
   for (int v = 0; v < views; ++v)
     for (int k = first[v]; k < first[v] + count[v]; k += SP_LANES) {
-      int4 b = (int4)(sx[k], sx[k], sy[k], sy[k]);
-      for (int l = 1; l < min(SP_LANES, first[v] + count[v] - k); ++l)
-        b = (int4)(min(b.x, sx[k + l]), max(b.y, sx[k + l]), min(b.z, sy[k + l]), max(b.w, sy[k + l]));
-      box[k / SP_LANES] = b;
+      const int8 valid = lane < (int8)(first[v] + count[v] - k); /* padding lanes repeat lane 0 */
+      const int8 x = select((int8)(sx[k]), vload8(0, sx + k), valid), y = select((int8)(sy[k]), vload8(0, sy + k), valid);
+      const int4 x0 = min(x.lo, x.hi), x1 = max(x.lo, x.hi), y0 = min(y.lo, y.hi), y1 = max(y.lo, y.hi);
+      const int2 a = min(x0.lo, x0.hi), b = max(x1.lo, x1.hi), c = min(y0.lo, y0.hi), d = max(y1.lo, y1.hi);
+      box[k / SP_LANES] = (int4)(min(a.x, a.y), max(b.x, b.y), min(c.x, c.y), max(d.x, d.y));
     }
 
   /* 2. Visibility: the tile's queues, every view slab. */
   ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut};
-  const int8 lane = vload8(0, sp_lane_index);
   const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
   for (int tv = 0; tv < P->tiles_v; ++tv) {
     const int v0 = tv * PMR_TILE_V, v1 = min(views, v0 + PMR_TILE_V) - 1;
@@ -230,9 +236,9 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
   uchar covered[PMR_SUBPIXEL_CAP];
   for (int v = 0; v < views; ++v)
     for (int k = first[v]; k < first[v] + count[v]; ++k) {
-      const int n = sid[k], s = ch.s0 + n % width;
+      const int n = sid[k];
       if (debug) {
-        const size_t at = (size_t)(ch.i0 + n / width) * (size_t)(3 * Wd) + (size_t)s;
+        const size_t at = (size_t)(ch.i0 + n / width) * (size_t)(3 * Wd) + (size_t)(ch.s0 + n % width);
         dbg_key[at] = best_key[k];
         dbg_depth[at] = best_depth[k];
       }
@@ -242,9 +248,8 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
         continue;
       }
       const float4 c = shade_mta_at(&in, mtas, best_mta[k], light, Xc + sx[k], Yc + sy[k], v);
-      const int channel = s % 3;
       ushort h;
-      vstore_half(channel == 0 ? c.x : (channel == 1 ? c.y : c.z), 0, (half*)&h);
+      vstore_half(channel[k] == 0 ? c.x : (channel[k] == 1 ? c.y : c.z), 0, (half*)&h);
       value[n] = h;
       covered[n] = 1;
     }

@@ -89,7 +89,7 @@ struct Pipeline::Impl {
   ClKernel k_fine_subpixel, k_subpixel_straddle;
   bool subpixel = false, keep_volume = true;
   bool subpixel_debug = false;  // debug outputs per display subpixel (when no view volume is rendered)
-  ClBuffer chunks, sample_x, sample_y;
+  ClBuffer chunks, sample_x, sample_y, column_a, column_b;
   uint32_t num_chunks = 0;
   size_t debug_entries = 1;
   uint32_t last_mtas = 0;
@@ -455,6 +455,11 @@ void Pipeline::Impl::configure_subpixel(const std::string& options, int views, c
   }
   const TileOwnership own = tile_ownership(encode_params, columns, rows, tile[0]);
   upload_straddles(own);
+  // the column table's a_mod_n and b as planes, for 8-column vector loads (8 entries of slack at the end)
+  std::vector<int32_t> a(columns.size() + 8), b(columns.size() + 8);
+  for (size_t s = 0; s < columns.size(); ++s) a[s] = columns[s].a_mod_n, b[s] = columns[s].b;
+  upload_table(column_a, a, "subpixel column views");
+  upload_table(column_b, b, "subpixel column ranks");
   upload_table(sample_x, subpixel_sample_columns(encode_params), "subpixel sample columns");
   upload_table(sample_y, subpixel_sample_rows(encode_params), "subpixel sample rows");
   const std::vector<PmrSampleChunk> list = subpixel_chunks(own, tile[0], tile[1], capacity);
@@ -472,7 +477,7 @@ void Pipeline::Impl::straddle_alpha_stage(ClKernel& k, Events& ev) {
 void Pipeline::Impl::subpixel_stage(Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
   k_fine_subpixel.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut,
-                       encode_buf, encode_columns, encode_rows, sample_x, sample_y, chunks, num_chunks, straddle_slot, straddle_slots,
+                       encode_buf, column_a, column_b, encode_rows, sample_x, sample_y, chunks, num_chunks, straddle_slot, straddle_slots,
                        straddle_cov, display, cl_uint(subpixel_debug), dbg_key, dbg_depth);
   ev.add(kFine, rt.launch(k_fine_subpixel, num_chunks, 1));
   straddle_alpha_stage(k_subpixel_straddle, ev);

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cli/bench_command.h"
+#include "cli/quality_command.h"
 #include "cli/info_command.h"
 #include "cli/options.h"
 #include "cli/render_command.h"
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
     args.erase(args.begin());
     if (cmd == "render") return pmr::run_render(args);
     if (cmd == "bench") return pmr::run_bench(args);
+    if (cmd == "quality") return pmr::run_quality(args);
     if (cmd == "info") return pmr::run_info(args);
     if (cmd == "verify") return pmr::run_verify(args);
     throw pmr::Error("unknown command '" + cmd + "' (try pmr --help)");

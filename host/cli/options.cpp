@@ -249,6 +249,7 @@ std::string main_help() {
          "usage:\n"
          "  pmr render [SCENE.gltf|SCENE.glb] [options]   render N views and the encoded display image\n"
          "  pmr bench [SCENE] [options]                  performance sweeps over view count and method\n"
+         "  pmr quality [SCENE] [options]                sampling error against a 4x finer reference\n"
          "  pmr info                                     list OpenCL platforms and devices\n"
          "  pmr info SCENE                               what a scene holds (cameras, animations, ...)\n"
          "  pmr verify DIR --frames LIST                 which frames of a sequence are missing or broken\n"

@@ -69,6 +69,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["scene"] = info.scene;
   j["frame"] = info.frame;
   j["method"] = info.method;
+  j["sampling"] = info.sampling;
   j["tile"] = {{"x", info.tile_x}, {"y", info.tile_y}, {"v", info.tile_v}};
   j["camera"] = info.camera;
   if (info.has_bounds)
@@ -206,6 +207,9 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
     return t;
   };
   if (!a.contains("turntable") || turn(get(a, "turntable")) != turn(get(b, "turntable"))) return "turntable";
+  // sidecars written before --sampling existed sampled the views
+  auto sampling = [&](const json& o) { return get(o, "sampling").is_null() ? json("view") : get(o, "sampling"); };
+  if (sampling(a) != sampling(b)) return "sampling";
   // the rig as configured (an animated camera moves the focal plane from frame to frame)
   const json ra = get(a, "rig"), rb = get(b, "rig");
   if (!ra.is_object()) return "rig";

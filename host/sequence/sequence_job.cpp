@@ -92,6 +92,7 @@ int run_sequence(const RenderOptions& o) {
   info.tile_y = o.pipeline.tile_y;
   info.tile_v = o.pipeline.tile_v;
   info.method = to_string(o.pipeline.method);
+  info.sampling = to_string(o.pipeline.sampling);
   info.camera = o.rig.camera;
   info.has_bounds = true;
   info.bounds_lo = renderer.bounds_lo();
@@ -188,12 +189,15 @@ int run_sequence(const RenderOptions& o) {
     upload_s += fr.upload_ms / 1000.0;
     if (!fr.visible) progress.message("pmr: warning: frame " + std::to_string(f) + ": nothing visible, written as a transparent image");
     if (o.verbose) {
+      // the fused path and --sampling subpixel write the display image from the fine raster's tiles
+      const bool subpixel = pc.sampling == Sampling::Subpixel, tiled_encode = pipeline.fused() || subpixel;
+      const char* encode_label = subpixel ? " + subpixel samples" : " + encode (fused)";
       char line[320];
       std::snprintf(line, sizeof line,
                     "pmr: frame %ld: pose %.2f ms, upload %.2f ms; stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, "
                     "fine raster%s %.2f, %s %.2f; %u MTAs, %llu tile-queue entries, %d queue regrowth(s)",
-                    f, fr.pose_ms, fr.upload_ms, fr.times.vertex, fr.times.setup, fr.times.bin, pipeline.fused() ? " + encode (fused)" : "",
-                    fr.times.fine, pipeline.fused() ? "straddling alpha" : "encode", fr.times.encode, fr.times.mtas,
+                    f, fr.pose_ms, fr.upload_ms, fr.times.vertex, fr.times.setup, fr.times.bin, tiled_encode ? encode_label : "",
+                    fr.times.fine, tiled_encode ? "straddling alpha" : "encode", fr.times.encode, fr.times.mtas,
                     (unsigned long long)fr.times.bin_entries, fr.times.retries);
       progress.message(line);
     }

@@ -99,6 +99,7 @@ struct SidecarInfo {
   std::string scene;            // the scene file as given (empty = the bundled default scene)
   int frame = 0;
   std::string method = "pmr";   // "pmr" or the baseline's name
+  std::string sampling = "view";  // "view" or "subpixel" (docs/SAMPLING.md)
   int tile_x = 16, tile_y = 2, tile_v = 16;
   int camera = -1;              // glTF camera index, -1 = the default framing of the bounding sphere
   bool has_bounds = false;      // world bounds of the scene the default framing used

@@ -1,6 +1,8 @@
 // `pmr bench` at a tiny configuration: the CSV has the documented columns, one row per point, and the
 // methods' images agree; the synthetic scene has about the requested triangle count.
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,7 +25,7 @@ std::vector<std::string> split_csv(const std::string& line) {
 TEST(Bench, WritesCsvWithOneRowPerPoint) {
   const std::string csv = ::testing::TempDir() + "pmr_bench_test_" + std::to_string(getpid()) + ".csv";
   const std::string cmd = std::string(PMR_BINARY) +
-                          " bench --synthetic 2000 --views 1,3,8 --method pmr,multipass,duplicate --frames 1"
+                          " bench --synthetic 2000 --views 1,3,8 --method pmr,multipass,duplicate --sampling view,subpixel --frames 1"
                           " --view-size 64x32 --display 320x180 --csv " + csv + " > /dev/null 2>&1";
   const int st = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << cmd;
@@ -35,17 +37,32 @@ TEST(Bench, WritesCsvWithOneRowPerPoint) {
             0u)
       << header;
   const auto cols = split_csv(header);
+  auto column = [&](const std::string& name) {
+    const auto it = std::find(cols.begin(), cols.end(), name);
+    EXPECT_NE(it, cols.end()) << name;
+    return size_t(it - cols.begin());
+  };
+  const size_t mismatch = column("coverage_mismatch"), sampling = column("sampling"), samples = column("samples");
   std::string line;
-  int rows = 0;
+  int rows = 0, subpixel_rows = 0;
   while (std::getline(in, line)) {
     const auto f = split_csv(line);
     ASSERT_EQ(f.size(), cols.size()) << line;
     EXPECT_GT(std::stod(f[9]), 0.0) << "ms_median";
     EXPECT_LE(std::stod(f[10]), std::stod(f[9])) << "ms_min <= ms_median";
-    EXPECT_LT(std::stod(f.back()), 0.001) << "coverage mismatch between methods: " << line;
+    EXPECT_LT(std::stod(f[mismatch]), 0.001) << "coverage mismatch between methods: " << line;
+    if (f[sampling] == "subpixel") {  // PMR only, one sample per display subpixel
+      ++subpixel_rows;
+      EXPECT_EQ(f[1], "pmr") << line;
+      EXPECT_EQ(std::stod(f[samples]), 3.0 * 320 * 180) << line;
+    } else {
+      EXPECT_EQ(f[sampling], "view") << line;
+      EXPECT_EQ(std::stod(f[samples]), std::stod(f[2]) * 64 * 32) << line;
+    }
     ++rows;
   }
-  EXPECT_EQ(rows, 9);
+  EXPECT_EQ(rows, 12);
+  EXPECT_EQ(subpixel_rows, 3);
 }
 
 TEST(Bench, SyntheticSceneHasAboutTheRequestedTriangles) {

@@ -240,6 +240,59 @@ TEST(SubpixelSampling, CloserToAFinerReferenceThanViewSampling) {
   }
 }
 
+// With a product that needs the views (--write views), the views are rendered on their grids as with
+// --sampling view, and the display image is the same as without them.
+TEST(SubpixelSampling, ViewsStillRenderedOnTheirGridsWhenAsked) {
+  const Scene scene = test::random_scene(80, 4242u, true);
+  Display d;
+  d.width = 96, d.height = 54;
+  RigConfig rc;
+  rc.views = 9, rc.view_w = 40, rc.view_h = 24;
+  const Rig rig = make_rig(rc, d, glm::dvec3(-1.0), glm::dvec3(1.0));
+  auto render = [&](Sampling sampling, bool fuse, std::vector<uint16_t>* volume) {
+    PipelineConfig pc;
+    pc.sampling = sampling;
+    pc.fuse_encode = fuse;
+    Pipeline p(test::runtime(), pc);
+    p.set_scene(scene);
+    p.configure(rig, &d);
+    p.render(rig);
+    EXPECT_EQ(p.has_volume(), volume != nullptr);
+    if (volume) p.read_volume(*volume);
+    std::vector<uint16_t> image;
+    p.read_display(image);
+    return image;
+  };
+  std::vector<uint16_t> views_sub, views_view;
+  const std::vector<uint16_t> alone = render(Sampling::Subpixel, true, nullptr);
+  const std::vector<uint16_t> with_views = render(Sampling::Subpixel, false, &views_sub);
+  render(Sampling::View, false, &views_view);
+  EXPECT_EQ(with_views, alone);
+  EXPECT_EQ(views_sub, views_view);
+  size_t drawn = 0;
+  for (size_t i = 3; i < alone.size(); i += 4) drawn += alone[i] != 0;
+  EXPECT_GT(drawn, alone.size() / 40);
+}
+
+TEST(SubpixelSampling, CommandLine) {
+  const std::string out = test::temp_dir("subpixel_cli");
+  test::expect_one_error_line(test::run("render --sampling pixel --out " + out), "unknown sampling 'pixel'");
+  test::expect_one_error_line(test::run("render --sampling subpixel --bilinear --out " + out), "--bilinear");
+  test::expect_one_error_line(test::run("render --sampling subpixel --method multipass --out " + out), "--method pmr");
+  test::expect_one_error_line(test::run("render --sampling subpixel --preset lg-portrait --out " + out),
+                              "--camera-spacing linear");
+  EXPECT_EQ(test::count_entries(out), 0u) << "nothing written on bad options";
+  const std::string small = " --views 6 --view-size 48x24 --display 160x90 --out " + out;
+  const test::CliRun r = test::run("render --sampling subpixel --write encoded,views" + small);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(test::exists(out + "/frame_0000.exr"));
+  EXPECT_TRUE(test::exists(out + "/frame_0000.views.exr"));
+  EXPECT_NE(test::read_file(out + "/frame_0000.json").find("\"sampling\": \"subpixel\""), std::string::npos);
+  // --resume keeps frames of the same sampling and refuses another
+  EXPECT_EQ(test::run("render --sampling subpixel --write encoded,views --resume" + small).status, 0);
+  test::expect_one_error_line(test::run("render --write encoded,views --resume" + small), "sampling differs");
+}
+
 TEST(SubpixelSampling, ImageDifferenceCountsColourChannelsOnly) {
   // two pixels: alpha differs everywhere (ignored), one colour channel by 0.5, one by 2^-9 (under the
   // differing threshold)

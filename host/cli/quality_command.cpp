@@ -12,17 +12,19 @@
 namespace pmr {
 
 std::string quality_help() {
-  return "usage: pmr quality [SCENE] [--scale K] [render options]\n"
+  return "usage: pmr quality [SCENE] [--scale K] [--also-view-size WxH ...] [render options]\n"
          "Renders frame 0 of SCENE (default: the bundled scene) with --sampling subpixel, --sampling view and\n"
          "--sampling view --bilinear, and compares each encoded image with a reference: --sampling view\n"
          "with views K times wider and taller (default 4), nearest sampling. Per sampling it prints the\n"
          "RMSE over every subpixel's colour (linear) and the fraction of subpixels differing by more than\n"
-         "1/256. The rig and display options are those of pmr render (--preset, --views, --view-size, ...);\n"
+         "1/256. --also-view-size adds --sampling view at another view size (repeatable).\n"
+         "The rig and display options are those of pmr render (--preset, --views, --view-size, ...);\n"
          "views are evenly spaced. See docs/SAMPLING.md.\n";
 }
 
 int run_quality(const std::vector<std::string>& args) {
   int scale = 4;
+  std::vector<std::pair<int, int>> extra;
   std::vector<std::string> rest;
   for (size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "-h" || args[i] == "--help") {
@@ -38,6 +40,12 @@ int run_quality(const std::vector<std::string>& args) {
       scale = int(k);
       continue;
     }
+    if (args[i] == "--also-view-size") {  // checked as --view-size is
+      if (i + 1 >= args.size()) throw Error("option --also-view-size needs a value (see pmr quality --help)");
+      const RenderOptions r = parse_render_options({"--view-size", args[++i]});
+      extra.push_back({r.rig.view_w, r.rig.view_h});
+      continue;
+    }
     rest.push_back(args[i]);
   }
   RenderOptions o = parse_render_options(rest);
@@ -46,7 +54,7 @@ int run_quality(const std::vector<std::string>& args) {
   if (o.scene.empty()) o.scene = default_scene_path();
   const Scene scene = load_scene(o.scene);
   ClRuntime rt;
-  const std::vector<SamplingQualityRow> rows = sampling_quality(rt, scene, o.rig, o.display, scale);
+  const std::vector<SamplingQualityRow> rows = sampling_quality(rt, scene, o.rig, o.display, scale, extra);
   std::printf("# %s: %zu triangles; %d views; display %dx%d; device %s\n", o.scene.c_str(), scene.triangles.size(),
               o.rig.views, o.display.width, o.display.height, rt.device_name().c_str());
   std::printf("%-16s %10s %10s %10s %10s %10s\n", "sampling", "view", "Msamples", "render_ms", "rmse", "differing");

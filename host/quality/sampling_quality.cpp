@@ -55,7 +55,8 @@ std::vector<uint16_t> render_display(const ClRuntime& rt, const Scene& scene, Ri
 }  // namespace
 
 std::vector<SamplingQualityRow> sampling_quality(const ClRuntime& rt, const Scene& scene, const RigConfig& rig,
-                                                 const Display& display, int scale) {
+                                                 const Display& display, int scale,
+                                                 const std::vector<std::pair<int, int>>& extra_view_sizes) {
   if (scale < 1 || rig.view_w * scale > PMR_MAX_RASTER || rig.view_h * scale > PMR_MAX_RASTER)
     throw Error("the reference views (" + std::to_string(rig.view_w) + "x" + std::to_string(rig.view_h) + " times " +
                 std::to_string(scale) + ") exceed " + std::to_string(PMR_MAX_RASTER) + " px; use a smaller --view-size");
@@ -77,6 +78,14 @@ std::vector<SamplingQualityRow> sampling_quality(const ClRuntime& rt, const Scen
       render_display(rt, scene, rig, nearest, Sampling::View, rows[2]),
       render_display(rt, scene, rig, bilinear, Sampling::View, rows[3])};
   for (int k = 0; k < 3; ++k) rows[size_t(k) + 1].error = compare_display_images(images[k], reference);
+  for (const auto& size : extra_view_sizes) {
+    SamplingQualityRow row;
+    row.name = "view";
+    RigConfig larger = rig;
+    larger.view_w = size.first, larger.view_h = size.second;
+    row.error = compare_display_images(render_display(rt, scene, larger, nearest, Sampling::View, row), reference);
+    rows.push_back(row);
+  }
   return rows;
 }
 

@@ -31,8 +31,10 @@ struct SamplingQualityRow {
   ImageDifference error;  // against the reference
 };
 // Frame 0 of `scene` with the rig and display given; throws pmr::Error when the reference views would
-// exceed the raster limit (8192 px).
+// exceed the raster limit (8192 px). `extra_view_sizes` adds rows of --sampling view at other view
+// sizes (the cost of matching subpixel sampling's error by rendering larger views).
 std::vector<SamplingQualityRow> sampling_quality(const ClRuntime& rt, const Scene& scene, const RigConfig& rig,
-                                                 const Display& display, int scale);
+                                                 const Display& display, int scale,
+                                                 const std::vector<std::pair<int, int>>& extra_view_sizes = {});
 
 }  // namespace pmr

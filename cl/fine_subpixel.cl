@@ -135,7 +135,8 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
       }
     }
   }
-  /* each vector's bounding box (x0, x1, y0, y1): an MTA skips the vectors it cannot reach */
+  /* each vector's bounding box (x0, x1, y0, y1): an MTA skips the vectors it cannot reach; x0 and x1
+   * do not decrease along a run */
   int4 box[SP_SLOTS / SP_LANES];
   const int8 lane = vload8(0, sp_lane_index);
   for (int v = 0; v < views; ++v)
@@ -196,7 +197,8 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
         double z0 = 0.0, gx = 0.0, gy = 0.0, bx = 0.0, by = 0.0;
         for (int k = k0; k < k1; k += SP_LANES) {
           const int4 b = box[k / SP_LANES];
-          if (b.y < mx0 || b.x > mx1 || b.w < my0 || b.z > my1) continue;
+          if (b.x > mx1) break; /* a run's vectors go left to right (sorted by column) */
+          if (b.y < mx0 || b.w < my0 || b.z > my1) continue;
           const double8 x = convert_double8(vload8(0, sx + k)), y = convert_double8(vload8(0, sy + k));
           long8 hit = convert_long8(lane < (int8)(k1 - k));
           hit &= (double8)(dy[0]) * x + (double8)(dx[0]) * y >= (double8)(T[0]);

@@ -150,6 +150,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
 
   /* 2. Visibility: the tile's queues, every view slab. */
   ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut};
+  const double8 lane_d = convert_double8(lane);
   const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
   for (int tv = 0; tv < P->tiles_v; ++tv) {
     const int v0 = tv * PMR_TILE_V, v1 = min(views, v0 + PMR_TILE_V) - 1;
@@ -200,11 +201,15 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
           if (b.x > mx1) break; /* a run's vectors go left to right (sorted by column) */
           if (b.y < mx0 || b.w < my0 || b.z > my1) continue;
           const double8 x = convert_double8(vload8(0, sx + k)), y = convert_double8(vload8(0, sy + k));
-          long8 hit = convert_long8(lane < (int8)(k1 - k));
-          hit &= (double8)(dy[0]) * x + (double8)(dx[0]) * y >= (double8)(T[0]);
-          hit &= (double8)(dy[1]) * x + (double8)(dx[1]) * y >= (double8)(T[1]);
-          hit &= (double8)(dy[2]) * x + (double8)(dx[2]) * y >= (double8)(T[2]);
-          if (!any(hit)) continue;
+          long8 hit = ((double8)(dy[0]) * x + (double8)(dx[0]) * y >= (double8)(T[0])) &
+                      ((double8)(dy[1]) * x + (double8)(dx[1]) * y >= (double8)(T[1])) &
+                      ((double8)(dy[2]) * x + (double8)(dx[2]) * y >= (double8)(T[2]));
+          if (k1 - k < SP_LANES) hit &= lane_d < (double8)(k1 - k); /* the run's padding */
+          /* any(hit) as an OR of the lanes (a true lane is -1): any() on long8 compiles to a slow
+           * sequence of branches here */
+          const long4 h4 = hit.lo | hit.hi;
+          const long2 h2 = h4.lo | h4.hi;
+          if ((h2.x | h2.y) == 0) continue;
           if (!have_plane) { /* set up on the first covered sample: tiny MTAs often cover none */
             const long y0 = m.y[0], y1 = m.y[1], y2 = m.y[2];
             const long area = (y1 - y0) * (xv[2] - xv[0]) - (xv[1] - xv[0]) * (y2 - y0);

@@ -55,13 +55,8 @@ inline vint edge_lanes(long F, long bias, long G, vint ramp, bool narrow, vint l
 inline vint mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, vint win, long X, long Y, int i, float cutoff) {
   int w[VW];
   vstore_vint(win, 0, w);
-  for (int k = 0; k < VW; ++k) {
-    if (!w[k]) continue;
-    const long Xk = X + (long)k * PMR_X_ONE;
-    const long e[3] = {m->sign * mta_edge(m, 1, 2, Xk, Y, i), m->sign * mta_edge(m, 2, 0, Xk, Y, i),
-                       m->sign * mta_edge(m, 0, 1, Xk, Y, i)};
-    if (!(base_color(in, m->tri, source_barycentrics(m, e)).w >= cutoff)) w[k] = 0;
-  }
+  for (int k = 0; k < VW; ++k)
+    if (w[k] && !mta_alpha_passes(in, m, X + (long)k * PMR_X_ONE, Y, i, cutoff)) w[k] = 0;
   return vload_vint(0, w);
 }
 

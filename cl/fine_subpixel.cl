@@ -34,13 +34,8 @@ inline int8 sp_mask_alpha(const ShadeInputs* in, const PmrMta* m, int8 win, cons
                           long Yc, int v, float cutoff) {
   int w[SP_LANES];
   vstore8(win, 0, w);
-  for (int l = 0; l < SP_LANES; ++l) {
-    if (!w[l]) continue;
-    const long X = Xc + sx[l], Y = Yc + sy[l];
-    const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, v), m->sign * mta_edge(m, 2, 0, X, Y, v),
-                       m->sign * mta_edge(m, 0, 1, X, Y, v)};
-    if (!(base_color(in, m->tri, source_barycentrics(m, e)).w >= cutoff)) w[l] = 0;
-  }
+  for (int l = 0; l < SP_LANES; ++l)
+    if (w[l] && !mta_alpha_passes(in, m, Xc + sx[l], Yc + sy[l], v, cutoff)) w[l] = 0;
   return vload8(0, w);
 }
 

@@ -95,6 +95,14 @@ inline float4 shade(const ShadeInputs* in, float3 light, uint tri, float3 b, boo
   return (float4)(c.x * lambert, c.y * lambert, c.z * lambert, 1.0f);
 }
 
+/* alphaMode MASK: the MTA's base colour alpha at raster point (X, Y) of view `view` passes the cutoff
+ * (barycentrics from its exact edge functions there). */
+inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, long Y, int view, float cutoff) {
+  const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, view), m->sign * mta_edge(m, 2, 0, X, Y, view),
+                     m->sign * mta_edge(m, 0, 1, X, Y, view)};
+  return base_color(in, m->tri, source_barycentrics(m, e)).w >= cutoff;
+}
+
 /* Lit colour of MTA `id` at raster point (X, Y) (16.16 / 24.8) of view `view`: barycentrics from its
  * exact edge functions there. */
 inline float4 shade_mta_at(const ShadeInputs* in, global const PmrMta* mtas, uint id, float3 light, long X, long Y,

@@ -62,7 +62,7 @@ TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
   std::mt19937 rng(20261123);
   const int tiles[][3] = {{16, 2, 16}, {4, 4, 4}, {8, 3, 5}, {3, 1, 2}, {32, 8, 1}};
   size_t covered_total = 0, straddles_seen = 0;
-  for (int trial = 0; trial < 10; ++trial) {
+  for (int trial = 0; trial < 11; ++trial) {
     std::uniform_int_distribution<int> views_d(1, 40), vw(6, 90), vh(4, 60), dw(10, 130), dh(6, 80);
     Display d;
     d.width = dw(rng), d.height = dh(rng);
@@ -71,7 +71,8 @@ TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
     d.offset = parse_rational(random_decimal(rng, -30.0, 30.0, 9), "O");
     d.reversed = trial % 3 == 1;
     RigConfig rc;
-    rc.views = trial == 0 ? 1 : views_d(rng);
+    // one view; 700 views (over 512: the chunk capacity's other branch) with 64 px wide tiles
+    rc.views = trial == 0 ? 1 : (trial == 10 ? 700 : views_d(rng));
     rc.view_w = vw(rng), rc.view_h = vh(rng);
     if (trial == 4) {  // Looking Glass conventions: gen3 subpixel cells (the column map changes with the
                        // row class), the shader's 1 - fract phase, BGR subpixel order
@@ -84,7 +85,8 @@ TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
     if (trial == 5) rc.view_w = 3 * d.width, rc.view_h = 2 * d.height;  // views larger than the display
     const Rig rig = make_rig(rc, d, glm::dvec3(-1.0), glm::dvec3(1.0));
     const Scene scene = test::random_scene(150, 900u + unsigned(trial), trial % 2 == 0);
-    const int* tile = tiles[trial % 5];
+    const int wide_tile[3] = {64, 4, 8};
+    const int* tile = trial == 10 ? wide_tile : tiles[trial % 5];
     SCOPED_TRACE("trial " + std::to_string(trial) + ": " + std::to_string(rc.views) + " views of " +
                  std::to_string(rc.view_w) + "x" + std::to_string(rc.view_h) + ", display " + std::to_string(d.width) +
                  "x" + std::to_string(d.height) + ", tile " + std::to_string(tile[0]) + "x" + std::to_string(tile[1]) +
@@ -281,7 +283,16 @@ TEST(SubpixelSampling, CommandLine) {
   test::expect_one_error_line(test::run("render --sampling subpixel --method multipass --out " + out), "--method pmr");
   test::expect_one_error_line(test::run("render --sampling subpixel --preset lg-portrait --out " + out),
                               "--camera-spacing linear");
+  test::expect_one_error_line(test::run("render --sampling subpixel --blend-views --out " + out), "--blend-views");
   EXPECT_EQ(test::count_entries(out), 0u) << "nothing written on bad options";
+  test::expect_one_error_line(test::run("bench --sampling subpixel --method multipass --views 2"), "--method pmr");
+  test::expect_one_error_line(test::run("bench --sampling view,subpixel --bilinear --views 2"), "--bilinear");
+  // without the encoded image there is nothing to sample per subpixel: a warning, the views as usual
+  const std::string views_only = test::temp_dir("subpixel_views_only");
+  const test::CliRun v = test::run("render --sampling subpixel --write views --views 4 --view-size 32x16 --display 96x54 --out " + views_only);
+  ASSERT_EQ(v.status, 0) << v.output;
+  EXPECT_NE(v.output.find("warning: --sampling subpixel samples the encoded image"), std::string::npos) << v.output;
+  EXPECT_TRUE(test::exists(views_only + "/frame_0000.views.exr"));
   const std::string small = " --views 6 --view-size 48x24 --display 160x90 --out " + out;
   const test::CliRun r = test::run("render --sampling subpixel --write encoded,views" + small);
   ASSERT_EQ(r.status, 0) << r.output;

@@ -120,6 +120,11 @@ BenchOptions parse(const std::vector<std::string>& args) {
   o.animation = r.animation, o.fps = r.fps;
   o.turntable = r.turntable, o.turntable_deg = r.turntable_deg, o.turntable_frames = r.turntable ? r.turntable_frames : 1;
   if (o.methods.empty() || o.views.empty() || o.samplings.empty()) throw Error("nothing to measure");
+  const bool subpixel = std::find(o.samplings.begin(), o.samplings.end(), Sampling::Subpixel) != o.samplings.end();
+  if (subpixel && (o.display.bilinear || o.display.blend_views))
+    throw Error("--sampling subpixel computes every subpixel at its own sample: --bilinear applies to --sampling view only");
+  if (subpixel && std::find(o.methods.begin(), o.methods.end(), Method::Pmr) == o.methods.end())
+    throw Error("--sampling subpixel renders with --method pmr: add pmr to --method");
   if (!o.generator.empty() && !o.scene.empty()) throw Error("give a SCENE or a generator (--synthetic, --objects), not both");
   if (!o.save_scene.empty() && o.triangle_counts.size() != 1)
     throw Error("--save-scene needs exactly one generated scene (--synthetic TRIS or --objects TRIS)");
@@ -193,7 +198,7 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
     std::vector<uint16_t> reference[2];  // per sampling: the first method's image
     for (Method method : o.methods)
       for (Sampling sampling : o.samplings) {
-      if (sampling == Sampling::Subpixel && method != Method::Pmr) continue;  // PMR only
+      if (sampling == Sampling::Subpixel && method != Method::Pmr) continue;  // PMR only (help says so)
       // samples per frame: the voxels, or each display subpixel once
       const double samples = sampling == Sampling::Subpixel ? subpixels : voxels;
       // the least a frame must move: every sample written once, the display image written once (half RGBA)
@@ -246,7 +251,7 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
         *csv << scene_name << ',' << to_string(method) << ',' << N << ',' << rig.view_w << ',' << rig.view_h << ','
              << display.width << ',' << display.height << ',' << scene.triangles.size() << ',' << o.frames << ',' << med
              << ',' << mn << ',' << median(setup) << ',' << median(tile) << ',' << median(fine) << ',' << median(encode)
-             << ',' << voxels / (med * 1e-3) * 1e-6 << ',' << mem_mb << ',' << floor_bytes / 1e6 << ',' << floor_ms << ','
+             << ',' << (sampling == Sampling::Subpixel ? 0.0 : voxels / (med * 1e-3) * 1e-6) << ',' << mem_mb << ',' << floor_bytes / 1e6 << ',' << floor_ms << ','
              << med / floor_ms << ',' << mismatch << ',' << to_string(sampling) << ',' << samples << ',' << msmp << '\n';
       }
   }

@@ -230,8 +230,19 @@ std::string frame_stem(const std::string& pattern, long frame) {
 }
 
 void finalize_render_options(RenderOptions& o) {
-  if (o.rig.angular_spacing && o.pipeline.sampling == Sampling::Subpixel)
-    throw Error("--sampling subpixel rasterizes with PMR, which needs evenly spaced views: add --camera-spacing linear");
+  if (o.pipeline.sampling == Sampling::Subpixel) {
+    if (o.rig.angular_spacing)
+      throw Error("--sampling subpixel rasterizes with PMR, which needs evenly spaced views: add --camera-spacing linear");
+    if (o.method_given && o.pipeline.method != Method::Pmr) throw Error("--sampling subpixel renders with --method pmr");
+    if (o.display.bilinear || o.display.blend_views)
+      throw Error("--sampling subpixel computes every subpixel at its own sample: --bilinear and --blend-views "
+                  "apply to --sampling view only");
+    if (!o.write_encoded) {  // the views are rendered on their grids in either case
+      o.pipeline.sampling = Sampling::View;
+      o.option_warnings.push_back("--sampling subpixel samples the encoded image, which --write does not ask for: "
+                                  "ignored");
+    }
+  }
   if (o.rig.angular_spacing && !o.method_given) {
     // PMR needs evenly spaced views; one conventional pass per view takes any spacing
     o.pipeline.method = Method::Multipass;

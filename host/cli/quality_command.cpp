@@ -19,7 +19,8 @@ std::string quality_help() {
          "RMSE over every subpixel's colour (linear) and the fraction of subpixels differing by more than\n"
          "1/256. --also-view-size adds --sampling view at another view size (repeatable).\n"
          "The rig and display options are those of pmr render (--preset, --views, --view-size, ...);\n"
-         "views are evenly spaced. See docs/SAMPLING.md.\n";
+         "views are evenly spaced; the sampling options (--sampling, --bilinear, --blend-views) are set by\n"
+         "the command itself, and nothing is written. See docs/SAMPLING.md.\n";
 }
 
 int run_quality(const std::vector<std::string>& args) {

@@ -182,6 +182,9 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
                    "reversed; with subpixel cells (display.cell_rows) k' = 0 and the offset of the pixel's cell and "
                    "channel (display.cell_offsets_1e14 / 10^14); channel k of view v sampled at "
                    "((j + (k + 0.5) / 3) / width, (i + 0.5) / height)"},
+      {"sampling", "view: that position read from view v's view_width x view_height raster (nearest, or bilinear "
+                   "per display.sampling); subpixel: view v rasterized at that position itself, truncated to the "
+                   "raster's 16.16 / 24.8 fixed point (docs/SAMPLING.md)"},
   };
   std::string text;
   emit(j, 0, text);

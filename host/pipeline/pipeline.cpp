@@ -309,6 +309,7 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   m.dbg_key = rt.buffer(m.debug_entries * 4, "debug keys");
   m.dbg_depth = rt.buffer(m.debug_entries * 4, "debug depth");
   m.dbg_count = rt.buffer(m.debug_entries * 4, "debug counts");
+  if (m.subpixel_debug) rt.fill_zero(m.dbg_count);  // the subpixel kernel keeps no counts
   if (m.tile_queue_capacity == 0) {
     m.tile_queue_capacity = std::max<size_t>(4096, size_t(m.mta_capacity) * 8);
     m.tile_queue = rt.buffer(m.tile_queue_capacity * sizeof(uint32_t), "tile queues");
@@ -414,6 +415,8 @@ void Pipeline::Impl::configure_fused(const std::string& options, int views, int 
   }
   const PmrEncodeParams& E = encode_params;
   const TileOwnership own = tile_ownership(E, columns, rows, tile_x);
+  upload_table(column_start, own.column_start, "fused column starts");
+  upload_table(row_start, own.row_start, "fused row starts");
   upload_straddles(own);
   // the fused kernel's column table, as planes for 8-pixel vector loads: [field (a_mod_n, b, px)][subpixel k][pixel j]
   const size_t W = size_t(E.display_w);
@@ -427,10 +430,8 @@ void Pipeline::Impl::configure_fused(const std::string& options, int views, int 
   rt.write(column_soa, soa.data(), bytes_of(soa));
 }
 
-// Ownership tables and the straddling pixels' coverage slots (fused and subpixel paths).
+// The straddling pixels' slots and coverage bytes (fused and subpixel paths).
 void Pipeline::Impl::upload_straddles(const TileOwnership& own) {
-  upload_table(column_start, own.column_start, "column starts");
-  upload_table(row_start, own.row_start, "row starts");
   upload_table(straddle_slot, own.straddle_slot, "straddle slots");
   upload_table(straddle_columns, own.straddling, "straddle columns");
   straddle_slots = uint32_t(own.straddling.size());
@@ -444,7 +445,6 @@ void Pipeline::Impl::configure_subpixel(const std::string& options, int views, c
   const int capacity = subpixel_chunk_capacity(views);
   if (subpixel_views != views) {
     if (subpixel_program) clReleaseProgram(subpixel_program);
-    subpixel_program = nullptr;
     subpixel_program = rt.build_program({"fine_subpixel.cl", "straddle_alpha.cl"},
                                         options + " -DPMR_SUBPIXEL_VIEWS=" + std::to_string(views) +
                                             " -DPMR_SUBPIXEL_CAP=" + std::to_string(capacity) +
@@ -460,8 +460,14 @@ void Pipeline::Impl::configure_subpixel(const std::string& options, int views, c
   for (size_t s = 0; s < columns.size(); ++s) a[s] = columns[s].a_mod_n, b[s] = columns[s].b;
   upload_table(column_a, a, "subpixel column views");
   upload_table(column_b, b, "subpixel column ranks");
-  upload_table(sample_x, subpixel_sample_columns(encode_params), "subpixel sample columns");
-  upload_table(sample_y, subpixel_sample_rows(encode_params), "subpixel sample rows");
+  // the samples must lie in the view pixels the encoder tables name (tile ownership relies on it)
+  const std::vector<int32_t> xs = subpixel_sample_columns(encode_params), ys = subpixel_sample_rows(encode_params);
+  for (size_t s = 0; s < xs.size(); ++s)
+    if (xs[s] >> PMR_X_FRAC_BITS != columns[s].px) throw Error("internal error: subpixel sample outside its column");
+  for (size_t i = 0; i < ys.size(); ++i)
+    if (ys[i] >> PMR_Y_FRAC_BITS != rows[i].py) throw Error("internal error: subpixel sample outside its row");
+  upload_table(sample_x, xs, "subpixel sample columns");
+  upload_table(sample_y, ys, "subpixel sample rows");
   const std::vector<PmrSampleChunk> list = subpixel_chunks(own, tile[0], tile[1], capacity);
   num_chunks = uint32_t(list.size());
   chunks = rt.buffer(std::max<size_t>(bytes_of(list), 16), "subpixel chunks", CL_MEM_READ_ONLY);
@@ -596,7 +602,9 @@ size_t Pipeline::device_bytes() const {
   size_t total = 0;
   for (const ClBuffer* b : {&m.positions, &m.attrs, &m.tris, &m.materials, &m.textures, &m.texels, &m.lut, &m.params_buf,
                             &m.encode_buf, &m.vertices, &m.pmr_vertices, &m.mtas, &m.mta_counter, &m.tile_counts,
-                            &m.tile_offsets, &m.tile_queue, &m.volume, &m.display, &m.encode_columns, &m.encode_rows, &m.dbg_key, &m.dbg_depth, &m.dbg_count})
+                            &m.tile_offsets, &m.tile_queue, &m.volume, &m.display, &m.encode_columns, &m.encode_rows, &m.dbg_key, &m.dbg_depth, &m.dbg_count,
+                            &m.column_start, &m.column_soa, &m.row_start, &m.straddle_slot, &m.straddle_columns, &m.straddle_cov,
+                            &m.chunks, &m.sample_x, &m.sample_y, &m.column_a, &m.column_b})
     total += b->get() ? b->size() : 0;
   return total;
 }

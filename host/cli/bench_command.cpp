@@ -35,6 +35,7 @@ struct BenchOptions {
   std::string keep = "view";
   int view_w = 1024, view_h = 512;  // per-view raster at N = 96 (keep total) or always (keep view)
   RigConfig rig;                    // cone, field of view (views and sizes come from the options above)
+  bool offset_given = false;        // --offset, or a Looking Glass preset's calibrated offset
   Display display;
   int tile[3] = {16, 2, 16};
   bool check = true;
@@ -116,6 +117,7 @@ BenchOptions parse(const std::vector<std::string>& args) {
   o.rig.angular_spacing = false;  // PMR renders evenly spaced views
   if (!o.views_given && std::find(rest.begin(), rest.end(), "--preset") != rest.end()) o.views = {r.rig.views};
   o.display = r.display;
+  o.offset_given = r.offset_given;
   o.tile[0] = r.pipeline.tile_x, o.tile[1] = r.pipeline.tile_y, o.tile[2] = r.pipeline.tile_v;
   o.animation = r.animation, o.fps = r.fps;
   o.turntable = r.turntable, o.turntable_deg = r.turntable_deg, o.turntable_frames = r.turntable ? r.turntable_frames : 1;
@@ -190,7 +192,7 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       rc.view_w = 2 * rc.view_h;
     }
     Display display = o.display;
-    display.offset = default_offset(display.lens_pitch, N);
+    if (!o.offset_given) display.offset = default_offset(display.lens_pitch, N);  // else the panel's own
     FrameRenderer renderer(scene, spec, rc, display, nullptr);
     const Rig& rig = renderer.rig();
     const double voxels = double(N) * rig.view_w * rig.view_h;

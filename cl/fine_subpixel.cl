@@ -88,7 +88,8 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
     const size_t block = (size_t)(E->cell_rows > 1 ? (E->display_h - 1 - i) % E->cell_rows : 0) * (size_t)(3 * Wd);
     const PmrEncodeRow row = rows[i];
     for (int s = ch.s0; s < ch.s1; s += 8, n += 8) {
-      int8 v = vload8(0, column_a + block + s) - (int8)(row.q_mod_n) + (vload8(0, column_b + block + s) < (int8)(row.s));
+      const int8 a = vload8(0, column_a + block + s), b = vload8(0, column_b + block + s);
+      int8 v = a - (int8)(row.q_mod_n) + (b < (int8)(row.s)); /* a true comparison is -1 */
       v = select(v, v + (int8)(views), v < (int8)(0));
       if (E->reversed) v = (int8)(views - 1) - v;
       vstore8(convert_ushort8(v), 0, view_of + n);
@@ -137,7 +138,8 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
   for (int v = 0; v < views; ++v)
     for (int k = first[v]; k < first[v] + count[v]; k += SP_LANES) {
       const int8 valid = lane < (int8)(first[v] + count[v] - k); /* padding lanes repeat lane 0 */
-      const int8 x = select((int8)(sx[k]), vload8(0, sx + k), valid), y = select((int8)(sy[k]), vload8(0, sy + k), valid);
+      const int8 x = select((int8)(sx[k]), vload8(0, sx + k), valid);
+      const int8 y = select((int8)(sy[k]), vload8(0, sy + k), valid);
       const int4 x0 = min(x.lo, x.hi), x1 = max(x.lo, x.hi), y0 = min(y.lo, y.hi), y1 = max(y.lo, y.hi);
       const int2 a = min(x0.lo, x0.hi), b = max(x1.lo, x1.hi), c = min(y0.lo, y0.hi), d = max(y1.lo, y1.hi);
       box[k / SP_LANES] = (int4)(min(a.x, a.y), max(b.x, b.y), min(c.x, c.y), max(d.x, d.y));
@@ -174,60 +176,61 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
       }
       const long my0 = ylo - Yc, my1 = yhi - Yc;
       for (int ib = i_lo; ib <= i_hi; ib += 16) {
-      uint pass = sp_view_mask(&m, ib, min(i_hi - ib + 1, 16), Xc, Xl - Xc);
-      while (pass != 0) { /* the passing views, lowest first */
-        const int v = ib + (31 - (int)clz(pass & (0u - pass)));
-        pass &= pass - 1u;
-        const int k0 = first[v], k1 = k0 + count[v];
-        if (k0 == k1) continue;
-        long xv[3];
-        for (int k = 0; k < 3; ++k) xv[k] = (long)m.x0[k] + (long)v * (long)m.dx[k];
-        const long mx0 = min(xv[0], min(xv[1], xv[2])) - Xc, mx1 = max(xv[0], max(xv[1], xv[2])) - Xc;
-        double dx[3], T[3];
-        const long di = (long)(v - i_lo);
-        for (int e = 0; e < 3; ++e) {
-          T[e] = (double)clamp(t_lo[e] + di * dt[e], -(1L << 48), 1L << 48);
-          dx[e] = (double)(dx_lo[e] + di * ddx[e]);
-        }
-        bool have_plane = false;
-        double z0 = 0.0, gx = 0.0, gy = 0.0, bx = 0.0, by = 0.0;
-        for (int k = k0; k < k1; k += SP_LANES) {
-          const int4 b = box[k / SP_LANES];
-          if (b.x > mx1) break; /* a run's vectors go left to right (sorted by column) */
-          if (b.y < mx0 || b.w < my0 || b.z > my1) continue;
-          const double8 x = convert_double8(vload8(0, sx + k)), y = convert_double8(vload8(0, sy + k));
-          long8 hit = ((double8)(dy[0]) * x + (double8)(dx[0]) * y >= (double8)(T[0])) &
-                      ((double8)(dy[1]) * x + (double8)(dx[1]) * y >= (double8)(T[1])) &
-                      ((double8)(dy[2]) * x + (double8)(dx[2]) * y >= (double8)(T[2]));
-          if (k1 - k < SP_LANES) hit &= lane_d < (double8)(k1 - k); /* the run's padding */
-          /* any(hit) as an OR of the lanes (a true lane is -1): any() on long8 compiles to a slow
-           * sequence of branches here */
-          const long4 h4 = hit.lo | hit.hi;
-          const long2 h2 = h4.lo | h4.hi;
-          if ((h2.x | h2.y) == 0) continue;
-          if (!have_plane) { /* set up on the first covered sample: tiny MTAs often cover none */
-            const long y0 = m.y[0], y1 = m.y[1], y2 = m.y[2];
-            const long area = (y1 - y0) * (xv[2] - xv[0]) - (xv[1] - xv[0]) * (y2 - y0);
-            const double inv = 1.0 / (double)area;
-            const double dz1 = (double)m.z[1] - (double)m.z[0], dz2 = (double)m.z[2] - (double)m.z[0];
-            gx = (dz1 * (double)(y0 - y2) + dz2 * (double)(y1 - y0)) * inv;
-            gy = (dz1 * (double)(xv[2] - xv[0]) - dz2 * (double)(xv[1] - xv[0])) * inv;
-            z0 = (double)m.z[0];
-            bx = (double)(Xc - xv[0]);
-            by = (double)(Yc - y0);
-            have_plane = true;
+        uint pass = sp_view_mask(&m, ib, min(i_hi - ib + 1, 16), Xc, Xl - Xc);
+        while (pass != 0) { /* the passing views, lowest first */
+          const int v = ib + (31 - (int)clz(pass & (0u - pass)));
+          pass &= pass - 1u;
+          const int k0 = first[v], k1 = k0 + count[v];
+          if (k0 == k1) continue;
+          long xv[3];
+          for (int k = 0; k < 3; ++k) xv[k] = (long)m.x0[k] + (long)v * (long)m.dx[k];
+          const long mx0 = min(xv[0], min(xv[1], xv[2])) - Xc, mx1 = max(xv[0], max(xv[1], xv[2])) - Xc;
+          double dx[3], T[3];
+          const long di = (long)(v - i_lo);
+          for (int e = 0; e < 3; ++e) {
+            T[e] = (double)clamp(t_lo[e] + di * dt[e], -(1L << 48), 1L << 48);
+            dx[e] = (double)(dx_lo[e] + di * ddx[e]);
           }
-          const float8 z = convert_float8((double8)(z0) + ((double8)(gx) * ((double8)(bx) + x) +
-                                                           (double8)(gy) * ((double8)(by) + y)));
-          const float8 bd = vload8(0, best_depth + k);
-          const uint8 bk = vload8(0, best_key + k);
-          int8 win = convert_int8(hit) & ((z < bd) | ((z == bd) & ((uint8)(m.key) < bk)));
-          if ((m.flags & PMR_MTA_MASK) && any(win)) win = sp_mask_alpha(&in, &m, win, sx + k, sy + k, Xc, Yc, v, cutoff);
-          vstore8(select(bd, z, win), 0, best_depth + k);
-          vstore8(select(bk, (uint8)(m.key), as_uint8(win)), 0, best_key + k);
-          vstore8(select(vload8(0, best_mta + k), (uint8)(id), as_uint8(win)), 0, best_mta + k);
+          bool have_plane = false;
+          double z0 = 0.0, gx = 0.0, gy = 0.0, bx = 0.0, by = 0.0;
+          for (int k = k0; k < k1; k += SP_LANES) {
+            const int4 b = box[k / SP_LANES];
+            if (b.x > mx1) break; /* a run's vectors go left to right (sorted by column) */
+            if (b.y < mx0 || b.w < my0 || b.z > my1) continue;
+            const double8 x = convert_double8(vload8(0, sx + k)), y = convert_double8(vload8(0, sy + k));
+            long8 hit = ((double8)(dy[0]) * x + (double8)(dx[0]) * y >= (double8)(T[0])) &
+                        ((double8)(dy[1]) * x + (double8)(dx[1]) * y >= (double8)(T[1])) &
+                        ((double8)(dy[2]) * x + (double8)(dx[2]) * y >= (double8)(T[2]));
+            if (k1 - k < SP_LANES) hit &= lane_d < (double8)(k1 - k); /* the run's padding */
+            /* any(hit) as an OR of the lanes (a true lane is -1): any() on long8 compiles to a slow
+             * sequence of branches here */
+            const long4 h4 = hit.lo | hit.hi;
+            const long2 h2 = h4.lo | h4.hi;
+            if ((h2.x | h2.y) == 0) continue;
+            if (!have_plane) { /* set up on the first covered sample: tiny MTAs often cover none */
+              const long y0 = m.y[0], y1 = m.y[1], y2 = m.y[2];
+              const long area = (y1 - y0) * (xv[2] - xv[0]) - (xv[1] - xv[0]) * (y2 - y0);
+              const double inv = 1.0 / (double)area;
+              const double dz1 = (double)m.z[1] - (double)m.z[0], dz2 = (double)m.z[2] - (double)m.z[0];
+              gx = (dz1 * (double)(y0 - y2) + dz2 * (double)(y1 - y0)) * inv;
+              gy = (dz1 * (double)(xv[2] - xv[0]) - dz2 * (double)(xv[1] - xv[0])) * inv;
+              z0 = (double)m.z[0];
+              bx = (double)(Xc - xv[0]);
+              by = (double)(Yc - y0);
+              have_plane = true;
+            }
+            const float8 z = convert_float8((double8)(z0) + ((double8)(gx) * ((double8)(bx) + x) +
+                                                             (double8)(gy) * ((double8)(by) + y)));
+            const float8 bd = vload8(0, best_depth + k);
+            const uint8 bk = vload8(0, best_key + k);
+            int8 win = convert_int8(hit) & ((z < bd) | ((z == bd) & ((uint8)(m.key) < bk)));
+            if ((m.flags & PMR_MTA_MASK) && any(win))
+              win = sp_mask_alpha(&in, &m, win, sx + k, sy + k, Xc, Yc, v, cutoff);
+            vstore8(select(bd, z, win), 0, best_depth + k);
+            vstore8(select(bk, (uint8)(m.key), as_uint8(win)), 0, best_key + k);
+            vstore8(select(vload8(0, best_mta + k), (uint8)(id), as_uint8(win)), 0, best_mta + k);
+          }
         }
-      }
       }
     }
   }

@@ -155,9 +155,10 @@ int run_sequence(const RenderOptions& o) {
     todo.push_back(f);
   }
   const long total = long(todo.size());
-  std::fprintf(stderr, "pmr: %s: %zu triangles, %d views of %dx%d -> %dx%d display; %ld frame(s)%s\n",
+  std::fprintf(stderr, "pmr: %s: %zu triangles, %d views of %dx%d -> %dx%d display%s; %ld frame(s)%s\n",
                o.scene.c_str(), scene.triangles.size(), rig.views, rig.view_w, rig.view_h, o.display.width,
-               o.display.height, total, skipped ? (", " + std::to_string(skipped) + " already complete").c_str() : "");
+               o.display.height, o.pipeline.sampling == Sampling::Subpixel ? " (subpixel sampling)" : "", total,
+               skipped ? (", " + std::to_string(skipped) + " already complete").c_str() : "");
   if (todo.empty()) {
     std::fprintf(stderr, "pmr: nothing to do\n");
     return 0;

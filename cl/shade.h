@@ -103,14 +103,12 @@ inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, lon
   return base_color(in, m->tri, source_barycentrics(m, e)).w >= cutoff;
 }
 
-/* Lit colour of MTA `id` at raster point (X, Y) (16.16 / 24.8) of view `view`: barycentrics from its
- * exact edge functions there. */
-inline float4 shade_mta_at(const ShadeInputs* in, global const PmrMta* mtas, uint id, float3 light, long X, long Y,
-                           int view) {
-  const PmrMta m = mtas[id];
-  const long e[3] = {m.sign * mta_edge(&m, 1, 2, X, Y, view), m.sign * mta_edge(&m, 2, 0, X, Y, view),
-                     m.sign * mta_edge(&m, 0, 1, X, Y, view)};
-  return shade(in, light, m.tri, source_barycentrics(&m, e), (m.flags & PMR_MTA_BACK) != 0);
+/* Lit colour of MTA m at raster point (X, Y) (16.16 / 24.8) of view `view`: barycentrics from its exact
+ * edge functions there. */
+inline float4 shade_mta_at(const ShadeInputs* in, const PmrMta* m, float3 light, long X, long Y, int view) {
+  const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, view), m->sign * mta_edge(m, 2, 0, X, Y, view),
+                     m->sign * mta_edge(m, 0, 1, X, Y, view)};
+  return shade(in, light, m->tri, source_barycentrics(m, e), (m->flags & PMR_MTA_BACK) != 0);
 }
 
 #endif

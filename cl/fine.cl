@@ -37,6 +37,8 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
   const uint* key_of = (const uint*)best_key;
   const uint* mta_of = (const uint*)best_mta;
   const int* count_of = (const int*)covered;
+  MtaCache cache;
+  cache.id = PMR_NO_KEY;
   for (int lv = 0; lv < nv; ++lv)
     for (int ly = 0; ly < ny; ++ly)
       for (int lx = 0; lx < nx; ++lx) {
@@ -44,7 +46,7 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
         const int view = v0 + lv, px = x0 + lx, py = y0 + ly;
         const size_t voxel = (((size_t)view + view_base) * H + (size_t)py) * W + (size_t)px;
         if (key_of[k] != PMR_NO_KEY)
-          vstore_half4(fine_shade_winner(&in, mtas, mta_of[k], light, px, py, view), voxel, volume);
+          vstore_half4(fine_shade_winner(&in, mtas, mta_of[k], &cache, light, px, py, view), voxel, volume);
         else
           vstore4((ushort4)(0), voxel, (global ushort*)volume); /* background */
         if (debug) {

@@ -63,12 +63,14 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
   const uint* key_of = (const uint*)best_key;
   const uint* mta_of = (const uint*)best_mta;
   ushort4 colour[FUSED_ROWS * VW];
+  MtaCache cache;
+  cache.id = PMR_NO_KEY;
   for (int view = 0; view < views; ++view)
     for (int ly = 0; ly < ny; ++ly)
       for (int lx = 0; lx < nx; ++lx) {
         const int k = fused_voxel(view, ly, lx);
         if (key_of[k] != PMR_NO_KEY)
-          vstore_half4(fine_shade_winner(&in, mtas, mta_of[k], light, x0 + lx, y0 + ly, view), k, (half*)colour);
+          vstore_half4(fine_shade_winner(&in, mtas, mta_of[k], &cache, light, x0 + lx, y0 + ly, view), k, (half*)colour);
         else
           colour[k] = (ushort4)(0);
       }

@@ -183,10 +183,10 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
 }
 
 /* Lit colour of the winning MTA `id` at voxel (px, py, view), sampled at the pixel center. */
-inline float4 fine_shade_winner(const ShadeInputs* in, global const PmrMta* mtas, uint id, float3 light, int px,
-                                int py, int view) {
-  const PmrMta m = mtas[id];
-  return shade_mta_at(in, &m, light, (long)px * PMR_X_ONE + PMR_HALF_X, (long)py * PMR_Y_ONE + PMR_HALF_Y, view);
+inline float4 fine_shade_winner(const ShadeInputs* in, global const PmrMta* mtas, uint id, MtaCache* cache,
+                                float3 light, int px, int py, int view) {
+  return shade_mta_at(in, cached_mta(cache, mtas, id), light, (long)px * PMR_X_ONE + PMR_HALF_X,
+                      (long)py * PMR_Y_ONE + PMR_HALF_Y, view);
 }
 
 /* Initial visibility state: nothing drawn. */

@@ -239,8 +239,8 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
   const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
   ushort value[PMR_SUBPIXEL_CAP];
   uchar covered[PMR_SUBPIXEL_CAP];
-  uint shaded_id = PMR_NO_KEY;
-  PmrMta shaded;
+  MtaCache cache;
+  cache.id = PMR_NO_KEY;
   for (int v = 0; v < views; ++v)
     for (int k = first[v]; k < first[v] + count[v]; ++k) {
       const int n = sid[k];
@@ -254,11 +254,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
         covered[n] = 0;
         continue;
       }
-      if (best_mta[k] != shaded_id) { /* neighbouring samples of a view mostly share their winner */
-        shaded_id = best_mta[k];
-        shaded = mtas[shaded_id];
-      }
-      const float4 c = shade_mta_at(&in, &shaded, light, Xc + sx[k], Yc + sy[k], v);
+      const float4 c = shade_mta_at(&in, cached_mta(&cache, mtas, best_mta[k]), light, Xc + sx[k], Yc + sy[k], v);
       ushort h;
       vstore_half(channel[k] == 0 ? c.x : (channel[k] == 1 ? c.y : c.z), 0, (half*)&h);
       value[n] = h;

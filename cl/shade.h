@@ -103,6 +103,21 @@ inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, lon
   return base_color(in, m->tri, source_barycentrics(m, e)).w >= cutoff;
 }
 
+/* The MTA loaded last for shading: neighbouring voxels and samples mostly share their winner, and an
+ * MTA is 108 bytes from anywhere in the queue. Start with id = PMR_NO_KEY. */
+typedef struct {
+  uint id;
+  PmrMta m;
+} MtaCache;
+
+inline const PmrMta* cached_mta(MtaCache* c, global const PmrMta* mtas, uint id) {
+  if (c->id != id) {
+    c->id = id;
+    c->m = mtas[id];
+  }
+  return &c->m;
+}
+
 /* Lit colour of MTA m at raster point (X, Y) (16.16 / 24.8) of view `view`: barycentrics from its exact
  * edge functions there. */
 inline float4 shade_mta_at(const ShadeInputs* in, const PmrMta* m, float3 light, long X, long Y, int view) {

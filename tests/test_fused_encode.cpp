@@ -24,14 +24,9 @@ std::vector<uint16_t> encode(const Scene& scene, const Rig& rig, const Display& 
   PipelineConfig pc;
   pc.tile_x = tile[0], pc.tile_y = tile[1], pc.tile_v = tile[2];
   pc.fuse_encode = fuse;
-  Pipeline p(test::runtime(), pc);
-  p.set_scene(scene);
-  p.configure(rig, &d);
-  p.render(rig);
-  *fused = p.fused();
-  std::vector<uint16_t> image;
-  p.read_display(image);
-  return image;
+  test::EncodedRender r = test::render_encoded(scene, rig, d, pc);
+  *fused = r.fused;
+  return r.image;
 }
 
 class FusedEncode : public ::testing::TestWithParam<FusedCase> {};

@@ -107,6 +107,19 @@ glm::vec3 focal_point(const Rig& rig, double x, double y) {
   return glm::vec3(world);
 }
 
+EncodedRender render_encoded(const Scene& scene, const Rig& rig, const Display& d, const PipelineConfig& pc) {
+  Pipeline p(runtime(), pc);
+  p.set_scene(scene);
+  p.configure(rig, &d);
+  p.render(rig);
+  EncodedRender r;
+  r.fused = p.fused();
+  r.has_volume = p.has_volume();
+  if (r.has_volume) p.read_volume(r.volume);
+  p.read_display(r.image);
+  return r;
+}
+
 PmrParams params_for(const Rig& rig, int tx, int ty, int tv) {
   PmrParams P = make_params(rig);
   P.tiles_x = (rig.view_w + tx - 1) / tx;

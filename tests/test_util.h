@@ -36,6 +36,13 @@ struct Rendered {
 };
 Rendered render(const Scene& scene, const Rig& rig, int tx = 4, int ty = 4, int tv = 4, const Display* display = nullptr,
                 std::vector<uint16_t>* encoded = nullptr);
+// One frame through a pipeline configured with `pc` and display `d`: the encoded image, which path the
+// pipeline chose, and the view volume when it kept one.
+struct EncodedRender {
+  std::vector<uint16_t> image, volume;
+  bool fused = false, has_volume = false;
+};
+EncodedRender render_encoded(const Scene& scene, const Rig& rig, const Display& d, const PipelineConfig& pc);
 
 // Path of the shared glTF corpus (PMR_SOURCE_DIR/../shared/gltf), empty if absent.
 std::string corpus_dir();

@@ -123,10 +123,11 @@ BenchOptions parse(const std::vector<std::string>& args) {
   o.turntable = r.turntable, o.turntable_deg = r.turntable_deg, o.turntable_frames = r.turntable ? r.turntable_frames : 1;
   if (o.methods.empty() || o.views.empty() || o.samplings.empty()) throw Error("nothing to measure");
   const bool subpixel = std::find(o.samplings.begin(), o.samplings.end(), Sampling::Subpixel) != o.samplings.end();
-  if (subpixel && (o.display.bilinear || o.display.blend_views))
-    throw Error("--sampling subpixel computes every subpixel at its own sample: --bilinear applies to --sampling view only");
-  if (subpixel && std::find(o.methods.begin(), o.methods.end(), Method::Pmr) == o.methods.end())
-    throw Error("--sampling subpixel renders with --method pmr: add pmr to --method");
+  // subpixel rows are measured for pmr alone (the other methods' rows are skipped)
+  if (subpixel) {
+    const bool pmr = std::find(o.methods.begin(), o.methods.end(), Method::Pmr) != o.methods.end();
+    check_subpixel_sampling(pmr ? Method::Pmr : o.methods[0], o.display);
+  }
   if (!o.generator.empty() && !o.scene.empty()) throw Error("give a SCENE or a generator (--synthetic, --objects), not both");
   if (!o.save_scene.empty() && o.triangle_counts.size() != 1)
     throw Error("--save-scene needs exactly one generated scene (--synthetic TRIS or --objects TRIS)");

@@ -233,10 +233,7 @@ void finalize_render_options(RenderOptions& o) {
   if (o.pipeline.sampling == Sampling::Subpixel) {
     if (o.rig.angular_spacing)
       throw Error("--sampling subpixel rasterizes with PMR, which needs evenly spaced views: add --camera-spacing linear");
-    if (o.method_given && o.pipeline.method != Method::Pmr) throw Error("--sampling subpixel renders with --method pmr");
-    if (o.display.bilinear || o.display.blend_views)
-      throw Error("--sampling subpixel computes every subpixel at its own sample: --bilinear and --blend-views "
-                  "apply to --sampling view only");
+    check_subpixel_sampling(o.pipeline.method, o.display);  // pmr unless --method says otherwise
     if (!o.write_encoded) {  // the views are rendered on their grids in either case
       o.pipeline.sampling = Sampling::View;
       o.option_warnings.push_back("--sampling subpixel samples the encoded image, which --write does not ask for: "

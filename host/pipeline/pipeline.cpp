@@ -146,6 +146,13 @@ Sampling parse_sampling(const std::string& name) {
 
 const char* to_string(Sampling s) { return s == Sampling::Subpixel ? "subpixel" : "view"; }
 
+void check_subpixel_sampling(Method method, const Display& display) {
+  if (method != Method::Pmr) throw Error("--sampling subpixel renders with --method pmr");
+  if (display.bilinear || display.blend_views)
+    throw Error("--sampling subpixel computes every subpixel at its own sample: --bilinear and --blend-views "
+                "apply to --sampling view only");
+}
+
 Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
     : impl_(new Impl(runtime)), config_(config) {
   tile_[0] = config.tile_x, tile_[1] = config.tile_y, tile_[2] = config.tile_v;
@@ -267,10 +274,7 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   m.subpixel = config_.sampling == Sampling::Subpixel;
   if (m.subpixel) {
     if (!display) throw Error("--sampling subpixel samples a display's subpixels: it needs a display");
-    if (config_.method != Method::Pmr) throw Error("--sampling subpixel renders with --method pmr");
-    if (display->bilinear || display->blend_views)
-      throw Error("--sampling subpixel computes every subpixel at its own sample: --bilinear and --blend-views "
-                  "apply to --sampling view only");
+    check_subpixel_sampling(config_.method, *display);
   }
   const int lanes = fine_lanes(tile_[0]);
   const size_t fused_private = size_t(tile_[0] + lanes - 1) / lanes * lanes * tile_[1] * rig.views * 20;

@@ -31,6 +31,10 @@ enum class Sampling {
 };
 Sampling parse_sampling(const std::string& name);  // "view", "subpixel"
 const char* to_string(Sampling s);
+// Throws pmr::Error when --sampling subpixel cannot render with this method and display (PMR only;
+// nearest, unblended sampling). Pipeline::configure checks it; the command line calls it before loading
+// a scene.
+void check_subpixel_sampling(Method method, const Display& display);
 
 struct PipelineConfig {
   Method method = Method::Pmr;

@@ -11,6 +11,7 @@
 #include "cli/render_command.h"
 #include "cli/verify_command.h"
 #include "pmr/error.h"
+#include "pmr/version.h"
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
@@ -18,6 +19,10 @@ int main(int argc, char** argv) {
     if (args.empty() || args[0] == "-h" || args[0] == "--help" || args[0] == "help") {
       std::fputs(pmr::main_help().c_str(), args.empty() ? stderr : stdout);
       return args.empty() ? 2 : 0;
+    }
+    if (args[0] == "--version" || args[0] == "version") {
+      std::printf("pmr %s\n", pmr::program_version());
+      return 0;
     }
     const std::string cmd = args[0];
     args.erase(args.begin());

@@ -261,6 +261,7 @@ std::string main_help() {
          "  pmr info                                     list OpenCL platforms and devices\n"
          "  pmr info SCENE                               what a scene holds (cameras, animations, ...)\n"
          "  pmr verify DIR --frames LIST                 which frames of a sequence are missing or broken\n"
+         "  pmr --version                                the program version (as sidecars record it)\n"
          "  pmr --help | pmr render --help\n";
 }
 

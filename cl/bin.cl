@@ -89,7 +89,7 @@ inline bool in_view(const PmrMta* m, int i, long X0, long X1) {
 
 kernel void bin_count(global const PmrParams* P, global const PmrMta* mtas, uint num_mtas,
                       volatile global uint* tile_counts) {
-  const uint id = get_global_id(0);
+  const uint id = pmr_item_id();
   if (id >= num_mtas) return;
   const PmrMta m = mtas[id];
 #define BIN_EMIT(tile) atomic_inc(&tile_counts[tile])
@@ -100,7 +100,7 @@ kernel void bin_count(global const PmrParams* P, global const PmrMta* mtas, uint
 kernel void bin_fill(global const PmrParams* P, global const PmrMta* mtas, uint num_mtas,
                      volatile global uint* tile_counts, global const uint* tile_offsets,
                      global uint* tile_queue) {
-  const uint id = get_global_id(0);
+  const uint id = pmr_item_id();
   if (id >= num_mtas) return;
   const PmrMta m = mtas[id];
 #define BIN_EMIT(tile) tile_queue[tile_offsets[tile] + atomic_dec(&tile_counts[tile]) - 1u] = id

@@ -10,6 +10,11 @@
 #pragma OPENCL FP_CONTRACT OFF
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 
+/* This work-item's item in a launch over N items (ClRuntime::launch). The host folds long launches
+ * into rows of fewer than 65535 work-items, so no grid dimension reaches PoCL's "small grid" limit and
+ * PoCL compiles exactly one work-group function per (kernel, local size). */
+inline uint pmr_item_id(void) { return (uint)(get_global_id(1) * get_global_size(0) + get_global_id(0)); }
+
 #define PMR_HALF_X (PMR_X_ONE / 2)
 #define PMR_HALF_Y (PMR_Y_ONE / 2)
 

@@ -11,7 +11,7 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
                         global const uchar4* texels, global const float* srgb_lut,
                         global half* volume, global uint* debug_key, global float* debug_depth,
                         global uint* debug_count) {
-  const uint tile = get_global_id(0);
+  const uint tile = pmr_item_id();
   const uint tiles_xy = (uint)P->tiles_x * (uint)P->tiles_y;
   if (tile >= tiles_xy * (uint)P->tiles_v) return;
   const int x0 = (int)(tile % (uint)P->tiles_x) * PMR_TILE_X;

@@ -40,7 +40,7 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
                         global const PmrEncodeRow* rows, global const int* column_start,
                         global const int* row_start, global const int* straddle_slot, uint straddle_slots,
                         global uchar* straddle_cov, global half* display) {
-  const uint tile_xy = get_global_id(0);
+  const uint tile_xy = pmr_item_id();
   const uint tiles_x = (uint)P->tiles_x, tiles_y = (uint)P->tiles_y;
   if (tile_xy >= tiles_x * tiles_y) return;
   const int x0 = (int)(tile_xy % tiles_x) * PMR_TILE_X, y0 = (int)(tile_xy / tiles_x) * PMR_TILE_Y;

@@ -72,7 +72,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
                           global const PmrSampleChunk* chunks, uint num_chunks, global const int* straddle_slot,
                           uint straddle_slots, global uchar* straddle_cov, global half* display,
                           uint debug, global uint* dbg_key, global float* dbg_depth) {
-  const uint chunk = get_global_id(0);
+  const uint chunk = pmr_item_id();
   if (chunk >= num_chunks) return;
   const PmrSampleChunk ch = chunks[chunk];
   const int views = P->views, width = ch.s1 - ch.s0;

@@ -113,7 +113,7 @@ typedef struct {
 kernel void setup_triangles(global const PmrParams* P, global const PmrTriangle* tris,
                             global const PmrVertex* verts, global const PmrMaterial* materials,
                             global PmrMta* mtas, volatile global uint* counter) {
-  const uint t = get_global_id(0);
+  const uint t = pmr_item_id();
   if (t >= P->num_triangles) return;
   const PmrTriangle tri = tris[t];
   PmrVertex v[3] = {verts[tri.v[0]], verts[tri.v[1]], verts[tri.v[2]]};

@@ -4,7 +4,7 @@
 
 kernel void vertex_transform(global const PmrParams* P, global const float* positions,
                              global PmrVertex* out) {
-  const uint v = get_global_id(0);
+  const uint v = pmr_item_id();
   if (v >= P->num_vertices) return;
   const double px = positions[3 * v], py = positions[3 * v + 1], pz = positions[3 * v + 2];
   global const double* V = P->view; /* column-major */
@@ -20,7 +20,7 @@ kernel void vertex_transform(global const PmrParams* P, global const float* posi
  * (x = x0 + view * dx, no disparity), so that a single-view pass sees exactly PMR's positions. */
 kernel void vertex_select_view(global const PmrParams* P, global const PmrVertex* pmr_verts, int view,
                                global PmrVertex* out) {
-  const uint v = get_global_id(0);
+  const uint v = pmr_item_id();
   if (v >= P->num_vertices) return;
   PmrVertex r = pmr_verts[v];
   r.x0 += view * r.dx;

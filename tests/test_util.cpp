@@ -132,8 +132,10 @@ PmrParams params_for(const Rig& rig, int tx, int ty, int tv) {
 
 namespace pmr::test {
 
-CliRun run(const std::string& args) {
-  const std::string cmd = std::string(PMR_BINARY) + " " + args + " 2>&1";
+CliRun run(const std::string& args) { return run_env("", args); }
+
+CliRun run_env(const std::string& env, const std::string& args) {
+  const std::string cmd = (env.empty() ? "" : "env " + env + " ") + std::string(PMR_BINARY) + " " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;
   char buf[4096];

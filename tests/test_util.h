@@ -64,6 +64,8 @@ struct CliRun {
   std::string output;
 };
 CliRun run(const std::string& args);
+// The same with environment assignments for the process, e.g. "POCL_CACHE_DIR='/tmp/x'".
+CliRun run_env(const std::string& env, const std::string& args);
 // A fresh folder per test and process, so that two test runs on one machine cannot meet.
 std::string temp_dir(const std::string& name);
 bool exists(const std::string& path);

@@ -18,6 +18,12 @@ enum Stage { kVertex, kSetup, kBin, kFine, kEncode, kStages };
 // voxel of a screen tile over all views); larger configurations use the unfused path.
 constexpr size_t kFusedPrivateBudget = size_t(256) << 10;
 
+// Work-group sizes, explicit for every launch (see ClRuntime::launch): the per-item stages (vertex,
+// setup, tile raster) run groups of 64 work-items, several per core and wide enough for 16-lane vector
+// code; the fine raster runs one work-item per tile in groups of 8, which keeps the two cores balanced.
+constexpr size_t kItemGroup = 64;
+constexpr size_t kFineGroup = 8;
+
 // Fine raster vector width (PMR_VW): the smallest of 4, 8, 16 lanes that holds a tile row (wider rows
 // take several vectors).
 int fine_lanes(int tile_x) { return tile_x <= 4 ? 4 : (tile_x <= 8 ? 8 : 16); }
@@ -94,8 +100,33 @@ struct Pipeline::Impl {
   size_t debug_entries = 1;
   uint32_t last_mtas = 0;
   uint64_t num_tiles = 0;
+  // Kernel builds: OpenCL program builds plus the work-group functions compiled by the warm-up frame
+  // (Pipeline::build_kernels), and the (kernel, local size) pairs that frame launched.
+  double build_seconds = 0.0;
+  bool warming = false;
+  std::vector<std::string> variants;
 
   explicit Impl(const ClRuntime& r) : rt(r) {}
+
+  // Every stage launches through these: the real grid, or while warming one work-group of the same
+  // local size on a frame in which every count is zero (the kernels return at once).
+  cl_event launch(const ClKernel& k, size_t items, size_t local) {
+    return warming ? warm(k, local, 1) : rt.launch(k, items, local);
+  }
+  cl_event launch_2d(const ClKernel& k, size_t gx, size_t gy, size_t lx, size_t ly) {
+    return warming ? warm(k, lx, ly) : rt.launch_2d(k, gx, gy, lx, ly);
+  }
+  cl_event warm(const ClKernel& k, size_t lx, size_t ly) {
+    const std::string v = k.name() + " " + std::to_string(lx) + "x" + std::to_string(ly);
+    if (std::find(variants.begin(), variants.end(), v) == variants.end()) variants.push_back(v);
+    return rt.launch_one_group(k, lx, ly);
+  }
+  cl_program build(const std::vector<std::string>& files, const std::string& options) {
+    const auto t0 = std::chrono::steady_clock::now();
+    cl_program p = rt.build_program(files, options);
+    build_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return p;
+  }
 
   // Each stage enqueues its kernel(s) for the parameters P (written to params_buf here).
   void vertex_stage(const PmrParams& P, Events& ev);
@@ -164,12 +195,13 @@ Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
     throw Error("invalid --tile " + std::to_string(tx) + "x" + std::to_string(ty) + "x" + std::to_string(tv) +
                 ": " + std::to_string(tx * ty * tv) + " voxels exceed the device's work-group limit of " +
                 std::to_string(runtime.max_work_group_size()));
-  const std::string options = "-cl-std=CL1.2 -cl-fp32-correctly-rounded-divide-sqrt -DPMR_TILE_X=" +
+  // -w: PoCL's compiler would print "N warnings generated." on the user's terminal at every cold build
+  const std::string options = "-cl-std=CL1.2 -w -cl-fp32-correctly-rounded-divide-sqrt -DPMR_TILE_X=" +
                               std::to_string(tx) + " -DPMR_TILE_Y=" + std::to_string(ty) +
                               " -DPMR_TILE_V=" + std::to_string(tv) + " -DPMR_VW=" + std::to_string(fine_lanes(tx));
   Impl& m = *impl_;
   build_options_ = options;
-  m.program = runtime.build_program({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl"}, options);
+  m.program = m.build({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl"}, options);
   m.k_vertex = ClKernel(m.program, "vertex_transform");
   m.k_vertex_select = ClKernel(m.program, "vertex_select_view");
   m.k_setup = ClKernel(m.program, "setup_triangles");
@@ -319,7 +351,29 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
     m.tile_queue = rt.buffer(m.tile_queue_capacity * sizeof(uint32_t), "tile queues");
   }
   rt.finish();
+  build_kernels(rig);
 }
+
+// PoCL compiles a kernel's work-group function when a launch first needs it (and caches it on disk):
+// seconds per function on a cold cache. One frame with nothing in it, each launch a single work-group
+// of its real local size, compiles every function the configuration will use before the first frame.
+void Pipeline::build_kernels(const Rig& rig) {
+  Impl& m = *impl_;
+  const auto t0 = std::chrono::steady_clock::now();
+  m.warming = true;
+  m.variants.clear();
+  try {
+    render(rig);
+  } catch (...) {
+    m.warming = false;
+    throw;
+  }
+  m.warming = false;
+  m.build_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double Pipeline::kernel_build_seconds() const { return impl_->build_seconds; }
+const std::vector<std::string>& Pipeline::kernel_variants() const { return impl_->variants; }
 
 void Pipeline::set_mta_capacity(uint32_t capacity) {
   impl_->mta_capacity = std::max<uint32_t>(1, capacity);
@@ -330,13 +384,13 @@ void Pipeline::set_mta_capacity(uint32_t capacity) {
 void Pipeline::Impl::vertex_stage(const PmrParams& P, Events& ev) {
   rt.write(params_buf, &P, sizeof P);
   k_vertex.args(params_buf, positions, vertices);
-  ev.add(kVertex, rt.launch(k_vertex, num_vertices, 0));
+  ev.add(kVertex, launch(k_vertex, num_vertices, kItemGroup));
 }
 
 void Pipeline::Impl::select_view_stage(const PmrParams& P, int view, Events& ev) {
   rt.write(params_buf, &P, sizeof P);
   k_vertex_select.args(params_buf, pmr_vertices, view, vertices);
-  ev.add(kVertex, rt.launch(k_vertex_select, num_vertices, 0));
+  ev.add(kVertex, launch(k_vertex_select, num_vertices, kItemGroup));
 }
 
 // Primitive setup, redone with a larger MTA queue until everything fits (never drops work).
@@ -348,7 +402,7 @@ void Pipeline::Impl::setup_stage(PmrParams& P, Events& ev, StageTimes& t) {
     const uint32_t zero = 0;
     rt.write(mta_counter, &zero, sizeof zero);
     k_setup.args(params_buf, tris, vertices, materials, mtas, mta_counter);
-    ev.add(kSetup, rt.launch(k_setup, num_triangles, 0));
+    ev.add(kSetup, launch(k_setup, num_triangles, kItemGroup));
     rt.read(mta_counter, &last_mtas, sizeof last_mtas);
     if (last_mtas <= mta_capacity) break;
     const uint64_t grown = uint64_t(last_mtas) + last_mtas / 4 + 64;
@@ -364,7 +418,7 @@ void Pipeline::Impl::setup_stage(PmrParams& P, Events& ev, StageTimes& t) {
 // Tile raster: count entries per tile, exclusive scan on the host (sizes the queue), fill.
 void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
   k_bin_count.args(params_buf, mtas, last_mtas, tile_counts);
-  ev.add(kBin, rt.launch(k_bin_count, last_mtas, 0));
+  ev.add(kBin, launch(k_bin_count, last_mtas, kItemGroup));
   std::vector<uint32_t> counts(num_tiles + 1);
   rt.read(tile_counts, counts.data(), size_t(num_tiles) * 4);
   uint64_t total = 0;
@@ -386,23 +440,22 @@ void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
   }
   t.bin_entries += total;
   k_bin_fill.args(params_buf, mtas, last_mtas, tile_counts, tile_offsets, tile_queue);
-  ev.add(kBin, rt.launch(k_bin_fill, last_mtas, 0));
+  ev.add(kBin, launch(k_bin_fill, last_mtas, kItemGroup));
 }
 
 void Pipeline::Impl::fine_stage(Events& ev) {
   k_fine.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, volume,
               dbg_key, dbg_depth, dbg_count);
-  // one work-item per tile; small work-groups keep the two cores balanced
-  const size_t group = 8;
-  ev.add(kFine, rt.launch(k_fine, (size_t(num_tiles) + group - 1) / group * group, group));
+  ev.add(kFine, launch(k_fine, size_t(num_tiles), kFineGroup));
 }
 
 void Pipeline::Impl::encode_stage(Events& ev) {
-  rt.write(encode_buf, &encode_params, sizeof encode_params);
+  const PmrEncodeParams nothing{};  // warming: a display of 0 x 0
+  rt.write(encode_buf, warming ? &nothing : &encode_params, sizeof encode_params);
   ClKernel& k = encode_params.blend ? k_encode_blend : encode_params.bilinear ? k_encode_bilinear : k_encode;
   k.args(encode_buf, encode_columns, encode_rows, volume, display);
   const size_t runs = (size_t(encode_params.display_w) + PMR_ENCODE_RUN - 1) / PMR_ENCODE_RUN;
-  ev.add(kEncode, rt.launch_2d(k, runs, size_t(encode_params.display_h), 8, 1));
+  ev.add(kEncode, launch_2d(k, runs, size_t(encode_params.display_h), 8, 1));
 }
 
 // Tables of the fused path: the first subpixel of every view column and the first display row of every
@@ -412,7 +465,7 @@ void Pipeline::Impl::configure_fused(const std::string& options, int views, int 
                                      const std::vector<PmrEncodeColumn>& columns, const std::vector<PmrEncodeRow>& rows) {
   if (fused_views != views) {
     if (fused_program) clReleaseProgram(fused_program);
-    fused_program = rt.build_program({"fine_encode.cl", "straddle_alpha.cl"}, options + " -DPMR_FUSED_VIEWS=" + std::to_string(views));
+    fused_program = build({"fine_encode.cl", "straddle_alpha.cl"}, options + " -DPMR_FUSED_VIEWS=" + std::to_string(views));
     fused_views = views;
     k_fine_encode = ClKernel(fused_program, "fine_encode");
     k_straddle_alpha = ClKernel(fused_program, "encode_straddle_alpha");
@@ -449,7 +502,7 @@ void Pipeline::Impl::configure_subpixel(const std::string& options, int views, c
   const int capacity = subpixel_chunk_capacity(views);
   if (subpixel_views != views) {
     if (subpixel_program) clReleaseProgram(subpixel_program);
-    subpixel_program = rt.build_program({"fine_subpixel.cl", "straddle_alpha.cl"},
+    subpixel_program = build({"fine_subpixel.cl", "straddle_alpha.cl"},
                                         options + " -DPMR_SUBPIXEL_VIEWS=" + std::to_string(views) +
                                             " -DPMR_SUBPIXEL_CAP=" + std::to_string(capacity) +
                                             " -DPMR_SUBPIXEL_SLOTS=" + std::to_string(kSubpixelSlots));
@@ -480,16 +533,17 @@ void Pipeline::Impl::configure_subpixel(const std::string& options, int views, c
 
 void Pipeline::Impl::straddle_alpha_stage(ClKernel& k, Events& ev) {
   if (straddle_slots == 0) return;
-  k.args(encode_buf, straddle_columns, straddle_slots, straddle_cov, display);
-  ev.add(kEncode, rt.launch_2d(k, straddle_slots, size_t(encode_params.display_h), 1, 8));
+  k.args(encode_buf, straddle_columns, warming ? 0u : straddle_slots, straddle_cov, display);
+  ev.add(kEncode, launch_2d(k, straddle_slots, size_t(encode_params.display_h), 1, 8));
 }
 
 void Pipeline::Impl::subpixel_stage(Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
   k_fine_subpixel.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut,
-                       encode_buf, column_a, column_b, encode_rows, sample_x, sample_y, chunks, num_chunks, straddle_slot, straddle_slots,
+                       encode_buf, column_a, column_b, encode_rows, sample_x, sample_y, chunks, warming ? 0u : num_chunks,
+                       straddle_slot, straddle_slots,
                        straddle_cov, display, cl_uint(subpixel_debug), dbg_key, dbg_depth);
-  ev.add(kFine, rt.launch(k_fine_subpixel, num_chunks, 1));
+  ev.add(kFine, launch(k_fine_subpixel, num_chunks, 1));
   straddle_alpha_stage(k_subpixel_straddle, ev);
 }
 
@@ -499,7 +553,7 @@ void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
                      encode_buf, column_soa, encode_rows, column_start, row_start, straddle_slot, straddle_slots,
                      straddle_cov, display);
   const size_t screen_tiles = size_t(P.tiles_x) * P.tiles_y;
-  ev.add(kFine, rt.launch(k_fine_encode, screen_tiles, 1));
+  ev.add(kFine, launch(k_fine_encode, screen_tiles, 1));
   straddle_alpha_stage(k_straddle_alpha, ev);
 }
 
@@ -521,6 +575,7 @@ StageTimes Pipeline::render(const Rig& rig) {
   P.debug_outputs = config_.debug_outputs ? 1u : 0u;
   P.setup_mode = config_.method == Method::Duplicate ? PMR_SETUP_DUPLICATE : PMR_SETUP_MTA;
   P.sample_area = m.subpixel ? PMR_SAMPLES_PIXEL : PMR_SAMPLES_CENTER;
+  if (m.warming) P.num_vertices = P.num_triangles = 0, P.tiles_x = P.tiles_y = P.tiles_v = 0;  // an empty frame
 
   if (config_.method != Method::Multipass) {
     m.vertex_stage(P, ev);

@@ -80,6 +80,12 @@ class Pipeline {
   void configure(const Rig& rig, const Display* display);
   // Renders one frame with the rig given to configure() (camera pose may change between frames).
   StageTimes render(const Rig& rig);
+  // Seconds spent building kernels: program builds and the work-group functions configure() compiles
+  // ahead of the first frame (every launch has a fixed local size, so frames compile nothing).
+  double kernel_build_seconds() const;
+  // The (kernel, local size) pairs the configuration launches, e.g. "bin_count 64x1": one PoCL
+  // work-group function each.
+  const std::vector<std::string>& kernel_variants() const;
 
   const PipelineConfig& config() const { return config_; }
   // Bytes of device buffers currently allocated.
@@ -112,6 +118,7 @@ class Pipeline {
  struct Impl;
 
  private:
+  void build_kernels(const Rig& rig);
   std::unique_ptr<Impl> impl_;
   PipelineConfig config_;
   int tiles_x_ = 0, tiles_y_ = 0, tiles_v_ = 0;

@@ -263,25 +263,45 @@ void ClRuntime::fill_zero(const ClBuffer& b) const {
            "clEnqueueFillBuffer");
 }
 
-cl_event ClRuntime::launch(const ClKernel& k, size_t global, size_t local) const {
+namespace {
+
+cl_event enqueue(cl_command_queue q, const ClKernel& k, cl_uint dims, const size_t* global, const size_t* local) {
   cl_event e = nullptr;
-  if (global == 0) {  // nothing to do; a marker keeps the profiling code uniform
-    cl_check(clEnqueueMarkerWithWaitList(queue_, 0, nullptr, &e), "clEnqueueMarkerWithWaitList");
-    return e;
-  }
-  const size_t* lp = local ? &local : nullptr;
-  cl_check(clEnqueueNDRangeKernel(queue_, k.get(), 1, nullptr, &global, lp, 0, nullptr, &e),
-           "launching kernel " + k.name() + " (global " + std::to_string(global) + ", local " +
-               std::to_string(local) + ")");
+  cl_check(clEnqueueNDRangeKernel(q, k.get(), dims, nullptr, global, local, 0, nullptr, &e),
+           "launching kernel " + k.name() + " (global " + std::to_string(global[0]) + "x" +
+               std::to_string(dims > 1 ? global[1] : 1) + ", local " + std::to_string(local[0]) + "x" +
+               std::to_string(dims > 1 ? local[1] : 1) + ")");
   return e;
 }
 
+}  // namespace
+
+cl_event ClRuntime::launch(const ClKernel& k, size_t items, size_t local) const {
+  if (items == 0) {  // nothing to do; a marker keeps the profiling code uniform
+    cl_event e = nullptr;
+    cl_check(clEnqueueMarkerWithWaitList(queue_, 0, nullptr, &e), "clEnqueueMarkerWithWaitList");
+    return e;
+  }
+  if (local == 0 || local >= kSmallGridLimit) throw Error("internal error: launch of " + k.name() + " without a valid local size");
+  const size_t row = (kSmallGridLimit - 1) / local * local;
+  const size_t rows = (items + row - 1) / row;
+  if (rows >= kSmallGridLimit)
+    throw Error("kernel " + k.name() + ": " + std::to_string(items) + " work-items are more than one launch can hold");
+  const size_t width = rows == 1 ? (items + local - 1) / local * local : row;
+  const size_t global[2] = {width, rows}, lsize[2] = {local, 1};
+  return enqueue(queue_, k, 2, global, lsize);
+}
+
 cl_event ClRuntime::launch_2d(const ClKernel& k, size_t gx, size_t gy, size_t lx, size_t ly) const {
-  cl_event e = nullptr;
   const size_t global[2] = {(gx + lx - 1) / lx * lx, (gy + ly - 1) / ly * ly}, local[2] = {lx, ly};
-  cl_check(clEnqueueNDRangeKernel(queue_, k.get(), 2, nullptr, global, local, 0, nullptr, &e),
-           "launching kernel " + k.name() + " (2D " + std::to_string(global[0]) + "x" + std::to_string(global[1]) + ")");
-  return e;
+  if (global[0] >= kSmallGridLimit || global[1] >= kSmallGridLimit)
+    throw Error("internal error: 2D launch of " + k.name() + " beyond the small-grid limit");
+  return enqueue(queue_, k, 2, global, local);
+}
+
+cl_event ClRuntime::launch_one_group(const ClKernel& k, size_t lx, size_t ly) const {
+  const size_t global[2] = {lx, ly}, local[2] = {lx, ly};
+  return enqueue(queue_, k, 2, global, local);
 }
 
 void ClRuntime::finish() const { cl_check(clFinish(queue_), "clFinish"); }

@@ -88,10 +88,24 @@ class ClRuntime {
   void write(const ClBuffer& b, const void* data, size_t bytes, size_t offset = 0) const;
   void read(const ClBuffer& b, void* data, size_t bytes, size_t offset = 0) const;
   void fill_zero(const ClBuffer& b) const;
-  // Launches a kernel; returns its event (caller releases) for profiling.
-  cl_event launch(const ClKernel& k, size_t global, size_t local) const;
-  // 2D launch; the global size is rounded up to a multiple of the local size.
+  // Every launch names its local size. PoCL compiles (and caches on disk) one work-group function
+  // per kernel, local size, zero/non-zero global offset and "small grid" (every grid dimension under
+  // kSmallGridLimit work-items). A local size left to PoCL follows the global size, so data-dependent
+  // counts (the MTAs of a frame) meant a new compilation of seconds for almost every frame. With
+  // explicit local sizes and grids kept small, a configuration compiles a fixed set of functions,
+  // once (Pipeline::configure builds them all before the first frame).
+  static constexpr size_t kSmallGridLimit = 65535;  // PoCL's grid_width_specialization_limit (USHRT_MAX)
+  // Launches `items` work-items (kernels index them with pmr_item_id(), cl/common.h) in work-groups of
+  // `local`. Counts of up to a row (the largest multiple of `local` below kSmallGridLimit) run as one
+  // row; longer launches are folded into rows of that width (a 2D grid); the padding work-items past
+  // `items` must return at once. items == 0 enqueues a marker. Returns the event (caller releases).
+  cl_event launch(const ClKernel& k, size_t items, size_t local) const;
+  // 2D launch; the global size is rounded up to a multiple of the local size. Throws if a dimension
+  // would reach kSmallGridLimit.
   cl_event launch_2d(const ClKernel& k, size_t gx, size_t gy, size_t lx, size_t ly) const;
+  // One work-group of the given local size, for building a kernel's work-group function ahead of
+  // time (the kernel must do nothing harmful for its arguments at the time).
+  cl_event launch_one_group(const ClKernel& k, size_t lx, size_t ly = 1) const;
   void finish() const;
 
  private:

@@ -165,14 +165,18 @@ int run_sequence(const RenderOptions& o) {
   }
 
   ClRuntime runtime;
-  const auto t_build = std::chrono::steady_clock::now();
   PipelineConfig pc = o.pipeline;
   pc.fuse_encode = !need_volume;  // the volume is only kept when a product needs it
   pc.debug_outputs = o.write_depth;  // per-voxel depth
   Pipeline pipeline(runtime, pc);
-  renderer.attach(pipeline, o.write_encoded ? &o.display : nullptr);
-  if (o.verbose)
-    std::fprintf(stderr, "pmr: device %s; kernels built in %.2f s\n", runtime.device_name().c_str(), seconds_since(t_build));
+  renderer.attach(pipeline, o.write_encoded ? &o.display : nullptr);  // builds every kernel the frames use
+  if (o.verbose) {
+    std::string variants;
+    for (const std::string& v : pipeline.kernel_variants()) variants += (variants.empty() ? "" : ", ") + v;
+    std::fprintf(stderr, "pmr: device %s; kernels built in %.2f s (%zu work-group functions: %s)\n",
+                 runtime.device_name().c_str(), pipeline.kernel_build_seconds(), pipeline.kernel_variants().size(),
+                 variants.c_str());
+  }
 
   install_interrupt_handlers();
   FrameWriter writer(2);

@@ -50,16 +50,20 @@ const glm::vec3 kCorners[4] = {{-0.8f, -0.5f, 0.5f}, {0.8f, -0.3f, -0.5f}, {0.8f
 const std::string kArgs =
     " --views 5 --view-size 96x48 --display 240x135 --cone 30 --frames 37 --fps 24 --quilt 3x2 -q ";
 
+// The quadrilateral as a .glb, written once per process and removed at exit.
 std::string quad_scene() {
-  static const std::string path = [] {
-    Scene s = test::empty_scene(true);
-    test::add_triangle(s, kCorners[0], kCorners[1], kCorners[2]);
-    test::add_triangle(s, kCorners[0], kCorners[2], kCorners[3]);
-    const std::string p = ::testing::TempDir() + "pmr_exr_meta_quad_" + std::to_string(getpid()) + ".glb";
-    save_glb(s, p);
-    return p;
-  }();
-  return path;
+  struct File {
+    std::string path = ::testing::TempDir() + "pmr_exr_meta_quad_" + std::to_string(getpid()) + ".glb";
+    File() {
+      Scene s = test::empty_scene(true);
+      test::add_triangle(s, kCorners[0], kCorners[1], kCorners[2]);
+      test::add_triangle(s, kCorners[0], kCorners[2], kCorners[3]);
+      save_glb(s, path);
+    }
+    ~File() { std::remove(path.c_str()); }
+  };
+  static const File file;
+  return file.path;
 }
 
 struct Files {

@@ -15,6 +15,7 @@
 #include <exception>
 #include <limits>
 
+#include "output/exr_metadata.h"
 #include "pmr/error.h"
 #include "pmr/output.h"
 
@@ -131,7 +132,8 @@ std::string view_part_name(int i, int views) {
 }
 
 void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half,
-                    ExrCompression c, int threads, const float* depth, float pixel_aspect) {
+                    ExrCompression c, int threads, const float* depth, float pixel_aspect, const ExrMetadata* meta,
+                    ExrImage image) {
   check_image(path, width, height, 1, rgba_half);
   if (!(pixel_aspect > 0.0f) || !std::isfinite(pixel_aspect))
     throw Error("cannot write " + path + ": invalid pixel aspect ratio " + std::to_string(pixel_aspect));
@@ -141,6 +143,7 @@ void write_rgba_exr(const std::string& path, int width, int height, const uint16
     // display and data window (0,0)-(w-1,h-1), INCREASING_Y
     Imf::Header header(width, height, pixel_aspect);
     set_compression(header, c, path);
+    if (meta) add_exr_metadata(header, *meta, image, meta->center_view);
     if (depth) {  // half RGBA plus a float Z channel: the general interface
       for (const char* ch : {"R", "G", "B", "A"}) header.channels().insert(ch, Imf::Channel(Imf::HALF));
       header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
@@ -162,8 +165,12 @@ void write_rgba_exr(const std::string& path, int width, int height, const uint16
 }
 
 void write_views_exr(const std::string& path, int width, int height, int views, const uint16_t* volume,
-                     const float* depth, ExrCompression c, int threads, float pixel_aspect) {
+                     const float* depth, ExrCompression c, int threads, float pixel_aspect,
+                     const ExrMetadata* meta) {
   check_image(path, width, height, views, volume);
+  if (meta && meta->rig.views != views)
+    throw Error("cannot write " + path + ": the metadata's rig has " + std::to_string(meta->rig.views) + " views, the file " +
+                std::to_string(views));
   if (!(pixel_aspect > 0.0f) || !std::isfinite(pixel_aspect))
     throw Error("cannot write " + path + ": invalid pixel aspect ratio " + std::to_string(pixel_aspect));
   AtomicFile file(path);
@@ -178,6 +185,7 @@ void write_views_exr(const std::string& path, int width, int height, int views, 
       h.setType(Imf::SCANLINEIMAGE);
       for (const char* ch : {"R", "G", "B", "A"}) h.channels().insert(ch, Imf::Channel(Imf::HALF));
       if (depth) h.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+      if (meta) add_exr_metadata(h, *meta, ExrImage::Views, i);
       headers.push_back(std::move(h));
     }
     Imf::MultiPartOutputFile out(file.temp_path().c_str(), headers.data(), views);

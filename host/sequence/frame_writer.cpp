@@ -142,13 +142,15 @@ void FrameWriter::write(FrameFiles& f) {
                                &f.center_png, &f.quilt_png})
     if (!p->empty()) slots.push_back(register_temp_file(*p));
   auto done = [&](const std::string& path) { committed.push_back(path); };
+  const ExrMetadata* meta = f.has_meta ? &f.meta : nullptr;
   try {
     check();
     write_text_atomic(f.sidecar_path, f.sidecar_text);
     done(f.sidecar_path);
     if (!f.encoded_path.empty()) {
       check();
-      write_rgba_exr(f.encoded_path, f.display_w, f.display_h, f.display.data(), f.compression, exr_threads_);
+      write_rgba_exr(f.encoded_path, f.display_w, f.display_h, f.display.data(), f.compression, exr_threads_, nullptr,
+                     1.0f, meta, ExrImage::Encoded);
       done(f.encoded_path);
     }
     if (!f.depth.empty()) {
@@ -161,7 +163,7 @@ void FrameWriter::write(FrameFiles& f) {
     if (!f.views_path.empty()) {
       check();
       write_views_exr(f.views_path, f.view_w, f.view_h, f.views, f.volume.data(), depth, f.compression, exr_threads_,
-                      f.pixel_aspect);
+                      f.pixel_aspect, meta);
       done(f.views_path);
     }
     std::vector<uint16_t> quilt;
@@ -172,7 +174,7 @@ void FrameWriter::write(FrameFiles& f) {
     if (!f.quilt_path.empty()) {
       check();
       write_rgba_exr(f.quilt_path, qw, qh, quilt.data(), f.compression, exr_threads_,
-                     depth ? quilt_depth.data() : nullptr, f.pixel_aspect);
+                     depth ? quilt_depth.data() : nullptr, f.pixel_aspect, meta, ExrImage::Quilt);
       done(f.quilt_path);
     }
     if (!f.encoded_png.empty()) {

@@ -39,6 +39,10 @@ struct FrameFiles {
   std::vector<float> depth;
   double near = 0.0, far = 0.0;
   ExrCompression compression = ExrCompression::Zip;
+  // The frame's EXR header attributes (docs/OUTPUTS.md): every EXR of the frame gets them when
+  // has_meta; the writer builds each header from it (a rig and a few numbers, no image data).
+  bool has_meta = false;
+  ExrMetadata meta;
 };
 
 class FrameWriter {

@@ -211,6 +211,10 @@ int run_sequence(const RenderOptions& o) {
     files.compression = compression;
     files.sidecar_path = p.sidecar;
     files.sidecar_text = sidecar_json(fr.rig, o.display, frame_info(f, p, fr.angle));
+    files.has_meta = true;  // the EXR header attributes (docs/OUTPUTS.md)
+    files.meta.frame = f, files.meta.time = double(f) / spec.fps, files.meta.fps = spec.fps;
+    files.meta.sidecar = base_name(p.sidecar), files.meta.rig = fr.rig;
+    files.meta.center_view = center_view, files.meta.quilt = quilt;
     if (o.write_encoded) {
       files.encoded_path = p.encoded;
       files.display_w = o.display.width, files.display_h = o.display.height;

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "pmr/quilt.h"
 #include "pmr/rig.h"
 
 namespace pmr {
@@ -50,13 +51,29 @@ class AtomicFile {
 // a full disk shows here) on failure.
 void write_text_atomic(const std::string& path, const std::string& text);
 
+// What an EXR written for a frame records in its header besides the pixels (docs/OUTPUTS.md; built by
+// host/output/exr_metadata.cpp): the frame's place in the sequence, its sidecar, and the rig whose
+// per-view matrices become worldToCamera / worldToNDC.
+enum class ExrImage { Encoded, Views, Quilt };
+struct ExrMetadata {
+  long frame = 0;
+  double time = 0.0;        // seconds: frame / fps, as the sidecar records it
+  double fps = 24.0;
+  std::string sidecar;      // the sidecar's file name (in the same folder)
+  Rig rig;                  // this frame's rig (an animated camera moves it)
+  int center_view = 0;      // the view whose matrices the encoded image and the quilt carry
+  QuiltLayout quilt;        // the quilt's layout (its worldToNDC lands in the center view's tile)
+};
+
 // Half RGBA EXR (scanline, one part), row 0 at the top (data window (0,0)-(width-1,height-1)).
 // rgba_half: width*height*4 uint16 (IEEE half bits), row-major, RGBA, read in place (no copy).
 // threads > 0 sets OpenEXR's global thread count used for compression (Imf::setGlobalThreadCount).
 // depth (optional, [y][x] floats) adds a FLOAT channel "Z"; pixel_aspect is the header's
-// pixelAspectRatio (a quilt of non-square view pixels).
+// pixelAspectRatio (a quilt of non-square view pixels). meta (optional) adds the frame's attributes for
+// an image of kind `image` (Encoded or Quilt).
 void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half,
-                    ExrCompression c, int threads = 0, const float* depth = nullptr, float pixel_aspect = 1.0f);
+                    ExrCompression c, int threads = 0, const float* depth = nullptr, float pixel_aspect = 1.0f,
+                    const ExrMetadata* meta = nullptr, ExrImage image = ExrImage::Encoded);
 
 
 // The name of part i of a views file with `views` parts: view_000, view_001, ... with 3 digits, or as
@@ -67,9 +84,12 @@ std::string view_part_name(int i, int views);
 // volume: [view][y][x][4] halves, contiguous, row 0 at the top. If depth != nullptr each part also gets
 // a FLOAT channel "Z" from depth [view][y][x]. pixel_aspect is stored as each part's pixelAspectRatio
 // (a view raster's pixels are not square when its aspect differs from the display's: pass
-// A * height / width so that viewers show the views undistorted; 1 = square pixels).
+// A * height / width so that viewers show the views undistorted; 1 = square pixels). meta (optional)
+// adds the frame's attributes to every part, each with its own view's `view` name and matrices;
+// meta->rig.views must equal `views`.
 void write_views_exr(const std::string& path, int width, int height, int views, const uint16_t* volume,
-                     const float* depth, ExrCompression c, int threads = 0, float pixel_aspect = 1.0f);
+                     const float* depth, ExrCompression c, int threads = 0, float pixel_aspect = 1.0f,
+                     const ExrMetadata* meta = nullptr);
 
 // True when the EXR file opens and every part has all its pixel data (a truncated file is not
 // complete). Never throws.

@@ -66,6 +66,7 @@ bool plain_file_name(const std::string& name) {
 struct FolderScene {
   std::string scene;
   long reference_frame = -1;
+  std::string reference_text;  // its sidecar
   std::vector<std::string> versions;
 };
 
@@ -87,8 +88,7 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
       continue;
     }
     const SidecarProvenance p = sidecar_provenance(text);
-    auto [it, fresh] = seen.try_emplace(p.scene, 0, f);
-    ++it->second.first;
+    ++seen.try_emplace(p.scene, 0, f).first->second.first;
     const std::string v = p.version.empty() ? "unrecorded" : p.version;
     if (std::find(folder.versions.begin(), folder.versions.end(), v) == folder.versions.end()) folder.versions.push_back(v);
   }
@@ -99,6 +99,7 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
       folder.scene = scene;
       folder.reference_frame = count_first.second;
     }
+  if (folder.reference_frame >= 0) folder.reference_text = read_text_file(sidecar_path(dir, o, folder.reference_frame));
   return folder;
 }
 
@@ -127,8 +128,7 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
   if (!prov.scene.empty() && prov.scene != folder.scene)
     return stem + ".json was rendered from another scene than " + reference_name +
            " and the folder's other frames (scene checksums differ)";
-  const std::string reference = f == folder.reference_frame ? text : read_text_file(sidecar_path(dir, o, folder.reference_frame));
-  const std::string diff = sidecar_config_difference(reference, text);
+  const std::string diff = sidecar_config_difference(folder.reference_text, text);
   if (!diff.empty()) return stem + ".json was rendered with another configuration (" + diff + " differs)";
   if (prov.scene != folder.scene) return stem + ".json records no scene checksum, unlike " + reference_name;
   std::vector<std::pair<std::string, nlohmann::json>> listed;  // (kind, file name as listed)

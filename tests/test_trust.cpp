@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "output/checksum.h"
 #include "pmr/output.h"
 #include "pmr/version.h"
 #include "test_util.h"
@@ -55,6 +56,7 @@ json sidecar(const std::string& path) { return json::parse(read_bytes(path)); }
 struct Quad {
   double r = 1, g = 0, b = 0, size = 1;
   bool textured = false, embedded = false;
+  std::string bin = "quad.bin";  // the buffer's URI (percent-encoded), relative to the .gltf
 };
 
 std::string base64(const std::string& in) {
@@ -104,7 +106,7 @@ std::string write_quad(const std::string& dir, const Quad& q) {
         {{"bufferView", 3}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}}}},
   };
   doc["buffers"] = {{{"byteLength", bin.size()},
-                     {"uri", q.embedded ? "data:application/octet-stream;base64," + base64(bin) : "quad.bin"}}};
+                     {"uri", q.embedded ? "data:application/octet-stream;base64," + base64(bin) : q.bin}}};
   json material = {{"pbrMetallicRoughness", {{"baseColorFactor", {q.r, q.g, q.b, 1.0}}}}, {"doubleSided", true}};
   if (q.textured) {
     material["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
@@ -116,7 +118,12 @@ std::string write_quad(const std::string& dir, const Quad& q) {
     write_png_preview(dir + "/unused.png", 4, 4, px.data());
   }
   doc["materials"] = {material};
-  if (!q.embedded) write_bytes(dir + "/quad.bin", bin);
+  if (!q.embedded) {
+    std::string file = q.bin;  // decoded as tinygltf does (%20 only, here)
+    for (size_t at; (at = file.find("%20")) != std::string::npos;) file.replace(at, 3, " ");
+    fs::create_directories(fs::path(dir + "/" + file).parent_path());
+    write_bytes(dir + "/" + file, bin);
+  }
   write_bytes(dir + "/quad.gltf", doc.dump(1));
   return dir + "/quad.gltf";
 }
@@ -128,6 +135,14 @@ size_t count_of(const std::string& text, const std::string& what) {
 }
 
 }  // namespace
+
+// The hash and its text: XXH3-64 of nothing is 2d06800538d394c2 (xxhsum -H3 /dev/null).
+TEST(Trust, ChecksumIsXxh3In16HexDigits) {
+  EXPECT_EQ(checksum_hex("", 0), "2d06800538d394c2");
+  EXPECT_EQ(checksum_hex(uint64_t(0xab)), "00000000000000ab");
+  const std::string abc = "abc";
+  EXPECT_EQ(checksum64(abc.data(), abc.size()), XXH3_64bits(abc.data(), abc.size()));
+}
 
 // Without --write, verify checks every output the sidecar lists: a deleted views file and a truncated
 // quilt make their frames broken (they passed before: only the encoded image was checked).
@@ -227,8 +242,14 @@ TEST(Trust, SidecarRecordsVersionAndChecksums) {
   const json want = {{"quad.bin", xxh3_of(dir + "/scene/quad.bin")}, {"tex.png", xxh3_of(dir + "/scene/tex.png")}};
   EXPECT_EQ(j["checksums"]["scene_files"], want) << j["checksums"].dump();
   EXPECT_FALSE(j["checksums"].contains("display_config"));
-  // a scene in a subfolder of the working directory, its buffer in a subfolder of its own: relative paths
-  // (a data: URI is no file)
+  // the buffer in a subfolder, its URI percent-encoded: the path relative to the scene's folder, decoded
+  Quad sub;
+  sub.bin = "data/my%20quad.bin";
+  const std::string in_sub = write_quad(dir + "/sub", sub);
+  ASSERT_EQ(run("render " + in_sub + kSmall + "--out " + dir + "/s").status, 0);
+  EXPECT_EQ(sidecar(dir + "/s/frame_0000.json")["checksums"]["scene_files"],
+            json({{"data/my quad.bin", xxh3_of(dir + "/sub/data/my quad.bin")}}));
+  // a data: URI is no file
   Quad e;
   e.embedded = true;
   const std::string embedded = write_quad(dir + "/embedded", e);

@@ -36,23 +36,6 @@ std::string verify_help() {
          "a --frames list to resubmit (with --resume); exit code 1 if there are any.\n";
 }
 
-// A file name taken from a sidecar, safe to print on a terminal: control characters, DEL, backslashes
-// and bytes outside ASCII as \xNN, at most 120 characters.
-std::string printable(const std::string& name) {
-  std::string out;
-  for (unsigned char c : name) {
-    if (out.size() >= 120) return out + "...";
-    if (c < 0x20 || c >= 0x7f || c == '\\') {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    } else {
-      out += char(c);
-    }
-  }
-  return out;
-}
-
 // A listed output must be a plain file name in the frame's folder.
 bool plain_file_name(const std::string& name) {
   if (name.empty() || name == "." || name == "..") return false;
@@ -153,22 +136,21 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
   }
   std::vector<std::string> images;
   for (const auto& [kind, value] : listed) {
-    if (!value.is_string()) return stem + ".json lists a " + printable(kind) + " output that is not a file name";
+    if (!value.is_string()) return stem + ".json lists a " + printable_text(kind) + " output that is not a file name";
     const std::string name = value.get<std::string>();
     if (!plain_file_name(name))
-      return stem + ".json lists " + printable(kind) + " output '" + printable(name) +
+      return stem + ".json lists " + printable_text(kind) + " output '" + printable_text(name) +
              "', which is not a plain file name in the folder";
     const fs::path path = fs::path(dir) / name;
     const fs::file_status st = fs::symlink_status(path, ec);
-    if (st.type() == fs::file_type::not_found) return printable(name) + " is missing";
+    if (st.type() == fs::file_type::not_found) return printable_text(name) + " is missing";
     if (st.type() != fs::file_type::regular)
-      return printable(name) + " is not a regular file (" +
+      return printable_text(name) + " is not a regular file (" +
              (st.type() == fs::file_type::symlink ? "a symbolic link" : st.type() == fs::file_type::directory ? "a folder" : "a special file") + ")";
     images.push_back(path.string());
   }
-  std::string problem = frame_problem(sidecar, images);
-  // frame_problem names files by their (already checked, plain) names; keep terminals safe anyway
-  return printable(problem);
+  // frame_problem names the files by their (plain, but maybe not ASCII) names
+  return printable_text(frame_problem(sidecar, images), std::string::npos);
 }
 
 }  // namespace
@@ -217,7 +199,7 @@ int run_verify(const std::vector<std::string>& args) {
   }
   if (folder.versions.size() > 1) {  // not a problem: versions do not change pixels (docs/SEQUENCES.md)
     std::string list;
-    for (const std::string& v : folder.versions) list += (list.empty() ? "" : ", ") + printable(v);
+    for (const std::string& v : folder.versions) list += (list.empty() ? "" : ", ") + printable_text(v);
     std::fprintf(stderr, "pmr verify: note: the frames were rendered by %zu pmr versions (%s)\n", folder.versions.size(),
                  list.c_str());
   }

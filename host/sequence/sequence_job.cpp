@@ -111,9 +111,9 @@ int run_sequence(const RenderOptions& o) {
   info.display_source = o.display_source;
   info.scene_checksum = scene.source_checksum;
   for (const SceneInputFile& f : scene.input_files) info.scene_files.push_back({f.path, f.checksum});
-  if (o.has_calibration) info.display_config_checksum = o.calibration.checksum;
   if (o.has_calibration) {
     const LookingGlassCalibration& c = o.calibration;
+    info.display_config_checksum = c.checksum;
     info.calibration_serial = c.serial;
     info.calibration = {{"pitch", c.pitch},         {"slope", c.slope},       {"center", c.center},
                         {"DPI", c.dpi},             {"screenW", c.screen_w},  {"screenH", c.screen_h},
@@ -165,7 +165,7 @@ int run_sequence(const RenderOptions& o) {
         ++skipped;
         if (had.version != program_version()) {
           ++old_version_frames;
-          const std::string v = had.version.empty() ? "unrecorded" : had.version;
+          const std::string v = had.version.empty() ? "unrecorded" : printable_text(had.version);
           if (std::find(old_versions.begin(), old_versions.end(), v) == old_versions.end()) old_versions.push_back(v);
         }
         continue;

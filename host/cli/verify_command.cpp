@@ -1,12 +1,16 @@
 // Checks a sequence's output folder frame by frame: the sidecar is there and parses, names this frame
-// and its time, and shows the same configuration as the folder's other frames; every requested image
-// it lists exists and is complete. Missing or broken frames are printed on stdout as a --frames list
-// to resubmit (details on stderr); the exit code is 1 when any frame is missing or broken.
+// and its time, was rendered from the same scene (its recorded checksums) and with the same
+// configuration as the folder's other frames; every output it lists (or, with --write / --preview, every
+// requested kind) is a regular file in the folder and complete. Missing or broken frames are printed on
+// stdout as a --frames list to resubmit (details on stderr); the exit code is 1 when any frame is
+// missing or broken.
 #include "cli/verify_command.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 
 #include <nlohmann/json.hpp>
 
@@ -24,16 +28,70 @@ namespace fs = std::filesystem;
 
 std::string verify_help() {
   return "usage: pmr verify DIR --frames LIST [--write LIST] [--name PATTERN] [--preview]\n"
-         "Checks that every listed frame in DIR is complete: its sidecar names the frame and its time and\n"
-         "shows the same configuration as the other frames, and every requested output (--write, default\n"
-         "encoded; --preview for the PNGs) exists and opens completely. Prints the missing or broken frames\n"
-         "on stdout as a --frames list to resubmit (with --resume); exit code 1 if there are any.\n";
+         "Checks that every listed frame in DIR is complete: its sidecar names the frame and its time, was\n"
+         "rendered from the same scene as the folder's other frames (the scene checksums it records; the\n"
+         "scene most frames show counts as the folder's) and with the same configuration, and every output\n"
+         "it lists exists as a regular file in DIR and opens completely. --write LIST (and --preview for the\n"
+         "PNGs) checks just those kinds of output instead. Prints the missing or broken frames on stdout as\n"
+         "a --frames list to resubmit (with --resume); exit code 1 if there are any.\n";
 }
 
-// What is wrong with one frame ("" if nothing), given the folder's reference sidecar text.
-std::string check_frame(const std::string& dir, const RenderOptions& o, long f, std::string& reference) {
+// A listed output must be a plain file name in the frame's folder.
+bool plain_file_name(const std::string& name) {
+  if (name.empty() || name == "." || name == "..") return false;
+  for (unsigned char c : name)
+    if (c == '/' || c == '\\' || c < 0x20 || c == 0x7f) return false;
+  return true;
+}
+
+// What the folder's frames were rendered from: the scene identity most sidecars record (ties: the
+// earliest frame's), the first frame showing it (the configuration reference) and the program versions.
+struct FolderScene {
+  std::string scene;
+  long reference_frame = -1;
+  std::string reference_text;  // its sidecar
+  std::vector<std::string> versions;
+};
+
+std::string sidecar_path(const std::string& dir, const RenderOptions& o, long f) {
+  return (fs::path(dir) / (frame_stem(o.name, f) + ".json")).string();
+}
+
+FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const std::vector<long>& frames) {
+  std::map<std::string, std::pair<long, long>> seen;  // identity -> (count, first frame)
+  FolderScene folder;
+  for (long f : frames) {
+    const std::string path = sidecar_path(dir, o, f);
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) continue;
+    const std::string text = read_text_file(path);
+    try {
+      if (!nlohmann::json::parse(text).is_object()) continue;
+    } catch (const std::exception&) {
+      continue;
+    }
+    const SidecarProvenance p = sidecar_provenance(text);
+    ++seen.try_emplace(p.scene, 0, f).first->second.first;
+    const std::string v = p.version.empty() ? "unrecorded" : p.version;
+    if (std::find(folder.versions.begin(), folder.versions.end(), v) == folder.versions.end()) folder.versions.push_back(v);
+  }
+  long best = 0;
+  for (const auto& [scene, count_first] : seen)
+    if (count_first.first > best || (count_first.first == best && count_first.second < folder.reference_frame)) {
+      best = count_first.first;
+      folder.scene = scene;
+      folder.reference_frame = count_first.second;
+    }
+  if (folder.reference_frame >= 0) folder.reference_text = read_text_file(sidecar_path(dir, o, folder.reference_frame));
+  return folder;
+}
+
+// What is wrong with one frame ("" if nothing), given what the folder's frames were rendered from.
+// explicit_kinds: --write / --preview were given, check those kinds; else every output the sidecar lists.
+std::string check_frame(const std::string& dir, const RenderOptions& o, bool explicit_kinds, long f,
+                        const FolderScene& folder) {
   const std::string stem = frame_stem(o.name, f);
-  const std::string sidecar = (fs::path(dir) / (stem + ".json")).string();
+  const std::string sidecar = sidecar_path(dir, o, f);
   std::error_code ec;
   if (!fs::is_regular_file(sidecar, ec)) return stem + ".json is missing";
   const std::string text = read_text_file(sidecar);
@@ -48,25 +106,51 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, long f, 
   if (!j.contains("fps") || !j.contains("time") || !j["fps"].is_number() || !j["time"].is_number() ||
       std::fabs(j["time"].get<double>() - double(f) / j["fps"].get<double>()) > 1e-9)
     return stem + ".json has a time that is not frame / fps";
-  if (reference.empty()) reference = text;
-  const std::string diff = sidecar_config_difference(reference, text);
+  const SidecarProvenance prov = sidecar_provenance(text);
+  const std::string reference_name = frame_stem(o.name, folder.reference_frame) + ".json";
+  if (!prov.scene.empty() && prov.scene != folder.scene)
+    return stem + ".json was rendered from another scene than " + reference_name +
+           " and the folder's other frames (scene checksums differ)";
+  const std::string diff = sidecar_config_difference(folder.reference_text, text);
   if (!diff.empty()) return stem + ".json was rendered with another configuration (" + diff + " differs)";
-  std::vector<std::string> kinds;
-  if (o.write_encoded) kinds.push_back("encoded");
-  if (o.write_views) kinds.push_back("views");
-  if (o.write_quilt) kinds.push_back("quilt");
-  if (o.preview) {
-    kinds.push_back("preview_center");
-    if (o.write_encoded) kinds.push_back("preview_encoded");
-    if (o.write_quilt) kinds.push_back("preview_quilt");
+  if (prov.scene != folder.scene) return stem + ".json records no scene checksum, unlike " + reference_name;
+  std::vector<std::pair<std::string, nlohmann::json>> listed;  // (kind, file name as listed)
+  const nlohmann::json* outputs = j.contains("outputs") && j["outputs"].is_object() ? &j["outputs"] : nullptr;
+  if (explicit_kinds) {
+    std::vector<std::string> kinds;
+    if (o.write_encoded) kinds.push_back("encoded");
+    if (o.write_views) kinds.push_back("views");
+    if (o.write_quilt) kinds.push_back("quilt");
+    if (o.preview) {
+      kinds.push_back("preview_center");
+      if (o.write_encoded) kinds.push_back("preview_encoded");
+      if (o.write_quilt) kinds.push_back("preview_quilt");
+    }
+    for (const std::string& kind : kinds) {
+      if (!outputs || !outputs->contains(kind)) return stem + ".json lists no " + kind + " output";
+      listed.push_back({kind, (*outputs)[kind]});
+    }
+  } else {
+    if (!outputs || outputs->empty()) return stem + ".json lists no outputs";
+    for (auto it = outputs->begin(); it != outputs->end(); ++it) listed.push_back({it.key(), it.value()});
   }
   std::vector<std::string> images;
-  for (const std::string& kind : kinds) {
-    if (!j.contains("outputs") || !j["outputs"].contains(kind) || !j["outputs"][kind].is_string())
-      return stem + ".json lists no " + kind + " output";
-    images.push_back((fs::path(dir) / j["outputs"][kind].get<std::string>()).string());
+  for (const auto& [kind, value] : listed) {
+    if (!value.is_string()) return stem + ".json lists a " + printable_text(kind) + " output that is not a file name";
+    const std::string name = value.get<std::string>();
+    if (!plain_file_name(name))
+      return stem + ".json lists " + printable_text(kind) + " output '" + printable_text(name) +
+             "', which is not a plain file name in the folder";
+    const fs::path path = fs::path(dir) / name;
+    const fs::file_status st = fs::symlink_status(path, ec);
+    if (st.type() == fs::file_type::not_found) return printable_text(name) + " is missing";
+    if (st.type() != fs::file_type::regular)
+      return printable_text(name) + " is not a regular file (" +
+             (st.type() == fs::file_type::symlink ? "a symbolic link" : st.type() == fs::file_type::directory ? "a folder" : "a special file") + ")";
+    images.push_back(path.string());
   }
-  return frame_problem(sidecar, images);
+  // frame_problem names the files by their (plain, but maybe not ASCII) names
+  return printable_text(frame_problem(sidecar, images), std::string::npos);
 }
 
 }  // namespace
@@ -103,13 +187,21 @@ int run_verify(const std::vector<std::string>& args) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw Error("cannot verify " + dir + ": not a folder");
   const std::vector<long> frames = parse_frame_list(o.frames);
+  bool explicit_kinds = false;
+  for (const std::string& r : rest) explicit_kinds |= r == "--write" || r == "--preview";
+  const FolderScene folder = folder_scene(dir, o, frames);
   std::vector<long> bad;
-  std::string reference;
   for (long f : frames) {
-    const std::string problem = check_frame(dir, o, f, reference);
+    const std::string problem = check_frame(dir, o, explicit_kinds, f, folder);
     if (problem.empty()) continue;
     bad.push_back(f);
     std::fprintf(stderr, "pmr verify: frame %ld: %s\n", f, problem.c_str());
+  }
+  if (folder.versions.size() > 1) {  // not a problem: versions do not change pixels (docs/SEQUENCES.md)
+    std::string list;
+    for (const std::string& v : folder.versions) list += (list.empty() ? "" : ", ") + printable_text(v);
+    std::fprintf(stderr, "pmr verify: note: the frames were rendered by %zu pmr versions (%s)\n", folder.versions.size(),
+                 list.c_str());
   }
   std::fprintf(stderr, "pmr verify: %zu of %zu frame(s) complete%s\n", frames.size() - bad.size(), frames.size(),
                bad.empty() ? "" : "; resubmit the list below with --resume");

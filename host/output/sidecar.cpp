@@ -1,10 +1,14 @@
 // The per-frame JSON sidecar (DESIGN section 6): everything needed to reproduce or check a frame.
 
+#include <map>
+
 #include <glm/gtc/constants.hpp>
 #include <nlohmann/json.hpp>
 
+#include "output/checksum.h"
 #include "pmr/error.h"
 #include "pmr/output.h"
+#include "pmr/version.h"
 
 namespace pmr {
 namespace {
@@ -66,7 +70,20 @@ double degrees(double rad) { return rad * (180.0 / glm::pi<double>()); }
 std::string sidecar_json(const Rig& rig, const Display& display, const SidecarInfo& info) {
   json j;
   j["format"] = "pmr-sidecar-1";
+  j["program_version"] = program_version();
   j["scene"] = info.scene;
+  if (!info.scene_checksum.empty() || !info.display_config_checksum.empty()) {
+    json c;
+    c["algorithm"] = kChecksumAlgorithm;
+    if (!info.scene_checksum.empty()) {
+      c["scene"] = info.scene_checksum;
+      json files = json::object();
+      for (const auto& [file, sum] : info.scene_files) files[file] = sum;
+      c["scene_files"] = files;
+    }
+    if (!info.display_config_checksum.empty()) c["display_config"] = info.display_config_checksum;
+    j["checksums"] = c;
+  }
   j["frame"] = info.frame;
   j["method"] = info.method;
   j["sampling"] = info.sampling;
@@ -191,7 +208,11 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   return text + "\n";
 }
 
-std::string sidecar_config_difference(const std::string& existing, const std::string& expected) {
+std::string sidecar_config_difference(const std::string& existing, const std::string& expected,
+                                      bool ignore_scene_derived) {
+  // compared as plain JSON, whose objects are sorted: the order of a sidecar's keys is no difference (a
+  // sidecar rewritten by another tool compares as before)
+  using json = nlohmann::json;
   const json b = json::parse(expected);
   json a;
   try {
@@ -202,11 +223,18 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   if (!a.is_object() || !b.is_object()) return "unreadable";
   // a member of either side, null when absent (so a damaged sidecar compares unequal, never crashes)
   auto get = [](const json& o, const char* key) { return o.is_object() && o.contains(key) ? o[key] : json(); };
-  for (const char* key : {"format", "scene", "method", "tile", "camera", "display", "fps", "animation", "depth_channel"})
+  for (const char* key : {"format", "scene", "method", "tile", "camera", "display", "fps", "depth_channel"})
     if (!a.contains(key) || get(a, key) != get(b, key)) return key;
-  // the turntable without this frame's angle
-  auto turn = [](json t) {
+  // the animation (its name comes from the scene file)
+  auto anim = [&](json t) {
+    if (ignore_scene_derived && t.is_object()) t.erase("name");
+    return t;
+  };
+  if (!a.contains("animation") || anim(get(a, "animation")) != anim(get(b, "animation"))) return "animation";
+  // the turntable without this frame's angle (and its pivot, the center of the scene's bounds)
+  auto turn = [&](json t) {
     if (t.is_object()) t.erase("angle_deg");
+    if (ignore_scene_derived && t.is_object()) t.erase("pivot");
     return t;
   };
   if (!a.contains("turntable") || turn(get(a, "turntable")) != turn(get(b, "turntable"))) return "turntable";
@@ -219,8 +247,37 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   for (const char* key : {"views", "view_width", "view_height", "cone_deg", "yfov_deg", "aspect", "camera_spacing"})
     if (!ra.contains(key) || get(ra, key) != get(rb, key)) return std::string("rig.") + key;
   // the framing (it follows from the scene file's content and the animation)
-  if (!a.contains("scene_bounds") || get(a, "scene_bounds") != get(b, "scene_bounds")) return "scene_bounds";
+  if (!ignore_scene_derived && (!a.contains("scene_bounds") || get(a, "scene_bounds") != get(b, "scene_bounds")))
+    return "scene_bounds";
   return "";
+}
+
+SidecarProvenance sidecar_provenance(const std::string& sidecar_text) {
+  SidecarProvenance p;
+  json j;
+  try {
+    j = json::parse(sidecar_text);
+  } catch (const std::exception&) {
+    return p;
+  }
+  if (!j.is_object()) return p;
+  if (const auto v = j.find("program_version"); v != j.end() && v->is_string()) p.version = v->get<std::string>();
+  const auto c = j.find("checksums");
+  if (c == j.end() || !c->is_object()) return p;
+  const auto algorithm = c->find("algorithm"), scene = c->find("scene"), files = c->find("scene_files");
+  if (algorithm == c->end() || !algorithm->is_string() || scene == c->end() || !scene->is_string() ||
+      files == c->end() || !files->is_object())
+    return p;
+  // canonical: files sorted by path, every value a string
+  std::map<std::string, std::string> sorted;
+  for (auto it = files->begin(); it != files->end(); ++it) {
+    if (!it.value().is_string()) return p;
+    sorted[it.key()] = it.value().get<std::string>();
+  }
+  json identity = json::array({*algorithm, *scene});
+  for (const auto& [file, sum] : sorted) identity.push_back(json::array({file, sum}));
+  p.scene = identity.dump(-1, ' ', false, json::error_handler_t::replace);
+  return p;
 }
 
 void write_sidecar(const std::string& path, const Rig& rig, const Display& display, const SidecarInfo& info) {

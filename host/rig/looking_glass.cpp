@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "output/checksum.h"
 #include "pmr/display_presets.h"
 #include "pmr/error.h"
 
@@ -56,6 +57,10 @@ LookingGlassCalibration read_looking_glass_calibration(const std::string& path, 
   }
   if (!doc.is_object()) throw Error(path + ": not a JSON calibration file (expected an object)");
   LookingGlassCalibration c;
+  {
+    const std::string bytes = ss.str();
+    c.checksum = checksum_hex(bytes.data(), bytes.size());
+  }
   if (doc.contains("serial") && doc["serial"].is_string()) c.serial = doc["serial"].get<std::string>();
   if (doc.contains("configVersion") && doc["configVersion"].is_string()) c.config_version = doc["configVersion"].get<std::string>();
   c.pitch = number_field(doc, "pitch", path, true, 0);

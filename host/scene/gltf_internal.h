@@ -43,6 +43,9 @@ struct SourceFile {
   bool glb = false;                     // detected by the magic bytes, not by the extension
   std::string base_dir;                 // directory relative URIs are resolved against
   std::set<int> base_color_images;      // images some material uses as baseColorTexture
+  std::string checksum;                 // of `bytes` as read from disk (before a GLB is cut)
+  // External files only unused images name (resolved like tinygltf does): never read
+  std::set<std::string> unused_image_files;
   std::vector<std::string> ignored_extensions;  // in extensionsUsed, not required, not implemented
 };
 SourceFile read_source(const std::string& path);

@@ -13,6 +13,7 @@
 #include <limits>
 #include <map>
 
+#include "output/checksum.h"
 #include "pmr/error.h"
 #include "pmr/scene.h"
 #include "scene/gltf_internal.h"
@@ -26,6 +27,8 @@ using namespace gltf;
 
 struct FsContext {
   std::string prefix;  // base_dir with a trailing '/'
+  const std::set<std::string>* skip = nullptr;  // files only unused images name: not read
+  std::map<std::string, std::string> read;      // path relative to base_dir -> checksum of the bytes read
 };
 
 // tinygltf looks for external files in base_dir and then in the working directory; only the former
@@ -40,7 +43,13 @@ bool fs_exists(const std::string& path, void* user) {
 
 std::string fs_expand(const std::string& path, void*) { return path; }
 
-bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+// Every file read is checksummed from the bytes read (the sidecar lists them). A file that only unused
+// images name is not read at all: tinygltf then warns "File is empty", which the loader ignores, and the
+// image stays undecoded as it would anyway.
+bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+  auto* ctx = static_cast<FsContext*>(user);
+  out->clear();
+  if (ctx->skip && ctx->skip->count(path)) return true;
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   const std::streamoff size = in ? std::streamoff(in.tellg()) : -1;
   if (size < 0) {
@@ -53,6 +62,8 @@ bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::strin
     if (err) *err += "cannot read " + path + "\n";
     return false;
   }
+  // fs_exists only accepts paths under the prefix
+  ctx->read[path.substr(std::min(path.size(), ctx->prefix.size()))] = checksum_hex(out->data(), out->size());
   return true;
 }
 
@@ -102,8 +113,12 @@ bool load_image(tinygltf::Image* image, int index, std::string*, std::string*, i
   return true;
 }
 
-void load_model(const std::string& path, const SourceFile& src, tinygltf::Model& model, ImageContext& images) {
-  FsContext fs{src.base_dir.back() == '/' ? src.base_dir : src.base_dir + "/"};
+// `files_read` receives the files read besides the scene file (relative path -> checksum).
+void load_model(const std::string& path, const SourceFile& src, tinygltf::Model& model, ImageContext& images,
+                std::map<std::string, std::string>& files_read) {
+  FsContext fs;
+  fs.prefix = src.base_dir.back() == '/' ? src.base_dir : src.base_dir + "/";
+  fs.skip = &src.unused_image_files;
   images.model = &model;
   images.wanted = &src.base_color_images;
   tinygltf::TinyGLTF loader;
@@ -125,6 +140,7 @@ void load_model(const std::string& path, const SourceFile& src, tinygltf::Model&
     const std::string msg = one_line(err.empty() ? warn : err);
     fail(path, "not a valid glTF file: " + (msg.empty() ? std::string("tinygltf gave no reason") : msg));
   }
+  files_read = std::move(fs.read);
 }
 
 // ---- materials and textures ---------------------------------------------------------------------------
@@ -697,7 +713,8 @@ Scene load_scene(const std::string& path) {
   const SourceFile src = read_source(path);
   tinygltf::Model model;
   ImageContext images;
-  load_model(path, src, model, images);
+  std::map<std::string, std::string> files_read;
+  load_model(path, src, model, images, files_read);
   const std::vector<int> parent = validate_model(model, path);
   const std::vector<int> roots = scene_roots(model, parent, path);
 
@@ -722,6 +739,8 @@ Scene load_scene(const std::string& path) {
     scene.animations.push_back({clip.name, clip.start, clip.end, clip.channels.size()});
   describe_structure(L, roots);
   if (!L.motion->clips.empty()) scene.motion = L.motion;
+  scene.source_checksum = src.checksum;
+  for (const auto& [file, sum] : files_read) scene.input_files.push_back({file, sum});
   return scene;
 }
 

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 
+#include "output/checksum.h"
 #include "pmr/error.h"
 #include "scene/gltf_internal.h"
 
@@ -203,6 +204,28 @@ std::set<int> base_color_images(const json& doc) {
   return images;
 }
 
+bool is_data_uri(const std::string& uri) { return uri.rfind("data:", 0) == 0; }
+
+// Files named only by images that are never decoded (tinygltf would read them; load_model skips them).
+std::set<std::string> unused_image_files(const json& doc, const std::string& base_dir, const std::set<int>& used) {
+  std::set<std::string> unused, needed;
+  auto uri_of = [](const json& o) -> std::string {
+    const json* u = member(o, "uri");
+    return u && u->is_string() ? u->get<std::string>() : std::string();
+  };
+  if (const json* images = member(doc, "images"); images && images->is_array())
+    for (size_t i = 0; i < images->size(); ++i) {
+      const std::string u = uri_of((*images)[i]);
+      if (u.empty() || is_data_uri(u)) continue;
+      (used.count(int(i)) ? needed : unused).insert(resolve_uri(base_dir, u));
+    }
+  if (const json* buffers = member(doc, "buffers"); buffers && buffers->is_array())
+    for (const json& b : *buffers)
+      if (const std::string u = uri_of(b); !u.empty() && !is_data_uri(u)) needed.insert(resolve_uri(base_dir, u));
+  for (const std::string& f : needed) unused.erase(f);
+  return unused;
+}
+
 std::string base_dir_of(const std::string& path) {
   const size_t slash = path.find_last_of('/');
   if (slash == std::string::npos) return ".";
@@ -246,6 +269,7 @@ std::string resolve_uri(const std::string& base_dir, const std::string& uri) {
 SourceFile read_source(const std::string& path) {
   SourceFile src;
   src.bytes = read_whole_file(path);
+  src.checksum = checksum_hex(src.bytes.data(), src.bytes.size());
   src.base_dir = base_dir_of(path);
   src.glb = src.bytes.size() >= 4 && std::memcmp(src.bytes.data(), "glTF", 4) == 0;
   int64_t bin_length = -1;
@@ -273,6 +297,7 @@ SourceFile read_source(const std::string& path) {
   check_extensions(path, doc, src);
   check_buffers(path, doc, src, bin_length);
   src.base_color_images = base_color_images(doc);
+  src.unused_image_files = unused_image_files(doc, src.base_dir, src.base_color_images);
   return src;
 }
 

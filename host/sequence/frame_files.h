@@ -24,4 +24,8 @@ std::string frame_problem(const std::string& sidecar, const std::vector<std::str
 
 std::string read_text_file(const std::string& path);
 
+// Text taken from a sidecar (a file name, a version), safe to print on a terminal: control characters,
+// DEL, backslashes and bytes outside ASCII as \xNN, at most `limit` characters (then "...").
+std::string printable_text(const std::string& text, size_t limit = 120);
+
 }  // namespace pmr

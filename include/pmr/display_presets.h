@@ -19,6 +19,7 @@ struct LookingGlassCalibration {
   // assigns a cell to each pixel (CellPatternMode 0..4).
   std::vector<std::array<double, 6>> cells;
   int cell_pattern = 0;
+  std::string checksum;  // XXH3-64 of the file's bytes as read (output/checksum.h), 16 hex digits
 };
 
 // Reads and checks a visual.json: one clear pmr::Error naming the file and the field on anything

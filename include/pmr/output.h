@@ -144,6 +144,12 @@ struct SidecarInfo {
   std::string display_source;          // "preset NAME" or "calibration FILE"
   std::vector<std::pair<std::string, double>> calibration;  // the calibration file's values, as read
   std::string calibration_serial;
+  // Checksums of what the render read (output/checksum.h; "" = not recorded): the scene file, every
+  // other file the loader read (path relative to the scene's folder, checksum), the --display-config
+  // file. The program version is always recorded (pmr::program_version()).
+  std::string scene_checksum;
+  std::vector<std::pair<std::string, std::string>> scene_files;
+  std::string display_config_checksum;
 };
 
 // The sidecar's JSON text (pretty printed, doubles with round-trip precision).
@@ -152,7 +158,21 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
 // framing, fps, animation, turntable; not the frame, its time or the outputs) of two sidecars' JSON
 // texts. Returns "" when they agree, else the first differing key (or "unreadable" when `existing` does
 // not parse).
-std::string sidecar_config_difference(const std::string& existing, const std::string& expected);
+// With ignore_scene_derived, the keys that follow from the scene file's content (scene_bounds, the
+// turntable's pivot, the animation's name) are not compared: for a frame known to come from another
+// scene (sidecar_provenance), only the configuration the user chose matters.
+std::string sidecar_config_difference(const std::string& existing, const std::string& expected,
+                                      bool ignore_scene_derived = false);
+
+// Where a sidecar's frame came from. Never throws: a damaged or old sidecar gives empty strings.
+struct SidecarProvenance {
+  // The scene's identity: the checksum algorithm, the scene file's and every other read file's
+  // checksums as one canonical string; "" when the sidecar records none (written before pmr recorded
+  // them, or damaged). Two frames with equal non-empty identities were rendered from the same bytes.
+  std::string scene;
+  std::string version;  // program_version, "" when absent
+};
+SidecarProvenance sidecar_provenance(const std::string& sidecar_text);
 
 // Writes the JSON sidecar (DESIGN section 6) atomically. Matrices are 16 numbers, column-major.
 void write_sidecar(const std::string& path, const Rig& rig, const Display& display, const SidecarInfo& info);

@@ -49,6 +49,13 @@ struct SceneStructure {
   std::string generator;                              // asset.generator
 };
 
+// A file the loader read besides the scene file itself (an external buffer or a decoded image), with
+// the checksum (output/checksum.h) of its bytes as read.
+struct SceneInputFile {
+  std::string path;      // relative to the scene file's folder, as the URI names it (percent-decoded)
+  std::string checksum;  // XXH3-64, 16 hex digits
+};
+
 struct Scene {
   std::vector<glm::vec3> positions;       // world space, one per vertex
   std::vector<PmrVertexAttr> attributes;  // one per vertex (normal in world space)
@@ -63,6 +70,11 @@ struct Scene {
   std::vector<SceneAnimation> animations;
   std::shared_ptr<const SceneMotion> motion;
   SceneStructure structure;  // null when no animation can move anything
+  // What the render read (docs/SEQUENCES.md, "What a sidecar records"): the checksum of the scene file
+  // (a .glb's whole file, a .gltf's JSON) and of every other file read, sorted by path. data: URIs and
+  // images no material samples as base colour are not files read. Hashed from the loader's own bytes.
+  std::string source_checksum;
+  std::vector<SceneInputFile> input_files;
 };
 
 constexpr int kNoAnimation = -1, kAllAnimations = -2;

@@ -1,0 +1,346 @@
+// "A finished folder can be trusted": pmr verify checks every output a sidecar lists (plain names of
+// regular files in the folder only), sidecars record the program version and checksums of what the
+// render read, --resume renders frames from another scene again (one line), verify reports them.
+// Each test runs the real pmr binary on a tiny scene and display.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <xxhash.h>
+
+#include <cinttypes>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "output/checksum.h"
+#include "pmr/output.h"
+#include "pmr/version.h"
+#include "test_util.h"
+
+namespace pmr {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using test::run;
+
+const std::string kSmall = " --views 4 --view-size 64x32 --display 240x135 -q ";
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+// XXH3-64 of a file's bytes, computed here with libxxhash directly, as 16 hex digits.
+std::string xxh3_of(const std::string& path) {
+  const std::string bytes = read_bytes(path);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016" PRIx64, uint64_t(XXH3_64bits(bytes.data(), bytes.size())));
+  return hex;
+}
+
+json sidecar(const std::string& path) { return json::parse(read_bytes(path)); }
+
+// A quad in the z = 0 plane, [-s, s]^2, facing +Z, written as dir/quad.gltf + dir/quad.bin. With
+// `textured` its material samples dir/tex.png as base colour; a second image (dir/unused.png) is
+// referenced only as a normal map, which pmr never samples. With `embedded` the buffer is a data: URI.
+struct Quad {
+  double r = 1, g = 0, b = 0, size = 1;
+  bool textured = false, embedded = false;
+  std::string bin = "quad.bin";  // the buffer's URI (percent-encoded), relative to the .gltf
+};
+
+std::string base64(const std::string& in) {
+  static const char t[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < in.size(); i += 3) {
+    uint32_t v = uint32_t(uint8_t(in[i])) << 16;
+    if (i + 1 < in.size()) v |= uint32_t(uint8_t(in[i + 1])) << 8;
+    if (i + 2 < in.size()) v |= uint8_t(in[i + 2]);
+    out += t[v >> 18 & 63];
+    out += t[v >> 12 & 63];
+    out += i + 1 < in.size() ? t[v >> 6 & 63] : '=';
+    out += i + 2 < in.size() ? t[v & 63] : '=';
+  }
+  return out;
+}
+
+std::string write_quad(const std::string& dir, const Quad& q) {
+  fs::create_directories(dir);
+  const float s = float(q.size);
+  const float pos[] = {-s, -s, 0, s, -s, 0, s, s, 0, -s, s, 0};
+  const float nrm[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+  const float uv[] = {0, 1, 1, 1, 1, 0, 0, 0};
+  const uint16_t idx[] = {0, 1, 2, 0, 2, 3};
+  std::string bin;
+  bin.append(reinterpret_cast<const char*>(pos), sizeof pos);
+  bin.append(reinterpret_cast<const char*>(nrm), sizeof nrm);
+  bin.append(reinterpret_cast<const char*>(uv), sizeof uv);
+  bin.append(reinterpret_cast<const char*>(idx), sizeof idx);
+  bin.append(4, '\0');  // 4-byte multiple
+  json doc = {
+      {"asset", {{"version", "2.0"}}},
+      {"scene", 0},
+      {"scenes", {{{"nodes", {0}}}}},
+      {"nodes", {{{"mesh", 0}}}},
+      {"meshes",
+       {{{"primitives", {{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}, {"TEXCOORD_0", 2}}}, {"indices", 3}, {"material", 0}}}}}}},
+      {"bufferViews",
+       {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 48}},
+        {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 48}},
+        {{"buffer", 0}, {"byteOffset", 96}, {"byteLength", 32}},
+        {{"buffer", 0}, {"byteOffset", 128}, {"byteLength", 12}}}},
+      {"accessors",
+       {{{"bufferView", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}, {"min", {-s, -s, 0}}, {"max", {s, s, 0}}},
+        {{"bufferView", 1}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}},
+        {{"bufferView", 2}, {"componentType", 5126}, {"count", 4}, {"type", "VEC2"}},
+        {{"bufferView", 3}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}}}},
+  };
+  doc["buffers"] = {{{"byteLength", bin.size()},
+                     {"uri", q.embedded ? "data:application/octet-stream;base64," + base64(bin) : q.bin}}};
+  json material = {{"pbrMetallicRoughness", {{"baseColorFactor", {q.r, q.g, q.b, 1.0}}}}, {"doubleSided", true}};
+  if (q.textured) {
+    material["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+    material["normalTexture"] = {{"index", 1}};
+    doc["textures"] = {{{"source", 0}}, {{"source", 1}}};
+    doc["images"] = {{{"uri", "tex.png"}}, {{"uri", "unused.png"}}};
+    std::vector<uint16_t> px(4 * 4 * 4, 0x3c00);  // half 1.0: white
+    write_png_preview(dir + "/tex.png", 4, 4, px.data());
+    write_png_preview(dir + "/unused.png", 4, 4, px.data());
+  }
+  doc["materials"] = {material};
+  if (!q.embedded) {
+    std::string file = q.bin;  // decoded as tinygltf does (%20 only, here)
+    for (size_t at; (at = file.find("%20")) != std::string::npos;) file.replace(at, 3, " ");
+    fs::create_directories(fs::path(dir + "/" + file).parent_path());
+    write_bytes(dir + "/" + file, bin);
+  }
+  write_bytes(dir + "/quad.gltf", doc.dump(1));
+  return dir + "/quad.gltf";
+}
+
+size_t count_of(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+}  // namespace
+
+// The hash and its text: XXH3-64 of nothing is 2d06800538d394c2 (xxhsum -H3 /dev/null).
+TEST(Trust, ChecksumIsXxh3In16HexDigits) {
+  EXPECT_EQ(checksum_hex("", 0), "2d06800538d394c2");
+  EXPECT_EQ(checksum_hex(uint64_t(0xab)), "00000000000000ab");
+  const std::string abc = "abc";
+  EXPECT_EQ(checksum64(abc.data(), abc.size()), XXH3_64bits(abc.data(), abc.size()));
+}
+
+// Without --write, verify checks every output the sidecar lists: a deleted views file and a truncated
+// quilt make their frames broken (they passed before: only the encoded image was checked).
+TEST(Trust, VerifyChecksEveryListedOutput) {
+  const std::string dir = test::temp_dir("trust_listed");
+  const std::string scene = write_quad(dir + "/scene", {});
+  const std::string out = dir + "/out";
+  const test::CliRun r = run("render " + scene + " --frames 0:2 --write encoded,views,quilt" + kSmall + "--out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  test::CliRun v = run("verify " + out + " --frames 0:2");
+  EXPECT_EQ(v.status, 0) << v.output;
+  const json j = sidecar(out + "/frame_0001.json");
+  fs::remove(out + "/frame_0000.views.exr");
+  const std::string quilt = out + "/" + j["outputs"]["quilt"].get<std::string>();
+  fs::resize_file(quilt, fs::file_size(quilt) / 2);
+  v = run("verify " + out + " --frames 0:2");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frame 0: frame_0000.views.exr is missing"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("frame 1: " + j["outputs"]["quilt"].get<std::string>() + " is truncated"), std::string::npos)
+      << v.output;
+  EXPECT_NE(v.output.find("1 of 3 frame(s) complete"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("0:1\n"), std::string::npos) << v.output;
+  // --write names the kinds to check, as before
+  v = run("verify " + out + " --frames 0:2 --write encoded");
+  EXPECT_EQ(v.status, 0) << v.output;
+  // --resume renders both again; then the folder verifies
+  const test::CliRun again = run("render " + scene + " --frames 0:2 --resume --write encoded,views,quilt" + kSmall + "--out " + out);
+  EXPECT_EQ(again.status, 0) << again.output;
+  EXPECT_EQ(run("verify " + out + " --frames 0:2").status, 0);
+}
+
+// A listed output must be a plain file name of a regular file in the frame's folder.
+TEST(Trust, VerifyRefusesOutputsOutsideTheFolderAndSymlinks) {
+  const std::string dir = test::temp_dir("trust_names");
+  const std::string scene = write_quad(dir + "/scene", {});
+  const std::string out = dir + "/out";
+  ASSERT_EQ(run("render " + scene + " --frames 0:1" + kSmall + "--out " + out).status, 0);
+  const std::string good = read_bytes(out + "/frame_0000.json");
+  auto relist = [&](const std::string& name) {
+    json j = json::parse(good);
+    j["outputs"]["encoded"] = name;
+    write_bytes(out + "/frame_0000.json", j.dump(1));
+  };
+  // a complete EXR one folder up, named through ..
+  fs::copy_file(out + "/frame_0000.exr", dir + "/x.exr");
+  relist("../x.exr");
+  test::CliRun v = run("verify " + out + " --frames 0:1");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frame 0: frame_0000.json lists encoded output '../x.exr', which is not a plain file name"),
+            std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("\n0\n"), std::string::npos) << v.output;
+  for (const std::string& bad : std::vector<std::string>{"..", ".", "", "a\\b.exr", std::string("a\0b", 3), dir + "/x.exr"}) {
+    relist(bad);
+    v = run("verify " + out + " --frames 0");
+    EXPECT_EQ(v.status, 1) << "'" << bad << "': " << v.output;
+    EXPECT_NE(v.output.find("not a plain file name"), std::string::npos) << v.output;
+  }
+  // control characters are not printed as such
+  relist("\x1b]0;owned\x07.exr");
+  v = run("verify " + out + " --frames 0");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_EQ(v.output.find('\x1b'), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("\\x1b]0;owned\\x07.exr"), std::string::npos) << v.output;
+  // a symbolic link to a complete image (its own name), a folder, a FIFO
+  write_bytes(out + "/frame_0000.json", good);
+  fs::rename(out + "/frame_0000.exr", dir + "/real.exr");
+  fs::create_symlink(dir + "/real.exr", out + "/frame_0000.exr");
+  v = run("verify " + out + " --frames 0:1");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frame 0: frame_0000.exr is not a regular file (a symbolic link)"), std::string::npos) << v.output;
+  fs::remove(out + "/frame_0000.exr");
+  fs::create_directory(out + "/frame_0000.exr");
+  v = run("verify " + out + " --frames 0:1");
+  EXPECT_NE(v.output.find("frame_0000.exr is not a regular file (a folder)"), std::string::npos) << v.output;
+  fs::remove(out + "/frame_0000.exr");
+  ASSERT_EQ(mkfifo((out + "/frame_0000.exr").c_str(), 0600), 0);
+  v = run("verify " + out + " --frames 0:1");  // must not block opening the FIFO
+  EXPECT_NE(v.output.find("frame_0000.exr is not a regular file (a special file)"), std::string::npos) << v.output;
+  fs::remove(out + "/frame_0000.exr");
+  fs::rename(dir + "/real.exr", out + "/frame_0000.exr");
+  EXPECT_EQ(run("verify " + out + " --frames 0:1").status, 0);
+}
+
+// The sidecar records the program version and the checksums of the scene file and of every file the
+// render read: a .gltf's external buffer and the texture it samples (not the image nothing samples);
+// a data: URI and a .glb are the scene file alone; the --display-config file's checksum.
+TEST(Trust, SidecarRecordsVersionAndChecksums) {
+  const std::string dir = test::temp_dir("trust_sums");
+  Quad q;
+  q.textured = true;
+  const std::string scene = write_quad(dir + "/scene", q);
+  ASSERT_EQ(run("render " + scene + kSmall + "--out " + dir + "/o").status, 0);
+  json j = sidecar(dir + "/o/frame_0000.json");
+  EXPECT_EQ(j["program_version"], program_version());
+  EXPECT_EQ(j["checksums"]["algorithm"], "XXH3-64");
+  EXPECT_EQ(j["checksums"]["scene"], xxh3_of(scene));
+  const json want = {{"quad.bin", xxh3_of(dir + "/scene/quad.bin")}, {"tex.png", xxh3_of(dir + "/scene/tex.png")}};
+  EXPECT_EQ(j["checksums"]["scene_files"], want) << j["checksums"].dump();
+  EXPECT_FALSE(j["checksums"].contains("display_config"));
+  // the buffer in a subfolder, its URI percent-encoded: the path relative to the scene's folder, decoded
+  Quad sub;
+  sub.bin = "data/my%20quad.bin";
+  const std::string in_sub = write_quad(dir + "/sub", sub);
+  ASSERT_EQ(run("render " + in_sub + kSmall + "--out " + dir + "/s").status, 0);
+  EXPECT_EQ(sidecar(dir + "/s/frame_0000.json")["checksums"]["scene_files"],
+            json({{"data/my quad.bin", xxh3_of(dir + "/sub/data/my quad.bin")}}));
+  // a data: URI is no file
+  Quad e;
+  e.embedded = true;
+  const std::string embedded = write_quad(dir + "/embedded", e);
+  ASSERT_EQ(run("render " + embedded + kSmall + "--out " + dir + "/e").status, 0);
+  j = sidecar(dir + "/e/frame_0000.json");
+  EXPECT_EQ(j["checksums"]["scene"], xxh3_of(embedded));
+  EXPECT_EQ(j["checksums"]["scene_files"], json::object());
+  // the bundled default scene (.glb, one file) and a calibration file
+  fs::create_directories(dir + "/cal");
+  write_bytes(dir + "/cal/visual.json", R"({"serial": "LKG-P0", "pitch": {"value": 52.1}, "slope": {"value": -7.1},
+    "center": {"value": 0.56}, "DPI": {"value": 324}, "screenW": {"value": 1536}, "screenH": {"value": 2048},
+    "viewCone": {"value": 40}})");
+  const test::CliRun r = run("render --display-config " + dir + "/cal/visual.json --view-size 42x56 -q --out " + dir + "/d");
+  ASSERT_EQ(r.status, 0) << r.output;
+  j = sidecar(dir + "/d/frame_0000.json");
+  EXPECT_EQ(j["checksums"]["scene"], xxh3_of(j["scene"].get<std::string>()));
+  EXPECT_EQ(j["checksums"]["scene_files"], json::object());
+  EXPECT_EQ(j["checksums"]["display_config"], xxh3_of(dir + "/cal/visual.json"));
+}
+
+// A material colour changed in the scene: --resume renders the frames from the old scene again and says
+// so in one line; frames from another scene are reported by verify. A change that moves the framing
+// bounds is no configuration refusal either; a sidecar without checksums counts as another scene; a
+// program version change is reported, not rendered again.
+TEST(Trust, ResumeRendersFramesFromAnotherSceneAgain) {
+  const std::string dir = test::temp_dir("trust_resume");
+  const std::string out = dir + "/out";
+  const std::string scene = write_quad(dir + "/scene", {});
+  const std::string args = " --frames 0:3 --turntable 360:8" + kSmall + "--out " + out;
+  ASSERT_EQ(run("render " + scene + args).status, 0);
+  const std::string red = read_bytes(out + "/frame_0000.exr");
+  // the same scene: everything kept
+  test::CliRun r = run("render " + scene + " --resume" + args);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("nothing to do"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("different scene"), std::string::npos) << r.output;
+  // green: every old frame again, one line
+  Quad green;
+  green.r = 0, green.g = 1;
+  write_quad(dir + "/scene", green);
+  r = run("render " + scene + " --resume --frames 0:5 --turntable 360:8" + kSmall + "--out " + out);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(count_of(r.output, "different scene"), 1u) << r.output;
+  EXPECT_NE(r.output.find("pmr: --resume: 4 frame(s) were rendered from a different scene (frame_0000.json, "
+                          "frame_0001.json, frame_0002.json, ...): rendering them again\n"),
+            std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("6 frame(s) in"), std::string::npos) << r.output;
+  EXPECT_NE(read_bytes(out + "/frame_0000.exr"), red);
+  EXPECT_EQ(sidecar(out + "/frame_0003.json")["checksums"]["scene"], xxh3_of(scene));
+  EXPECT_EQ(run("verify " + out + " --frames 0:5").status, 0);
+  // frames 6 and 7 rendered from the red scene: verify reports them (the folder's scene is the green one)
+  write_quad(dir + "/scene", {});
+  ASSERT_EQ(run("render " + scene + " --frames 6:7 --turntable 360:8" + kSmall + "--out " + out).status, 0);
+  test::CliRun v = run("verify " + out + " --frames 0:7");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frame 6: frame_0006.json was rendered from another scene than frame_0000.json"),
+            std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("6 of 8 frame(s) complete"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("6:7\n"), std::string::npos) << v.output;
+  // a bigger quad: the framing bounds and the turntable pivot change with it, no refusal, all again
+  Quad big;
+  big.size = 2;
+  write_quad(dir + "/scene", big);
+  r = run("render " + scene + " --resume --frames 0:7 --turntable 360:8" + kSmall + "--out " + out);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("8 frame(s) were rendered from a different scene"), std::string::npos) << r.output;
+  EXPECT_EQ(run("verify " + out + " --frames 0:7").status, 0);
+  // no checksums recorded (an older pmr): rendered again; another version: kept, one line
+  json j = sidecar(out + "/frame_0001.json");
+  j.erase("checksums");
+  write_bytes(out + "/frame_0001.json", j.dump(1));
+  j = sidecar(out + "/frame_0002.json");
+  j["program_version"] = "0.15.0+gabcdef0";
+  write_bytes(out + "/frame_0002.json", j.dump(1));
+  v = run("verify " + out + " --frames 0:7");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frame 1: frame_0001.json records no scene checksum"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("note: the frames were rendered by 2 pmr versions"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("\n1\n"), std::string::npos) << v.output;  // the version alone is no problem
+  r = run("render " + scene + " --resume --frames 0:7 --turntable 360:8" + kSmall + "--out " + out);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("1 frame(s) were rendered from a different scene; 1 of them record no scene checksum "
+                          "(frame_0001.json): rendering them again"),
+            std::string::npos) << r.output;
+  EXPECT_EQ(count_of(r.output, "another pmr version"), 1u) << r.output;
+  EXPECT_NE(r.output.find("1 kept frame(s) were rendered by another pmr version (0.15.0+gabcdef0; this is " +
+                          std::string(program_version()) + ")"),
+            std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("1 frame(s) in"), std::string::npos) << r.output;
+  EXPECT_EQ(sidecar(out + "/frame_0002.json")["program_version"], "0.15.0+gabcdef0");
+  EXPECT_EQ(run("verify " + out + " --frames 0:7").status, 0);
+}
+
+}  // namespace pmr

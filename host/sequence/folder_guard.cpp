@@ -135,6 +135,17 @@ void split_pattern(const std::string& p, std::string& prefix, std::string& suffi
 
 }  // namespace
 
+std::string without_view_matrices(const std::string& sidecar) {
+  // The layout sidecar_json writes: top-level members indented by two spaces, everything nested deeper
+  // (JSON strings hold no raw newline), so the first "\n  ]" after the member closes its array.
+  const std::string open = ",\n  \"views\": [", close = "\n  ]";
+  const size_t begin = sidecar.find(open);
+  if (begin == std::string::npos) return sidecar;
+  const size_t end = sidecar.find(close, begin + open.size());
+  if (end == std::string::npos) return sidecar;
+  return sidecar.substr(0, begin) + sidecar.substr(end + close.size());
+}
+
 std::string folder_lock_name(const std::string& pattern, const std::string& expected) {
   return kLockPrefix + hash_hex(pattern) + "-" + hash_hex(expected);
 }
@@ -163,6 +174,14 @@ long sidecar_frame(const std::string& pattern, const std::string& file_name) {
 FolderGuard::FolderGuard(const std::string& dir, const std::string& pattern, const std::vector<long>& job_frames,
                          const std::string& expected, bool overwrite) {
   const std::string own_name = folder_lock_name(pattern, expected);
+  const std::string expected_config = without_view_matrices(expected);
+  // The configuration difference of a sidecar, compared without its view matrices (most of a sidecar
+  // with many views; 48 views: 1.3 -> 0.23 ms per comparison). A cut that does not parse (a sidecar not
+  // laid out as pmr writes them) is compared whole.
+  auto difference = [&](const std::string& text) {
+    const std::string diff = sidecar_config_difference(without_view_matrices(text), expected_config);
+    return diff == "unreadable" ? sidecar_config_difference(text, expected) : diff;
+  };
   const std::string same_pattern = own_name.substr(0, kLockPrefix.size() + kHexDigits + 1);
   lock_path_ = (fs::path(dir) / own_name).string();
 
@@ -231,7 +250,7 @@ FolderGuard::FolderGuard(const std::string& dir, const std::string& pattern, con
       const std::string text = held ? read_fd(fd) : std::string();
       ::close(fd);
       if (!held) continue;  // cannot tell (e.g. a read-only file over NFS)
-      const std::string diff = sidecar_config_difference(text, expected);
+      const std::string diff = difference(text);
       if (diff.empty()) continue;  // the same configuration under another fingerprint (e.g. other --write)
       throw Error(dir + " is being rendered right now by a pmr process with another configuration (" +
                   (diff == "unreadable" ? std::string("unrecorded") : diff + " differs") + "; it holds " + name +
@@ -240,10 +259,13 @@ FolderGuard::FolderGuard(const std::string& dir, const std::string& pattern, con
 
     // 3. Finished frames outside this job (every shard's frames count as this job's).
     std::sort(sidecars.begin(), sidecars.end());
+    if (sidecars.size() >= 10000)  // about 0.3 ms each (48 views): say why the start takes a while
+      std::fprintf(stderr, "pmr: comparing the configuration of %zu frame(s) outside --frames in %s\n", sidecars.size(),
+                   dir.c_str());
     long others = 0;
     std::string first_name, first_diff;
     for (const auto& [frame, name] : sidecars) {
-      const std::string diff = sidecar_config_difference(read_text_file((fs::path(dir) / name).string()), expected);
+      const std::string diff = difference(read_text_file((fs::path(dir) / name).string()));
       // unreadable: a broken frame, not a configuration (pmr verify reports it)
       if (diff.empty() || diff == "unreadable") continue;
       if (others++ == 0) first_name = name, first_diff = diff;

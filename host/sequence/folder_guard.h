@@ -49,6 +49,11 @@ class FolderGuard {
 // The lock file's name (no folder) for a --name pattern and an expected sidecar text.
 std::string folder_lock_name(const std::string& pattern, const std::string& expected);
 
+// The sidecar text without its top-level "views" member (the per-view matrices: derived from the rig,
+// camera and framing, which sidecar_config_difference compares, and not compared themselves), when it
+// is laid out as sidecar_json writes it; else unchanged. The folder scan compares these.
+std::string without_view_matrices(const std::string& sidecar);
+
 // The frame number when `file_name` is "<stem>.json" for a stem the pattern makes, else -1.
 long sidecar_frame(const std::string& pattern, const std::string& file_name);
 

@@ -129,8 +129,9 @@ TEST(Verify, ReportsMissingAndBrokenFramesAsAFramesList) {
   EXPECT_EQ(v.status, 1) << v.output;
   EXPECT_NE(v.output.find("frame 1: frame_0001.json was rendered with another configuration"), std::string::npos) << v.output;
   ASSERT_EQ(test::run("render --frames 1 -q" + args).status, 0);
-  // frame 6 rendered again at another fps: another configuration
-  ASSERT_EQ(test::run("render --frames 6 -q --fps 30" + args).status, 0);
+  // frame 6 rendered again at another fps: another configuration (--overwrite: the other frames stay
+  // in the first one)
+  ASSERT_EQ(test::run("render --frames 6 -q --fps 30 --overwrite" + args).status, 0);
   v = test::run("verify " + out + " --frames 0:7");
   EXPECT_EQ(v.status, 1) << v.output;
   EXPECT_NE(v.output.find("2:6:2\n"), std::string::npos) << v.output;  // frames 2, 4, 6

@@ -240,7 +240,6 @@ TEST(Sequence, BadSequenceOptionsFailWithOneLine) {
   expect_one_error_line(run("render --name frame --out " + out), "--name");
   expect_one_error_line(run("render --name a/%d --out " + out), "--name");
   expect_one_error_line(run("render --animation walk" + kSmall + "--out " + out), "no animations");
-  expect_one_error_line(run("render --overwrite" + kSmall + "--out " + out), "--overwrite");
 }
 
 }  // namespace pmr

@@ -18,11 +18,13 @@
 #include "pmr/quilt.h"
 #include "pmr/version.h"
 #include "runtime/cl_runtime.h"
+#include "sequence/folder_guard.h"
 #include "sequence/frame_files.h"
 #include "sequence/frame_list.h"
 #include "sequence/frame_renderer.h"
 #include "sequence/frame_writer.h"
 #include "sequence/progress.h"
+#include "sequence/range_warning.h"
 #include "sequence/shard.h"
 
 namespace pmr {
@@ -42,7 +44,6 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 int run_sequence(const RenderOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   const ExrCompression compression = parse_exr_compression(o.compression);
-  if (o.overwrite && !o.resume) throw Error("--overwrite only applies with --resume");
   std::vector<long> frames;
   if (o.frames != "all") frames = parse_frame_list(o.frames);  // before the long work: fail early
   // Everything that can be checked cheaply is checked before the long work starts.
@@ -66,7 +67,9 @@ int run_sequence(const RenderOptions& o) {
       throw Error("--frames all would reach frame " + std::to_string(last) + ", beyond " + std::to_string(kMaxFrame));
     for (long f = first; f <= last; ++f) frames.push_back(f);
   }
+  std::vector<long> job_frames;  // every shard's frames (the folder guard's "this job")
   if (!o.shard.empty()) {
+    job_frames = frames;
     const Shard shard = parse_shard(o.shard, o.shard_count, o.shard_first, [](const char* n) { return std::getenv(n); });
     const size_t all = frames.size();
     frames = shard_frames(frames, shard);
@@ -76,6 +79,8 @@ int run_sequence(const RenderOptions& o) {
   std::vector<std::string> warnings;
   FrameRenderer renderer(scene, spec, o.rig, o.display, &warnings);
   for (const auto& w : warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
+  if (const std::string w = frames_outside_animation(scene, spec, frames, o.frames == "all"); !w.empty())
+    std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
   const Rig& rig = renderer.rig();
   const bool need_volume = o.write_views || o.write_quilt || o.preview;
   QuiltLayout quilt;
@@ -136,6 +141,11 @@ int run_sequence(const RenderOptions& o) {
     i.depth = o.write_depth;
     return i;
   };
+
+  // One folder, one configuration: no other configuration rendering into it now, none left beside
+  // this run's frames (folder_guard.h). Held until the end of the run.
+  const FolderGuard folder_guard(o.out_dir, o.name, o.shard.empty() ? frames : job_frames,
+                                 sidecar_json(rig, o.display, frame_info(0, paths(0), 0.0)), o.overwrite);
 
   // --resume: a frame is complete when all its requested files exist (they appear only whole: atomic
   // renames, sidecar first); it is kept when its sidecar shows the same scene (checksums of the scene

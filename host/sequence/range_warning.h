@@ -1,0 +1,19 @@
+// The warning for requested frames outside the chosen animation's range (docs/SEQUENCES.md).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "pmr/scene.h"
+#include "sequence/frame_renderer.h"
+
+namespace pmr {
+
+// "" when every frame lies inside the range `--frames all` selects (animation_frame_range), when the
+// frames are `--frames all` themselves, or when no animation is selected (a still scene, or a turntable
+// alone: frames past one turn keep turning). Else one line (without "pmr: warning: ") naming the
+// frames outside and the animation's range, e.g. "frames 49:240 lie outside the animation 'Walk'
+// (frames 0:48 at 24 fps): they repeat its last pose".
+std::string frames_outside_animation(const Scene& scene, const SequenceSpec& spec, const std::vector<long>& frames,
+                                     bool frames_all);
+
+}  // namespace pmr

@@ -16,7 +16,6 @@
 #include "pmr/error.h"
 #include "pmr/output.h"
 #include "pmr/quilt.h"
-#include "pmr/version.h"
 #include "runtime/cl_runtime.h"
 #include "sequence/folder_guard.h"
 #include "sequence/frame_files.h"
@@ -25,6 +24,7 @@
 #include "sequence/frame_writer.h"
 #include "sequence/progress.h"
 #include "sequence/range_warning.h"
+#include "sequence/resume_plan.h"
 #include "sequence/shard.h"
 
 namespace pmr {
@@ -147,64 +147,12 @@ int run_sequence(const RenderOptions& o) {
   const FolderGuard folder_guard(o.out_dir, o.name, o.shard.empty() ? frames : job_frames,
                                  sidecar_json(rig, o.display, frame_info(0, paths(0), 0.0)), o.overwrite);
 
-  // --resume: a frame is complete when all its requested files exist (they appear only whole: atomic
-  // renames, sidecar first); it is kept when its sidecar shows the same scene (checksums of the scene
-  // file and of every file it read) and the same configuration. A frame from another scene (or whose
-  // sidecar records no checksum) is rendered again, whatever the scene changed (framing bounds too); a
-  // different configuration is refused unless --overwrite. A program version change alone re-renders
-  // nothing (pixels are meant to be stable across versions): it is only reported.
-  std::vector<long> todo;
-  long skipped = 0;
-  std::vector<std::string> other_scene;  // sidecars of frames rendered from another scene
-  long unrecorded = 0;                   // ... of them recording no scene checksum
-  std::vector<std::string> old_versions;  // versions of kept frames other than this program's
-  long old_version_frames = 0;
-  std::string scene_now;  // this run's scene identity (sidecar_provenance)
-  for (long f : frames) {
-    const FramePaths p = paths(f);
-    // complete = every file present and readable (a node may have died during a rename on a network
-    // file system); anything less is rendered again
-    if (o.resume && frame_problem(p.sidecar, p.images()).empty()) {
-      const std::string expected = sidecar_json(rig, o.display, frame_info(f, p, 0.0));
-      if (scene_now.empty()) scene_now = sidecar_provenance(expected).scene;
-      const std::string existing = read_text_file(p.sidecar);
-      const SidecarProvenance had = sidecar_provenance(existing);
-      const bool same_scene = !had.scene.empty() && had.scene == scene_now;
-      const std::string diff = sidecar_config_difference(existing, expected, /*ignore_scene_derived=*/!same_scene);
-      if (diff.empty() && same_scene) {
-        ++skipped;
-        if (had.version != program_version()) {
-          ++old_version_frames;
-          const std::string v = had.version.empty() ? "unrecorded" : printable_text(had.version);
-          if (std::find(old_versions.begin(), old_versions.end(), v) == old_versions.end()) old_versions.push_back(v);
-        }
-        continue;
-      }
-      if (!diff.empty() && !o.overwrite)
-        throw Error("--resume: " + p.sidecar + " was rendered with a different configuration (" + diff +
-                    " differs); use --overwrite to re-render such frames, or another --out folder");
-      if (diff.empty()) {
-        other_scene.push_back(base_name(p.sidecar));
-        unrecorded += had.scene.empty();
-      }
-    }
-    todo.push_back(f);
-  }
-  // one line each, naming the first few sidecars
-  auto first_few = [](const std::vector<std::string>& names) {
-    std::string s;
-    for (size_t i = 0; i < names.size() && i < 3; ++i) s += (i ? ", " : "") + names[i];
-    return names.size() > 3 ? s + ", ..." : s;
-  };
-  if (!other_scene.empty())
-    std::fprintf(stderr, "pmr: --resume: %zu frame(s) were rendered from a different scene%s (%s): rendering them again\n",
-                 other_scene.size(),
-                 unrecorded ? ("; " + std::to_string(unrecorded) + " of them record no scene checksum").c_str() : "",
-                 first_few(other_scene).c_str());
-  if (old_version_frames)
-    std::fprintf(stderr, "pmr: --resume: %ld kept frame(s) were rendered by another pmr version (%s; this is %s): "
-                 "kept, a version change alone renders nothing again\n",
-                 old_version_frames, first_few(old_versions).c_str(), program_version());
+  const ResumePlan plan = plan_resume(frames, o.resume, o.overwrite, paths, [&](long f, const FramePaths& p) {
+    return sidecar_json(rig, o.display, frame_info(f, p, 0.0));
+  });
+  for (const std::string& note : plan.notes) std::fprintf(stderr, "pmr: %s\n", note.c_str());
+  const std::vector<long>& todo = plan.todo;
+  const long skipped = plan.kept;
   const long total = long(todo.size());
   std::fprintf(stderr, "pmr: %s: %zu triangles, %d views of %dx%d -> %dx%d display%s; %ld frame(s)%s\n",
                o.scene.c_str(), scene.triangles.size(), rig.views, rig.view_w, rig.view_h, o.display.width,

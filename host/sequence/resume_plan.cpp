@@ -1,0 +1,76 @@
+#include "sequence/resume_plan.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "pmr/error.h"
+#include "pmr/output.h"
+#include "pmr/version.h"
+
+namespace pmr {
+
+namespace {
+
+std::string base_name(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+// "a, b, c, ..." of the first three names
+std::string first_few(const std::vector<std::string>& names) {
+  std::string s;
+  for (size_t i = 0; i < names.size() && i < 3; ++i) s += (i ? ", " : "") + names[i];
+  return names.size() > 3 ? s + ", ..." : s;
+}
+
+}  // namespace
+
+ResumePlan plan_resume(const std::vector<long>& frames, bool resume, bool overwrite,
+                       const std::function<FramePaths(long)>& paths,
+                       const std::function<std::string(long, const FramePaths&)>& expected) {
+  ResumePlan plan;
+  std::vector<std::string> other_scene;   // sidecars of frames rendered from another scene
+  long unrecorded = 0;                    // ... of them recording no scene checksum
+  std::vector<std::string> old_versions;  // versions of kept frames other than this program's
+  long old_version_frames = 0;
+  std::string scene_now;  // this run's scene identity (sidecar_provenance)
+  for (long f : frames) {
+    const FramePaths p = paths(f);
+    // complete = every file present and readable (a node may have died during a rename on a network
+    // file system); anything less is rendered again
+    if (resume && frame_problem(p.sidecar, p.images()).empty()) {
+      const std::string want = expected(f, p);
+      if (scene_now.empty()) scene_now = sidecar_provenance(want).scene;
+      const std::string existing = read_text_file(p.sidecar);
+      const SidecarProvenance had = sidecar_provenance(existing);
+      const bool same_scene = !had.scene.empty() && had.scene == scene_now;
+      const std::string diff = sidecar_config_difference(existing, want, /*ignore_scene_derived=*/!same_scene);
+      if (diff.empty() && same_scene) {
+        ++plan.kept;
+        if (had.version != program_version()) {
+          ++old_version_frames;
+          const std::string v = had.version.empty() ? "unrecorded" : printable_text(had.version);
+          if (std::find(old_versions.begin(), old_versions.end(), v) == old_versions.end()) old_versions.push_back(v);
+        }
+        continue;
+      }
+      if (!diff.empty() && !overwrite)
+        throw Error("--resume: " + p.sidecar + " was rendered with a different configuration (" + diff +
+                    " differs); use --overwrite to re-render such frames, or another --out folder");
+      if (diff.empty()) {
+        other_scene.push_back(base_name(p.sidecar));
+        unrecorded += had.scene.empty();
+      }
+    }
+    plan.todo.push_back(f);
+  }
+  if (!other_scene.empty())
+    plan.notes.push_back("--resume: " + std::to_string(other_scene.size()) +
+                         " frame(s) were rendered from a different scene" +
+                         (unrecorded ? "; " + std::to_string(unrecorded) + " of them record no scene checksum" : "") +
+                         " (" + first_few(other_scene) + "): rendering them again");
+  if (old_version_frames)
+    plan.notes.push_back("--resume: " + std::to_string(old_version_frames) +
+                         " kept frame(s) were rendered by another pmr version (" + first_few(old_versions) +
+                         "; this is " + program_version() + "): kept, a version change alone renders nothing again");
+  return plan;
+}
+
+}  // namespace pmr

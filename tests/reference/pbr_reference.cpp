@@ -1,0 +1,76 @@
+#include "reference/pbr_reference.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pmr::ref {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double clamp01(double x) { return std::min(1.0, std::max(0.0, x)); }
+
+glm::dvec3 f0_of(const glm::dvec3& base, double metallic) { return glm::mix(glm::dvec3(0.04), base, metallic); }
+
+}  // namespace
+
+glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
+                    const glm::dvec3& l) {
+  const double nl = clamp01(glm::dot(n, l));
+  if (nl <= 0.0) return glm::dvec3(0.0);
+  const double nv = clamp01(glm::dot(n, v));
+  const glm::dvec3 hv = l + v;
+  const glm::dvec3 h = glm::length(hv) > 0.0 ? glm::normalize(hv) : n;
+  const double nh = clamp01(glm::dot(n, h)), vh = clamp01(glm::dot(v, h));
+  const double alpha = r * r, a2 = alpha * alpha;
+  const glm::dvec3 f0 = f0_of(base, metallic);
+  const glm::dvec3 F = f0 + (1.0 - f0) * std::pow(1.0 - vh, 5.0);
+  const double dd = nh * nh * (a2 - 1.0) + 1.0;
+  const double D = a2 / (kPi * dd * dd);
+  const double s = nl * std::sqrt(nv * nv * (1.0 - a2) + a2) + nv * std::sqrt(nl * nl * (1.0 - a2) + a2);
+  const double vis = s > 0.0 ? 0.5 / s : 0.0;
+  const glm::dvec3 c_diff = base * (1.0 - metallic);
+  return ((1.0 - F) * c_diff / kPi + F * (D * vis)) * nl;
+}
+
+glm::dvec3 light_irradiance(const PunctualLight& light, const glm::dvec3& p, glm::dvec3& l) {
+  if (light.type == LightType::Directional) {
+    l = -light.direction;
+    return light.color_intensity;
+  }
+  const glm::dvec3 d = light.position - p;
+  const double dist = glm::length(d);
+  if (!(dist > 0.0)) {
+    l = glm::dvec3(0.0);
+    return glm::dvec3(0.0);
+  }
+  l = d / dist;
+  double w = 1.0 / (dist * dist);
+  if (light.range > 0.0) w *= clamp01(1.0 - std::pow(dist / light.range, 4.0));
+  if (light.type == LightType::Spot) {
+    const double c = glm::dot(light.direction, -l);
+    w *= std::pow(clamp01((c - light.cos_outer) / std::max(0.001, light.cos_inner - light.cos_outer)), 2.0);
+  }
+  return light.color_intensity * w;
+}
+
+glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& lights, const EnvironmentTerms& env,
+                     double exposure) {
+  if (s.unlit) return exposure * s.base;
+  const double r = std::min(1.0, std::max(0.03, s.roughness));
+  const glm::dvec3 v = glm::normalize(s.eye - s.p);
+  glm::dvec3 sum(0.0);
+  for (const PunctualLight& light : lights) {
+    glm::dvec3 l;
+    const glm::dvec3 E = light_irradiance(light, s.p, l);
+    sum += brdf_cos(s.base, s.metallic, r, s.n, v, l) * E;
+  }
+  const glm::dvec3 f0 = f0_of(s.base, s.metallic), c_diff = s.base * (1.0 - s.metallic);
+  const glm::dvec2 ab = env.split_sum(clamp01(glm::dot(s.n, v)), r);
+  const glm::dvec3 reflected = glm::reflect(-v, s.n);
+  sum += s.ao * (c_diff * env.irradiance(s.n) + (f0 * ab.x + ab.y) * env.prefiltered(reflected, r));
+  return exposure * (sum + s.emissive);
+}
+
+}  // namespace pmr::ref

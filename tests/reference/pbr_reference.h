@@ -1,0 +1,54 @@
+// Double-precision reference of the physically based shading model (--shading pbr, docs/SHADING.md):
+// the glTF metallic-roughness BRDF, punctual lights and the colour assembly, evaluated exactly as the
+// model states them (the kernels' cl/brdf.h computes the same in float).
+#pragma once
+#include <functional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace pmr::ref {
+
+// f(l, v) * dot(n, l) for unit n, v, l; r = the clamped roughness (alpha = r^2).
+glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
+                    const glm::dvec3& l);
+
+enum class LightType { Directional = 0, Point = 1, Spot = 2 };
+
+struct PunctualLight {
+  LightType type = LightType::Directional;
+  glm::dvec3 color_intensity{1.0};  // colour x intensity
+  glm::dvec3 position{0.0};         // world space (point, spot)
+  glm::dvec3 direction{0.0, 0.0, -1.0};  // unit, the direction the light travels (the node's -Z)
+  double range = 0.0;               // 0: none
+  double cos_inner = 1.0, cos_outer = 0.0;
+};
+
+// Irradiance on a surface facing the light at p, and the unit direction toward it.
+glm::dvec3 light_irradiance(const PunctualLight& light, const glm::dvec3& p, glm::dvec3& l);
+
+// The material inputs at a surface point and how it is seen.
+struct SurfacePoint {
+  glm::dvec3 base{1.0};     // base colour (rgb)
+  double metallic = 0.0, roughness = 1.0;  // roughness before clamping
+  glm::dvec3 n{0.0, 0.0, 1.0};  // unit shading normal (back faces already flipped)
+  glm::dvec3 p{0.0};        // world position
+  glm::dvec3 eye{0.0, 0.0, 1.0};  // the view's camera position (world)
+  double ao = 1.0;
+  glm::dvec3 emissive{0.0};
+  bool unlit = false;
+};
+
+// The environment's precomputed terms: I(n) (irradiance / pi), P(d, r) and the split-sum (A, B).
+struct EnvironmentTerms {
+  std::function<glm::dvec3(const glm::dvec3&)> irradiance;
+  std::function<glm::dvec3(const glm::dvec3&, double)> prefiltered;
+  std::function<glm::dvec2(double, double)> split_sum;  // (dot(n, v), r) -> (A, B)
+};
+
+// exposure x (sum over lights of f E dot(n, l) + ao (c_diff I(n) + (F0 A + B) P(reflect(-v, n), r)) + e);
+// unlit: exposure x base.
+glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& lights, const EnvironmentTerms& env,
+                     double exposure);
+
+}  // namespace pmr::ref

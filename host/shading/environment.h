@@ -15,25 +15,32 @@
 // - Prefiltered levels, equirectangular RGB maps for a fixed set of roughness values r_k:
 //     P(d, r) = integral of L(l) D(dot(d, h)) dot(d, l) dl / integral of D(dot(d, h)) dot(d, l) dl
 //   over dot(d, l) > 0, h = normalize(l + d), alpha = r^2, D = GGX. Level 0 (r = 0) is the image
-//   itself (box-downsampled when wider than kEnvMaxBaseWidth), so P(d, 0) is the bilinear image
-//   lookup. Levels 1.. are r = 0.2, 0.25, 0.3, 0.35, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0 at W x W/2
-//   texels, W = the power of two >= 20 / r^2 clamped to [128, 512] and to at most 2x the image's own
-//   width (rounded up to a power of two, at least 128): 512x256 for r = 0.2, 0.25; 256x128 for
-//   r = 0.3, 0.35; 128x64 from r = 0.4 on. Each level is the exact discrete convolution of the image
-//   (resampled to the level's grid) with the GGX lobe over all texels of the hemisphere (no sampling
-//   noise, no truncated tails), done row pair by row pair with FFTs along the rows.
+//   itself (box-downsampled by 2 while wider than kEnvMaxBaseWidth), so P(d, 0) is the bilinear
+//   image lookup. Levels 1..14 are r = 0.2, 0.22, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.7,
+//   0.8, 0.9, 1.0 at W x W/2 texels, W = the power of two >= 16 / r^2 clamped to [128, 512] and to
+//   at most max(128, the power of two >= 2x the image's width): 512x256 for r = 0.2 and 0.22,
+//   256x128 for r = 0.25 to 0.35, 128x64 from r = 0.4 on. Each level is the exact discrete
+//   convolution of the image (resampled to the level's grid: mean of bilinear lookups over each
+//   texel) with the GGX lobe over every texel of the hemisphere (no sampling noise, no truncated
+//   tails), normalized by the discrete sum of the weights, done row pair by row pair with FFTs.
 // - I(n) = irradiance / pi about n = the cosine-weighted mean radiance. At r = 1 (alpha = 1) D is
-//   constant and P(n, 1) is exactly this mean, so I(n) is read from the last level (r = 1).
-// - Between levels: a roughness -> level coordinate table (kEnvRoughnessNodes nodes over r in [0, 1],
-//   linear in between) gives c(r); P(d, r) = mix(level floor(c), level floor(c) + 1, fract(c)),
-//   bilinear within each level. Between r = 0 and 0.2, c = r / 0.2 (a plain blend of the image and
-//   the r = 0.2 level: not an approximation of P with a stated error). From r = 0.2 on, the weight
-//   between two levels is chosen so that a point light at d (the sharpest peak there is, whose P
-//   scales like 1 / (alpha^2 N(alpha)), N the normalization integral) is interpolated exactly.
+//   constant and P(n, 1) is exactly this mean, so I(n) is read from the last level (r = 1). (Order-2
+//   spherical harmonics were not used: for a point light they are 6% high facing it and 9% of its
+//   irradiance wrong at 90 degrees, far from the 1% we want with a sun in the map.)
+// - Between levels: a table of c(r), the fractional level coordinate, kEnvRoughnessNodes nodes at
+//   r = i / 100 (linear in between; each level's r is a node where c is the level's index).
+//   l = floor(c), f = c - l (l at most level_count - 2), P = the levels l and l + 1, each bilinear:
+//     l = 0 (r < 0.2): (1 - f) * P_0 + f * P_1 with f = r / 0.2, a plain blend of the image and the
+//       r = 0.2 level, not an approximation of P with a stated error;
+//     l >= 1: per channel P_l * (P_{l+1} / P_l)^f when both are > 0 (else the linear blend), with
+//       f chosen so that a point light at d (whose P goes like 1 / (alpha^2 N(alpha)), N the
+//       normalization integral) is interpolated exactly: f = log(p(r) / p(r_l)) / log(p(r_{l+1}) /
+//       p(r_l)), p the point peak. Linear blending between levels 0.05 apart was 10% off at a sun.
 // - The split-sum terms (A, B)(dot(n, v), r) of DESIGN 4b's F (Schlick), D (GGX) and height-
 //   correlated Smith Vis: integral of f_spec * dot(n, l) dl = F0 * A + B. A kEnvSplitSumSize^2
-//   table with nodes at dot(n, v) = i / (N - 1), r = j / (N - 1), bilinear, computed once per process
-//   (independent of the environment) with 8192 Hammersley GGX samples per node; r = 0 is exact
+//   table, nodes at dot(n, v) = (i / (N - 1))^2 (denser at grazing angles, where A changes fast) and
+//   r = j / (N - 1), bilinear in (sqrt(dot(n, v)), r), computed once per process (independent of
+//   the environment; about 0.5 s of CPU) with 8192 Hammersley GGX samples per node; r = 0 is exact
 //   (A = 1 - (1 - dot(n, v))^5, B = (1 - dot(n, v))^5).
 //
 // Flat layout for upload (EnvironmentTables::data, 32-bit floats; EnvTablesHeader says where):
@@ -41,12 +48,13 @@
 //                starting at float offset levels[k].offset
 //   [roughness]  kEnvRoughnessNodes floats at roughness_offset: c(r) at r = i / (nodes - 1)
 //   [split sum]  kEnvSplitSumSize^2 nodes of 2 floats (A, B) at split_sum_offset, node (i, j) =
-//                (dot(n, v) = i / (N - 1), r = j / (N - 1)) at split_sum_offset + 2 * (j * N + i)
-// The uniform environment (no image; radiance 0.2 by default) has every level 1x1 texel.
+//                (dot(n, v) = (i / (N - 1))^2, r = j / (N - 1)) at split_sum_offset + 2 * (j * N + i)
+// For a 1024x512 image: 4 x (524288 + 2 x 131072 + 3 x 32768 + 9 x 8192) floats + 101 + 8192,
+// about 3.8 M floats (15 MB). The uniform environment (no image; radiance 0.2) has 1x1 levels.
 //
-// Cost: prefiltering is O(sum over levels of H^2 W log W); for a 1024x512 image about 0.3 s on
-// 2 cores (docs/SHADING.md). Accuracy against brute-force integration: docs/SHADING.md and
-// tests/test_environment.cpp.
+// Cost: per level H^2 / 4 complex FFTs of length W and 3 H^2 W / 2 multiply-adds; about 1 s for a
+// 1024x512 image on 2 cores (measured: docs/SHADING.md). Accuracy against brute-force integration:
+// docs/SHADING.md and tests/test_environment.cpp.
 #pragma once
 #include <cstdint>
 #include <string>

@@ -1,0 +1,163 @@
+// Environment lighting for the physically based shading model (DESIGN section 4b): loading an
+// equirectangular image of linear radiance, the direction <-> image mapping, and the tables that are
+// precomputed once per environment so that the kernels and the C++ reference read the same numbers.
+//
+// Mapping. A world-space direction d = (x, y, z) reads the image at
+//   u = 1/2 + atan2(x, -z) / (2 pi),  v = acos(y) / pi
+// (u from the image's left, v from its top): -Z is the middle column, +X is at u = 3/4, +Y is the top
+// row. Texel (j, i) has its center at u = (j + 1/2) / W, v = (i + 1/2) / H; lookups are bilinear,
+// wrapping in u and clamped in v. A rotation of DEG degrees turns the map counter-clockwise seen from
+// above (right-hand rule about +Y, as the turntable): a feature at +X moves to -Z at DEG = 90. It is
+// applied at lookup time (d is turned by -DEG before the mapping); the intensity also multiplies at
+// lookup time, so neither changes the tables.
+//
+// What is precomputed (all radiance in the image's units, before intensity):
+// - Prefiltered levels, equirectangular RGB maps for a fixed set of roughness values r_k:
+//     P(d, r) = integral of L(l) D(dot(d, h)) dot(d, l) dl / integral of D(dot(d, h)) dot(d, l) dl
+//   over dot(d, l) > 0, h = normalize(l + d), alpha = r^2, D = GGX. Level 0 (r = 0) is the image
+//   itself (box-downsampled by 2 while wider than kEnvMaxBaseWidth), so P(d, 0) is the bilinear
+//   image lookup. Levels 1..14 are r = 0.2, 0.22, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.55, 0.6, 0.7,
+//   0.8, 0.9, 1.0 at W x W/2 texels, W = the power of two >= 16 / r^2 clamped to [128, 512] and to
+//   at most max(128, the power of two >= 2x the image's width): 512x256 for r = 0.2 and 0.22,
+//   256x128 for r = 0.25 to 0.35, 128x64 from r = 0.4 on. Each level is the exact discrete
+//   convolution of the image (resampled to the level's grid: mean of bilinear lookups over each
+//   texel) with the GGX lobe over every texel of the hemisphere (no sampling noise, no truncated
+//   tails), normalized by the discrete sum of the weights, done row pair by row pair with FFTs.
+// - I(n) = irradiance / pi about n = the cosine-weighted mean radiance. At r = 1 (alpha = 1) D is
+//   constant and P(n, 1) is exactly this mean, so I(n) is read from the last level (r = 1). (Order-2
+//   spherical harmonics were not used: for a point light they are 6% high facing it and 9% of its
+//   irradiance wrong at 90 degrees, far from the 1% we want with a sun in the map.)
+// - Between levels: a table of c(r), the fractional level coordinate, kEnvRoughnessNodes nodes at
+//   r = i / 100 (linear in between; each level's r is a node where c is the level's index).
+//   l = floor(c), f = c - l (l at most level_count - 2), P = the levels l and l + 1, each bilinear:
+//     l = 0 (r < 0.2): (1 - f) * P_0 + f * P_1 with f = r / 0.2, a plain blend of the image and the
+//       r = 0.2 level, not an approximation of P with a stated error;
+//     l >= 1: per channel P_l * (P_{l+1} / P_l)^f when both are > 0 (else the linear blend), with
+//       f chosen so that a point light at d (whose P goes like 1 / (alpha^2 N(alpha)), N the
+//       normalization integral) is interpolated exactly: f = log(p(r) / p(r_l)) / log(p(r_{l+1}) /
+//       p(r_l)), p the point peak. Linear blending between levels 0.05 apart was 10% off at a sun.
+// - The split-sum terms (A, B)(dot(n, v), r) of DESIGN 4b's F (Schlick), D (GGX) and height-
+//   correlated Smith Vis: integral of f_spec * dot(n, l) dl = F0 * A + B. A kEnvSplitSumSize^2
+//   table, nodes at dot(n, v) = (i / (N - 1))^2 (denser at grazing angles, where A changes fast) and
+//   r = j / (N - 1), bilinear in (sqrt(dot(n, v)), r), computed once per process (independent of
+//   the environment; about 0.5 s of CPU) with 8192 Hammersley GGX samples per node; r = 0 is exact
+//   (A = 1 - (1 - dot(n, v))^5, B = (1 - dot(n, v))^5).
+//
+// Flat layout for upload (EnvironmentTables::data, 32-bit floats; EnvTablesHeader says where):
+//   [levels]     level k: width_k * height_k texels of 4 floats (R, G, B, 0), rows top to bottom,
+//                starting at float offset levels[k].offset
+//   [roughness]  kEnvRoughnessNodes floats at roughness_offset: c(r) at r = i / (nodes - 1)
+//   [split sum]  kEnvSplitSumSize^2 nodes of 2 floats (A, B) at split_sum_offset, node (i, j) =
+//                (dot(n, v) = (i / (N - 1))^2, r = j / (N - 1)) at split_sum_offset + 2 * (j * N + i)
+// For a 1024x512 image: 4 x (524288 + 2 x 131072 + 3 x 32768 + 9 x 8192) floats + 101 + 8192,
+// about 3.8 M floats (15 MB). The uniform environment (no image; radiance 0.2) has 1x1 levels.
+//
+// Cost: per level H^2 / 4 complex FFTs of length W and 3 H^2 W / 2 multiply-adds; about 1 s for a
+// 1024x512 image on 2 cores (measured: docs/SHADING.md). Accuracy against brute-force integration:
+// docs/SHADING.md and tests/test_environment.cpp.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace pmr {
+
+constexpr int kEnvMaxLevels = 16;
+constexpr int kEnvRoughnessNodes = 101;  // r = 0, 0.01, ..., 1: every level's r is a node
+constexpr int kEnvSplitSumSize = 64;
+constexpr int kEnvMaxBaseWidth = 4096;  // level 0 is box-downsampled by 2 until it is at most this wide
+// Memory budget for an image: at most kEnvMaxTexels texels (8192x4096; decoding needs at most
+// 16 bytes per texel, 512 MiB) and, for .hdr, a file of at most kEnvMaxFileBytes.
+constexpr uint64_t kEnvMaxTexels = uint64_t(1) << 25;
+constexpr uint64_t kEnvMaxFileBytes = uint64_t(1) << 28;
+
+// C-compatible (32-bit scalars only) description of EnvironmentTables::data, to be mirrored in the
+// kernels' shared header when they sample it.
+struct EnvLevel {
+  uint32_t width, height;  // texels
+  uint32_t offset;         // float offset of texel (0, 0) in data
+  float roughness;         // r of this level
+};
+struct EnvTablesHeader {
+  uint32_t level_count;       // levels in use (level 0 = the image)
+  uint32_t roughness_nodes;   // kEnvRoughnessNodes
+  uint32_t roughness_offset;  // float offset of c(r)
+  uint32_t split_sum_size;    // kEnvSplitSumSize
+  uint32_t split_sum_offset;  // float offset of the (A, B) table
+  float intensity;            // multiplies every radiance read (0 = off)
+  float rotation_cos, rotation_sin;  // of the map's rotation angle
+  EnvLevel levels[kEnvMaxLevels];
+};
+
+struct EnvironmentTables {
+  EnvTablesHeader header{};
+  std::vector<float> data;
+};
+
+// Linear radiance, row 0 at the top, 3 floats (R, G, B) per texel.
+struct EnvironmentImage {
+  int width = 0, height = 0;
+  std::vector<float> rgb;
+};
+
+// Reads FILE.hdr (Radiance RGBE) or FILE.exr (R, G, B channels or Y; half, float or uint; the data
+// window). Throws pmr::Error, one line naming the file, for: an unknown extension, a missing or
+// unreadable file, a truncated or corrupt one, a zero or over-budget size, a negative or non-finite
+// value (naming the first such pixel, column and row from the top-left; see check_environment_image
+// for the tiny negative values lossy compression leaves, which read as 0).
+EnvironmentImage load_environment_image(const std::string& path);
+
+// Checks the image (size, finite non-negative values) and sets negative values down to
+// -kEnvNegativeTolerance x the image's mean value (lossy-compression noise) to 0; throws pmr::Error
+// mentioning `name` and the first bad pixel otherwise.
+constexpr double kEnvNegativeTolerance = 1e-2;
+void check_environment_image(EnvironmentImage& image, const std::string& name);
+
+struct EnvironmentOptions {
+  std::string file;           // empty: the uniform environment
+  double rotation_deg = 0.0;  // counter-clockwise seen from above
+  double intensity = 1.0;     // >= 0; 0 turns the environment off
+  double uniform_radiance = 0.2;  // the radiance of the uniform environment (DESIGN 4b: 0.2)
+};
+
+class Environment {
+ public:
+  // The uniform environment of the given radiance (before intensity).
+  static Environment uniform(double radiance = 0.2);
+  // Prefilters an image (checked with check_environment_image).
+  static Environment from_image(const EnvironmentImage& image, const std::string& name = "environment");
+  // load_environment_image + from_image, or uniform() when options.file is empty; then the rotation
+  // and intensity (which must be finite, intensity >= 0).
+  static Environment make(const EnvironmentOptions& options);
+
+  void set_rotation(double degrees);
+  void set_intensity(double intensity);
+
+  // Host-side evaluation from exactly the tables (as the kernels will sample them), intensity and
+  // rotation applied; directions need not be unit length (zero vectors read +Y).
+  glm::dvec3 radiance(const glm::dvec3& d) const;                // the map: P(d, 0)
+  glm::dvec3 irradiance(const glm::dvec3& n) const;              // I(n) = P(n, 1)
+  glm::dvec3 prefiltered(const glm::dvec3& d, double r) const;   // P(d, r), r clamped to [0, 1]
+  glm::dvec3 level_sample(int level, const glm::dvec3& d) const; // one level, bilinear
+
+  const EnvironmentTables& tables() const { return tables_; }
+  double prefilter_seconds() const { return prefilter_seconds_; }  // wall time of from_image
+
+ private:
+  EnvironmentTables tables_;
+  double prefilter_seconds_ = 0.0;
+};
+
+// (A, B) for (dot(n, v), r) from the table (bilinear; arguments clamped to [0, 1]).
+glm::dvec2 split_sum(double n_dot_v, double r);
+// The table itself: kEnvSplitSumSize^2 nodes of (A, B), node (i, j) at 2 * (j * N + i). Computed on
+// first use (thread-safe), about 30 ms.
+const std::vector<float>& split_sum_table();
+
+// The roughness of each prefiltered level after level 0, and c(r) (the fractional level coordinate).
+const std::vector<double>& environment_level_roughness();
+double environment_level_coordinate(double r);
+
+}  // namespace pmr

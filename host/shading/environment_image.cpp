@@ -1,0 +1,289 @@
+// Reading environment images: Radiance .hdr through stb_image (Debian's libstb-dev header, compiled
+// here with only the HDR decoder, functions static to this file) and .exr through OpenEXR.
+//
+// stb_image's HDR decoder reads past the end of the data as zero bytes: a truncated file decodes as
+// black texels, and a run-length count of 0 (which a truncated file produces) makes it loop forever.
+// So the bytes are read into memory and walked first with stb's own rules (check_hdr_data), and
+// stbi_loadf_from_memory only runs on data that is complete.
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+
+#include "pmr/error.h"
+#include "shading/environment.h"
+
+#define STB_IMAGE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_HDR
+#define STBI_NO_STDIO
+#define STBI_MAX_DIMENSIONS (1 << 24)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#include <stb/stb_image.h>
+#pragma GCC diagnostic pop
+
+namespace pmr {
+namespace {
+
+// A file name safe to print: control characters, DEL, backslashes and non-ASCII bytes as \xNN, at most
+// 160 characters.
+std::string printable(const std::string& text) {
+  std::string out;
+  for (unsigned char c : text) {
+    if (out.size() >= 160) return out + "...";
+    if (c < 0x20 || c >= 0x7f || c == '\\') {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out += char(c);
+    }
+  }
+  return out;
+}
+
+std::string one_line(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+  return printable(s);
+}
+
+[[noreturn]] void fail(const std::string& path, const std::string& why) {
+  throw Error("cannot read environment " + printable(path) + ": " + why);
+}
+
+std::string lower_extension(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  const size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string ext = path.substr(dot);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+void check_size(const std::string& path, uint64_t w, uint64_t h) {
+  if (w == 0 || h == 0) fail(path, "the image is empty (" + std::to_string(w) + "x" + std::to_string(h) + ")");
+  if (w > kEnvMaxTexels || h > kEnvMaxTexels || w * h > kEnvMaxTexels)
+    fail(path, "the image is too large (" + std::to_string(w) + "x" + std::to_string(h) +
+                   "); environments may have at most " + std::to_string(kEnvMaxTexels) + " texels (8192x4096)");
+}
+
+// ---- Radiance .hdr --------------------------------------------------------------------------------
+
+// Walks the header and the scanlines as stb_image 2.27 decodes them (stbi__hdr_load) and returns ""
+// when every byte the decoder will read is present and well formed, else what is wrong.
+std::string check_hdr_data(const std::vector<unsigned char>& b, int& width, int& height) {
+  size_t p = 0;
+  auto line = [&](std::string& out) {  // stb's tokens: up to a newline, at most 1023 characters
+    out.clear();
+    if (p >= b.size()) return false;
+    while (p < b.size() && b[p] != '\n') {
+      if (out.size() < 1023) out += char(b[p]);
+      ++p;
+    }
+    if (p < b.size()) ++p;  // the newline
+    return true;
+  };
+  std::string t;
+  if (!line(t) || (t != "#?RADIANCE" && t != "#?RGBE")) return "not a Radiance HDR file (no #?RADIANCE line)";
+  bool rgbe = false;
+  for (;;) {
+    if (!line(t)) return "truncated header";
+    if (t.empty()) break;
+    if (t == "FORMAT=32-bit_rle_rgbe") rgbe = true;
+    if (t.rfind("FORMAT=", 0) == 0 && t != "FORMAT=32-bit_rle_rgbe")
+      return "unsupported pixel format '" + t.substr(7, 40) + "' (only 32-bit_rle_rgbe)";
+  }
+  if (!rgbe) return "no FORMAT=32-bit_rle_rgbe line in the header";
+  if (!line(t)) return "truncated header (no resolution line)";
+  long h = 0, w = 0;
+  char tail = 0;
+  if (std::sscanf(t.c_str(), "-Y %ld +X %ld%c", &h, &w, &tail) != 2)
+    return "unsupported resolution line '" + t.substr(0, 40) + "' (only -Y H +X W, rows top to bottom)";
+  if (w <= 0 || h <= 0) return "the image is empty (" + std::to_string(w) + "x" + std::to_string(h) + ")";
+  if (uint64_t(w) * uint64_t(h) > kEnvMaxTexels || w > (1 << 24) || h > (1 << 24))
+    return "the image is too large (" + std::to_string(w) + "x" + std::to_string(h) + "); environments may have at most " +
+           std::to_string(kEnvMaxTexels) + " texels (8192x4096)";
+  width = int(w), height = int(h);
+  const uint64_t flat_bytes = uint64_t(w) * uint64_t(h) * 4;
+  auto truncated = [&](long row) {
+    return "truncated pixel data (row " + std::to_string(row) + " of " + std::to_string(h) + " is incomplete)";
+  };
+  if (w < 8 || w >= 32768) {
+    if (b.size() - p < flat_bytes) return truncated(long((b.size() - p) / (uint64_t(w) * 4)));
+    return "";
+  }
+  for (long j = 0; j < h; ++j) {
+    if (b.size() - p < 4) return truncated(j);
+    if (b[p] != 2 || b[p + 1] != 2 || (b[p + 2] & 0x80)) {
+      if (j != 0) return "corrupt pixel data (row " + std::to_string(j) + " is not run-length encoded)";
+      if (b.size() - p < flat_bytes) return truncated(long((b.size() - p) / (uint64_t(w) * 4)));
+      return "";
+    }
+    const long len = (long(b[p + 2]) << 8) | b[p + 3];
+    if (len != w) return "corrupt pixel data (row " + std::to_string(j) + " has length " + std::to_string(len) + ")";
+    p += 4;
+    for (int k = 0; k < 4; ++k) {
+      long i = 0;
+      while (i < w) {
+        if (p >= b.size()) return truncated(j);
+        unsigned count = b[p++];
+        if (count > 128) {
+          count -= 128;
+          if (p >= b.size()) return truncated(j);
+          ++p;
+        } else {
+          if (count == 0) return "corrupt pixel data (row " + std::to_string(j) + ": a run of length 0)";
+          if (b.size() - p < count) return truncated(j);
+          p += count;
+        }
+        if (long(count) > w - i) return "corrupt pixel data (row " + std::to_string(j) + ": a run past the row's end)";
+        i += long(count);
+      }
+    }
+  }
+  return "";
+}
+
+EnvironmentImage read_hdr(const std::string& path) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0) fail(path, std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) fail(path, "not a regular file");
+  if (uint64_t(st.st_size) > kEnvMaxFileBytes)
+    fail(path, "the file is too large (" + std::to_string(st.st_size) + " bytes; at most " +
+                   std::to_string(kEnvMaxFileBytes) + ")");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) fail(path, std::strerror(errno));
+  std::vector<unsigned char> bytes(static_cast<size_t>(st.st_size));
+  if (!bytes.empty() && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size())))
+    fail(path, "read error");
+  if (bytes.empty()) fail(path, "the file is empty");
+  if (bytes.size() > size_t(INT32_MAX)) fail(path, "the file is too large");
+  int w = 0, h = 0;
+  const std::string problem = check_hdr_data(bytes, w, h);
+  if (!problem.empty()) fail(path, problem);
+  // stb's own view of the size, checked against the budget before anything is decoded.
+  int sw = 0, sh = 0, comp = 0;
+  if (!stbi_info_from_memory(bytes.data(), int(bytes.size()), &sw, &sh, &comp))
+    fail(path, "not a readable Radiance HDR file (" + one_line(stbi_failure_reason()) + ")");
+  check_size(path, uint64_t(sw), uint64_t(sh));
+  if (sw != w || sh != h) fail(path, "inconsistent size in the header");
+  float* pixels = stbi_loadf_from_memory(bytes.data(), int(bytes.size()), &sw, &sh, &comp, 3);
+  if (!pixels) fail(path, "cannot decode it (" + one_line(stbi_failure_reason()) + ")");
+  EnvironmentImage img;
+  img.width = sw, img.height = sh;
+  img.rgb.assign(pixels, pixels + size_t(sw) * size_t(sh) * 3);
+  stbi_image_free(pixels);
+  return img;
+}
+
+// ---- OpenEXR ----------------------------------------------------------------------------------------
+
+EnvironmentImage read_exr(const std::string& path) {
+  struct stat st {};
+  if (stat(path.c_str(), &st) != 0) fail(path, std::strerror(errno));
+  if (!S_ISREG(st.st_mode)) fail(path, "not a regular file");
+  if (st.st_size == 0) fail(path, "the file is empty");
+  EnvironmentImage img;
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i dw = file.header().dataWindow();
+    const int64_t w = int64_t(dw.max.x) - int64_t(dw.min.x) + 1, h = int64_t(dw.max.y) - int64_t(dw.min.y) + 1;
+    if (w <= 0 || h <= 0) fail(path, "the image is empty");
+    check_size(path, uint64_t(w), uint64_t(h));
+    const Imf::ChannelList& ch = file.header().channels();
+    const bool rgb = ch.findChannel("R") && ch.findChannel("G") && ch.findChannel("B");
+    const bool gray = !rgb && ch.findChannel("Y");
+    if (!rgb && !gray) fail(path, "no R, G, B (or Y) channels");
+    img.width = int(w), img.height = int(h);
+    img.rgb.assign(size_t(w) * size_t(h) * 3, 0.0f);
+    Imf::FrameBuffer fb;
+    const size_t xs = 3 * sizeof(float), ys = size_t(w) * xs;
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < (rgb ? 3 : 1); ++c)
+      fb.insert(rgb ? names[c] : "Y",
+                Imf::Slice::Make(Imf::FLOAT, img.rgb.data() + c, dw, xs, ys));
+    file.setFrameBuffer(fb);
+    if (!file.isComplete()) fail(path, "the file is truncated (some pixel data is missing)");
+    file.readPixels(dw.min.y, dw.max.y);
+    if (gray)
+      for (size_t t = 0; t < size_t(w) * size_t(h); ++t) img.rgb[3 * t + 1] = img.rgb[3 * t + 2] = img.rgb[3 * t];
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {  // Iex::BaseExc derives from std::exception
+    std::string msg = e.what();
+    for (size_t at = msg.find(path); !path.empty() && at != std::string::npos; at = msg.find(path))
+      msg.replace(at, path.size(), "the file");
+    fail(path, "not a readable OpenEXR file (" + one_line(msg.substr(0, 200)) + ")");
+  }
+  return img;
+}
+
+}  // namespace
+
+namespace {
+
+void check_image(EnvironmentImage& img, const std::string& lead) {
+  if (img.width <= 0 || img.height <= 0) throw Error(lead + "the image is empty");
+  if (uint64_t(img.width) * uint64_t(img.height) > kEnvMaxTexels) throw Error(lead + "the image is too large");
+  if (img.rgb.size() != size_t(img.width) * size_t(img.height) * 3)
+    throw Error(lead + "pixel data does not match the size");
+  static const char* channel[3] = {"R", "G", "B"};
+  auto refuse = [&](size_t t, const char* what) {
+    const size_t px = t / 3;
+    char value[64];
+    std::snprintf(value, sizeof value, "%g", double(img.rgb[t]));
+    throw Error(lead + "pixel (" + std::to_string(px % size_t(img.width)) + ", " + std::to_string(px / size_t(img.width)) +
+                ") (column, row from the top-left) has " + what + channel[t % 3] + " = " + value +
+                "; radiance must be finite and >= 0");
+  };
+  double sum = 0.0;
+  for (size_t t = 0; t < img.rgb.size(); ++t) {
+    if (!std::isfinite(img.rgb[t])) refuse(t, "non-finite ");
+    sum += std::max(0.0f, img.rgb[t]);
+  }
+  // Lossy EXR compression (DWA) leaves tiny negative values, e.g. -2e-4 in images of mean 0.1 to 1:
+  // those down to -kEnvNegativeTolerance x the mean are read as 0, anything below is refused.
+  const double tolerance = kEnvNegativeTolerance * sum / double(img.rgb.size());
+  for (size_t t = 0; t < img.rgb.size(); ++t)
+    if (img.rgb[t] < 0.0f) {
+      if (double(img.rgb[t]) < -tolerance) refuse(t, "negative ");
+      img.rgb[t] = 0.0f;
+    }
+}
+
+}  // namespace
+
+void check_environment_image(EnvironmentImage& img, const std::string& name) {
+  check_image(img, "environment " + printable(name) + ": ");
+}
+
+EnvironmentImage load_environment_image(const std::string& path) {
+  if (path.empty()) throw Error("cannot read environment: no file name given");
+  const std::string ext = lower_extension(path);
+  EnvironmentImage img;
+  if (ext == ".hdr")
+    img = read_hdr(path);
+  else if (ext == ".exr")
+    img = read_exr(path);
+  else
+    fail(path, "unknown extension '" + printable(ext.substr(0, 16)) + "' (an environment is a .hdr or .exr file)");
+  check_image(img, "cannot read environment " + printable(path) + ": ");
+  return img;
+}
+
+}  // namespace pmr

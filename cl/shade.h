@@ -1,9 +1,12 @@
-/* Shading (DESIGN section 4): view-independent Lambert with one directional light, base colour from
- * baseColorFactor * baseColorTexture (sRGB-decoded, bilinear, glTF wrap modes) * COLOR_0. */
+/* Shading (docs/SHADING.md), the one module every path calls: base colour from baseColorFactor *
+ * baseColorTexture (sRGB-decoded, bilinear, glTF wrap modes) * COLOR_0, then either view-independent
+ * Lambert with one directional light, or glTF metallic-roughness (cl/brdf.h) seen from each view's own
+ * camera, lit by the default directional light and the uniform default environment. */
 #ifndef PMR_CL_SHADE_H
 #define PMR_CL_SHADE_H
 
 #include "common.h"
+#include "brdf.h"
 
 inline int wrap_texel(int c, int size, int mode) {
   if ((uint)c < (uint)size) return c; /* inside: every mode leaves it (and skips a division) */
@@ -56,7 +59,40 @@ typedef struct {
   global const PmrTexture* textures;
   global const uchar4* texels;
   global const float* srgb_lut;
+  global const PmrParams* P;
+  global const float* positions;   /* world space, 3 floats per vertex: the surface point (pbr)  */
+  global const float4* eyes;       /* each view's camera position, world space (pbr)            */
+  global const float2* split_sum;  /* PMR_SPLIT_SUM_N^2 (A, B) (see PMR_SPLIT_SUM_N)             */
 } ShadeInputs;
+
+/* The split-sum table's bilinear lookup, as pmr::split_sum (host/shading/environment.cpp) does it. */
+inline float2 split_sum(global const float2* t, float nv, float r) {
+  const int n = PMR_SPLIT_SUM_N;
+  const float x = sqrt(clamp(nv, 0.0f, 1.0f)) * (float)(n - 1), y = clamp(r, 0.0f, 1.0f) * (float)(n - 1);
+  const int x0 = min((int)x, n - 2), y0 = min((int)y, n - 2);
+  const float fx = x - (float)x0, fy = y - (float)y0;
+  const float2 a = t[y0 * n + x0], b = t[y0 * n + x0 + 1], c = t[(y0 + 1) * n + x0], d = t[(y0 + 1) * n + x0 + 1];
+  const float2 top = a + (b - a) * fx, bottom = c + (d - c) * fx;
+  return top + (bottom - top) * fy;
+}
+
+/* glTF metallic-roughness at source barycentrics b of triangle t with shading normal n (back faces
+ * flipped) and base colour c, seen from view `view`'s camera: the default light (E toward `light`) and
+ * the uniform default environment of radiance L, for which I(n) = L and the prefiltered radiance is L. */
+inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, float3 n, float3 base, float3 light,
+                        int view) {
+  global const PmrParams* P = in->P;
+  const PmrMaterial mat = in->materials[t->material];
+  const float3 p = b.x * vload3(t->v[0], in->positions) + b.y * vload3(t->v[1], in->positions) +
+                   b.z * vload3(t->v[2], in->positions);
+  const float3 v = normalize(in->eyes[view + (int)P->view_base].xyz - p);
+  const float metallic = mat.metallic, r = pbr_roughness(mat.roughness);
+  const float3 direct = brdf_cos(base, metallic, r, n, v, light) * P->light_irradiance;
+  const float2 ab = split_sum(in->split_sum, clamp(dot(n, v), 0.0f, 1.0f), r);
+  const float L = P->env_radiance;
+  const float3 ambient = base * (1.0f - metallic) * L + (pbr_f0(base, metallic) * ab.x + ab.y) * L;
+  return direct + ambient;
+}
 
 /* Unlit base colour (RGBA) at source barycentrics b of triangle `tri`. */
 inline float4 base_color(const ShadeInputs* in, uint tri, float3 b) {
@@ -77,8 +113,8 @@ inline float4 base_color(const ShadeInputs* in, uint tri, float3 b) {
   return c;
 }
 
-/* Lit colour; alpha is coverage (1). */
-inline float4 shade(const ShadeInputs* in, float3 light, uint tri, float3 b, bool back) {
+/* Lit colour in view `view` of the pass (the volume's view + P->view_base); alpha is coverage (1). */
+inline float4 shade(const ShadeInputs* in, float3 light, uint tri, float3 b, bool back, int view) {
   const PmrTriangle t = in->tris[tri];
   float3 n;
   if (t.has_normals) {
@@ -90,9 +126,14 @@ inline float4 shade(const ShadeInputs* in, float3 light, uint tri, float3 b, boo
     n = vload3(0, t.face_normal);
   }
   if (back) n = -n;
-  const float lambert = 0.2f + 0.8f * max(0.0f, dot(n, light));
   const float4 c = base_color(in, tri, b);
-  return (float4)(c.x * lambert, c.y * lambert, c.z * lambert, 1.0f);
+  const float exposure = in->P->exposure;
+  if (in->P->shading == PMR_SHADING_PBR) {
+    const float3 rgb = shade_pbr(in, &t, b, n, c.xyz, light, view) * exposure;
+    return (float4)(rgb, 1.0f);
+  }
+  const float lambert = 0.2f + 0.8f * max(0.0f, dot(n, light));
+  return (float4)(c.x * lambert * exposure, c.y * lambert * exposure, c.z * lambert * exposure, 1.0f);
 }
 
 /* alphaMode MASK: the MTA's base colour alpha at raster point (X, Y) of view `view` passes the cutoff
@@ -123,7 +164,7 @@ inline const PmrMta* cached_mta(MtaCache* c, global const PmrMta* mtas, uint id)
 inline float4 shade_mta_at(const ShadeInputs* in, const PmrMta* m, float3 light, long X, long Y, int view) {
   const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, view), m->sign * mta_edge(m, 2, 0, X, Y, view),
                      m->sign * mta_edge(m, 0, 1, X, Y, view)};
-  return shade(in, light, m->tri, source_barycentrics(m, e), (m->flags & PMR_MTA_BACK) != 0);
+  return shade(in, light, m->tri, source_barycentrics(m, e), (m->flags & PMR_MTA_BACK) != 0, view);
 }
 
 #endif

@@ -29,6 +29,8 @@ struct BenchOptions {
   std::vector<int> views = {1, 2, 4, 8, 16, 32, 48, 64, 96};
   std::vector<Method> methods = {Method::Pmr, Method::Multipass, Method::Duplicate};
   std::vector<Sampling> samplings = {Sampling::View};  // subpixel applies to pmr only
+  Shading shading = Shading::Lambert;
+  double exposure_ev = 0.0, environment_intensity = 1.0;
   bool views_given = false;
   int frames = 5;
   std::string csv;
@@ -79,6 +81,12 @@ BenchOptions parse(const std::vector<std::string>& args) {
     } else if (a == "--sampling") {
       o.samplings.clear();
       for (const auto& m : split(value())) o.samplings.push_back(parse_sampling(m));
+    } else if (a == "--shading") {
+      o.shading = parse_shading(value());
+    } else if (a == "--exposure") {
+      o.exposure_ev = parse_exposure(value());
+    } else if (a == "--environment-intensity") {
+      o.environment_intensity = parse_environment_intensity(value());
     } else if (a == "--frames") {
       const std::string v = value();
       o.frames = std::atoi(v.c_str());
@@ -210,6 +218,7 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       PipelineConfig pc;
       pc.method = method;
       pc.sampling = sampling;
+      pc.shading = o.shading, pc.exposure_ev = o.exposure_ev, pc.environment_intensity = o.environment_intensity;
       pc.tile_x = o.tile[0], pc.tile_y = o.tile[1], pc.tile_v = o.tile[2];
       pc.fuse_encode = true;  // the encoded-only job, as pmr render runs it
       Pipeline p(rt, pc);
@@ -271,6 +280,7 @@ std::string bench_help() {
          "Times whole frames (render + encode, no file I/O) per view count and method.\n"
          "  --views LIST        view counts (default 1,2,4,8,16,32,48,64,96)\n"
          "  --method LIST       pmr, multipass, duplicate (default all three)\n"
+         "  --shading S, --exposure EV, --environment-intensity X   as for pmr render (default lambert)\n"
          "  --sampling LIST     view, subpixel (default view; subpixel with pmr only): samples per frame are\n"
          "                      the voxels, or each display subpixel once\n"
          "  --frames K          timed frames per point after one warm-up frame (default 5)\n"

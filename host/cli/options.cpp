@@ -23,6 +23,22 @@ double parse_double(const std::string& text, const std::string& opt) {
   return v;
 }
 
+}  // namespace
+
+double parse_exposure(const std::string& text) {
+  const double ev = parse_double(text, "--exposure");
+  if (ev < -64.0 || ev > 64.0) throw Error("invalid --exposure '" + text + "': expected EV from -64 to 64");
+  return ev;
+}
+
+double parse_environment_intensity(const std::string& text) {
+  const double x = parse_double(text, "--environment-intensity");
+  if (x < 0.0 || x > 1e6) throw Error("invalid --environment-intensity '" + text + "': expected 0 to 1e6");
+  return x;
+}
+
+namespace {
+
 int parse_int(const std::string& text, const std::string& opt, int lo, int hi) {
   char* end = nullptr;
   errno = 0;
@@ -187,6 +203,9 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     else if (a == "--verbose" || a == "-v") o.verbose = true;
     else if (a == "--method") o.pipeline.method = parse_method(value()), o.method_given = true;
     else if (a == "--sampling") o.pipeline.sampling = parse_sampling(value());
+    else if (a == "--shading") o.pipeline.shading = parse_shading(value());
+    else if (a == "--exposure") o.pipeline.exposure_ev = parse_exposure(value());
+    else if (a == "--environment-intensity") o.pipeline.environment_intensity = parse_environment_intensity(value());
     else if (a == "--camera-spacing") {
       const std::string v = value();
       if (v != "linear" && v != "angular") throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
@@ -333,6 +352,14 @@ std::string render_help() {
          "  --sampling S           view (default): the views rendered on their grids, each subpixel reading\n"
          "                         its view's nearest pixel; subpixel: every display subpixel rasterized at\n"
          "                         its own sample in its own view (docs/SAMPLING.md)\n"
+         "shading (docs/SHADING.md):\n"
+         "  --shading S            lambert (default): base colour x (0.2 + 0.8 max(0, n.l)), the same in every\n"
+         "                         view; pbr: glTF metallic-roughness seen from each view's own camera, lit by\n"
+         "                         a directional light and a uniform environment (so far: base colour,\n"
+         "                         metallic and roughness factors; textures beyond base colour, scene lights\n"
+         "                         and environment images are not read yet)\n"
+         "  --exposure EV          the colour times 2^EV, either model (default 0)\n"
+         "  --environment-intensity X  pbr: scales the uniform environment of radiance 0.2 (0 turns it off)\n"
          "  --verbose              per-stage device times and queue sizes\n"
          "Environment: PMR_DEVICE=substring selects the OpenCL device by name (default: first CPU device).\n";
 }

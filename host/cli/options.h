@@ -9,6 +9,10 @@
 
 namespace pmr {
 
+// --exposure EV and --environment-intensity X, checked (shared by render and bench).
+double parse_exposure(const std::string& text);
+double parse_environment_intensity(const std::string& text);
+
 struct RenderOptions {
   std::string scene;            // empty = the bundled default scene
   std::string out_dir = "out";

@@ -63,6 +63,16 @@ json matrix_json(const glm::dmat4& m) {
 
 json vec3_json(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }
 
+// The shading model and its light as used (docs/SHADING.md). Sidecars written before --shading existed
+// have none: they were lambert at exposure 0.
+json shading_json(const SidecarInfo& info) {
+  json s = {{"model", info.shading}, {"exposure_ev", info.exposure_ev}};
+  if (info.shading == "pbr")
+    s["environment"] = {{"kind", "uniform"}, {"radiance", 0.2 * info.environment_intensity},
+                        {"intensity", info.environment_intensity}};
+  return s;
+}
+
 double degrees(double rad) { return rad * (180.0 / glm::pi<double>()); }
 
 }  // namespace
@@ -87,6 +97,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["frame"] = info.frame;
   j["method"] = info.method;
   j["sampling"] = info.sampling;
+  j["shading"] = shading_json(info);
   j["tile"] = {{"x", info.tile_x}, {"y", info.tile_y}, {"v", info.tile_v}};
   j["camera"] = info.camera;
   if (info.has_bounds)
@@ -241,6 +252,10 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   // sidecars written before --sampling existed sampled the views
   auto sampling = [&](const json& o) { return get(o, "sampling").is_null() ? json("view") : get(o, "sampling"); };
   if (sampling(a) != sampling(b)) return "sampling";
+  auto shading = [&](const json& o) {
+    return get(o, "shading").is_null() ? json({{"model", "lambert"}, {"exposure_ev", 0.0}}) : get(o, "shading");
+  };
+  if (shading(a) != shading(b)) return "shading";
   // the rig as configured (an animated camera moves the focal plane from frame to frame)
   const json ra = get(a, "rig"), rb = get(b, "rig");
   if (!ra.is_object()) return "rig";

@@ -1,10 +1,13 @@
 #include "pipeline/pipeline.h"
 
 #include "pipeline/tile_tables.h"
+#include "shading/environment.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+
+#include <glm/gtc/constants.hpp>
 
 #include "pmr/error.h"
 
@@ -71,6 +74,7 @@ struct Pipeline::Impl {
   // scene
   uint32_t num_vertices = 0, num_triangles = 0;
   ClBuffer positions, attrs, tris, materials, textures, texels, lut;
+  ClBuffer eyes, split_sum;  // each view's camera position (per frame); the pbr split-sum table
   // frame
   PmrParams params{};
   PmrEncodeParams encode_params{};
@@ -177,6 +181,14 @@ Sampling parse_sampling(const std::string& name) {
 
 const char* to_string(Sampling s) { return s == Sampling::Subpixel ? "subpixel" : "view"; }
 
+Shading parse_shading(const std::string& name) {
+  if (name == "lambert") return Shading::Lambert;
+  if (name == "pbr") return Shading::Pbr;
+  throw Error("unknown shading '" + name + "' (expected lambert or pbr)");
+}
+
+const char* to_string(Shading s) { return s == Shading::Pbr ? "pbr" : "lambert"; }
+
 void check_subpixel_sampling(Method method, const Display& display) {
   if (method != Method::Pmr) throw Error("--sampling subpixel renders with --method pmr");
   if (display.bilinear || display.blend_views)
@@ -217,6 +229,12 @@ Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
   const auto lut = srgb_lut();
   m.lut = runtime.buffer(bytes_of(lut), "sRGB table", CL_MEM_READ_ONLY);
   runtime.write(m.lut, lut.data(), bytes_of(lut));
+  // the split-sum table (pbr only: computing it costs about 0.5 s of CPU once per process)
+  static_assert(kEnvSplitSumSize == PMR_SPLIT_SUM_N, "the kernels' split-sum table size");
+  const std::vector<float> none(2, 0.0f);
+  const std::vector<float>& table = config.shading == Shading::Pbr ? split_sum_table() : none;
+  m.split_sum = runtime.buffer(bytes_of(table), "split-sum table", CL_MEM_READ_ONLY);
+  runtime.write(m.split_sum, table.data(), bytes_of(table));
 }
 
 Pipeline::~Pipeline() = default;
@@ -444,7 +462,7 @@ void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
 }
 
 void Pipeline::Impl::fine_stage(Events& ev) {
-  k_fine.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, volume,
+  k_fine.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, volume,
               dbg_key, dbg_depth, dbg_count);
   ev.add(kFine, launch(k_fine, size_t(num_tiles), kFineGroup));
 }
@@ -539,7 +557,7 @@ void Pipeline::Impl::straddle_alpha_stage(ClKernel& k, Events& ev) {
 
 void Pipeline::Impl::subpixel_stage(Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
-  k_fine_subpixel.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut,
+  k_fine_subpixel.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum,
                        encode_buf, column_a, column_b, encode_rows, sample_x, sample_y, chunks, warming ? 0u : num_chunks,
                        straddle_slot, straddle_slots,
                        straddle_cov, display, cl_uint(subpixel_debug), dbg_key, dbg_depth);
@@ -549,7 +567,7 @@ void Pipeline::Impl::subpixel_stage(Events& ev) {
 
 void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
-  k_fine_encode.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut,
+  k_fine_encode.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum,
                      encode_buf, column_soa, encode_rows, column_start, row_start, straddle_slot, straddle_slots,
                      straddle_cov, display);
   const size_t screen_tiles = size_t(P.tiles_x) * P.tiles_y;
@@ -575,6 +593,16 @@ StageTimes Pipeline::render(const Rig& rig) {
   P.debug_outputs = config_.debug_outputs ? 1u : 0u;
   P.setup_mode = config_.method == Method::Duplicate ? PMR_SETUP_DUPLICATE : PMR_SETUP_MTA;
   P.sample_area = m.subpixel ? PMR_SAMPLES_PIXEL : PMR_SAMPLES_CENTER;
+  P.shading = config_.shading == Shading::Pbr ? PMR_SHADING_PBR : PMR_SHADING_LAMBERT;
+  P.exposure = float(std::exp2(config_.exposure_ev));
+  P.env_radiance = float(0.2 * config_.environment_intensity);
+  P.light_irradiance = float(0.8 * glm::pi<double>());
+  {  // each view's camera position in world space (the view vector of pbr; the camera may move)
+    std::vector<glm::vec4> eyes(size_t(rig.views));
+    for (int i = 0; i < rig.views; ++i) eyes[size_t(i)] = glm::vec4(glm::vec3(glm::inverse(rig.view_matrix(i))[3]), 1.0f);
+    if (m.eyes.size() != bytes_of(eyes)) m.eyes = m.rt.buffer(bytes_of(eyes), "camera positions", CL_MEM_READ_ONLY);
+    m.rt.write(m.eyes, eyes.data(), bytes_of(eyes));
+  }
   if (m.warming) P.num_vertices = P.num_triangles = 0, P.tiles_x = P.tiles_y = P.tiles_v = 0;  // an empty frame
 
   if (config_.method != Method::Multipass) {
@@ -663,7 +691,7 @@ size_t Pipeline::device_bytes() const {
                             &m.encode_buf, &m.vertices, &m.pmr_vertices, &m.mtas, &m.mta_counter, &m.tile_counts,
                             &m.tile_offsets, &m.tile_queue, &m.volume, &m.display, &m.encode_columns, &m.encode_rows, &m.dbg_key, &m.dbg_depth, &m.dbg_count,
                             &m.column_start, &m.column_soa, &m.row_start, &m.straddle_slot, &m.straddle_columns, &m.straddle_cov,
-                            &m.chunks, &m.sample_x, &m.sample_y, &m.column_a, &m.column_b})
+                            &m.chunks, &m.sample_x, &m.sample_y, &m.column_a, &m.column_b, &m.eyes, &m.split_sum})
     total += b->get() ? b->size() : 0;
   return total;
 }

@@ -36,6 +36,14 @@ const char* to_string(Sampling s);
 // a scene.
 void check_subpixel_sampling(Method method, const Display& display);
 
+// How winners are shaded (docs/SHADING.md).
+enum class Shading {
+  Lambert,  // view-independent: base colour x (0.2 + 0.8 max(0, n.l)), one directional light
+  Pbr,      // glTF metallic-roughness seen from each view's camera
+};
+Shading parse_shading(const std::string& name);  // "lambert", "pbr"
+const char* to_string(Shading s);
+
 struct PipelineConfig {
   Method method = Method::Pmr;
   // PMR: the 3D tile (voxels over x, y, view) of one fine work-group. The single-view baselines use
@@ -54,6 +62,9 @@ struct PipelineConfig {
   // fuse_encode is off (a product needs them); debug outputs are per voxel of those views, or without
   // them per display subpixel ([row][3 * column + k]).
   Sampling sampling = Sampling::View;
+  Shading shading = Shading::Lambert;
+  double exposure_ev = 0.0;            // colour x 2^EV, either model
+  double environment_intensity = 1.0;  // pbr: scales the uniform default environment (radiance 0.2)
 };
 
 struct StageTimes {  // milliseconds

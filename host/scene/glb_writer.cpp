@@ -63,8 +63,8 @@ void save_glb(const Scene& scene, const std::string& path) {
     const PmrMaterial& mat = scene.materials[m];
     json jm = {{"pbrMetallicRoughness",
                 {{"baseColorFactor", {mat.base_color[0], mat.base_color[1], mat.base_color[2], mat.base_color[3]}},
-                 {"metallicFactor", 0.0},
-                 {"roughnessFactor", 0.5}}},
+                 {"metallicFactor", mat.metallic},
+                 {"roughnessFactor", mat.roughness}}},
                {"doubleSided", mat.double_sided != 0}};
     if (mat.alpha_mode == PMR_ALPHA_MASK) jm["alphaMode"] = "MASK", jm["alphaCutoff"] = mat.alpha_cutoff;
     if (mat.alpha_mode == PMR_ALPHA_BLEND) jm["alphaMode"] = "BLEND";

@@ -13,6 +13,8 @@ PmrMaterial default_material() {
   m.alpha_mode = PMR_ALPHA_OPAQUE;
   m.alpha_cutoff = 0.5f;
   m.double_sided = 0;
+  m.metallic = 1.0f;  // glTF's defaults
+  m.roughness = 1.0f;
   return m;
 }
 

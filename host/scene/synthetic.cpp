@@ -15,6 +15,7 @@ Scene make_synthetic_scene(size_t triangles, uint32_t seed) {
   const size_t spheres = std::max<size_t>(1, (triangles + per_sphere / 2) / per_sphere);
   Scene s;
   s.materials.push_back(default_material());
+  s.materials[0].metallic = 0.0f, s.materials[0].roughness = 0.5f;  // painted plastic under --shading pbr
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   // radius shrinks with the count so that the spheres keep a similar total screen coverage
@@ -118,6 +119,7 @@ Scene make_objects_scene(size_t triangles, uint32_t seed) {
   std::uniform_real_distribution<float> u(0.0f, 1.0f);
   for (size_t k = 0; k < objects; ++k) {
     PmrMaterial m = default_material();
+    m.metallic = 0.0f, m.roughness = 0.5f;  // painted plastic under --shading pbr
     m.base_color[0] = 0.15f + 0.85f * u(rng), m.base_color[1] = 0.15f + 0.85f * u(rng), m.base_color[2] = 0.15f + 0.85f * u(rng);
     m.double_sided = 1;
     const uint32_t material = uint32_t(s.materials.size());

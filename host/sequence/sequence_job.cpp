@@ -99,6 +99,9 @@ int run_sequence(const RenderOptions& o) {
   info.tile_v = o.pipeline.tile_v;
   info.method = to_string(o.pipeline.method);
   info.sampling = to_string(o.pipeline.sampling);
+  info.shading = to_string(o.pipeline.shading);
+  info.exposure_ev = o.pipeline.exposure_ev;
+  info.environment_intensity = o.pipeline.environment_intensity;
   info.camera = o.rig.camera;
   info.has_bounds = true;
   info.bounds_lo = renderer.bounds_lo();

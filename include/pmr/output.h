@@ -120,6 +120,9 @@ struct SidecarInfo {
   int frame = 0;
   std::string method = "pmr";   // "pmr" or the baseline's name
   std::string sampling = "view";  // "view" or "subpixel" (docs/SAMPLING.md)
+  std::string shading = "lambert";  // "lambert" or "pbr" (docs/SHADING.md)
+  double exposure_ev = 0.0;
+  double environment_intensity = 1.0;  // pbr: scales the uniform environment
   int tile_x = 16, tile_y = 2, tile_v = 16;
   int camera = -1;              // glTF camera index, -1 = the default framing of the bounding sphere
   bool has_bounds = false;      // world bounds of the scene the default framing used

@@ -83,6 +83,14 @@ typedef int64_t pmr_i64;
 /* PmrParams.sample_area: where the samples of a raster pixel lie, for the tile raster's conservative
  * tests. --sampling view samples pixel centers; --sampling subpixel samples each display subpixel at
  * its own position, anywhere in [px, px + 1) x [py, py + 1) of its view's raster. */
+/* PmrParams.shading (docs/SHADING.md): view-independent Lambert, or glTF metallic-roughness. */
+#define PMR_SHADING_LAMBERT 0u
+#define PMR_SHADING_PBR 1u
+
+/* The split-sum table of --shading pbr (host/shading/environment.h): (A, B) pairs, node (i, j) at
+ * cos(n, v) = (i / (N - 1))^2 and roughness j / (N - 1), stored at j * N + i. */
+#define PMR_SPLIT_SUM_N 64
+
 #define PMR_SAMPLES_CENTER 0u
 #define PMR_SAMPLES_PIXEL 1u
 
@@ -108,6 +116,10 @@ typedef struct {
   pmr_u32 view_base;      /* volume slice of local view 0 (multipass renders one view a pass) */
   pmr_u32 setup_mode;     /* PMR_SETUP_MTA or PMR_SETUP_DUPLICATE                            */
   pmr_u32 sample_area;    /* PMR_SAMPLES_CENTER or PMR_SAMPLES_PIXEL                          */
+  pmr_u32 shading;        /* PMR_SHADING_LAMBERT or PMR_SHADING_PBR                           */
+  float exposure;         /* 2^EV: scales the colour of either model                          */
+  float env_radiance;     /* pbr: radiance of the uniform default environment (0.2 x intensity) */
+  float light_irradiance; /* pbr: irradiance E of the default directional light (0.8 pi)       */
   pmr_u32 pad_params;
 } PmrParams;
 
@@ -161,6 +173,8 @@ typedef struct {
   pmr_i32 alpha_mode;     /* PMR_ALPHA_*                                                     */
   float alpha_cutoff;
   pmr_u32 double_sided;
+  float metallic;         /* metallicFactor (pbr)                                             */
+  float roughness;        /* roughnessFactor (pbr; clamped to [0.03, 1] when shading)          */
 } PmrMaterial;
 
 typedef struct {

@@ -289,6 +289,47 @@ TEST_F(SceneMaterialsTest, FileTangentsFollowNodesMorphsMirrorsAndTheTurntable) 
   EXPECT_EQ(fresh.tangents, s.tangents);
 }
 
+// A skinned mesh's tangents take the blended joint matrix (not the node's): a joint mirrored by
+// scale (-1, 1, 1) gives (-1, 0, 0) with w = -1; its animated 90 degree turn about +Z then (0, -1, 0).
+TEST_F(SceneMaterialsTest, SkinnedTangentsFollowTheJointMatrices) {
+  GltfFile g;
+  const Quad q = quad(g);
+  const int tan = g.data<float>({1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1}, kFloat, "VEC4");
+  const int joints = g.data<uint8_t>(std::vector<uint8_t>(16, 0), kUByte, "VEC4");
+  const int weights = g.data<float>({1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}, kFloat, "VEC4");
+  g.add("images", {{"uri", png_uri(kPixel)}});
+  g.add("textures", {{"source", 0}});
+  g.add("materials", {{"normalTexture", {{"index", 0}}}});
+  g.mesh(json::array({{{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}, {"TANGENT", tan},
+                                       {"JOINTS_0", joints}, {"WEIGHTS_0", weights}}},
+                       {"indices", q.idx},
+                       {"material", 0}}}));
+  g.add("nodes", {{"mesh", 0}, {"skin", 0}, {"translation", {5, 0, 0}}});  // ignored: skinned
+  g.add("nodes", {{"scale", {-1, 1, 1}}});
+  g.add("skins", {{"joints", {1}}});
+  g.scene({0, 1});
+  const double h = std::sqrt(0.5);
+  const int times = g.data<float>({0.0f, 1.0f}, kFloat, "SCALAR");
+  const int turns = g.data<float>({0, 0, 0, 1, 0, 0, float(h), float(h)}, kFloat, "VEC4");
+  g.doc["animations"] = {{{"samplers", {{{"input", times}, {"output", turns}}}},
+                          {"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "rotation"}}}}}}}};
+  const Scene s = load_scene(g.write(dir_, "skinned"));
+  ASSERT_EQ(s.tangents.size(), 4u);
+  for (const glm::vec4& t : s.tangents) {
+    EXPECT_VEC_NEAR(glm::vec3(t), glm::vec3(-1, 0, 0), 1e-6);
+    EXPECT_EQ(t.w, -1.0f);
+  }
+  PoseRequest r;
+  r.animation = 0;
+  r.time = 1.0;
+  Scene p;
+  pose_scene(s, r, p);
+  for (const glm::vec4& t : p.tangents) {
+    EXPECT_VEC_NEAR(glm::vec3(t), glm::vec3(0, -1, 0), 1e-6);
+    EXPECT_EQ(t.w, -1.0f);
+  }
+}
+
 // Generated tangents: u along +x gives t = +x; mirroring u or v flips what it must.
 TEST_F(SceneMaterialsTest, GeneratedTangentsFollowTheUvDirections) {
   GltfFile g;

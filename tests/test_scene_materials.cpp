@@ -450,6 +450,16 @@ TEST_F(SceneMaterialsTest, LightsMoveWithTheirNodesAnimationAndTheTurntable) {
   EXPECT_EQ(p.lights[0].position, s.lights[0].position);
 }
 
+// A light on a node scaled to zero (hidden) has no direction: it loads, shining along -Z, with a warning.
+TEST_F(SceneMaterialsTest, ALightOnAZeroScaleNodeWarns) {
+  GltfFile g = lights_file();
+  g.doc["nodes"][3]["scale"] = {0, 0, 0};
+  const Scene s = load_scene(g.write(dir_, "hidden"));
+  ASSERT_EQ(s.lights.size(), 4u);
+  EXPECT_EQ(s.lights[1].direction, glm::dvec3(0, 0, -1));
+  EXPECT_EQ(warnings_with(s, "node 3 places a light with a degenerate matrix"), 1u) << all_warnings(s);
+}
+
 struct LightCase {
   const char* name;
   std::function<void(json&)> edit;  // on the document of lights_file()

@@ -470,8 +470,8 @@ std::vector<Instance> walk(Loader& L, const std::vector<int>& roots) {
       l.position = glm::dvec3(world[3]);
       const glm::dvec3 dir = -glm::dvec3(world[2]);
       const double len = glm::length(dir);
-      if (!(len > 0.0) || !std::isfinite(len)) fail(L.file, "node " + std::to_string(index) + " places a light but its matrix has no -Z direction");
-      l.direction = dir / len;
+      if (len > 0.0 && std::isfinite(len)) l.direction = dir / len;
+      else L.warn("node " + std::to_string(index) + " places a light with a degenerate matrix (zero scale?): shining along -Z");
       L.scene.lights.push_back(l);
       L.motion->light_node.push_back(index);
     }

@@ -589,6 +589,7 @@ TEST_F(SceneMaterialsTest, InfoListsLightsAndMaterialFeatures) {
                       {"emissiveFactor", {1, 0.5, 0.25}},
                       {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}},
                                       {"KHR_materials_unlit", json::object()}}}});
+  g.doc["asset"]["generator"] = "Exporter\x1b[2J";
   const std::string path = g.write(dir_, "info");
   const test::CliRun r = test::run("info '" + path + "'");
   ASSERT_EQ(r.status, 0) << r.output;
@@ -599,7 +600,7 @@ TEST_F(SceneMaterialsTest, InfoListsLightsAndMaterialFeatures) {
         "1 'Shiny\\x1b[31m': alpha MASK (cutoff 0.5), double sided, unlit",
         "metallic 1, roughness 1, emissive (1, 0.5, 0.25) x strength 4",
         "metallic-roughness (texture 0 2x1, linear, set 1, transform offset (0.5, 0) rotation 0 scale (1, 1))",
-        "0 (default): alpha OPAQUE, single sided"})
+        "0 (default): alpha OPAQUE, single sided", "(generator: Exporter\\x1b[2J)"})
     EXPECT_NE(r.output.find(part), std::string::npos) << part << "\n" << r.output;
   EXPECT_EQ(r.output.find('\x1b'), std::string::npos) << "names are printed sanitized";
 }

@@ -92,7 +92,7 @@ void describe_lights(const Scene& s) {
 void describe_scene(const std::string& path) {
   const Scene s = load_scene(path);
   const SceneStructure& d = s.structure;
-  std::printf("scene: %s%s\n", path.c_str(), d.generator.empty() ? "" : (" (generator: " + d.generator + ")").c_str());
+  std::printf("scene: %s%s\n", path.c_str(), d.generator.empty() ? "" : (" (generator: " + printable_text(d.generator, 120) + ")").c_str());
   std::printf("triangles: %zu, vertices: %zu (%zu mesh instance(s) of %zu mesh(es), %zu primitive(s), %zu node(s))\n",
               s.triangles.size(), s.positions.size(), d.mesh_instances, d.meshes, d.primitives, d.nodes);
   size_t textured = 0;

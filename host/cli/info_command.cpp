@@ -6,25 +6,104 @@
 #include "pmr/error.h"
 #include "pmr/scene.h"
 #include "runtime/cl_runtime.h"
+#include "sequence/frame_files.h"
 #include "sequence/frame_renderer.h"
 
 namespace pmr {
 
 namespace {
 
-std::string quoted(const std::string& name) { return name.empty() ? "(unnamed)" : "'" + name + "'"; }
+// Names come from the file: control and non-ASCII bytes are escaped, long names cut.
+std::string quoted(const std::string& name) { return name.empty() ? "(unnamed)" : "'" + printable_text(name, 80) + "'"; }
+
+// %g, with rounding noise below 1e-12 (a direction's zero component) printed as 0.
+std::string number(double v) {
+  if (std::abs(v) < 1e-12) v = 0.0;
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// "normal (set 1, transform offset (0, 1) rotation 1.571 scale (0.5, 0.5))"
+std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
+  static const char* const short_names[kTextureSlots] = {"base colour", "metallic-roughness", "normal", "occlusion",
+                                                         "emissive"};
+  std::string t = std::string(short_names[kind]) + " (texture " + std::to_string(slot.texture);
+  if (slot.texture >= 0 && size_t(slot.texture) < s.textures.size())
+    t += " " + std::to_string(s.textures[size_t(slot.texture)].width) + "x" + std::to_string(s.textures[size_t(slot.texture)].height);
+  t += std::string(slot.srgb ? ", sRGB" : ", linear") + ", set " + std::to_string(slot.texcoord);
+  if (slot.transform)
+    t += ", transform offset (" + number(slot.offset[0]) + ", " + number(slot.offset[1]) + ") rotation " +
+         number(slot.rotation) + " scale (" + number(slot.scale[0]) + ", " + number(slot.scale[1]) + ")";
+  return t + ")";
+}
+
+void describe_materials(const Scene& s) {
+  for (size_t i = 0; i < s.materials.size(); ++i) {
+    const PmrMaterial& m = s.materials[i];
+    const SceneMaterialInputs in = i < s.material_inputs.size() ? s.material_inputs[i] : SceneMaterialInputs{};
+    std::string line = "  " + std::to_string(i) + " " + (i == 0 ? std::string("(default)") : quoted(in.name)) + ": ";
+    line += m.alpha_mode == PMR_ALPHA_MASK ? "alpha MASK (cutoff " + number(m.alpha_cutoff) + ")"
+            : m.alpha_mode == PMR_ALPHA_BLEND ? std::string("alpha BLEND")
+                                              : std::string("alpha OPAQUE");
+    line += m.double_sided ? ", double sided" : ", single sided";
+    if (in.unlit) line += ", unlit";
+    line += ", base (" + number(m.base_color[0]) + ", " + number(m.base_color[1]) + ", " + number(m.base_color[2]) + ", " +
+            number(m.base_color[3]) + ")";
+    line += ", metallic " + number(in.metallic) + ", roughness " + number(in.roughness);
+    if (in.emissive[0] > 0 || in.emissive[1] > 0 || in.emissive[2] > 0 || in.slots[kSlotEmissive].texture >= 0)
+      line += ", emissive (" + number(in.emissive[0]) + ", " + number(in.emissive[1]) + ", " + number(in.emissive[2]) +
+              ") x strength " + number(in.emissive_strength);
+    if (in.slots[kSlotNormal].texture >= 0) line += ", normal scale " + number(in.normal_scale);
+    if (in.slots[kSlotOcclusion].texture >= 0) line += ", occlusion strength " + number(in.occlusion_strength);
+    std::printf("%s\n", line.c_str());
+    for (int k = 0; k < kTextureSlots; ++k)
+      if (in.slots[size_t(k)].texture >= 0) std::printf("      %s\n", slot_text(s, in.slots[size_t(k)], k).c_str());
+    if (!in.unimplemented.empty()) {
+      std::string list;
+      for (const std::string& e : in.unimplemented) list += (list.empty() ? "" : ", ") + printable_text(e, 80);
+      std::printf("      not drawn: %s\n", list.c_str());
+    }
+  }
+}
+
+void describe_lights(const Scene& s) {
+  std::printf("lights: %zu%s\n", s.lights.size(), s.lights.empty() ? "" : " (KHR_lights_punctual, rest pose, world space)");
+  for (size_t i = 0; i < s.lights.size(); ++i) {
+    const SceneLight& l = s.lights[i];
+    const char* type = l.type == SceneLightType::Directional ? "directional" : l.type == SceneLightType::Point ? "point" : "spot";
+    std::string line = "  " + std::to_string(i) + " " + quoted(l.name) + " (light " + std::to_string(l.light) + "): " + type +
+                       ", node " + std::to_string(l.node) + " " + quoted(l.node_name) + ", color (" + number(l.color[0]) +
+                       ", " + number(l.color[1]) + ", " + number(l.color[2]) + "), intensity " + number(l.intensity) +
+                       (l.type == SceneLightType::Directional ? " lux" : " cd");
+    if (l.type != SceneLightType::Directional) line += l.range > 0 ? ", range " + number(l.range) : ", no range";
+    if (l.type == SceneLightType::Spot)
+      line += ", cones inner " + number(l.inner_cone * 180.0 / 3.14159265358979323846) + " deg outer " +
+              number(l.outer_cone * 180.0 / 3.14159265358979323846) + " deg";
+    if (l.type != SceneLightType::Directional)
+      line += ", at (" + number(l.position.x) + ", " + number(l.position.y) + ", " + number(l.position.z) + ")";
+    if (l.type != SceneLightType::Point)
+      line += ", toward (" + number(l.direction.x) + ", " + number(l.direction.y) + ", " + number(l.direction.z) + ")";
+    std::printf("%s\n", line.c_str());
+  }
+}
 
 // What a user needs to pick --camera and --animation, and to see what the loader made of the file.
 void describe_scene(const std::string& path) {
   const Scene s = load_scene(path);
   const SceneStructure& d = s.structure;
-  std::printf("scene: %s%s\n", path.c_str(), d.generator.empty() ? "" : (" (generator: " + d.generator + ")").c_str());
+  std::printf("scene: %s%s\n", path.c_str(), d.generator.empty() ? "" : (" (generator: " + printable_text(d.generator, 120) + ")").c_str());
   std::printf("triangles: %zu, vertices: %zu (%zu mesh instance(s) of %zu mesh(es), %zu primitive(s), %zu node(s))\n",
               s.triangles.size(), s.positions.size(), d.mesh_instances, d.meshes, d.primitives, d.nodes);
   size_t textured = 0;
   for (const PmrMaterial& m : s.materials) textured += m.texture >= 0;
   std::printf("materials: %zu (with the default one; %zu textured), textures: %zu\n", s.materials.size(), textured,
               s.textures.size());
+  describe_materials(s);
+  if (d.generated_tangent_primitives)
+    std::printf("tangents: generated for %zu primitive(s) with a normal texture and no TANGENT\n",
+                d.generated_tangent_primitives);
+  describe_lights(s);
   std::printf("cameras: %zu\n", s.cameras.size());
   for (size_t i = 0; i < s.cameras.size(); ++i) {
     const SceneCamera& c = s.cameras[i];
@@ -75,8 +154,9 @@ int run_info(const std::vector<std::string>& args) {
   if (args.size() > 1) throw Error("pmr info takes at most one scene file");
   if (args.size() == 1 && (args[0] == "-h" || args[0] == "--help")) {
     std::printf("usage: pmr info            list OpenCL platforms and devices\n"
-                "       pmr info SCENE      what a glTF scene holds: triangles, materials, cameras, animations,\n"
-                "                           skins, morph targets, bounds, and the loader's warnings\n");
+                "       pmr info SCENE      what a glTF scene holds: triangles, materials and their textures,\n"
+                "                           lights, cameras, animations, skins, morph targets, bounds, and the\n"
+                "                           loader's warnings\n");
     return 0;
   }
   if (args.size() == 1) {

@@ -37,6 +37,8 @@ const Rule kPosition{"POSITION", 1u << 3,
                          combo(kUByte, true) | combo(kShort, false) | combo(kShort, true) |
                          combo(kUShort, false) | combo(kUShort, true)};
 const Rule kNormal{"NORMAL", 1u << 3, combo(kFloat, false) | combo(kByte, true) | combo(kShort, true)};
+// TANGENT: xyz unit, w the handedness (+-1); KHR_mesh_quantization adds normalized byte and short.
+const Rule kTangent{"TANGENT", 1u << 4, combo(kFloat, false) | combo(kByte, true) | combo(kShort, true)};
 const Rule kTexcoord{"TEXCOORD", 1u << 2,
                      combo(kFloat, false) | combo(kUByte, true) | combo(kUShort, true) | combo(kByte, false) |
                          combo(kByte, true) | combo(kUByte, false) | combo(kShort, false) |
@@ -223,6 +225,7 @@ const Rule& rule_for(Semantic semantic) {
   switch (semantic) {
     case Semantic::Position: return kPosition;
     case Semantic::Normal: return kNormal;
+    case Semantic::Tangent: return kTangent;
     case Semantic::Texcoord: return kTexcoord;
     case Semantic::Color: return kColor;
     case Semantic::KeyTimes: return kKeyTimes;

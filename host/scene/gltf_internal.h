@@ -42,13 +42,24 @@ struct SourceFile {
   std::vector<unsigned char> bytes;     // the whole file (a GLB is cut to the length its header gives)
   bool glb = false;                     // detected by the magic bytes, not by the extension
   std::string base_dir;                 // directory relative URIs are resolved against
-  std::set<int> base_color_images;      // images some material uses as baseColorTexture
+  std::set<int> sampled_images;         // images some material slot samples (base colour, metallic-
+                                        // roughness, normal, occlusion, emissive): decoded and read
   std::string checksum;                 // of `bytes` as read from disk (before a GLB is cut)
   // External files only unused images name (resolved like tinygltf does): never read
   std::set<std::string> unused_image_files;
-  std::vector<std::string> ignored_extensions;  // in extensionsUsed, not required, not implemented
+  std::vector<std::string> ignored_extensions;  // in extensionsUsed, not implemented (the material
+                                                // extensions of material_extension_fallback excepted)
+  // KHR_lights_punctual, validated: the file's lights (position and direction unset) and per node
+  // the light it places (-1 = none).
+  std::vector<SceneLight> lights;
+  std::vector<int> node_light;
 };
 SourceFile read_source(const std::string& path);
+
+// For a material extension the renderer does not implement but can draw without (its appearance
+// changes, nothing else): what is drawn instead, e.g. "drawn opaque, without transmission". nullptr
+// for any other extension.
+const char* material_extension_fallback(const std::string& name);
 
 // A member of a JSON object, nullptr when absent or when `object` is not an object.
 const nlohmann::json* member(const nlohmann::json& object, const char* key);
@@ -90,7 +101,7 @@ std::vector<bool> moving_nodes(const SceneMotion& motion);
 // ---- gltf_accessors.cpp ----------------------------------------------------------------------------
 
 enum class Semantic {
-  Position, Normal, Texcoord, Color, Indices, KeyTimes, AnimationOutput, Joints, Weights, InverseBind, MorphDelta
+  Position, Normal, Tangent, Texcoord, Color, Indices, KeyTimes, AnimationOutput, Joints, Weights, InverseBind, MorphDelta
 };
 
 // One vertex attribute, decoded to float (normalized integers mapped per the glTF spec), sparse

@@ -3,10 +3,12 @@
 // Order of work: read_source() checks the file and its JSON before tinygltf parses it (so that Draco,
 // unknown required extensions, truncated GLBs and missing buffers get clear messages), tinygltf parses,
 // validate_model() checks every reference the walk follows, then the default scene is walked and each
-// mesh instance is emitted with its node's world matrix. Only base-colour images are decoded.
+// mesh instance is emitted with its node's world matrix. Only images some implemented material slot
+// samples are decoded (base colour, metallic-roughness, normal, occlusion, emissive).
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -120,7 +122,7 @@ void load_model(const std::string& path, const SourceFile& src, tinygltf::Model&
   fs.prefix = src.base_dir.back() == '/' ? src.base_dir : src.base_dir + "/";
   fs.skip = &src.unused_image_files;
   images.model = &model;
-  images.wanted = &src.base_color_images;
+  images.wanted = &src.sampled_images;
   tinygltf::TinyGLTF loader;
   loader.SetFsCallbacks({&fs_exists, &fs_expand, &fs_read, &fs_write, &fs});
   loader.SetImageLoader(&load_image, &images);
@@ -155,8 +157,9 @@ struct UvTransform {
 };
 
 struct MaterialUv {
-  int set = 0;  // TEXCOORD_n of the base colour texture
+  int set = 0;  // TEXCOORD_n of the texture
   UvTransform transform;
+  float offset[2] = {0, 0}, rotation = 0, scale[2] = {1, 1};  // the extension's values (when active)
 };
 
 struct Loader {
@@ -168,10 +171,16 @@ struct Loader {
   const ImageContext& images;
   Scene& scene;
   std::set<std::string> seen;
-  std::vector<MaterialUv> material_uv;   // per glTF material
+  std::vector<MaterialUv> material_uv;   // per glTF material: its base colour texture's set and transform
+  std::vector<std::array<int, kTextureSlots>> slot_sets;  // per glTF material and slot: TEXCOORD set, -1 = no texture
+  int texcoord_sets = 0;                 // 1 + the highest set any slot samples
   std::map<int, int> scene_texture_of;   // glTF texture -> Scene::textures index (-1: unusable)
+  std::map<std::array<int, 3>, int> scene_texture_of_image;  // (image, wrap s, wrap t) -> Scene::textures
+  const std::vector<SceneLight>* light_defs = nullptr;  // SourceFile::lights
+  const std::vector<int>* node_light = nullptr;         // SourceFile::node_light
   std::set<int> used_materials;          // glTF materials of emitted primitives
   size_t point_line_primitives = 0, skipped_triangles = 0, nonfinite_attributes = 0, leftover_indices = 0;
+  size_t generated_tangents = 0;         // primitives
   std::shared_ptr<SceneMotion> motion;   // always built; kept in the scene when a clip moves something
   std::vector<glm::dmat4> rest_world;     // per node
   std::vector<std::vector<glm::dmat4>> rest_joints;  // per skin: joint matrices at rest
@@ -193,13 +202,16 @@ bool finite_numbers(const tinygltf::Value& v, size_t n, double* out) {
   return true;
 }
 
-MaterialUv material_uv(Loader& L, const tinygltf::TextureInfo& info, int material) {
+// `slot_name` is "" for the base colour texture (its messages predate the other slots).
+MaterialUv material_uv(Loader& L, int texcoord, const tinygltf::ExtensionMap& extensions, int material,
+                       const std::string& slot_name = "") {
   MaterialUv uv;
-  uv.set = info.texCoord;
-  auto ext = info.extensions.find("KHR_texture_transform");
-  if (ext == info.extensions.end()) return uv;
+  uv.set = texcoord;
+  auto ext = extensions.find("KHR_texture_transform");
+  if (ext == extensions.end()) return uv;
   const tinygltf::Value& t = ext->second;
-  const std::string name = "material " + std::to_string(material) + " KHR_texture_transform";
+  const std::string name = "material " + std::to_string(material) + (slot_name.empty() ? "" : " " + slot_name) +
+                           " KHR_texture_transform";
   if (!t.IsObject()) {
     L.warn(name + " is not an object; ignored");
     return uv;
@@ -223,6 +235,9 @@ MaterialUv material_uv(Loader& L, const tinygltf::TextureInfo& info, int materia
   }
   const double c = std::cos(rotation), s = std::sin(rotation);
   uv.transform = {true, c * scale[0], s * scale[1], -s * scale[0], c * scale[1], offset[0], offset[1]};
+  uv.offset[0] = float(offset[0]), uv.offset[1] = float(offset[1]);
+  uv.rotation = float(rotation);
+  uv.scale[0] = float(scale[0]), uv.scale[1] = float(scale[1]);
   return uv;
 }
 
@@ -269,9 +284,15 @@ int wrap_mode(Loader& L, int mode, int sampler) {
   return PMR_WRAP_REPEAT;
 }
 
-int scene_texture(Loader& L, int texture) {
+// The Scene::textures index of a glTF texture, decoding its image on first use; -1 when unusable (with
+// a warning). One image sampled with the same wrap modes is stored once, whichever textures and slots
+// name it.
+int scene_texture(Loader& L, int texture, int slot) {
   auto cached = L.scene_texture_of.find(texture);
-  if (cached != L.scene_texture_of.end()) return cached->second;
+  if (cached != L.scene_texture_of.end()) {
+    if (cached->second >= 0) L.scene.textures[size_t(cached->second)].slots |= 1u << slot;
+    return cached->second;
+  }
   int& result = L.scene_texture_of[texture] = -1;
   const tinygltf::Texture& t = L.model.textures[size_t(texture)];
   const std::string name = "texture " + std::to_string(texture);
@@ -301,14 +322,102 @@ int scene_texture(Loader& L, int texture) {
     st.wrap_s = wrap_mode(L, s.wrapS, t.sampler);
     st.wrap_t = wrap_mode(L, s.wrapT, t.sampler);
   }
+  const std::array<int, 3> key = {t.source, st.wrap_s, st.wrap_t};
+  auto same = L.scene_texture_of_image.find(key);
+  if (same != L.scene_texture_of_image.end()) {
+    L.scene.textures[size_t(same->second)].slots |= 1u << slot;
+    return result = same->second;
+  }
+  st.slots = 1u << slot;
   L.scene.textures.push_back(std::move(st));
-  return result = int(L.scene.textures.size() - 1);
+  result = int(L.scene.textures.size() - 1);
+  L.scene_texture_of_image[key] = result;
+  return result;
+}
+
+// A number property of a material, checked finite and within [lo, hi] (clamped, with a warning).
+float material_number(Loader& L, double value, double fallback, double lo, double hi, const std::string& what) {
+  if (!std::isfinite(value)) {
+    L.warn(what + " is not finite; using " + one_line(std::to_string(fallback)));
+    return float(fallback);
+  }
+  if (value < lo || value > hi) {
+    const double clamped = std::min(hi, std::max(lo, value));
+    L.warn(what + " is outside [" + std::to_string(lo).substr(0, 3) + ", " +
+           (std::isfinite(hi) ? std::to_string(hi).substr(0, 3) : std::string("inf")) + "]; clamped");
+    return float(clamped);
+  }
+  return float(value);
+}
+
+// The PBR inputs of glTF material i (DESIGN 4b). Records each slot's TEXCOORD set in L.slot_sets.
+SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int i) {
+  const std::string name = "material " + std::to_string(i);
+  SceneMaterialInputs m;
+  m.name = g.name;
+  const double inf = std::numeric_limits<double>::infinity();
+  m.metallic = material_number(L, g.pbrMetallicRoughness.metallicFactor, 1.0, 0.0, 1.0, name + " metallicFactor");
+  m.roughness = material_number(L, g.pbrMetallicRoughness.roughnessFactor, 1.0, 0.0, 1.0, name + " roughnessFactor");
+  m.normal_scale = material_number(L, g.normalTexture.scale, 1.0, -inf, inf, name + " normalTexture.scale");
+  m.occlusion_strength = material_number(L, g.occlusionTexture.strength, 1.0, 0.0, 1.0, name + " occlusionTexture.strength");
+  if (g.emissiveFactor.size() == 3)
+    for (int c = 0; c < 3; ++c)
+      m.emissive[c] = material_number(L, g.emissiveFactor[size_t(c)], 0.0, 0.0, 1.0, name + " emissiveFactor");
+  for (const auto& [ext, value] : g.extensions) {
+    if (ext == "KHR_materials_emissive_strength") {
+      const tinygltf::Value* v = value.IsObject() && value.Has("emissiveStrength") ? &value.Get("emissiveStrength") : nullptr;
+      if (v && v->IsNumber())
+        m.emissive_strength = material_number(L, v->GetNumberAsDouble(), 1.0, 0.0, inf, name + " emissiveStrength");
+      else if (v || !value.IsObject())
+        L.warn(name + " KHR_materials_emissive_strength has no valid emissiveStrength; using 1");
+    } else if (ext == "KHR_materials_unlit") {
+      m.unlit = true;
+    } else if (material_extension_fallback(ext)) {
+      m.unimplemented.push_back(ext);
+    }
+  }
+  struct Info {
+    int index, texcoord;
+    const tinygltf::ExtensionMap* extensions;
+  };
+  const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
+  const Info infos[kTextureSlots] = {
+      {pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, &pbr.baseColorTexture.extensions},
+      {pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, &pbr.metallicRoughnessTexture.extensions},
+      {g.normalTexture.index, g.normalTexture.texCoord, &g.normalTexture.extensions},
+      {g.occlusionTexture.index, g.occlusionTexture.texCoord, &g.occlusionTexture.extensions},
+      {g.emissiveTexture.index, g.emissiveTexture.texCoord, &g.emissiveTexture.extensions}};
+  std::array<int, kTextureSlots> sets;
+  for (int slot = 0; slot < kTextureSlots; ++slot) {
+    SceneTextureSlot& out = m.slots[size_t(slot)];
+    out.srgb = slot == kSlotBaseColor || slot == kSlotEmissive;
+    sets[size_t(slot)] = -1;
+    const Info& info = infos[slot];
+    if (info.index < 0) continue;
+    // The base colour slot's transform was read (and warned about) by build_materials already.
+    const MaterialUv uv = slot == kSlotBaseColor ? L.material_uv[size_t(i)]
+                                                 : material_uv(L, info.texcoord, *info.extensions, i, texture_slot_name(slot));
+    out.texcoord = uv.set;
+    out.transform = uv.transform.active;
+    if (out.transform) {
+      out.offset[0] = uv.offset[0], out.offset[1] = uv.offset[1];
+      out.rotation = uv.rotation;
+      out.scale[0] = uv.scale[0], out.scale[1] = uv.scale[1];
+    }
+    out.texture = slot == kSlotBaseColor ? L.scene.materials.back().texture : scene_texture(L, info.index, slot);
+    sets[size_t(slot)] = uv.set;
+    L.texcoord_sets = std::max(L.texcoord_sets, uv.set + 1);
+  }
+  L.slot_sets.push_back(sets);
+  return m;
 }
 
 
 // Scene::materials[0] is the default material; glTF material i is Scene::materials[i + 1].
 void build_materials(Loader& L) {
   L.scene.materials.push_back(default_material());
+  L.scene.material_inputs.emplace_back();
+  L.scene.material_inputs[0].slots[kSlotBaseColor].srgb = L.scene.material_inputs[0].slots[kSlotEmissive].srgb = true;
   for (size_t i = 0; i < L.model.materials.size(); ++i) {
     const tinygltf::Material& g = L.model.materials[i];
     const std::string name = "material " + std::to_string(i);
@@ -331,9 +440,10 @@ void build_materials(Loader& L) {
     if (std::isfinite(rough) && rough >= 0.0 && rough <= 1.0) m.roughness = float(rough);
     else L.warn(name + " has an invalid roughnessFactor; using 1");
     const tinygltf::TextureInfo& info = g.pbrMetallicRoughness.baseColorTexture;
-    L.material_uv.push_back(material_uv(L, info, int(i)));
-    if (info.index >= 0) m.texture = scene_texture(L, info.index);
+    L.material_uv.push_back(material_uv(L, info.texCoord, info.extensions, int(i)));
+    if (info.index >= 0) m.texture = scene_texture(L, info.index, kSlotBaseColor);
     L.scene.materials.push_back(m);
+    L.scene.material_inputs.push_back(material_inputs(L, g, int(i)));
   }
 }
 
@@ -358,6 +468,18 @@ std::vector<Instance> walk(Loader& L, const std::vector<int>& roots) {
       for (int r = 0; r < 4; ++r)
         if (!std::isfinite(world[c][r])) fail(L.file, "node " + std::to_string(index) + " has a world matrix that overflows");
     if (node.mesh >= 0) instances.push_back({node.mesh, index});
+    if (const int light = (*L.node_light)[size_t(index)]; light >= 0) {
+      SceneLight l = (*L.light_defs)[size_t(light)];
+      l.node = index;
+      l.node_name = node.name;
+      l.position = glm::dvec3(world[3]);
+      const glm::dvec3 dir = -glm::dvec3(world[2]);
+      const double len = glm::length(dir);
+      if (len > 0.0 && std::isfinite(len)) l.direction = dir / len;
+      else L.warn("node " + std::to_string(index) + " places a light with a degenerate matrix (zero scale?): shining along -Z");
+      L.scene.lights.push_back(l);
+      L.motion->light_node.push_back(index);
+    }
     if (node.camera >= 0 && !L.scene.cameras[size_t(node.camera)].placed) {
       L.scene.cameras[size_t(node.camera)].placed = true;
       L.scene.cameras[size_t(node.camera)].world_from_camera = world;
@@ -384,6 +506,7 @@ size_t walk_count(const Loader& L, const std::vector<int>& roots) {
 struct Decoded {
   std::shared_ptr<DeformSource> geo;     // positions, normals, morph targets, joints and weights
   std::vector<float> uv, col;            // empty when the attribute is absent
+  std::vector<std::vector<float>> sets;  // TEXCOORD_k as stored, for the sets its material samples (else empty)
   std::vector<uint32_t> tris;            // 3 local vertex indices per triangle, as authored (CCW front)
   uint32_t material = 0;                 // Scene::materials index
 };
@@ -457,6 +580,26 @@ Decoded decode_primitive(Loader& L, int mesh, int index) {
       }
     geo.joints = std::move(j), geo.weights = std::move(w), geo.influences = k;
   }
+  // Every set a texture slot of the material samples, untransformed (Scene::texcoords); each must exist.
+  d.sets.resize(size_t(L.texcoord_sets));
+  int normal_set = -1;
+  if (p.material >= 0) {
+    const std::array<int, kTextureSlots>& sets = L.slot_sets[size_t(p.material)];
+    for (int slot = 0; slot < kTextureSlots; ++slot) {
+      const int k = sets[size_t(slot)];
+      if (k < 0 || !d.sets[size_t(k)].empty()) continue;
+      d.sets[size_t(k)] = read("TEXCOORD_" + std::to_string(k), Semantic::Texcoord);
+      if (d.sets[size_t(k)].empty()) {
+        const std::string& mesh_name = L.model.meshes[size_t(mesh)].name;
+        const std::string& mat_name = L.model.materials[size_t(p.material)].name;
+        fail(L.file, "material " + std::to_string(p.material) + (mat_name.empty() ? "" : " '" + one_line(mat_name, true) + "'") +
+                         " " + texture_slot_name(slot) + " samples TEXCOORD_" + std::to_string(k) + ", which mesh " +
+                         std::to_string(mesh) + (mesh_name.empty() ? "" : " '" + one_line(mesh_name, true) + "'") +
+                         " primitive " + std::to_string(index) + " does not have");
+      }
+    }
+    normal_set = sets[kSlotNormal];
+  }
   const MaterialUv uv = p.material >= 0 ? L.material_uv[size_t(p.material)] : MaterialUv{};
   d.uv = read("TEXCOORD_" + std::to_string(uv.set), Semantic::Texcoord);
   if (uv.transform.active) {
@@ -494,6 +637,19 @@ Decoded decode_primitive(Loader& L, int mesh, int index) {
     d.tris.insert(d.tris.end(), t, t + 3);
   }
   if (mode == TINYGLTF_MODE_TRIANGLES && n % 3 != 0) ++L.leftover_indices;
+  // Tangents where a normal texture needs them: the file's (morphed by its TANGENT targets), else
+  // generated from the normal texture's UV set at the rest shape.
+  if (normal_set >= 0) {
+    geo.tan = read("TANGENT", Semantic::Tangent);
+    if (!geo.tan.empty()) {
+      for (size_t k = 0; k < p.targets.size(); ++k)
+        geo.target_tan.push_back(read_from(p.targets[k], "TANGENT", Semantic::MorphDelta,
+                                           "TANGENT of " + where + " morph target " + std::to_string(k)));
+    } else {
+      geo.tan = generate_tangents(geo.pos, geo.nrm, d.sets[size_t(normal_set)], d.tris);
+      ++L.generated_tangents;
+    }
+  }
   return d;
 }
 
@@ -525,8 +681,21 @@ void emit(Loader& L, const Decoded& d, const Instance& inst) {
   s.positions.resize(base + geo.vertices);
   s.attributes.resize(base + geo.vertices);
   std::vector<uint8_t> bad_position(geo.vertices, 0), bad_normal(geo.vertices, 0);
+  if (!geo.tan.empty() || !s.tangents.empty()) s.tangents.resize(s.positions.size(), glm::vec4(0.0f));
   deform(geo, L.motion->nodes[size_t(inst.node)].weights, skin >= 0 ? L.rest_joints[size_t(skin)].data() : nullptr,
-         world, &s.positions[base], &s.attributes[base], bad_position.data(), bad_normal.data());
+         world, &s.positions[base], &s.attributes[base], bad_position.data(), bad_normal.data(),
+         geo.tan.empty() ? nullptr : &s.tangents[base]);
+  s.texcoords.resize(size_t(L.texcoord_sets));
+  for (size_t k = 0; k < s.texcoords.size(); ++k) {
+    std::vector<glm::vec2>& set = s.texcoords[k];
+    set.resize(s.positions.size(), glm::vec2(0.0f));
+    if (k >= d.sets.size() || d.sets[k].empty()) continue;
+    for (size_t v = 0; v < geo.vertices; ++v) {
+      glm::vec2 t(d.sets[k][2 * v], d.sets[k][2 * v + 1]);
+      if (!std::isfinite(t.x) || !std::isfinite(t.y)) t = glm::vec2(0.0f), ++L.nonfinite_attributes;
+      set[base + v] = t;
+    }
+  }
   for (size_t v = 0; v < geo.vertices; ++v) {
     PmrVertexAttr& a = s.attributes[base + v];
     for (int c = 0; c < 2; ++c) {
@@ -689,6 +858,13 @@ void summary_warnings(Loader& L, const SourceFile& src) {
   if (L.skipped_triangles)
     L.warn(std::to_string(L.skipped_triangles) + " triangle(s) with non-finite vertex positions skipped");
   if (L.nonfinite_attributes) L.warn("non-finite texture coordinates or colours replaced by defaults");
+  // One line per material extension the renderer does not implement, over the materials drawn.
+  std::map<std::string, size_t> unimplemented;
+  for (int m : L.used_materials)
+    for (const std::string& ext : L.scene.material_inputs[size_t(m) + 1].unimplemented) ++unimplemented[ext];
+  for (const auto& [ext, count] : unimplemented)
+    L.warn(ext + " (" + std::to_string(count) + (count == 1 ? " material" : " materials") + "): " +
+           material_extension_fallback(ext));
   std::vector<std::string> blend;
   for (int m : L.used_materials)
     if (L.model.materials[size_t(m)].alphaMode == "BLEND") blend.push_back(std::to_string(m));
@@ -710,6 +886,7 @@ void describe_structure(Loader& L, const std::vector<int>& roots) {
   }
   for (const tinygltf::Skin& skin : L.model.skins) d.skin_joints.push_back(skin.joints.size());
   d.generator = L.model.asset.generator;
+  d.generated_tangent_primitives = L.generated_tangents;
 }
 
 }  // namespace
@@ -725,6 +902,8 @@ Scene load_scene(const std::string& path) {
 
   Scene scene;
   Loader L(model, path, images, scene);
+  L.light_defs = &src.lights;
+  L.node_light = &src.node_light;
   L.motion = read_motion(model, parent, path);
   L.rest_world = world_matrices(*L.motion, rest_local_matrices(*L.motion));
   for (const MotionSkin& skin : L.motion->skins) L.rest_joints.push_back(joint_matrices(skin, L.rest_world));
@@ -737,6 +916,8 @@ Scene load_scene(const std::string& path) {
   build_cameras(L);
   emit_instances(L, walk(L, roots));
   check_cameras(L);
+  if (!scene.tangents.empty()) scene.tangents.resize(scene.positions.size(), glm::vec4(0.0f));
+  for (std::vector<glm::vec2>& set : scene.texcoords) set.resize(scene.positions.size(), glm::vec2(0.0f));
   summary_warnings(L, src);
   if (scene.triangles.empty())
     L.warn("the scene has no triangles to render: every frame will be a transparent image");

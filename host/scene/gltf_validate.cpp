@@ -36,10 +36,12 @@ namespace {
 // million levels deep would overflow the stack. Real glTF nests less than ten levels.
 constexpr int kMaxJsonDepth = 128;
 
-// Required extensions we implement. KHR_mesh_quantization only widens the component types the generic
-// accessor reader already accepts; KHR_texture_transform is applied to the stored UVs.
+// Extensions we implement. KHR_mesh_quantization only widens the component types the generic accessor
+// reader already accepts; KHR_texture_transform is applied per texture slot; the material and light
+// extensions are read into the scene (DESIGN 4b).
 bool extension_supported(const std::string& name) {
-  return name == "KHR_mesh_quantization" || name == "KHR_texture_transform";
+  return name == "KHR_mesh_quantization" || name == "KHR_texture_transform" || name == "KHR_lights_punctual" ||
+         name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit";
 }
 
 uint32_t read_u32le(const unsigned char* p) {
@@ -137,15 +139,101 @@ void check_extensions(const std::string& path, const json& doc, SourceFile& src)
       const std::string name = e.get<std::string>();
       if (name == "KHR_draco_mesh_compression")
         fail(path, "requires KHR_draco_mesh_compression (Draco-compressed meshes), which this renderer does not support");
-      if (!extension_supported(name))
+      // A material extension only changes how a surface looks: drawn without it, with one warning
+      // per extension (the loader's), even when required.
+      if (!extension_supported(name) && !material_extension_fallback(name))
         fail(path, "requires extension " + name + ", which this renderer does not support");
     }
   }
   if (const json* used = member(doc, "extensionsUsed")) {
     if (!used->is_array()) return;
     for (const json& e : *used)
-      if (e.is_string() && !extension_supported(e.get<std::string>()))
+      if (e.is_string() && !extension_supported(e.get<std::string>()) && !material_extension_fallback(e.get<std::string>()))
         src.ignored_extensions.push_back(e.get<std::string>());
+  }
+}
+
+// KHR_lights_punctual on the raw JSON: tinygltf reads an absent range as 0 and coerces odd values, so
+// the checks that matter for lighting (DESIGN 4b) are made here, each a one-line error.
+void read_lights(const std::string& path, const json& doc, SourceFile& src) {
+  const json* nodes = member(doc, "nodes");
+  const size_t node_count = nodes && nodes->is_array() ? nodes->size() : 0;
+  src.node_light.assign(node_count, -1);
+  const json* ext = member(doc, "extensions");
+  const json* khr = ext ? member(*ext, "KHR_lights_punctual") : nullptr;
+  const json* lights = khr ? member(*khr, "lights") : nullptr;
+  if (khr && (!khr->is_object() || (lights && !lights->is_array())))
+    fail(path, "KHR_lights_punctual: lights is not an array");
+  const double pi = 3.14159265358979323846;
+  if (lights) {
+    for (size_t i = 0; i < lights->size(); ++i) {
+      const json& l = (*lights)[i];
+      SceneLight out;
+      out.light = int(i);
+      const json* name = member(l, "name");
+      if (name && name->is_string()) out.name = name->get<std::string>();
+      const std::string where = "KHR_lights_punctual light " + std::to_string(i) +
+                                (out.name.empty() ? std::string() : " '" + one_line(out.name, true) + "'");
+      if (!l.is_object()) fail(path, where + " is not an object");
+      auto number = [&](const json& parent, const char* key, double fallback) {
+        const json* v = member(parent, key);
+        if (!v) return fallback;
+        if (!v->is_number()) fail(path, where + " " + key + " is not a number");
+        const double d = v->get<double>();
+        if (!std::isfinite(d)) fail(path, where + " " + key + " is not finite");
+        return d;
+      };
+      const json* type = member(l, "type");
+      const std::string t = type && type->is_string() ? type->get<std::string>() : std::string();
+      if (t == "directional") out.type = SceneLightType::Directional;
+      else if (t == "point") out.type = SceneLightType::Point;
+      else if (t == "spot") out.type = SceneLightType::Spot;
+      else if (!type) fail(path, where + " has no type");
+      else fail(path, where + " has unknown type " + (type->is_string() ? "'" + one_line(t, true) + "'" : std::string("(not a string)")) +
+                          " (directional, point or spot expected)");
+      if (const json* color = member(l, "color")) {
+        if (!color->is_array() || color->size() != 3) fail(path, where + " color is not an array of 3 numbers");
+        for (size_t c = 0; c < 3; ++c) {
+          const json& v = (*color)[c];
+          if (!v.is_number() || !std::isfinite(v.get<double>())) fail(path, where + " color has a non-finite or non-numeric value");
+          if (v.get<double>() < 0.0) fail(path, where + " color has a negative value (" + v.dump() + ")");
+          out.color[c] = float(v.get<double>());
+        }
+      }
+      const double intensity = number(l, "intensity", 1.0);
+      if (intensity < 0.0) fail(path, where + " has a negative intensity (" + member(l, "intensity")->dump() + ")");
+      out.intensity = float(intensity);
+      if (member(l, "range")) {
+        const double range = number(l, "range", 0.0);
+        if (!(range > 0.0)) fail(path, where + " range must be positive (is " + member(l, "range")->dump() + ")");
+        out.range = float(range);
+      }
+      if (out.type == SceneLightType::Spot) {
+        const json* spot = member(l, "spot");
+        if (spot && !spot->is_object()) fail(path, where + " spot is not an object");
+        const json empty = json::object();
+        const double inner = number(spot ? *spot : empty, "innerConeAngle", 0.0);
+        const double outer = number(spot ? *spot : empty, "outerConeAngle", pi / 4.0);
+        if (!(inner >= 0.0 && inner < outer && outer <= pi / 2.0))
+          fail(path, where + " spot cone angles must satisfy 0 <= innerConeAngle < outerConeAngle <= pi/2 (inner " +
+                         std::to_string(inner) + ", outer " + std::to_string(outer) + ")");
+        out.inner_cone = float(inner), out.outer_cone = float(outer);
+      }
+      src.lights.push_back(out);
+    }
+  }
+  for (size_t n = 0; n < node_count; ++n) {
+    const json* next = member((*nodes)[n], "extensions");
+    const json* use = next ? member(*next, "KHR_lights_punctual") : nullptr;
+    if (!use) continue;
+    const std::string where = "node " + std::to_string(n) + " KHR_lights_punctual";
+    const json* light = member(*use, "light");
+    if (!light || !light->is_number_integer()) fail(path, where + " has no integer light index");
+    const int64_t index = json_index(light);
+    if (index < 0 || size_t(index) >= src.lights.size())
+      fail(path, where + " refers to light " + light->dump() + ", which does not exist (the file has " +
+                     std::to_string(src.lights.size()) + ")");
+    src.node_light[n] = int(index);
   }
 }
 
@@ -187,19 +275,25 @@ void check_buffers(const std::string& path, const json& doc, const SourceFile& s
   }
 }
 
-// Only images used as a base colour are decoded; normal, ORM and other maps are never sampled.
-std::set<int> base_color_images(const json& doc) {
+// Only images some implemented material slot samples are decoded (and read): base colour,
+// metallic-roughness, normal, occlusion, emissive. Images of unimplemented extensions (clear coat,
+// transmission, ...) never are.
+std::set<int> sampled_images(const json& doc) {
   std::set<int> images;
   const json* materials = member(doc, "materials");
   const json* textures = member(doc, "textures");
   if (!materials || !materials->is_array() || !textures || !textures->is_array()) return images;
   for (const json& m : *materials) {
     const json* pbr = member(m, "pbrMetallicRoughness");
-    const json* info = pbr ? member(*pbr, "baseColorTexture") : nullptr;
-    const int64_t t = json_index(info ? member(*info, "index") : nullptr);
-    if (t < 0 || size_t(t) >= textures->size()) continue;
-    const int64_t image = json_index(member((*textures)[size_t(t)], "source"));
-    if (image >= 0) images.insert(int(image));
+    const json* infos[] = {pbr ? member(*pbr, "baseColorTexture") : nullptr,
+                           pbr ? member(*pbr, "metallicRoughnessTexture") : nullptr, member(m, "normalTexture"),
+                           member(m, "occlusionTexture"), member(m, "emissiveTexture")};
+    for (const json* info : infos) {
+      const int64_t t = json_index(info ? member(*info, "index") : nullptr);
+      if (t < 0 || size_t(t) >= textures->size()) continue;
+      const int64_t image = json_index(member((*textures)[size_t(t)], "source"));
+      if (image >= 0) images.insert(int(image));
+    }
   }
   return images;
 }
@@ -234,6 +328,24 @@ std::string base_dir_of(const std::string& path) {
 }
 
 }  // namespace
+
+const char* material_extension_fallback(const std::string& name) {
+  static const std::pair<const char*, const char*> table[] = {
+      {"KHR_materials_transmission", "drawn opaque, without transmission"},
+      {"KHR_materials_volume", "drawn as thin surfaces, without volume absorption"},
+      {"KHR_materials_clearcoat", "drawn without the clear coat layer"},
+      {"KHR_materials_sheen", "drawn without sheen"},
+      {"KHR_materials_specular", "drawn with the default specular (F0 0.04, white)"},
+      {"KHR_materials_ior", "drawn with the default index of refraction 1.5 (F0 0.04)"},
+      {"KHR_materials_iridescence", "drawn without iridescence"},
+      {"KHR_materials_anisotropy", "drawn with isotropic highlights"},
+      {"KHR_materials_pbrSpecularGlossiness",
+       "drawn from their metallic-roughness properties (the defaults where absent), not specular-glossiness"},
+  };
+  for (const auto& [ext, fallback] : table)
+    if (name == ext) return fallback;
+  return nullptr;
+}
 
 const json* member(const json& object, const char* key) {
   if (!object.is_object()) return nullptr;
@@ -296,8 +408,9 @@ SourceFile read_source(const std::string& path) {
   check_schema(path, doc);
   check_extensions(path, doc, src);
   check_buffers(path, doc, src, bin_length);
-  src.base_color_images = base_color_images(doc);
-  src.unused_image_files = unused_image_files(doc, src.base_dir, src.base_color_images);
+  read_lights(path, doc, src);
+  src.sampled_images = sampled_images(doc);
+  src.unused_image_files = unused_image_files(doc, src.base_dir, src.sampled_images);
   return src;
 }
 
@@ -349,11 +462,19 @@ void check_meshes(const tinygltf::Model& m, const std::string& file) {
 
 void check_materials(const tinygltf::Model& m, const std::string& file) {
   for (size_t i = 0; i < m.materials.size(); ++i) {
-    const tinygltf::TextureInfo& info = m.materials[i].pbrMetallicRoughness.baseColorTexture;
-    const std::string name = "material " + std::to_string(i) + " baseColorTexture";
-    if (info.index != -1 && !in_range(info.index, m.textures))
-      fail(file, ref_error(name, "texture", info.index, m.textures.size()));
-    if (info.texCoord < 0) fail(file, name + " has a negative texCoord");
+    const tinygltf::Material& mat = m.materials[i];
+    const std::pair<int, int> infos[] = {
+        {mat.pbrMetallicRoughness.baseColorTexture.index, mat.pbrMetallicRoughness.baseColorTexture.texCoord},
+        {mat.pbrMetallicRoughness.metallicRoughnessTexture.index, mat.pbrMetallicRoughness.metallicRoughnessTexture.texCoord},
+        {mat.normalTexture.index, mat.normalTexture.texCoord},
+        {mat.occlusionTexture.index, mat.occlusionTexture.texCoord},
+        {mat.emissiveTexture.index, mat.emissiveTexture.texCoord}};
+    for (int slot = 0; slot < kTextureSlots; ++slot) {
+      const std::string name = "material " + std::to_string(i) + " " + texture_slot_name(slot);
+      const auto [index, texcoord] = infos[slot];
+      if (index != -1 && !in_range(index, m.textures)) fail(file, ref_error(name, "texture", index, m.textures.size()));
+      if (texcoord < 0) fail(file, name + " has a negative texCoord");
+    }
   }
   for (size_t i = 0; i < m.textures.size(); ++i) {
     const tinygltf::Texture& t = m.textures[i];

@@ -90,17 +90,19 @@ void parallel_for(size_t n, size_t grain, const std::function<void(size_t, size_
 
 void deform(const DeformSource& src, const std::vector<float>& morph_weights, const glm::dmat4* joints,
             const glm::dmat4& world, glm::vec3* positions, PmrVertexAttr* attributes, uint8_t* bad_position,
-            uint8_t* bad_normal) {
+            uint8_t* bad_normal, glm::vec4* tangents) {
   // Vertices are independent: split them over the cores (a 100k-vertex skinned, morphed mesh).
   parallel_for(src.vertices, 16384, [&](size_t b, size_t e) {
-    deform_range(src, morph_weights, joints, world, b, e, positions, attributes, bad_position, bad_normal);
+    deform_range(src, morph_weights, joints, world, b, e, positions, attributes, bad_position, bad_normal, tangents);
   });
 }
 
 void deform_range(const DeformSource& src, const std::vector<float>& morph_weights, const glm::dmat4* joints,
                   const glm::dmat4& world, size_t begin, size_t end, glm::vec3* positions, PmrVertexAttr* attributes,
-                  uint8_t* bad_position, uint8_t* bad_normal) {
+                  uint8_t* bad_position, uint8_t* bad_normal, glm::vec4* tangents) {
   const bool has_normals = !src.nrm.empty();
+  const bool has_tangents = tangents && !src.tan.empty();
+  const double world_sign = glm::determinant(glm::dmat3(world)) < 0.0 ? -1.0 : 1.0;
   // Morph targets with a zero weight are skipped (they add nothing), so a mesh at its base shape costs
   // nothing extra.
   std::vector<size_t> targets;
@@ -119,7 +121,15 @@ void deform_range(const DeformSource& src, const std::vector<float>& morph_weigh
       if (has_normals && !src.target_nrm[k].empty())
         n += w * glm::dvec3(src.target_nrm[k][3 * v], src.target_nrm[k][3 * v + 1], src.target_nrm[k][3 * v + 2]);
     }
-    glm::dvec3 wp, wn;
+    glm::dvec3 t(0.0);
+    if (has_tangents) {
+      t = glm::dvec3(src.tan[4 * v], src.tan[4 * v + 1], src.tan[4 * v + 2]);
+      for (size_t k : targets)
+        if (k < src.target_tan.size() && !src.target_tan[k].empty())
+          t += double(morph_weights[k]) * glm::dvec3(src.target_tan[k][3 * v], src.target_tan[k][3 * v + 1], src.target_tan[k][3 * v + 2]);
+    }
+    glm::dvec3 wp, wn, wt;
+    double tangent_sign = world_sign;
     double weight_sum = 0.0;
     glm::dmat4 skin(0.0);
     if (skinned) {
@@ -139,9 +149,13 @@ void deform_range(const DeformSource& src, const std::vector<float>& morph_weigh
       const glm::dvec3 a(skin[0]), b(skin[1]), c(skin[2]);
       const double det = glm::dot(a, glm::cross(b, c));
       wn = (glm::cross(b, c) * n.x + glm::cross(c, a) * n.y + glm::cross(a, b) * n.z) * (det < 0.0 ? -1.0 : 1.0);
+      // Tangents are directions on the surface: they take the matrix itself, like edges do.
+      wt = a * t.x + b * t.y + c * t.z;
+      tangent_sign = det < 0.0 ? -1.0 : 1.0;
     } else {  // rigid (or a skinned vertex without weights: it keeps its node's transform)
       wp = glm::dvec3(world * glm::dvec4(p, 1.0));
       wn = normal_matrix * n;
+      wt = m3 * t;
     }
     glm::vec3 pf(wp);
     const bool bad = !finite(pf);
@@ -152,6 +166,11 @@ void deform_range(const DeformSource& src, const std::vector<float>& morph_weigh
     if (!has_normals)
       for (float& c : attributes[v].normal) c = 0.0f;
     if (bad_normal) bad_normal[v] = !ok;
+    if (has_tangents) {
+      const double len = glm::length(wt);
+      const double w = (src.tan[4 * v + 3] < 0.0f ? -1.0 : 1.0) * tangent_sign;
+      tangents[v] = len > 0.0 && std::isfinite(len) ? glm::vec4(glm::vec3(wt / len), float(w)) : glm::vec4(0.0f, 0.0f, 0.0f, float(w));
+    }
   }
 }
 

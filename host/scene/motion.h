@@ -51,6 +51,8 @@ struct DeformSource {
   size_t vertices = 0;
   std::vector<float> pos, nrm;                            // 3 per vertex; nrm empty when absent
   std::vector<std::vector<float>> target_pos, target_nrm;  // per morph target, 3 per vertex or empty
+  std::vector<float> tan;                                 // 4 per vertex (xyz, w handedness) or empty
+  std::vector<std::vector<float>> target_tan;             // per morph target, 3 per vertex or empty
   int influences = 0;                                     // joint influences per vertex: 0, 4 or 8
   std::vector<uint16_t> joints;                           // influences per vertex (skin joint slots)
   std::vector<float> weights;                             // influences per vertex
@@ -73,6 +75,7 @@ struct SceneMotion {
   std::vector<MotionSkin> skins;
   std::vector<Deformable> deformables;
   std::vector<int> camera_node;  // per scene camera: the node that places it, -1 if none
+  std::vector<int> light_node;   // per Scene::lights entry: the node that places it
 };
 
 // Node transform from its TRS (unit quaternion), T * R * S.
@@ -92,14 +95,28 @@ void parallel_for(size_t n, size_t grain, const std::function<void(size_t, size_
 // Places src's vertices: morph targets with `morph_weights` (may be empty), then the skin's joint
 // matrices if `joints` is not null, else the rigid `world`. Writes positions and unit normals (normal
 // left zero when absent or degenerate, so shading falls back to the face normal). Vertices whose
-// position is not finite are flagged in bad_position (if given) and set to the origin.
+// position is not finite are flagged in bad_position (if given) and set to the origin. With
+// `tangents` (and src.tan) also the tangents: xyz morphed by the TANGENT targets, then by the blended
+// joint matrix's or the world matrix's upper 3x3, normalized (zero when degenerate); w = the sign of
+// src's w times the sign of that matrix's determinant (Scene::tangents).
 void deform(const DeformSource& src, const std::vector<float>& morph_weights, const glm::dmat4* joints,
             const glm::dmat4& world, glm::vec3* positions, PmrVertexAttr* attributes,
-            uint8_t* bad_position = nullptr, uint8_t* bad_normal = nullptr);
+            uint8_t* bad_position = nullptr, uint8_t* bad_normal = nullptr, glm::vec4* tangents = nullptr);
 // The same for vertices [begin, end) only (the output pointers still address vertex 0).
 void deform_range(const DeformSource& src, const std::vector<float>& morph_weights, const glm::dmat4* joints,
                   const glm::dmat4& world, size_t begin, size_t end, glm::vec3* positions, PmrVertexAttr* attributes,
-                  uint8_t* bad_position, uint8_t* bad_normal);
+                  uint8_t* bad_position, uint8_t* bad_normal, glm::vec4* tangents = nullptr);
+
+// Tangents for a mesh without TANGENT, in its own space (DESIGN 4b; MikkTSpace in essence): per
+// triangle the direction of increasing u from the UV derivatives, per corner projected onto the
+// vertex normal's plane and weighted by the corner's angle, summed over the corners that share a
+// position, normal and UV and the same UV orientation (MikkTSpace's welding), normalized. w is +1
+// where the triangles' UVs (with v pointing up, as MikkTSpace sees them) keep their orientation, -1
+// where they mirror it. pos and nrm hold 3 floats per vertex (nrm may be empty: face normals are
+// used), uv 2 per vertex (glTF's convention, v down), tris 3 indices per triangle. Returns 4 floats
+// per vertex; a vertex no triangle gives a direction gets some unit vector orthogonal to its normal.
+std::vector<float> generate_tangents(const std::vector<float>& pos, const std::vector<float>& nrm,
+                                     const std::vector<float>& uv, const std::vector<uint32_t>& tris);
 
 // Unit normal of a triangle, +Z when it has no area.
 glm::vec3 face_normal(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);

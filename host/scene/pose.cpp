@@ -59,7 +59,9 @@ void deform_instances(const Scene& rest, const SceneMotion& m, const PoseRequest
   for (const Deformable& d : m.deformables) {
     const glm::dmat4& w = world[size_t(d.node)];
     const glm::dmat4* jm = d.skin >= 0 ? joints[size_t(d.skin)].data() : nullptr;
-    deform(*d.source, weights[size_t(d.node)], jm, w, &out.positions[d.vertex_begin], &out.attributes[d.vertex_begin]);
+    glm::vec4* tangents = d.source->tan.empty() || out.tangents.empty() ? nullptr : &out.tangents[d.vertex_begin];
+    deform(*d.source, weights[size_t(d.node)], jm, w, &out.positions[d.vertex_begin], &out.attributes[d.vertex_begin],
+           nullptr, nullptr, tangents);
     const bool mirrored = d.skin < 0 && glm::determinant(glm::dmat3(w)) < 0.0;
     parallel_for(d.triangle_end - d.triangle_begin, 32768, [&](size_t b, size_t e) {
       for (size_t t = d.triangle_begin + b; t < d.triangle_begin + e; ++t) {
@@ -73,6 +75,14 @@ void deform_instances(const Scene& rest, const SceneMotion& m, const PoseRequest
   }
   for (size_t c = 0; c < out.cameras.size() && c < m.camera_node.size(); ++c)
     if (m.camera_node[c] >= 0 && out.cameras[c].placed) out.cameras[c].world_from_camera = world[size_t(m.camera_node[c])];
+  // Lights: the node's origin and -Z (a degenerate matrix keeps the rest direction).
+  for (size_t l = 0; l < out.lights.size() && l < m.light_node.size(); ++l) {
+    const glm::dmat4& w = world[size_t(m.light_node[l])];
+    out.lights[l].position = glm::dvec3(w[3]);
+    const glm::dvec3 dir = -glm::dvec3(w[2]);
+    const double len = glm::length(dir);
+    if (len > 0.0 && std::isfinite(len)) out.lights[l].direction = dir / len;
+  }
 }
 
 // Rotation about +Y by `deg` degrees, exact at multiples of 90 (so a quarter turn does not smear
@@ -104,6 +114,12 @@ void turn(const PoseRequest& r, Scene& out) {
     const glm::dvec3 rn = R * glm::dvec3(t.face_normal[0], t.face_normal[1], t.face_normal[2]);
     for (int c = 0; c < 3; ++c) t.face_normal[c] = float(rn[c]);
   }
+  // A rotation keeps handedness: w stays.
+  for (glm::vec4& t : out.tangents) t = glm::vec4(glm::vec3(R * glm::dvec3(t)), t.w);
+  for (SceneLight& l : out.lights) {
+    l.position = R * l.position + shift;
+    l.direction = R * l.direction;
+  }
 }
 
 bool animates(const Scene& rest, const PoseRequest& r) {
@@ -130,12 +146,15 @@ bool pose_scene(const Scene& rest, const PoseRequest& r, Scene& out) {
     throw Error("pose_scene: no animation " + std::to_string(r.animation));
   const bool animated = animates(rest, r);
   // Sizes differ on first use; afterwards only what a pose can change needs resetting.
-  if (out.positions.size() != rest.positions.size() || out.triangles.size() != rest.triangles.size() || r.turntable) {
+  if (out.positions.size() != rest.positions.size() || out.triangles.size() != rest.triangles.size() ||
+      out.tangents.size() != rest.tangents.size() || r.turntable) {
     out.positions = rest.positions;
     out.attributes = rest.attributes;
     out.triangles = rest.triangles;
+    out.tangents = rest.tangents;
   }
   out.cameras = rest.cameras;
+  out.lights = rest.lights;
   if (animated) {
     deform_instances(rest, *rest.motion, r, out);
   } else if (rest.motion) {  // undo an earlier animated pose of the moving instances
@@ -143,6 +162,7 @@ bool pose_scene(const Scene& rest, const PoseRequest& r, Scene& out) {
       const size_t n = d.source->vertices;
       std::copy_n(&rest.positions[d.vertex_begin], n, &out.positions[d.vertex_begin]);
       std::copy_n(&rest.attributes[d.vertex_begin], n, &out.attributes[d.vertex_begin]);
+      if (!rest.tangents.empty()) std::copy_n(&rest.tangents[d.vertex_begin], n, &out.tangents[d.vertex_begin]);
       std::copy(&rest.triangles[d.triangle_begin], &rest.triangles[0] + d.triangle_end, &out.triangles[d.triangle_begin]);
     }
   }

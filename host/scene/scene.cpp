@@ -18,6 +18,12 @@ PmrMaterial default_material() {
   return m;
 }
 
+const char* texture_slot_name(int slot) {
+  static const char* const names[kTextureSlots] = {"baseColorTexture", "metallicRoughnessTexture", "normalTexture",
+                                                   "occlusionTexture", "emissiveTexture"};
+  return slot >= 0 && slot < kTextureSlots ? names[slot] : "?";
+}
+
 bool scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi) {
   glm::dvec3 l(std::numeric_limits<double>::infinity()), h = -l;
   bool any = false;

@@ -13,10 +13,70 @@
 
 namespace pmr {
 
+// An image decoded once for every material slot that samples it with the same wrap modes. The bytes
+// are as stored in the image: colour slots (base colour, emissive) decode them from sRGB, data slots
+// (metallic-roughness, normal, occlusion) read them as linear values (SceneTextureSlot::srgb).
 struct SceneTexture {
   int width = 0, height = 0;
-  std::vector<uint8_t> rgba;  // width * height * 4 bytes, sRGB-encoded colour, row 0 = top of image
+  std::vector<uint8_t> rgba;  // width * height * 4 bytes as stored in the image, row 0 = top of image
   int wrap_s = PMR_WRAP_REPEAT, wrap_t = PMR_WRAP_REPEAT;
+  uint32_t slots = 0;         // bit (1 << SceneTextureSlotKind) for each kind of slot that samples it
+};
+
+// The texture slots of a glTF metallic-roughness material (DESIGN section 4b), in this order.
+enum SceneTextureSlotKind : int {
+  kSlotBaseColor = 0,          // RGBA, sRGB
+  kSlotMetallicRoughness = 1,  // B metallic, G roughness, linear
+  kSlotNormal = 2,             // RGB tangent-space normal, linear
+  kSlotOcclusion = 3,          // R occlusion, linear
+  kSlotEmissive = 4,           // RGB, sRGB
+  kTextureSlots = 5
+};
+const char* texture_slot_name(int slot);  // "baseColorTexture", ... (the glTF property names)
+
+// One textureInfo of a material. texcoord is the TEXCOORD_n set sampled (the KHR_texture_transform
+// texCoord override already applied); the transform maps that set's stored (untransformed) values:
+// u' = sx cos(r) u + sy sin(r) v + ox, v' = -sx sin(r) u + sy cos(r) v + oy.
+struct SceneTextureSlot {
+  int texture = -1;        // index into Scene::textures; -1 = none (absent, or its image is unusable)
+  int texcoord = 0;        // index into Scene::texcoords
+  bool srgb = false;       // true for base colour and emissive
+  bool transform = false;  // KHR_texture_transform present (else the identity)
+  float offset[2] = {0.0f, 0.0f};
+  float rotation = 0.0f;   // radians
+  float scale[2] = {1.0f, 1.0f};
+};
+
+// Everything of a glTF material the physically based model reads (DESIGN 4b), beside the PmrMaterial
+// the Lambert model reads (base colour factor, alpha mode and cutoff, sidedness stay there).
+struct SceneMaterialInputs {
+  std::string name;                      // as in the file ("" when unnamed or the default material)
+  float metallic = 1.0f, roughness = 1.0f;  // metallicFactor, roughnessFactor (validated to [0, 1])
+  float normal_scale = 1.0f;             // normalTexture.scale
+  float occlusion_strength = 1.0f;       // occlusionTexture.strength (validated to [0, 1])
+  float emissive[3] = {0.0f, 0.0f, 0.0f};  // emissiveFactor (linear)
+  float emissive_strength = 1.0f;        // KHR_materials_emissive_strength (1 without it)
+  bool unlit = false;                    // KHR_materials_unlit
+  std::array<SceneTextureSlot, kTextureSlots> slots;  // indexed by SceneTextureSlotKind
+  std::vector<std::string> unimplemented;  // material extensions present but not drawn (warned once per scene)
+};
+
+// A KHR_lights_punctual light placed by one node of the rendered scene (a light used by two nodes is
+// two SceneLights). position and direction are world space; pose_scene moves them with the node's
+// animation and the turntable.
+enum class SceneLightType { Directional, Point, Spot };
+struct SceneLight {
+  std::string name;            // the light's name in the file
+  int light = 0;               // index into the file's KHR_lights_punctual lights
+  int node = 0;                // the node that places it
+  std::string node_name;       // that node's name in the file
+  SceneLightType type = SceneLightType::Directional;
+  float color[3] = {1.0f, 1.0f, 1.0f};  // linear
+  float intensity = 1.0f;      // directional: lux; point and spot: candela
+  float range = 0.0f;          // 0 = not given (no window); point and spot only
+  float inner_cone = 0.0f, outer_cone = 0.7853981634f;  // spot: radians, 0 <= inner < outer <= pi / 2
+  glm::dvec3 position{0.0};    // the node's origin
+  glm::dvec3 direction{0.0, 0.0, -1.0};  // unit, the node's -Z: where the light shines
 };
 
 // A glTF camera, placed by the first node (in scene traversal order) that uses it. Cameras that no
@@ -47,6 +107,7 @@ struct SceneStructure {
   std::vector<size_t> skin_joints;                    // per skin: its joint count
   std::vector<std::pair<int, size_t>> morph_meshes;   // (mesh index, morph target count) per mesh with targets
   std::string generator;                              // asset.generator
+  size_t generated_tangent_primitives = 0;            // primitives with a normal texture and no TANGENT
 };
 
 // A file the loader read besides the scene file itself (an external buffer or a decoded image), with
@@ -62,7 +123,21 @@ struct Scene {
   std::vector<PmrTriangle> triangles;     // CCW front (winding already fixed for mirrored nodes)
   std::vector<PmrMaterial> materials;     // at least one: index 0 may be the glTF default material
                                           // (load_scene: 0 is the default, glTF material i is i + 1)
-  std::vector<SceneTexture> textures;     // referenced by PmrMaterial::texture
+  std::vector<SceneTexture> textures;     // referenced by PmrMaterial::texture and SceneTextureSlot::texture
+  // Physically based inputs (DESIGN 4b). material_inputs is parallel to materials (same index), or
+  // empty (generated scenes: every material has the defaults). texcoords[k] is TEXCOORD_k for every
+  // vertex, as stored in the file (no KHR_texture_transform applied: each slot has its own), for each
+  // set k some material slot samples ((0, 0) for vertices of meshes without it, whose materials do not
+  // sample it). tangents is empty or one per vertex: world-space unit xyz, and w = the file's
+  // handedness times sign(det) of the matrix that placed the vertex (the node's world matrix or the
+  // blended joint matrix), so the world bitangent is w * cross(n, t); xyz = 0 where the vertex has
+  // no tangent (its material has no normal texture). Tangents are the file's, or generated for
+  // meshes with a normal texture and no TANGENT. pose_scene updates tangents and lights; texcoords,
+  // like materials, are read from the rest scene.
+  std::vector<SceneMaterialInputs> material_inputs;
+  std::vector<std::vector<glm::vec2>> texcoords;
+  std::vector<glm::vec4> tangents;
+  std::vector<SceneLight> lights;         // KHR_lights_punctual, in scene traversal order
   std::vector<SceneCamera> cameras;       // one per glTF camera, same order (see SceneCamera::placed)
   std::vector<std::string> warnings;      // non-fatal problems, one line each
   // The arrays above hold the rest pose: no animation applied, default morph weights, skins bound to
@@ -72,7 +147,8 @@ struct Scene {
   SceneStructure structure;  // null when no animation can move anything
   // What the render read (docs/SEQUENCES.md, "What a sidecar records"): the checksum of the scene file
   // (a .glb's whole file, a .gltf's JSON) and of every other file read, sorted by path. data: URIs and
-  // images no material samples as base colour are not files read. Hashed from the loader's own bytes.
+  // images no material slot samples (base colour, metallic-roughness, normal, occlusion, emissive)
+  // are not files read. Hashed from the loader's own bytes.
   std::string source_checksum;
   std::vector<SceneInputFile> input_files;
 };
@@ -88,7 +164,8 @@ struct PoseRequest {
   glm::dvec3 pivot{0.0};
 };
 
-// Writes the posed geometry (positions, attributes, triangles) and cameras of `rest` into `out`.
+// Writes the posed geometry (positions, attributes, triangles, tangents), cameras and lights of `rest`
+// into `out`.
 // `out` starts as anything: its arrays are sized and filled from `rest` on first use and rewritten
 // where the pose differs, so a pose depends only on the request, never on earlier frames. Materials
 // and textures of `out` are left alone. Returns true when some geometry differs from the rest pose's

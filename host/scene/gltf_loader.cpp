@@ -434,16 +434,14 @@ void build_materials(Loader& L) {
     if (std::isfinite(g.alphaCutoff) && g.alphaCutoff >= 0.0) m.alpha_cutoff = float(g.alphaCutoff);
     else L.warn(name + " has an invalid alphaCutoff; using 0.5");
     m.double_sided = g.doubleSided ? 1u : 0u;
-    const double metal = g.pbrMetallicRoughness.metallicFactor, rough = g.pbrMetallicRoughness.roughnessFactor;
-    if (std::isfinite(metal) && metal >= 0.0 && metal <= 1.0) m.metallic = float(metal);
-    else L.warn(name + " has an invalid metallicFactor; using 1");
-    if (std::isfinite(rough) && rough >= 0.0 && rough <= 1.0) m.roughness = float(rough);
-    else L.warn(name + " has an invalid roughnessFactor; using 1");
     const tinygltf::TextureInfo& info = g.pbrMetallicRoughness.baseColorTexture;
     L.material_uv.push_back(material_uv(L, info.texCoord, info.extensions, int(i)));
     if (info.index >= 0) m.texture = scene_texture(L, info.index, kSlotBaseColor);
     L.scene.materials.push_back(m);
     L.scene.material_inputs.push_back(material_inputs(L, g, int(i)));
+    // the factors the kernels read, as material_inputs checked them
+    L.scene.materials.back().metallic = L.scene.material_inputs.back().metallic;
+    L.scene.materials.back().roughness = L.scene.material_inputs.back().roughness;
   }
 }
 

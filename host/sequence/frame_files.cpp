@@ -46,21 +46,6 @@ std::string read_text_file(const std::string& path) {
   return ss.str();
 }
 
-std::string printable_text(const std::string& text, size_t limit) {
-  std::string out;
-  for (unsigned char c : text) {
-    if (out.size() >= limit) return out + "...";
-    if (c < 0x20 || c >= 0x7f || c == '\\') {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    } else {
-      out += char(c);
-    }
-  }
-  return out;
-}
-
 std::string frame_problem(const std::string& sidecar, const std::vector<std::string>& images) {
   std::error_code ec;
   auto name = [](const std::string& p) { return fs::path(p).filename().string(); };

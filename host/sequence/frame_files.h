@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cli/options.h"
+#include "pmr/printable.h"  // printable_text, for names read from sidecars
 #include "pmr/quilt.h"
 
 namespace pmr {
@@ -23,9 +24,5 @@ FramePaths frame_paths(const RenderOptions& o, long frame, const QuiltLayout& qu
 std::string frame_problem(const std::string& sidecar, const std::vector<std::string>& images);
 
 std::string read_text_file(const std::string& path);
-
-// Text taken from a sidecar (a file name, a version), safe to print on a terminal: control characters,
-// DEL, backslashes and bytes outside ASCII as \xNN, at most `limit` characters (then "...").
-std::string printable_text(const std::string& text, size_t limit = 120);
 
 }  // namespace pmr

@@ -20,6 +20,7 @@
 #include <fstream>
 
 #include "pmr/error.h"
+#include "pmr/printable.h"
 #include "shading/environment.h"
 
 #define STB_IMAGE_STATIC
@@ -39,22 +40,8 @@
 namespace pmr {
 namespace {
 
-// A file name safe to print: control characters, DEL, backslashes and non-ASCII bytes as \xNN, at most
-// 160 characters.
-std::string printable(const std::string& text) {
-  std::string out;
-  for (unsigned char c : text) {
-    if (out.size() >= 160) return out + "...";
-    if (c < 0x20 || c >= 0x7f || c == '\\') {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\x%02x", c);
-      out += buf;
-    } else {
-      out += char(c);
-    }
-  }
-  return out;
-}
+// A file name safe to print, at most 160 characters.
+std::string printable(const std::string& text) { return printable_text(text, 160); }
 
 std::string one_line(std::string s) {
   for (char& c : s)

@@ -247,22 +247,27 @@ void Pipeline::set_scene(const Scene& scene) {
                 std::to_string(PMR_MAX_TRIANGLES - 1) + " are supported");
   m.num_vertices = uint32_t(scene.positions.size());
   m.num_triangles = uint32_t(scene.triangles.size());
+  // The kernels sample only base colour textures so far: the data maps the loader also decodes
+  // (metallic-roughness, normal, occlusion, emissive; SceneTexture::slots) keep their table entry,
+  // empty, and are not uploaded. Hand-made scenes (slots 0) upload everything.
+  auto sampled = [](const SceneTexture& t) { return t.slots == 0 || (t.slots & (1u << kSlotBaseColor)) != 0; };
   std::vector<PmrTexture> tex_table;
   size_t total_texels = 0;
   for (const auto& t : scene.textures) {
     PmrTexture d{};
     d.offset = uint32_t(total_texels);
-    d.width = t.width;
-    d.height = t.height;
+    d.width = sampled(t) ? t.width : 0;
+    d.height = sampled(t) ? t.height : 0;
     d.wrap_s = t.wrap_s;
     d.wrap_t = t.wrap_t;
     tex_table.push_back(d);
-    total_texels += size_t(t.width) * t.height;
+    total_texels += size_t(d.width) * d.height;
   }
   if (total_texels >= (size_t(1) << 32)) throw Error("the scene's textures are too large (over 4 G texels)");
   std::vector<uint8_t> texels(total_texels * 4);
   for (size_t i = 0; i < scene.textures.size(); ++i)
-    std::copy(scene.textures[i].rgba.begin(), scene.textures[i].rgba.end(), texels.begin() + size_t(tex_table[i].offset) * 4);
+    if (tex_table[i].width > 0)
+      std::copy(scene.textures[i].rgba.begin(), scene.textures[i].rgba.end(), texels.begin() + size_t(tex_table[i].offset) * 4);
 
   m.positions = rt.buffer(bytes_of(scene.positions), "vertex positions", CL_MEM_READ_ONLY);
   rt.write(m.positions, scene.positions.data(), bytes_of(scene.positions));

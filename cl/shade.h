@@ -78,11 +78,13 @@ inline float2 split_sum(global const float2* t, float nv, float r) {
 
 /* glTF metallic-roughness at source barycentrics b of triangle t with shading normal n (back faces
  * flipped) and base colour c, seen from view `view`'s camera: the default light (E toward `light`) and
- * the uniform default environment of radiance L, for which I(n) = L and the prefiltered radiance is L. */
+ * the uniform default environment of radiance L, for which I(n) = L and the prefiltered radiance is L,
+ * plus the emissive factor; an unlit material is its base colour. */
 inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, float3 n, float3 base, float3 light,
                         int view) {
   global const PmrParams* P = in->P;
   const PmrMaterial mat = in->materials[t->material];
+  if (mat.unlit) return base;
   const float3 p = b.x * vload3(t->v[0], in->positions) + b.y * vload3(t->v[1], in->positions) +
                    b.z * vload3(t->v[2], in->positions);
   const float3 v = normalize(in->eyes[view + (int)P->view_base].xyz - p);
@@ -91,7 +93,7 @@ inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, f
   const float2 ab = split_sum(in->split_sum, clamp(dot(n, v), 0.0f, 1.0f), r);
   const float L = P->env_radiance;
   const float3 ambient = base * (1.0f - metallic) * L + (pbr_f0(base, metallic) * ab.x + ab.y) * L;
-  return direct + ambient;
+  return direct + ambient + vload3(0, mat.emissive);
 }
 
 /* Unlit base colour (RGBA) at source barycentrics b of triangle `tri`. */

@@ -43,6 +43,8 @@ ref::SurfacePoint surface_at(const Scene& s, const Rig& rig, uint32_t tri, const
   ref::SurfacePoint sp;
   sp.base = glm::dvec3(ref::base_color(s, tri, b));
   sp.metallic = mat.metallic, sp.roughness = mat.roughness;
+  sp.emissive = glm::dvec3(mat.emissive[0], mat.emissive[1], mat.emissive[2]);
+  sp.unlit = mat.unlit != 0;
   glm::dvec3 n(t.face_normal[0], t.face_normal[1], t.face_normal[2]);
   if (t.has_normals) {
     glm::dvec3 sum(0.0);
@@ -85,16 +87,18 @@ const PmrMta* mta_of(const std::multimap<uint32_t, PmrMta>& by_key, uint32_t key
 }
 
 // Quads with curved normals and vertex colours, one material each: metals and dielectrics over
-// roughness 0.2 .. 1, a double-sided back face.
+// roughness 0.2 .. 1, an emissive one, an unlit one, a double-sided back face.
 Scene material_quads() {
   Scene s = test::empty_scene(true);
-  const float metal[4] = {1.0f, 0.0f, 1.0f, 0.0f}, rough[4] = {0.25f, 0.2f, 0.6f, 1.0f};
-  for (int q = 0; q < 4; ++q) {
+  const float metal[6] = {1.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.5f}, rough[6] = {0.25f, 0.2f, 0.6f, 1.0f, 0.5f, 0.5f};
+  for (int q = 0; q < 6; ++q) {
     PmrMaterial m = s.materials[0];
     m.metallic = metal[q], m.roughness = rough[q];
-    m.base_color[0] = 0.9f - 0.2f * q, m.base_color[1] = 0.5f + 0.1f * q, m.base_color[2] = 0.3f;
+    m.base_color[0] = 0.9f - 0.12f * q, m.base_color[1] = 0.5f + 0.08f * q, m.base_color[2] = 0.3f;
+    if (q == 4) m.emissive[0] = 0.6f, m.emissive[1] = 0.3f, m.emissive[2] = 1.5f;  // with an emissive strength
+    if (q == 5) m.unlit = 1;
     s.materials.push_back(m);
-    const float x0 = -1.3f + 0.66f * q, x1 = x0 + 0.6f, z = 0.3f * (q % 2) - 0.15f;
+    const float x0 = -1.3f + 0.44f * q, x1 = x0 + 0.4f, z = 0.3f * (q % 2) - 0.15f;
     test::add_triangle(s, {x0, -0.9f, z + 0.3f}, {x1, -0.8f, z - 0.3f}, {x1, 0.9f, z}, uint32_t(q + 1));
     test::add_triangle(s, {x0, -0.9f, z + 0.3f}, {x1, 0.9f, z}, {x0, 1.0f, z + 0.2f}, uint32_t(q + 1));
   }
@@ -122,6 +126,7 @@ TEST(Pbr, EveryShadedVoxelMatchesTheReference) {
   const auto env = uniform_environment(0.2);
   const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
   size_t compared = 0, bad = 0, back = 0;
+  std::map<uint32_t, size_t> per_material;
   double worst = 0.0;
   for (size_t v = 0; v < out.key.size(); ++v) {
     if (out.key[v] == PMR_NO_KEY) continue;
@@ -142,9 +147,12 @@ TEST(Pbr, EveryShadedVoxelMatchesTheReference) {
                       << " vs " << want[c];
     }
     ++compared;
+    ++per_material[s.triangles[m->tri].material];
   }
   EXPECT_EQ(bad, 0u);
   EXPECT_GT(compared, size_t(3000));
+  for (uint32_t material = 1; material <= 6; ++material)  // every quad, the emissive and unlit ones too
+    EXPECT_GT(per_material[material], size_t(100)) << "material " << material;
   EXPECT_GT(back, 0u) << "the scene should contain a back face";
   std::printf("[ pbr      ] %zu voxels, largest error %.3f of the bound\n", compared, worst);
 }

@@ -13,7 +13,7 @@ static_assert(sizeof(PmrMta) == 27 * 4, "PmrMta layout");
 static_assert(offsetof(PmrMta, bary) == 60 && offsetof(PmrMta, tri) == 84 && offsetof(PmrMta, flags) == 104, "PmrMta layout");
 static_assert(sizeof(PmrVertexAttr) == 36, "PmrVertexAttr layout");
 static_assert(sizeof(PmrTriangle) == 32, "PmrTriangle layout");
-static_assert(sizeof(PmrMaterial) == 40, "PmrMaterial layout");
+static_assert(sizeof(PmrMaterial) == 56, "PmrMaterial layout");
 static_assert(sizeof(PmrTexture) == 32, "PmrTexture layout");
 static_assert(sizeof(PmrEncodeParams) == 48 && offsetof(PmrEncodeParams, display_w) == 0, "PmrEncodeParams layout");
 static_assert(sizeof(PmrEncodeColumn) == 16 && sizeof(PmrEncodeRow) == 16, "encoder table layout");

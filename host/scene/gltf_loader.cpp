@@ -440,8 +440,10 @@ void build_materials(Loader& L) {
     L.scene.materials.push_back(m);
     L.scene.material_inputs.push_back(material_inputs(L, g, int(i)));
     // the factors the kernels read, as material_inputs checked them
-    L.scene.materials.back().metallic = L.scene.material_inputs.back().metallic;
-    L.scene.materials.back().roughness = L.scene.material_inputs.back().roughness;
+    const SceneMaterialInputs& in = L.scene.material_inputs.back();
+    PmrMaterial& dm = L.scene.materials.back();
+    dm.metallic = in.metallic, dm.roughness = in.roughness, dm.unlit = in.unlit ? 1u : 0u;
+    for (int c = 0; c < 3; ++c) dm.emissive[c] = in.emissive[c] * in.emissive_strength;
   }
 }
 

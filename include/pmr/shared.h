@@ -175,6 +175,8 @@ typedef struct {
   pmr_u32 double_sided;
   float metallic;         /* metallicFactor (pbr)                                             */
   float roughness;        /* roughnessFactor (pbr; clamped to [0.03, 1] when shading)          */
+  float emissive[3];      /* emissiveFactor x KHR_materials_emissive_strength (pbr, linear)    */
+  pmr_u32 unlit;          /* KHR_materials_unlit (pbr): the colour is exposure x base          */
 } PmrMaterial;
 
 typedef struct {

@@ -9,6 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pmr/error.h"
+#include "pmr/scene.h"
+
 namespace pmr::test {
 
 namespace gltf_builder_detail {
@@ -168,6 +171,18 @@ struct GltfFile {
 inline void write_bytes(const fs::path& path, const std::vector<uint8_t>& bytes) {
   std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), long(bytes.size()));
 }
+
+// The loader's error for a file, or "(loaded without error)".
+inline std::string load_error(const std::string& path) {
+  try {
+    load_scene(path);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(loaded without error)";
+}
+
+inline bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 }  // namespace gltf_builder_detail
 

@@ -11,16 +11,8 @@ namespace {
 test::Rendered render_with(Method method, const Scene& scene, const Rig& rig, bool snapped = false) {
   PipelineConfig pc;
   pc.method = method;
-  pc.debug_outputs = true;
   pc.multipass_snapped = snapped;
-  Pipeline p(test::runtime(), pc);
-  p.set_scene(scene);
-  p.configure(rig, nullptr);
-  test::Rendered r;
-  r.times = p.render(rig);
-  p.read_debug(r.key, r.depth, r.count);
-  p.read_volume(r.volume);
-  return r;
+  return test::render_with(scene, rig, pc);
 }
 
 size_t covered(const test::Rendered& r) {

@@ -21,18 +21,9 @@ test::Rendered render_pbr(const Scene& scene, const Rig& rig, double exposure_ev
   PipelineConfig pc;
   pc.tile_x = 4, pc.tile_y = 4, pc.tile_v = 4;
   pc.method = method;
-  pc.debug_outputs = true;
   pc.shading = shading;
   pc.exposure_ev = exposure_ev;
-  Pipeline p(test::runtime(), pc);
-  p.set_scene(scene);
-  p.configure(rig, nullptr);
-  test::Rendered r;
-  r.times = p.render(rig);
-  p.read_debug(r.key, r.depth, r.count);
-  p.read_volume(r.volume);
-  r.mtas = p.read_mtas();
-  return r;
+  return test::render_with(scene, rig, pc);
 }
 
 // The model's inputs at source barycentrics b of triangle `tri` seen from view `view`, computed here
@@ -79,12 +70,34 @@ ref::EnvironmentTerms uniform_environment(double radiance) {
   return env;
 }
 
-const PmrMta* mta_of(const std::multimap<uint32_t, PmrMta>& by_key, uint32_t key, int view) {
-  auto range = by_key.equal_range(key);
-  for (auto it = range.first; it != range.second; ++it)
-    if (view >= it->second.view_lo && view <= it->second.view_hi) return &it->second;
-  return nullptr;
-}
+// The reference colour of every covered voxel of a render (volume index v), under the default light
+// and environment: the winning MTA found by its key and view, then the model at its barycentrics.
+struct VoxelReference {
+  const Scene& scene;
+  const Rig& rig;
+  const test::Rendered& out;
+  std::multimap<uint32_t, PmrMta> by_key;
+  std::vector<ref::PunctualLight> lights = default_light(rig);
+  ref::EnvironmentTerms env = uniform_environment(0.2);
+
+  VoxelReference(const Scene& s, const Rig& r, const test::Rendered& o) : scene(s), rig(r), out(o) {
+    for (const PmrMta& m : out.mtas) by_key.emplace(m.key, m);
+  }
+  // The winner of voxel v (null if none matches its key and view).
+  const PmrMta* mta(size_t v) const {
+    const int view = int(v / (size_t(rig.view_w) * size_t(rig.view_h)));
+    auto range = by_key.equal_range(out.key[v]);
+    for (auto it = range.first; it != range.second; ++it)
+      if (view >= it->second.view_lo && view <= it->second.view_hi) return &it->second;
+    return nullptr;
+  }
+  glm::dvec3 colour(size_t v, const PmrMta& m) const {
+    const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
+    const int px = int(v % W), py = int((v / W) % H), view = int(v / (W * H));
+    const glm::dvec3 b = ref::source_barycentrics(m, px, py, view);
+    return ref::pbr_color(surface_at(scene, rig, m.tri, b, (m.flags & PMR_MTA_BACK) != 0, view), lights, env, 1.0);
+  }
+};
 
 // Quads with curved normals and vertex colours, one material each: metals and dielectrics over
 // roughness 0.2 .. 1, an emissive one, an unlit one, a double-sided back face.
@@ -120,10 +133,7 @@ TEST(Pbr, EveryShadedVoxelMatchesTheReference) {
   const Rig rig = test::small_rig(7, 72, 40);
   const Scene s = material_quads();
   const test::Rendered out = render_pbr(s, rig);
-  std::multimap<uint32_t, PmrMta> by_key;
-  for (const PmrMta& m : out.mtas) by_key.emplace(m.key, m);
-  const auto lights = default_light(rig);
-  const auto env = uniform_environment(0.2);
+  const VoxelReference reference(s, rig, out);
   const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
   size_t compared = 0, bad = 0, back = 0;
   std::map<uint32_t, size_t> per_material;
@@ -131,12 +141,10 @@ TEST(Pbr, EveryShadedVoxelMatchesTheReference) {
   for (size_t v = 0; v < out.key.size(); ++v) {
     if (out.key[v] == PMR_NO_KEY) continue;
     const int px = int(v % W), py = int((v / W) % H), view = int(v / (W * H));
-    const PmrMta* m = mta_of(by_key, out.key[v], view);
+    const PmrMta* m = reference.mta(v);
     ASSERT_NE(m, nullptr) << "no MTA for key " << out.key[v];
-    const bool is_back = (m->flags & PMR_MTA_BACK) != 0;
-    back += is_back;
-    const glm::dvec3 b = ref::source_barycentrics(*m, px, py, view);
-    const glm::dvec3 want = ref::pbr_color(surface_at(s, rig, m->tri, b, is_back, view), lights, env, 1.0);
+    back += (m->flags & PMR_MTA_BACK) != 0;
+    const glm::dvec3 want = reference.colour(v, *m);
     for (int c = 0; c < 3; ++c) {
       half got;
       got.setBits(out.volume[v * 4 + size_t(c)]);
@@ -191,10 +199,7 @@ TEST(Pbr, SpecularHighlightMovesWithTheViews) {
   const Rig rig = make_rig(rc, Display{}, glm::dvec3(-1.0), glm::dvec3(1.0));
   const Scene s = sphere(0.8f, glm::vec3(0.0f), 1.0f, 0.2f);
   const test::Rendered out = render_pbr(s, rig);
-  std::multimap<uint32_t, PmrMta> by_key;
-  for (const PmrMta& m : out.mtas) by_key.emplace(m.key, m);
-  const auto lights = default_light(rig);
-  const auto env = uniform_environment(0.2);
+  const VoxelReference reference(s, rig, out);
   const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
   double moved_got = 0.0, moved_want = 0.0;
   glm::dvec2 first_got(0.0), first_want(0.0);
@@ -208,10 +213,9 @@ TEST(Pbr, SpecularHighlightMovesWithTheViews) {
         half g;
         g.setBits(out.volume[v * 4 + 1]);
         if (float(g) > best_got) best_got = float(g), at_got = glm::dvec2(px, py);
-        const PmrMta* m = mta_of(by_key, out.key[v], view);
+        const PmrMta* m = reference.mta(v);
         ASSERT_NE(m, nullptr);
-        const glm::dvec3 b = ref::source_barycentrics(*m, int(px), int(py), view);
-        const double want = ref::pbr_color(surface_at(s, rig, m->tri, b, false, view), lights, env, 1.0).y;
+        const double want = reference.colour(v, *m).y;
         if (want > best_want) best_want = want, at_want = glm::dvec2(px, py);
       }
     EXPECT_LE(glm::length(at_got - at_want), 1.0 + 1e-9) << "view " << view << ": highlight at (" << at_got.x << ","

@@ -28,17 +28,6 @@ using nlohmann::json;
 using namespace pmr::test::gltf_builder_detail;
 
 
-std::string load_error(const std::string& path) {
-  try {
-    load_scene(path);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(loaded without error)";
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
 bool any_warning(const Scene& s, const std::string& part) {
   for (const std::string& w : s.warnings)
     if (contains(w, part)) return true;

@@ -40,17 +40,6 @@ class SceneMaterialsTest : public ::testing::Test {
   fs::path dir_;
 };
 
-std::string load_error(const std::string& path) {
-  try {
-    load_scene(path);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(loaded without error)";
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
 size_t warnings_with(const Scene& s, const std::string& part) {
   return size_t(std::count_if(s.warnings.begin(), s.warnings.end(), [&](const std::string& w) { return contains(w, part); }));
 }

@@ -76,6 +76,11 @@ Rendered render(const Scene& scene, const Rig& rig, int tx, int ty, int tv, cons
                 std::vector<uint16_t>* encoded) {
   PipelineConfig pc;
   pc.tile_x = tx, pc.tile_y = ty, pc.tile_v = tv;
+  return render_with(scene, rig, pc, display, encoded);
+}
+
+Rendered render_with(const Scene& scene, const Rig& rig, PipelineConfig pc, const Display* display,
+                     std::vector<uint16_t>* encoded) {
   pc.debug_outputs = true;
   Pipeline p(runtime(), pc);
   p.set_scene(scene);

@@ -36,6 +36,9 @@ struct Rendered {
 };
 Rendered render(const Scene& scene, const Rig& rig, int tx = 4, int ty = 4, int tv = 4, const Display* display = nullptr,
                 std::vector<uint16_t>* encoded = nullptr);
+// The same with a whole configuration (debug outputs are turned on: the keys are read back).
+Rendered render_with(const Scene& scene, const Rig& rig, PipelineConfig pc, const Display* display = nullptr,
+                     std::vector<uint16_t>* encoded = nullptr);
 // One frame through a pipeline configured with `pc` and display `d`: the encoded image, which path the
 // pipeline chose, and the view volume when it kept one.
 struct EncodedRender {

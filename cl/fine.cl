@@ -9,7 +9,7 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
                         global const PmrTriangle* tris, global const PmrVertexAttr* attrs,
                         global const PmrMaterial* materials, global const PmrTexture* textures,
                         global const uchar4* texels, global const float* srgb_lut, global const float* positions,
-                        global const float4* eyes, global const float2* split_sum,
+                        global const float4* eyes, global const float2* split_sum, global const float2* texcoords, global const float4* tangents,
                         global half* volume, global uint* debug_key, global float* debug_depth,
                         global uint* debug_count) {
   const uint tile = pmr_item_id();
@@ -22,7 +22,7 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
   const int nv = min(PMR_TILE_V, P->views - v0);
   const bool debug = P->debug_outputs != 0;
 
-  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum};
+  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents};
   vfloat best_depth[FINE_ROWS];
   vuint best_key[FINE_ROWS], best_mta[FINE_ROWS];
   vint covered[FINE_ROWS];

@@ -36,7 +36,7 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
                         global const PmrTriangle* tris, global const PmrVertexAttr* attrs,
                         global const PmrMaterial* materials, global const PmrTexture* textures,
                         global const uchar4* texels, global const float* srgb_lut, global const float* positions,
-                        global const float4* eyes, global const float2* split_sum,
+                        global const float4* eyes, global const float2* split_sum, global const float2* texcoords, global const float4* tangents,
                         global const PmrEncodeParams* E, global const int* column_soa,
                         global const PmrEncodeRow* rows, global const int* column_start,
                         global const int* row_start, global const int* straddle_slot, uint straddle_slots,
@@ -48,7 +48,7 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
   const int nx = min(PMR_TILE_X, P->view_w - x0), ny = min(PMR_TILE_Y, P->view_h - y0);
   const int views = P->views;
 
-  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum};
+  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents};
   vfloat best_depth[FUSED_ROWS];
   vuint best_key[FUSED_ROWS], best_mta[FUSED_ROWS];
   fine_clear_state(FUSED_ROWS, best_depth, best_key, best_mta);

@@ -67,7 +67,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
                           global const PmrVertexAttr* attrs, global const PmrMaterial* materials,
                           global const PmrTexture* textures, global const uchar4* texels,
                           global const float* srgb_lut, global const float* positions,
-                        global const float4* eyes, global const float2* split_sum, global const PmrEncodeParams* E,
+                        global const float4* eyes, global const float2* split_sum, global const float2* texcoords, global const float4* tangents, global const PmrEncodeParams* E,
                           global const int* column_a, global const int* column_b, global const PmrEncodeRow* rows,
                           global const int* sample_x, global const int* sample_y,
                           global const PmrSampleChunk* chunks, uint num_chunks, global const int* straddle_slot,
@@ -147,7 +147,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
     }
 
   /* 2. Visibility: the tile's queues, every view slab. */
-  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum};
+  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents};
   const double8 lane_d = convert_double8(lane);
   const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
   for (int tv = 0; tv < P->tiles_v; ++tv) {

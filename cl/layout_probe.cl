@@ -28,4 +28,7 @@ kernel void layout_probe(global uint* out) {
   out[20] = sizeof(PmrEncodeParams);
   PROBE(21, PmrEncodeParams, display_w);
   PROBE(22, PmrEncodeParams, bilinear);
+  PROBE(23, PmrMaterial, maps);
+  PROBE(24, PmrMaterial, occlusion_strength);
+  out[25] = sizeof(PmrTextureMap);
 }

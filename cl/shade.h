@@ -1,7 +1,8 @@
 /* Shading (docs/SHADING.md), the one module every path calls: base colour from baseColorFactor *
  * baseColorTexture (sRGB-decoded, bilinear, glTF wrap modes) * COLOR_0, then either view-independent
- * Lambert with one directional light, or glTF metallic-roughness (cl/brdf.h) seen from each view's own
- * camera, lit by the default directional light and the uniform default environment. */
+ * Lambert with one directional light, or glTF metallic-roughness (cl/brdf.h) with the material's
+ * metallic-roughness, normal, occlusion and emissive maps, seen from each view's own camera, lit by the
+ * default directional light and the uniform default environment. */
 #ifndef PMR_CL_SHADE_H
 #define PMR_CL_SHADE_H
 
@@ -21,13 +22,17 @@ inline int wrap_texel(int c, int size, int mode) {
   return r < 0 ? r + size : r;
 }
 
-inline float4 texel(global const uchar4* texels, global const float* srgb_lut, const PmrTexture* t, int x, int y) {
+/* Texel (x, y): colour maps decode sRGB, data maps (metallic-roughness, normal, occlusion) are linear. */
+inline float4 texel(global const uchar4* texels, global const float* srgb_lut, const PmrTexture* t, int x, int y,
+                    bool srgb) {
   const uchar4 c = texels[t->offset + (uint)(y * t->width + x)];
+  if (!srgb) return convert_float4(c) * (1.0f / 255.0f);
   return (float4)(srgb_lut[c.x], srgb_lut[c.y], srgb_lut[c.z], (float)c.w * (1.0f / 255.0f));
 }
 
 /* Bilinear sample; uv (0,0) is the top-left corner of the image (row 0). */
-inline float4 sample_texture(global const uchar4* texels, global const float* srgb_lut, const PmrTexture* t, float u, float v) {
+inline float4 sample_texture(global const uchar4* texels, global const float* srgb_lut, const PmrTexture* t, float u,
+                             float v, bool srgb) {
   const float fx = u * (float)t->width - 0.5f, fy = v * (float)t->height - 0.5f;
   const float x0f = floor(fx), y0f = floor(fy);
   const float ax = fx - x0f, ay = fy - y0f;
@@ -35,8 +40,8 @@ inline float4 sample_texture(global const uchar4* texels, global const float* sr
   const int x0 = (int)clamp(x0f, -1.0e8f, 1.0e8f), y0 = (int)clamp(y0f, -1.0e8f, 1.0e8f);
   const int xa = wrap_texel(x0, t->width, t->wrap_s), xb = wrap_texel(x0 + 1, t->width, t->wrap_s);
   const int ya = wrap_texel(y0, t->height, t->wrap_t), yb = wrap_texel(y0 + 1, t->height, t->wrap_t);
-  const float4 c00 = texel(texels, srgb_lut, t, xa, ya), c10 = texel(texels, srgb_lut, t, xb, ya);
-  const float4 c01 = texel(texels, srgb_lut, t, xa, yb), c11 = texel(texels, srgb_lut, t, xb, yb);
+  const float4 c00 = texel(texels, srgb_lut, t, xa, ya, srgb), c10 = texel(texels, srgb_lut, t, xb, ya, srgb);
+  const float4 c01 = texel(texels, srgb_lut, t, xa, yb, srgb), c11 = texel(texels, srgb_lut, t, xb, yb, srgb);
   const float4 top = c00 + (c10 - c00) * ax, bottom = c01 + (c11 - c01) * ax;
   return top + (bottom - top) * ay;
 }
@@ -63,6 +68,8 @@ typedef struct {
   global const float* positions;   /* world space, 3 floats per vertex: the surface point (pbr)  */
   global const float4* eyes;       /* each view's camera position, world space (pbr)            */
   global const float2* split_sum;  /* PMR_SPLIT_SUM_N^2 (A, B) (see PMR_SPLIT_SUM_N)             */
+  global const float2* texcoords;  /* TEXCOORD set k of vertex v at k * num_vertices + v (pbr maps) */
+  global const float4* tangents;   /* world tangent per vertex (w: bitangent sign), pbr normal maps */
 } ShadeInputs;
 
 /* The split-sum table's bilinear lookup, as pmr::split_sum (host/shading/environment.cpp) does it. */
@@ -76,24 +83,67 @@ inline float2 split_sum(global const float2* t, float nv, float r) {
   return top + (bottom - top) * fy;
 }
 
-/* glTF metallic-roughness at source barycentrics b of triangle t with shading normal n (back faces
- * flipped) and base colour c, seen from view `view`'s camera: the default light (E toward `light`) and
- * the uniform default environment of radiance L, for which I(n) = L and the prefiltered radiance is L,
- * plus the emissive factor; an unlit material is its base colour. */
-inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, float3 n, float3 base, float3 light,
-                        int view) {
+/* Material map `map` of triangle t at source barycentrics b: its TEXCOORD set interpolated, then its
+ * KHR_texture_transform. */
+inline float4 sample_map(const ShadeInputs* in, const PmrTextureMap* map, const PmrTriangle* t, float3 b, bool srgb) {
+  const uint set = map->texcoord * in->P->num_vertices;
+  const float2 uv = b.x * in->texcoords[set + t->v[0]] + b.y * in->texcoords[set + t->v[1]] +
+                    b.z * in->texcoords[set + t->v[2]];
+  const float u = map->uv_transform[0] * uv.x + map->uv_transform[1] * uv.y + map->uv_transform[2];
+  const float v = map->uv_transform[3] * uv.x + map->uv_transform[4] * uv.y + map->uv_transform[5];
+  const PmrTexture tex = in->textures[map->texture];
+  return sample_texture(in->texels, in->srgb_lut, &tex, u, v, srgb);
+}
+
+/* The normal map applied to the interpolated normal n (before any back-face flip): the interpolated
+ * tangent made orthogonal to n, the bitangent sign(w) * cross(n, t), m = (2 s - 1) * (scale, scale, 1).
+ * A vertex without a tangent (zero) leaves n as it is. */
+inline float3 mapped_normal(const ShadeInputs* in, const PmrMaterial* mat, const PmrTriangle* t, float3 b, float3 n) {
+  const float4 tw = b.x * in->tangents[t->v[0]] + b.y * in->tangents[t->v[1]] + b.z * in->tangents[t->v[2]];
+  float3 tangent = tw.xyz - n * dot(n, tw.xyz);
+  const float len = length(tangent);
+  if (!(len > 1e-12f)) return n;
+  tangent *= 1.0f / len;
+  const float3 bitangent = (tw.w < 0.0f ? -1.0f : 1.0f) * cross(n, tangent);
+  const float3 s = sample_map(in, &mat->maps[PMR_MAP_NORMAL], t, b, false).xyz;
+  const float3 m = (2.0f * s - 1.0f) * (float3)(mat->normal_scale, mat->normal_scale, 1.0f);
+  const float3 mapped = tangent * m.x + bitangent * m.y + n * m.z;
+  const float mlen = length(mapped);
+  return mlen > 0.0f ? mapped * (1.0f / mlen) : n;
+}
+
+/* glTF metallic-roughness at source barycentrics b of triangle t with interpolated normal n (not yet
+ * flipped for a back face) and base colour c, seen from view `view`'s camera: the material's maps
+ * (metallic-roughness, normal, occlusion, emissive), the default light (E toward `light`) and the
+ * uniform default environment of radiance L, for which I(n) = L and the prefiltered radiance is L, plus
+ * the emissive term; an unlit material is its base colour. */
+inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, float3 n, bool back, float3 base,
+                        float3 light, int view) {
   global const PmrParams* P = in->P;
   const PmrMaterial mat = in->materials[t->material];
   if (mat.unlit) return base;
+  float metallic = mat.metallic, roughness = mat.roughness;
+  if (mat.maps[PMR_MAP_METALLIC_ROUGHNESS].texture >= 0) {
+    const float4 s = sample_map(in, &mat.maps[PMR_MAP_METALLIC_ROUGHNESS], t, b, false);
+    metallic *= s.z, roughness *= s.y;
+  }
+  if (mat.maps[PMR_MAP_NORMAL].texture >= 0) n = mapped_normal(in, &mat, t, b, n);
+  if (back) n = -n; /* t, b and n together */
+  float ao = 1.0f;
+  if (mat.maps[PMR_MAP_OCCLUSION].texture >= 0)
+    ao = 1.0f + mat.occlusion_strength * (sample_map(in, &mat.maps[PMR_MAP_OCCLUSION], t, b, false).x - 1.0f);
+  float3 emissive = vload3(0, mat.emissive);
+  if (mat.maps[PMR_MAP_EMISSIVE].texture >= 0) emissive *= sample_map(in, &mat.maps[PMR_MAP_EMISSIVE], t, b, true).xyz;
+
   const float3 p = b.x * vload3(t->v[0], in->positions) + b.y * vload3(t->v[1], in->positions) +
                    b.z * vload3(t->v[2], in->positions);
   const float3 v = normalize(in->eyes[view + (int)P->view_base].xyz - p);
-  const float metallic = mat.metallic, r = pbr_roughness(mat.roughness);
+  const float r = pbr_roughness(roughness);
   const float3 direct = brdf_cos(base, metallic, r, n, v, light) * P->light_irradiance;
   const float2 ab = split_sum(in->split_sum, clamp(dot(n, v), 0.0f, 1.0f), r);
   const float L = P->env_radiance;
   const float3 ambient = base * (1.0f - metallic) * L + (pbr_f0(base, metallic) * ab.x + ab.y) * L;
-  return direct + ambient + vload3(0, mat.emissive);
+  return direct + ao * ambient + emissive;
 }
 
 /* Unlit base colour (RGBA) at source barycentrics b of triangle `tri`. */
@@ -110,7 +160,7 @@ inline float4 base_color(const ShadeInputs* in, uint tri, float3 b) {
     const PmrTexture tex = in->textures[mat.texture];
     const float u = b.x * a0->uv[0] + b.y * a1->uv[0] + b.z * a2->uv[0];
     const float v = b.x * a0->uv[1] + b.y * a1->uv[1] + b.z * a2->uv[1];
-    c *= sample_texture(in->texels, in->srgb_lut, &tex, u, v);
+    c *= sample_texture(in->texels, in->srgb_lut, &tex, u, v, true);
   }
   return c;
 }
@@ -127,13 +177,13 @@ inline float4 shade(const ShadeInputs* in, float3 light, uint tri, float3 b, boo
   } else {
     n = vload3(0, t.face_normal);
   }
-  if (back) n = -n;
   const float4 c = base_color(in, tri, b);
   const float exposure = in->P->exposure;
   if (in->P->shading == PMR_SHADING_PBR) {
-    const float3 rgb = shade_pbr(in, &t, b, n, c.xyz, light, view) * exposure;
+    const float3 rgb = shade_pbr(in, &t, b, n, back, c.xyz, light, view) * exposure;
     return (float4)(rgb, 1.0f);
   }
+  if (back) n = -n;
   const float lambert = 0.2f + 0.8f * max(0.0f, dot(n, light));
   return (float4)(c.x * lambert * exposure, c.y * lambert * exposure, c.z * lambert * exposure, 1.0f);
 }

@@ -25,7 +25,8 @@ TEST(Layout, DeviceStructsMatchHost) {
       sizeof(PmrMta), offsetof(PmrMta, bary), offsetof(PmrMta, key), offsetof(PmrMta, flags),
       sizeof(PmrVertexAttr), offsetof(PmrVertexAttr, color), sizeof(PmrTriangle), offsetof(PmrTriangle, face_normal),
       sizeof(PmrMaterial), offsetof(PmrMaterial, alpha_cutoff), sizeof(PmrTexture), offsetof(PmrTexture, wrap_t),
-      sizeof(PmrEncodeParams), offsetof(PmrEncodeParams, display_w), offsetof(PmrEncodeParams, bilinear)};
+      sizeof(PmrEncodeParams), offsetof(PmrEncodeParams, display_w), offsetof(PmrEncodeParams, bilinear),
+      offsetof(PmrMaterial, maps), offsetof(PmrMaterial, occlusion_strength), sizeof(PmrTextureMap)};
   for (size_t i = 0; i < sizeof want / sizeof want[0]; ++i) EXPECT_EQ(got[i], want[i]) << "probe " << i;
 }
 

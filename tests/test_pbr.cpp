@@ -6,8 +6,13 @@
 #include <Imath/half.h>
 
 #include <glm/gtc/constants.hpp>
+#include <filesystem>
+#include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
 
+#include "reference/material_reference.h"
 #include "reference/pbr_reference.h"
 #include "reference/shade_reference.h"
 #include "shading/environment.h"
@@ -27,25 +32,11 @@ test::Rendered render_pbr(const Scene& scene, const Rig& rig, double exposure_ev
 }
 
 // The model's inputs at source barycentrics b of triangle `tri` seen from view `view`, computed here
-// from the scene (as 4a defines the shading normal), for the reference.
+// from the scene's material inputs (tests/reference/material_reference.h), for the reference.
 ref::SurfacePoint surface_at(const Scene& s, const Rig& rig, uint32_t tri, const glm::dvec3& b, bool back, int view) {
   const PmrTriangle& t = s.triangles[tri];
-  const PmrMaterial& mat = s.materials[t.material];
   ref::SurfacePoint sp;
-  sp.base = glm::dvec3(ref::base_color(s, tri, b));
-  sp.metallic = mat.metallic, sp.roughness = mat.roughness;
-  sp.emissive = glm::dvec3(mat.emissive[0], mat.emissive[1], mat.emissive[2]);
-  sp.unlit = mat.unlit != 0;
-  glm::dvec3 n(t.face_normal[0], t.face_normal[1], t.face_normal[2]);
-  if (t.has_normals) {
-    glm::dvec3 sum(0.0);
-    for (int k = 0; k < 3; ++k) {
-      const float* nk = s.attributes[t.v[k]].normal;
-      sum += b[k] * glm::dvec3(nk[0], nk[1], nk[2]);
-    }
-    if (glm::length(sum) > 0.0) n = glm::normalize(sum);
-  }
-  sp.n = back ? -n : n;
+  ref::material_at(s, tri, b, back, sp);
   sp.p = glm::dvec3(0.0);
   for (int k = 0; k < 3; ++k) sp.p += b[k] * glm::dvec3(s.positions[t.v[k]]);
   sp.eye = glm::dvec3(glm::inverse(rig.view_matrix(view))[3]);
@@ -163,6 +154,170 @@ TEST(Pbr, EveryShadedVoxelMatchesTheReference) {
     EXPECT_GT(per_material[material], size_t(100)) << "material " << material;
   EXPECT_GT(back, 0u) << "the scene should contain a back face";
   std::printf("[ pbr      ] %zu voxels, largest error %.3f of the bound\n", compared, worst);
+}
+
+// Two quads whose materials use every map: metallic-roughness, normal (scale 0.8) and occlusion
+// (strength 0.7) on the left, sampled on TEXCOORD_1 through a texture transform and TEXCOORD_0; an
+// emissive map and a mirrored normal map (tangent w = -1, tangents not orthogonal to the normals) on the
+// right. Procedural 16x16 textures, curved normals.
+Scene mapped_quads() {
+  Scene s = test::empty_scene(false);
+  s.material_inputs.resize(1);
+  auto texture = [&](auto texel_of) {
+    SceneTexture t;
+    t.width = 16, t.height = 16;
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) {
+        const glm::dvec4 c = texel_of(x, y);
+        for (int k = 0; k < 4; ++k) t.rgba.push_back(uint8_t(std::lround(255.0 * glm::clamp(c[k], 0.0, 1.0))));
+      }
+    s.textures.push_back(t);
+    return int(s.textures.size() - 1);
+  };
+  const int mr = texture([](int x, int y) { return glm::dvec4(0.0, 0.3 + 0.045 * x, y / 15.0, 1.0); });
+  const int normal = texture([](int x, int y) {
+    return glm::dvec4(0.5 + 0.35 * std::sin(0.8 * x), 0.5 + 0.35 * std::cos(0.6 * y), 0.85, 1.0);
+  });
+  const int occlusion = texture([](int x, int y) { return glm::dvec4(0.25 + 0.05 * ((x + y) % 16), 0.0, 0.0, 1.0); });
+  const int emissive = texture([](int x, int y) { return glm::dvec4(x / 15.0, 0.5, 1.0 - y / 15.0, 1.0); });
+  for (int q = 0; q < 2; ++q) {
+    PmrMaterial m = s.materials[0];
+    m.base_color[0] = 0.8f, m.base_color[1] = 0.6f - 0.2f * q, m.base_color[2] = 0.4f + 0.3f * q;
+    m.metallic = 0.9f, m.roughness = 0.8f;
+    s.materials.push_back(m);
+    SceneMaterialInputs in;
+    in.metallic = m.metallic, in.roughness = m.roughness;
+    in.slots[kSlotBaseColor].srgb = in.slots[kSlotEmissive].srgb = true;
+    SceneTextureSlot& n = in.slots[kSlotNormal];
+    n.texture = normal, n.texcoord = 1 - q;
+    in.normal_scale = 0.8f;
+    if (q == 0) {
+      SceneTextureSlot& a = in.slots[kSlotMetallicRoughness];
+      a.texture = mr, a.texcoord = 1, a.transform = true;
+      a.offset[0] = 0.1f, a.offset[1] = -0.2f, a.rotation = 0.4f, a.scale[0] = 1.5f, a.scale[1] = 0.7f;
+      in.slots[kSlotOcclusion].texture = occlusion, in.slots[kSlotOcclusion].texcoord = 0;
+      in.occlusion_strength = 0.7f;
+    } else {
+      in.slots[kSlotEmissive].texture = emissive, in.slots[kSlotEmissive].texcoord = 1;
+      in.emissive[0] = in.emissive[1] = in.emissive[2] = 0.5f;
+      in.emissive_strength = 2.0f;
+      in.metallic = 0.0f, in.roughness = 0.5f;
+    }
+    s.material_inputs.push_back(in);
+    const float x0 = -1.2f + 1.2f * q, x1 = x0 + 1.1f;
+    test::add_triangle(s, {x0, -0.9f, 0.2f}, {x1, -0.8f, -0.2f}, {x1, 0.9f, 0.0f}, uint32_t(q + 1));
+    test::add_triangle(s, {x0, -0.9f, 0.2f}, {x1, 0.9f, 0.0f}, {x0, 1.0f, 0.1f}, uint32_t(q + 1));
+  }
+  s.texcoords.assign(2, std::vector<glm::vec2>(s.positions.size()));
+  s.tangents.resize(s.positions.size());
+  for (size_t k = 0; k < s.positions.size(); ++k) {
+    const glm::vec3 p = s.positions[k];
+    s.texcoords[0][k] = glm::vec2(0.5f * p.x + 0.6f, 0.5f - 0.5f * p.y);
+    s.texcoords[1][k] = glm::vec2(0.9f * p.y + 0.3f * p.x, 0.4f * p.x - 0.2f);
+    const bool right = s.triangles[k / 3].material == 2;
+    s.tangents[k] = right ? glm::vec4(0.8f, 0.5f, 0.3f, -1.0f) : glm::vec4(1.0f, 0.1f * float(k % 3), 0.0f, 1.0f);
+    PmrVertexAttr& a = s.attributes[k];
+    const glm::vec3 nk = glm::normalize(glm::vec3(0.4f * float(k % 3) - 0.4f, 0.3f * float(k % 2) - 0.15f, 1.0f));
+    a.normal[0] = nk.x, a.normal[1] = nk.y, a.normal[2] = nk.z;
+  }
+  return s;
+}
+
+// Every map against the reference; the reference itself must see the maps (so a kernel that ignored
+// them would fail).
+TEST(Pbr, MaterialMapsMatchTheReference) {
+  const Rig rig = test::small_rig(5, 72, 40);
+  const Scene s = mapped_quads();
+  Scene plain = s;
+  plain.material_inputs.clear();
+  const test::Rendered out = render_pbr(s, rig);
+  const VoxelReference reference(s, rig, out), without_maps(plain, rig, out);
+  size_t compared = 0, bad = 0, changed = 0;
+  std::map<uint32_t, size_t> per_material;
+  double worst = 0.0;
+  for (size_t v = 0; v < out.key.size(); ++v) {
+    if (out.key[v] == PMR_NO_KEY) continue;
+    const PmrMta* m = reference.mta(v);
+    ASSERT_NE(m, nullptr);
+    const glm::dvec3 want = reference.colour(v, *m), plain_colour = without_maps.colour(v, *m);
+    changed += glm::length(want - plain_colour) > 0.05 * glm::length(plain_colour);
+    for (int c = 0; c < 3; ++c) {
+      half got;
+      got.setBits(out.volume[v * 4 + size_t(c)]);
+      const double err = std::abs(double(float(got)) - want[c]), tol = 0.01 * std::abs(want[c]) + 1e-3;
+      worst = std::max(worst, err / tol);
+      if (err > tol && ++bad <= 5) ADD_FAILURE() << "voxel " << v << " channel " << c << ": " << float(got) << " vs " << want[c];
+    }
+    ++compared;
+    ++per_material[s.triangles[m->tri].material];
+  }
+  EXPECT_EQ(bad, 0u);
+  EXPECT_GT(per_material[1], size_t(1000));
+  EXPECT_GT(per_material[2], size_t(1000));
+  EXPECT_GT(changed, compared * 3 / 4) << "the maps should change most voxels";
+  std::printf("[ pbr maps ] %zu voxels, %zu changed by the maps, largest error %.3f of the bound\n", compared, changed,
+              worst);
+}
+
+// Real models with maps (../shared/gltf): Avocado (metallic-roughness and normal maps, TANGENT), the same
+// file with TANGENT removed (generated tangents), MultiUVTest (an emissive map on TEXCOORD_1). Every
+// shaded voxel whose roughness is at least 0.2 matches the reference.
+TEST(Pbr, RealModelsWithMapsMatchTheReference) {
+  const std::string dir = test::corpus_dir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/gltf not found: real-model pbr test skipped";
+  namespace fs = std::filesystem;
+  // Avocado without TANGENT: its .gltf with the attribute removed, beside copies of its other files.
+  const fs::path tmp = fs::temp_directory_path() / ("pmr_pbr_models_" + std::to_string(::getpid()));
+  fs::remove_all(tmp);
+  fs::create_directories(tmp);
+  const fs::path avocado = fs::path(dir) / "Avocado" / "glTF";
+  for (const auto& e : fs::directory_iterator(avocado)) fs::copy_file(e.path(), tmp / e.path().filename());
+  {
+    std::ifstream in(avocado / "Avocado.gltf");
+    nlohmann::json doc = nlohmann::json::parse(in);
+    for (auto& mesh : doc["meshes"])
+      for (auto& prim : mesh["primitives"]) prim["attributes"].erase("TANGENT");
+    std::ofstream(tmp / "Avocado.gltf") << doc.dump();
+  }
+  const std::vector<std::string> files = {(avocado / "Avocado.gltf").string(), (tmp / "Avocado.gltf").string(),
+                                          dir + "/MultiUVTest/glTF/MultiUVTest.gltf"};
+  for (const std::string& f : files) {
+    SCOPED_TRACE(f);
+    const Scene s = load_scene(f);
+    if (f == files[1]) EXPECT_GT(s.structure.generated_tangent_primitives, 0u) << "the copy should have no TANGENT";
+    glm::dvec3 lo, hi;
+    ASSERT_TRUE(scene_bounds(s, lo, hi));
+    RigConfig rc;
+    rc.views = 5, rc.view_w = 96, rc.view_h = 64;
+    const Rig rig = make_rig(rc, Display{}, lo, hi);
+    const test::Rendered out = render_pbr(s, rig);
+    const VoxelReference reference(s, rig, out);
+    size_t compared = 0, bad = 0;
+    double worst = 0.0;
+    for (size_t v = 0; v < out.key.size(); ++v) {
+      if (out.key[v] == PMR_NO_KEY) continue;
+      const PmrMta* m = reference.mta(v);
+      ASSERT_NE(m, nullptr);
+      const int W = rig.view_w, H = rig.view_h;
+      const int view = int(v / size_t(W * H));
+      const glm::dvec3 b = ref::source_barycentrics(*m, int(v % size_t(W)), int((v / size_t(W)) % size_t(H)), view);
+      if (surface_at(s, rig, m->tri, b, false, view).roughness < 0.2) continue;
+      const glm::dvec3 want = reference.colour(v, *m);
+      for (int c = 0; c < 3; ++c) {
+        half got;
+        got.setBits(out.volume[v * 4 + size_t(c)]);
+        const double err = std::abs(double(float(got)) - want[c]), tol = 0.01 * std::abs(want[c]) + 1e-3;
+        worst = std::max(worst, err / tol);
+        if (err > tol && ++bad <= 5) ADD_FAILURE() << "voxel " << v << " channel " << c << ": " << float(got) << " vs " << want[c];
+      }
+      ++compared;
+    }
+    EXPECT_EQ(bad, 0u);
+    EXPECT_GT(compared, size_t(2000));
+    std::printf("[ pbr      ] %s: %zu voxels, largest error %.3f of the bound\n", fs::path(f).filename().c_str(), compared,
+                worst);
+  }
+  fs::remove_all(tmp);
 }
 
 // A smooth sphere (lat-long grid, smooth normals) of one material.

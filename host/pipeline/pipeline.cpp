@@ -1,5 +1,6 @@
 #include "pipeline/pipeline.h"
 
+#include "pipeline/material_tables.h"
 #include "pipeline/tile_tables.h"
 #include "shading/environment.h"
 
@@ -75,6 +76,8 @@ struct Pipeline::Impl {
   uint32_t num_vertices = 0, num_triangles = 0;
   ClBuffer positions, attrs, tris, materials, textures, texels, lut;
   ClBuffer eyes, split_sum;  // each view's camera position (per frame); the pbr split-sum table
+  ClBuffer texcoords, tangents;  // the TEXCOORD sets the material maps sample; world tangents (pbr)
+  bool has_tangents = false;
   // frame
   PmrParams params{};
   PmrEncodeParams encode_params{};
@@ -247,27 +250,10 @@ void Pipeline::set_scene(const Scene& scene) {
                 std::to_string(PMR_MAX_TRIANGLES - 1) + " are supported");
   m.num_vertices = uint32_t(scene.positions.size());
   m.num_triangles = uint32_t(scene.triangles.size());
-  // The kernels sample only base colour textures so far: the data maps the loader also decodes
-  // (metallic-roughness, normal, occlusion, emissive; SceneTexture::slots) keep their table entry,
-  // empty, and are not uploaded. Hand-made scenes (slots 0) upload everything.
-  auto sampled = [](const SceneTexture& t) { return t.slots == 0 || (t.slots & (1u << kSlotBaseColor)) != 0; };
-  std::vector<PmrTexture> tex_table;
-  size_t total_texels = 0;
-  for (const auto& t : scene.textures) {
-    PmrTexture d{};
-    d.offset = uint32_t(total_texels);
-    d.width = sampled(t) ? t.width : 0;
-    d.height = sampled(t) ? t.height : 0;
-    d.wrap_s = t.wrap_s;
-    d.wrap_t = t.wrap_t;
-    tex_table.push_back(d);
-    total_texels += size_t(d.width) * d.height;
-  }
-  if (total_texels >= (size_t(1) << 32)) throw Error("the scene's textures are too large (over 4 G texels)");
-  std::vector<uint8_t> texels(total_texels * 4);
-  for (size_t i = 0; i < scene.textures.size(); ++i)
-    if (tex_table[i].width > 0)
-      std::copy(scene.textures[i].rgba.begin(), scene.textures[i].rgba.end(), texels.begin() + size_t(tex_table[i].offset) * 4);
+  const MaterialTables tables = make_material_tables(scene);
+  m.has_tangents = scene.tangents.size() == scene.positions.size() && !scene.positions.empty();
+  const std::vector<glm::vec4> no_tangents(1, glm::vec4(0.0f));
+  const std::vector<glm::vec4>& tangents = m.has_tangents ? scene.tangents : no_tangents;
 
   m.positions = rt.buffer(bytes_of(scene.positions), "vertex positions", CL_MEM_READ_ONLY);
   rt.write(m.positions, scene.positions.data(), bytes_of(scene.positions));
@@ -275,12 +261,16 @@ void Pipeline::set_scene(const Scene& scene) {
   rt.write(m.attrs, scene.attributes.data(), bytes_of(scene.attributes));
   m.tris = rt.buffer(bytes_of(scene.triangles), "triangles", CL_MEM_READ_ONLY);
   rt.write(m.tris, scene.triangles.data(), bytes_of(scene.triangles));
-  m.materials = rt.buffer(bytes_of(scene.materials), "materials", CL_MEM_READ_ONLY);
-  rt.write(m.materials, scene.materials.data(), bytes_of(scene.materials));
-  m.textures = rt.buffer(bytes_of(tex_table), "texture table", CL_MEM_READ_ONLY);
-  rt.write(m.textures, tex_table.data(), bytes_of(tex_table));
-  m.texels = rt.buffer(texels.size(), "texels", CL_MEM_READ_ONLY);
-  rt.write(m.texels, texels.data(), texels.size());
+  m.materials = rt.buffer(bytes_of(tables.materials), "materials", CL_MEM_READ_ONLY);
+  rt.write(m.materials, tables.materials.data(), bytes_of(tables.materials));
+  m.textures = rt.buffer(std::max<size_t>(bytes_of(tables.textures), 16), "texture table", CL_MEM_READ_ONLY);
+  rt.write(m.textures, tables.textures.data(), bytes_of(tables.textures));
+  m.texels = rt.buffer(std::max<size_t>(tables.texels.size(), 16), "texels", CL_MEM_READ_ONLY);
+  rt.write(m.texels, tables.texels.data(), tables.texels.size());
+  m.texcoords = rt.buffer(bytes_of(tables.texcoords), "texture coordinates", CL_MEM_READ_ONLY);
+  rt.write(m.texcoords, tables.texcoords.data(), bytes_of(tables.texcoords));
+  m.tangents = rt.buffer(bytes_of(tangents), "tangents", CL_MEM_READ_ONLY);
+  rt.write(m.tangents, tangents.data(), bytes_of(tangents));
   m.vertices = rt.buffer(size_t(m.num_vertices) * sizeof(PmrVertex), "transformed vertices");
   if (config_.method == Method::Multipass && config_.multipass_snapped)
     m.pmr_vertices = rt.buffer(size_t(m.num_vertices) * sizeof(PmrVertex), "PMR vertices");
@@ -300,6 +290,8 @@ void Pipeline::update_geometry(const Scene& posed) {
   m.rt.write(m.positions, posed.positions.data(), bytes_of(posed.positions));
   m.rt.write(m.attrs, posed.attributes.data(), bytes_of(posed.attributes));
   m.rt.write(m.tris, posed.triangles.data(), bytes_of(posed.triangles));
+  if (m.has_tangents && posed.tangents.size() == posed.positions.size())
+    m.rt.write(m.tangents, posed.tangents.data(), bytes_of(posed.tangents));
 }
 
 size_t Pipeline::volume_bytes() const {
@@ -467,7 +459,7 @@ void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
 }
 
 void Pipeline::Impl::fine_stage(Events& ev) {
-  k_fine.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, volume,
+  k_fine.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents, volume,
               dbg_key, dbg_depth, dbg_count);
   ev.add(kFine, launch(k_fine, size_t(num_tiles), kFineGroup));
 }
@@ -562,7 +554,7 @@ void Pipeline::Impl::straddle_alpha_stage(ClKernel& k, Events& ev) {
 
 void Pipeline::Impl::subpixel_stage(Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
-  k_fine_subpixel.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum,
+  k_fine_subpixel.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents,
                        encode_buf, column_a, column_b, encode_rows, sample_x, sample_y, chunks, warming ? 0u : num_chunks,
                        straddle_slot, straddle_slots,
                        straddle_cov, display, cl_uint(subpixel_debug), dbg_key, dbg_depth);
@@ -572,7 +564,7 @@ void Pipeline::Impl::subpixel_stage(Events& ev) {
 
 void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
-  k_fine_encode.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum,
+  k_fine_encode.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents,
                      encode_buf, column_soa, encode_rows, column_start, row_start, straddle_slot, straddle_slots,
                      straddle_cov, display);
   const size_t screen_tiles = size_t(P.tiles_x) * P.tiles_y;

@@ -15,6 +15,9 @@ PmrMaterial default_material() {
   m.double_sided = 0;
   m.metallic = 1.0f;  // glTF's defaults
   m.roughness = 1.0f;
+  for (PmrTextureMap& map : m.maps) map = PmrTextureMap{-1, 0, {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f}};
+  m.normal_scale = 1.0f;
+  m.occlusion_strength = 1.0f;
   return m;
 }
 

@@ -167,6 +167,22 @@ typedef struct {
   pmr_u32 has_normals;
 } PmrTriangle;
 
+/* The texture maps of a material beyond base colour, read by --shading pbr (PmrMaterial.maps). */
+#define PMR_MAP_METALLIC_ROUGHNESS 0 /* B metallic, G roughness (linear)                       */
+#define PMR_MAP_NORMAL 1             /* tangent-space normal (linear)                          */
+#define PMR_MAP_OCCLUSION 2          /* R occlusion (linear)                                   */
+#define PMR_MAP_EMISSIVE 3           /* RGB (sRGB-encoded)                                     */
+#define PMR_MAPS 4
+
+/* One texture map of a material: which texture, sampled at which TEXCOORD set, through which
+ * KHR_texture_transform (the identity without one). Producer: host/pipeline (from the scene's material
+ * inputs). */
+typedef struct {
+  pmr_i32 texture;        /* index into the texture table, -1 = none                         */
+  pmr_u32 texcoord;       /* TEXCOORD set: entries [texcoord * num_vertices, ...) of the texcoord buffer */
+  float uv_transform[6];  /* u' = t0 u + t1 v + t2, v' = t3 u + t4 v + t5                     */
+} PmrTextureMap;
+
 typedef struct {
   float base_color[4];    /* baseColorFactor (linear)                                        */
   pmr_i32 texture;        /* index into the texture table, -1 = none                         */
@@ -177,6 +193,9 @@ typedef struct {
   float roughness;        /* roughnessFactor (pbr; clamped to [0.03, 1] when shading)          */
   float emissive[3];      /* emissiveFactor x KHR_materials_emissive_strength (pbr, linear)    */
   pmr_u32 unlit;          /* KHR_materials_unlit (pbr): the colour is exposure x base          */
+  PmrTextureMap maps[PMR_MAPS]; /* pbr: indexed by PMR_MAP_*; the base colour map is `texture` */
+  float normal_scale;     /* normalTexture.scale                                             */
+  float occlusion_strength; /* occlusionTexture.strength                                     */
 } PmrMaterial;
 
 typedef struct {

@@ -17,12 +17,24 @@ int wrap(int c, int n, int mode) {
   return ((c % n) + n) % n;
 }
 
-glm::dvec4 texel(const SceneTexture& t, int x, int y) {
+glm::dvec4 texel(const SceneTexture& t, int x, int y, bool srgb) {
   const uint8_t* p = &t.rgba[(size_t(y) * t.width + x) * 4];
-  return {srgb_to_linear(p[0] / 255.0), srgb_to_linear(p[1] / 255.0), srgb_to_linear(p[2] / 255.0), p[3] / 255.0};
+  const glm::dvec4 c(p[0] / 255.0, p[1] / 255.0, p[2] / 255.0, p[3] / 255.0);
+  return srgb ? glm::dvec4(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z), c.w) : c;
 }
 
 }  // namespace
+
+glm::dvec4 sample_texture(const SceneTexture& tex, const glm::dvec2& uv, bool srgb) {
+  const double fx = uv.x * tex.width - 0.5, fy = uv.y * tex.height - 0.5;
+  const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
+  const double ax = fx - x0, ay = fy - y0;
+  const int xa = wrap(x0, tex.width, tex.wrap_s), xb = wrap(x0 + 1, tex.width, tex.wrap_s);
+  const int ya = wrap(y0, tex.height, tex.wrap_t), yb = wrap(y0 + 1, tex.height, tex.wrap_t);
+  const glm::dvec4 top = glm::mix(texel(tex, xa, ya, srgb), texel(tex, xb, ya, srgb), ax);
+  const glm::dvec4 bottom = glm::mix(texel(tex, xa, yb, srgb), texel(tex, xb, yb, srgb), ax);
+  return glm::mix(top, bottom, ay);
+}
 
 glm::dvec3 source_barycentrics(const PmrMta& m, int px, int py, int view) {
   return source_barycentrics_at(m, int64_t(px) * PMR_X_ONE + PMR_X_ONE / 2, int64_t(py) * PMR_Y_ONE + PMR_Y_ONE / 2, view);
@@ -66,17 +78,7 @@ glm::dvec4 base_color(const Scene& scene, uint32_t tri, const glm::dvec3& b) {
     uv += b[k] * glm::dvec2(a.uv[0], a.uv[1]);
   }
   c *= vc;
-  if (mat.texture >= 0) {
-    const SceneTexture& tex = scene.textures[size_t(mat.texture)];
-    const double fx = uv.x * tex.width - 0.5, fy = uv.y * tex.height - 0.5;
-    const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
-    const double ax = fx - x0, ay = fy - y0;
-    const int xa = wrap(x0, tex.width, tex.wrap_s), xb = wrap(x0 + 1, tex.width, tex.wrap_s);
-    const int ya = wrap(y0, tex.height, tex.wrap_t), yb = wrap(y0 + 1, tex.height, tex.wrap_t);
-    const glm::dvec4 top = glm::mix(texel(tex, xa, ya), texel(tex, xb, ya), ax);
-    const glm::dvec4 bottom = glm::mix(texel(tex, xa, yb), texel(tex, xb, yb), ax);
-    c *= glm::mix(top, bottom, ay);
-  }
+  if (mat.texture >= 0) c *= sample_texture(scene.textures[size_t(mat.texture)], uv, true);
   return c;
 }
 

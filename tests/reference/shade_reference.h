@@ -13,6 +13,9 @@ namespace pmr::ref {
 glm::dvec3 source_barycentrics(const PmrMta& m, int px, int py, int view);
 // The same at raster point (X, Y) in fixed point (16.16, 24.8): a --sampling subpixel sample.
 glm::dvec3 source_barycentrics_at(const PmrMta& m, int64_t sample_x, int64_t sample_y, int view);
+// Bilinear sample at uv ((0, 0) = the image's top-left corner) with the texture's wrap modes; colour
+// textures decode sRGB, data textures are linear.
+glm::dvec4 sample_texture(const SceneTexture& tex, const glm::dvec2& uv, bool srgb);
 // Unlit base colour (factor * texture * COLOR_0) at source barycentrics b of triangle `tri`.
 glm::dvec4 base_color(const Scene& scene, uint32_t tri, const glm::dvec3& b);
 // Lit colour (alpha = 1) with the light direction `light` (world space, unit).

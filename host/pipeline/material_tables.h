@@ -1,0 +1,29 @@
+// The scene's materials as the kernels read them: PmrMaterial with its texture maps filled from the
+// loader's material inputs, the texture table and its texels, and the TEXCOORD sets the maps sample.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "pmr/scene.h"
+#include "pmr/shared.h"
+
+namespace pmr {
+
+struct MaterialTables {
+  std::vector<PmrMaterial> materials;  // Scene::materials, the pbr fields from Scene::material_inputs
+  std::vector<PmrTexture> textures;    // one per Scene::textures
+  std::vector<uint8_t> texels;         // RGBA8 as stored, textures back to back (PmrTexture::offset)
+  std::vector<glm::vec2> texcoords;    // TEXCOORD set k of vertex v at k * vertices + v (at least one entry)
+};
+
+// Throws pmr::Error when the scene's material inputs do not fit its arrays (a map's texture or
+// TEXCOORD set missing: the loader never produces that) or the textures exceed 4 G texels.
+// A normal map is dropped (drawn with the interpolated normal) when the scene has no tangents.
+MaterialTables make_material_tables(const Scene& scene);
+
+// KHR_texture_transform of a slot as the 2x3 matrix of PmrTextureMap::uv_transform.
+void texture_transform_matrix(const SceneTextureSlot& slot, float out[6]);
+
+}  // namespace pmr

@@ -1,0 +1,71 @@
+#include "reference/material_reference.h"
+
+#include <cmath>
+
+#include "reference/shade_reference.h"
+
+namespace pmr::ref {
+
+glm::dvec2 transformed_uv(const SceneTextureSlot& slot, const glm::dvec2& uv) {
+  if (!slot.transform) return uv;
+  const double c = std::cos(double(slot.rotation)), s = std::sin(double(slot.rotation));
+  const double sx = slot.scale[0], sy = slot.scale[1];
+  return {sx * c * uv.x + sy * s * uv.y + slot.offset[0], -sx * s * uv.x + sy * c * uv.y + slot.offset[1]};
+}
+
+namespace {
+
+// The slot's texture at b, or nothing (false) when the slot has none.
+bool sample_slot(const Scene& scene, const PmrTriangle& t, const glm::dvec3& b, const SceneTextureSlot& slot,
+                 glm::dvec4& out) {
+  if (slot.texture < 0) return false;
+  glm::dvec2 uv(0.0);
+  for (int k = 0; k < 3; ++k) uv += b[k] * glm::dvec2(scene.texcoords[size_t(slot.texcoord)][t.v[k]]);
+  out = sample_texture(scene.textures[size_t(slot.texture)], transformed_uv(slot, uv), slot.srgb);
+  return true;
+}
+
+}  // namespace
+
+void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool back, SurfacePoint& sp) {
+  const PmrTriangle& t = scene.triangles[tri];
+  const PmrMaterial& mat = scene.materials[t.material];
+  sp.base = glm::dvec3(base_color(scene, tri, b));
+  glm::dvec3 n(t.face_normal[0], t.face_normal[1], t.face_normal[2]);
+  if (t.has_normals) {
+    glm::dvec3 sum(0.0);
+    for (int k = 0; k < 3; ++k) {
+      const float* nk = scene.attributes[t.v[k]].normal;
+      sum += b[k] * glm::dvec3(nk[0], nk[1], nk[2]);
+    }
+    if (glm::length(sum) > 0.0) n = glm::normalize(sum);
+  }
+  sp.metallic = mat.metallic, sp.roughness = mat.roughness;
+  sp.emissive = glm::dvec3(mat.emissive[0], mat.emissive[1], mat.emissive[2]);
+  sp.unlit = mat.unlit != 0;
+  sp.ao = 1.0;
+  if (t.material < scene.material_inputs.size()) {
+    const SceneMaterialInputs& in = scene.material_inputs[t.material];
+    sp.metallic = in.metallic, sp.roughness = in.roughness, sp.unlit = in.unlit;
+    sp.emissive = glm::dvec3(in.emissive[0], in.emissive[1], in.emissive[2]) * double(in.emissive_strength);
+    glm::dvec4 s;
+    if (sample_slot(scene, t, b, in.slots[kSlotMetallicRoughness], s)) sp.metallic *= s.z, sp.roughness *= s.y;
+    if (sample_slot(scene, t, b, in.slots[kSlotOcclusion], s)) sp.ao = 1.0 + in.occlusion_strength * (s.x - 1.0);
+    if (sample_slot(scene, t, b, in.slots[kSlotEmissive], s)) sp.emissive *= glm::dvec3(s);
+    if (!scene.tangents.empty() && sample_slot(scene, t, b, in.slots[kSlotNormal], s)) {
+      glm::dvec4 tw(0.0);
+      for (int k = 0; k < 3; ++k) tw += b[k] * glm::dvec4(scene.tangents[t.v[k]]);
+      glm::dvec3 tangent = glm::dvec3(tw) - n * glm::dot(n, glm::dvec3(tw));
+      if (glm::length(tangent) > 1e-9) {
+        tangent = glm::normalize(tangent);
+        const glm::dvec3 bitangent = (tw.w < 0.0 ? -1.0 : 1.0) * glm::cross(n, tangent);
+        const glm::dvec3 m = (2.0 * glm::dvec3(s) - 1.0) * glm::dvec3(in.normal_scale, in.normal_scale, 1.0);
+        const glm::dvec3 mapped = tangent * m.x + bitangent * m.y + n * m.z;
+        if (glm::length(mapped) > 0.0) n = glm::normalize(mapped);
+      }
+    }
+  }
+  sp.n = back ? -n : n;
+}
+
+}  // namespace pmr::ref

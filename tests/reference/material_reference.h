@@ -1,0 +1,23 @@
+// Double-precision reference of the physically based model's material inputs at a surface point
+// (docs/SHADING.md, "Materials"), read from the scene's material inputs as the loader stores them
+// (Scene::material_inputs, textures, texcoords, tangents), independently of how the pipeline packs
+// them for the kernels.
+#pragma once
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "pmr/scene.h"
+#include "reference/pbr_reference.h"
+
+namespace pmr::ref {
+
+// Fills base, metallic, roughness, n (the interpolated normal, the normal map, then the back-face
+// flip), ao, emissive and unlit of `sp` for source barycentrics b of triangle `tri`. p and eye are left
+// to the caller.
+void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool back, SurfacePoint& sp);
+
+// KHR_texture_transform of a slot applied to uv.
+glm::dvec2 transformed_uv(const SceneTextureSlot& slot, const glm::dvec2& uv);
+
+}  // namespace pmr::ref

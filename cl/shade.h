@@ -85,7 +85,7 @@ inline float2 split_sum(global const float2* t, float nv, float r) {
 
 /* Material map `map` of triangle t at source barycentrics b: its TEXCOORD set interpolated, then its
  * KHR_texture_transform. */
-inline float4 sample_map(const ShadeInputs* in, const PmrTextureMap* map, const PmrTriangle* t, float3 b, bool srgb) {
+inline float4 sample_map(const ShadeInputs* in, global const PmrTextureMap* map, const PmrTriangle* t, float3 b, bool srgb) {
   const uint set = map->texcoord * in->P->num_vertices;
   const float2 uv = b.x * in->texcoords[set + t->v[0]] + b.y * in->texcoords[set + t->v[1]] +
                     b.z * in->texcoords[set + t->v[2]];
@@ -98,7 +98,7 @@ inline float4 sample_map(const ShadeInputs* in, const PmrTextureMap* map, const 
 /* The normal map applied to the interpolated normal n (before any back-face flip): the interpolated
  * tangent made orthogonal to n, the bitangent sign(w) * cross(n, t), m = (2 s - 1) * (scale, scale, 1).
  * A vertex without a tangent (zero) leaves n as it is. */
-inline float3 mapped_normal(const ShadeInputs* in, const PmrMaterial* mat, const PmrTriangle* t, float3 b, float3 n) {
+inline float3 mapped_normal(const ShadeInputs* in, global const PmrMaterial* mat, const PmrTriangle* t, float3 b, float3 n) {
   const float4 tw = b.x * in->tangents[t->v[0]] + b.y * in->tangents[t->v[1]] + b.z * in->tangents[t->v[2]];
   float3 tangent = tw.xyz - n * dot(n, tw.xyz);
   const float len = length(tangent);
@@ -120,20 +120,21 @@ inline float3 mapped_normal(const ShadeInputs* in, const PmrMaterial* mat, const
 inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, float3 n, bool back, float3 base,
                         float3 light, int view) {
   global const PmrParams* P = in->P;
-  const PmrMaterial mat = in->materials[t->material];
-  if (mat.unlit) return base;
-  float metallic = mat.metallic, roughness = mat.roughness;
-  if (mat.maps[PMR_MAP_METALLIC_ROUGHNESS].texture >= 0) {
-    const float4 s = sample_map(in, &mat.maps[PMR_MAP_METALLIC_ROUGHNESS], t, b, false);
+  /* a pointer, not a copy: most voxels read a few of its 192 bytes */
+  global const PmrMaterial* mat = &in->materials[t->material];
+  if (mat->unlit) return base;
+  float metallic = mat->metallic, roughness = mat->roughness;
+  if (mat->maps[PMR_MAP_METALLIC_ROUGHNESS].texture >= 0) {
+    const float4 s = sample_map(in, &mat->maps[PMR_MAP_METALLIC_ROUGHNESS], t, b, false);
     metallic *= s.z, roughness *= s.y;
   }
-  if (mat.maps[PMR_MAP_NORMAL].texture >= 0) n = mapped_normal(in, &mat, t, b, n);
+  if (mat->maps[PMR_MAP_NORMAL].texture >= 0) n = mapped_normal(in, mat, t, b, n);
   if (back) n = -n; /* t, b and n together */
   float ao = 1.0f;
-  if (mat.maps[PMR_MAP_OCCLUSION].texture >= 0)
-    ao = 1.0f + mat.occlusion_strength * (sample_map(in, &mat.maps[PMR_MAP_OCCLUSION], t, b, false).x - 1.0f);
-  float3 emissive = vload3(0, mat.emissive);
-  if (mat.maps[PMR_MAP_EMISSIVE].texture >= 0) emissive *= sample_map(in, &mat.maps[PMR_MAP_EMISSIVE], t, b, true).xyz;
+  if (mat->maps[PMR_MAP_OCCLUSION].texture >= 0)
+    ao = 1.0f + mat->occlusion_strength * (sample_map(in, &mat->maps[PMR_MAP_OCCLUSION], t, b, false).x - 1.0f);
+  float3 emissive = vload3(0, mat->emissive);
+  if (mat->maps[PMR_MAP_EMISSIVE].texture >= 0) emissive *= sample_map(in, &mat->maps[PMR_MAP_EMISSIVE], t, b, true).xyz;
 
   const float3 p = b.x * vload3(t->v[0], in->positions) + b.y * vload3(t->v[1], in->positions) +
                    b.z * vload3(t->v[2], in->positions);
@@ -149,15 +150,15 @@ inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, f
 /* Unlit base colour (RGBA) at source barycentrics b of triangle `tri`. */
 inline float4 base_color(const ShadeInputs* in, uint tri, float3 b) {
   const PmrTriangle t = in->tris[tri];
-  const PmrMaterial mat = in->materials[t.material];
+  global const PmrMaterial* mat = &in->materials[t.material];
   global const PmrVertexAttr* a0 = &in->attrs[t.v[0]];
   global const PmrVertexAttr* a1 = &in->attrs[t.v[1]];
   global const PmrVertexAttr* a2 = &in->attrs[t.v[2]];
-  float4 c = (float4)(mat.base_color[0], mat.base_color[1], mat.base_color[2], mat.base_color[3]);
+  float4 c = (float4)(mat->base_color[0], mat->base_color[1], mat->base_color[2], mat->base_color[3]);
   const float4 vc = b.x * vload4(0, a0->color) + b.y * vload4(0, a1->color) + b.z * vload4(0, a2->color);
   c *= vc;
-  if (mat.texture >= 0) {
-    const PmrTexture tex = in->textures[mat.texture];
+  if (mat->texture >= 0) {
+    const PmrTexture tex = in->textures[mat->texture];
     const float u = b.x * a0->uv[0] + b.y * a1->uv[0] + b.z * a2->uv[0];
     const float v = b.x * a0->uv[1] + b.y * a1->uv[1] + b.z * a2->uv[1];
     c *= sample_texture(in->texels, in->srgb_lut, &tex, u, v, true);

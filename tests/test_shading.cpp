@@ -13,6 +13,14 @@
 namespace pmr {
 namespace {
 
+// These tests compare with the Lambert reference (tests/reference/shade_reference.cpp).
+PipelineConfig lambert() {
+  PipelineConfig pc;
+  pc.tile_x = pc.tile_y = pc.tile_v = 4;
+  pc.shading = Shading::Lambert;
+  return pc;
+}
+
 SceneTexture checker(int w, int h, int mode_s, int mode_t, bool alpha_holes) {
   SceneTexture t;
   t.width = w, t.height = h, t.wrap_s = mode_s, t.wrap_t = mode_t;
@@ -86,7 +94,7 @@ TEST(Shading, TexturedVertexColouredLitMatchesReference) {
   // a back-facing triangle (clockwise from the camera) behind, double-sided, without normals
   test::add_triangle(s, {-1.0f, -1.0f, -0.9f}, {-0.2f, 0.6f, -0.9f}, {0.8f, -0.9f, -0.8f});
   s.triangles.back().has_normals = 0;
-  const test::Rendered out = test::render(s, rig);
+  const test::Rendered out = test::render_with(s, rig, lambert());
   EXPECT_GT(compare_shading(s, rig, out), size_t(2000));
   size_t back = 0;
   for (const PmrMta& m : out.mtas) back += (m.flags & PMR_MTA_BACK) != 0;
@@ -110,7 +118,7 @@ TEST(Shading, AlphaMaskDiscardsBelowCutoff) {
   test::add_triangle(s, {-6, -3, 0.5f}, {6, 3, 0.5f}, {-6, 3, 0.5f}, 1);
   const float uv[6][2] = {{0, 4}, {8, 4}, {8, 0}, {0, 4}, {8, 0}, {0, 0}};
   for (int k = 0; k < 6; ++k) s.attributes[size_t(6 + k)].uv[0] = uv[k][0], s.attributes[size_t(6 + k)].uv[1] = uv[k][1];
-  const test::Rendered out = test::render(s, rig);
+  const test::Rendered out = test::render_with(s, rig, lambert());
   std::multimap<uint32_t, PmrMta> by_key;
   for (const PmrMta& m : out.mtas) by_key.emplace(m.key, m);
   const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);

@@ -36,6 +36,7 @@ SubpixelRender render_subpixels(const Scene& scene, const Rig& rig, const Displa
   PipelineConfig pc;
   pc.tile_x = tile[0], pc.tile_y = tile[1], pc.tile_v = tile[2];
   pc.sampling = Sampling::Subpixel;
+  pc.shading = Shading::Lambert;  // compared with the Lambert reference
   pc.fuse_encode = true;  // no view volume: debug outputs per display subpixel
   pc.debug_outputs = true;
   Pipeline p(test::runtime(), pc);

@@ -29,7 +29,7 @@ struct BenchOptions {
   std::vector<int> views = {1, 2, 4, 8, 16, 32, 48, 64, 96};
   std::vector<Method> methods = {Method::Pmr, Method::Multipass, Method::Duplicate};
   std::vector<Sampling> samplings = {Sampling::View};  // subpixel applies to pmr only
-  Shading shading = Shading::Lambert;
+  Shading shading = Shading::Pbr;
   double exposure_ev = 0.0, environment_intensity = 1.0;
   bool views_given = false;
   int frames = 5;
@@ -280,7 +280,7 @@ std::string bench_help() {
          "Times whole frames (render + encode, no file I/O) per view count and method.\n"
          "  --views LIST        view counts (default 1,2,4,8,16,32,48,64,96)\n"
          "  --method LIST       pmr, multipass, duplicate (default all three)\n"
-         "  --shading S, --exposure EV, --environment-intensity X   as for pmr render (default lambert)\n"
+         "  --shading S, --exposure EV, --environment-intensity X   as for pmr render (default pbr)\n"
          "  --sampling LIST     view, subpixel (default view; subpixel with pmr only): samples per frame are\n"
          "                      the voxels, or each display subpixel once\n"
          "  --frames K          timed frames per point after one warm-up frame (default 5)\n"

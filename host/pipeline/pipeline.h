@@ -62,7 +62,7 @@ struct PipelineConfig {
   // fuse_encode is off (a product needs them); debug outputs are per voxel of those views, or without
   // them per display subpixel ([row][3 * column + k]).
   Sampling sampling = Sampling::View;
-  Shading shading = Shading::Lambert;
+  Shading shading = Shading::Pbr;
   double exposure_ev = 0.0;            // colour x 2^EV, either model
   double environment_intensity = 1.0;  // pbr: scales the uniform default environment (radiance 0.2)
 };

@@ -463,9 +463,9 @@ class Gltf:
             {'attributes': dict(attrs), 'indices': indices, 'material': material, 'mode': 4}]})
         return (len(self.meshes) - 1, ntri)
 
-    def material(self, name, rgba, roughness=0.5, **extra):
+    def material(self, name, rgba, roughness=0.5, metallic=0.0, **extra):
         mat = {'name': name, 'pbrMetallicRoughness': {
-            'baseColorFactor': clean(rgba), 'metallicFactor': 0.0,
+            'baseColorFactor': clean(rgba), 'metallicFactor': f32(metallic),
             'roughnessFactor': f32(roughness)}}
         if 'texture' in extra:
             mat['pbrMetallicRoughness']['baseColorTexture'] = {'index': extra.pop('texture')}
@@ -552,13 +552,13 @@ def build():
     # Materials (baseColorFactor in linear RGB).
     m_floor = g.material('FloorTiles', (1.0, 1.0, 1.0, 1.0), 0.9, texture=tex_floor)
     m_red = g.material('Red', (0.80, 0.05, 0.04, 1.0), 0.35)
-    m_gold = g.material('Gold', (0.95, 0.58, 0.10, 1.0), 0.3)
+    m_gold = g.material('Gold', (0.95, 0.58, 0.10, 1.0), 0.3, metallic=1.0)
     m_rainbow = g.material('VertexRainbow', (1.0, 1.0, 1.0, 1.0), 0.4)
     m_cyan = g.material('Cyan', (0.05, 0.55, 0.75, 1.0), 0.4)
     m_flag = g.material('FlagMagenta', (0.75, 0.06, 0.45, 1.0), 0.8, doubleSided=True)
     m_grille = g.material('GrilleBronze', (1.0, 1.0, 1.0, 1.0), 0.45, texture=tex_grille,
                           alphaMode='MASK', alphaCutoff=0.5)
-    m_steel = g.material('Steel', (0.55, 0.56, 0.58, 1.0), 0.3)
+    m_steel = g.material('Steel', (0.55, 0.56, 0.58, 1.0), 0.3, metallic=1.0)
     m_green = g.material('Green', (0.10, 0.60, 0.12, 1.0), 0.5)
     m_blue = g.material('Blue', (0.06, 0.16, 0.80, 1.0), 0.45)
     m_orange = g.material('Orange', (0.95, 0.30, 0.02, 1.0), 0.5)

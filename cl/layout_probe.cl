@@ -28,4 +28,8 @@ kernel void layout_probe(global uint* out) {
   out[20] = sizeof(PmrEncodeParams);
   PROBE(21, PmrEncodeParams, display_w);
   PROBE(22, PmrEncodeParams, bilinear);
+  out[40] = sizeof(PmrEnvironment);
+  PROBE(41, PmrEnvironment, intensity);
+  PROBE(42, PmrEnvironment, levels);
+  out[43] = sizeof(PmrEnvLevel);
 }

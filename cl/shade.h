@@ -102,8 +102,9 @@ inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, f
   if (in->env->level_count == 0) {
     irradiance = prefiltered = (float3)(P->env_radiance);
   } else {
-    irradiance = env_irradiance(in->env, in->env_data, n);
-    prefiltered = env_prefiltered(in->env, in->env_data, 2.0f * nv * n - v, r); /* reflect(-v, n) */
+    const float4 uv = env_uv(in->env, n, 2.0f * nv * n - v); /* n and reflect(-v, n) */
+    irradiance = metallic < 1.0f ? env_irradiance(in->env, in->env_data, uv.xy) : (float3)(0.0f); /* c_diff = 0 */
+    prefiltered = env_prefiltered(in->env, in->env_data, uv.zw, r);
   }
   const float ao = 1.0f; /* ambient occlusion: scales the environment term only */
   const float3 ambient = ao * (base * (1.0f - metallic) * irradiance + (pbr_f0(base, metallic) * ab.x + ab.y) * prefiltered);

@@ -382,7 +382,7 @@ std::string render_help() {
          "  --environment FILE     pbr: light with an equirectangular image of linear radiance (.hdr or .exr,\n"
          "                         path relative to the current folder) instead of the uniform environment\n"
          "                         and the directional light; -Z is the image's middle column, +Y its top row;\n"
-         "                         prefiltered once per run (about 1 s for 1024x512). Needs --shading pbr\n"
+         "                         prefiltered once per run (1-2.5 s for 1024x512). Needs --shading pbr\n"
          "  --environment-rotation DEG  pbr: turn the image DEG degrees counter-clockwise seen from above\n"
          "                         (+X moves toward -Z; default 0)\n"
          "  --environment-intensity X  pbr: scales the environment, the image or the uniform one of radiance\n"

@@ -123,8 +123,8 @@ class Environment {
   void set_rotation(double degrees);
   void set_intensity(double intensity);
 
-  // Host-side evaluation from exactly the tables (as the kernels will sample them), intensity and
-  // rotation applied; directions need not be unit length (zero vectors read +Y).
+  // Host-side evaluation from exactly the tables (as cl/environment.h samples them on the device),
+  // intensity and rotation applied; directions need not be unit length (zero vectors read +Y).
   glm::dvec3 radiance(const glm::dvec3& d) const;                // the map: P(d, 0)
   glm::dvec3 irradiance(const glm::dvec3& n) const;              // I(n) = P(n, 1)
   glm::dvec3 prefiltered(const glm::dvec3& d, double r) const;   // P(d, r), r clamped to [0, 1]

@@ -72,7 +72,8 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
                           global const int* sample_x, global const int* sample_y,
                           global const PmrSampleChunk* chunks, uint num_chunks, global const int* straddle_slot,
                           uint straddle_slots, global uchar* straddle_cov, global half* display,
-                          uint debug, global uint* dbg_key, global float* dbg_depth) {
+                          uint debug, global uint* dbg_key, global float* dbg_depth,
+                          global const PmrEnvironment* env, global const float4* env_data) {
   const uint chunk = pmr_item_id();
   if (chunk >= num_chunks) return;
   const PmrSampleChunk ch = chunks[chunk];
@@ -147,7 +148,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
     }
 
   /* 2. Visibility: the tile's queues, every view slab. */
-  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents};
+  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, env_data};
   const double8 lane_d = convert_double8(lane);
   const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
   for (int tv = 0; tv < P->tiles_v; ++tv) {

@@ -31,4 +31,8 @@ kernel void layout_probe(global uint* out) {
   PROBE(23, PmrMaterial, maps);
   PROBE(24, PmrMaterial, occlusion_strength);
   out[25] = sizeof(PmrTextureMap);
+  out[40] = sizeof(PmrEnvironment);
+  PROBE(41, PmrEnvironment, intensity);
+  PROBE(42, PmrEnvironment, levels);
+  out[43] = sizeof(PmrEnvLevel);
 }

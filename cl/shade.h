@@ -2,12 +2,14 @@
  * baseColorTexture (sRGB-decoded, bilinear, glTF wrap modes) * COLOR_0, then either view-independent
  * Lambert with one directional light, or glTF metallic-roughness (cl/brdf.h) with the material's
  * metallic-roughness, normal, occlusion and emissive maps, seen from each view's own camera, lit by the
- * default directional light and the uniform default environment. */
+ * default directional light and the uniform default environment or an environment image
+ * (cl/environment.h). */
 #ifndef PMR_CL_SHADE_H
 #define PMR_CL_SHADE_H
 
 #include "common.h"
 #include "brdf.h"
+#include "environment.h"
 
 inline int wrap_texel(int c, int size, int mode) {
   if ((uint)c < (uint)size) return c; /* inside: every mode leaves it (and skips a division) */
@@ -70,6 +72,8 @@ typedef struct {
   global const float2* split_sum;  /* PMR_SPLIT_SUM_N^2 (A, B) (see PMR_SPLIT_SUM_N)             */
   global const float2* texcoords;  /* TEXCOORD set k of vertex v at k * num_vertices + v (pbr maps) */
   global const float4* tangents;   /* world tangent per vertex (w: bitangent sign), pbr normal maps */
+  global const PmrEnvironment* env; /* pbr: the environment image's tables, level_count 0 = none */
+  global const float4* env_data;    /* ... their data (cl/environment.h)                        */
 } ShadeInputs;
 
 /* The split-sum table's bilinear lookup, as pmr::split_sum (host/shading/environment.cpp) does it. */
@@ -114,9 +118,10 @@ inline float3 mapped_normal(const ShadeInputs* in, global const PmrMaterial* mat
 
 /* glTF metallic-roughness at source barycentrics b of triangle t with interpolated normal n (not yet
  * flipped for a back face) and base colour c, seen from view `view`'s camera: the material's maps
- * (metallic-roughness, normal, occlusion, emissive), the default light (E toward `light`) and the
- * uniform default environment of radiance L, for which I(n) = L and the prefiltered radiance is L, plus
- * the emissive term; an unlit material is its base colour. */
+ * (metallic-roughness, normal, occlusion, emissive), the default light (E toward `light`; the host sets
+ * E = 0 when it is off), the environment times the occlusion, plus the emissive term; an unlit material
+ * is its base colour. The environment is the image's I(n) and P(reflect(-v, n), r) when one is given,
+ * else the uniform default of radiance L, for which I(n) = P = L and no table is read. */
 inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, float3 n, bool back, float3 base,
                         float3 light, int view) {
   global const PmrParams* P = in->P;
@@ -140,11 +145,20 @@ inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, f
                    b.z * vload3(t->v[2], in->positions);
   const float3 v = normalize(in->eyes[view + (int)P->view_base].xyz - p);
   const float r = pbr_roughness(roughness);
-  const float3 direct = brdf_cos(base, metallic, r, n, v, light) * P->light_irradiance;
-  const float2 ab = split_sum(in->split_sum, clamp(dot(n, v), 0.0f, 1.0f), r);
-  const float L = P->env_radiance;
-  const float3 ambient = base * (1.0f - metallic) * L + (pbr_f0(base, metallic) * ab.x + ab.y) * L;
-  return direct + ao * ambient + emissive;
+  const float E = P->light_irradiance;
+  const float3 direct = E > 0.0f ? brdf_cos(base, metallic, r, n, v, light) * E : (float3)(0.0f);
+  const float nv = dot(n, v);
+  const float2 ab = split_sum(in->split_sum, clamp(nv, 0.0f, 1.0f), r);
+  float3 irradiance, prefiltered;
+  if (in->env->level_count == 0) {
+    irradiance = prefiltered = (float3)(P->env_radiance);
+  } else {
+    const float4 uv = env_uv(in->env, n, 2.0f * nv * n - v); /* n and reflect(-v, n) */
+    irradiance = metallic < 1.0f ? env_irradiance(in->env, in->env_data, uv.xy) : (float3)(0.0f); /* c_diff = 0 */
+    prefiltered = env_prefiltered(in->env, in->env_data, uv.zw, r);
+  }
+  const float3 ambient = ao * (base * (1.0f - metallic) * irradiance + (pbr_f0(base, metallic) * ab.x + ab.y) * prefiltered);
+  return direct + ambient + emissive;
 }
 
 /* Unlit base colour (RGBA) at source barycentrics b of triangle `tri`. */

@@ -5,11 +5,6 @@
 // The maximum errors are printed ("[env] ..."); docs/SHADING.md quotes them.
 #include <gtest/gtest.h>
 
-#include <ImfChannelList.h>
-#include <ImfFrameBuffer.h>
-#include <ImfHeader.h>
-#include <ImfOutputFile.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -20,6 +15,7 @@
 #include <limits>
 #include <thread>
 
+#include "environment_maps.h"
 #include "pmr/error.h"
 #include "shading/environment.h"
 
@@ -28,13 +24,13 @@ namespace {
 
 namespace fs = std::filesystem;
 constexpr double kPi = 3.14159265358979323846;
+using test::direction_of;
+using test::make_map;
+using test::sun_sky;
+using test::write_exr;
+const glm::dvec3 kSun = test::sun_direction();
 
 // ---- independent reference code -------------------------------------------------------------------
-
-glm::dvec3 direction_of(double u, double v) {  // DESIGN 4b, inverted
-  const double th = kPi * v, ph = 2.0 * kPi * (u - 0.5);
-  return {std::sin(th) * std::sin(ph), std::cos(th), -std::sin(th) * std::cos(ph)};
-}
 
 glm::dvec3 lookup(const EnvironmentImage& m, const glm::dvec3& d) {
   const glm::dvec3 n = glm::normalize(d);
@@ -111,42 +107,7 @@ glm::dvec3 around(glm::dvec3 c, double angle_deg, double azimuth) {
 
 // ---- test maps ------------------------------------------------------------------------------------
 
-EnvironmentImage make_map(int w, int h, const std::function<glm::dvec3(glm::dvec3)>& f) {
-  EnvironmentImage m;
-  m.width = w, m.height = h;
-  m.rgb.resize(size_t(w) * size_t(h) * 3);
-  for (int i = 0; i < h; ++i)
-    for (int j = 0; j < w; ++j) {
-      const glm::dvec3 v = f(direction_of((j + 0.5) / w, (i + 0.5) / h));
-      for (int c = 0; c < 3; ++c) m.rgb[(size_t(i) * size_t(w) + size_t(j)) * 3 + size_t(c)] = float(v[c]);
-    }
-  return m;
-}
-
-const glm::dvec3 kSun = glm::normalize(direction_of(0.6, 0.3));
-
-// A sky gradient, darker ground, and a sun disc of radius 3 degrees about 1000 times brighter.
-glm::dvec3 sun_sky(glm::dvec3 d) {
-  if (glm::dot(d, kSun) > std::cos(3.0 * kPi / 180)) return {2000.0, 1800.0, 1500.0};
-  if (d.y < 0) return glm::dvec3(0.12, 0.1, 0.08) * (1 + 0.5 * d.x);
-  return glm::dvec3(0.4, 0.6, 1.0) * (0.5 + 1.5 * d.y) + glm::dvec3(0.2, 0.1, 0.0) * (1 - d.y);
-}
-
 std::string temp_path(const std::string& name) { return ::testing::TempDir() + "pmr_env_" + name; }
-
-void write_exr(const std::string& path, const EnvironmentImage& m) {
-  Imf::Header h(m.width, m.height);
-  h.channels().insert("R", Imf::Channel(Imf::FLOAT));
-  h.channels().insert("G", Imf::Channel(Imf::FLOAT));
-  h.channels().insert("B", Imf::Channel(Imf::FLOAT));
-  Imf::OutputFile f(path.c_str(), h);
-  Imf::FrameBuffer fb;
-  const char* names[3] = {"R", "G", "B"};
-  for (int c = 0; c < 3; ++c)
-    fb.insert(names[c], Imf::Slice(Imf::FLOAT, (char*)(m.rgb.data() + c), 12, 12 * size_t(m.width)));
-  f.setFrameBuffer(fb);
-  f.writePixels(m.height);
-}
 
 // Minimal Radiance writer: run-length scanlines (dumps only) for widths 8..32767, flat otherwise.
 std::vector<unsigned char> hdr_bytes(const EnvironmentImage& m) {

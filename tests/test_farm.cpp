@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 
 using Env = std::map<std::string, std::string>;
 
-Environment from(const Env& env) {
+ProcessEnvironment from(const Env& env) {
   return [env](const char* name) -> const char* {
     auto it = env.find(name);
     return it == env.end() ? nullptr : it->second.c_str();

@@ -28,6 +28,11 @@ TEST(Layout, DeviceStructsMatchHost) {
       sizeof(PmrEncodeParams), offsetof(PmrEncodeParams, display_w), offsetof(PmrEncodeParams, bilinear),
       offsetof(PmrMaterial, maps), offsetof(PmrMaterial, occlusion_strength), sizeof(PmrTextureMap)};
   for (size_t i = 0; i < sizeof want / sizeof want[0]; ++i) EXPECT_EQ(got[i], want[i]) << "probe " << i;
+  // the environment header of --shading pbr (probes 40..43)
+  EXPECT_EQ(got[40], sizeof(PmrEnvironment));
+  EXPECT_EQ(got[41], offsetof(PmrEnvironment, intensity));
+  EXPECT_EQ(got[42], offsetof(PmrEnvironment, levels));
+  EXPECT_EQ(got[43], sizeof(PmrEnvLevel));
 }
 
 }  // namespace

@@ -9,9 +9,12 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <unistd.h>
 
+#include "environment_maps.h"
 #include "reference/material_reference.h"
 #include "reference/pbr_reference.h"
 #include "reference/shade_reference.h"
@@ -416,6 +419,239 @@ TEST(Pbr, MethodsShadeAlike) {
   }
   EXPECT_GT(same, covered * 9 / 10);
   EXPECT_GT(covered, size_t(1000));
+}
+
+
+// ---- environment images (--environment) ------------------------------------------------------------
+
+// The terms the kernels must reproduce: the host lookups of the very Environment they are given.
+ref::EnvironmentTerms image_environment(const Environment& e) {
+  ref::EnvironmentTerms env;
+  env.irradiance = [&e](const glm::dvec3& n) { return e.irradiance(n); };
+  env.prefiltered = [&e](const glm::dvec3& d, double r) { return e.prefiltered(d, r); };
+  env.split_sum = [](double nv, double r) { return split_sum(nv, r); };
+  return env;
+}
+
+// A 64x32 sky: a gradient, a darker ground and one sun texel about 1000 times brighter (tests/
+// environment_maps.h), seen in reflection by the default rig's camera on +Z.
+std::shared_ptr<Environment> sky_environment(double rotation_deg, double intensity) {
+  auto e = std::make_shared<Environment>(Environment::from_image(test::make_map(64, 32, test::sun_sky), "sky"));
+  e->set_rotation(rotation_deg);
+  e->set_intensity(intensity);
+  return e;
+}
+
+test::Rendered render_environment(const Scene& scene, const Rig& rig, const std::shared_ptr<const Environment>& e,
+                                  Method method = Method::Pmr) {
+  PipelineConfig pc;
+  pc.tile_x = 4, pc.tile_y = 4, pc.tile_v = 4;
+  pc.method = method;
+  pc.shading = Shading::Pbr;
+  pc.environment = e;
+  pc.environment_intensity = e->tables().header.intensity;
+  return test::render_with(scene, rig, pc);
+}
+
+// Every covered voxel against the reference lit by the environment alone (an image turns the default
+// light off): the number compared, and the largest error as a fraction of the bound (1% relative plus
+// 1e-3 absolute per channel); the first failures are reported.
+struct Agreement {
+  size_t compared = 0;
+  double worst = 0.0;
+};
+Agreement compare_with_environment(const Scene& s, const Rig& rig, const test::Rendered& out, const Environment& e,
+                                   const std::string& what) {
+  VoxelReference reference(s, rig, out);
+  reference.lights.clear();
+  reference.env = image_environment(e);
+  const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
+  Agreement a;
+  size_t bad = 0;
+  for (size_t v = 0; v < out.key.size(); ++v) {
+    if (out.key[v] == PMR_NO_KEY) continue;
+    const PmrMta* m = reference.mta(v);
+    if (!m) {
+      ADD_FAILURE() << what << ": no MTA for key " << out.key[v];
+      return a;
+    }
+    const glm::dvec3 want = reference.colour(v, *m);
+    for (int c = 0; c < 3; ++c) {
+      half got;
+      got.setBits(out.volume[v * 4 + size_t(c)]);
+      const double err = std::abs(double(float(got)) - want[c]), tol = 0.01 * std::abs(want[c]) + 1e-3;
+      a.worst = std::max(a.worst, err / tol);
+      if (err > tol && ++bad <= 5)
+        ADD_FAILURE() << what << ": voxel (" << v % W << "," << (v / W) % H << "," << v / (W * H) << ") channel " << c
+                      << ": " << float(got) << " vs " << want[c];
+    }
+    ++a.compared;
+  }
+  EXPECT_EQ(bad, 0u) << what;
+  return a;
+}
+
+// The kernels' lookups (cl/environment.h: polynomial atan2, log2 and exp2 in float) against the host's
+// in double precision, directly: random directions, the axes, the poles and the u seam, every
+// roughness from 0 to 1, a turned map with a sun. Within 1e-4 relative plus 1e-6 absolute (float
+// texel coordinates, next to a sun texel 1000 times brighter than its neighbours).
+TEST(PbrEnvironment, KernelLookupsMatchTheHost) {
+  const Environment e = *sky_environment(37.0, 1.7);
+  std::mt19937 g(11);
+  std::normal_distribution<double> N;
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  std::vector<glm::dvec3> dirs = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},     {0, -1, 0},     {0, 0, 1},
+                                  {0, 0, -1}, {1e-3, 0, 1}, {-1e-3, 0, 1}, {0.2, 0.98, 0.01}, test::sun_direction()};
+  while (dirs.size() < 4000) dirs.push_back(glm::normalize(glm::dvec3(N(g), N(g), N(g))));
+  std::vector<float> in;
+  std::vector<double> rs;
+  for (size_t i = 0; i < dirs.size(); ++i) {
+    const glm::vec3 d(dirs[i]);
+    rs.push_back(i % 10 == 0 ? double(i % 11) / 10.0 : U(g));
+    in.insert(in.end(), {d.x, d.y, d.z, float(rs.back())});
+  }
+  const ClRuntime& rt = test::runtime();
+  cl_program program = rt.build_program({"environment_probe.cl"}, "-cl-std=CL1.2");
+  std::vector<float> out(6 * dirs.size());
+  {
+    ClKernel k(program, "environment_probe");
+    const EnvironmentTables& t = e.tables();
+    ClBuffer h = rt.buffer(sizeof t.header, "probe header"), data = rt.buffer(t.data.size() * 4, "probe data"),
+             a = rt.buffer(in.size() * 4, "probe in"), b = rt.buffer(out.size() * 4, "probe out");
+    rt.write(h, &t.header, sizeof t.header);
+    rt.write(data, t.data.data(), t.data.size() * 4);
+    rt.write(a, in.data(), in.size() * 4);
+    k.args(h, data, a, b, cl_uint(dirs.size()));
+    clReleaseEvent(rt.launch(k, dirs.size(), 64));
+    rt.read(b, out.data(), out.size() * 4);
+  }
+  clReleaseProgram(program);
+  double worst = 0.0;
+  for (size_t i = 0; i < dirs.size(); ++i) {
+    const glm::dvec3 d = glm::dvec3(glm::vec3(dirs[i]));  // the float direction the kernel saw
+    const glm::dvec3 want[2] = {e.irradiance(d), e.prefiltered(d, double(float(rs[i])))};
+    for (int k = 0; k < 6; ++k) {
+      const double w = want[k / 3][k % 3], err = std::abs(double(out[6 * i + size_t(k)]) - w), tol = 1e-4 * w + 1e-6;
+      worst = std::max(worst, err / tol);
+      ASSERT_LE(err, tol) << "direction " << i << " (" << d.x << ", " << d.y << ", " << d.z << "), r " << rs[i]
+                          << (k < 3 ? ": I" : ": P") << " channel " << k % 3;
+    }
+  }
+  std::printf("[ env look ] %zu directions, largest error %.3f of the bound\n", dirs.size(), worst);
+}
+
+// Metal and dielectric spheres over roughness, and the material quads (vertex colours, curved normals,
+// emissive, unlit, a back face), under the sky at two rotations: every shaded voxel within the bound of
+// the reference evaluated with the same Environment's lookups.
+TEST(PbrEnvironment, SpheresAndQuadsMatchTheReference) {
+  const Rig rig = test::small_rig(5, 48, 32);
+  double worst = 0.0;
+  size_t compared = 0;
+  for (double rotation : {0.0, 130.0}) {
+    const std::shared_ptr<const Environment> e = sky_environment(rotation, 1.0);
+    for (float metallic : {1.0f, 0.0f})
+      for (float roughness : {0.2f, 0.3f, 0.47f, 0.75f, 1.0f}) {
+        const Scene s = sphere(0.9f, glm::vec3(0.0f), metallic, roughness);
+        const std::string what = "metallic " + std::to_string(metallic) + ", roughness " + std::to_string(roughness) +
+                                 ", rotation " + std::to_string(rotation);
+        const Agreement a = compare_with_environment(s, rig, render_environment(s, rig, e), *e, what);
+        EXPECT_GT(a.compared, size_t(800)) << what;
+        worst = std::max(worst, a.worst), compared += a.compared;
+      }
+    const Scene q = material_quads();
+    const Agreement a = compare_with_environment(q, rig, render_environment(q, rig, e), *e, "quads");
+    EXPECT_GT(a.compared, size_t(1000));
+    worst = std::max(worst, a.worst), compared += a.compared;
+  }
+  std::printf("[ pbr env  ] %zu voxels, largest error %.3f of the bound\n", compared, worst);
+}
+
+// Rotation turns the map counter-clockwise seen from above: a sun at +X turned by 90 degrees lights the
+// scene as a sun at -Z does (the same image shifted by a quarter of its width), and not as before.
+TEST(PbrEnvironment, RotationMovesTheSunAsDocumented) {
+  const Rig rig = test::small_rig(3, 48, 32);
+  auto sun_at = [](glm::dvec3 sun) {
+    return test::make_map(64, 32, [sun](glm::dvec3 d) {
+      return glm::dot(d, sun) > std::cos(0.2) ? glm::dvec3(50.0, 40.0, 30.0) : glm::dvec3(0.1, 0.2, 0.3);
+    });
+  };
+  auto turned = std::make_shared<Environment>(Environment::from_image(sun_at({1, 0, 0})));
+  const Environment unturned = *turned;
+  turned->set_rotation(90.0);
+  const auto behind = std::make_shared<const Environment>(Environment::from_image(sun_at({0, 0, -1})));
+  const Scene s = sphere(0.9f, glm::vec3(0.0f), 0.0f, 0.6f);
+  const test::Rendered a = render_environment(s, rig, turned), b = render_environment(s, rig, behind),
+                       c = render_environment(s, rig, std::make_shared<const Environment>(unturned));
+  size_t lit = 0, changed = 0;
+  for (size_t i = 0; i < a.volume.size(); ++i) {
+    if (i % 4 == 3 || a.key[i / 4] == PMR_NO_KEY) continue;
+    half x, y, z;
+    x.setBits(a.volume[i]), y.setBits(b.volume[i]), z.setBits(c.volume[i]);
+    ASSERT_NEAR(float(x), float(y), 2e-3 * std::abs(float(y)) + 1e-4) << "value " << i;
+    lit += float(x) > 0.0f;
+    changed += std::abs(float(x) - float(z)) > 0.1f * std::max(float(x), float(z));
+  }
+  EXPECT_GT(lit, size_t(1000));
+  EXPECT_GT(changed, lit / 4) << "turning the map by 90 degrees should relight the sphere";
+}
+
+// The intensity scales the image and 0 turns it off (and with an image the default light is off, so a
+// scene without emission renders black).
+TEST(PbrEnvironment, IntensityScalesAndZeroTurnsOff) {
+  const Rig rig = test::small_rig(3, 40, 24);
+  const Scene s = sphere(0.9f, glm::vec3(0.0f), 0.5f, 0.4f);
+  const test::Rendered one = render_environment(s, rig, sky_environment(0.0, 1.0)),
+                       more = render_environment(s, rig, sky_environment(0.0, 2.5)),
+                       off = render_environment(s, rig, sky_environment(0.0, 0.0));
+  size_t lit = 0;
+  for (size_t i = 0; i < one.volume.size(); ++i) {
+    if (i % 4 == 3 || one.key[i / 4] == PMR_NO_KEY) continue;
+    half x, y, z;
+    x.setBits(one.volume[i]), y.setBits(more.volume[i]), z.setBits(off.volume[i]);
+    ASSERT_NEAR(float(y), 2.5 * float(x), std::ldexp(2.5 * std::abs(float(x)), -9) + 1e-6) << "value " << i;
+    ASSERT_EQ(float(z), 0.0f) << "value " << i;
+    lit += float(x) > 0.0f;
+  }
+  EXPECT_GT(lit, size_t(1000));
+}
+
+// Every rendering path shades with the environment alike: multipass fed PMR's positions and the fused
+// raster + encode give PMR's values bit for bit; --sampling subpixel (which samples elsewhere) lights
+// the same scene to the same overall brightness.
+TEST(PbrEnvironment, PathsShadeAlike) {
+  const Rig rig = test::small_rig(5, 48, 32);
+  const Scene s = material_quads();
+  const std::shared_ptr<const Environment> e = sky_environment(30.0, 1.0);
+  PipelineConfig pc;
+  pc.shading = Shading::Pbr, pc.environment = e;
+  pc.tile_x = 4, pc.tile_y = 4, pc.tile_v = 4;
+  const test::Rendered pmr = test::render_with(s, rig, pc);
+  PipelineConfig snapped = pc;
+  snapped.method = Method::Multipass, snapped.multipass_snapped = true;
+  const test::Rendered multipass = test::render_with(s, rig, snapped);
+  EXPECT_EQ(pmr.volume, multipass.volume);
+  Display d;
+  d.width = 240, d.height = 135;
+  d.offset = default_offset(d.lens_pitch, rig.views);
+  PipelineConfig fused = pc;
+  fused.fuse_encode = true;
+  const test::EncodedRender f = test::render_encoded(s, rig, d, fused), u = test::render_encoded(s, rig, d, pc);
+  ASSERT_TRUE(f.fused);
+  EXPECT_EQ(f.image, u.image);
+  PipelineConfig subpixel = fused;
+  subpixel.sampling = Sampling::Subpixel;
+  const test::EncodedRender sp = test::render_encoded(s, rig, d, subpixel);
+  double sum_view = 0.0, sum_subpixel = 0.0;
+  size_t lit = 0;
+  for (size_t i = 0; i < f.image.size(); ++i) {
+    if (i % 4 == 3) continue;
+    half x, y;
+    x.setBits(f.image[i]), y.setBits(sp.image[i]);
+    sum_view += float(x), sum_subpixel += float(y);
+    lit += float(x) > 0.0f;
+  }
+  EXPECT_GT(lit, size_t(1000));
+  EXPECT_NEAR(sum_subpixel, sum_view, 0.05 * sum_view);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include "pmr/scene.h"
 #include "runtime/cl_runtime.h"
 #include "sequence/frame_renderer.h"
+#include "shading/environment.h"
 
 namespace pmr {
 
@@ -48,6 +49,11 @@ struct BenchOptions {
   bool turntable = false;
   double turntable_deg = 0.0;
   long turntable_frames = 1;
+  // --environment FILE and --environment-rotation DEG (pbr), prefiltered once for every point
+  std::string environment_file;
+  double environment_rotation_deg = 0.0;
+  bool environment_rotation_given = false;
+  std::shared_ptr<const Environment> environment;
 };
 
 std::vector<std::string> split(const std::string& s) {
@@ -87,6 +93,12 @@ BenchOptions parse(const std::vector<std::string>& args) {
       o.exposure_ev = parse_exposure(value());
     } else if (a == "--environment-intensity") {
       o.environment_intensity = parse_environment_intensity(value());
+    } else if (a == "--environment") {
+      o.environment_file = value();
+      if (o.environment_file.empty()) throw Error("invalid --environment '': expected a .hdr or .exr file");
+    } else if (a == "--environment-rotation") {
+      o.environment_rotation_deg = parse_environment_rotation(value());
+      o.environment_rotation_given = true;
     } else if (a == "--frames") {
       const std::string v = value();
       o.frames = std::atoi(v.c_str());
@@ -130,6 +142,9 @@ BenchOptions parse(const std::vector<std::string>& args) {
   o.animation = r.animation, o.fps = r.fps;
   o.turntable = r.turntable, o.turntable_deg = r.turntable_deg, o.turntable_frames = r.turntable ? r.turntable_frames : 1;
   if (o.methods.empty() || o.views.empty() || o.samplings.empty()) throw Error("nothing to measure");
+  std::vector<std::string> warnings;
+  check_environment_options(o.environment_file, o.environment_rotation_given, o.shading, warnings);
+  for (const std::string& w : warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
   const bool subpixel = std::find(o.samplings.begin(), o.samplings.end(), Sampling::Subpixel) != o.samplings.end();
   // subpixel rows are measured for pmr alone (the other methods' rows are skipped)
   if (subpixel) {
@@ -219,6 +234,7 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       pc.method = method;
       pc.sampling = sampling;
       pc.shading = o.shading, pc.exposure_ev = o.exposure_ev, pc.environment_intensity = o.environment_intensity;
+      pc.environment = o.environment;
       pc.tile_x = o.tile[0], pc.tile_y = o.tile[1], pc.tile_v = o.tile[2];
       pc.fuse_encode = true;  // the encoded-only job, as pmr render runs it
       Pipeline p(rt, pc);
@@ -280,7 +296,8 @@ std::string bench_help() {
          "Times whole frames (render + encode, no file I/O) per view count and method.\n"
          "  --views LIST        view counts (default 1,2,4,8,16,32,48,64,96)\n"
          "  --method LIST       pmr, multipass, duplicate (default all three)\n"
-         "  --shading S, --exposure EV, --environment-intensity X   as for pmr render (default pbr)\n"
+         "  --shading S, --exposure EV, --environment FILE, --environment-rotation DEG,\n"
+         "  --environment-intensity X   as for pmr render (default pbr)\n"
          "  --sampling LIST     view, subpixel (default view; subpixel with pmr only): samples per frame are\n"
          "                      the voxels, or each display subpixel once\n"
          "  --frames K          timed frames per point after one warm-up frame (default 5)\n"
@@ -318,6 +335,14 @@ int run_bench(const std::vector<std::string>& args) {
   if (!o.csv.empty()) {
     csv.reset(new std::ofstream(o.csv));
     if (!*csv) throw Error("cannot write " + o.csv);
+  }
+  if (!o.environment_file.empty()) {  // prefiltered once, before the first point
+    o.environment = std::make_shared<const Environment>(
+        Environment::make({o.environment_file, o.environment_rotation_deg, o.environment_intensity}));
+    const PmrEnvironment& h = o.environment->tables().header;
+    std::printf("# environment %s: %ux%u, prefiltered in %.2f s (%.1f MB of tables)\n", o.environment_file.c_str(),
+                h.levels[0].width, h.levels[0].height, o.environment->prefilter_seconds(),
+                double(o.environment->tables().data.size() * sizeof(float)) / 1e6);
   }
   ClRuntime rt;
   const double bw = copy_bandwidth(rt);

@@ -37,6 +37,18 @@ double parse_environment_intensity(const std::string& text) {
   return x;
 }
 
+double parse_environment_rotation(const std::string& text) {
+  return parse_double(text, "--environment-rotation");  // any finite angle
+}
+
+void check_environment_options(const std::string& file, bool rotation_given, Shading shading,
+                               std::vector<std::string>& warnings) {
+  if (!file.empty() && shading != Shading::Pbr)
+    throw Error("--environment lights the pbr model only: add --shading pbr");
+  if (file.empty() && rotation_given)
+    warnings.push_back("--environment-rotation turns an environment image: without --environment it does nothing");
+}
+
 namespace {
 
 int parse_int(const std::string& text, const std::string& opt, int lo, int hi) {
@@ -206,6 +218,13 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     else if (a == "--shading") o.pipeline.shading = parse_shading(value());
     else if (a == "--exposure") o.pipeline.exposure_ev = parse_exposure(value());
     else if (a == "--environment-intensity") o.pipeline.environment_intensity = parse_environment_intensity(value());
+    else if (a == "--environment") {
+      o.environment_file = value();
+      if (o.environment_file.empty()) throw Error("invalid --environment '': expected a .hdr or .exr file");
+    } else if (a == "--environment-rotation") {
+      o.environment_rotation_deg = parse_environment_rotation(value());
+      o.environment_rotation_given = true;
+    }
     else if (a == "--camera-spacing") {
       const std::string v = value();
       if (v != "linear" && v != "angular") throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
@@ -249,6 +268,7 @@ std::string frame_stem(const std::string& pattern, long frame) {
 }
 
 void finalize_render_options(RenderOptions& o) {
+  check_environment_options(o.environment_file, o.environment_rotation_given, o.pipeline.shading, o.option_warnings);
   if (o.pipeline.sampling == Sampling::Subpixel) {
     if (o.rig.angular_spacing)
       throw Error("--sampling subpixel rasterizes with PMR, which needs evenly spaced views: add --camera-spacing linear");
@@ -355,10 +375,18 @@ std::string render_help() {
          "shading (docs/SHADING.md):\n"
          "  --shading S            pbr (default): glTF metallic-roughness with every material map, seen from\n"
          "                         each view's own camera, so highlights move across the views; lit by a\n"
-         "                         directional light and a uniform environment; lambert: base colour x\n"
-         "                         (0.2 + 0.8 max(0, n.l)), the same in every view (faster)\n"
+         "                         directional light and a uniform environment, or by --environment;\n"
+         "                         lambert: base colour x (0.2 + 0.8 max(0, n.l)), the same in every view\n"
+         "                         (faster)\n"
          "  --exposure EV          the colour times 2^EV, either model (default 0)\n"
-         "  --environment-intensity X  pbr: scales the uniform environment of radiance 0.2 (0 turns it off)\n"
+         "  --environment FILE     pbr: light with an equirectangular image of linear radiance (.hdr or .exr,\n"
+         "                         path relative to the current folder) instead of the uniform environment\n"
+         "                         and the directional light; -Z is the image's middle column, +Y its top row;\n"
+         "                         prefiltered once per run (1-2.5 s for 1024x512). Needs --shading pbr\n"
+         "  --environment-rotation DEG  pbr: turn the image DEG degrees counter-clockwise seen from above\n"
+         "                         (+X moves toward -Z; default 0)\n"
+         "  --environment-intensity X  pbr: scales the environment, the image or the uniform one of radiance\n"
+         "                         0.2 (0 turns it off; default 1)\n"
          "  --verbose              per-stage device times and queue sizes\n"
          "Environment: PMR_DEVICE=substring selects the OpenCL device by name (default: first CPU device).\n";
 }

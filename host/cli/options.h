@@ -9,9 +9,16 @@
 
 namespace pmr {
 
-// --exposure EV and --environment-intensity X, checked (shared by render and bench).
+// --exposure EV, --environment-intensity X and --environment-rotation DEG, checked (shared by render
+// and bench).
 double parse_exposure(const std::string& text);
 double parse_environment_intensity(const std::string& text);
+double parse_environment_rotation(const std::string& text);
+// Checks --environment and --environment-rotation against the shading model: an environment image
+// lights --shading pbr only (an error with lambert); a rotation without an image is a warning, added
+// to `warnings`.
+void check_environment_options(const std::string& file, bool rotation_given, Shading shading,
+                               std::vector<std::string>& warnings);
 
 struct RenderOptions {
   std::string scene;            // empty = the bundled default scene
@@ -46,6 +53,11 @@ struct RenderOptions {
   bool help = false;
   bool preset_help = false;  // --preset help
   bool method_given = false;   // --method was on the command line
+  // pbr: --environment FILE (relative to the current folder; "" = the uniform default) and its
+  // --environment-rotation (the intensity is pipeline.environment_intensity)
+  std::string environment_file;
+  double environment_rotation_deg = 0.0;
+  bool environment_rotation_given = false;
 };
 
 // Parses the arguments after `render`. Throws pmr::Error with one line on bad input.

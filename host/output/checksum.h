@@ -21,4 +21,8 @@ std::string checksum_hex(uint64_t h);
 // checksum_hex(checksum64(data, size)).
 std::string checksum_hex(const void* data, size_t size);
 
+// The checksum (as checksum_hex) of a whole file, read in pieces; throws pmr::Error naming it when it
+// cannot be read.
+std::string checksum_file(const std::string& path);
+
 }  // namespace pmr

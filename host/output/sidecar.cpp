@@ -64,11 +64,19 @@ json matrix_json(const glm::dmat4& m) {
 json vec3_json(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }
 
 // The shading model and its light as used (docs/SHADING.md). Sidecars written before --shading existed
-// have none: they were lambert at exposure 0.
+// have none: they were lambert at exposure 0. An environment image is recorded by its file (as given),
+// the checksum of its bytes, rotation and intensity, so --resume renders again when any of them changes.
 json shading_json(const SidecarInfo& info) {
   json s = {{"model", info.shading}, {"exposure_ev", info.exposure_ev}};
-  if (info.shading == "pbr")
+  if (info.shading == "pbr" && info.environment_file.empty())
     s["environment"] = {{"kind", "uniform"}, {"radiance", 0.2 * info.environment_intensity},
+                        {"intensity", info.environment_intensity}};
+  else if (info.shading == "pbr")
+    s["environment"] = {{"kind", "image"},
+                        {"file", info.environment_file},
+                        {"checksum", info.environment_checksum},
+                        {"checksum_algorithm", kChecksumAlgorithm},
+                        {"rotation_deg", info.environment_rotation_deg},
                         {"intensity", info.environment_intensity}};
   return s;
 }

@@ -78,6 +78,7 @@ struct Pipeline::Impl {
   ClBuffer eyes, split_sum;  // each view's camera position (per frame); the pbr split-sum table
   ClBuffer texcoords, tangents;  // the TEXCOORD sets the material maps sample; world tangents (pbr)
   bool has_tangents = false;
+  ClBuffer env, env_data;    // pbr: the environment image's header and tables (level_count 0: none)
   // frame
   PmrParams params{};
   PmrEncodeParams encode_params{};
@@ -199,6 +200,30 @@ void check_subpixel_sampling(Method method, const Display& display) {
                 "apply to --sampling view only");
 }
 
+namespace {
+
+// The environment image's tables, uploaded once per pipeline (the Environment is prefiltered once per
+// process and shared); without one, an empty header (level_count 0) selects the uniform default.
+void upload_environment(Pipeline::Impl& m, const PipelineConfig& config) {
+  const Environment* e = config.environment.get();
+  if (e && config.shading != Shading::Pbr) throw Error("an environment image needs --shading pbr");
+  if (e && e->tables().header.intensity != float(config.environment_intensity))
+    throw Error("internal error: the environment's intensity differs from the configuration's");
+  const PmrEnvironment none{};
+  const std::vector<float> no_data(4, 0.0f);
+  const PmrEnvironment& header = e ? e->tables().header : none;
+  const std::vector<float>& data = e ? e->tables().data : no_data;
+  if (bytes_of(data) > m.rt.max_alloc_bytes())
+    throw Error("the environment's tables need " + std::to_string(bytes_of(data) >> 20) + " MiB, more than the device "
+                "can allocate at once (" + std::to_string(m.rt.max_alloc_bytes() >> 20) + " MiB): use a smaller image");
+  m.env = m.rt.buffer(sizeof header, "environment header", CL_MEM_READ_ONLY);
+  m.rt.write(m.env, &header, sizeof header);
+  m.env_data = m.rt.buffer(bytes_of(data), "environment tables", CL_MEM_READ_ONLY);
+  m.rt.write(m.env_data, data.data(), bytes_of(data));
+}
+
+}  // namespace
+
 Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
     : impl_(new Impl(runtime)), config_(config) {
   tile_[0] = config.tile_x, tile_[1] = config.tile_y, tile_[2] = config.tile_v;
@@ -238,6 +263,7 @@ Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
   const std::vector<float>& table = config.shading == Shading::Pbr ? split_sum_table() : none;
   m.split_sum = runtime.buffer(bytes_of(table), "split-sum table", CL_MEM_READ_ONLY);
   runtime.write(m.split_sum, table.data(), bytes_of(table));
+  upload_environment(m, config);
 }
 
 Pipeline::~Pipeline() = default;
@@ -460,7 +486,7 @@ void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
 
 void Pipeline::Impl::fine_stage(Events& ev) {
   k_fine.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents, volume,
-              dbg_key, dbg_depth, dbg_count);
+              dbg_key, dbg_depth, dbg_count, env, env_data);
   ev.add(kFine, launch(k_fine, size_t(num_tiles), kFineGroup));
 }
 
@@ -557,7 +583,7 @@ void Pipeline::Impl::subpixel_stage(Events& ev) {
   k_fine_subpixel.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents,
                        encode_buf, column_a, column_b, encode_rows, sample_x, sample_y, chunks, warming ? 0u : num_chunks,
                        straddle_slot, straddle_slots,
-                       straddle_cov, display, cl_uint(subpixel_debug), dbg_key, dbg_depth);
+                       straddle_cov, display, cl_uint(subpixel_debug), dbg_key, dbg_depth, env, env_data);
   ev.add(kFine, launch(k_fine_subpixel, num_chunks, 1));
   straddle_alpha_stage(k_subpixel_straddle, ev);
 }
@@ -566,7 +592,7 @@ void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
   k_fine_encode.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents,
                      encode_buf, column_soa, encode_rows, column_start, row_start, straddle_slot, straddle_slots,
-                     straddle_cov, display);
+                     straddle_cov, display, env, env_data);
   const size_t screen_tiles = size_t(P.tiles_x) * P.tiles_y;
   ev.add(kFine, launch(k_fine_encode, screen_tiles, 1));
   straddle_alpha_stage(k_straddle_alpha, ev);
@@ -593,7 +619,8 @@ StageTimes Pipeline::render(const Rig& rig) {
   P.shading = config_.shading == Shading::Pbr ? PMR_SHADING_PBR : PMR_SHADING_LAMBERT;
   P.exposure = float(std::exp2(config_.exposure_ev));
   P.env_radiance = float(0.2 * config_.environment_intensity);
-  P.light_irradiance = float(0.8 * glm::pi<double>());
+  // the default light shines only when no environment image is given (and the scene has no lights)
+  P.light_irradiance = config_.environment ? 0.0f : float(0.8 * glm::pi<double>());
   {  // each view's camera position in world space (the view vector of pbr; the camera may move)
     std::vector<glm::vec4> eyes(size_t(rig.views));
     for (int i = 0; i < rig.views; ++i) eyes[size_t(i)] = glm::vec4(glm::vec3(glm::inverse(rig.view_matrix(i))[3]), 1.0f);
@@ -688,7 +715,7 @@ size_t Pipeline::device_bytes() const {
                             &m.encode_buf, &m.vertices, &m.pmr_vertices, &m.mtas, &m.mta_counter, &m.tile_counts,
                             &m.tile_offsets, &m.tile_queue, &m.volume, &m.display, &m.encode_columns, &m.encode_rows, &m.dbg_key, &m.dbg_depth, &m.dbg_count,
                             &m.column_start, &m.column_soa, &m.row_start, &m.straddle_slot, &m.straddle_columns, &m.straddle_cov,
-                            &m.chunks, &m.sample_x, &m.sample_y, &m.column_a, &m.column_b, &m.eyes, &m.split_sum})
+                            &m.chunks, &m.sample_x, &m.sample_y, &m.column_a, &m.column_b, &m.eyes, &m.split_sum, &m.env, &m.env_data})
     total += b->get() ? b->size() : 0;
   return total;
 }

@@ -15,6 +15,8 @@
 
 namespace pmr {
 
+class Environment;
+
 // How the N views are rasterized. All three produce the same images (see tests/test_methods.cpp).
 enum class Method {
   Pmr,        // multi-view triangles over (x, y, view): the paper's method
@@ -65,6 +67,10 @@ struct PipelineConfig {
   Shading shading = Shading::Pbr;
   double exposure_ev = 0.0;            // colour x 2^EV, either model
   double environment_intensity = 1.0;  // pbr: scales the uniform default environment (radiance 0.2)
+  // pbr: an environment image, prefiltered once (Environment::make) and shared by every pipeline of
+  // a process; its rotation and intensity are its own (the intensity must equal environment_intensity).
+  // It replaces the uniform default and turns the default light off. Null: the uniform default.
+  std::shared_ptr<const Environment> environment;
 };
 
 struct StageTimes {  // milliseconds

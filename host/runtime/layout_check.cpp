@@ -19,3 +19,7 @@ static_assert(sizeof(PmrTexture) == 32, "PmrTexture layout");
 static_assert(sizeof(PmrEncodeParams) == 48 && offsetof(PmrEncodeParams, display_w) == 0, "PmrEncodeParams layout");
 static_assert(sizeof(PmrEncodeColumn) == 16 && sizeof(PmrEncodeRow) == 16, "encoder table layout");
 static_assert(sizeof(PmrSampleChunk) == 32, "PmrSampleChunk layout");
+static_assert(sizeof(PmrEnvLevel) == 16 && offsetof(PmrEnvLevel, roughness) == 12, "PmrEnvLevel layout");
+static_assert(sizeof(PmrEnvironment) == 32 + 16 * PMR_ENV_MAX_LEVELS && offsetof(PmrEnvironment, intensity) == 20 &&
+                  offsetof(PmrEnvironment, levels) == 32,
+              "PmrEnvironment layout");

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "output/checksum.h"
 #include "output/interrupt.h"
 #include "pmr/error.h"
 #include "pmr/output.h"
@@ -26,6 +27,7 @@
 #include "sequence/range_warning.h"
 #include "sequence/resume_plan.h"
 #include "sequence/shard.h"
+#include "shading/environment.h"
 
 namespace pmr {
 
@@ -51,6 +53,20 @@ int run_sequence(const RenderOptions& o) {
   make_encode_params(o.display, o.rig.views, o.rig.view_w, o.rig.view_h);
 
   for (const auto& w : o.option_warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
+  // The environment image, prefiltered once for every frame (before the scene: a bad file fails fast).
+  std::shared_ptr<const Environment> environment;
+  std::string environment_checksum;
+  if (!o.environment_file.empty()) {
+    environment = std::make_shared<const Environment>(Environment::make(
+        {o.environment_file, o.environment_rotation_deg, o.pipeline.environment_intensity}));
+    environment_checksum = checksum_file(o.environment_file);
+    if (o.verbose) {
+      const PmrEnvironment& h = environment->tables().header;
+      std::fprintf(stderr, "pmr: environment %s: %ux%u, prefiltered in %.2f s (%.1f MB of tables)\n",
+                   o.environment_file.c_str(), h.levels[0].width, h.levels[0].height, environment->prefilter_seconds(),
+                   double(environment->tables().data.size() * sizeof(float)) / 1e6);
+    }
+  }
   const Scene scene = load_scene(o.scene);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
   SequenceSpec spec;
@@ -102,6 +118,9 @@ int run_sequence(const RenderOptions& o) {
   info.shading = to_string(o.pipeline.shading);
   info.exposure_ev = o.pipeline.exposure_ev;
   info.environment_intensity = o.pipeline.environment_intensity;
+  info.environment_file = o.environment_file;
+  info.environment_checksum = environment_checksum;
+  info.environment_rotation_deg = o.environment_rotation_deg;
   info.camera = o.rig.camera;
   info.has_bounds = true;
   info.bounds_lo = renderer.bounds_lo();
@@ -170,6 +189,7 @@ int run_sequence(const RenderOptions& o) {
   PipelineConfig pc = o.pipeline;
   pc.fuse_encode = !need_volume;  // the volume is only kept when a product needs it
   pc.debug_outputs = o.write_depth;  // per-voxel depth
+  pc.environment = environment;
   Pipeline pipeline(runtime, pc);
   renderer.attach(pipeline, o.write_encoded ? &o.display : nullptr);  // builds every kernel the frames use
   if (o.verbose) {

@@ -19,7 +19,7 @@ bool read_long(const char* text, long& out) {
   return true;
 }
 
-long env_long(const Environment& env, const char* name, bool& present) {
+long env_long(const ProcessEnvironment& env, const char* name, bool& present) {
   long v = 0;
   const char* text = env(name);
   present = read_long(text, v);
@@ -45,7 +45,7 @@ long position(long id, long first, long step, const std::string& source) {
 
 }  // namespace
 
-Shard parse_shard(const std::string& text, long shard_count, long shard_first, const Environment& env) {
+Shard parse_shard(const std::string& text, long shard_count, long shard_first, const ProcessEnvironment& env) {
   if (text != "auto") {
     long k = 0, n = 0;
     const auto slash = text.find('/');

@@ -62,9 +62,11 @@
 
 #include <glm/glm.hpp>
 
+#include "pmr/shared.h"
+
 namespace pmr {
 
-constexpr int kEnvMaxLevels = 16;
+constexpr int kEnvMaxLevels = PMR_ENV_MAX_LEVELS;
 constexpr int kEnvRoughnessNodes = 101;  // r = 0, 0.01, ..., 1: every level's r is a node
 constexpr int kEnvSplitSumSize = 64;
 constexpr int kEnvMaxBaseWidth = 4096;  // level 0 is box-downsampled by 2 until it is at most this wide
@@ -73,23 +75,9 @@ constexpr int kEnvMaxBaseWidth = 4096;  // level 0 is box-downsampled by 2 until
 constexpr uint64_t kEnvMaxTexels = uint64_t(1) << 25;
 constexpr uint64_t kEnvMaxFileBytes = uint64_t(1) << 28;
 
-// C-compatible (32-bit scalars only) description of EnvironmentTables::data, to be mirrored in the
-// kernels' shared header when they sample it.
-struct EnvLevel {
-  uint32_t width, height;  // texels
-  uint32_t offset;         // float offset of texel (0, 0) in data
-  float roughness;         // r of this level
-};
-struct EnvTablesHeader {
-  uint32_t level_count;       // levels in use (level 0 = the image)
-  uint32_t roughness_nodes;   // kEnvRoughnessNodes
-  uint32_t roughness_offset;  // float offset of c(r)
-  uint32_t split_sum_size;    // kEnvSplitSumSize
-  uint32_t split_sum_offset;  // float offset of the (A, B) table
-  float intensity;            // multiplies every radiance read (0 = off)
-  float rotation_cos, rotation_sin;  // of the map's rotation angle
-  EnvLevel levels[kEnvMaxLevels];
-};
+// The description of EnvironmentTables::data, shared with the kernels (include/pmr/shared.h).
+using EnvLevel = PmrEnvLevel;
+using EnvTablesHeader = PmrEnvironment;
 
 struct EnvironmentTables {
   EnvTablesHeader header{};
@@ -135,8 +123,8 @@ class Environment {
   void set_rotation(double degrees);
   void set_intensity(double intensity);
 
-  // Host-side evaluation from exactly the tables (as the kernels will sample them), intensity and
-  // rotation applied; directions need not be unit length (zero vectors read +Y).
+  // Host-side evaluation from exactly the tables (as cl/environment.h samples them on the device),
+  // intensity and rotation applied; directions need not be unit length (zero vectors read +Y).
   glm::dvec3 radiance(const glm::dvec3& d) const;                // the map: P(d, 0)
   glm::dvec3 irradiance(const glm::dvec3& n) const;              // I(n) = P(n, 1)
   glm::dvec3 prefiltered(const glm::dvec3& d, double r) const;   // P(d, r), r clamped to [0, 1]

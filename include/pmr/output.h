@@ -153,6 +153,10 @@ struct SidecarInfo {
   std::string scene_checksum;
   std::vector<std::pair<std::string, std::string>> scene_files;
   std::string display_config_checksum;
+  // pbr: the environment image (--environment as given, "" = the uniform default), its checksum and
+  // rotation (its intensity is environment_intensity)
+  std::string environment_file, environment_checksum;
+  double environment_rotation_deg = 0.0;
 };
 
 // The sidecar's JSON text (pretty printed, doubles with round-trip precision).

@@ -250,4 +250,27 @@ typedef struct {
   pmr_i32 pad0, pad1, pad2;
 } PmrSampleChunk;
 
+/* --shading pbr with an environment image (--environment): where the prefiltered tables lie in the
+ * environment data buffer (host/shading/environment.h describes the tables, the mapping and how they
+ * are sampled; its Environment::level_sample, irradiance and prefiltered are the kernels' lookups in
+ * double precision). Producer: host/shading/environment.cpp; the pipeline uploads it and the float data.
+ * level_count == 0 (no image) selects the uniform default environment, which reads no table. */
+#define PMR_ENV_MAX_LEVELS 16
+typedef struct {
+  pmr_u32 width, height;  /* texels                                                          */
+  pmr_u32 offset;         /* float offset of texel (0, 0) in the data, a multiple of 4 (RGB0 texels) */
+  float roughness;        /* r of this level (level 0: 0, the image)                          */
+} PmrEnvLevel;
+
+typedef struct {
+  pmr_u32 level_count;       /* levels in use (level 0 = the image, the last r = 1); 0 = no image */
+  pmr_u32 roughness_nodes;   /* nodes of c(r), the fractional level coordinate, at r = i / (nodes - 1) */
+  pmr_u32 roughness_offset;  /* float offset of c(r)                                        */
+  pmr_u32 split_sum_size;    /* the split-sum table (PMR_SPLIT_SUM_N)                        */
+  pmr_u32 split_sum_offset;  /* float offset of its (A, B) pairs                             */
+  float intensity;           /* multiplies every radiance read (0 = off)                     */
+  float rotation_cos, rotation_sin;  /* of the map's rotation (counter-clockwise seen from above) */
+  PmrEnvLevel levels[PMR_ENV_MAX_LEVELS];
+} PmrEnvironment;
+
 #endif /* PMR_SHARED_H */

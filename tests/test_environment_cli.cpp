@@ -1,0 +1,106 @@
+// --environment and --environment-rotation on the command line: bad files and options fail with one
+// line and write nothing, the sidecar records the environment, and --resume notices when it changes.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "environment_maps.h"
+#include "output/checksum.h"
+#include "test_util.h"
+
+namespace pmr {
+namespace {
+
+using test::count_entries;
+using test::expect_one_error_line;
+using test::run;
+using test::temp_dir;
+
+const std::string kSmall = " --views 4 --view-size 48x24 --display 192x108 --shading pbr";
+
+// A 64x32 sky with a sun (tests/environment_maps.h) in `dir`.
+std::string write_sky(const std::string& dir, const std::string& name, double scale = 1.0) {
+  std::system(("mkdir -p '" + dir + "'").c_str());
+  const std::string path = dir + "/" + name;
+  test::write_exr(path, test::make_map(64, 32, [scale](glm::dvec3 d) { return scale * test::sun_sky(d); }));
+  return path;
+}
+
+nlohmann::json sidecar(const std::string& out) {
+  std::ifstream in(out + "/frame_0000.json");
+  return nlohmann::json::parse(in);
+}
+
+TEST(EnvironmentCli, BadEnvironmentsFailWithOneLineAndWriteNothing) {
+  const std::string out = temp_dir("env_bad");
+  expect_one_error_line(run("render" + kSmall + " --environment missing.hdr --out " + out), "missing.hdr");
+  const std::string dir = temp_dir("env_bad_files");
+  std::system(("mkdir -p '" + dir + "'").c_str());
+  std::ofstream(dir + "/broken.exr") << "not an image";
+  expect_one_error_line(run("render" + kSmall + " --environment '" + dir + "/broken.exr' --out " + out), "broken.exr");
+  EnvironmentImage nan = test::make_map(8, 4, test::sun_sky);
+  nan.rgb[5] = std::nanf("");
+  test::write_exr(dir + "/nan.exr", nan);
+  expect_one_error_line(run("render" + kSmall + " --environment '" + dir + "/nan.exr' --out " + out), "non-finite");
+  const std::string sky = write_sky(dir, "sky.exr");
+  expect_one_error_line(
+      run("render --views 4 --view-size 48x24 --display 192x108 --shading lambert --environment '" + sky + "' --out " + out),
+      "--shading pbr");
+  expect_one_error_line(run("render" + kSmall + " --environment '" + sky + "' --environment-rotation inf --out " + out),
+                        "--environment-rotation");
+  expect_one_error_line(run("render" + kSmall + " --environment '" + sky + "' --environment-rotation 1e999 --out " + out),
+                        "--environment-rotation");
+  expect_one_error_line(run("bench --views 4 --method pmr --frames 1 --environment missing.exr --shading pbr"),
+                        "missing.exr");
+  EXPECT_EQ(count_entries(out), 0u) << "nothing written for a bad environment";
+}
+
+// The sidecar records the image (file as given, checksum, rotation, intensity); --resume keeps frames
+// of the same environment and refuses, or with --overwrite renders again, when the rotation or the
+// file's content changed. --verbose prints the prefilter time.
+TEST(EnvironmentCli, SidecarRecordsItAndResumeNoticesChanges) {
+  const std::string dir = temp_dir("env_resume");
+  const std::string sky = write_sky(dir, "sky.exr"), out = dir + "/out";
+  const std::string env = kSmall + " --environment '" + sky + "' --environment-intensity 1.5 --out '" + out + "'";
+  const test::CliRun first = run("render" + env + " --environment-rotation 30 --verbose");
+  ASSERT_EQ(first.status, 0) << first.output;
+  EXPECT_NE(first.output.find("prefiltered in"), std::string::npos) << first.output;
+  const nlohmann::json e = sidecar(out)["shading"]["environment"];
+  EXPECT_EQ(e["kind"], "image");
+  EXPECT_EQ(e["file"], sky);
+  EXPECT_EQ(e["checksum"], checksum_file(sky));
+  EXPECT_EQ(e["checksum_algorithm"], "XXH3-64");
+  EXPECT_EQ(e["rotation_deg"], 30.0);
+  EXPECT_EQ(e["intensity"], 1.5);
+
+  const test::CliRun same = run("render" + env + " --environment-rotation 30 --resume");
+  ASSERT_EQ(same.status, 0) << same.output;
+  EXPECT_NE(same.output.find("nothing to do"), std::string::npos) << same.output;
+  expect_one_error_line(run("render" + env + " --environment-rotation 45 --resume"), "shading differs");
+  const test::CliRun turned = run("render" + env + " --environment-rotation 45 --resume --overwrite");
+  ASSERT_EQ(turned.status, 0) << turned.output;
+  EXPECT_EQ(turned.output.find("nothing to do"), std::string::npos) << turned.output;
+  EXPECT_EQ(sidecar(out)["shading"]["environment"]["rotation_deg"], 45.0);
+
+  write_sky(dir, "sky.exr", 2.0);  // the same name, other content
+  expect_one_error_line(run("render" + env + " --environment-rotation 45 --resume"), "shading differs");
+  const test::CliRun changed = run("render" + env + " --environment-rotation 45 --resume --overwrite");
+  ASSERT_EQ(changed.status, 0) << changed.output;
+  EXPECT_EQ(sidecar(out)["shading"]["environment"]["checksum"], checksum_file(sky));
+}
+
+// Without an image the sidecar records the uniform default as before, and a rotation alone warns.
+TEST(EnvironmentCli, UniformDefaultAndRotationWithoutImage) {
+  const std::string out = temp_dir("env_uniform");
+  const test::CliRun r = run("render" + kSmall + " --environment-rotation 20 --out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("without --environment it does nothing"), std::string::npos) << r.output;
+  const nlohmann::json e = sidecar(out)["shading"]["environment"];
+  EXPECT_EQ(e["kind"], "uniform");
+  EXPECT_FALSE(e.contains("rotation_deg"));
+}
+
+}  // namespace
+}  // namespace pmr

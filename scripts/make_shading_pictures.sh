@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# Rebuilds the pictures of docs/SHADING.md with the renderer itself (`pmr render --write views`) and
+# scripts/shading_pictures.py (Python standard library only), which crops the views, lays them side
+# by side on a grey background and writes 8-bit sRGB PNGs converted exactly as `pmr render --preview`
+# converts (checked byte for byte against the renderer's center-view preview of every center view):
+#
+#   docs/shading_default_scene.png      data/default_scene.glb, center view, --shading lambert | pbr
+#   docs/shading_suzanne.png            the Khronos sample model Suzanne, center view, lambert | pbr
+#   docs/shading_highlight_views.png    a glossy gold sphere (made here by shading_pictures.py sphere),
+#                                       views 0, N/2 and N-1 of the default 96; the brightest pixel of each
+#                                       view is ticked in the margin and printed
+#   docs/shading_environment_forest.png the Khronos sample model AnisotropyStrengthTest, center view,
+#                                       pbr with the default light | pbr under Blender's forest.exr
+#
+# usage: scripts/make_shading_pictures.sh [GLTF_DIR]
+#   GLTF_DIR   folder of the Khronos sample models (GLTF_DIR/Suzanne/glTF/Suzanne.gltf, ...); default
+#              $PMR_GLTF_DIR, else ../shared/gltf relative to the repository
+#   PMR        the renderer (default build/pmr; build it with scripts/setup.sh build)
+#   FOREST     the environment image (default Blender's CC0 world HDRI, Debian package blender-data:
+#              /usr/share/blender/datafiles/studiolights/world/forest.exr)
+#   OUT        where the pictures go (default docs)
+# A picture whose input is missing is skipped with a message naming the file, the others are made,
+# and the script then exits with status 1. The renders go to a temporary folder that is removed.
+# Runs in about half a minute on 2 cores. Not part of the tests or CI.
+set -euo pipefail
+# paths given by the caller are relative to the caller's folder, the defaults to the repository's
+from_caller() { case $1 in /*) echo "$1" ;; *) echo "$PWD/$1" ;; esac; }
+GLTF_DIR=$( [ -n "${1:-${PMR_GLTF_DIR:-}}" ] && from_caller "${1:-$PMR_GLTF_DIR}" || echo ../shared/gltf)
+PMR=$( [ -n "${PMR:-}" ] && from_caller "$PMR" || echo build/pmr)
+FOREST=$(from_caller "${FOREST:-/usr/share/blender/datafiles/studiolights/world/forest.exr}")
+OUT=$( [ -n "${OUT:-}" ] && from_caller "$OUT" || echo docs)
+cd "$(dirname "$0")/.."
+PICTURES="python3 scripts/shading_pictures.py"
+
+[ -x "$PMR" ] || { echo "make_shading_pictures: $PMR not found: build it with scripts/setup.sh build" >&2; exit 1; }
+mkdir -p "$OUT"
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+skipped=()
+MODELS_HINT="the Khronos sample models are looked for in $GLTF_DIR: give their folder as the first argument"
+
+# render NAME SCENE ARGS...: the views of one run into $WORK/NAME (views file and center preview)
+render() {
+  local name=$1 scene=$2
+  shift 2
+  "$PMR" render "$scene" --write views --preview --quiet --out "$WORK/$name" "$@"
+}
+views() { echo "$WORK/$1/frame_0000.views.exr:$2"; }
+center() { echo "$WORK/$1/frame_0000.center.png"; }
+present() {  # present FILE PICTURE HINT
+  [ -f "$1" ] && return 0
+  echo "make_shading_pictures: $1 not found ($3): $2 not rebuilt" >&2
+  skipped+=("$2")
+  return 1
+}
+
+# Views of 16:9 (display 166x93 cm: pixels square to 0.4%), 9 views so that view 4 is the center
+# camera itself.
+pair() {  # pair OUT SCENE VIEW_SIZE: the center view under lambert and pbr
+  local out=$1 scene=$2 size=$3
+  render lambert "$scene" --views 9 --view-size "$size" --shading lambert
+  render pbr "$scene" --views 9 --view-size "$size" --shading pbr
+  $PICTURES strip "$out" "$(views lambert 4)" "$(views pbr 4)" --check-center "$(center lambert)" "$(center pbr)"
+}
+
+echo "== default scene, lambert | pbr"
+pair "$OUT/shading_default_scene.png" data/default_scene.glb 1024x576
+
+echo "== Suzanne, lambert | pbr"
+SUZANNE=$GLTF_DIR/Suzanne/glTF/Suzanne.gltf
+if present "$SUZANNE" "$OUT/shading_suzanne.png" "$MODELS_HINT"; then
+  pair "$OUT/shading_suzanne.png" "$SUZANNE" 800x450
+fi
+
+echo "== a glossy sphere in views 0, 48 and 95 of 96"
+$PICTURES sphere "$WORK/sphere.glb"
+render sphere "$WORK/sphere.glb" --views 96 --view-size 512x288
+$PICTURES strip "$OUT/shading_highlight_views.png" "$(views sphere 0)" "$(views sphere 48)" "$(views sphere 95)" --mark \
+  --check-center - "$(center sphere)" -
+
+echo "== AnisotropyStrengthTest, default light | forest.exr"
+ANISOTROPY=$GLTF_DIR/AnisotropyStrengthTest/glTF-Binary/AnisotropyStrengthTest.glb
+if present "$ANISOTROPY" "$OUT/shading_environment_forest.png" "$MODELS_HINT" &&
+   present "$FOREST" "$OUT/shading_environment_forest.png" "set FOREST, or install Debian's blender-data"; then
+  # the model's KHR_materials_anisotropy warning is expected: it is drawn isotropic
+  render light "$ANISOTROPY" --views 9 --view-size 720x405 2> >(grep -v KHR_materials_anisotropy >&2)
+  render forest "$ANISOTROPY" --views 9 --view-size 720x405 --environment "$FOREST" \
+    2> >(grep -v KHR_materials_anisotropy >&2)
+  $PICTURES strip "$OUT/shading_environment_forest.png" "$(views light 4)" "$(views forest 4)" \
+    --check-center "$(center light)" "$(center forest)"
+fi
+
+if [ ${#skipped[@]} -gt 0 ]; then
+  echo "make_shading_pictures: NOT rebuilt (inputs missing): ${skipped[*]}" >&2
+  exit 1
+fi
+echo "make_shading_pictures: every picture rebuilt in $OUT"

@@ -803,6 +803,7 @@ TEST(PbrLights, TheDefaultLightOnlyWithoutSceneLights) {
 
   // Lambert: no light table, and the same pixels with or without the scene's lights.
   PipelineConfig lambert;
+  lambert.shading = Shading::Lambert;
   EXPECT_TRUE(used(s, lambert).empty());
   const test::Rendered with = render_pbr(s, rig, 0.0, Method::Pmr, Shading::Lambert);
   s.lights.clear();

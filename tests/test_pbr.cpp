@@ -805,8 +805,7 @@ TEST(PbrLights, EveryPathShadesWithTheLights) {
 }
 
 // The default light is used only for a scene without lights, and not at all with an environment image.
-// Lambert keeps its one light whatever the
-// scene's lights.
+// Lambert keeps its one light whatever the scene's lights.
 TEST(PbrLights, TheDefaultLightOnlyWithoutSceneLights) {
   const Rig rig = test::small_rig(5, 48, 32);
   const SceneLight bulb = make_light(SceneLightType::Point, glm::dvec3(0.0, 0.0, 2.0), glm::dvec3(0, 0, -1), 4.0f);

@@ -10,6 +10,7 @@
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "environment_maps.h"
 #include "gltf_builder.h"
 #include "pmr/output.h"
 #include "shading/lights.h"
@@ -144,6 +145,13 @@ TEST(PbrLightsSidecar, OlderSidecarsCompareAsBefore) {
   json damaged = old;
   damaged.erase("light_dir_world");
   EXPECT_EQ(sidecar_config_difference(damaged.dump(), with_default), "shading");
+  // with an environment image there was no default light
+  json old_image = old, unlit = json::parse(pbr_sidecar(rig, 2, {}));
+  old_image["shading"]["environment"] = unlit["shading"]["environment"] = {{"kind", "image"}, {"file", "sky.exr"}};
+  EXPECT_EQ(sidecar_config_difference(old_image.dump(), unlit.dump()), "");
+  json lit = json::parse(with_default);
+  lit["shading"]["environment"] = old_image["shading"]["environment"];
+  EXPECT_EQ(sidecar_config_difference(old_image.dump(), lit.dump()), "shading");
   // before --shading: lambert at exposure 0
   SidecarInfo lambert;
   lambert.has_bounds = true;
@@ -220,8 +228,8 @@ TEST(PbrLightsSidecar, ResumeComparesTheLightsOfEachFrame) {
   EXPECT_EQ(sidecar_at(out + "/frame_0001.json")["shading"]["lights"][0]["intensity"], 3.0);
 }
 
-// Without lights in the file, pbr records the default light (toward light_dir_world); lambert records
-// none.
+// Without lights in the file, pbr records the default light (toward light_dir_world), and none with an
+// environment image; the file's lights stay with an image; lambert records none.
 TEST(PbrLightsSidecar, TheDefaultLightAndLambert) {
   const std::string out = test::temp_dir("pbr_lights_default");
   CliRun r = run("render --shading pbr" + kSmall + "--out " + out);
@@ -232,6 +240,22 @@ TEST(PbrLightsSidecar, TheDefaultLightAndLambert) {
   EXPECT_EQ(lights[0].at("source"), "default");
   for (int c = 0; c < 3; ++c)
     EXPECT_EQ(lights[0].at("direction").at(c).get<double>(), -j.at("light_dir_world").at(c).get<double>());
+  const std::string in = test::temp_dir("pbr_lights_default_in");
+  fs::create_directories(in);
+  const std::string sky = in + "/sky.exr";
+  test::write_exr(sky, test::make_map(64, 32, test::sun_sky));
+  r = run("render --shading pbr --environment '" + sky + "'" + kSmall + "--out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(sidecar_at(out + "/frame_0000.json").at("shading").at("lights"), json::array());
+  r = run("render '" + lights_scene(in, 2.0) + "' --shading pbr --environment '" + sky + "' --frames 1 --fps 1" + kSmall +
+          "--out " + out + "_image");
+  ASSERT_EQ(r.status, 0) << r.output;
+  const json file_lights = sidecar_at(out + "_image/frame_0001.json").at("shading").at("lights");
+  ASSERT_EQ(file_lights.size(), 2u);
+  EXPECT_EQ(file_lights[0].at("position"), json({1.0, 0.0, 1.0}));
+  r = run("render '" + lights_scene(in, 2.0) + "' --shading pbr --environment '" + sky + "' --frames 1 --fps 1 --resume" +
+          kSmall + "--out " + out + "_image");
+  EXPECT_NE(r.output.find("nothing to do"), std::string::npos) << r.output;
   r = run("render --shading lambert" + kSmall + "--out " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_FALSE(sidecar_at(out + "/frame_0000.json").at("shading").contains("lights"));

@@ -48,11 +48,7 @@ inline float3 brdf_cos(float3 base, float metallic, float r, float3 n, float3 v,
  * along `direction` (the node's -Z). Point and spot: colour x intensity (candela) / d^2, times the range
  * window clamp(1 - (d / range)^4, 0, 1) when range > 0; a spot also times
  * clamp((cos_angle - cos_outer) / max(0.001, cos_inner - cos_outer), 0, 1)^2 with cos_angle between
- * its direction and -l. */
-#define PMR_LIGHT_DIRECTIONAL 0
-#define PMR_LIGHT_POINT 1
-#define PMR_LIGHT_SPOT 2
-
+ * its direction and -l. type is PMR_LIGHT_* (include/pmr/shared.h, with the light table's PmrLight). */
 inline float3 light_irradiance(int type, float3 color_intensity, float3 position, float3 direction, float range,
                                float cos_inner, float cos_outer, float3 p, float3* l) {
   if (type == PMR_LIGHT_DIRECTIONAL) {

@@ -41,7 +41,7 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
                         global const PmrEncodeRow* rows, global const int* column_start,
                         global const int* row_start, global const int* straddle_slot, uint straddle_slots,
                         global uchar* straddle_cov, global half* display, global const PmrEnvironment* env,
-                        global const float4* env_data) {
+                        global const float4* env_data, global const PmrLight* lights) {
   const uint tile_xy = pmr_item_id();
   const uint tiles_x = (uint)P->tiles_x, tiles_y = (uint)P->tiles_y;
   if (tile_xy >= tiles_x * tiles_y) return;
@@ -49,7 +49,8 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
   const int nx = min(PMR_TILE_X, P->view_w - x0), ny = min(PMR_TILE_Y, P->view_h - y0);
   const int views = P->views;
 
-  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, env_data};
+  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, env_data,
+                    lights};
   vfloat best_depth[FUSED_ROWS];
   vuint best_key[FUSED_ROWS], best_mta[FUSED_ROWS];
   fine_clear_state(FUSED_ROWS, best_depth, best_key, best_mta);

@@ -73,7 +73,8 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
                           global const PmrSampleChunk* chunks, uint num_chunks, global const int* straddle_slot,
                           uint straddle_slots, global uchar* straddle_cov, global half* display,
                           uint debug, global uint* dbg_key, global float* dbg_depth,
-                          global const PmrEnvironment* env, global const float4* env_data) {
+                          global const PmrEnvironment* env, global const float4* env_data,
+                          global const PmrLight* lights) {
   const uint chunk = pmr_item_id();
   if (chunk >= num_chunks) return;
   const PmrSampleChunk ch = chunks[chunk];
@@ -148,7 +149,8 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
     }
 
   /* 2. Visibility: the tile's queues, every view slab. */
-  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, env_data};
+  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, env_data,
+                    lights};
   const double8 lane_d = convert_double8(lane);
   const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
   for (int tv = 0; tv < P->tiles_v; ++tv) {

@@ -31,6 +31,12 @@ kernel void layout_probe(global uint* out) {
   PROBE(23, PmrMaterial, maps);
   PROBE(24, PmrMaterial, occlusion_strength);
   out[25] = sizeof(PmrTextureMap);
+  PROBE(26, PmrParams, num_lights);
+  out[27] = sizeof(PmrLight);
+  PROBE(28, PmrLight, type);
+  PROBE(29, PmrLight, range);
+  PROBE(30, PmrLight, direction);
+  PROBE(31, PmrLight, cos_outer);
   out[40] = sizeof(PmrEnvironment);
   PROBE(41, PmrEnvironment, intensity);
   PROBE(42, PmrEnvironment, levels);

@@ -2,8 +2,8 @@
  * baseColorTexture (sRGB-decoded, bilinear, glTF wrap modes) * COLOR_0, then either view-independent
  * Lambert with one directional light, or glTF metallic-roughness (cl/brdf.h) with the material's
  * metallic-roughness, normal, occlusion and emissive maps, seen from each view's own camera, lit by the
- * default directional light and the uniform default environment or an environment image
- * (cl/environment.h). */
+ * frame's light table (the file's punctual lights or the default light) and the uniform default
+ * environment or an environment image (cl/environment.h). */
 #ifndef PMR_CL_SHADE_H
 #define PMR_CL_SHADE_H
 
@@ -74,6 +74,7 @@ typedef struct {
   global const float4* tangents;   /* world tangent per vertex (w: bitangent sign), pbr normal maps */
   global const PmrEnvironment* env; /* pbr: the environment image's tables, level_count 0 = none */
   global const float4* env_data;    /* ... their data (cl/environment.h)                        */
+  global const PmrLight* lights;   /* P->num_lights punctual lights, world space (pbr)           */
 } ShadeInputs;
 
 /* The split-sum table's bilinear lookup, as pmr::split_sum (host/shading/environment.cpp) does it. */
@@ -118,12 +119,13 @@ inline float3 mapped_normal(const ShadeInputs* in, global const PmrMaterial* mat
 
 /* glTF metallic-roughness at source barycentrics b of triangle t with interpolated normal n (not yet
  * flipped for a back face) and base colour c, seen from view `view`'s camera: the material's maps
- * (metallic-roughness, normal, occlusion, emissive), the default light (E toward `light`; the host sets
- * E = 0 when it is off), the environment times the occlusion, plus the emissive term; an unlit material
- * is its base colour. The environment is the image's I(n) and P(reflect(-v, n), r) when one is given,
- * else the uniform default of radiance L, for which I(n) = P = L and no table is read. */
+ * (metallic-roughness, normal, occlusion, emissive), the sum over the light table of f E n.l (the
+ * file's punctual lights, or the default light, or none), the environment times the occlusion, plus the
+ * emissive term; an unlit material is its base colour. The environment is the image's I(n) and
+ * P(reflect(-v, n), r) when one is given, else the uniform default of radiance L, for which
+ * I(n) = P = L and no table is read. */
 inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, float3 n, bool back, float3 base,
-                        float3 light, int view) {
+                        int view) {
   global const PmrParams* P = in->P;
   /* a pointer, not a copy: most voxels read a few of its 192 bytes */
   global const PmrMaterial* mat = &in->materials[t->material];
@@ -145,8 +147,15 @@ inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, f
                    b.z * vload3(t->v[2], in->positions);
   const float3 v = normalize(in->eyes[view + (int)P->view_base].xyz - p);
   const float r = pbr_roughness(roughness);
-  const float E = P->light_irradiance;
-  const float3 direct = E > 0.0f ? brdf_cos(base, metallic, r, n, v, light) * E : (float3)(0.0f);
+  float3 direct = (float3)(0.0f);
+  const uint num_lights = P->num_lights;
+  for (uint i = 0; i < num_lights; ++i) {
+    global const PmrLight* light = &in->lights[i];
+    float3 l;
+    const float3 E = light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
+                                      vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, p, &l);
+    direct += brdf_cos(base, metallic, r, n, v, l) * E;
+  }
   const float nv = dot(n, v);
   const float2 ab = split_sum(in->split_sum, clamp(nv, 0.0f, 1.0f), r);
   float3 irradiance, prefiltered;
@@ -180,7 +189,8 @@ inline float4 base_color(const ShadeInputs* in, uint tri, float3 b) {
   return c;
 }
 
-/* Lit colour in view `view` of the pass (the volume's view + P->view_base); alpha is coverage (1). */
+/* Lit colour in view `view` of the pass (the volume's view + P->view_base); alpha is coverage (1).
+ * `light`: the unit direction toward Lambert's one light (pbr reads the light table instead). */
 inline float4 shade(const ShadeInputs* in, float3 light, uint tri, float3 b, bool back, int view) {
   const PmrTriangle t = in->tris[tri];
   float3 n;
@@ -195,7 +205,7 @@ inline float4 shade(const ShadeInputs* in, float3 light, uint tri, float3 b, boo
   const float4 c = base_color(in, tri, b);
   const float exposure = in->P->exposure;
   if (in->P->shading == PMR_SHADING_PBR) {
-    const float3 rgb = shade_pbr(in, &t, b, n, back, c.xyz, light, view) * exposure;
+    const float3 rgb = shade_pbr(in, &t, b, n, back, c.xyz, view) * exposure;
     return (float4)(rgb, 1.0f);
   }
   if (back) n = -n;

@@ -26,7 +26,9 @@ TEST(Layout, DeviceStructsMatchHost) {
       sizeof(PmrVertexAttr), offsetof(PmrVertexAttr, color), sizeof(PmrTriangle), offsetof(PmrTriangle, face_normal),
       sizeof(PmrMaterial), offsetof(PmrMaterial, alpha_cutoff), sizeof(PmrTexture), offsetof(PmrTexture, wrap_t),
       sizeof(PmrEncodeParams), offsetof(PmrEncodeParams, display_w), offsetof(PmrEncodeParams, bilinear),
-      offsetof(PmrMaterial, maps), offsetof(PmrMaterial, occlusion_strength), sizeof(PmrTextureMap)};
+      offsetof(PmrMaterial, maps), offsetof(PmrMaterial, occlusion_strength), sizeof(PmrTextureMap),
+      offsetof(PmrParams, num_lights), sizeof(PmrLight), offsetof(PmrLight, type), offsetof(PmrLight, range),
+      offsetof(PmrLight, direction), offsetof(PmrLight, cos_outer)};
   for (size_t i = 0; i < sizeof want / sizeof want[0]; ++i) EXPECT_EQ(got[i], want[i]) << "probe " << i;
   // the environment header of --shading pbr (probes 40..43)
   EXPECT_EQ(got[40], sizeof(PmrEnvironment));

@@ -6,6 +6,7 @@
 #include <Imath/half.h>
 
 #include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -15,10 +16,13 @@
 #include <unistd.h>
 
 #include "environment_maps.h"
+#include "gltf_builder.h"
 #include "reference/material_reference.h"
 #include "reference/pbr_reference.h"
 #include "reference/shade_reference.h"
+#include "sequence/frame_renderer.h"
 #include "shading/environment.h"
+#include "shading/lights.h"
 #include "test_util.h"
 
 namespace pmr {
@@ -652,6 +656,357 @@ TEST(PbrEnvironment, PathsShadeAlike) {
   }
   EXPECT_GT(lit, size_t(1000));
   EXPECT_NEAR(sum_subpixel, sum_view, 0.05 * sum_view);
+}
+
+
+// ---- KHR_lights_punctual -----------------------------------------------------------------------------
+
+// The reference's light for a scene light, from its definition (colour, intensity, cone angles in
+// double precision), not from the kernels' table.
+ref::PunctualLight reference_light(const SceneLight& l) {
+  ref::PunctualLight r;
+  r.type = l.type == SceneLightType::Point  ? ref::LightType::Point
+           : l.type == SceneLightType::Spot ? ref::LightType::Spot
+                                            : ref::LightType::Directional;
+  r.color_intensity = glm::dvec3(l.color[0], l.color[1], l.color[2]) * double(l.intensity);
+  r.position = l.position;
+  r.direction = l.direction;
+  r.range = l.range;
+  r.cos_inner = std::cos(double(l.inner_cone));
+  r.cos_outer = std::cos(double(l.outer_cone));
+  return r;
+}
+
+SceneLight make_light(SceneLightType type, const glm::dvec3& position, const glm::dvec3& direction, float intensity,
+                      float range = 0.0f) {
+  SceneLight l;
+  l.type = type;
+  l.position = position;
+  l.direction = glm::normalize(direction);
+  l.intensity = intensity;
+  l.range = range;
+  return l;
+}
+
+// Every covered voxel of `out` against the reference (1% + 1e-3 per channel); returns how many were
+// compared. `lit`, when given, counts the voxels the reference's lights brighten by more than 0.02
+// against the environment alone, and `dark` those they do not brighten at all.
+size_t expect_voxels_match(const VoxelReference& reference, size_t* lit = nullptr, size_t* dark = nullptr) {
+  const test::Rendered& out = reference.out;
+  VoxelReference unlit = reference;  // the same environment, no lights
+  unlit.lights.clear();
+  size_t compared = 0, bad = 0;
+  double worst = 0.0;
+  for (size_t v = 0; v < out.key.size(); ++v) {
+    if (out.key[v] == PMR_NO_KEY) continue;
+    const PmrMta* m = reference.mta(v);
+    if (!m) {
+      ADD_FAILURE() << "no MTA for key " << out.key[v];
+      return compared;
+    }
+    const glm::dvec3 want = reference.colour(v, *m), ambient = unlit.colour(v, *m);
+    for (int c = 0; c < 3; ++c) {
+      half got;
+      got.setBits(out.volume[v * 4 + size_t(c)]);
+      const double err = std::abs(double(float(got)) - want[c]), tol = 0.01 * std::abs(want[c]) + 1e-3;
+      worst = std::max(worst, err / tol);
+      if (err > tol && ++bad <= 5) ADD_FAILURE() << "voxel " << v << " channel " << c << ": " << float(got) << " vs " << want[c];
+    }
+    const double gain = glm::length(want - ambient);
+    if (lit) *lit += gain > 0.02;
+    if (dark) *dark += gain == 0.0;
+    ++compared;
+  }
+  EXPECT_EQ(bad, 0u);
+  std::printf("[ lights   ] %zu voxels, largest error %.3f of the bound\n", compared, worst);
+  return compared;
+}
+
+// A directional, a point and a spot light (both with a range that ends inside the scene, the spot's cone
+// edge crossing the quads), alone and together: every shaded voxel against the reference with the same
+// lights, and each light lights some voxels and (point, spot) leaves others dark.
+// For material_quads(): a coloured directional light, a point light whose range ends inside the scene,
+// and a spot light whose cone edge crosses the quads.
+std::vector<SceneLight> three_lights() {
+  SceneLight sun = make_light(SceneLightType::Directional, glm::dvec3(5.0), glm::dvec3(0.4, -0.3, -1.0), 2.0f);
+  sun.name = "sun";
+  sun.color[0] = 1.0f, sun.color[1] = 0.6f, sun.color[2] = 0.3f;
+  SceneLight bulb = make_light(SceneLightType::Point, glm::dvec3(0.2, 0.3, 1.5), glm::dvec3(0, 0, -1), 3.0f, 2.2f);
+  bulb.color[0] = 0.8f, bulb.color[1] = 0.9f;
+  SceneLight spot = make_light(SceneLightType::Spot, glm::dvec3(0.3, 0.2, 2.0), glm::dvec3(-0.1, 0.0, -1.0), 6.0f, 4.0f);
+  spot.inner_cone = 0.2f, spot.outer_cone = 0.35f;
+  return {sun, bulb, spot};
+}
+
+TEST(PbrLights, EveryShadedVoxelMatchesTheReferenceUnderEachLight) {
+  const Rig rig = test::small_rig(7, 72, 40);
+  const std::vector<SceneLight> lights = three_lights();
+  const SceneLight &sun = lights[0], &bulb = lights[1], &spot = lights[2];
+  const struct {
+    const char* name;
+    std::vector<SceneLight> lights;
+    bool leaves_dark;
+  } cases[] = {{"directional", {sun}, false}, {"point", {bulb}, true}, {"spot", {spot}, true}, {"all three", {sun, bulb, spot}, false}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    Scene s = material_quads();
+    s.lights = c.lights;
+    const test::Rendered out = render_pbr(s, rig);
+    VoxelReference reference(s, rig, out);
+    reference.lights.clear();
+    for (const SceneLight& l : c.lights) reference.lights.push_back(reference_light(l));
+    size_t lit = 0, dark = 0;
+    EXPECT_GT(expect_voxels_match(reference, &lit, &dark), size_t(3000));
+    EXPECT_GT(lit, size_t(500)) << "the light should light much of the scene";
+    if (c.leaves_dark) EXPECT_GT(dark, size_t(300)) << "outside the range or the cone nothing should be lit";
+  }
+}
+
+// The fused raster + encode path and --sampling subpixel get the same lights as the fine raster: the
+// fused image equals the encoded view volume bit for bit, and with a view raster of 3 W_d x H_d (every
+// subpixel's sample a pixel center) subpixel sampling gives view sampling's image (but for depth ties:
+// a few pixels in a thousand). The lights change most pixels, so a path without them would differ.
+TEST(PbrLights, EveryPathShadesWithTheLights) {
+  Scene s = material_quads();
+  s.lights = three_lights();
+  Display d;
+  d.width = 64, d.height = 40;
+  d.lens_pitch = parse_rational("7.3125", "L");
+  d.tan_slant = parse_rational("-0.15", "T");
+  RigConfig rc;
+  rc.views = 10, rc.view_w = 3 * d.width, rc.view_h = d.height;
+  d.offset = default_offset(d.lens_pitch, rc.views);
+  const Rig rig = make_rig(rc, d, glm::dvec3(-1.0), glm::dvec3(1.0));
+  auto render = [&](Sampling sampling, bool fuse) {
+    PipelineConfig pc;
+    pc.shading = Shading::Pbr;
+    pc.sampling = sampling;
+    pc.fuse_encode = fuse;
+    return test::render_encoded(s, rig, d, pc);
+  };
+  const test::EncodedRender unfused = render(Sampling::View, false), fused = render(Sampling::View, true),
+                            subpixel = render(Sampling::Subpixel, true);
+  ASSERT_TRUE(fused.fused);
+  ASSERT_FALSE(unfused.fused);
+  EXPECT_EQ(fused.image, unfused.image);
+  ASSERT_EQ(subpixel.image.size(), unfused.image.size());
+  size_t differ = 0, drawn = 0;
+  for (size_t i = 0; i < unfused.image.size(); i += 4) {
+    differ += !std::equal(&subpixel.image[i], &subpixel.image[i] + 4, &unfused.image[i]);
+    drawn += unfused.image[i + 3] != 0;
+  }
+  EXPECT_LE(differ, unfused.image.size() / 4 / 1000);
+  EXPECT_GT(drawn, unfused.image.size() / 4 / 8);
+  s.lights.clear();  // the default light instead
+  const std::vector<uint16_t> unlit = render(Sampling::View, true).image;
+  size_t changed = 0;
+  for (size_t i = 0; i < unlit.size(); i += 4) changed += unlit[i] != fused.image[i];
+  EXPECT_GT(changed, drawn / 2);
+}
+
+// The default light is used only for a scene without lights, and not at all with an environment image.
+// Lambert keeps its one light whatever the scene's lights.
+TEST(PbrLights, TheDefaultLightOnlyWithoutSceneLights) {
+  const Rig rig = test::small_rig(5, 48, 32);
+  const SceneLight bulb = make_light(SceneLightType::Point, glm::dvec3(0.0, 0.0, 2.0), glm::dvec3(0, 0, -1), 4.0f);
+  auto used = [&](const Scene& s, PipelineConfig pc) {
+    pc.tile_x = 4, pc.tile_y = 4, pc.tile_v = 4;
+    Pipeline p(test::runtime(), pc);
+    p.set_scene(s);
+    p.configure(rig, nullptr);
+    p.render(rig);
+    return p.lights_used();
+  };
+  PipelineConfig pbr;
+  pbr.shading = Shading::Pbr;
+  Scene s = material_quads();
+  std::vector<SceneLight> l = used(s, pbr);
+  ASSERT_EQ(l.size(), 1u);
+  EXPECT_TRUE(is_default_light(l[0]));
+  EXPECT_EQ(l[0].type, SceneLightType::Directional);
+  EXPECT_EQ(l[0].direction, -rig.light_world());
+  EXPECT_FLOAT_EQ(l[0].intensity, float(0.8 * glm::pi<double>()));
+  s.lights = {bulb};
+  l = used(s, pbr);
+  ASSERT_EQ(l.size(), 1u);
+  EXPECT_FALSE(is_default_light(l[0]));
+  EXPECT_EQ(l[0].position, bulb.position);
+
+  // An environment image replaces the default light, never the scene's lights: without scene lights
+  // the image alone lights the voxels; with a scene light, that light and the image.
+  const std::shared_ptr<const Environment> sky = sky_environment(0.0, 1.0);
+  PipelineConfig imaged = pbr;
+  imaged.environment = sky;
+  s.lights.clear();
+  EXPECT_TRUE(used(s, imaged).empty());
+  const test::Rendered alone = render_environment(s, rig, sky);
+  EXPECT_GT(compare_with_environment(s, rig, alone, *sky, "the image alone").compared, size_t(1000));
+  s.lights = {bulb};
+  EXPECT_EQ(used(s, imaged).size(), 1u);
+  const test::Rendered both = render_environment(s, rig, sky);
+  VoxelReference reference(s, rig, both);
+  reference.lights = {reference_light(bulb)};
+  reference.env = image_environment(*sky);
+  size_t lit = 0;
+  EXPECT_GT(expect_voxels_match(reference, &lit), size_t(1000));
+  EXPECT_GT(lit, size_t(300)) << "the scene's light should light the voxels beside the image";
+
+  // Lambert: no light table, and the same pixels with or without the scene's lights.
+  PipelineConfig lambert;
+  lambert.shading = Shading::Lambert;
+  EXPECT_TRUE(used(s, lambert).empty());
+  const test::Rendered with = render_pbr(s, rig, 0.0, Method::Pmr, Shading::Lambert);
+  s.lights.clear();
+  const test::Rendered without = render_pbr(s, rig, 0.0, Method::Pmr, Shading::Lambert);
+  EXPECT_EQ(with.volume, without.volume);
+}
+
+// A grey dielectric quad 3 x 2 in the z = 0 plane facing +Z, and a point light on its own node at
+// (-1, 0, 1) (range 3); with `animated`, the light's node alone moves to (1, 0, 1) at t = 1 s (LINEAR).
+std::string lit_quad_file(const std::string& dir, bool animated) {
+  using namespace test;
+  GltfFile g;
+  const int pos = g.data<float>({-1.5f, -1, 0, 1.5f, -1, 0, 1.5f, 1, 0, -1.5f, 1, 0}, kFloat, "VEC3");
+  const int nrm = g.data<float>({0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1}, kFloat, "VEC3");
+  const int idx = g.data<uint16_t>({0, 1, 2, 0, 2, 3}, kUShort, "SCALAR");
+  g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {
+      {{"name", "Bulb"}, {"type", "point"}, {"color", {1.0, 0.9, 0.8}}, {"intensity", 2.0}, {"range", 3.0}}};
+  g.add("materials", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1}}, {"metallicFactor", 0.0},
+                                                {"roughnessFactor", 0.5}}}});
+  g.mesh(json::array({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}}, {"indices", idx}, {"material", 0}}}));
+  g.add("nodes", {{"mesh", 0}});
+  g.add("nodes", {{"name", "BulbNode"}, {"translation", {-1, 0, 1}},
+                  {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  if (animated) {
+    const int times = g.data<float>({0.0f, 1.0f}, kFloat, "SCALAR");
+    const int moves = g.data<float>({-1, 0, 1, 1, 0, 1}, kFloat, "VEC3");
+    g.doc["animations"] = {{{"samplers", {{{"input", times}, {"output", moves}}}},
+                            {"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}}}}}};
+  }
+  g.scene({0, 1});
+  return g.write(dir, animated ? "animated_bulb" : "bulb");
+}
+
+// One frame through the frame loop (FrameRenderer: posing, the lights' upload), read back like
+// test::render_with.
+test::Rendered render_frame(FrameRenderer& renderer, Pipeline& p, long frame, FrameRenderer::Frame* info) {
+  test::Rendered r;
+  *info = renderer.render(frame);
+  p.read_debug(r.key, r.depth, r.count);
+  p.read_volume(r.volume);
+  r.mtas = p.read_mtas();
+  return r;
+}
+
+PipelineConfig frame_loop_config() {
+  PipelineConfig pc;
+  pc.tile_x = 4, pc.tile_y = 4, pc.tile_v = 4;
+  pc.shading = Shading::Pbr;
+  pc.debug_outputs = true;
+  return pc;
+}
+
+// The light's node is the only animated node (no geometry moves): the frame loop still moves the light.
+// Frames 0 and 1 (t = 0 and 1 s) each match the reference with the light where the animation puts it,
+// and the two frames differ.
+TEST(PbrLights, AnAnimatedLightMovesBetweenFrames) {
+  const std::string dir = test::temp_dir("pbr_lights_animated");
+  std::filesystem::create_directories(dir);
+  const Scene s = load_scene(lit_quad_file(dir, true));
+  ASSERT_EQ(s.lights.size(), 1u);
+  SequenceSpec spec;
+  select_animation(s, "", spec);
+  spec.fps = 1.0;
+  RigConfig rc;
+  rc.views = 5, rc.view_w = 64, rc.view_h = 40;
+  FrameRenderer renderer(s, spec, rc, Display{}, nullptr);
+  const PipelineConfig pc = frame_loop_config();
+  Pipeline p(test::runtime(), pc);
+  renderer.attach(p, nullptr);
+  std::vector<uint16_t> volumes[2];
+  for (long f : {0L, 1L}) {
+    SCOPED_TRACE("frame " + std::to_string(f));
+    FrameRenderer::Frame fr;
+    const test::Rendered out = render_frame(renderer, p, f, &fr);
+    SceneLight want = s.lights[0];
+    want.position = glm::dvec3(f == 0 ? -1.0 : 1.0, 0.0, 1.0);
+    ASSERT_EQ(fr.lights.size(), 1u);
+    EXPECT_EQ(fr.lights[0].position, want.position);
+    const std::vector<SceneLight> expected = renderer.frame_lights(f, pc);
+    ASSERT_EQ(expected.size(), 1u);
+    EXPECT_EQ(expected[0].position, fr.lights[0].position) << "the lights a resumed run expects";
+    VoxelReference reference(s, renderer.rig(), out);
+    reference.lights = {reference_light(want)};
+    size_t lit = 0;
+    EXPECT_GT(expect_voxels_match(reference, &lit), size_t(2000));
+    EXPECT_GT(lit, size_t(1000));
+    volumes[f] = out.volume;
+  }
+  size_t changed = 0, covered = 0;
+  for (size_t i = 0; i < volumes[0].size(); i += 4) {
+    half a, b;
+    a.setBits(volumes[0][i]), b.setBits(volumes[1][i]);
+    covered += float(a) > 0.0f;
+    changed += std::abs(float(a) - float(b)) > 0.05f * std::max(float(a), float(b));
+  }
+  EXPECT_GT(changed, covered / 3) << "the light moved from one side of the quad to the other";
+}
+
+// A turntable turns the file's lights with the geometry (about +Y through the pivot), and leaves the
+// default light where it is in the center camera's view.
+TEST(PbrLights, TheTurntableTurnsLightsWithTheGeometry) {
+  const std::string dir = test::temp_dir("pbr_lights_turntable");
+  std::filesystem::create_directories(dir);
+  Scene s = load_scene(lit_quad_file(dir, false));
+  SequenceSpec spec;
+  spec.turntable = true, spec.turntable_deg = 360.0, spec.turntable_frames = 8;  // frame 1: 45 degrees
+  RigConfig rc;
+  rc.views = 5, rc.view_w = 64, rc.view_h = 40;
+  const PipelineConfig pc = frame_loop_config();
+  {
+    FrameRenderer renderer(s, spec, rc, Display{}, nullptr);
+    Pipeline p(test::runtime(), pc);
+    renderer.attach(p, nullptr);
+    FrameRenderer::Frame fr;
+    const test::Rendered out = render_frame(renderer, p, 1, &fr);
+    EXPECT_DOUBLE_EQ(fr.angle, 45.0);
+    // the light turned here with glm's rotation, not pose_scene's
+    const glm::dvec3 c = renderer.pivot();
+    const glm::dmat4 turn = glm::rotate(glm::dmat4(1.0), glm::radians(45.0), glm::dvec3(0, 1, 0));
+    SceneLight want = s.lights[0];
+    want.position = c + glm::dvec3(turn * glm::dvec4(s.lights[0].position - c, 1.0));
+    ASSERT_EQ(fr.lights.size(), 1u);
+    EXPECT_NEAR(glm::length(fr.lights[0].position - want.position), 0.0, 1e-12);
+    // the reference surface: the geometry turned as pose_scene turns it (tested in test_pose.cpp)
+    Scene posed = s;  // materials, textures and texture coordinates are the rest scene's
+    PoseRequest r;
+    r.turntable = true, r.turntable_deg = 45.0, r.pivot = c;
+    pose_scene(s, r, posed);
+    VoxelReference reference(posed, renderer.rig(), out);
+    reference.lights = {reference_light(want)};
+    EXPECT_GT(expect_voxels_match(reference), size_t(1000));
+    // the test can tell: with the light left unturned, many voxels would differ
+    VoxelReference unturned(posed, renderer.rig(), out);
+    unturned.lights = {reference_light(s.lights[0])};
+    size_t differ = 0;
+    for (size_t v = 0; v < out.key.size(); ++v) {
+      if (out.key[v] == PMR_NO_KEY) continue;
+      const PmrMta* m = reference.mta(v);
+      if (m && glm::length(reference.colour(v, *m) - unturned.colour(v, *m)) > 0.05) ++differ;
+    }
+    EXPECT_GT(differ, size_t(500));
+  }
+  s.lights.clear();  // the default light does not turn
+  FrameRenderer renderer(s, spec, rc, Display{}, nullptr);
+  Pipeline p(test::runtime(), pc);
+  renderer.attach(p, nullptr);
+  for (long f : {1L, 3L}) {
+    const FrameRenderer::Frame fr = renderer.render(f);
+    ASSERT_EQ(fr.lights.size(), 1u);
+    EXPECT_TRUE(is_default_light(fr.lights[0]));
+    EXPECT_EQ(fr.lights[0].direction, -renderer.rig().light_world()) << "frame " << f;
+  }
 }
 
 }  // namespace

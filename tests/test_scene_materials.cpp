@@ -513,6 +513,25 @@ TEST_F(SceneMaterialsTest, OverflowingLightNumbersAreErrors) {
   EXPECT_EQ(e.find('\n'), std::string::npos);
 }
 
+// The same for a colour value and a range (today the JSON parser itself refuses the overflowing literal,
+// before the loader's own finiteness checks).
+TEST_F(SceneMaterialsTest, OverflowingLightColourAndRangeAreErrors) {
+  const struct {
+    const char *from, *to, *message;
+  } cases[] = {{"\"color\":[1,0.5,0.25]", "\"color\":[1,1e999,0.25]", "color has a non-finite or non-numeric value"},
+               {"\"range\":10", "\"range\":1e999", "range is not finite"}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.to);
+    std::string text = lights_file().finished("data:application/octet-stream;base64," + base64(lights_file().bin)).dump();
+    ASSERT_NE(text.find(c.from), std::string::npos) << text;
+    text.replace(text.find(c.from), std::string(c.from).size(), c.to);
+    std::ofstream(dir_ / "inf.gltf") << text;
+    const std::string e = load_error((dir_ / "inf.gltf").string());
+    EXPECT_TRUE(contains(e, c.message) || contains(e, "invalid JSON")) << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos);
+  }
+}
+
 // ---- warnings --------------------------------------------------------------------------------------------------
 
 TEST_F(SceneMaterialsTest, OneWarningPerUnimplementedMaterialExtension) {

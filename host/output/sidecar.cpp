@@ -9,6 +9,7 @@
 #include "pmr/error.h"
 #include "pmr/output.h"
 #include "pmr/version.h"
+#include "shading/lights.h"
 
 namespace pmr {
 namespace {
@@ -63,21 +64,48 @@ json matrix_json(const glm::dmat4& m) {
 
 json vec3_json(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }
 
-// The shading model and its light as used (docs/SHADING.md). Sidecars written before --shading existed
-// have none: they were lambert at exposure 0. An environment image is recorded by its file (as given),
-// the checksum of its bytes, rotation and intensity, so --resume renders again when any of them changes.
+const char* light_type_name(SceneLightType t) {
+  return t == SceneLightType::Point ? "point" : t == SceneLightType::Spot ? "spot" : "directional";
+}
+
+// One light as pbr used it, world space, with what its type reads: a position for point and spot
+// lights, a direction (where the light travels) for directional and spot lights, a range (null: none)
+// for point and spot lights, the cone angles (radians) for spots.
+json light_json(const SceneLight& l) {
+  const bool is_default = is_default_light(l);
+  json j = {{"name", l.name}, {"source", is_default ? "default" : "file"}};
+  if (!is_default) j["light"] = l.light, j["node"] = l.node;
+  j["type"] = light_type_name(l.type);
+  j["color"] = {double(l.color[0]), double(l.color[1]), double(l.color[2])};
+  j["intensity"] = double(l.intensity);
+  if (l.type != SceneLightType::Directional) j["position"] = vec3_json(l.position);
+  if (l.type != SceneLightType::Point) j["direction"] = vec3_json(l.direction);
+  if (l.type != SceneLightType::Directional) j["range"] = l.range > 0.0f ? json(double(l.range)) : json();
+  if (l.type == SceneLightType::Spot)
+    j["inner_cone_angle"] = double(l.inner_cone), j["outer_cone_angle"] = double(l.outer_cone);
+  return j;
+}
+
+// The shading model and its lights as used (docs/SHADING.md). Sidecars written before --shading existed
+// have none: they were lambert at exposure 0. Lambert's one light is the top-level light_dir_*. An
+// environment image is recorded by its file (as given), the checksum of its bytes, rotation and
+// intensity, so --resume renders again when any of them changes.
 json shading_json(const SidecarInfo& info) {
   json s = {{"model", info.shading}, {"exposure_ev", info.exposure_ev}};
-  if (info.shading == "pbr" && info.environment_file.empty())
+  if (info.shading != "pbr") return s;
+  if (info.environment_file.empty())
     s["environment"] = {{"kind", "uniform"}, {"radiance", 0.2 * info.environment_intensity},
                         {"intensity", info.environment_intensity}};
-  else if (info.shading == "pbr")
+  else
     s["environment"] = {{"kind", "image"},
                         {"file", info.environment_file},
                         {"checksum", info.environment_checksum},
                         {"checksum_algorithm", kChecksumAlgorithm},
                         {"rotation_deg", info.environment_rotation_deg},
                         {"intensity", info.environment_intensity}};
+  json lights = json::array();
+  for (const SceneLight& l : info.lights) lights.push_back(light_json(l));
+  s["lights"] = lights;
   return s;
 }
 
@@ -210,8 +238,9 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
       {"depth", "the Z channel of the views and quilt EXRs (when written) is the view-space depth w: the distance "
                 "along the view's axis, positive in front of the camera; +infinity where nothing was drawn"},
       {"color", "linear-light RGB; alpha = coverage; background (0, 0, 0, 0)"},
-      {"light", "directional, toward the light, fixed in the center camera's view space; "
-                "color = base * (0.2 + 0.8 * max(0, dot(n, l)))"},
+      {"light", "light_dir_*: lambert's one directional light, toward the light, fixed in the center camera's "
+                "view space; color = base * (0.2 + 0.8 * max(0, dot(n, l))). pbr is lit by shading.lights instead "
+                "(world space; a light's direction is where it travels)"},
       {"encoding", "display pixel (j, i), row 0 at the top, subpixel k in {0,1,2} (R,G,B left to right): "
                    "t = (3 j + k' - 3 i tan_slant - offset) / lens_pitch with k' = k (subpixel_order rgb) or 2 - k "
                    "(bgr), v = floor(frac(phase_sign * t) * views) evaluated exactly, v -> views - 1 - v if "
@@ -260,8 +289,31 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   // sidecars written before --sampling existed sampled the views
   auto sampling = [&](const json& o) { return get(o, "sampling").is_null() ? json("view") : get(o, "sampling"); };
   if (sampling(a) != sampling(b)) return "sampling";
+  // the lights: their poses follow the frame, so other frames' (pmr verify, the folder scan) are compared
+  // without them; they follow from the scene file (its lights, or the default light when it has none and
+  // no environment image lights it)
+  const bool same_frame = !get(a, "frame").is_null() && get(a, "frame") == get(b, "frame");
   auto shading = [&](const json& o) {
-    return get(o, "shading").is_null() ? json({{"model", "lambert"}, {"exposure_ev", 0.0}}) : get(o, "shading");
+    json s = get(o, "shading").is_null() ? json({{"model", "lambert"}, {"exposure_ev", 0.0}}) : get(o, "shading");
+    if (!s.is_object()) return s;
+    if (get(s, "model") == "pbr" && !s.contains("lights")) {
+      // written before pmr recorded the lights, when pbr used the default light, or none with an image
+      const json toward = get(o, "light_dir_world");
+      s["lights"] = json();
+      if (get(get(s, "environment"), "kind") == "image")
+        s["lights"] = json::array();
+      else if (toward.is_array() && toward.size() == 3 && toward[0].is_number() && toward[1].is_number() && toward[2].is_number())
+        s["lights"] = json::array({json::parse(light_json(default_light(glm::dvec3(toward[0].get<double>(), toward[1].get<double>(),
+                                                                                    toward[2].get<double>())))
+                                                   .dump())});
+    }
+    if (ignore_scene_derived) {
+      s.erase("lights");
+    } else if (!same_frame && s.contains("lights") && s["lights"].is_array()) {
+      for (json& l : s["lights"])
+        if (l.is_object()) l.erase("position"), l.erase("direction");
+    }
+    return s;
   };
   if (shading(a) != shading(b)) return "shading";
   // the rig as configured (an animated camera moves the focal plane from frame to frame)

@@ -3,12 +3,11 @@
 #include "pipeline/material_tables.h"
 #include "pipeline/tile_tables.h"
 #include "shading/environment.h"
+#include "shading/lights.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-
-#include <glm/gtc/constants.hpp>
 
 #include "pmr/error.h"
 
@@ -79,6 +78,9 @@ struct Pipeline::Impl {
   ClBuffer texcoords, tangents;  // the TEXCOORD sets the material maps sample; world tangents (pbr)
   bool has_tangents = false;
   ClBuffer env, env_data;    // pbr: the environment image's header and tables (level_count 0: none)
+  std::vector<SceneLight> scene_lights;  // the scene's lights as last given (set_scene, update_lights)
+  std::vector<SceneLight> used_lights;   // the last frame's resolved lights (pbr)
+  ClBuffer lights;                       // their table (PmrLight), uploaded every frame
   // frame
   PmrParams params{};
   PmrEncodeParams encode_params{};
@@ -280,6 +282,7 @@ void Pipeline::set_scene(const Scene& scene) {
   m.has_tangents = scene.tangents.size() == scene.positions.size() && !scene.positions.empty();
   const std::vector<glm::vec4> no_tangents(1, glm::vec4(0.0f));
   const std::vector<glm::vec4>& tangents = m.has_tangents ? scene.tangents : no_tangents;
+  m.scene_lights = scene.lights;
 
   m.positions = rt.buffer(bytes_of(scene.positions), "vertex positions", CL_MEM_READ_ONLY);
   rt.write(m.positions, scene.positions.data(), bytes_of(scene.positions));
@@ -319,6 +322,10 @@ void Pipeline::update_geometry(const Scene& posed) {
   if (m.has_tangents && posed.tangents.size() == posed.positions.size())
     m.rt.write(m.tangents, posed.tangents.data(), bytes_of(posed.tangents));
 }
+
+void Pipeline::update_lights(const std::vector<SceneLight>& lights) { impl_->scene_lights = lights; }
+
+const std::vector<SceneLight>& Pipeline::lights_used() const { return impl_->used_lights; }
 
 size_t Pipeline::volume_bytes() const {
   const PmrParams& p = impl_->params;
@@ -486,7 +493,7 @@ void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
 
 void Pipeline::Impl::fine_stage(Events& ev) {
   k_fine.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents, volume,
-              dbg_key, dbg_depth, dbg_count, env, env_data);
+              dbg_key, dbg_depth, dbg_count, env, env_data, lights);
   ev.add(kFine, launch(k_fine, size_t(num_tiles), kFineGroup));
 }
 
@@ -583,7 +590,7 @@ void Pipeline::Impl::subpixel_stage(Events& ev) {
   k_fine_subpixel.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents,
                        encode_buf, column_a, column_b, encode_rows, sample_x, sample_y, chunks, warming ? 0u : num_chunks,
                        straddle_slot, straddle_slots,
-                       straddle_cov, display, cl_uint(subpixel_debug), dbg_key, dbg_depth, env, env_data);
+                       straddle_cov, display, cl_uint(subpixel_debug), dbg_key, dbg_depth, env, env_data, lights);
   ev.add(kFine, launch(k_fine_subpixel, num_chunks, 1));
   straddle_alpha_stage(k_subpixel_straddle, ev);
 }
@@ -592,7 +599,7 @@ void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
   k_fine_encode.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents,
                      encode_buf, column_soa, encode_rows, column_start, row_start, straddle_slot, straddle_slots,
-                     straddle_cov, display, env, env_data);
+                     straddle_cov, display, env, env_data, lights);
   const size_t screen_tiles = size_t(P.tiles_x) * P.tiles_y;
   ev.add(kFine, launch(k_fine_encode, screen_tiles, 1));
   straddle_alpha_stage(k_straddle_alpha, ev);
@@ -619,8 +626,17 @@ StageTimes Pipeline::render(const Rig& rig) {
   P.shading = config_.shading == Shading::Pbr ? PMR_SHADING_PBR : PMR_SHADING_LAMBERT;
   P.exposure = float(std::exp2(config_.exposure_ev));
   P.env_radiance = float(0.2 * config_.environment_intensity);
-  // the default light shines only when no environment image is given (and the scene has no lights)
-  P.light_irradiance = config_.environment ? 0.0f : float(0.8 * glm::pi<double>());
+  {  // the light table (pbr; the lights move with their nodes, and the default light with the camera;
+     // an environment image replaces the default light)
+    m.used_lights.clear();
+    if (config_.shading == Shading::Pbr) m.used_lights = resolve_lights(m.scene_lights, rig, !config_.environment);
+    std::vector<PmrLight> table;
+    for (const SceneLight& l : m.used_lights) table.push_back(device_light(l));
+    P.num_lights = uint32_t(table.size());
+    table.resize(std::max<size_t>(table.size(), 1));  // no empty buffers
+    if (m.lights.size() != bytes_of(table)) m.lights = m.rt.buffer(bytes_of(table), "lights", CL_MEM_READ_ONLY);
+    m.rt.write(m.lights, table.data(), bytes_of(table));
+  }
   {  // each view's camera position in world space (the view vector of pbr; the camera may move)
     std::vector<glm::vec4> eyes(size_t(rig.views));
     for (int i = 0; i < rig.views; ++i) eyes[size_t(i)] = glm::vec4(glm::vec3(glm::inverse(rig.view_matrix(i))[3]), 1.0f);
@@ -715,7 +731,8 @@ size_t Pipeline::device_bytes() const {
                             &m.encode_buf, &m.vertices, &m.pmr_vertices, &m.mtas, &m.mta_counter, &m.tile_counts,
                             &m.tile_offsets, &m.tile_queue, &m.volume, &m.display, &m.encode_columns, &m.encode_rows, &m.dbg_key, &m.dbg_depth, &m.dbg_count,
                             &m.column_start, &m.column_soa, &m.row_start, &m.straddle_slot, &m.straddle_columns, &m.straddle_cov,
-                            &m.chunks, &m.sample_x, &m.sample_y, &m.column_a, &m.column_b, &m.eyes, &m.split_sum, &m.env, &m.env_data})
+                            &m.chunks, &m.sample_x, &m.sample_y, &m.column_a, &m.column_b, &m.eyes, &m.split_sum, &m.env, &m.env_data,
+                            &m.lights})
     total += b->get() ? b->size() : 0;
   return total;
 }

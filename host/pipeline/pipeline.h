@@ -69,7 +69,8 @@ struct PipelineConfig {
   double environment_intensity = 1.0;  // pbr: scales the uniform default environment (radiance 0.2)
   // pbr: an environment image, prefiltered once (Environment::make) and shared by every pipeline of
   // a process; its rotation and intensity are its own (the intensity must equal environment_intensity).
-  // It replaces the uniform default and turns the default light off. Null: the uniform default.
+  // It replaces the uniform default and turns the default light off (host/shading/lights.h; the file's
+  // lights stay). Null: the uniform default.
   std::shared_ptr<const Environment> environment;
 };
 
@@ -92,6 +93,12 @@ class Pipeline {
   // Replaces positions, attributes and triangles (a posed frame of the scene given to set_scene: same
   // counts, same materials and textures). Only a copy: no buffer is reallocated.
   void update_geometry(const Scene& posed);
+  // Replaces the scene's lights (world space, posed: Scene::lights of a posed frame). set_scene takes the
+  // scene's own; every render() resolves them with its rig (resolve_lights) into the kernels' table.
+  void update_lights(const std::vector<SceneLight>& lights);
+  // The lights --shading pbr lit the last frame with (world space, the default light included); empty
+  // under lambert, whose one fixed light is the rig's.
+  const std::vector<SceneLight>& lights_used() const;
   // Allocates the per-configuration buffers (view volume, tile queues, display image). The display
   // may be null when only the view volume is needed.
   void configure(const Rig& rig, const Display* display);

@@ -23,3 +23,7 @@ static_assert(sizeof(PmrEnvLevel) == 16 && offsetof(PmrEnvLevel, roughness) == 1
 static_assert(sizeof(PmrEnvironment) == 32 + 16 * PMR_ENV_MAX_LEVELS && offsetof(PmrEnvironment, intensity) == 20 &&
                   offsetof(PmrEnvironment, levels) == 32,
               "PmrEnvironment layout");
+static_assert(offsetof(PmrParams, num_lights) == 280, "PmrParams layout");
+static_assert(sizeof(PmrLight) == 64 && offsetof(PmrLight, type) == 12 && offsetof(PmrLight, range) == 28 &&
+                  offsetof(PmrLight, direction) == 32 && offsetof(PmrLight, cos_outer) == 48,
+              "PmrLight layout");

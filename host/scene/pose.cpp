@@ -49,11 +49,30 @@ void sample_nodes(const SceneMotion& m, const PoseRequest& r, std::vector<glm::d
   }
 }
 
-void deform_instances(const Scene& rest, const SceneMotion& m, const PoseRequest& r, Scene& out) {
+// Cameras and lights placed by their nodes' world matrices.
+void place_cameras_and_lights(const SceneMotion& m, const std::vector<glm::dmat4>& world, Scene& out) {
+  for (size_t c = 0; c < out.cameras.size() && c < m.camera_node.size(); ++c)
+    if (m.camera_node[c] >= 0 && out.cameras[c].placed) out.cameras[c].world_from_camera = world[size_t(m.camera_node[c])];
+  // Lights: the node's origin and -Z (a degenerate matrix keeps the rest direction).
+  for (size_t l = 0; l < out.lights.size() && l < m.light_node.size(); ++l) {
+    const glm::dmat4& w = world[size_t(m.light_node[l])];
+    out.lights[l].position = glm::dvec3(w[3]);
+    const glm::dvec3 dir = -glm::dvec3(w[2]);
+    const double len = glm::length(dir);
+    if (len > 0.0 && std::isfinite(len)) out.lights[l].direction = dir / len;
+  }
+}
+
+// The world matrices of every node at the request's time, and their morph weights.
+std::vector<glm::dmat4> posed_world(const SceneMotion& m, const PoseRequest& r, std::vector<std::vector<float>>& weights) {
   std::vector<glm::dmat4> local;
-  std::vector<std::vector<float>> weights;
   sample_nodes(m, r, local, weights);
-  const std::vector<glm::dmat4> world = world_matrices(m, local);
+  return world_matrices(m, local);
+}
+
+void deform_instances(const Scene& rest, const SceneMotion& m, const PoseRequest& r, Scene& out) {
+  std::vector<std::vector<float>> weights;
+  const std::vector<glm::dmat4> world = posed_world(m, r, weights);
   std::vector<std::vector<glm::dmat4>> joints(m.skins.size());
   for (size_t s = 0; s < m.skins.size(); ++s) joints[s] = joint_matrices(m.skins[s], world);
   for (const Deformable& d : m.deformables) {
@@ -73,16 +92,7 @@ void deform_instances(const Scene& rest, const SceneMotion& m, const PoseRequest
       }
     });
   }
-  for (size_t c = 0; c < out.cameras.size() && c < m.camera_node.size(); ++c)
-    if (m.camera_node[c] >= 0 && out.cameras[c].placed) out.cameras[c].world_from_camera = world[size_t(m.camera_node[c])];
-  // Lights: the node's origin and -Z (a degenerate matrix keeps the rest direction).
-  for (size_t l = 0; l < out.lights.size() && l < m.light_node.size(); ++l) {
-    const glm::dmat4& w = world[size_t(m.light_node[l])];
-    out.lights[l].position = glm::dvec3(w[3]);
-    const glm::dvec3 dir = -glm::dvec3(w[2]);
-    const double len = glm::length(dir);
-    if (len > 0.0 && std::isfinite(len)) out.lights[l].direction = dir / len;
-  }
+  place_cameras_and_lights(m, world, out);
 }
 
 // Rotation about +Y by `deg` degrees, exact at multiples of 90 (so a quarter turn does not smear
@@ -101,6 +111,15 @@ glm::dmat3 rotation_y(double deg) {
   return glm::dmat3(glm::dvec3(c, 0, -s), glm::dvec3(0, 1, 0), glm::dvec3(s, 0, c));
 }
 
+void turn_lights(const PoseRequest& r, std::vector<SceneLight>& lights) {
+  const glm::dmat3 R = rotation_y(r.turntable_deg);
+  const glm::dvec3 shift = r.pivot - R * r.pivot;
+  for (SceneLight& l : lights) {
+    l.position = R * l.position + shift;
+    l.direction = R * l.direction;
+  }
+}
+
 void turn(const PoseRequest& r, Scene& out) {
   const glm::dmat3 R = rotation_y(r.turntable_deg);
   const glm::dvec3 shift = r.pivot - R * r.pivot;
@@ -116,10 +135,7 @@ void turn(const PoseRequest& r, Scene& out) {
   }
   // A rotation keeps handedness: w stays.
   for (glm::vec4& t : out.tangents) t = glm::vec4(glm::vec3(R * glm::dvec3(t)), t.w);
-  for (SceneLight& l : out.lights) {
-    l.position = R * l.position + shift;
-    l.direction = R * l.direction;
-  }
+  turn_lights(r, out.lights);
 }
 
 bool animates(const Scene& rest, const PoseRequest& r) {
@@ -127,6 +143,12 @@ bool animates(const Scene& rest, const PoseRequest& r) {
   for (size_t c = 0; c < rest.motion->clips.size(); ++c)
     if (clip_selected(int(c), r.animation) && !rest.motion->clips[c].channels.empty()) return true;
   return false;
+}
+
+void check_request(const Scene& rest, const PoseRequest& r) {
+  if (r.animation != kNoAnimation && r.animation != kAllAnimations &&
+      (r.animation < 0 || size_t(r.animation) >= rest.animations.size()))
+    throw Error("pose_scene: no animation " + std::to_string(r.animation));
 }
 
 }  // namespace
@@ -140,10 +162,19 @@ double turntable_angle(long frame, double degrees, long frames) {
 
 bool pose_moves(const Scene& rest, const PoseRequest& r) { return r.turntable || animates(rest, r); }
 
+void pose_cameras_and_lights(const Scene& rest, const PoseRequest& r, Scene& out) {
+  check_request(rest, r);
+  out.cameras = rest.cameras;
+  out.lights = rest.lights;
+  if (animates(rest, r)) {
+    std::vector<std::vector<float>> weights;
+    place_cameras_and_lights(*rest.motion, posed_world(*rest.motion, r, weights), out);
+  }
+  if (r.turntable) turn_lights(r, out.lights);
+}
+
 bool pose_scene(const Scene& rest, const PoseRequest& r, Scene& out) {
-  if (r.animation != kNoAnimation && r.animation != kAllAnimations &&
-      (r.animation < 0 || size_t(r.animation) >= rest.animations.size()))
-    throw Error("pose_scene: no animation " + std::to_string(r.animation));
+  check_request(rest, r);
   const bool animated = animates(rest, r);
   // Sizes differ on first use; afterwards only what a pose can change needs resetting.
   if (out.positions.size() != rest.positions.size() || out.triangles.size() != rest.triangles.size() ||

@@ -5,6 +5,7 @@
 
 #include "pmr/error.h"
 #include "scene/motion.h"
+#include "shading/lights.h"
 
 namespace pmr {
 
@@ -158,7 +159,10 @@ FrameRenderer::Frame FrameRenderer::render(long frame) {
   out.time = r.time;
   out.angle = r.turntable_deg;
   out.rig = rig_;
-  if (rest_.triangles.empty()) return out;
+  if (rest_.triangles.empty()) {  // nothing is rendered; the sidecar still records the lights
+    out.lights = frame_lights(frame, pipeline_->config());
+    return out;
+  }
   const auto t0 = std::chrono::steady_clock::now();
   if (moves_) {
     const bool changed = pose_scene(rest_, r, posed_);
@@ -166,11 +170,22 @@ FrameRenderer::Frame FrameRenderer::render(long frame) {
     out.pose_ms = ms_since(t0);
     const auto t1 = std::chrono::steady_clock::now();
     if (changed) pipeline_->update_geometry(posed_);
+    // the lights every frame: an animation may move a light and no geometry (changed is false then)
+    pipeline_->update_lights(posed_.lights);
     out.upload_ms = ms_since(t1);
   }
   out.times = pipeline_->render(out.rig);
   out.visible = out.times.mtas > 0;
+  out.lights = pipeline_->lights_used();
   return out;
+}
+
+std::vector<SceneLight> FrameRenderer::frame_lights(long frame, const PipelineConfig& config) const {
+  if (config.shading != Shading::Pbr) return {};
+  if (!moves_) return resolve_lights(rest_.lights, rig_, !config.environment);
+  Scene placed;
+  pose_cameras_and_lights(rest_, request(frame), placed);
+  return resolve_lights(placed.lights, camera_moves_ ? rig_for(placed, nullptr) : rig_, !config.environment);
 }
 
 }  // namespace pmr

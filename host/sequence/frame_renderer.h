@@ -1,5 +1,5 @@
 // One frame of a sequence, the same for `pmr render` and `pmr bench`: the scene posed at the frame's
-// time (animation) and angle (turntable), uploaded if it moved, the rig (fixed, or following an animated
+// time (animation) and angle (turntable), uploaded if it moved (its lights every frame), the rig (fixed, or following an animated
 // glTF camera), and the pipeline run. The framing is computed once over the chosen animation's whole
 // time range (DESIGN section 7), so any frame renders the same alone as inside a longer sequence.
 #pragma once
@@ -51,8 +51,14 @@ class FrameRenderer {
     double pose_ms = 0.0;    // posing (animation sampling, morphing, skinning, turntable) on the host
     double upload_ms = 0.0;  // copying the posed geometry to the device
     bool visible = false;    // some MTA was produced (false: a transparent image)
+    // pbr: the lights the frame was shaded with (world space, posed; the default light when the scene
+    // has none), as the sidecar records them; empty under lambert
+    std::vector<SceneLight> lights;
   };
   Frame render(long frame);
+  // The lights render(frame) shades with under `config` (Frame::lights), without rendering it: posed
+  // lights and cameras only, for the sidecars --resume expects.
+  std::vector<SceneLight> frame_lights(long frame, const PipelineConfig& config) const;
 
   const Rig& rig() const { return rig_; }
   const glm::dvec3& bounds_lo() const { return lo_; }

@@ -67,6 +67,9 @@ int run_sequence(const RenderOptions& o) {
                    double(environment->tables().data.size() * sizeof(float)) / 1e6);
     }
   }
+  // the pipeline's configuration: the sidecars a resumed run expects need it too (which lights)
+  PipelineConfig pc = o.pipeline;
+  pc.environment = environment;
   const Scene scene = load_scene(o.scene);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
   SequenceSpec spec;
@@ -148,11 +151,12 @@ int run_sequence(const RenderOptions& o) {
                         {"flipImageY", c.flip_y},   {"flipSubp", c.flip_subp}, {"invView", c.inv_view},
                         {"CellPatternMode", c.cell_pattern}, {"subpixelCells", double(c.cells.size())}};
   }
-  auto frame_info = [&](long frame, const FramePaths& p, double angle) {
+  auto frame_info = [&](long frame, const FramePaths& p, double angle, std::vector<SceneLight> lights) {
     SidecarInfo i = info;
     i.frame = int(frame);
     i.time = double(frame) / spec.fps;
     i.turntable_angle = angle;
+    i.lights = std::move(lights);
     const std::pair<const char*, const std::string*> kinds[] = {
         {"encoded", &p.encoded}, {"views", &p.views}, {"quilt", &p.quilt}, {"preview_encoded", &p.encoded_png},
         {"preview_center", &p.center_png}, {"preview_quilt", &p.quilt_png}};
@@ -167,10 +171,11 @@ int run_sequence(const RenderOptions& o) {
   // One folder, one configuration: no other configuration rendering into it now, none left beside
   // this run's frames (folder_guard.h). Held until the end of the run.
   const FolderGuard folder_guard(o.out_dir, o.name, o.shard.empty() ? frames : job_frames,
-                                 sidecar_json(rig, o.display, frame_info(0, paths(0), 0.0)), o.overwrite);
+                                 sidecar_json(rig, o.display, frame_info(0, paths(0), 0.0, renderer.frame_lights(0, pc))),
+                                 o.overwrite);
 
   const ResumePlan plan = plan_resume(frames, o.resume, o.overwrite, paths, [&](long f, const FramePaths& p) {
-    return sidecar_json(rig, o.display, frame_info(f, p, 0.0));
+    return sidecar_json(rig, o.display, frame_info(f, p, 0.0, renderer.frame_lights(f, pc)));
   });
   for (const std::string& note : plan.notes) std::fprintf(stderr, "pmr: %s\n", note.c_str());
   const std::vector<long>& todo = plan.todo;
@@ -186,10 +191,8 @@ int run_sequence(const RenderOptions& o) {
   }
 
   ClRuntime runtime;
-  PipelineConfig pc = o.pipeline;
   pc.fuse_encode = !need_volume;  // the volume is only kept when a product needs it
   pc.debug_outputs = o.write_depth;  // per-voxel depth
-  pc.environment = environment;
   Pipeline pipeline(runtime, pc);
   renderer.attach(pipeline, o.write_encoded ? &o.display : nullptr);  // builds every kernel the frames use
   if (o.verbose) {
@@ -232,7 +235,7 @@ int run_sequence(const RenderOptions& o) {
     files.frame = f;
     files.compression = compression;
     files.sidecar_path = p.sidecar;
-    files.sidecar_text = sidecar_json(fr.rig, o.display, frame_info(f, p, fr.angle));
+    files.sidecar_text = sidecar_json(fr.rig, o.display, frame_info(f, p, fr.angle, fr.lights));
     files.has_meta = true;  // the EXR header attributes (docs/OUTPUTS.md)
     files.meta.frame = f, files.meta.time = double(f) / spec.fps, files.meta.fps = spec.fps;
     files.meta.sidecar = base_name(p.sidecar), files.meta.rig = fr.rig;

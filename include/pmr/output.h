@@ -10,6 +10,7 @@
 
 #include "pmr/quilt.h"
 #include "pmr/rig.h"
+#include "pmr/scene.h"
 
 namespace pmr {
 
@@ -123,6 +124,7 @@ struct SidecarInfo {
   std::string shading = "lambert";  // "lambert" or "pbr" (docs/SHADING.md)
   double exposure_ev = 0.0;
   double environment_intensity = 1.0;  // pbr: scales the uniform environment
+  std::vector<SceneLight> lights;      // pbr: the frame's lights as used (FrameRenderer::Frame::lights)
   int tile_x = 16, tile_y = 2, tile_v = 16;
   int camera = -1;              // glTF camera index, -1 = the default framing of the bounding sphere
   bool has_bounds = false;      // world bounds of the scene the default framing used
@@ -162,11 +164,12 @@ struct SidecarInfo {
 // The sidecar's JSON text (pretty printed, doubles with round-trip precision).
 std::string sidecar_json(const Rig& rig, const Display& display, const SidecarInfo& info);
 // Compares the configuration that decides a frame's pixels (scene, method, tile, camera, display, rig,
-// framing, fps, animation, turntable; not the frame, its time or the outputs) of two sidecars' JSON
-// texts. Returns "" when they agree, else the first differing key (or "unreadable" when `existing` does
+// framing, fps, animation, turntable, shading and its lights; not the frame, its time or the outputs) of
+// two sidecars' JSON texts. The lights' positions and directions follow the frame (animation, turntable):
+// they are compared only between sidecars of the same frame. Returns "" when they agree, else the first differing key (or "unreadable" when `existing` does
 // not parse).
 // With ignore_scene_derived, the keys that follow from the scene file's content (scene_bounds, the
-// turntable's pivot, the animation's name) are not compared: for a frame known to come from another
+// turntable's pivot, the animation's name, the lights) are not compared: for a frame known to come from another
 // scene (sidecar_provenance), only the configuration the user chose matters.
 std::string sidecar_config_difference(const std::string& existing, const std::string& expected,
                                       bool ignore_scene_derived = false);

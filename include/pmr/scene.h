@@ -172,6 +172,11 @@ struct PoseRequest {
 // arrays (so the renderer must upload it).
 bool pose_scene(const Scene& rest, const PoseRequest& request, Scene& out);
 
+// Writes the posed cameras and lights of `rest` into `out`, the same as pose_scene places them, without
+// posing any geometry (out's geometry is left alone): what a frame's sidecar records, for frames not
+// rendered (--resume).
+void pose_cameras_and_lights(const Scene& rest, const PoseRequest& request, Scene& out);
+
 // True if the request can move any vertex or camera (an animation that targets something, or a
 // turntable). A static request's frames are the rest scene.
 bool pose_moves(const Scene& rest, const PoseRequest& request);

@@ -94,6 +94,11 @@ typedef int64_t pmr_i64;
 #define PMR_SAMPLES_CENTER 0u
 #define PMR_SAMPLES_PIXEL 1u
 
+/* PmrLight.type: KHR_lights_punctual's three kinds. */
+#define PMR_LIGHT_DIRECTIONAL 0
+#define PMR_LIGHT_POINT 1
+#define PMR_LIGHT_SPOT 2
+
 /* Frame parameters, one copy per frame, read by every stage. Producer: host/pipeline. */
 typedef struct {
   double view[16];        /* center camera view matrix, column-major (world -> center view space) */
@@ -119,7 +124,7 @@ typedef struct {
   pmr_u32 shading;        /* PMR_SHADING_LAMBERT or PMR_SHADING_PBR                           */
   float exposure;         /* 2^EV: scales the colour of either model                          */
   float env_radiance;     /* pbr: radiance of the uniform default environment (0.2 x intensity) */
-  float light_irradiance; /* pbr: irradiance E of the default directional light (0.8 pi)       */
+  pmr_u32 num_lights;     /* pbr: entries of the light table (PmrLight), the kernels' last argument */
   pmr_u32 pad_params;
 } PmrParams;
 
@@ -204,6 +209,21 @@ typedef struct {
   pmr_i32 wrap_s, wrap_t; /* PMR_WRAP_*                                                      */
   pmr_u32 pad0, pad1, pad2;
 } PmrTexture;
+
+/* One punctual light of --shading pbr, world space, as resolved for the frame (the file's
+ * KHR_lights_punctual lights, posed, or the default light; host/shading/lights.h). Producer: host, every
+ * frame. cl/brdf.h light_irradiance() evaluates it. */
+typedef struct {
+  float color[3];         /* colour x intensity, linear: lux (directional) or candela (point, spot) */
+  pmr_u32 type;           /* PMR_LIGHT_*                                                      */
+  float position[3];      /* the light's origin (point, spot)                                  */
+  float range;            /* point, spot: the distance window's range; 0 = none                */
+  float direction[3];     /* unit: the direction the light travels (its node's -Z); the direction
+                             toward a directional light is -direction (directional, spot)      */
+  float cos_inner;        /* spot: cos(innerConeAngle)                                         */
+  float cos_outer;        /* spot: cos(outerConeAngle)                                         */
+  pmr_u32 pad0, pad1, pad2;
+} PmrLight;
 
 /* Encoder parameters (DESIGN section 5): sizes and flags. The subpixel-to-view map itself is in the
  * tables below, computed exactly by the host (host/rig/display.cpp). */

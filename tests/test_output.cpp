@@ -23,6 +23,7 @@
 #include "pmr/error.h"
 #include "pmr/output.h"
 #include "pmr/rig.h"
+#include "test_util.h"
 
 namespace pmr {
 namespace {
@@ -406,22 +407,6 @@ TEST(Output, PrepareOutputDir) {
 }
 
 // ---------------------------------------------------------------------------------------------------
-Rig sidecar_rig() {
-  Rig rig;
-  rig.views = 3;
-  rig.view_w = 64;
-  rig.view_h = 32;
-  rig.yfov = glm::radians(40.0);
-  rig.cone = glm::radians(30.0);
-  rig.aspect = 166.0 / 93.0;
-  rig.focal = 5.0;
-  rig.near = 3.0;
-  rig.near_eff = 3.5;
-  rig.far = 8.0;
-  rig.center_view = glm::lookAt(glm::dvec3(3.0, 2.0, 4.0), glm::dvec3(0.0, 0.5, 0.0), glm::dvec3(0.0, 1.0, 0.0));
-  return rig;
-}
-
 glm::dmat4 matrix_from_json(const nlohmann::json& a) {
   EXPECT_TRUE(a.is_array());
   EXPECT_EQ(a.size(), 16u);
@@ -433,7 +418,7 @@ glm::dmat4 matrix_from_json(const nlohmann::json& a) {
 
 TEST(Output, SidecarMatricesReproduceTheRig) {
   TempDir dir;
-  const Rig rig = sidecar_rig();
+  const Rig rig = test::sidecar_rig();
   Display display;
   SidecarInfo info;
   info.scene = "scene.glb";
@@ -517,7 +502,7 @@ TEST(Output, SidecarMatricesReproduceTheRig) {
 }
 
 TEST(Output, SidecarSingleViewHasNoInfiniteNumbers) {
-  Rig rig = sidecar_rig();
+  Rig rig = test::sidecar_rig();
   rig.views = 1;
   const nlohmann::json j = nlohmann::json::parse(sidecar_json(rig, Display{}, SidecarInfo{}));
   EXPECT_EQ(j.at("views").size(), 1u);

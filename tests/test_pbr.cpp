@@ -50,6 +50,22 @@ ref::SurfacePoint surface_at(const Scene& s, const Rig& rig, uint32_t tri, const
   return sp;
 }
 
+// The model's bound on one voxel of a render: 1% relative plus 1e-3 absolute per colour channel.
+// Counts the channels outside it (reporting the first five) and the largest error as a fraction of it.
+struct BoundCheck {
+  size_t bad = 0;
+  double worst = 0.0;
+  void voxel(const test::Rendered& out, size_t v, const glm::dvec3& want, const std::string& what = "voxel") {
+    for (int c = 0; c < 3; ++c) {
+      half got;
+      got.setBits(out.volume[v * 4 + size_t(c)]);
+      const double err = std::abs(double(float(got)) - want[c]), tol = 0.01 * std::abs(want[c]) + 1e-3;
+      worst = std::max(worst, err / tol);
+      if (err > tol && ++bad <= 5) ADD_FAILURE() << what << " " << v << " channel " << c << ": " << float(got) << " vs " << want[c];
+    }
+  }
+};
+
 // The defaults: one directional light toward the rig's light direction with E = 0.8 pi, a uniform
 // environment of radiance 0.2 (I = P = 0.2) and the split-sum table the kernels are given.
 std::vector<ref::PunctualLight> default_light(const Rig& rig) {
@@ -132,35 +148,25 @@ TEST(Pbr, EveryShadedVoxelMatchesTheReference) {
   const Scene s = material_quads();
   const test::Rendered out = render_pbr(s, rig);
   const VoxelReference reference(s, rig, out);
-  const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
-  size_t compared = 0, bad = 0, back = 0;
+  size_t compared = 0, back = 0;
   std::map<uint32_t, size_t> per_material;
-  double worst = 0.0;
+  BoundCheck check;
   for (size_t v = 0; v < out.key.size(); ++v) {
     if (out.key[v] == PMR_NO_KEY) continue;
-    const int px = int(v % W), py = int((v / W) % H), view = int(v / (W * H));
     const PmrMta* m = reference.mta(v);
     ASSERT_NE(m, nullptr) << "no MTA for key " << out.key[v];
     back += (m->flags & PMR_MTA_BACK) != 0;
     const glm::dvec3 want = reference.colour(v, *m);
-    for (int c = 0; c < 3; ++c) {
-      half got;
-      got.setBits(out.volume[v * 4 + size_t(c)]);
-      const double err = std::abs(double(float(got)) - want[c]), tol = 0.01 * std::abs(want[c]) + 1e-3;
-      worst = std::max(worst, err / tol);
-      if (err > tol && ++bad <= 5)
-        ADD_FAILURE() << "voxel (" << px << "," << py << "," << view << ") channel " << c << ": " << float(got)
-                      << " vs " << want[c];
-    }
+    check.voxel(out, v, want);
     ++compared;
     ++per_material[s.triangles[m->tri].material];
   }
-  EXPECT_EQ(bad, 0u);
+  EXPECT_EQ(check.bad, 0u);
   EXPECT_GT(compared, size_t(3000));
   for (uint32_t material = 1; material <= 6; ++material)  // every quad, the emissive and unlit ones too
     EXPECT_GT(per_material[material], size_t(100)) << "material " << material;
   EXPECT_GT(back, 0u) << "the scene should contain a back face";
-  std::printf("[ pbr      ] %zu voxels, largest error %.3f of the bound\n", compared, worst);
+  std::printf("[ pbr      ] %zu voxels, largest error %.3f of the bound\n", compared, check.worst);
 }
 
 // Two quads whose materials use every map: metallic-roughness, normal (scale 0.8) and occlusion
@@ -239,31 +245,25 @@ TEST(Pbr, MaterialMapsMatchTheReference) {
   plain.material_inputs.clear();
   const test::Rendered out = render_pbr(s, rig);
   const VoxelReference reference(s, rig, out), without_maps(plain, rig, out);
-  size_t compared = 0, bad = 0, changed = 0;
+  size_t compared = 0, changed = 0;
   std::map<uint32_t, size_t> per_material;
-  double worst = 0.0;
+  BoundCheck check;
   for (size_t v = 0; v < out.key.size(); ++v) {
     if (out.key[v] == PMR_NO_KEY) continue;
     const PmrMta* m = reference.mta(v);
     ASSERT_NE(m, nullptr);
     const glm::dvec3 want = reference.colour(v, *m), plain_colour = without_maps.colour(v, *m);
     changed += glm::length(want - plain_colour) > 0.05 * glm::length(plain_colour);
-    for (int c = 0; c < 3; ++c) {
-      half got;
-      got.setBits(out.volume[v * 4 + size_t(c)]);
-      const double err = std::abs(double(float(got)) - want[c]), tol = 0.01 * std::abs(want[c]) + 1e-3;
-      worst = std::max(worst, err / tol);
-      if (err > tol && ++bad <= 5) ADD_FAILURE() << "voxel " << v << " channel " << c << ": " << float(got) << " vs " << want[c];
-    }
+    check.voxel(out, v, want);
     ++compared;
     ++per_material[s.triangles[m->tri].material];
   }
-  EXPECT_EQ(bad, 0u);
+  EXPECT_EQ(check.bad, 0u);
   EXPECT_GT(per_material[1], size_t(1000));
   EXPECT_GT(per_material[2], size_t(1000));
   EXPECT_GT(changed, compared * 3 / 4) << "the maps should change most voxels";
   std::printf("[ pbr maps ] %zu voxels, %zu changed by the maps, largest error %.3f of the bound\n", compared, changed,
-              worst);
+              check.worst);
 }
 
 // Real models with maps (../shared/gltf): Avocado (metallic-roughness and normal maps, TANGENT), the same
@@ -291,7 +291,9 @@ TEST(Pbr, RealModelsWithMapsMatchTheReference) {
   for (const std::string& f : files) {
     SCOPED_TRACE(f);
     const Scene s = load_scene(f);
-    if (f == files[1]) EXPECT_GT(s.structure.generated_tangent_primitives, 0u) << "the copy should have no TANGENT";
+    if (f == files[1]) {
+      EXPECT_GT(s.structure.generated_tangent_primitives, 0u) << "the copy should have no TANGENT";
+    }
     glm::dvec3 lo, hi;
     ASSERT_TRUE(scene_bounds(s, lo, hi));
     RigConfig rc;
@@ -299,8 +301,8 @@ TEST(Pbr, RealModelsWithMapsMatchTheReference) {
     const Rig rig = make_rig(rc, Display{}, lo, hi);
     const test::Rendered out = render_pbr(s, rig);
     const VoxelReference reference(s, rig, out);
-    size_t compared = 0, bad = 0;
-    double worst = 0.0;
+    size_t compared = 0;
+    BoundCheck check;
     for (size_t v = 0; v < out.key.size(); ++v) {
       if (out.key[v] == PMR_NO_KEY) continue;
       const PmrMta* m = reference.mta(v);
@@ -310,19 +312,13 @@ TEST(Pbr, RealModelsWithMapsMatchTheReference) {
       const glm::dvec3 b = ref::source_barycentrics(*m, int(v % size_t(W)), int((v / size_t(W)) % size_t(H)), view);
       if (surface_at(s, rig, m->tri, b, false, view).roughness < 0.2) continue;
       const glm::dvec3 want = reference.colour(v, *m);
-      for (int c = 0; c < 3; ++c) {
-        half got;
-        got.setBits(out.volume[v * 4 + size_t(c)]);
-        const double err = std::abs(double(float(got)) - want[c]), tol = 0.01 * std::abs(want[c]) + 1e-3;
-        worst = std::max(worst, err / tol);
-        if (err > tol && ++bad <= 5) ADD_FAILURE() << "voxel " << v << " channel " << c << ": " << float(got) << " vs " << want[c];
-      }
+      check.voxel(out, v, want);
       ++compared;
     }
-    EXPECT_EQ(bad, 0u);
+    EXPECT_EQ(check.bad, 0u);
     EXPECT_GT(compared, size_t(2000));
     std::printf("[ pbr      ] %s: %zu voxels, largest error %.3f of the bound\n", fs::path(f).filename().c_str(), compared,
-                worst);
+                check.worst);
   }
   fs::remove_all(tmp);
 }
@@ -469,9 +465,8 @@ Agreement compare_with_environment(const Scene& s, const Rig& rig, const test::R
   VoxelReference reference(s, rig, out);
   reference.lights.clear();
   reference.env = image_environment(e);
-  const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
   Agreement a;
-  size_t bad = 0;
+  BoundCheck check;
   for (size_t v = 0; v < out.key.size(); ++v) {
     if (out.key[v] == PMR_NO_KEY) continue;
     const PmrMta* m = reference.mta(v);
@@ -480,18 +475,11 @@ Agreement compare_with_environment(const Scene& s, const Rig& rig, const test::R
       return a;
     }
     const glm::dvec3 want = reference.colour(v, *m);
-    for (int c = 0; c < 3; ++c) {
-      half got;
-      got.setBits(out.volume[v * 4 + size_t(c)]);
-      const double err = std::abs(double(float(got)) - want[c]), tol = 0.01 * std::abs(want[c]) + 1e-3;
-      a.worst = std::max(a.worst, err / tol);
-      if (err > tol && ++bad <= 5)
-        ADD_FAILURE() << what << ": voxel (" << v % W << "," << (v / W) % H << "," << v / (W * H) << ") channel " << c
-                      << ": " << float(got) << " vs " << want[c];
-    }
+    check.voxel(out, v, want, what);
     ++a.compared;
   }
-  EXPECT_EQ(bad, 0u) << what;
+  EXPECT_EQ(check.bad, 0u) << what;
+  a.worst = check.worst;
   return a;
 }
 
@@ -695,8 +683,8 @@ size_t expect_voxels_match(const VoxelReference& reference, size_t* lit = nullpt
   const test::Rendered& out = reference.out;
   VoxelReference unlit = reference;  // the same environment, no lights
   unlit.lights.clear();
-  size_t compared = 0, bad = 0;
-  double worst = 0.0;
+  size_t compared = 0;
+  BoundCheck check;
   for (size_t v = 0; v < out.key.size(); ++v) {
     if (out.key[v] == PMR_NO_KEY) continue;
     const PmrMta* m = reference.mta(v);
@@ -705,20 +693,14 @@ size_t expect_voxels_match(const VoxelReference& reference, size_t* lit = nullpt
       return compared;
     }
     const glm::dvec3 want = reference.colour(v, *m), ambient = unlit.colour(v, *m);
-    for (int c = 0; c < 3; ++c) {
-      half got;
-      got.setBits(out.volume[v * 4 + size_t(c)]);
-      const double err = std::abs(double(float(got)) - want[c]), tol = 0.01 * std::abs(want[c]) + 1e-3;
-      worst = std::max(worst, err / tol);
-      if (err > tol && ++bad <= 5) ADD_FAILURE() << "voxel " << v << " channel " << c << ": " << float(got) << " vs " << want[c];
-    }
+    check.voxel(out, v, want);
     const double gain = glm::length(want - ambient);
     if (lit) *lit += gain > 0.02;
     if (dark) *dark += gain == 0.0;
     ++compared;
   }
-  EXPECT_EQ(bad, 0u);
-  std::printf("[ lights   ] %zu voxels, largest error %.3f of the bound\n", compared, worst);
+  EXPECT_EQ(check.bad, 0u);
+  std::printf("[ lights   ] %zu voxels, largest error %.3f of the bound\n", compared, check.worst);
   return compared;
 }
 
@@ -758,7 +740,9 @@ TEST(PbrLights, EveryShadedVoxelMatchesTheReferenceUnderEachLight) {
     size_t lit = 0, dark = 0;
     EXPECT_GT(expect_voxels_match(reference, &lit, &dark), size_t(3000));
     EXPECT_GT(lit, size_t(500)) << "the light should light much of the scene";
-    if (c.leaves_dark) EXPECT_GT(dark, size_t(300)) << "outside the range or the cone nothing should be lit";
+    if (c.leaves_dark) {
+      EXPECT_GT(dark, size_t(300)) << "outside the range or the cone nothing should be lit";
+    }
   }
 }
 

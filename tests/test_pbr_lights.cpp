@@ -26,22 +26,6 @@ using test::run;
 
 const std::string kSmall = " --views 4 --view-size 64x32 --display 240x135 -q ";
 
-Rig sidecar_rig() {
-  Rig rig;
-  rig.views = 3;
-  rig.view_w = 64;
-  rig.view_h = 32;
-  rig.yfov = glm::radians(40.0);
-  rig.cone = glm::radians(30.0);
-  rig.aspect = 166.0 / 93.0;
-  rig.focal = 5.0;
-  rig.near = 3.0;
-  rig.near_eff = 3.5;
-  rig.far = 8.0;
-  rig.center_view = glm::lookAt(glm::dvec3(3.0, 2.0, 4.0), glm::dvec3(0.0, 0.5, 0.0), glm::dvec3(0.0, 1.0, 0.0));
-  return rig;
-}
-
 SceneLight file_light(SceneLightType type, int index, const glm::dvec3& position) {
   SceneLight l;
   l.name = "light " + std::to_string(index);
@@ -66,7 +50,7 @@ std::string pbr_sidecar(const Rig& rig, int frame, const std::vector<SceneLight>
 }
 
 TEST(PbrLightsSidecar, RecordsEachLightAsUsed) {
-  const Rig rig = sidecar_rig();
+  const Rig rig = test::sidecar_rig();
   const std::vector<SceneLight> lights = {file_light(SceneLightType::Spot, 0, {1, 2, 3}),
                                           file_light(SceneLightType::Point, 1, {-1, 0, 0}),
                                           default_light(rig.light_world())};
@@ -105,7 +89,7 @@ TEST(PbrLightsSidecar, RecordsEachLightAsUsed) {
 }
 
 TEST(PbrLightsSidecar, ConfigDifferenceComparesTheLights) {
-  const Rig rig = sidecar_rig();
+  const Rig rig = test::sidecar_rig();
   const std::vector<SceneLight> lights = {file_light(SceneLightType::Spot, 0, {1, 2, 3}),
                                           file_light(SceneLightType::Point, 1, {-1, 0, 0})};
   const std::string here = pbr_sidecar(rig, 5, lights);
@@ -134,7 +118,7 @@ TEST(PbrLightsSidecar, ConfigDifferenceComparesTheLights) {
 // Sidecars written before the lights were recorded: lambert ones as before, pbr ones were lit by the
 // default light.
 TEST(PbrLightsSidecar, OlderSidecarsCompareAsBefore) {
-  const Rig rig = sidecar_rig();
+  const Rig rig = test::sidecar_rig();
   json old = json::parse(pbr_sidecar(rig, 2, {}));
   old["shading"].erase("lights");
   const std::string with_default = pbr_sidecar(rig, 2, {default_light(rig.light_world())});

@@ -1,5 +1,7 @@
 #include "test_util.h"
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <Imath/half.h>
 
 #include <gtest/gtest.h>
@@ -62,6 +64,22 @@ Scene random_scene(int n, uint32_t seed, bool double_sided) {
   }
   // keep the framing fixed: the scene bounds are always the unit box
   return s;
+}
+
+Rig sidecar_rig() {
+  Rig rig;
+  rig.views = 3;
+  rig.view_w = 64;
+  rig.view_h = 32;
+  rig.yfov = glm::radians(40.0);
+  rig.cone = glm::radians(30.0);
+  rig.aspect = 166.0 / 93.0;
+  rig.focal = 5.0;
+  rig.near = 3.0;
+  rig.near_eff = 3.5;
+  rig.far = 8.0;
+  rig.center_view = glm::lookAt(glm::dvec3(3.0, 2.0, 4.0), glm::dvec3(0.0, 0.5, 0.0), glm::dvec3(0.0, 1.0, 0.0));
+  return rig;
 }
 
 Rig small_rig(int views, int w, int h) {

@@ -25,6 +25,8 @@ Scene random_scene(int n, uint32_t seed, bool double_sided);
 
 // The default rig (paper-8k display, framing the unit box [-1,1]^3) with a small view raster.
 Rig small_rig(int views, int w, int h);
+// A fixed rig (3 views of 64x32, a camera at (3, 2, 4) looking at (0, 0.5, 0)) for sidecar tests.
+Rig sidecar_rig();
 
 // Renders the scene with the given rig and tile size; returns the pipeline for read-back.
 struct Rendered {

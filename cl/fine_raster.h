@@ -31,7 +31,6 @@ typedef PMR_CAT(float, PMR_VW) vfloat;
 #define vload_vint PMR_CAT(vload, PMR_VW)
 #define vstore_vint PMR_CAT(vstore, PMR_VW)
 #define convert_vfloat PMR_CAT(convert_float, PMR_VW)
-#define as_vint PMR_CAT(as_int, PMR_VW)
 
 /* A tile row is FINE_CHUNKS vectors; the private visibility state is FINE_ROWS vectors per array. */
 #define FINE_CHUNKS ((PMR_TILE_X + VW - 1) / VW)
@@ -51,18 +50,13 @@ inline vint edge_lanes(long F, long bias, long G, vint ramp, bool narrow, vint l
   return (vint)(T <= 0 ? -1 : 0);
 }
 
-/* alphaMode MASK: of the lanes in `win` (the row chunk from raster point (X, Y) of view i), those whose
- * base colour alpha passes the cutoff. Rare: the lanes' alpha is computed SW at a time. */
+/* alphaMode MASK: of the lanes in `win`, those whose base colour alpha passes the cutoff. Rare path,
+ * one lane at a time with the exact edge functions. */
 inline vint mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, vint win, long X, long Y, int i, float cutoff) {
   int w[VW];
   vstore_vint(win, 0, w);
-  for (int h = 0; h < VW; h += SW) {
-    int act[SW], pass[SW];
-    for (int l = 0; l < SW; ++l) act[l] = h + l < VW ? w[h + l] : 0;
-    const sfloat3 e = lane_edges_row(m, X + (long)h * PMR_X_ONE, Y, i);
-    vstore_s(mta_alpha_lanes(in, m, e, vload_s(0, act), cutoff), 0, pass);
-    for (int l = 0; l < SW && h + l < VW; ++l) w[h + l] = pass[l];
-  }
+  for (int k = 0; k < VW; ++k)
+    if (w[k] && !mta_alpha_passes(in, m, X + (long)k * PMR_X_ONE, Y, i, cutoff)) w[k] = 0;
   return vload_vint(0, w);
 }
 
@@ -188,36 +182,11 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
   }
 }
 
-/* Lit colours of a row chunk's winners: lane l is voxel (px0 + l, py) of view `view`, won by MTA mta[l]
- * where `won`. Written to rgb[3 l + channel] for those lanes only. The chunk goes SW lanes at a time;
- * within them, the lanes that share a winner are shaded as one vector (shade_lanes), which costs about
- * what one voxel did before: on real models a chunk holds a few winners. */
-inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                             vuint mta, vint won, int px0, int py, int view, float* rgb) {
-  uint ids[VW];
-  int w[VW];
-  vstore_vint(as_vint(mta), 0, (int*)ids);
-  vstore_vint(won, 0, w);
-  const long Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
-  for (int h = 0; h < VW; h += SW) {
-    int todo[SW];
-    for (int l = 0; l < SW; ++l) todo[l] = h + l < VW ? w[h + l] : 0;
-    for (int f = 0; f < SW; ++f) {
-      if (!todo[f]) continue;
-      const uint id = ids[h + f];
-      int group[SW];
-      for (int l = 0; l < SW; ++l) {
-        group[l] = todo[l] && ids[h + l] == id ? -1 : 0;
-        todo[l] &= ~group[l];
-      }
-      const PmrMta* m = cached_mta(cache, mtas, id);
-      const sfloat3 e = lane_edges_row(m, (long)(px0 + h) * PMR_X_ONE + PMR_HALF_X, Y, view);
-      float c[3][SW];
-      s3_store(shade_lanes(in, m, light, e, vload_s(0, group), view), c[0], c[1], c[2]);
-      for (int l = f; l < SW; ++l)
-        if (group[l]) rgb[3 * (h + l)] = c[0][l], rgb[3 * (h + l) + 1] = c[1][l], rgb[3 * (h + l) + 2] = c[2][l];
-    }
-  }
+/* Lit colour of the winning MTA `id` at voxel (px, py, view), sampled at the pixel center. */
+inline float4 fine_shade_winner(const ShadeInputs* in, global const PmrMta* mtas, uint id, MtaCache* cache,
+                                float3 light, int px, int py, int view) {
+  return shade_mta_at(in, cached_mta(cache, mtas, id), light, (long)px * PMR_X_ONE + PMR_HALF_X,
+                      (long)py * PMR_Y_ONE + PMR_HALF_Y, view);
 }
 
 /* Initial visibility state: nothing drawn. */

@@ -28,11 +28,15 @@
 
 constant int sp_lane_index[SP_LANES] = {0, 1, 2, 3, 4, 5, 6, 7};
 
-/* alphaMode MASK: of the lanes in `win` (samples (Xc + sx[l], Yc + sy[l]) of view v), those whose base
- * colour alpha passes the cutoff (rare). */
+/* alphaMode MASK: of the lanes in `win`, those whose base colour alpha passes the cutoff (rare path, one
+ * lane at a time with the exact edge functions). */
 inline int8 sp_mask_alpha(const ShadeInputs* in, const PmrMta* m, int8 win, const int* sx, const int* sy, long Xc,
                           long Yc, int v, float cutoff) {
-  return mta_alpha_lanes(in, m, lane_edges_at(m, Xc, Yc, sx, sy, SP_LANES, v), win, cutoff);
+  int w[SP_LANES];
+  vstore8(win, 0, w);
+  for (int l = 0; l < SP_LANES; ++l)
+    if (w[l] && !mta_alpha_passes(in, m, Xc + sx[l], Yc + sy[l], v, cutoff)) w[l] = 0;
+  return vload8(0, w);
 }
 
 /* Bit l set: in view ib + l (l < n <= 16) the MTA's x extent reaches the chunk's samples, [0, span]
@@ -242,43 +246,23 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
   MtaCache cache;
   cache.id = PMR_NO_KEY;
   for (int v = 0; v < views; ++v)
-    for (int k0 = first[v]; k0 < first[v] + count[v]; k0 += SW) {
-      /* SW samples of view v at a time; those sharing a winner are shaded as one vector */
-      const int kn = min(SW, first[v] + count[v] - k0);
-      int todo[SW];
-      for (int l = 0; l < SW; ++l) {
-        const int k = k0 + l;
-        todo[l] = l < kn && best_key[k] != PMR_NO_KEY;
-        if (l >= kn) continue;
-        const int n = sid[k];
-        if (debug) {
-          const size_t at = (size_t)(ch.i0 + n / width) * (size_t)(3 * Wd) + (size_t)(ch.s0 + n % width);
-          dbg_key[at] = best_key[k];
-          dbg_depth[at] = best_depth[k];
-        }
-        if (!todo[l]) value[n] = 0, covered[n] = 0;
+    for (int k = first[v]; k < first[v] + count[v]; ++k) {
+      const int n = sid[k];
+      if (debug) {
+        const size_t at = (size_t)(ch.i0 + n / width) * (size_t)(3 * Wd) + (size_t)(ch.s0 + n % width);
+        dbg_key[at] = best_key[k];
+        dbg_depth[at] = best_depth[k];
       }
-      for (int f = 0; f < kn; ++f) {
-        if (!todo[f]) continue;
-        const uint id = best_mta[k0 + f];
-        int group[SW];
-        for (int l = 0; l < SW; ++l) {
-          group[l] = todo[l] && best_mta[k0 + l] == id ? -1 : 0;
-          todo[l] &= ~group[l];
-        }
-        const PmrMta* m = cached_mta(&cache, mtas, id);
-        float c[3][SW];
-        s3_store(shade_lanes(&in, m, light, lane_edges_at(m, Xc, Yc, sx + k0, sy + k0, kn, v), vload_s(0, group), v), c[0],
-                 c[1], c[2]);
-        for (int l = f; l < kn; ++l) {
-          if (!group[l]) continue;
-          const int k = k0 + l, n = sid[k];
-          ushort h;
-          vstore_half(c[channel[k]][l], 0, (half*)&h);
-          value[n] = h;
-          covered[n] = 1;
-        }
+      if (best_key[k] == PMR_NO_KEY) {
+        value[n] = 0;
+        covered[n] = 0;
+        continue;
       }
+      const float4 c = shade_mta_at(&in, cached_mta(&cache, mtas, best_mta[k]), light, Xc + sx[k], Yc + sy[k], v);
+      ushort h;
+      vstore_half(channel[k] == 0 ? c.x : (channel[k] == 1 ? c.y : c.z), 0, (half*)&h);
+      value[n] = h;
+      covered[n] = 1;
     }
 
   /* 4. The display pixels: whole ones with their alpha (the three subpixels' mean coverage, as

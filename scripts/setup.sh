@@ -9,7 +9,7 @@ PACKAGES=(
   g++ cmake make pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
-  libopenexr-dev openexr libpng-dev libxxhash-dev
+  libopenexr-dev openexr libpng-dev libxxhash-dev libdeflate-dev
   libgtest-dev
   python3 python3-matplotlib
 )

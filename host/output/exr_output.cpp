@@ -16,6 +16,7 @@
 #include <limits>
 
 #include "output/exr_metadata.h"
+#include "output/exr_zip.h"
 #include "pmr/error.h"
 #include "pmr/output.h"
 
@@ -67,6 +68,9 @@ void set_compression(Imf::Header& h, ExrCompression c, const std::string& path) 
   h.compression() = to_imf(c, path);
   if (c == ExrCompression::ZipFast) h.zipCompressionLevel() = 1;
 }
+
+// The deflate level of our ZIP writer (libdeflate's scale, 1-12): see docs/SEQUENCES.md for sizes and times.
+int zip_level(ExrCompression c) { return c == ExrCompression::ZipFast ? 1 : 4; }
 
 void check_image(const std::string& path, int width, int height, int layers, const void* data) {
   if (width < 1 || height < 1 || layers < 1)
@@ -144,6 +148,19 @@ void write_rgba_exr(const std::string& path, int width, int height, const uint16
     Imf::Header header(width, height, pixel_aspect);
     set_compression(header, c, path);
     if (meta) add_exr_metadata(header, *meta, image, meta->center_view);
+    if (c == ExrCompression::Zip || c == ExrCompression::ZipFast) {  // our own chunk writer (exr_zip.h)
+      for (const char* ch : {"R", "G", "B", "A"}) header.channels().insert(ch, Imf::Channel(Imf::HALF));
+      const char* base = reinterpret_cast<const char*>(rgba_half);
+      const size_t xs = 4 * sizeof(uint16_t), ys = xs * size_t(width);
+      std::vector<ExrZipChannel> channels = {
+          {"R", base, xs, ys}, {"G", base + 2, xs, ys}, {"B", base + 4, xs, ys}, {"A", base + 6, xs, ys}};
+      if (depth) {
+        header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+        channels.push_back({"Z", reinterpret_cast<const char*>(depth), sizeof(float), sizeof(float) * size_t(width)});
+      }
+      write_zip_exr(file.temp_path(), path, header, channels, zip_level(c), threads);
+      return;
+    }
     if (depth) {  // half RGBA plus a float Z channel: the general interface
       for (const char* ch : {"R", "G", "B", "A"}) header.channels().insert(ch, Imf::Channel(Imf::HALF));
       header.channels().insert("Z", Imf::Channel(Imf::FLOAT));

@@ -1,0 +1,173 @@
+// The ZIP EXR writer (host/output/exr_zip.*): its files are read back by OpenEXR itself, bit for bit,
+// pass OpenEXR's own file checker, and are no larger than OpenEXR's ZIP of the same pixels.
+#include <gtest/gtest.h>
+
+#include <ImfChannelList.h>
+#include <ImfCheckFile.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <half.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <vector>
+
+#include "output/exr_zip.h"
+#include "pmr/output.h"
+#include "test_util.h"
+
+namespace pmr {
+namespace {
+
+// Half RGBA with smooth gradients, flat areas, edges and a little noise, like a rendered frame; or
+// noise in every bit (`noise`), which deflate cannot shrink (stored chunks).
+std::vector<uint16_t> test_image(int w, int h, bool noise, unsigned seed) {
+  std::mt19937 g(seed);
+  std::vector<uint16_t> px(size_t(w) * size_t(h) * 4);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int k = 0; k < 4; ++k) {
+        uint16_t bits;
+        if (noise) {
+          bits = uint16_t(g() & 0x7bffu);  // finite halves
+        } else {
+          const bool inside = (x - w / 2) * (x - w / 2) + (y - h / 2) * (y - h / 2) < w * h / 8;
+          const float v = k == 3 ? (inside ? 1.0f : 0.0f)
+                                 : (inside ? 0.3f + 0.5f * float(x) / float(w) + 0.01f * float(g() % 4) : 0.0f);
+          const half hv(v);
+          bits = hv.bits();
+        }
+        px[(size_t(y) * size_t(w) + size_t(x)) * 4 + size_t(k)] = bits;
+      }
+  return px;
+}
+
+struct Decoded {
+  std::vector<uint16_t> rgba;
+  std::vector<float> z;
+  Imf::Compression compression;
+};
+
+// Read with OpenEXR's general interface, channel by channel.
+Decoded read_back(const std::string& path, int w, int h, bool with_z) {
+  Imf::InputFile in(path.c_str());
+  const Imath::Box2i dw = in.header().dataWindow();
+  EXPECT_EQ(dw.max.x - dw.min.x + 1, w);
+  EXPECT_EQ(dw.max.y - dw.min.y + 1, h);
+  Decoded d;
+  d.compression = in.header().compression();
+  d.rgba.assign(size_t(w) * size_t(h) * 4, 0xffffu);
+  Imf::FrameBuffer fb;
+  const char* names[4] = {"R", "G", "B", "A"};
+  for (int k = 0; k < 4; ++k)
+    fb.insert(names[k], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(d.rgba.data() + k), 8, 8 * size_t(w)));
+  if (with_z) {
+    d.z.assign(size_t(w) * size_t(h), -1.0f);
+    fb.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(d.z.data()), 4, 4 * size_t(w)));
+  }
+  in.setFrameBuffer(fb);
+  in.readPixels(dw.min.y, dw.max.y);
+  return d;
+}
+
+TEST(ExrZip, OpenExrReadsItBitForBit) {
+  const std::string dir = test::temp_dir("exr_zip_roundtrip");
+  std::filesystem::create_directories(dir);
+  // sizes: a partial last chunk (16 lines per chunk), a single line, a single column
+  for (const auto& [w, h] : std::vector<std::pair<int, int>>{{37, 41}, {300, 1}, {1, 33}, {640, 64}})
+    for (const bool noise : {false, true})
+      for (const ExrCompression c : {ExrCompression::Zip, ExrCompression::ZipFast})
+        for (const bool with_z : {false, true}) {
+          SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + (noise ? " noise" : " smooth") +
+                       (with_z ? " with Z" : "") + " " + to_string(c));
+          const std::vector<uint16_t> px = test_image(w, h, noise, unsigned(w * 131 + h));
+          std::vector<float> z(size_t(w) * size_t(h));
+          for (size_t i = 0; i < z.size(); ++i) z[i] = noise ? float(i % 977) * 0.37f : 1.0f / float(1 + i % 13);
+          const std::string path = dir + "/t.exr";
+          write_rgba_exr(path, w, h, px.data(), c, 2, with_z ? z.data() : nullptr);
+          const Decoded d = read_back(path, w, h, with_z);
+          EXPECT_EQ(d.compression, Imf::ZIP_COMPRESSION);
+          EXPECT_EQ(std::memcmp(d.rgba.data(), px.data(), px.size() * 2), 0);
+          if (with_z) EXPECT_EQ(std::memcmp(d.z.data(), z.data(), z.size() * 4), 0);
+        }
+  std::filesystem::remove_all(dir);
+}
+
+// Imf::checkOpenEXRFile runs the library's read paths (scanline, tiled, deep, core) over the file. It
+// must judge our file as it judges OpenEXR's own file of the same pixels, and a file cut short
+// differently (so the check can fail).
+TEST(ExrZip, PassesOpenExrsFileCheck) {
+  const std::string dir = test::temp_dir("exr_zip_check");
+  std::filesystem::create_directories(dir);
+  const int w = 200, h = 70;
+  const std::vector<uint16_t> px = test_image(w, h, false, 7);
+  const std::string ours = dir + "/ours.exr", theirs = dir + "/theirs.exr", cut = dir + "/cut.exr";
+  write_rgba_exr(ours, w, h, px.data(), ExrCompression::Zip, 2);
+  {
+    Imf::Header header(w, h);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    for (const char* ch : {"R", "G", "B", "A"}) header.channels().insert(ch, Imf::Channel(Imf::HALF));
+    Imf::OutputFile out(theirs.c_str(), header);
+    Imf::FrameBuffer fb;
+    const char* names[4] = {"R", "G", "B", "A"};
+    for (int k = 0; k < 4; ++k)
+      fb.insert(names[k], Imf::Slice(Imf::HALF, (char*)(px.data() + k), 8, 8 * size_t(w)));
+    out.setFrameBuffer(fb);
+    out.writePixels(h);
+  }
+  const std::string bytes = test::read_file(ours);
+  std::ofstream(cut, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size() * 2 / 3));
+  const bool good = Imf::checkOpenEXRFile(theirs.c_str(), false, false, true);
+  EXPECT_EQ(Imf::checkOpenEXRFile(ours.c_str(), false, false, true), good);
+  EXPECT_NE(Imf::checkOpenEXRFile(cut.c_str(), false, false, true), good);
+  std::filesystem::remove_all(dir);
+}
+
+// At the default level the files are no more than 5% larger than OpenEXR's ZIP (zlib level 4).
+TEST(ExrZip, NoLargerThanOpenExrsZip) {
+  const std::string dir = test::temp_dir("exr_zip_size");
+  std::filesystem::create_directories(dir);
+  const int w = 1024, h = 256;
+  const std::vector<uint16_t> px = test_image(w, h, false, 11);
+  const std::string ours = dir + "/ours.exr", theirs = dir + "/theirs.exr";
+  write_rgba_exr(ours, w, h, px.data(), ExrCompression::Zip, 2);
+  {
+    Imf::Header header(w, h);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    for (const char* ch : {"R", "G", "B", "A"}) header.channels().insert(ch, Imf::Channel(Imf::HALF));
+    Imf::OutputFile out(theirs.c_str(), header);
+    Imf::FrameBuffer fb;
+    const char* names[4] = {"R", "G", "B", "A"};
+    for (int k = 0; k < 4; ++k)
+      fb.insert(names[k], Imf::Slice(Imf::HALF, (char*)(px.data() + k), 8, 8 * size_t(w)));
+    out.setFrameBuffer(fb);
+    out.writePixels(h);
+  }
+  const auto a = std::filesystem::file_size(ours), b = std::filesystem::file_size(theirs);
+  std::printf("[ exr zip  ] ours %zu bytes, OpenEXR's %zu bytes\n", size_t(a), size_t(b));
+  EXPECT_LE(double(a), 1.05 * double(b));
+  std::filesystem::remove_all(dir);
+}
+
+// The preconditioning is OpenEXR's (ImfZip.cpp): split into even and odd bytes, then each byte minus
+// its predecessor plus 128, written here from the file format's description.
+TEST(ExrZip, PreconditioningIsTheFormats) {
+  for (const size_t n : {size_t(1), size_t(2), size_t(7), size_t(64)}) {
+    std::vector<unsigned char> raw(n), out(n), expect;
+    for (size_t i = 0; i < n; ++i) raw[i] = static_cast<unsigned char>(i * 37 + 11);
+    for (size_t i = 0; i < n; i += 2) expect.push_back(raw[i]);
+    for (size_t i = 1; i < n; i += 2) expect.push_back(raw[i]);
+    for (size_t i = n - 1; i >= 1; --i) expect[i] = static_cast<unsigned char>((expect[i] - expect[i - 1] + 128) & 255);
+    exr_zip_precondition(raw.data(), n, out.data());
+    EXPECT_EQ(out, expect) << n << " bytes";
+  }
+}
+
+}  // namespace
+}  // namespace pmr

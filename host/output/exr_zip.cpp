@@ -17,6 +17,7 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <thread>
 
 #include "pmr/error.h"
@@ -44,37 +45,79 @@ void put32(std::vector<unsigned char>& out, uint32_t v) {
   for (int k = 0; k < 4; ++k) out.push_back(static_cast<unsigned char>(v >> (8 * k)));
 }
 
-// The raw bytes of the scanlines [y0, y1) (little-endian values; this host is little-endian).
-void gather_chunk(const std::vector<ChunkChannel>& channels, int width, int y0, int y1, unsigned char* raw) {
+// EXR's ZIP preconditioning (OpenEXR's ImfZip.cpp, which every reader inverts) of the raw bytes of the
+// scanlines [y0, y1), in two passes straight from the pixels: first the bytes at even raw offsets then
+// those at odd ones (split), then each byte as its difference from the previous one + 128 (out). Every
+// channel's scanline has an even number of bytes, so the parity of a value's bytes is their parity
+// within the value: a half's low byte is even, a float's bytes 0 and 2 are. Little-endian host.
+size_t precondition_chunk(const std::vector<ChunkChannel>& channels, int width, int y0, int y1, unsigned char* split,
+                          unsigned char* out) {
+  size_t n = 0;
+  for (const ChunkChannel& c : channels) n += size_t(width) * c.bytes;
+  n *= size_t(y1 - y0);
+  unsigned char* even = split;
+  unsigned char* odd = split + n / 2;
   for (int y = y0; y < y1; ++y)
     for (const ChunkChannel& c : channels) {
       const char* row = c.base + size_t(y) * c.y_stride;
-      if (c.x_stride == c.bytes) {
-        std::memcpy(raw, row, size_t(width) * c.bytes);
-      } else if (c.bytes == 2) {
-        for (int x = 0; x < width; ++x) std::memcpy(raw + 2 * size_t(x), row + size_t(x) * c.x_stride, 2);
+      if (c.bytes == 2) {
+        for (int x = 0; x < width; ++x) {
+          uint16_t v;
+          std::memcpy(&v, row + size_t(x) * c.x_stride, 2);
+          even[x] = static_cast<unsigned char>(v);
+          odd[x] = static_cast<unsigned char>(v >> 8);
+        }
+        even += width, odd += width;
       } else {
-        for (int x = 0; x < width; ++x) std::memcpy(raw + 4 * size_t(x), row + size_t(x) * c.x_stride, 4);
+        for (int x = 0; x < width; ++x) {
+          uint32_t v;
+          std::memcpy(&v, row + size_t(x) * c.x_stride, 4);
+          even[2 * x] = static_cast<unsigned char>(v), even[2 * x + 1] = static_cast<unsigned char>(v >> 16);
+          odd[2 * x] = static_cast<unsigned char>(v >> 8), odd[2 * x + 1] = static_cast<unsigned char>(v >> 24);
+        }
+        even += 2 * size_t(width), odd += 2 * size_t(width);
       }
-      raw += size_t(width) * c.bytes;
+    }
+  out[0] = split[0];
+  for (size_t i = 1; i < n; ++i) out[i] = static_cast<unsigned char>(split[i] - split[i - 1] + 128u);
+  return n;
+}
+
+// The raw bytes of the scanlines [y0, y1): each channel's values in turn, scanline by scanline (a chunk
+// that deflate does not shrink is stored so).
+void raw_chunk(const std::vector<ChunkChannel>& channels, int width, int y0, int y1, unsigned char* raw) {
+  for (int y = y0; y < y1; ++y)
+    for (const ChunkChannel& c : channels) {
+      const char* row = c.base + size_t(y) * c.y_stride;
+      for (int x = 0; x < width; ++x, raw += c.bytes) std::memcpy(raw, row + size_t(x) * c.x_stride, c.bytes);
     }
 }
 
-}  // namespace
+// A compressing thread's buffers, kept from file to file: fresh ones would cost a page fault every
+// 4 kB on every frame.
+struct Scratch {
+  int level = 0;
+  std::unique_ptr<libdeflate_compressor, void (*)(libdeflate_compressor*)> z{nullptr, libdeflate_free_compressor};
+  std::vector<unsigned char> split, pre, packed;
+};
 
-void exr_zip_precondition(const unsigned char* raw, size_t n, unsigned char* out) {
-  if (n == 0) return;
-  unsigned char* t1 = out;
-  unsigned char* t2 = out + (n + 1) / 2;
-  for (size_t i = 0; i + 1 < n; i += 2) *t1++ = raw[i], *t2++ = raw[i + 1];
-  if (n % 2) *t1 = raw[n - 1];
-  unsigned p = out[0];
-  for (size_t i = 1; i < n; ++i) {
-    const unsigned v = out[i];
-    out[i] = static_cast<unsigned char>(v - p + 128u);
-    p = v;
-  }
+std::mutex scratch_mutex;
+std::vector<std::unique_ptr<Scratch>> scratch_pool;
+
+std::unique_ptr<Scratch> take_scratch() {
+  std::lock_guard<std::mutex> lock(scratch_mutex);
+  if (scratch_pool.empty()) return std::make_unique<Scratch>();
+  std::unique_ptr<Scratch> s = std::move(scratch_pool.back());
+  scratch_pool.pop_back();
+  return s;
 }
+
+void give_back(std::unique_ptr<Scratch> s) {
+  std::lock_guard<std::mutex> lock(scratch_mutex);
+  scratch_pool.push_back(std::move(s));
+}
+
+}  // namespace
 
 void write_zip_exr(const std::string& path, const std::string& shown_path, const Imf::Header& header,
                    const std::vector<ExrZipChannel>& channels, int level, int threads) {
@@ -113,29 +156,32 @@ void write_zip_exr(const std::string& path, const std::string& shown_path, const
   std::atomic<int> next{0};
   std::atomic<bool> failed{false};
   auto work = [&] {
-    std::unique_ptr<libdeflate_compressor, void (*)(libdeflate_compressor*)> z(libdeflate_alloc_compressor(level),
-                                                                                libdeflate_free_compressor);
-    if (!z) {
-      failed = true;
-      return;
-    }
+    std::unique_ptr<Scratch> scratch = take_scratch();
+    Scratch& S = *scratch;
+    if (!S.z || S.level != level) S.z.reset(libdeflate_alloc_compressor(level)), S.level = level;
     const size_t max_raw = line_bytes * kLinesPerChunk;
-    std::vector<unsigned char> raw(max_raw), pre(max_raw), packed(libdeflate_zlib_compress_bound(z.get(), max_raw));
-    for (int c; (c = next++) < chunks && !failed;) {
-      const int y0 = c * kLinesPerChunk, y1 = std::min(height, y0 + kLinesPerChunk);
-      const size_t n = line_bytes * size_t(y1 - y0);
-      gather_chunk(order, width, y0, y1, raw.data());
-      exr_zip_precondition(raw.data(), n, pre.data());
-      const size_t size = libdeflate_zlib_compress(z.get(), pre.data(), n, packed.data(), packed.size());
-      const bool stored = size == 0 || size >= n;  // 0: did not fit the bound (cannot happen)
-      std::vector<unsigned char>& out = data[size_t(c)];
-      const unsigned char* bytes = stored ? raw.data() : packed.data();
-      const size_t count = stored ? n : size;
-      out.reserve(8 + count);
-      put32(out, uint32_t(dw.min.y + y0));
-      put32(out, uint32_t(count));
-      out.insert(out.end(), bytes, bytes + count);
+    if (S.z && S.split.size() < max_raw) {
+      S.split.resize(max_raw), S.pre.resize(max_raw);
+      S.packed.resize(libdeflate_zlib_compress_bound(S.z.get(), max_raw));
     }
+    if (!S.z) failed = true;
+    for (int c; !failed && (c = next++) < chunks;) {
+      const int y0 = c * kLinesPerChunk, y1 = std::min(height, y0 + kLinesPerChunk);
+      const size_t n = precondition_chunk(order, width, y0, y1, S.split.data(), S.pre.data());
+      const size_t size = libdeflate_zlib_compress(S.z.get(), S.pre.data(), n, S.packed.data(), S.packed.size());
+      std::vector<unsigned char>& out = data[size_t(c)];
+      out.reserve(8 + (size == 0 || size >= n ? n : size));
+      put32(out, uint32_t(dw.min.y + y0));
+      if (size == 0 || size >= n) {  // stored: the scanlines' raw bytes (0: did not fit the bound, cannot happen)
+        put32(out, uint32_t(n));
+        raw_chunk(order, width, y0, y1, S.split.data());
+        out.insert(out.end(), S.split.data(), S.split.data() + n);
+      } else {
+        put32(out, uint32_t(size));
+        out.insert(out.end(), S.packed.data(), S.packed.data() + size);
+      }
+    }
+    give_back(std::move(scratch));
   };
   if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
   threads = std::max(1, std::min(threads, chunks));

@@ -25,8 +25,4 @@ struct ExrZipChannel {
 void write_zip_exr(const std::string& path, const std::string& shown_path, const Imf::Header& header,
                    const std::vector<ExrZipChannel>& channels, int level, int threads);
 
-// EXR's ZIP preconditioning of one chunk's raw bytes (OpenEXR's ImfZip.cpp, which every reader
-// inverts): even bytes then odd bytes, then each byte as its difference from the previous + 128.
-void exr_zip_precondition(const unsigned char* raw, size_t n, unsigned char* out);
-
 }  // namespace pmr

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # Installs (idempotently) the Debian packages the project needs, then configures and builds it.
-# Usage: scripts/setup.sh [BUILD_DIR]   (default: build)
+# Usage: scripts/setup.sh [BUILD_DIR [TARGET...]]   (default: build, every target)
+# TARGET names CMake targets to build instead of all of them (render.sh builds only pmr).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${1:-build}
+TARGETS=("${@:2}")
 
 PACKAGES=(
   g++ cmake make pkg-config
@@ -25,4 +27,8 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$BUILD_DIR" -j "$(nproc)"
+if [ ${#TARGETS[@]} -gt 0 ]; then
+  cmake --build "$BUILD_DIR" -j "$(nproc)" --target "${TARGETS[@]}"
+else
+  cmake --build "$BUILD_DIR" -j "$(nproc)"
+fi

@@ -1,6 +1,6 @@
 // The three methods render the same images (issue 3): PMR and multipass fed the same snapped per-view
 // positions are bit-identical; multipass with its own per-view matrices differs only on a few edge
-// pixels (DESIGN section 7); duplicate uses PMR's per-view positions and matches within the fill rule.
+// pixels (DESIGN section 8); duplicate uses PMR's per-view positions and matches within the fill rule.
 #include <gtest/gtest.h>
 
 #include "test_util.h"

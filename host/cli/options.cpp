@@ -348,7 +348,7 @@ std::string render_help() {
          "  --view-size WxH        view raster in pixels (default 1024x512; each side <= 8192)\n"
          "  --cone DEG             view cone (default 80)\n"
          "  --yfov DEG             vertical field of view (default from the display: 2 atan(46.5 / 200))\n"
-         "  --camera-spacing S     linear (DESIGN, default for paper-8k) or angular (Looking Glass: D tan(cone\n"
+         "  --camera-spacing S     linear (PMR's, default for paper-8k) or angular (Looking Glass: D tan(cone\n"
          "                         ((i + 1/2) / N - 1/2)), default for the Looking Glass presets; angular\n"
          "                         renders with --method multipass for now\n"
          "  --camera K             use the scene's glTF camera K (pose and field of view) instead of framing\n"
@@ -390,7 +390,8 @@ std::string render_help() {
          "  --environment-intensity X  pbr: scales the environment, the image or the uniform one of radiance\n"
          "                         0.2 (0 turns it off; default 1)\n"
          "  --verbose              per-stage device times and queue sizes\n"
-         "Environment: PMR_DEVICE=substring selects the OpenCL device by name (default: first CPU device).\n";
+         "Environment: PMR_DEVICE=substring selects the OpenCL device by name (default: first CPU device).\n"
+         "Docs in the source tree: README.md, docs/DESIGN.md (rig, framing, encoder, files), docs/SHADING.md.\n";
 }
 
 }  // namespace pmr

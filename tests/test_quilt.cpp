@@ -149,7 +149,8 @@ TEST(Quilt, CliQuiltDepthAndPreviews) {
   }
   EXPECT_GT(covered, 6u * 96 * 48 / 10);
   // previews
-  auto check_png = [](const std::string& png, const std::vector<uint16_t>& exr, int w, int h) {
+  // opaque: the encoded preview, RGB over black with alpha 255 (read_png_rgba8 expands RGB so)
+  auto check_png = [](const std::string& png, const std::vector<uint16_t>& exr, int w, int h, bool opaque = false) {
     int pw = 0, ph = 0;
     std::vector<uint8_t> rgba;
     read_png_rgba8(png, pw, ph, rgba);
@@ -158,14 +159,15 @@ TEST(Quilt, CliQuiltDepthAndPreviews) {
     for (size_t i = 0; i < size_t(w) * h; ++i)
       for (int c = 0; c < 4; ++c) {
         const double lin = half_value(exr[i * 4 + c]);
-        const double expect = 255.0 * (c < 3 ? srgb_encode(lin) : std::min(1.0, std::max(0.0, lin)));
+        const double expect =
+            255.0 * (c < 3 ? srgb_encode(lin) : opaque ? 1.0 : std::min(1.0, std::max(0.0, lin)));
         ASSERT_LE(std::abs(double(rgba[i * 4 + c]) - expect), 1.0) << png << " pixel " << i << " channel " << c;
       }
   };
   int w = 0, h = 0;
   std::vector<uint16_t> encoded, center;
   read_rgba_exr(out + "/f00.exr", w, h, encoded);
-  check_png(out + "/f00.png", encoded, w, h);
+  check_png(out + "/f00.png", encoded, w, h, true);
   read_views_exr_part(out + "/f00.views.exr", 3, w, h, center);
   check_png(out + "/f00.center.png", center, w, h);
   EXPECT_EQ(j["preview_center_view"], 3);

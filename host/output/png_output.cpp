@@ -38,7 +38,7 @@ uint8_t to_byte(double v) { return uint8_t(std::lround(std::min(1.0, std::max(0.
 
 }  // namespace
 
-void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half) {
+void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half, bool opaque) {
   if (width < 1 || height < 1 || !rgba_half) throw Error("cannot write " + path + ": empty image");
   // sRGB lookup for every half value: the curve is applied once per distinct input, not per pixel
   static const std::vector<uint8_t> lut = [] {  // thread-safe initialization
@@ -56,19 +56,22 @@ void write_png_preview(const std::string& path, int width, int height, const uin
   PngError err;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, on_error, on_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
-  std::vector<uint8_t> row(size_t(width) * 4);
+  const size_t channels = opaque ? 3 : 4;
+  std::vector<uint8_t> row(size_t(width) * channels);
   bool ok = png && info;
   if (ok && setjmp(png_jmpbuf(png)) == 0) {
     png_init_io(png, f);
     png_set_compression_level(png, 1);
-    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE,
+    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA,
+                 PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
     png_write_info(png, info);
     for (int y = 0; y < height; ++y) {
       const uint16_t* src = rgba_half + size_t(y) * size_t(width) * 4;
       for (size_t x = 0; x < size_t(width); ++x) {
-        for (int c = 0; c < 3; ++c) row[4 * x + size_t(c)] = lut[src[4 * x + size_t(c)]];
+        for (int c = 0; c < 3; ++c) row[channels * x + size_t(c)] = lut[src[4 * x + size_t(c)]];
+        if (opaque) continue;
         half a;
         a.setBits(src[4 * x + 3]);
         row[4 * x + 3] = to_byte(double(float(a)));

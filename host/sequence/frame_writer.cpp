@@ -179,7 +179,7 @@ void FrameWriter::write(FrameFiles& f) {
     }
     if (!f.encoded_png.empty()) {
       check();
-      write_png_preview(f.encoded_png, f.display_w, f.display_h, f.display.data());
+      write_png_preview(f.encoded_png, f.display_w, f.display_h, f.display.data(), true);
       done(f.encoded_png);
     }
     if (!f.center_png.empty()) {

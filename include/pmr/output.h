@@ -106,10 +106,14 @@ std::vector<std::string> read_exr_part_names(const std::string& path);
 void read_views_exr_part(const std::string& path, int part, int& width, int& height,
                          std::vector<uint16_t>& rgba_half, std::vector<float>* depth = nullptr);
 
-// An 8-bit sRGB PNG with alpha for a person to look at: the linear half RGBA values (row 0 at the top)
-// encoded with the sRGB transfer curve, clamped to [0, 1] and rounded; alpha linear. Written atomically,
-// fast deflate (a preview, not an archive).
-void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half);
+// An 8-bit sRGB PNG for a person to look at: the linear half RGBA values (row 0 at the top) encoded with
+// the sRGB transfer curve, clamped to [0, 1] and rounded; alpha linear. Written atomically, fast deflate
+// (a preview, not an archive). `opaque`: RGB only, what the pixels show over black. The encoded image is
+// previewed so: its three subpixels come from three views, so no one alpha per pixel composites it
+// right (a viewer would darken covered subpixels next to empty ones), while the display shows it over
+// black.
+void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half,
+                       bool opaque = false);
 // Reads an 8-bit RGBA (or RGB, gray: expanded) PNG, row 0 at the top (for the tests).
 void read_png_rgba8(const std::string& path, int& width, int& height, std::vector<uint8_t>& rgba);
 // The sRGB transfer curve (IEC 61966-2-1) of a linear value, clamped to [0, 1].

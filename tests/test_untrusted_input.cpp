@@ -401,5 +401,53 @@ TEST_F(UntrustedInput, UnsupportedDataUriImagesSaySo) {
   }
 }
 
+// ---- 3. index fields as 64-bit values ------------------------------------------------------------------
+
+TEST_F(UntrustedInput, IndexFieldsDoNotWrapIn32Bits) {
+  GltfFile base;
+  const int pos = base.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
+  const int idx = base.data<uint16_t>({0, 1, 2}, kUShort, "SCALAR");
+  base.mesh(json::array({{{"attributes", {{"POSITION", pos}}}, {"indices", idx}}}));
+  base.add("nodes", {{"mesh", 0}});
+  base.scene({0});
+  ASSERT_EQ(load_error(base.write(dir_, "valid")), "(loaded without error)");
+  const uint64_t wrap = uint64_t(1) << 32;  // reads as 0 in an int
+  struct Case {
+    const char* name;
+    std::function<void(json&)> edit;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {"bufferView", [&](json& d) { d["accessors"][0]["bufferView"] = wrap; }, "accessor 0 refers to bufferView 4294967296"},
+      {"buffer", [&](json& d) { d["bufferViews"][0]["buffer"] = wrap; }, "bufferView 0 refers to buffer 4294967296"},
+      {"mesh", [&](json& d) { d["nodes"][0]["mesh"] = wrap; }, "node 0 refers to mesh 4294967296"},
+      {"scene nodes", [&](json& d) { d["scenes"][0]["nodes"][0] = wrap; }, "scene 0 refers to node 4294967296"},
+      {"scene", [&](json& d) { d["scene"] = wrap; }, "the default scene refers to scene 4294967296"},
+      {"children", [&](json& d) { d["nodes"][0]["children"] = {wrap + 1}; }, "node 0 children refers to node 4294967297"},
+      {"indices", [&](json& d) { d["meshes"][0]["primitives"][0]["indices"] = wrap + 1; },
+       "mesh 0 primitive 0 indices refers to accessor 4294967297"},
+      {"attribute", [&](json& d) { d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = wrap; },
+       "attribute POSITION refers to accessor 4294967296"},
+      {"mode", [&](json& d) { d["meshes"][0]["primitives"][0]["mode"] = wrap + 4; },
+       "mesh 0 primitive 0 has mode 4294967300, which is not a glTF primitive mode (0 to 6)"},
+      {"componentType", [&](json& d) { d["accessors"][0]["componentType"] = wrap + 5126; },
+       "accessor 0 componentType is 4294972422, which is not a glTF component type"},
+      {"2^31", [&](json& d) { d["nodes"][0]["mesh"] = uint64_t(1) << 31; }, "node 0 refers to mesh 2147483648,"},
+      {"2^64-1", [&](json& d) { d["nodes"][0]["mesh"] = UINT64_MAX; }, "node 0 refers to mesh 18446744073709551615,"},
+      {"no scenes", [&](json& d) {
+         d.erase("scenes");
+         d["scene"] = wrap;
+       }, "scene 4294967296 is the default but there are no scenes"},
+  };
+  for (const Case& c : cases) {
+    json d = base.finished("valid.bin");
+    c.edit(d);
+    std::ofstream(dir_ / "case.gltf") << d.dump();
+    const std::string e = load_error((dir_ / "case.gltf").string());
+    EXPECT_TRUE(contains(e, c.message)) << c.name << ": " << e;
+    EXPECT_FALSE(contains(e, "-2147483648")) << c.name << ": " << e;
+  }
+}
+
 }  // namespace
 }  // namespace pmr::test

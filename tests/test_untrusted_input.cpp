@@ -449,5 +449,68 @@ TEST_F(UntrustedInput, IndexFieldsDoNotWrapIn32Bits) {
   }
 }
 
+// ---- 4. names reach the terminal sanitized -----------------------------------------------------------
+
+TEST(TerminalText, EscapesControlsIncludingC1InUtf8) {
+  EXPECT_EQ(terminal_text("plain"), "plain");
+  EXPECT_EQ(terminal_text("caf\xc3\xa9 \xe6\xa8\xa1\xe5\x9e\x8b"), "caf\xc3\xa9 \xe6\xa8\xa1\xe5\x9e\x8b") << "UTF-8 kept";
+  EXPECT_EQ(terminal_text("a\x1b]0;title\x07z"), "a\\x1b]0;title\\x07z");
+  EXPECT_EQ(terminal_text("csi\xc2\x9b" "2J"), "csi\\xc2\\x9b2J") << "U+009B (CSI) in UTF-8";
+  EXPECT_EQ(terminal_text("c1\xc2\x80\xc2\x9f\xc2\xa0"), "c1\\xc2\\x80\\xc2\\x9f\xc2\xa0") << "U+0080..U+009F, not U+00A0";
+  EXPECT_EQ(terminal_text("raw\x9b"), "raw\\x9b") << "a lone 8-bit CSI";
+  EXPECT_EQ(terminal_text("overlong\xc0\x9b"), "overlong\\xc0\\x9b");
+  EXPECT_EQ(terminal_text("cut\xe6\xa8"), "cut\\xe6\\xa8");
+  EXPECT_EQ(terminal_text("del\x7f"), "del\\x7f");
+  EXPECT_EQ(terminal_text("two\nlines"), "two lines");
+}
+
+// A file whose names, asset.version and extension names carry escape sequences (ESC, BEL, 8-bit and
+// UTF-8 CSI): neither pmr info nor its error messages print them raw.
+TEST_F(UntrustedInput, NamesFromFilesReachTheTerminalSanitized) {
+  // (JSON text is UTF-8: a lone 0x9b byte cannot be in it, U+009B can)
+  const std::string evil = "x\x1b]0;pwned\x07\x1b[2K\rpmr: all good\xc2\x9b" "31m";
+  auto raw_controls = [](const std::string& out) {
+    for (size_t i = 0; i < out.size(); ++i) {
+      const unsigned char c = static_cast<unsigned char>(out[i]);
+      if ((c < 0x20 && c != '\n') || c == 0x7f || c == 0x9b) return true;
+      if (c == 0xc2 && i + 1 < out.size() && static_cast<unsigned char>(out[i + 1]) >= 0x80 &&
+          static_cast<unsigned char>(out[i + 1]) <= 0x9f)
+        return true;
+    }
+    return false;
+  };
+  TexturedTriangle t;
+  t.g.doc["nodes"][0]["name"] = evil;
+  t.g.doc["meshes"][0]["name"] = evil;
+  t.g.doc["materials"][0]["name"] = evil;
+  t.g.doc["asset"]["generator"] = evil;
+  t.g.doc["extensionsUsed"] = {evil};
+  const std::string scene = t.write(dir_, "names", {{"uri", evil + ".png"}, {"name", evil}});
+  CliRun r = run("info " + scene);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_FALSE(raw_controls(r.output)) << r.output;
+  EXPECT_TRUE(contains(r.output, "extensions used but not implemented")) << r.output;
+  // errors: asset.version, a required extension, an image outside the folder
+  json d = t.g.finished("names.bin");
+  d["asset"]["version"] = evil;
+  std::ofstream(dir_ / "version.gltf") << d.dump();
+  r = run("info " + (dir_ / "version.gltf").string());
+  expect_one_error_line(r, "is not supported (2.x only)");
+  EXPECT_FALSE(raw_controls(r.output)) << r.output;
+  d = t.g.finished("names.bin");
+  d["images"] = json::array({{{"uri", "names.png"}}});
+  d["extensionsRequired"] = {evil};
+  std::ofstream(dir_ / "required.gltf") << d.dump();
+  r = run("info " + (dir_ / "required.gltf").string());
+  expect_one_error_line(r, "which this renderer does not support");
+  EXPECT_FALSE(raw_controls(r.output)) << r.output;
+  const std::string outside = TexturedTriangle().write(dir_, "outside", {{"uri", "../" + evil + ".png"}});
+  write_bytes(dir_.parent_path() / (evil + ".png"), make_png(1, 1, 6, 8, {1, 2, 3, 4}));
+  r = run("info " + outside);
+  expect_one_error_line(r, "lies outside the scene folder");
+  EXPECT_FALSE(raw_controls(r.output)) << r.output;
+  fs::remove(dir_.parent_path() / (evil + ".png"));
+}
+
 }  // namespace
 }  // namespace pmr::test

@@ -10,6 +10,7 @@
 
 #include "output/checksum.h"
 #include "pmr/error.h"
+#include "pmr/printable.h"
 #include "scene/gltf_internal.h"
 
 namespace pmr::gltf {
@@ -21,10 +22,17 @@ void fail(const std::string& file, const std::string& what) { throw pmr::Error(f
 std::string one_line(const std::string& text, bool ascii_only) {
   constexpr size_t kMax = 300;
   std::string out;
-  for (char c : text) {
-    if (out.size() == kMax) return out + "...";
-    const unsigned char u = static_cast<unsigned char>(c);
-    out += c == '\n' ? ' ' : (u < 0x20 || u == 0x7f || (ascii_only && u > 0x7f)) ? '?' : c;
+  for (size_t i = 0; i < text.size();) {
+    if (out.size() >= kMax) return out + "...";
+    // well-formed UTF-8 of a printable character is kept; C1 controls in their UTF-8 form (U+009B is
+    // CSI), stray bytes and every other control are not
+    const size_t n = ascii_only && static_cast<unsigned char>(text[i]) >= 0x80 ? 0 : printable_utf8_length(text, i);
+    if (n > 0) {
+      out.append(text, i, n);
+      i += n;
+    } else {
+      out += text[i++] == '\n' ? ' ' : '?';
+    }
   }
   while (!out.empty() && out.back() == ' ') out.pop_back();
   return out;
@@ -140,7 +148,7 @@ void check_extensions(const std::string& path, const json& doc, SourceFile& src)
       // A material extension only changes how a surface looks: drawn without it, with one warning
       // per extension (the loader's), even when required.
       if (!extension_supported(name) && !material_extension_fallback(name))
-        fail(path, "requires extension " + name + ", which this renderer does not support");
+        fail(path, "requires extension " + one_line(name) + ", which this renderer does not support");
     }
   }
   if (const json* used = member(doc, "extensionsUsed")) {
@@ -451,7 +459,7 @@ SourceFile read_source(const std::string& path, const InputLimits& limits) {
   const json* version = asset ? member(*asset, "version") : nullptr;
   if (!version || !version->is_string()) fail(path, "not a glTF file: asset.version is missing");
   const std::string v = version->get<std::string>();
-  if (v.rfind("2.", 0) != 0) fail(path, "glTF version " + v + " is not supported (2.x only)");
+  if (v.rfind("2.", 0) != 0) fail(path, "glTF version " + one_line(v) + " is not supported (2.x only)");
   check_schema(path, doc);
   check_extensions(path, doc, src);
   std::string confine;  // the scene folder's real path, "" when files may lie anywhere

@@ -23,9 +23,9 @@ struct LimitKey {
 };
 
 const LimitKey kLimitKeys[] = {
-    {"file-bytes", &InputLimits::file_bytes, "bytes read from any one file (scene, buffer, image, --environment, "
-                                             "--display-config)"},
-    {"texture-pixels", &InputLimits::texture_pixels, "pixels of one decoded texture image (width x height)"},
+    {"file-bytes", &InputLimits::file_bytes, "bytes read from one file (the scene, each buffer and image it\n"
+                                             "                         names, --display-config)"},
+    {"texture-pixels", &InputLimits::texture_pixels, "pixels (width x height) of one decoded texture image"},
 };
 
 // "4294967296", "4G", "256M": a positive integer, optionally times 1024^n.

@@ -54,6 +54,7 @@ struct BenchOptions {
   double environment_rotation_deg = 0.0;
   bool environment_rotation_given = false;
   std::shared_ptr<const Environment> environment;
+  InputLimits limits;  // --limit, --allow-outside-scene-folder (docs/SECURITY.md)
 };
 
 std::vector<std::string> split(const std::string& s) {
@@ -127,6 +128,10 @@ BenchOptions parse(const std::vector<std::string>& args) {
       rest.push_back(value());
     } else if (a == "--bilinear" || a == "--reverse-views") {
       rest.push_back(a);
+    } else if (a == "--limit") {
+      parse_limits(value(), o.limits);
+    } else if (a == "--allow-outside-scene-folder") {
+      o.limits.allow_outside_scene_folder = true;
     } else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see pmr bench --help)");
     else if (o.scene.empty()) o.scene = a;
     else throw Error("more than one scene given");
@@ -312,6 +317,8 @@ std::string bench_help() {
          "  --save-scene FILE   write the one generated scene to FILE (.glb) and exit: `pmr bench FILE` on\n"
          "                      any build then renders the very same triangles\n"
          "  --no-check          skip comparing the methods' images\n"
+         "  --limit KEY=VALUE[,...], --allow-outside-scene-folder  budgets and confinement for SCENE's\n"
+         "                      files, as for pmr render (docs/SECURITY.md)\n"
          "  --preset, --view-size, --display, --tile and the display options are as for pmr render (a\n"
          "  preset's view count unless --views; views evenly spaced), and so are\n"
          "  --animation, --fps and --turntable: the timed frames are then frames 0..K-1 of that sequence.\n"
@@ -352,7 +359,7 @@ int run_bench(const std::vector<std::string>& args) {
             "msamples_per_s\n";
   if (o.generator.empty()) {
     const std::string path = o.scene.empty() ? default_scene_path() : o.scene;
-    bench_scene(o, rt, bw, load_scene(path), path.substr(path.rfind('/') + 1), csv.get());
+    bench_scene(o, rt, bw, load_scene(path, o.limits), path.substr(path.rfind('/') + 1), csv.get());
   }
   for (size_t n : o.triangle_counts)
     bench_scene(o, rt, bw, generate(o.generator, n), o.generator + "-" + std::to_string(n), csv.get());

@@ -89,8 +89,8 @@ void describe_lights(const Scene& s) {
 }
 
 // What a user needs to pick --camera and --animation, and to see what the loader made of the file.
-void describe_scene(const std::string& path) {
-  const Scene s = load_scene(path);
+void describe_scene(const std::string& path, const InputLimits& limits) {
+  const Scene s = load_scene(path, limits);
   const SceneStructure& d = s.structure;
   std::printf("scene: %s%s\n", path.c_str(), d.generator.empty() ? "" : (" (generator: " + printable_text(d.generator, 120) + ")").c_str());
   std::printf("triangles: %zu, vertices: %zu (%zu mesh instance(s) of %zu mesh(es), %zu primitive(s), %zu node(s))\n",
@@ -151,18 +151,39 @@ void describe_scene(const std::string& path) {
 }  // namespace
 
 int run_info(const std::vector<std::string>& args) {
-  if (args.size() > 1) throw Error("pmr info takes at most one scene file");
-  if (args.size() == 1 && (args[0] == "-h" || args[0] == "--help")) {
-    std::printf("usage: pmr info            list OpenCL platforms and devices\n"
-                "       pmr info SCENE      what a glTF scene holds: triangles, materials and their textures,\n"
-                "                           lights, cameras, animations, skins, morph targets, bounds, and the\n"
-                "                           loader's warnings\n");
+  std::string scene;
+  InputLimits limits;
+  bool options = false;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "-h" || a == "--help") {
+      std::printf("usage: pmr info            list OpenCL platforms and devices\n"
+                  "       pmr info SCENE [--limit KEY=VALUE[,...]] [--allow-outside-scene-folder]\n"
+                  "                           what a glTF scene holds: triangles, materials and their textures,\n"
+                  "                           lights, cameras, animations, skins, morph targets, bounds, and the\n"
+                  "                           loader's warnings; the options as for pmr render (docs/SECURITY.md)\n");
+      return 0;
+    }
+    if (a == "--limit") {
+      if (i + 1 >= args.size()) throw Error("option --limit needs a value (see pmr info --help)");
+      parse_limits(args[++i], limits);
+      options = true;
+    } else if (a == "--allow-outside-scene-folder") {
+      limits.allow_outside_scene_folder = true;
+      options = true;
+    } else if (!a.empty() && a[0] == '-') {
+      throw Error("unknown option " + a + " (see pmr info --help)");
+    } else if (scene.empty()) {
+      scene = a;
+    } else {
+      throw Error("pmr info takes at most one scene file");
+    }
+  }
+  if (!scene.empty()) {
+    describe_scene(scene, limits);
     return 0;
   }
-  if (args.size() == 1) {
-    describe_scene(args[0]);
-    return 0;
-  }
+  if (options) throw Error("--limit and --allow-outside-scene-folder apply to a scene: pmr info SCENE ...");
   for (const auto& line : describe_opencl_devices()) std::printf("%s\n", line.c_str());
   return 0;
 }

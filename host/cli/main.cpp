@@ -11,6 +11,7 @@
 #include "cli/render_command.h"
 #include "cli/verify_command.h"
 #include "pmr/error.h"
+#include "pmr/printable.h"
 #include "pmr/version.h"
 
 int main(int argc, char** argv) {
@@ -33,13 +34,14 @@ int main(int argc, char** argv) {
     if (cmd == "verify") return pmr::run_verify(args);
     throw pmr::Error("unknown command '" + cmd + "' (try pmr --help)");
   } catch (const pmr::Error& e) {
-    std::fprintf(stderr, "pmr: error: %s\n", e.what());
+    // messages quote names from files: the last line of defence against escape sequences
+    std::fprintf(stderr, "pmr: error: %s\n", pmr::terminal_text(e.what()).c_str());
     return 1;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "pmr: error: out of host memory\n");
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "pmr: internal error: %s\n", e.what());
+    std::fprintf(stderr, "pmr: internal error: %s\n", pmr::terminal_text(e.what()).c_str());
     return 2;
   }
 }

@@ -101,6 +101,8 @@ RigConfig rig_for_serial(const LookingGlassCalibration& c, std::string& quilt) {
 
 // --preset and --display-config set the defaults that every other option then overrides.
 void apply_display_source(RenderOptions& o, const std::vector<std::string>& args) {
+  for (size_t i = 0; i + 1 < args.size(); ++i)  // the calibration file is read under the file-bytes budget
+    if (args[i] == "--limit") parse_limits(args[i + 1], o.input_limits);
   for (size_t i = 0; i + 1 < args.size(); ++i) {
     if (args[i] == "--preset") {
       if (args[i + 1] == "help") {
@@ -114,7 +116,7 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
       o.rig.angular_spacing = p.name != "paper-8k";  // Looking Glass software spaces its cameras angularly
       o.display_source = "preset " + p.name;
     } else if (args[i] == "--display-config") {
-      o.calibration = read_looking_glass_calibration(args[i + 1], &o.option_warnings);
+      o.calibration = read_looking_glass_calibration(args[i + 1], &o.option_warnings, o.input_limits.file_bytes);
       o.has_calibration = true;
       o.display = display_from_calibration(o.calibration);
       o.offset_given = true;  // the calibration's center decides it
@@ -230,6 +232,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
       if (v != "linear" && v != "angular") throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
       o.rig.angular_spacing = v == "angular";
     }
+    else if (a == "--limit") parse_limits(value(), o.input_limits);
+    else if (a == "--allow-outside-scene-folder") o.input_limits.allow_outside_scene_folder = true;
     else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see pmr render --help)");
     else if (o.scene.empty()) o.scene = a;
     else throw Error("more than one scene given ('" + o.scene + "' and '" + a + "')");
@@ -390,6 +394,11 @@ std::string render_help() {
          "  --environment-intensity X  pbr: scales the environment, the image or the uniform one of radiance\n"
          "                         0.2 (0 turns it off; default 1)\n"
          "  --verbose              per-stage device times and queue sizes\n"
+         "untrusted input (docs/SECURITY.md):\n"
+         "  --allow-outside-scene-folder  read files the scene names outside its folder (by default a\n"
+         "                         buffer or image that resolves outside it is an error); recorded in the sidecar\n"
+         "  --limit KEY=VALUE[,KEY=VALUE...]  raise or lower a budget (VALUE an integer, K/M/G/T = x1024^n):\n" +
+         limit_help() +
          "Environment: PMR_DEVICE=substring selects the OpenCL device by name (default: first CPU device).\n"
          "Docs in the source tree: README.md, docs/DESIGN.md (rig, framing, encoder, files), docs/SHADING.md.\n";
 }

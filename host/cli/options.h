@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "pipeline/pipeline.h"
+#include "pmr/input_files.h"
 #include "pmr/display_presets.h"
 #include "pmr/rig.h"
 
@@ -58,6 +59,8 @@ struct RenderOptions {
   std::string environment_file;
   double environment_rotation_deg = 0.0;
   bool environment_rotation_given = false;
+  // --limit KEY=VALUE,... and --allow-outside-scene-folder (docs/SECURITY.md)
+  InputLimits input_limits;
 };
 
 // Parses the arguments after `render`. Throws pmr::Error with one line on bad input.

@@ -151,6 +151,8 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
                   {"order", "view 0 in the bottom-left tile, then left to right, then upward"}};
   if (info.center_view >= 0) j["preview_center_view"] = info.center_view;
   j["depth_channel"] = info.depth;
+  // the scene's files were read without confinement to its folder (docs/SECURITY.md)
+  if (info.allow_outside_scene_folder) j["allow_outside_scene_folder"] = true;
   j["warnings"] = info.warnings;
   j["time"] = info.time;
   j["fps"] = info.fps;

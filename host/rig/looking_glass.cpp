@@ -44,23 +44,19 @@ Rational exact_decimal(long double x, const std::string& what) {
 
 }  // namespace
 
-LookingGlassCalibration read_looking_glass_calibration(const std::string& path, std::vector<std::string>* warnings) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path + ": cannot open the calibration file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+LookingGlassCalibration read_looking_glass_calibration(const std::string& path, std::vector<std::string>* warnings,
+                                                       uint64_t max_bytes) {
+  const std::vector<unsigned char> file = read_user_file(path, max_bytes);
+  const std::string text(file.begin(), file.end());
   json doc;
   try {
-    doc = json::parse(ss.str());
+    doc = json::parse(text);
   } catch (const std::exception& e) {
     throw Error(path + ": not a JSON calibration file (" + std::string(e.what()).substr(0, 120) + ")");
   }
   if (!doc.is_object()) throw Error(path + ": not a JSON calibration file (expected an object)");
   LookingGlassCalibration c;
-  {
-    const std::string bytes = ss.str();
-    c.checksum = checksum_hex(bytes.data(), bytes.size());
-  }
+  c.checksum = checksum_hex(text.data(), text.size());
   if (doc.contains("serial") && doc["serial"].is_string()) c.serial = doc["serial"].get<std::string>();
   if (doc.contains("configVersion") && doc["configVersion"].is_string()) c.config_version = doc["configVersion"].get<std::string>();
   c.pitch = number_field(doc, "pitch", path, true, 0);

@@ -10,6 +10,7 @@
 // and every failure is a pmr::Error naming the file and the offending element.
 #pragma once
 #include <cstdint>
+#include <map>
 #include <set>
 #include <string>
 #include <vector>
@@ -22,6 +23,7 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
+#include "pmr/input_files.h"
 #include "scene/motion.h"
 
 namespace pmr::gltf {
@@ -53,8 +55,16 @@ struct SourceFile {
   // the light it places (-1 = none).
   std::vector<SceneLight> lights;
   std::vector<int> node_light;
+  // The external files tinygltf will ask for (buffers, sampled images), read and checked here: inside
+  // the scene's folder (unless allowed outside), regular, within the file-bytes budget. Keyed by the
+  // path tinygltf asks for (resolve_uri); `uses` counts the buffers and images that name the file.
+  struct External {
+    std::vector<unsigned char> bytes;
+    int uses = 0;
+  };
+  std::map<std::string, External> external;
 };
-SourceFile read_source(const std::string& path);
+SourceFile read_source(const std::string& path, const InputLimits& limits);
 
 // For a material extension the renderer does not implement but can draw without (its appearance
 // changes, nothing else): what is drawn instead, e.g. "drawn opaque, without transmission". nullptr
@@ -72,6 +82,14 @@ void check_schema(const std::string& path, const nlohmann::json& doc);
 
 // Percent-decodes a relative URI the way tinygltf does and joins it to base_dir.
 std::string resolve_uri(const std::string& base_dir, const std::string& uri);
+
+// ---- texture_decode.cpp -------------------------------------------------------------------------------
+
+// Decodes a PNG or JPEG into `image` as tinygltf's own loader does (4 channels of 8 or 16 bits, rows
+// top first) after reading its header: an image of more than `max_pixels` pixels is not decoded and
+// sets `over_limit`. Returns "" when decoded, else why not.
+std::string decode_image(tinygltf::Image& image, const unsigned char* bytes, int size, uint64_t max_pixels,
+                         bool& over_limit);
 
 // ---- gltf_validate.cpp: after tinygltf ------------------------------------------------------------
 

@@ -5,18 +5,16 @@
 // validate_model() checks every reference the walk follows, then the default scene is walked and each
 // mesh instance is emitted with its node's world matrix. Only images some implemented material slot
 // samples are decoded (base colour, metallic-roughness, normal, occlusion, emissive).
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <map>
 
 #include "output/checksum.h"
 #include "pmr/error.h"
+#include "pmr/printable.h"
 #include "pmr/scene.h"
 #include "scene/gltf_internal.h"
 
@@ -29,43 +27,37 @@ using namespace gltf;
 
 struct FsContext {
   std::string prefix;  // base_dir with a trailing '/'
+  std::map<std::string, SourceFile::External>* external = nullptr;  // read_source's reads: all tinygltf gets
   const std::set<std::string>* skip = nullptr;  // files only unused images name: not read
   std::map<std::string, std::string> read;      // path relative to base_dir -> checksum of the bytes read
 };
 
-// tinygltf looks for external files in base_dir and then in the working directory; only the former
-// is the file's own folder. Empty files count as missing so that an empty image is a warning (tinygltf
-// would fail the whole load on it); empty buffers were already refused by read_source().
+// tinygltf looks for external files in base_dir and then in the working directory. It gets exactly the
+// files read_source() read and checked (inside the scene's folder, regular, within the budget), and
+// the files of unused images as empty (tinygltf then warns "File is empty", which the loader ignores,
+// and the image stays undecoded as it would anyway): nothing else, so it never opens a file itself.
 bool fs_exists(const std::string& path, void* user) {
   const auto* ctx = static_cast<const FsContext*>(user);
-  if (path.compare(0, ctx->prefix.size(), ctx->prefix) != 0) return false;
-  struct stat st {};
-  return stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0;
+  return ctx->external->count(path) > 0 || ctx->skip->count(path) > 0;
 }
 
 std::string fs_expand(const std::string& path, void*) { return path; }
 
-// Every file read is checksummed from the bytes read (the sidecar lists them). A file that only unused
-// images name is not read at all: tinygltf then warns "File is empty", which the loader ignores, and the
-// image stays undecoded as it would anyway.
+// Every file read is checksummed from the bytes read (the sidecar lists them). The bytes move to
+// tinygltf on the last use of a file that several buffers or images name.
 bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
   auto* ctx = static_cast<FsContext*>(user);
   out->clear();
-  if (ctx->skip && ctx->skip->count(path)) return true;
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  const std::streamoff size = in ? std::streamoff(in.tellg()) : -1;
-  if (size < 0) {
-    if (err) *err += "cannot open " + path + "\n";
-    return false;
+  auto it = ctx->external->find(path);
+  if (it == ctx->external->end()) {
+    if (!ctx->skip->count(path) && err) *err += "not read: " + path + "\n";
+    return ctx->skip->count(path) > 0;
   }
-  out->resize(size_t(size));
-  in.seekg(0);
-  if (size > 0 && !in.read(reinterpret_cast<char*>(out->data()), size)) {
-    if (err) *err += "cannot read " + path + "\n";
-    return false;
-  }
-  // fs_exists only accepts paths under the prefix
-  ctx->read[path.substr(std::min(path.size(), ctx->prefix.size()))] = checksum_hex(out->data(), out->size());
+  SourceFile::External& e = it->second;
+  const std::string relative = path.substr(std::min(path.size(), ctx->prefix.size()));
+  if (!ctx->read.count(relative)) ctx->read[relative] = checksum_hex(e.bytes.data(), e.bytes.size());
+  if (--e.uses > 0) *out = e.bytes;
+  else out->swap(e.bytes);
   return true;
 }
 
@@ -77,16 +69,19 @@ bool fs_write(std::string* err, const std::string&, const std::vector<unsigned c
 struct ImageContext {
   const tinygltf::Model* model = nullptr;  // the model tinygltf is filling (buffers come before images)
   const std::set<int>* wanted = nullptr;   // images to decode
+  uint64_t max_pixels = 0;                 // the texture-pixels budget
   std::map<int, std::string> failures;     // image index -> why it could not be decoded
+  std::string over_limit;                  // the first image over the budget: an error after parsing
 };
 
-// Decodes with tinygltf's own stb_image loader but never fails the load: an undecodable image is a
-// warning and an untextured material. Also checks what tinygltf does not: a GLB image's bufferView
-// must lie inside its buffer before its bytes are read.
+// Decodes (texture_decode.cpp) but never fails the load: an undecodable image is a warning and an
+// untextured material, and an image over the texture-pixels budget an error once tinygltf returns.
+// Also checks what tinygltf does not: a GLB image's bufferView must lie inside its buffer before its
+// bytes are read.
 bool load_image(tinygltf::Image* image, int index, std::string*, std::string*, int, int, const unsigned char* bytes,
                 int size, void* user) {
   auto* ctx = static_cast<ImageContext*>(user);
-  if (!ctx->wanted->count(index)) return true;  // never sampled: skip the decode
+  if (!ctx->wanted->count(index) || !ctx->over_limit.empty()) return true;  // never sampled: skip the decode
   if (image->bufferView >= 0) {
     const tinygltf::Model& m = *ctx->model;
     bool inside = size_t(image->bufferView) < m.bufferViews.size();
@@ -105,10 +100,15 @@ bool load_image(tinygltf::Image* image, int index, std::string*, std::string*, i
     ctx->failures[index] = "the image data is empty";
     return true;
   }
-  std::string err, warn;
-  if (!tinygltf::LoadImageData(image, index, &err, &warn, 0, 0, bytes, size, nullptr)) {
-    err = one_line(err.substr(0, err.find('\n')));
-    ctx->failures[index] = "cannot decode it" + (err.empty() ? std::string() : " (" + err + ")");
+  bool over = false;
+  const std::string why = decode_image(*image, bytes, size, ctx->max_pixels, over);
+  if (over) {
+    const std::string name = image->uri.empty() || image->uri.rfind("data:", 0) == 0 ? image->name : image->uri;
+    ctx->over_limit = "image " + std::to_string(index) + (name.empty() ? "" : " '" + one_line(name) + "'") + ": " + why;
+  } else if (!why.empty()) {
+    ctx->failures[index] = one_line(why);
+  }
+  if (!why.empty()) {
     image->image.clear();
     image->width = image->height = 0;
   }
@@ -116,10 +116,11 @@ bool load_image(tinygltf::Image* image, int index, std::string*, std::string*, i
 }
 
 // `files_read` receives the files read besides the scene file (relative path -> checksum).
-void load_model(const std::string& path, const SourceFile& src, tinygltf::Model& model, ImageContext& images,
+void load_model(const std::string& path, SourceFile& src, tinygltf::Model& model, ImageContext& images,
                 std::map<std::string, std::string>& files_read) {
   FsContext fs;
   fs.prefix = src.base_dir.back() == '/' ? src.base_dir : src.base_dir + "/";
+  fs.external = &src.external;
   fs.skip = &src.unused_image_files;
   images.model = &model;
   images.wanted = &src.sampled_images;
@@ -142,6 +143,7 @@ void load_model(const std::string& path, const SourceFile& src, tinygltf::Model&
     const std::string msg = one_line(err.empty() ? warn : err);
     fail(path, "not a valid glTF file: " + (msg.empty() ? std::string("tinygltf gave no reason") : msg));
   }
+  if (!images.over_limit.empty()) fail(path, images.over_limit);
   files_read = std::move(fs.read);
 }
 
@@ -284,6 +286,16 @@ int wrap_mode(Loader& L, int mode, int sampler) {
   return PMR_WRAP_REPEAT;
 }
 
+// tinygltf decodes data URIs of PNG and JPEG only and treats any other as a file name: say what the
+// data URI holds instead ("image/ktx2", "image/webp").
+std::string data_uri_problem(const std::string& uri) {
+  const size_t end = uri.find_first_of(";,");
+  const std::string type = uri.substr(5, end == std::string::npos ? 0 : end - 5);
+  if (type == "image/png" || type == "image/jpeg") return "its data URI cannot be decoded (base64 expected)";
+  return "its data URI holds " + (type.empty() ? std::string("no media type") : "type " + printable_text(type, 40)) +
+         ", which is not supported (PNG and JPEG only)";
+}
+
 // The Scene::textures index of a glTF texture, decoding its image on first use; -1 when unusable (with
 // a warning). One image sampled with the same wrap modes is stored once, whichever textures and slots
 // name it.
@@ -307,9 +319,10 @@ int scene_texture(Loader& L, int texture, int slot) {
   std::string why;
   if (img.image.empty()) {
     auto f = L.images.failures.find(t.source);
-    why = f != L.images.failures.end() ? f->second
-          : img.uri.empty()            ? std::string("no image data")
-                                       : "file not found or unreadable";
+    why = f != L.images.failures.end()  ? f->second
+          : img.uri.empty()             ? std::string("no image data")
+          : img.uri.rfind("data:", 0) == 0 ? data_uri_problem(img.uri)
+                                        : "file not found";
   } else {
     to_rgba8(img, st, why);
   }
@@ -891,10 +904,13 @@ void describe_structure(Loader& L, const std::vector<int>& roots) {
 
 }  // namespace
 
-Scene load_scene(const std::string& path) {
-  const SourceFile src = read_source(path);
+Scene load_scene(const std::string& path) { return load_scene(path, InputLimits()); }
+
+Scene load_scene(const std::string& path, const InputLimits& limits) {
+  SourceFile src = read_source(path, limits);
   tinygltf::Model model;
   ImageContext images;
+  images.max_pixels = limits.texture_pixels;
   std::map<std::string, std::string> files_read;
   load_model(path, src, model, images, files_read);
   const std::vector<int> parent = validate_model(model, path);

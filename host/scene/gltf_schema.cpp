@@ -49,6 +49,27 @@ class SchemaCheck {
     return s;
   }
 
+  // An optional reference (an integer >= 0) to an element of an array of `count`, checked as the
+  // 64-bit value written: tinygltf stores indices as int, so 2^32 would wrap to element 0 and 2^31 to a
+  // negative index. `owner` names the referring element as the later checks do ("node 0 children").
+  void reference(const json& obj, const char* key, const std::string& owner, const char* kind, int64_t count) const {
+    if (const json* v = member(obj, key)) reference_value(*v, owner + " " + key, owner, kind, count);
+  }
+  // `name` names the value itself in the messages of value() ("node 0 children").
+  void reference_value(const json& v, const std::string& name, const std::string& owner, const char* kind,
+                       int64_t count) const {
+    if (value(v, name, 0) >= count)
+      fail(path_, owner + " refers to " + kind + " " + v.dump() + ", which does not exist (the file has " +
+                      std::to_string(count) + ")");
+  }
+  // An optional array of references, as reference().
+  void references(const json& obj, const char* key, const std::string& owner, const char* kind, int64_t count) const {
+    const json* a = member(obj, key);
+    if (!a) return;
+    if (!a->is_array()) fail(path_, owner + " " + key + " is not an array");
+    for (const json& v : *a) reference_value(v, owner + " " + key, owner, kind, count);
+  }
+
   int64_t required_integer(const json& obj, const char* key, const std::string& where, int64_t lo, int64_t hi = -1,
                            const char* what = nullptr) const {
     if (!member(obj, key)) fail(path_, where + " has no " + key);
@@ -109,8 +130,8 @@ void check_texture_info(const SchemaCheck& c, const json& material, const std::s
   const char* in_pbr[] = {"baseColorTexture", "metallicRoughnessTexture"};
   auto check = [&](const json* info, const char* name) {
     if (!info) return;
-    c.integer(*info, "index", where + " " + name, 0);
-    c.integer(*info, "texCoord", where + " " + name, 0);
+    c.reference(*info, "index", where + " " + name, "texture", c.count("textures"));
+    c.integer(*info, "texCoord", where + " " + name, 0, int64_t(INT32_MAX) + 1, "TEXCOORD set");
   };
   for (const char* n : direct) check(member(material, n), n);
   if (pbr)
@@ -217,23 +238,32 @@ void check_skins(const SchemaCheck& c) {
 
 void check_schema(const std::string& path, const json& doc) {
   const SchemaCheck c(path, doc);
-  c.integer(doc, "scene", "the file's", 0);
+  const int64_t accessors = c.count("accessors"), buffer_views = c.count("bufferViews"), nodes = c.count("nodes");
+  if (c.count("scenes") > 0) {
+    if (const json* v = member(doc, "scene")) c.reference_value(*v, "the file's scene", "the default scene", "scene", c.count("scenes"));
+  } else if (const int64_t s = c.integer(doc, "scene", "the file's", 0); s > INT32_MAX) {
+    fail(path, "scene " + member(doc, "scene")->dump() + " is the default but there are no scenes");
+  }
   c.each("accessors", "accessor", [&](const json& a, const std::string& where) {
-    c.integer(a, "bufferView", where, 0);
+    c.reference(a, "bufferView", where, "bufferView", buffer_views);
     c.integer(a, "byteOffset", where, 0);
     c.integer(a, "count", where, 1);
+    // tinygltf stores the component type as int: 2^32 + 5126 would read as FLOAT
+    if (const json* t = member(a, "componentType"); t && !(t->is_number_integer() && t->get<int64_t>() >= 5120 &&
+                                                          t->get<int64_t>() <= 5126 && t->get<int64_t>() != 5124))
+      fail(path, where + " componentType is " + t->dump() + ", which is not a glTF component type");
     if (const json* sparse = member(a, "sparse")) {
       c.integer(*sparse, "count", where + " sparse", 1);
       for (const char* part : {"indices", "values"})
         if (const json* p = member(*sparse, part)) {
-          c.integer(*p, "bufferView", where + " sparse " + part, 0);
+          c.reference(*p, "bufferView", where + " sparse " + part, "bufferView", buffer_views);
           c.integer(*p, "byteOffset", where + " sparse " + part, 0);
         }
     }
   });
   c.each("buffers", "buffer", [&](const json& b, const std::string& where) { c.integer(b, "byteLength", where, 1); });
   c.each("bufferViews", "bufferView", [&](const json& v, const std::string& where) {
-    c.integer(v, "buffer", where, 0);
+    c.reference(v, "buffer", where, "buffer", c.count("buffers"));
     c.integer(v, "byteOffset", where, 0);
     c.integer(v, "byteLength", where, 1);
     const int64_t stride = c.integer(v, "byteStride", where, 4);
@@ -241,7 +271,9 @@ void check_schema(const std::string& path, const json& doc) {
       fail(path, where + " byteStride is " + std::to_string(stride) +
                      ", which the glTF schema does not allow (a multiple of 4 from 4 to 252)");
   });
-  c.each("images", "image", [&](const json& i, const std::string& where) { c.integer(i, "bufferView", where, 0); });
+  c.each("images", "image", [&](const json& i, const std::string& where) {
+    c.reference(i, "bufferView", where, "bufferView", buffer_views);
+  });
   c.each("materials", "material", [&](const json& m, const std::string& where) { check_texture_info(c, m, where); });
   c.each("meshes", "mesh", [&](const json& mesh, const std::string& where) {
     const json* prims = member(mesh, "primitives");
@@ -249,27 +281,34 @@ void check_schema(const std::string& path, const json& doc) {
     for (size_t p = 0; p < prims->size(); ++p) {
       const json& prim = (*prims)[p];
       const std::string w = where + " primitive " + std::to_string(p);
-      c.integer(prim, "indices", w, 0);
-      c.integer(prim, "material", w, 0);
+      if (const json* v = member(prim, "indices")) c.reference_value(*v, w + " indices", w + " indices", "accessor", accessors);
+      c.reference(prim, "material", w, "material", c.count("materials"));
+      if (const json* mode = member(prim, "mode"); mode && !(mode->is_number_integer() && mode->get<int64_t>() >= 0 &&
+                                                             mode->get<int64_t>() <= 6))
+        fail(path, w + " has mode " + mode->dump() + ", which is not a glTF primitive mode (0 to 6)");
       if (const json* attrs = member(prim, "attributes"))
         for (auto it = attrs->begin(); attrs->is_object() && it != attrs->end(); ++it)
-          c.value(it.value(), w + " attribute " + it.key(), 0);
+          c.reference_value(it.value(), w + " attribute " + it.key(), w + " attribute " + it.key(), "accessor", accessors);
       if (const json* targets = member(prim, "targets"); targets && targets->is_array())
         for (size_t t = 0; t < targets->size(); ++t)
           for (auto it = (*targets)[t].begin(); (*targets)[t].is_object() && it != (*targets)[t].end(); ++it)
-            c.value(it.value(), w + " morph target " + std::to_string(t) + " " + it.key(), 0);
+            c.reference_value(it.value(), w + " morph target " + std::to_string(t) + " " + it.key(),
+                              w + " morph target " + std::to_string(t) + " " + it.key(), "accessor", accessors);
     }
   });
   c.each("nodes", "node", [&](const json& n, const std::string& where) {
-    c.integer(n, "camera", where, 0);
-    c.integer(n, "mesh", where, 0);
+    c.reference(n, "camera", where, "camera", c.count("cameras"));
+    c.reference(n, "mesh", where, "mesh", c.count("meshes"));
     c.integer(n, "skin", where, 0, c.count("skins"), "skin");
-    c.indices(n, "children", where, -1, "node");
+    if (const json* ch = member(n, "children")) {
+      if (!ch->is_array()) fail(path, where + " children is not an array");
+      for (const json& v : *ch) c.reference_value(v, where + " children", where + " children", "node", nodes);
+    }
   });
-  c.each("scenes", "scene", [&](const json& s, const std::string& where) { c.indices(s, "nodes", where, -1, "node"); });
+  c.each("scenes", "scene", [&](const json& s, const std::string& where) { c.references(s, "nodes", where, "node", nodes); });
   c.each("textures", "texture", [&](const json& t, const std::string& where) {
-    c.integer(t, "sampler", where, 0);
-    c.integer(t, "source", where, 0);
+    c.reference(t, "sampler", where, "sampler", c.count("samplers"));
+    c.reference(t, "source", where, "image", c.count("images"));
   });
   check_animations(c);
   check_skins(c);

@@ -10,6 +10,7 @@
 
 #include "output/checksum.h"
 #include "pmr/error.h"
+#include "pmr/printable.h"
 #include "scene/gltf_internal.h"
 
 namespace pmr::gltf {
@@ -21,10 +22,17 @@ void fail(const std::string& file, const std::string& what) { throw pmr::Error(f
 std::string one_line(const std::string& text, bool ascii_only) {
   constexpr size_t kMax = 300;
   std::string out;
-  for (char c : text) {
-    if (out.size() == kMax) return out + "...";
-    const unsigned char u = static_cast<unsigned char>(c);
-    out += c == '\n' ? ' ' : (u < 0x20 || u == 0x7f || (ascii_only && u > 0x7f)) ? '?' : c;
+  for (size_t i = 0; i < text.size();) {
+    if (out.size() >= kMax) return out + "...";
+    // well-formed UTF-8 of a printable character is kept; C1 controls in their UTF-8 form (U+009B is
+    // CSI), stray bytes and every other control are not
+    const size_t n = ascii_only && static_cast<unsigned char>(text[i]) >= 0x80 ? 0 : printable_utf8_length(text, i);
+    if (n > 0) {
+      out.append(text, i, n);
+      i += n;
+    } else {
+      out += text[i++] == '\n' ? ' ' : '?';
+    }
   }
   while (!out.empty() && out.back() == ' ') out.pop_back();
   return out;
@@ -48,24 +56,22 @@ uint32_t read_u32le(const unsigned char* p) {
   return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
 }
 
-std::vector<unsigned char> read_whole_file(const std::string& path) {
+// The scene file itself is the user's choice (no confinement), but still a regular file under the
+// file-bytes budget: /dev/zero or a FIFO is refused, not read.
+std::vector<unsigned char> read_whole_file(const std::string& path, const InputLimits& limits) {
+  const InputFile check = check_input_file(path, "", limits.file_bytes);
+  if (check.status == InputFile::Status::NotFound) fail(path, "file not found");
+  if (check.status == InputFile::Status::NotRegular && check.reason.find("directory") != std::string::npos)
+    fail(path, "is a directory, not a glTF file");
+  if (check.status != InputFile::Status::Ok) fail(path, check.reason);
   struct stat st {};
-  if (stat(path.c_str(), &st) != 0) {
-    if (errno == ENOENT || errno == ENOTDIR) fail(path, "file not found");
-    fail(path, std::string("cannot access file: ") + std::strerror(errno));
-  }
-  if (S_ISDIR(st.st_mode)) fail(path, "is a directory, not a glTF file");
-  if (!S_ISREG(st.st_mode)) fail(path, "is not a regular file");
   // tinygltf takes the length as unsigned int; a GLB cannot exceed 4 GiB anyway.
-  if (uint64_t(st.st_size) > std::numeric_limits<uint32_t>::max())
+  if (stat(check.real_path.c_str(), &st) == 0 && uint64_t(st.st_size) > std::numeric_limits<uint32_t>::max())
     fail(path, "file is larger than 4 GiB, which glTF loading does not support");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) fail(path, std::string("cannot open file: ") + std::strerror(errno));
-  std::vector<unsigned char> bytes(size_t(st.st_size));
-  if (!bytes.empty() && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(bytes.size())))
-    fail(path, "cannot read file (I/O error or file changed while reading)");
-  if (bytes.empty()) fail(path, "file is empty");
-  return bytes;
+  InputFile f = read_input_file(path, "", limits.file_bytes);
+  if (f.status != InputFile::Status::Ok) fail(path, f.reason);
+  if (f.bytes.empty()) fail(path, "file is empty");
+  return std::move(f.bytes);
 }
 
 // Validates the GLB container strictly (tinygltf 2.7 lets the BIN chunk header run past the end) and
@@ -142,7 +148,7 @@ void check_extensions(const std::string& path, const json& doc, SourceFile& src)
       // A material extension only changes how a surface looks: drawn without it, with one warning
       // per extension (the loader's), even when required.
       if (!extension_supported(name) && !material_extension_fallback(name))
-        fail(path, "requires extension " + name + ", which this renderer does not support");
+        fail(path, "requires extension " + one_line(name) + ", which this renderer does not support");
     }
   }
   if (const json* used = member(doc, "extensionsUsed")) {
@@ -237,9 +243,45 @@ void read_lights(const std::string& path, const json& doc, SourceFile& src) {
   }
 }
 
+// Reads an external file the scene names into src.external (once, however many buffers and images
+// name it): confined to the scene's folder (`confine`, "" = anywhere), a regular file, within the
+// file-bytes budget and, for a buffer, exactly `byte_length` bytes (-1: any). `what` names it in
+// messages ("buffer 0: file 'a.bin'"). Returns false when the file does not exist and `missing_ok`.
+bool read_external(const std::string& path, SourceFile& src, const std::string& file, const std::string& what,
+                   const std::string& confine, const InputLimits& limits, int64_t byte_length, bool missing_ok) {
+  if (auto known = src.external.find(file); known != src.external.end()) {
+    ++known->second.uses;
+    if (byte_length >= 0 && uint64_t(byte_length) != known->second.bytes.size())
+      fail(path, what + " has " + std::to_string(known->second.bytes.size()) + " bytes but byteLength is " +
+                     std::to_string(byte_length));
+    return true;
+  }
+  const InputFile check = check_input_file(file, confine, limits.file_bytes);
+  if (check.status == InputFile::Status::NotFound) {
+    if (missing_ok) return false;
+    fail(path, what + " not found (looked for " + one_line(file) + ")");
+  }
+  if (check.status == InputFile::Status::Outside)
+    fail(path, what + " lies outside the scene folder (it resolves to " + one_line(check.real_path) +
+                   "); --allow-outside-scene-folder reads it");
+  if (check.status != InputFile::Status::Ok) fail(path, what + " " + check.reason);
+  struct stat st {};
+  if (byte_length >= 0 && stat(check.real_path.c_str(), &st) == 0 && uint64_t(st.st_size) != uint64_t(byte_length))
+    fail(path, what + " has " + std::to_string(st.st_size) + " bytes but byteLength is " + std::to_string(byte_length));
+  InputFile f = read_input_file(file, confine, limits.file_bytes);
+  if (f.status != InputFile::Status::Ok) fail(path, what + " " + f.reason);
+  if (byte_length >= 0 && uint64_t(byte_length) != f.bytes.size())
+    fail(path, what + " has " + std::to_string(f.bytes.size()) + " bytes but byteLength is " + std::to_string(byte_length));
+  SourceFile::External& e = src.external[file];
+  e.bytes = std::move(f.bytes);
+  e.uses = 1;
+  return true;
+}
+
 // Buffers are checked here so that a missing or short .bin gets a message naming the file (tinygltf
-// would say "File not found", or fail later with an unrelated error).
-void check_buffers(const std::string& path, const json& doc, const SourceFile& src, int64_t bin_length) {
+// would say "File not found", or fail later with an unrelated error), and read here (read_external).
+void check_buffers(const std::string& path, const json& doc, SourceFile& src, int64_t bin_length,
+                   const std::string& confine, const InputLimits& limits) {
   const json* buffers = member(doc, "buffers");
   if (!buffers || !buffers->is_array()) return;
   for (size_t i = 0; i < buffers->size(); ++i) {
@@ -265,13 +307,26 @@ void check_buffers(const std::string& path, const json& doc, const SourceFile& s
                           "application/gltf-buffer expected)");
       continue;  // tinygltf decodes it and checks the decoded size against byteLength
     }
-    const std::string file = resolve_uri(src.base_dir, u);
-    struct stat st {};
-    if (stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
-      fail(path, name + ": file '" + one_line(u) + "' not found (looked for " + one_line(file) + ")");
-    if (uint64_t(st.st_size) != byte_length)
-      fail(path, name + ": file '" + one_line(u) + "' has " + std::to_string(st.st_size) + " bytes but byteLength is " +
-                     std::to_string(byte_length));
+    if (byte_length > uint64_t(INT64_MAX)) fail(path, name + " has an impossible byteLength");
+    read_external(path, src, resolve_uri(src.base_dir, u), name + ": file '" + one_line(u) + "'", confine, limits,
+                  int64_t(byte_length), false);
+  }
+}
+
+// The files of the images some material samples (sampled_images), read like buffers; a missing one
+// is a warning later (the material is drawn untextured), any other refusal an error.
+void read_sampled_images(const std::string& path, const json& doc, SourceFile& src, const std::string& confine,
+                         const InputLimits& limits) {
+  const json* images = member(doc, "images");
+  if (!images || !images->is_array()) return;
+  for (int i : src.sampled_images) {
+    if (i < 0 || size_t(i) >= images->size()) continue;
+    const json* uri = member((*images)[size_t(i)], "uri");
+    if (!uri || !uri->is_string()) continue;
+    const std::string u = uri->get<std::string>();
+    if (u.empty() || u.rfind("data:", 0) == 0) continue;  // tinygltf decodes data URIs
+    read_external(path, src, resolve_uri(src.base_dir, u), "image " + std::to_string(i) + ": file '" + one_line(u) + "'",
+                  confine, limits, -1, true);
   }
 }
 
@@ -378,9 +433,9 @@ std::string resolve_uri(const std::string& base_dir, const std::string& uri) {
   return base_dir.back() == '/' ? base_dir + decoded : base_dir + "/" + decoded;
 }
 
-SourceFile read_source(const std::string& path) {
+SourceFile read_source(const std::string& path, const InputLimits& limits) {
   SourceFile src;
-  src.bytes = read_whole_file(path);
+  src.bytes = read_whole_file(path, limits);
   src.checksum = checksum_hex(src.bytes.data(), src.bytes.size());
   src.base_dir = base_dir_of(path);
   src.glb = src.bytes.size() >= 4 && std::memcmp(src.bytes.data(), "glTF", 4) == 0;
@@ -404,13 +459,19 @@ SourceFile read_source(const std::string& path) {
   const json* version = asset ? member(*asset, "version") : nullptr;
   if (!version || !version->is_string()) fail(path, "not a glTF file: asset.version is missing");
   const std::string v = version->get<std::string>();
-  if (v.rfind("2.", 0) != 0) fail(path, "glTF version " + v + " is not supported (2.x only)");
+  if (v.rfind("2.", 0) != 0) fail(path, "glTF version " + one_line(v) + " is not supported (2.x only)");
   check_schema(path, doc);
   check_extensions(path, doc, src);
-  check_buffers(path, doc, src, bin_length);
+  std::string confine;  // the scene folder's real path, "" when files may lie anywhere
+  if (!limits.allow_outside_scene_folder) {
+    confine = real_folder(src.base_dir);
+    if (confine.empty()) fail(path, "cannot resolve the scene's folder " + one_line(src.base_dir));
+  }
+  check_buffers(path, doc, src, bin_length, confine, limits);
   read_lights(path, doc, src);
   src.sampled_images = sampled_images(doc);
   src.unused_image_files = unused_image_files(doc, src.base_dir, src.sampled_images);
+  read_sampled_images(path, doc, src, confine, limits);
   return src;
 }
 

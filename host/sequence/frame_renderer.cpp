@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "pmr/error.h"
+#include "pmr/printable.h"
 #include "scene/motion.h"
 #include "shading/lights.h"
 
@@ -35,7 +36,7 @@ void select_animation(const Scene& scene, const std::string& choice, SequenceSpe
     return;
   }
   std::string known;
-  for (size_t i = 0; i < a.size(); ++i) known += (known.empty() ? "" : ", ") + std::to_string(i) + " '" + a[i].name + "'";
+  for (size_t i = 0; i < a.size(); ++i) known += (known.empty() ? "" : ", ") + std::to_string(i) + " '" + printable_text(a[i].name, 80) + "'";
   throw Error("--animation '" + choice + "': " +
               (a.empty() ? std::string("the scene has no animations") : "no such animation (the scene has " + known + ")"));
 }

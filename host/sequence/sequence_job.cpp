@@ -70,7 +70,7 @@ int run_sequence(const RenderOptions& o) {
   // the pipeline's configuration: the sidecars a resumed run expects need it too (which lights)
   PipelineConfig pc = o.pipeline;
   pc.environment = environment;
-  const Scene scene = load_scene(o.scene);
+  const Scene scene = load_scene(o.scene, o.input_limits);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
   SequenceSpec spec;
   select_animation(scene, o.animation, spec);
@@ -141,6 +141,7 @@ int run_sequence(const RenderOptions& o) {
   info.display_source = o.display_source;
   info.scene_checksum = scene.source_checksum;
   for (const SceneInputFile& f : scene.input_files) info.scene_files.push_back({f.path, f.checksum});
+  info.allow_outside_scene_folder = o.input_limits.allow_outside_scene_folder;
   if (o.has_calibration) {
     const LookingGlassCalibration& c = o.calibration;
     info.display_config_checksum = c.checksum;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "pmr/input_files.h"
 #include "pmr/rig.h"
 
 namespace pmr {
@@ -26,7 +27,10 @@ struct LookingGlassCalibration {
 // missing, non-numeric or absurd (zero DPI or slope, NaN, non-positive or huge screen size, malformed
 // subpixelCells or CellPatternMode, which gen3 panels carry).
 // `warnings` receives what is read but ignored (invView = 0, flipImageY, fringe, verticalAngle).
-LookingGlassCalibration read_looking_glass_calibration(const std::string& path, std::vector<std::string>* warnings);
+// The file must be a regular file of at most `max_bytes` (the file-bytes budget): a FIFO or /dev/zero
+// is refused, not read.
+LookingGlassCalibration read_looking_glass_calibration(const std::string& path, std::vector<std::string>* warnings,
+                                                       uint64_t max_bytes = InputLimits().file_bytes);
 
 // The display in DESIGN terms for a calibration, following Looking Glass's current interlacing shader
 // (looking-glass-webxr 0.6 / holoplay-core 0.0.11): pitch' = pitch W / DPI cos(atan(1 / slope)) and

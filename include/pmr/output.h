@@ -163,6 +163,7 @@ struct SidecarInfo {
   // rotation (its intensity is environment_intensity)
   std::string environment_file, environment_checksum;
   double environment_rotation_deg = 0.0;
+  bool allow_outside_scene_folder = false;  // --allow-outside-scene-folder: recorded only when given
 };
 
 // The sidecar's JSON text (pretty printed, doubles with round-trip precision).

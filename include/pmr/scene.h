@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "pmr/input_files.h"
 #include "pmr/shared.h"
 
 namespace pmr {
@@ -187,6 +188,10 @@ double turntable_angle(long frame, double degrees, long frames);
 // Loads a .gltf or .glb file (detected by content, not by extension) and validates it completely
 // before returning. Throws pmr::Error with one clear line on anything that cannot be rendered.
 Scene load_scene(const std::string& path);
+// The same under the budgets and confinement of `limits` (docs/SECURITY.md): every file the scene
+// names lies inside the scene's folder (unless limits.allow_outside_scene_folder), is a regular file
+// within limits.file_bytes, and no texture image over limits.texture_pixels is decoded.
+Scene load_scene(const std::string& path, const InputLimits& limits);
 
 // World-space axis-aligned bounds of all vertices referenced by triangles. Returns false (lo, hi
 // untouched) when there are none.

@@ -1,0 +1,69 @@
+// Texture images: PNG and JPEG (the glTF formats) through stb_image, compiled here with only those two
+// decoders, its functions static to this file.
+//
+// The header is read before anything is decoded. Debian's stb_image computes some buffer sizes in
+// 32-bit int arithmetic that it does not check: a 16-bit greyscale PNG of 32768x16385 expanded to 4
+// channels needs 4 x 32768 x 16385 x 2 bytes, which wraps to 262,144, and the decoder then writes
+// gigabytes into that buffer. So an image is decoded only when its pixels are within the
+// texture-pixels budget and its decoded size (4 channels of 1 or 2 bytes) fits in an int.
+#include <climits>
+#include <cstring>
+#include <string>
+
+#include "scene/gltf_internal.h"
+
+#define STB_IMAGE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_PNG
+#define STBI_ONLY_JPEG
+#define STBI_NO_STDIO
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#include <stb/stb_image.h>
+#pragma GCC diagnostic pop
+
+namespace pmr::gltf {
+
+std::string decode_image(tinygltf::Image& image, const unsigned char* bytes, int size, uint64_t max_pixels,
+                         bool& over_limit) {
+  over_limit = false;
+  int w = 0, h = 0, comp = 0;
+  if (!stbi_info_from_memory(bytes, size, &w, &h, &comp))
+    return std::string("cannot decode it: not a PNG or JPEG image (") + stbi_failure_reason() + ")";
+  const bool sixteen = stbi_is_16_bit_from_memory(bytes, size) != 0;
+  const uint64_t pixels = uint64_t(w) * uint64_t(h);
+  const std::string size_text = std::to_string(w) + "x" + std::to_string(h) + (sixteen ? " 16-bit" : "");
+  if (w <= 0 || h <= 0) return "the image has no pixels (" + size_text + ")";
+  if (pixels > max_pixels) {
+    over_limit = true;
+    return size_text + " is " + std::to_string(pixels) + " pixels, more than the texture-pixels limit of " +
+           std::to_string(max_pixels) + " (raise it with --limit texture-pixels=N)";
+  }
+  const uint64_t channel_bytes = sixteen ? 2 : 1, decoded = pixels * 4 * channel_bytes;
+  if (decoded > uint64_t(INT_MAX))
+    return size_text + " decodes to " + std::to_string(decoded) +
+           " bytes, more than the image decoder can address (2 GiB)";
+  int dw = 0, dh = 0, dc = 0;
+  void* data = sixteen ? static_cast<void*>(stbi_load_16_from_memory(bytes, size, &dw, &dh, &dc, 4))
+                       : static_cast<void*>(stbi_load_from_memory(bytes, size, &dw, &dh, &dc, 4));
+  if (!data) return std::string("cannot decode it (") + stbi_failure_reason() + ")";
+  if (dw != w || dh != h) {  // stb read the header twice: cannot differ, but the buffer size depends on it
+    stbi_image_free(data);
+    return "cannot decode it (inconsistent size)";
+  }
+  image.width = w;
+  image.height = h;
+  image.component = 4;
+  image.bits = sixteen ? 16 : 8;
+  image.pixel_type = sixteen ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+  const unsigned char* p = static_cast<const unsigned char*>(data);
+  image.image.assign(p, p + decoded);
+  stbi_image_free(data);
+  return "";
+}
+
+}  // namespace pmr::gltf

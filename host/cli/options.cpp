@@ -195,7 +195,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
       if (!(o.fps > 0.0) || o.fps > 10000.0) throw Error("invalid --fps: must be in (0, 10000]");
     } else if (a == "--animation") {
       o.animation = value();
-      if (o.animation.empty()) throw Error("invalid --animation '': expected a name, an index or all");
+      if (o.animation.empty()) throw Error("invalid --animation '': expected a name, an index, all or none");
     } else if (a == "--name") {
       o.name = value();
       check_name_pattern(o.name);
@@ -379,11 +379,16 @@ std::string render_help() {
          "                         number the stem of a single frame as given (--name duck: duck.exr)\n"
          "  --compression C        EXR compression: none, zip, zip-fast (ZIP at deflate level 1: about 35%\n"
          "                         less CPU, 15% larger), piz, rle (default zip)\n"
-         "sequences (an animated glTF plays; frame f samples time f / fps):\n"
+         "sequences (an animated glTF plays; frame f samples time f / fps; before the animation's first key\n"
+         "and after its last a frame holds the first or last pose, as glTF clamps):\n"
          "  --frames LIST          frames to render: N, A:B (inclusive), A:B:STEP, a comma list of these\n"
-         "                         (0:99,120,130:140), or all = the animation's time range (default 0)\n"
+         "                         (0:99,120,130:140), or all (default 0). all = the frames whose times lie\n"
+         "                         inside the animation's keys, ceil(start x fps) to floor(end x fps); with\n"
+         "                         --turntable one turn, 0 to FRAMES-1, however long the animation; frame 0\n"
+         "                         for a still scene. Frames outside the keys get a warning, except all\n"
          "  --fps F                frames per second (default 24)\n"
-         "  --animation A          NAME, INDEX or all (every animation at once); default: the first one\n"
+         "  --animation A          NAME, INDEX, all (every animation at once) or none (the rest pose);\n"
+         "                         default: the first one\n"
          "  --turntable DEG:FRAMES turn the scene DEG degrees every FRAMES frames about the vertical axis\n"
          "                         through its framing center (360:96 loops every 96 frames)\n"
          "  --resume               skip frames whose files are all present; refuse a changed configuration\n"

@@ -225,6 +225,11 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
       o.environment_rotation_deg = parse_environment_rotation(value());
       o.environment_rotation_given = true;
     }
+    else if (a == "--zoom") {
+      o.rig.zoom = parse_double(value(), a);
+      if (!(o.rig.zoom >= 0.001 && o.rig.zoom <= 1000.0)) throw Error("invalid --zoom: expected a factor from 0.001 to 1000");
+      o.zoom_given = true;
+    }
     else if (a == "--camera-spacing") {
       const std::string v = value();
       if (v != "linear" && v != "angular") throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
@@ -234,6 +239,9 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     else if (o.scene.empty()) o.scene = a;
     else throw Error("more than one scene given ('" + o.scene + "' and '" + a + "')");
   }
+  if (o.zoom_given && o.rig.camera >= 0)
+    throw Error("--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own: "
+                "give one of them");
   return o;
 }
 
@@ -414,6 +422,9 @@ std::string render_help() {
          "                         renders with --method multipass for now\n"
          "  --camera K             use the scene's glTF camera K (pose and field of view) instead of framing\n"
          "                         the scene's bounding sphere\n"
+         "  --zoom F               the scene appears F times larger (default 1: its bounding sphere fits the\n"
+         "                         view's height and width); the camera moves closer, the zero-parallax plane\n"
+         "                         stays through the sphere's center. Not with --camera\n"
          "display:\n"
          "  --display WxH          display image in pixels (default 7680x4320)\n"
          "  --display-size WxH     physical size in cm (default 166x93; sets the aspect A)\n"

@@ -58,6 +58,7 @@ struct RenderOptions {
   std::string environment_file;
   double environment_rotation_deg = 0.0;
   bool environment_rotation_given = false;
+  bool zoom_given = false;     // --zoom was on the command line (rig.zoom)
 };
 
 // Parses the arguments after `render`. Throws pmr::Error with one line on bad input.

@@ -118,7 +118,7 @@ TEST(Framing, ZoomScalesTheDistance) {
   EXPECT_THROW(make_rig(rc, Display{}, kLo, kHi, &pose, 0.5), Error);
 }
 
-// Sidecars written before --zoom existed framed at 1.
+// Sidecars written before --zoom existed framed at 1; the default framing's distance is compared.
 TEST(Framing, SidecarsCompareTheZoom) {
   SidecarInfo info;
   info.has_bounds = true, info.bounds_lo = kLo, info.bounds_hi = kHi;
@@ -130,6 +130,18 @@ TEST(Framing, SidecarsCompareTheZoom) {
   const std::string two = sidecar_json(framed(Display{}, 2.0), Display{}, info);
   EXPECT_EQ(sidecar_config_difference(old.dump(), two), "rig.zoom");
   EXPECT_EQ(sidecar_config_difference(one, two), "rig.zoom");
+  // a portrait display framed by its height (before the sphere fit both directions): another framing
+  const Display portrait = display_of_aspect(30, 40);
+  const Rig now = framed(portrait);
+  nlohmann::json before = nlohmann::json::parse(sidecar_json(now, portrait, info));
+  before["rig"]["focal_distance"] = kRadius / std::tan(now.yfov / 2.0);
+  ASSERT_NE(before["rig"]["focal_distance"].get<double>(), now.focal);
+  EXPECT_EQ(sidecar_config_difference(before.dump(), sidecar_json(now, portrait, info)), "rig.focal_distance");
+  // with a glTF camera the distance is not compared: an animated camera moves it from frame to frame
+  info.camera = 0;
+  before = nlohmann::json::parse(sidecar_json(now, portrait, info));
+  before["rig"]["focal_distance"] = 2.0 * now.focal;
+  EXPECT_EQ(sidecar_config_difference(before.dump(), sidecar_json(now, portrait, info)), "");
 }
 
 // From the command line: recorded, compared by --resume, refused with --camera and out of range.

@@ -328,6 +328,11 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   // the framing (it follows from the scene file's content and the animation)
   if (!ignore_scene_derived && (!a.contains("scene_bounds") || get(a, "scene_bounds") != get(b, "scene_bounds")))
     return "scene_bounds";
+  // the default framing's distance follows from the above, and from how pmr frames: a portrait
+  // display was framed by its height before the sphere fit both directions (a glTF camera's distance
+  // moves with an animated camera)
+  if (!ignore_scene_derived && get(a, "camera") == -1 && get(ra, "focal_distance") != get(rb, "focal_distance"))
+    return "rig.focal_distance";
   return "";
 }
 

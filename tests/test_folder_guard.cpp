@@ -104,12 +104,16 @@ TEST(FolderGuard, SidecarNamesFollowThePatternExactly) {
   EXPECT_EQ(sidecar_frame("shot_%d_v2", "shot_12_v2.json"), 12);
   EXPECT_EQ(sidecar_frame("shot_%d_v2", "shot_012_v2.json"), -1);
   EXPECT_EQ(sidecar_frame("a%%b%03d", "a%b007.json"), 7);
-  EXPECT_EQ(sidecar_frame("f%5d", "f   42.json"), 42);
+  EXPECT_EQ(sidecar_frame("f####", "f0042.json"), 42);  // Blender's spelling of f%04d
+  EXPECT_EQ(sidecar_frame("f####", "f42.json"), -1);
+  EXPECT_EQ(sidecar_frame("duck", "duck.json"), -1);  // no frame field: one frame, always this job's
   const std::string lock = folder_lock_name("frame_%04d", "{}");
   EXPECT_EQ(lock.rfind(".pmr-lock-", 0), 0u);
   EXPECT_EQ(sidecar_frame("frame_%04d", lock), -1);
   EXPECT_EQ(sidecar_frame("frame_%04d", lock + ".json"), -1);
   EXPECT_NE(folder_lock_name("frame_%04d", "{}"), folder_lock_name("shot_%04d", "{}"));
+  // two spellings of the same names share one lock: their runs see each other
+  EXPECT_EQ(folder_lock_name("frame_####", "{}"), folder_lock_name("frame_%04d", "{}"));
 }
 
 // Frames of another configuration outside this run: refused with the key and a frame named, nothing

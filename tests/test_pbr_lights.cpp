@@ -24,7 +24,7 @@ using nlohmann::json;
 using test::CliRun;
 using test::run;
 
-const std::string kSmall = " --views 4 --view-size 64x32 --display 240x135 -q ";
+const std::string kSmall = " --views 4 --view-size 64x32 --display 240x135 ";  // not -q: tests read the summary
 
 SceneLight file_light(SceneLightType type, int index, const glm::dvec3& position) {
   SceneLight l;

@@ -237,7 +237,7 @@ TEST(Sequence, BadSequenceOptionsFailWithOneLine) {
   expect_one_error_line(run("render --frames 5:2 --out " + out), "--frames");
   expect_one_error_line(run("render --fps 0 --out " + out), "--fps");
   expect_one_error_line(run("render --turntable 360:0 --out " + out), "--turntable");
-  expect_one_error_line(run("render --name frame --out " + out), "--name");
+  expect_one_error_line(run("render --name frame --frames 0:1 --out " + out), "--name");  // one name, two frames
   expect_one_error_line(run("render --name a/%d --out " + out), "--name");
   expect_one_error_line(run("render --animation walk" + kSmall + "--out " + out), "no animations");
 }

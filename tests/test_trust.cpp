@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 using json = nlohmann::json;
 using test::run;
 
-const std::string kSmall = " --views 4 --view-size 64x32 --display 240x135 -q ";
+const std::string kSmall = " --views 4 --view-size 64x32 --display 240x135 ";  // not -q: tests read the summary
 
 std::string read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -125,8 +125,8 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
     long first = 0, last = 0;
     std::string frames;
     try {
-      animation_frame_range(s, spec, first, last);
-      frames = std::to_string(first) + ":" + std::to_string(last);
+      frames = animation_key_frames(s, spec, first, last) ? std::to_string(first) + ":" + std::to_string(last)
+                                                          : "none (no frame time lies inside the keys)";
     } catch (const Error&) {
       frames = "too long to render";
     }

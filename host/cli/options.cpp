@@ -197,7 +197,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
       if (!(o.fps > 0.0) || o.fps > 10000.0) throw Error("invalid --fps: must be in (0, 10000]");
     } else if (a == "--animation") {
       o.animation = value();
-      if (o.animation.empty()) throw Error("invalid --animation '': expected a name, an index or all");
+      if (o.animation.empty()) throw Error("invalid --animation '': expected a name, an index, all or none");
     } else if (a == "--name") {
       o.name = value();
       check_name_pattern(o.name);
@@ -227,6 +227,11 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
       o.environment_rotation_deg = parse_environment_rotation(value());
       o.environment_rotation_given = true;
     }
+    else if (a == "--zoom") {
+      o.rig.zoom = parse_double(value(), a);
+      if (!(o.rig.zoom >= 0.001 && o.rig.zoom <= 1000.0)) throw Error("invalid --zoom: expected a factor from 0.001 to 1000");
+      o.zoom_given = true;
+    }
     else if (a == "--camera-spacing") {
       const std::string v = value();
       if (v != "linear" && v != "angular") throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
@@ -238,37 +243,94 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     else if (o.scene.empty()) o.scene = a;
     else throw Error("more than one scene given ('" + o.scene + "' and '" + a + "')");
   }
+  if (o.zoom_given && o.rig.camera >= 0)
+    throw Error("--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own: "
+                "give one of them");
   return o;
 }
 
-void check_name_pattern(const std::string& p) {
-  int conversions = 0;
+namespace {
+
+const char* const kNameExample = "e.g. --name shot_%04d or shot_#### (frame 7: shot_0007)";
+
+}  // namespace
+
+NamePattern parse_name_pattern(const std::string& p) {
+  NamePattern n;
+  auto refuse = [&](const std::string& why) -> Error {
+    return Error("invalid --name '" + p + "': " + why + "; " + kNameExample);
+  };
+  auto field = [&](int width) {
+    if (n.has_field) throw refuse("more than one frame number field");
+    n.has_field = true;
+    n.width = width;
+  };
   for (size_t i = 0; i < p.size(); ++i) {
-    if (p[i] == '/') throw Error("invalid --name '" + p + "': a file stem cannot contain '/'");
-    if (p[i] != '%') continue;
+    std::string& out = n.has_field ? n.suffix : n.prefix;
+    if (p[i] == '/') throw refuse("a file stem cannot contain '/' (--out names the folder)");
+    if (p[i] == '#') {  // Blender: a run of N '#' is the frame zero-padded to N digits
+      size_t j = i;
+      while (j < p.size() && p[j] == '#') ++j;
+      if (j - i > 99) throw refuse("at most 99 '#'");
+      field(int(j - i));
+      i = j - 1;
+      continue;
+    }
+    if (p[i] != '%') {
+      out += p[i];
+      continue;
+    }
     if (i + 1 < p.size() && p[i + 1] == '%') {
+      out += '%';
       ++i;
       continue;
     }
     size_t j = i + 1;
-    if (j < p.size() && p[j] == '0') ++j;
+    const bool zero = j < p.size() && p[j] == '0';
+    if (zero) ++j;
     size_t digits = 0;
     while (j < p.size() && std::isdigit((unsigned char)p[j])) ++j, ++digits;
-    if (j >= p.size() || p[j] != 'd' || digits > 2)
-      throw Error("invalid --name '" + p + "': only %d, %Nd or %0Nd (and %% for a percent sign) are allowed");
-    ++conversions;
+    const std::string spec = p.substr(i, std::min(j + 1, p.size()) - i);
+    if (j >= p.size() || p[j] != 'd')
+      throw refuse("'" + spec + "' is not a frame number field (%d, %0Nd or ####; %% for a percent sign)");
+    if (!zero && digits > 0) throw refuse("'" + spec + "' pads with spaces; use %0" + spec.substr(1) + " (zero-padded)");
+    if (digits > 2) throw refuse("'" + spec + "': at most 99 digits");
+    field(digits ? std::atoi(p.substr(i + 2, digits).c_str()) : 0);
     i = j;
   }
-  if (conversions != 1)
-    throw Error("invalid --name '" + p + "': it needs exactly one frame number conversion such as %04d");
-  if (frame_stem(p, 0).empty() || frame_stem(p, 0)[0] == '.')
-    throw Error("invalid --name '" + p + "': the file stem would be empty or hidden");
+  return n;
+}
+
+void check_name_pattern(const std::string& p) {
+  const std::string stem = frame_stem(p, 0);
+  if (stem.empty() || stem[0] == '.')
+    throw Error("invalid --name '" + p + "': the file stem would be empty or hidden; " + kNameExample);
 }
 
 std::string frame_stem(const std::string& pattern, long frame) {
-  char buf[512];
-  std::snprintf(buf, sizeof buf, pattern.c_str(), int(frame));  // checked by check_name_pattern
-  return buf;
+  const NamePattern n = parse_name_pattern(pattern);
+  if (!n.has_field) return n.prefix;
+  std::string number = std::to_string(frame);
+  if (number.size() < size_t(n.width)) number.insert(0, size_t(n.width) - number.size(), '0');
+  return n.prefix + number + n.suffix;
+}
+
+std::string canonical_name_pattern(const std::string& pattern) {
+  const NamePattern n = parse_name_pattern(pattern);
+  auto escaped = [](const std::string& text) {
+    std::string out;
+    for (char c : text) out += c == '%' ? std::string("%%") : std::string(1, c);
+    return out;
+  };
+  if (!n.has_field) return escaped(n.prefix);
+  const std::string field = n.width ? "%0" + std::to_string(n.width) + "d" : "%d";
+  return escaped(n.prefix) + field + escaped(n.suffix);
+}
+
+void check_name_covers_frames(const std::string& pattern, size_t frame_count) {
+  if (frame_count > 1 && !parse_name_pattern(pattern).has_field)
+    throw Error("--name '" + pattern + "' has no frame number field, so it names one frame, and " +
+                std::to_string(frame_count) + " frames were asked for; " + kNameExample);
 }
 
 void finalize_render_options(RenderOptions& o) {
@@ -315,7 +377,7 @@ std::string render_help() {
          "96 views of 1024x512, a 7680x4320 display of 166x93 cm seen from 200 cm, 80 degree view cone.\n"
          "\n"
          "output:\n"
-         "  --out DIR              output folder (created if missing; default: out)\n"
+         "  --out DIR, -o DIR      output folder (created if missing; default: out)\n"
          "  --write LIST           any of encoded, views, quilt, depth (default: encoded). DIR/frame_NNNN.exr is\n"
          "                         the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view,\n"
          "                         DIR/frame_NNNN_qsCxRaA.exr the views as a Looking Glass quilt (view 0 bottom\n"
@@ -323,22 +385,31 @@ std::string render_help() {
          "                         views and quilt files; DIR/frame_NNNN.json (rig, display, every view's\n"
          "                         matrices) is always written\n"
          "  --quilt CxR            quilt layout in tiles (default: the most square layout, e.g. 8x6 for 48)\n"
-         "  --preview              also 8-bit sRGB PNGs: the encoded image, the center view (N / 2) and the quilt\n"
-         "  --name PATTERN         file stem, printf-style with one integer (default frame_%04d)\n"
+         "  --preview              also 8-bit sRGB PNGs: the encoded image, the center view (N / 2; stretched to\n"
+         "                         square pixels, as a view's pixels span the display's aspect) and the quilt\n"
+         "                         (tiles as rendered; their pixel aspect in the PNG's pHYs chunk)\n"
+         "  --name PATTERN         file stem (default frame_%04d); the frame number as %d, zero-padded %0Nd or\n"
+         "                         Blender's #### (N '#': N digits), %% for a percent sign; without a frame\n"
+         "                         number the stem of a single frame as given (--name duck: duck.exr)\n"
          "  --compression C        EXR compression: none, zip, zip-fast (ZIP at deflate level 1: about 35%\n"
          "                         less CPU, 15% larger), piz, rle (default zip)\n"
-         "sequences (an animated glTF plays; frame f samples time f / fps):\n"
+         "sequences (an animated glTF plays; frame f samples time f / fps; before the animation's first key\n"
+         "and after its last a frame holds the first or last pose, as glTF clamps):\n"
          "  --frames LIST          frames to render: N, A:B (inclusive), A:B:STEP, a comma list of these\n"
-         "                         (0:99,120,130:140), or all = the animation's time range (default 0)\n"
+         "                         (0:99,120,130:140), or all (default 0). all = the frames whose times lie\n"
+         "                         inside the animation's keys, ceil(start x fps) to floor(end x fps); with\n"
+         "                         --turntable one turn, 0 to FRAMES-1, however long the animation; frame 0\n"
+         "                         for a still scene. Frames outside the keys get a warning, except all\n"
          "  --fps F                frames per second (default 24)\n"
-         "  --animation A          NAME, INDEX or all (every animation at once); default: the first one\n"
+         "  --animation A          NAME, INDEX, all (every animation at once) or none (the rest pose);\n"
+         "                         default: the first one\n"
          "  --turntable DEG:FRAMES turn the scene DEG degrees every FRAMES frames about the vertical axis\n"
          "                         through its framing center (360:96 loops every 96 frames)\n"
          "  --resume               skip frames whose files are all present; refuse a changed configuration\n"
          "  --overwrite            render even though the folder keeps frames of another configuration\n"
          "                         outside --frames (a warning counts them; without it the run refuses);\n"
          "                         with --resume: also re-render listed frames of another configuration\n"
-         "  --quiet                no progress output (errors and the summary still print)\n"
+         "  --quiet, -q            print only errors and warnings\n"
          "  --shard K/N|auto       render only task K's share of the frames (interleaved: positions K, K+N,\n"
          "                         ...); auto reads a Slurm, Kubernetes, AWS Batch, PBS, SGE or LSF array index\n"
          "                         (--shard-count N where the environment lacks the count, --shard-first F\n"
@@ -357,6 +428,9 @@ std::string render_help() {
          "                         renders with --method multipass for now\n"
          "  --camera K             use the scene's glTF camera K (pose and field of view) instead of framing\n"
          "                         the scene's bounding sphere\n"
+         "  --zoom F               the scene appears F times larger (default 1: its bounding sphere fits the\n"
+         "                         view's height and width); the camera moves closer, the zero-parallax plane\n"
+         "                         stays through the sphere's center. Not with --camera\n"
          "display:\n"
          "  --display WxH          display image in pixels (default 7680x4320)\n"
          "  --display-size WxH     physical size in cm (default 166x93; sets the aspect A)\n"
@@ -393,7 +467,7 @@ std::string render_help() {
          "                         (+X moves toward -Z; default 0)\n"
          "  --environment-intensity X  pbr: scales the environment, the image or the uniform one of radiance\n"
          "                         0.2 (0 turns it off; default 1)\n"
-         "  --verbose              per-stage device times and queue sizes\n"
+         "  --verbose, -v          per-stage device times and queue sizes\n"
          "untrusted input (docs/SECURITY.md):\n"
          "  --allow-outside-scene-folder  read files the scene names outside its folder (by default a\n"
          "                         buffer or image that resolves outside it is an error); recorded in the sidecar\n"

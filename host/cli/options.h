@@ -43,7 +43,7 @@ struct RenderOptions {
   std::string frames = "0";       // --frames LIST, or "all"
   double fps = 24.0;
   std::string animation;          // --animation NAME|INDEX|all; empty = the first animation
-  std::string name = "frame_%04d";  // --name: printf-style stem, one integer conversion
+  std::string name = "frame_%04d";  // --name: the file stem, with a frame field for sequences (NamePattern)
   bool turntable = false;
   double turntable_deg = 0.0;
   long turntable_frames = 0;
@@ -61,15 +61,29 @@ struct RenderOptions {
   bool environment_rotation_given = false;
   // --limit KEY=VALUE,... and --allow-outside-scene-folder (docs/SECURITY.md)
   InputLimits input_limits;
+  bool zoom_given = false;     // --zoom was on the command line (rig.zoom)
 };
 
 // Parses the arguments after `render`. Throws pmr::Error with one line on bad input.
 RenderOptions parse_render_options(const std::vector<std::string>& args);
-// Checks a --name pattern: exactly one integer conversion (%d, %4d, %04d), %% for a literal percent,
-// no '/'. Throws pmr::Error otherwise.
+// A --name pattern read: at most one frame number field, %d (as many digits as the number has), %0Nd
+// or Blender's run of N '#' (zero-padded to N digits); %% is a percent sign; no '/'. Without a field
+// the pattern is the stem of a single frame. Throws pmr::Error with one line (showing an accepted
+// example) otherwise, e.g. for the space-padded %Nd.
+struct NamePattern {
+  std::string prefix, suffix;  // the text before and after the field (%% read as %); no field: prefix
+  bool has_field = false;
+  int width = 0;               // zero-padded to this many digits; 0: as many as the number needs
+};
+NamePattern parse_name_pattern(const std::string& pattern);
+// Throws what parse_name_pattern throws, and when the stem would be empty or hidden.
 void check_name_pattern(const std::string& pattern);
 // The file stem of a frame under the pattern.
 std::string frame_stem(const std::string& pattern, long frame);
+// The pattern in one spelling (#### as %04d), so that two spellings of the same names compare equal.
+std::string canonical_name_pattern(const std::string& pattern);
+// Refuses a --name without a frame field for more than one frame (they would share one name).
+void check_name_covers_frames(const std::string& pattern, size_t frame_count);
 
 // Fills in derived defaults (the encoder offset) once all options are known.
 void finalize_render_options(RenderOptions& options);

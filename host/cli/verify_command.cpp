@@ -187,6 +187,7 @@ int run_verify(const std::vector<std::string>& args) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw Error("cannot verify " + dir + ": not a folder");
   const std::vector<long> frames = parse_frame_list(o.frames);
+  check_name_covers_frames(o.name, frames.size());
   bool explicit_kinds = false;
   for (const std::string& r : rest) explicit_kinds |= r == "--write" || r == "--preview";
   const FolderScene folder = folder_scene(dir, o, frames);

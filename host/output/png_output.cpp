@@ -38,7 +38,8 @@ uint8_t to_byte(double v) { return uint8_t(std::lround(std::min(1.0, std::max(0.
 
 }  // namespace
 
-void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half, bool opaque) {
+void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half,
+                       double pixel_aspect, bool opaque) {
   if (width < 1 || height < 1 || !rgba_half) throw Error("cannot write " + path + ": empty image");
   // sRGB lookup for every half value: the curve is applied once per distinct input, not per pixel
   static const std::vector<uint8_t> lut = [] {  // thread-safe initialization
@@ -63,9 +64,14 @@ void write_png_preview(const std::string& path, int width, int height, const uin
     png_init_io(png, f);
     png_set_compression_level(png, 1);
     png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA,
-                 PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    if (pixel_aspect != 1.0) {
+      // pixels per unit along x and y: a pixel is 1 / x wide and 1 / y tall, so y / x is its aspect
+      const double y = std::lround(100000.0 * pixel_aspect);
+      if (!(y >= 1.0 && y <= 2147483647.0)) throw Error("cannot write " + path + ": pixel aspect out of range");
+      png_set_pHYs(png, info, 100000, png_uint_32(y), PNG_RESOLUTION_UNKNOWN);
+    }
     png_write_info(png, info);
     for (int y = 0; y < height; ++y) {
       const uint16_t* src = rgba_half + size_t(y) * size_t(width) * 4;
@@ -87,6 +93,44 @@ void write_png_preview(const std::string& path, int width, int height, const uin
   if (!ok || !closed)
     throw Error("cannot write " + path + ": " + (err.message[0] ? err.message : std::strerror(errno)));
   file.commit();
+}
+
+std::vector<uint16_t> square_pixels(const uint16_t* rgba_half, int width, int height, double pixel_aspect,
+                                    int& out_width, int& out_height) {
+  if (!(pixel_aspect > 0.0) || !std::isfinite(pixel_aspect)) throw Error("square_pixels: invalid pixel aspect");
+  out_width = pixel_aspect > 1.0 ? int(std::lround(width * pixel_aspect)) : width;
+  out_height = pixel_aspect < 1.0 ? int(std::lround(height / pixel_aspect)) : height;
+  if (out_width == width && out_height == height)
+    return std::vector<uint16_t>(rgba_half, rgba_half + size_t(width) * size_t(height) * 4);
+  std::vector<uint16_t> out(size_t(out_width) * size_t(out_height) * 4);
+  // source position of an output pixel center, its two neighbours and the weight of the second
+  auto taps = [](int i, int n_out, int n_in, int& a, int& b, float& t) {
+    const double s = std::max(0.0, (i + 0.5) * double(n_in) / double(n_out) - 0.5);
+    a = std::min(int(s), n_in - 1);
+    b = std::min(a + 1, n_in - 1);
+    t = float(s - a);
+  };
+  auto at = [&](int x, int y, int c) {
+    half v;
+    v.setBits(rgba_half[(size_t(y) * size_t(width) + size_t(x)) * 4 + size_t(c)]);
+    return float(v);
+  };
+  for (int y = 0; y < out_height; ++y) {
+    int y0, y1;
+    float ty;
+    taps(y, out_height, height, y0, y1, ty);
+    for (int x = 0; x < out_width; ++x) {
+      int x0, x1;
+      float tx;
+      taps(x, out_width, width, x0, x1, tx);
+      for (int c = 0; c < 4; ++c) {
+        const float top = at(x0, y0, c) + tx * (at(x1, y0, c) - at(x0, y0, c));
+        const float bottom = at(x0, y1, c) + tx * (at(x1, y1, c) - at(x0, y1, c));
+        out[(size_t(y) * size_t(out_width) + size_t(x)) * 4 + size_t(c)] = half(top + ty * (bottom - top)).bits();
+      }
+    }
+  }
+  return out;
 }
 
 void read_png_rgba8(const std::string& path, int& width, int& height, std::vector<uint8_t>& rgba) {

@@ -208,6 +208,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   r["focal_distance"] = rig.focal;
   r["baseline"] = rig.baseline();
   r["camera_spacing"] = rig.angular ? "angular" : "linear";
+  r["zoom"] = rig.zoom;
   r["near"] = rig.near;
   r["near_used"] = rig.near_eff;
   r["far"] = rig.far;
@@ -323,9 +324,17 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   if (!ra.is_object()) return "rig";
   for (const char* key : {"views", "view_width", "view_height", "cone_deg", "yfov_deg", "aspect", "camera_spacing"})
     if (!ra.contains(key) || get(ra, key) != get(rb, key)) return std::string("rig.") + key;
+  // sidecars written before --zoom existed framed at 1
+  auto zoom = [&](const json& r) { return get(r, "zoom").is_null() ? json(1.0) : get(r, "zoom"); };
+  if (zoom(ra) != zoom(rb)) return "rig.zoom";
   // the framing (it follows from the scene file's content and the animation)
   if (!ignore_scene_derived && (!a.contains("scene_bounds") || get(a, "scene_bounds") != get(b, "scene_bounds")))
     return "scene_bounds";
+  // the default framing's distance follows from the above, and from how pmr frames: a portrait
+  // display was framed by its height before the sphere fit both directions (a glTF camera's distance
+  // moves with an animated camera)
+  if (!ignore_scene_derived && get(a, "camera") == -1 && get(ra, "focal_distance") != get(rb, "focal_distance"))
+    return "rig.focal_distance";
   return "";
 }
 

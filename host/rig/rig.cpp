@@ -68,6 +68,9 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
   check_positive(display.size_h_cm, "display height");
   check_positive(display.viewing_distance_cm, "viewing distance");
   if (!(config.cone_deg > 0.0 && config.cone_deg < 180.0)) throw Error("invalid --cone: must be in (0, 180) degrees");
+  check_positive(config.zoom, "--zoom");
+  if (camera_pose && config.zoom != 1.0)
+    throw Error("--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own");
 
   Rig rig;
   rig.views = config.views;
@@ -94,7 +97,10 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
     rig.focal = -(rig.center_view * glm::dvec4(c, 1.0)).z;
     if (!(rig.focal > 0.0)) throw Error("the selected camera looks away from the scene (its center is behind the camera)");
   } else {
-    rig.focal = R / tan_half;
+    // The sphere's cross-section through c fits the focal-plane window (half-height D tan(phi/2),
+    // half-width A D tan(phi/2)) in both directions: a portrait display frames by its width.
+    rig.focal = R / std::min(tan_half, rig.aspect * tan_half) / config.zoom;
+    rig.zoom = config.zoom;
     rig.center_view = glm::translate(glm::dmat4(1.0), -(c + glm::dvec3(0.0, 0.0, rig.focal)));
   }
   rig.near = std::max(rig.focal - 1.001 * R, 1e-3 * rig.focal);

@@ -117,22 +117,6 @@ std::string read_fd(int fd) {
   return text;
 }
 
-// The pattern's text before and after its frame conversion, with %% read as %.
-void split_pattern(const std::string& p, std::string& prefix, std::string& suffix) {
-  std::string* out = &prefix;
-  for (size_t i = 0; i < p.size(); ++i) {
-    if (p[i] != '%') {
-      *out += p[i];
-    } else if (i + 1 < p.size() && p[i + 1] == '%') {
-      *out += '%';
-      ++i;
-    } else {  // %d, %Nd, %0Nd (check_name_pattern allows nothing else)
-      while (i < p.size() && p[i] != 'd') ++i;
-      out = &suffix;
-    }
-  }
-}
-
 }  // namespace
 
 std::string without_view_matrices(const std::string& sidecar) {
@@ -147,7 +131,8 @@ std::string without_view_matrices(const std::string& sidecar) {
 }
 
 std::string folder_lock_name(const std::string& pattern, const std::string& expected) {
-  return kLockPrefix + hash_hex(pattern) + "-" + hash_hex(expected);
+  // canonical: frame_#### and frame_%04d name the same files
+  return kLockPrefix + hash_hex(canonical_name_pattern(pattern)) + "-" + hash_hex(expected);
 }
 
 long sidecar_frame(const std::string& pattern, const std::string& file_name) {
@@ -155,13 +140,13 @@ long sidecar_frame(const std::string& pattern, const std::string& file_name) {
   if (file_name.size() <= ext.size() || file_name.compare(file_name.size() - ext.size(), ext.size(), ext) != 0)
     return -1;
   const std::string stem = file_name.substr(0, file_name.size() - ext.size());
-  std::string prefix, suffix;
-  split_pattern(pattern, prefix, suffix);
+  const NamePattern name = parse_name_pattern(pattern);
+  if (!name.has_field) return -1;  // the stem of one frame, whichever its number: always this job's
+  const std::string &prefix = name.prefix, &suffix = name.suffix;
   if (stem.size() <= prefix.size() + suffix.size() || stem.compare(0, prefix.size(), prefix) != 0 ||
       stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) != 0)
     return -1;
-  std::string number = stem.substr(prefix.size(), stem.size() - prefix.size() - suffix.size());
-  number.erase(0, number.find_first_not_of(' '));  // %5d pads with spaces
+  const std::string number = stem.substr(prefix.size(), stem.size() - prefix.size() - suffix.size());
   if (number.empty() || number.size() > 8) return -1;
   for (char c : number)
     if (!std::isdigit((unsigned char)c)) return -1;
@@ -172,7 +157,7 @@ long sidecar_frame(const std::string& pattern, const std::string& file_name) {
 }
 
 FolderGuard::FolderGuard(const std::string& dir, const std::string& pattern, const std::vector<long>& job_frames,
-                         const std::string& expected, bool overwrite) {
+                         const std::string& expected, bool overwrite, bool quiet) {
   const std::string own_name = folder_lock_name(pattern, expected);
   const std::string expected_config = without_view_matrices(expected);
   // The configuration difference of a sidecar, compared without its view matrices (most of a sidecar
@@ -259,7 +244,7 @@ FolderGuard::FolderGuard(const std::string& dir, const std::string& pattern, con
 
     // 3. Finished frames outside this job (every shard's frames count as this job's).
     std::sort(sidecars.begin(), sidecars.end());
-    if (sidecars.size() >= 10000)  // about 0.3 ms each (48 views): say why the start takes a while
+    if (sidecars.size() >= 10000 && !quiet)  // about 0.3 ms each (48 views): say why the start takes a while
       std::fprintf(stderr, "pmr: comparing the configuration of %zu frame(s) outside --frames in %s\n", sidecars.size(),
                    dir.c_str());
     long others = 0;

@@ -28,10 +28,10 @@ class FolderGuard {
   // dir: the output folder (it exists); pattern: --name; job_frames: every frame of the job (before
   // sharding, any order); expected: this run's sidecar text for some frame (only its configuration
   // part matters, which is the same for every frame); overwrite: warn instead of refusing finished
-  // frames of another configuration. Throws pmr::Error with one line when the run must not go on
-  // (nothing is left behind then).
+  // frames of another configuration; quiet: print warnings only. Throws pmr::Error with one line when
+  // the run must not go on (nothing is left behind then).
   FolderGuard(const std::string& dir, const std::string& pattern, const std::vector<long>& job_frames,
-              const std::string& expected, bool overwrite);
+              const std::string& expected, bool overwrite, bool quiet = false);
   // Releases the lock; removes the lock file unless another process still holds it.
   ~FolderGuard();
   FolderGuard(const FolderGuard&) = delete;

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "pmr/error.h"
 #include "pmr/printable.h"
@@ -16,6 +17,11 @@ void select_animation(const Scene& scene, const std::string& choice, SequenceSpe
   if (choice.empty()) {
     spec.animation = a.empty() ? kNoAnimation : 0;
     spec.animation_label = a.empty() ? "" : label(0);
+    return;
+  }
+  if (choice == "none") {  // the rest pose (a clip named "none" is chosen by its index)
+    spec.animation = kNoAnimation;
+    spec.animation_label = "";
     return;
   }
   if (choice == "all") {
@@ -61,22 +67,38 @@ double ms_since(std::chrono::steady_clock::time_point t) {
 
 }  // namespace
 
-void animation_frame_range(const Scene& scene, const SequenceSpec& spec, long& first, long& last) {
+bool animation_key_frames(const Scene& scene, const SequenceSpec& spec, long& first, long& last) {
   double start = 0, end = 0;
-  if (spec.animation != kNoAnimation && key_range(scene, spec.animation, start, end)) {
-    // A tolerance keeps 1.0000001 s at 24 fps from adding a frame.
-    const double a = std::floor(start * spec.fps + 1e-6), b = std::ceil(end * spec.fps - 1e-6);
-    // The framing poses every frame of the range: refuse absurd ranges (key times near float's
-    // maximum, hours of animation) with one line instead of working for days or overflowing.
-    if (!(b - std::max(a, 0.0) < double(kMaxAnimationFrames)))
-      throw Error("the animation's keys span " + std::to_string(start) + " to " + std::to_string(end) + " s, over " +
-                  std::to_string(kMaxAnimationFrames) + " frames at " + std::to_string(spec.fps) + " fps");
-    first = std::max(0L, long(a));
-    last = std::max(first, long(b));
+  first = 0, last = -1;
+  if (spec.animation == kNoAnimation || !key_range(scene, spec.animation, start, end)) return false;
+  // The tolerance keeps key times stored as floats on their frames: CesiumMan's first key, 1/24 s as a
+  // float, is frame 1.00000003 at 24 fps, and frame 1 it stays.
+  const double a = std::ceil(start * spec.fps - 1e-6), b = std::floor(end * spec.fps + 1e-6);
+  // The framing poses every frame of the range: refuse absurd ranges (key times near float's
+  // maximum, hours of animation) with one line instead of working for days or overflowing.
+  if (!(b - std::max(a, 0.0) < double(kMaxAnimationFrames)))
+    throw Error("the animation's keys span " + std::to_string(start) + " to " + std::to_string(end) + " s, over " +
+                std::to_string(kMaxAnimationFrames) + " frames at " + std::to_string(spec.fps) + " fps");
+  first = std::max(0L, long(a));
+  last = std::max(first - 1, long(b));
+  return first <= last;
+}
+
+void animation_frame_range(const Scene& scene, const SequenceSpec& spec, long& first, long& last) {
+  if (spec.turntable) {
+    first = 0, last = std::max(0L, spec.turntable_frames - 1);
     return;
   }
-  first = 0;
-  last = spec.turntable ? std::max(0L, spec.turntable_frames - 1) : 0;
+  if (animation_key_frames(scene, spec, first, last)) return;
+  if (spec.animation != kNoAnimation && !scene.animations.empty()) {
+    double start = 0, end = 0;
+    key_range(scene, spec.animation, start, end);
+    char line[200];
+    std::snprintf(line, sizeof line, "--frames all: no frame time f / %g lies inside the animation's keys (%g to %g s): "
+                  "give --frames or a higher --fps", spec.fps, start, end);
+    throw Error(line);
+  }
+  first = last = 0;
 }
 
 PoseRequest FrameRenderer::request(long frame) const {
@@ -101,19 +123,22 @@ FrameRenderer::FrameRenderer(const Scene& rest, const SequenceSpec& spec, const 
     if (!cam.perspective || !cam.placed)
       throw Error("--camera " + std::to_string(rig_config.camera) + " is not a perspective camera placed in the scene");
   }
-  // Framing: the union of the bounds of every frame of the animation's range, without the turntable
-  // (its sphere is centered on the pivot, so turning does not change it).
-  SequenceSpec still = spec;
-  still.turntable = false;
+  // Framing: the union of the bounds of the animation's first and last pose (what frames outside its
+  // keys repeat) and of every frame inside its keys, without the turntable (its sphere is centered on
+  // the pivot, so turning does not change it).
   bool any = false;
   glm::dvec3 lo, hi;
   if (pose_moves(rest, PoseRequest{0.0, spec.animation})) {
-    long first = 0, last = 0;
-    animation_frame_range(rest, still, first, last);
+    double start = 0.0, end = 0.0;
+    key_range(rest, spec.animation, start, end);
+    long first = 0, last = -1;
+    animation_key_frames(rest, spec, first, last);
+    std::vector<double> times{start, end};
+    for (long f = first; f <= last; ++f) times.push_back(double(f) / spec.fps);
     Scene posed;
-    for (long f = first; f <= last; ++f) {
+    for (double t : times) {
       PoseRequest r;
-      r.time = double(f) / spec.fps;
+      r.time = t;
       r.animation = spec.animation;
       pose_scene(rest, r, posed);
       glm::dvec3 l, h;

@@ -1,7 +1,8 @@
 // One frame of a sequence, the same for `pmr render` and `pmr bench`: the scene posed at the frame's
 // time (animation) and angle (turntable), uploaded if it moved (its lights every frame), the rig (fixed, or following an animated
 // glTF camera), and the pipeline run. The framing is computed once over the chosen animation's whole
-// time range (DESIGN section 7), so any frame renders the same alone as inside a longer sequence.
+// time range, its first and last pose included (DESIGN section 7), so any frame renders the same alone
+// as inside a longer sequence.
 #pragma once
 #include <string>
 #include <vector>
@@ -21,14 +22,21 @@ struct SequenceSpec {
   long turntable_frames = 1;      // FRAMES of DEG:FRAMES
 };
 
-// Resolves --animation (NAME, INDEX or all; empty = the first animation if there is one) against the
-// scene's clips. Throws pmr::Error naming the known animations when nothing matches.
+// Resolves --animation (NAME, INDEX, all, or none = the rest pose; empty = the first animation if there
+// is one) against the scene's clips. Throws pmr::Error naming the known animations when nothing
+// matches.
 void select_animation(const Scene& scene, const std::string& choice, SequenceSpec& spec);
 
-// The frames covering the chosen animation's key range at the frame rate: floor(start * fps) to
-// ceil(end * fps) (so the last pose is included). Without animation: frame 0 alone, or one turn
-// 0..FRAMES-1 with a turntable. Throws pmr::Error when the range exceeds kMaxAnimationFrames.
+// The frames whose times f / fps lie inside the chosen animation's key range: ceil(start * fps) to
+// floor(end * fps) (within 1e-6 of a frame: float key times). Outside it a frame repeats the first or
+// the last pose (glTF clamps). Returns false, with last < first, when no frame time lies inside, and
+// when no animation is chosen. Throws pmr::Error when the range exceeds kMaxAnimationFrames.
 constexpr long kMaxAnimationFrames = 1000000;
+bool animation_key_frames(const Scene& scene, const SequenceSpec& spec, long& first, long& last);
+
+// The frames of --frames all: with a turntable one turn, 0..FRAMES-1 (an animation's time keeps
+// running, holding its last pose past its end); else the animation's key frames
+// (animation_key_frames; pmr::Error when there are none); without either frame 0 alone.
 void animation_frame_range(const Scene& scene, const SequenceSpec& spec, long& first, long& last);
 
 class FrameRenderer {

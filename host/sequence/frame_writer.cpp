@@ -179,18 +179,21 @@ void FrameWriter::write(FrameFiles& f) {
     }
     if (!f.encoded_png.empty()) {
       check();
-      write_png_preview(f.encoded_png, f.display_w, f.display_h, f.display.data(), true);
+      write_png_preview(f.encoded_png, f.display_w, f.display_h, f.display.data(), 1.0, true);  // opaque, over black
       done(f.encoded_png);
     }
     if (!f.center_png.empty()) {
       check();
       const size_t plane = size_t(f.view_w) * size_t(f.view_h) * 4;
-      write_png_preview(f.center_png, f.view_w, f.view_h, f.volume.data() + size_t(f.center_view) * plane);
+      int w = 0, h = 0;  // a view's pixels span the display's aspect: square them for viewers
+      const std::vector<uint16_t> square =
+          square_pixels(f.volume.data() + size_t(f.center_view) * plane, f.view_w, f.view_h, f.pixel_aspect, w, h);
+      write_png_preview(f.center_png, w, h, square.data());
       done(f.center_png);
     }
     if (!f.quilt_png.empty()) {
       check();
-      write_png_preview(f.quilt_png, qw, qh, quilt.data());
+      write_png_preview(f.quilt_png, qw, qh, quilt.data(), f.pixel_aspect);  // tiles as rendered
       done(f.quilt_png);
     }
   } catch (const Abandoned&) {

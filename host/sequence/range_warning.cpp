@@ -11,8 +11,8 @@ namespace pmr {
 std::string frames_outside_animation(const Scene& scene, const SequenceSpec& spec, const std::vector<long>& frames,
                                      bool frames_all) {
   if (frames_all || spec.animation == kNoAnimation) return "";
-  long first = 0, last = 0;
-  animation_frame_range(scene, spec, first, last);
+  long first = 0, last = -1;
+  const bool inside = animation_key_frames(scene, spec, first, last);
   std::vector<long> outside;
   bool before = false, after = false;
   for (long f : frames)
@@ -30,7 +30,8 @@ std::string frames_outside_animation(const Scene& scene, const SequenceSpec& spe
     list = (outside.size() == 1 ? "frame " : "frames ") + list;
   }
   char range[96];
-  std::snprintf(range, sizeof range, "frames %ld:%ld at %g fps", first, last, spec.fps);
+  if (inside) std::snprintf(range, sizeof range, "frames %ld:%ld at %g fps", first, last, spec.fps);
+  else std::snprintf(range, sizeof range, "no frame at %g fps lies inside its keys", spec.fps);
   const std::string what = spec.animation == kAllAnimations ? "the animations (all)" : "the animation '" + printable_text(spec.animation_label, 80) + "'";
   const char* pose = before && after ? "its first or last pose" : before ? "its first pose" : "its last pose";
   return list + (outside.size() == 1 ? " lies" : " lie") + " outside " + what + " (" + range + "): " +

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <filesystem>
 
+#include <nlohmann/json.hpp>
+
 #include "pmr/error.h"
 #include "pmr/output.h"
 #include "pmr/version.h"
@@ -18,6 +20,12 @@ std::string first_few(const std::vector<std::string>& names) {
   std::string s;
   for (size_t i = 0; i < names.size() && i < 3; ++i) s += (i ? ", " : "") + names[i];
   return names.size() > 3 ? s + ", ..." : s;
+}
+
+// The sidecar says it holds frame f (frame_problem has checked that it parses as an object).
+bool records_frame(const std::string& sidecar, long f) {
+  const nlohmann::json j = nlohmann::json::parse(sidecar, nullptr, false);
+  return j.is_object() && j.contains("frame") && j["frame"].is_number_integer() && j["frame"].get<long>() == f;
 }
 
 }  // namespace
@@ -36,9 +44,13 @@ ResumePlan plan_resume(const std::vector<long>& frames, bool resume, bool overwr
     // complete = every file present and readable (a node may have died during a rename on a network
     // file system); anything less is rendered again
     if (resume && frame_problem(p.sidecar, p.images()).empty()) {
+      const std::string existing = read_text_file(p.sidecar);
+      if (!records_frame(existing, f)) {  // a --name without a frame field: another frame's files
+        plan.todo.push_back(f);
+        continue;
+      }
       const std::string want = expected(f, p);
       if (scene_now.empty()) scene_now = sidecar_provenance(want).scene;
-      const std::string existing = read_text_file(p.sidecar);
       const SidecarProvenance had = sidecar_provenance(existing);
       const bool same_scene = !had.scene.empty() && had.scene == scene_now;
       const std::string diff = sidecar_config_difference(existing, want, /*ignore_scene_derived=*/!same_scene);

@@ -17,7 +17,8 @@ struct ResumePlan {
 // Without `resume` every frame is rendered. With it, a frame is kept when all its files are present
 // and whole (frame_problem) and its sidecar shows this scene (the checksums of the scene file and of
 // every file it read) and this configuration (`expected(frame, paths)`: the sidecar this run would
-// write). A frame from another scene, or whose sidecar records no checksum, is rendered again, whatever
+// write) and this frame (its sidecar's frame number: a --name without a frame field names every
+// frame alike). A frame from another scene, or whose sidecar records no checksum, is rendered again, whatever
 // the scene changed (framing bounds too). A different configuration throws pmr::Error unless
 // `overwrite`, which renders such frames again. A program version change alone renders nothing again
 // (pixels are meant to be stable across versions): it is only noted.

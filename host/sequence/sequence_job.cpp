@@ -48,6 +48,7 @@ int run_sequence(const RenderOptions& o) {
   const ExrCompression compression = parse_exr_compression(o.compression);
   std::vector<long> frames;
   if (o.frames != "all") frames = parse_frame_list(o.frames);  // before the long work: fail early
+  check_name_covers_frames(o.name, frames.size());
   // Everything that can be checked cheaply is checked before the long work starts.
   prepare_output_dir(o.out_dir);
   make_encode_params(o.display, o.rig.views, o.rig.view_w, o.rig.view_h);
@@ -85,6 +86,7 @@ int run_sequence(const RenderOptions& o) {
     if (last > kMaxFrame)
       throw Error("--frames all would reach frame " + std::to_string(last) + ", beyond " + std::to_string(kMaxFrame));
     for (long f = first; f <= last; ++f) frames.push_back(f);
+    check_name_covers_frames(o.name, frames.size());
   }
   std::vector<long> job_frames;  // every shard's frames (the folder guard's "this job")
   if (!o.shard.empty()) {
@@ -92,8 +94,9 @@ int run_sequence(const RenderOptions& o) {
     const Shard shard = parse_shard(o.shard, o.shard_count, o.shard_first, [](const char* n) { return std::getenv(n); });
     const size_t all = frames.size();
     frames = shard_frames(frames, shard);
-    std::fprintf(stderr, "pmr: %s: shard %ld of %ld, %zu of %zu frame(s)\n", shard.source.c_str(), shard.index,
-                 shard.count, frames.size(), all);
+    if (!o.quiet)
+      std::fprintf(stderr, "pmr: %s: shard %ld of %ld, %zu of %zu frame(s)\n", shard.source.c_str(), shard.index,
+                   shard.count, frames.size(), all);
   }
   std::vector<std::string> warnings;
   FrameRenderer renderer(scene, spec, o.rig, o.display, &warnings);
@@ -173,21 +176,24 @@ int run_sequence(const RenderOptions& o) {
   // this run's frames (folder_guard.h). Held until the end of the run.
   const FolderGuard folder_guard(o.out_dir, o.name, o.shard.empty() ? frames : job_frames,
                                  sidecar_json(rig, o.display, frame_info(0, paths(0), 0.0, renderer.frame_lights(0, pc))),
-                                 o.overwrite);
+                                 o.overwrite, o.quiet);
 
   const ResumePlan plan = plan_resume(frames, o.resume, o.overwrite, paths, [&](long f, const FramePaths& p) {
     return sidecar_json(rig, o.display, frame_info(f, p, 0.0, renderer.frame_lights(f, pc)));
   });
-  for (const std::string& note : plan.notes) std::fprintf(stderr, "pmr: %s\n", note.c_str());
+  // --quiet: errors and warnings only
+  if (!o.quiet)
+    for (const std::string& note : plan.notes) std::fprintf(stderr, "pmr: %s\n", note.c_str());
   const std::vector<long>& todo = plan.todo;
   const long skipped = plan.kept;
   const long total = long(todo.size());
-  std::fprintf(stderr, "pmr: %s: %zu triangles, %d views of %dx%d -> %dx%d display%s; %ld frame(s)%s\n",
-               o.scene.c_str(), scene.triangles.size(), rig.views, rig.view_w, rig.view_h, o.display.width,
-               o.display.height, o.pipeline.sampling == Sampling::Subpixel ? " (subpixel sampling)" : "", total,
-               skipped ? (", " + std::to_string(skipped) + " already complete").c_str() : "");
+  if (!o.quiet)
+    std::fprintf(stderr, "pmr: %s: %zu triangles, %d views of %dx%d -> %dx%d display%s; %ld frame(s)%s\n",
+                 o.scene.c_str(), scene.triangles.size(), rig.views, rig.view_w, rig.view_h, o.display.width,
+                 o.display.height, o.pipeline.sampling == Sampling::Subpixel ? " (subpixel sampling)" : "", total,
+                 skipped ? (", " + std::to_string(skipped) + " already complete").c_str() : "");
   if (todo.empty()) {
-    std::fprintf(stderr, "pmr: nothing to do\n");
+    if (!o.quiet) std::fprintf(stderr, "pmr: nothing to do\n");
     return 0;
   }
 
@@ -289,12 +295,13 @@ int run_sequence(const RenderOptions& o) {
   }
   const double wall = seconds_since(t_loop);
   const double n = double(std::max(1L, rendered));
-  std::fprintf(stderr,
-               "pmr: %ld frame(s) in %.2f s (%.2f s/frame; %ld skipped): render %.0f ms/frame (+ pose %.1f, upload %.1f), write %.0f "
-               "ms/frame on the writer thread (%s, %.1f MB/frame); total %.2f s\n",
-               rendered, wall, wall / n, skipped, 1000.0 * render_s / n, 1000.0 * pose_s / n, 1000.0 * upload_s / n,
-               1000.0 * writer.write_seconds() / n, to_string(compression), double(writer.bytes_written()) / n / 1e6,
-               seconds_since(t0));
+  if (!o.quiet)
+    std::fprintf(stderr,
+                 "pmr: %ld frame(s) in %.2f s (%.2f s/frame; %ld skipped): render %.0f ms/frame (+ pose %.1f, upload %.1f), write %.0f "
+                 "ms/frame on the writer thread (%s, %.1f MB/frame); total %.2f s\n",
+                 rendered, wall, wall / n, skipped, 1000.0 * render_s / n, 1000.0 * pose_s / n, 1000.0 * upload_s / n,
+                 1000.0 * writer.write_seconds() / n, to_string(compression), double(writer.bytes_written()) / n / 1e6,
+                 seconds_since(t0));
   if (!o.quiet && rendered == 1)
     for (const std::string& path : paths(todo[0]).images()) std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());
   if (!o.quiet && rendered == 1) std::fprintf(stderr, "pmr: wrote %s\n", paths(todo[0]).sidecar.c_str());

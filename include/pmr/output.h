@@ -108,12 +108,17 @@ void read_views_exr_part(const std::string& path, int part, int& width, int& hei
 
 // An 8-bit sRGB PNG for a person to look at: the linear half RGBA values (row 0 at the top) encoded with
 // the sRGB transfer curve, clamped to [0, 1] and rounded; alpha linear. Written atomically, fast deflate
-// (a preview, not an archive). `opaque`: RGB only, what the pixels show over black. The encoded image is
-// previewed so: its three subpixels come from three views, so no one alpha per pixel composites it
-// right (a viewer would darken covered subpixels next to empty ones), while the display shows it over
-// black.
+// (a preview, not an archive). A pixel_aspect (pixel width / height) other than 1 is recorded in a pHYs
+// chunk. `opaque`: RGB only, what the pixels show over black. The encoded image is previewed so: its
+// three subpixels come from three views, so no one alpha per pixel composites it right (a viewer would
+// darken covered subpixels next to empty ones), while the display shows it over black.
 void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half,
-                       bool opaque = false);
+                       double pixel_aspect = 1.0, bool opaque = false);
+// The image resampled to square pixels (most viewers ignore a PNG's pixel aspect): stretched along one
+// axis, never shrunk (width x pixel_aspect when > 1, else height / pixel_aspect), bilinear in linear
+// light on the premultiplied values, edges clamped. Unchanged when the size stays.
+std::vector<uint16_t> square_pixels(const uint16_t* rgba_half, int width, int height, double pixel_aspect,
+                                    int& out_width, int& out_height);
 // Reads an 8-bit RGBA (or RGB, gray: expanded) PNG, row 0 at the top (for the tests).
 void read_png_rgba8(const std::string& path, int& width, int& height, std::vector<uint8_t>& rgba);
 // The sRGB transfer curve (IEC 61966-2-1) of a linear value, clamped to [0, 1].

@@ -57,6 +57,9 @@ struct RigConfig {
   // Camera spacing along the baseline: linear (DESIGN section 2, PMR's evenly spaced views) or
   // angular as Looking Glass software places them, D tan(cone ((i + 1/2) / N - 1/2)).
   bool angular_spacing = false;
+  // The scene appears `zoom` times larger: D = D_fit / zoom, the focal plane still through the
+  // sphere's center (only when framing the bounding sphere, camera < 0).
+  double zoom = 1.0;
 };
 
 // The resolved rig of one frame.
@@ -69,6 +72,7 @@ struct Rig {
   double near_eff = 0;            // near raised (if needed) to keep disparity inside the guard band
   bool angular = false;           // camera spacing (RigConfig::angular_spacing)
   glm::dmat4 center_view{1.0};    // world -> center view space
+  double zoom = 1.0;              // RigConfig::zoom (1 with a glTF camera)
 
   double baseline() const;                    // B = 2 D tan(theta / 2)
   double camera_offset(int i) const;          // s_i (linear or angular spacing)

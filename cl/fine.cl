@@ -38,24 +38,29 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
   const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
   const float* depth_of = (const float*)best_depth;
   const uint* key_of = (const uint*)best_key;
-  const uint* mta_of = (const uint*)best_mta;
   const int* count_of = (const int*)covered;
   MtaCache cache;
   cache.id = PMR_NO_KEY;
   for (int lv = 0; lv < nv; ++lv)
     for (int ly = 0; ly < ny; ++ly)
-      for (int lx = 0; lx < nx; ++lx) {
-        const int k = ((lv * PMR_TILE_Y + ly) * FINE_CHUNKS + lx / VW) * VW + lx % VW;
-        const int view = v0 + lv, px = x0 + lx, py = y0 + ly;
-        const size_t voxel = (((size_t)view + view_base) * H + (size_t)py) * W + (size_t)px;
-        if (key_of[k] != PMR_NO_KEY)
-          vstore_half4(fine_shade_winner(&in, mtas, mta_of[k], &cache, light, px, py, view), voxel, volume);
-        else
-          vstore4((ushort4)(0), voxel, (global ushort*)volume); /* background */
-        if (debug) {
-          debug_key[voxel] = key_of[k];
-          debug_depth[voxel] = depth_of[k];
-          debug_count[voxel] = (uint)count_of[k];
+      for (int c = 0; c * VW < nx; ++c) {
+        const int r = (lv * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
+        const int view = v0 + lv, py = y0 + ly;
+        float rgb[3 * VW];
+        fine_shade_chunk(&in, mtas, &cache, light, best_mta[r], best_key[r] != (vuint)(PMR_NO_KEY), x0 + c * VW, py, view,
+                         rgb);
+        for (int l = 0; l < VW && c * VW + l < nx; ++l) {
+          const int k = r * VW + l, px = x0 + c * VW + l;
+          const size_t voxel = (((size_t)view + view_base) * H + (size_t)py) * W + (size_t)px;
+          if (key_of[k] != PMR_NO_KEY)
+            vstore_half4((float4)(rgb[3 * l], rgb[3 * l + 1], rgb[3 * l + 2], 1.0f), voxel, volume);
+          else
+            vstore4((ushort4)(0), voxel, (global ushort*)volume); /* background */
+          if (debug) {
+            debug_key[voxel] = key_of[k];
+            debug_depth[voxel] = depth_of[k];
+            debug_count[voxel] = (uint)count_of[k];
+          }
         }
       }
 }

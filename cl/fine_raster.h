@@ -31,6 +31,7 @@ typedef PMR_CAT(float, PMR_VW) vfloat;
 #define vload_vint PMR_CAT(vload, PMR_VW)
 #define vstore_vint PMR_CAT(vstore, PMR_VW)
 #define convert_vfloat PMR_CAT(convert_float, PMR_VW)
+#define as_vint PMR_CAT(as_int, PMR_VW)
 
 /* A tile row is FINE_CHUNKS vectors; the private visibility state is FINE_ROWS vectors per array. */
 #define FINE_CHUNKS ((PMR_TILE_X + VW - 1) / VW)
@@ -50,8 +51,8 @@ inline vint edge_lanes(long F, long bias, long G, vint ramp, bool narrow, vint l
   return (vint)(T <= 0 ? -1 : 0);
 }
 
-/* alphaMode MASK: of the lanes in `win`, those whose base colour alpha passes the cutoff. Rare path,
- * one lane at a time with the exact edge functions. */
+/* alphaMode MASK: of the lanes in `win` (the row chunk from raster point (X, Y) of view i), those whose
+ * base colour alpha passes the cutoff. Rare path, one lane at a time with the exact edge functions. */
 inline vint mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, vint win, long X, long Y, int i, float cutoff) {
   int w[VW];
   vstore_vint(win, 0, w);
@@ -182,11 +183,42 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
   }
 }
 
-/* Lit colour of the winning MTA `id` at voxel (px, py, view), sampled at the pixel center. */
-inline float4 fine_shade_winner(const ShadeInputs* in, global const PmrMta* mtas, uint id, MtaCache* cache,
-                                float3 light, int px, int py, int view) {
-  return shade_mta_at(in, cached_mta(cache, mtas, id), light, (long)px * PMR_X_ONE + PMR_HALF_X,
-                      (long)py * PMR_Y_ONE + PMR_HALF_Y, view);
+/* Lit colours of a row chunk's winners: lane l is voxel (px0 + l, py) of view `view`, won by MTA mta[l]
+ * where `won`. Written to rgb[3 l + channel] for those lanes only. SW lanes at a time: each winning
+ * MTA of the block is loaded once and blended into its lanes, then shade_lanes shades them all. */
+inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
+                             vuint mta, vint won, int px0, int py, int view, float* rgb) {
+  if (!any(won)) return; /* background */
+  int ids[VW + SW], w[VW + SW];
+  vstore_vint(as_vint(mta), 0, ids);
+  vstore_vint(won, 0, w);
+  for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = 0;
+  const long Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
+  const bool pbr = in->P->shading == PMR_SHADING_PBR;
+  for (int h = 0; h < VW; h += SW) {
+    const sint block_won = vload_s(0, w + h) != 0, block_ids = vload_s(0, ids + h);
+    uint todo = lane_bits(block_won);
+    if (todo == 0u) continue;
+    LaneWinners L;
+    lanes_clear(&L);
+    while (todo != 0u) {
+      const int f = 31 - (int)clz(todo & (0u - todo));
+      const uint id = (uint)ids[h + f];
+      const sint take = block_won & (block_ids == (sint)((int)id));
+      const uint bits = lane_bits(take);
+      todo &= ~bits;
+      const PmrMta* m = cached_mta(cache, mtas, id);
+      lanes_add(&L, in, m, take, bits, pbr);
+      long E[3], step[3];
+      mta_edges_at(m, (long)(px0 + h + f) * PMR_X_ONE + PMR_HALF_X, Y, view, E);
+      mta_edge_steps(m, step);
+      lanes_step_edges(&L, take, f, E, step);
+    }
+    float c[3][SW];
+    s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
+    for (int l = 0; l < SW && h + l < VW; ++l)
+      if (w[h + l]) rgb[3 * (h + l)] = c[0][l], rgb[3 * (h + l) + 1] = c[1][l], rgb[3 * (h + l) + 2] = c[2][l];
+  }
 }
 
 /* Initial visibility state: nothing drawn. */

@@ -28,8 +28,40 @@
 
 constant int sp_lane_index[SP_LANES] = {0, 1, 2, 3, 4, 5, 6, 7};
 
-/* alphaMode MASK: of the lanes in `win`, those whose base colour alpha passes the cutoff (rare path, one
- * lane at a time with the exact edge functions). */
+/* The exact edge functions of MTA m at the samples (Xc + sx[l], Yc + sy[l]) of view v of the lanes in
+ * `bits`, into e (per lane). */
+inline void sp_edges(const PmrMta* m, uint bits, const int* sx, const int* sy, long Xc, long Yc, int v, float (*e)[SW]) {
+  for (uint b = bits; b != 0u; b &= b - 1u) {
+    const int l = 31 - (int)clz(b & (0u - b));
+    long E[3];
+    mta_edges_at(m, Xc + sx[l], Yc + sy[l], v, E);
+    e[0][l] = (float)E[0], e[1][l] = (float)E[1], e[2][l] = (float)E[2];
+  }
+}
+
+/* The winners of the samples (Xc + sx[l], Yc + sy[l]) of view v, l < SW: MTA ids[l] where `act`. */
+inline void sp_winners(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, const int* ids, sint act,
+                       const int* sx, const int* sy, long Xc, long Yc, int v, LaneWinners* L) {
+  const bool pbr = in->P->shading == PMR_SHADING_PBR;
+  lanes_clear(L);
+  float e[3][SW];
+  for (int l = 0; l < SW; ++l) e[0][l] = e[1][l] = e[2][l] = 1.0f;
+  const sint lane_ids = vload_s(0, ids);
+  uint todo = lane_bits(act);
+  while (todo != 0u) {
+    const int f = 31 - (int)clz(todo & (0u - todo));
+    const sint take = act & (lane_ids == (sint)(ids[f]));
+    const uint bits = lane_bits(take);
+    todo &= ~bits;
+    const PmrMta* m = cached_mta(cache, mtas, (uint)ids[f]);
+    lanes_add(L, in, m, take, bits, pbr);
+    sp_edges(m, bits, sx, sy, Xc, Yc, v, e);
+  }
+  L->e = LANE3(e);
+}
+
+/* alphaMode MASK: of the lanes in `win` (samples (Xc + sx[l], Yc + sy[l]) of view v), those whose base
+ * colour alpha passes the cutoff (rare path, one lane at a time with the exact edge functions). */
 inline int8 sp_mask_alpha(const ShadeInputs* in, const PmrMta* m, int8 win, const int* sx, const int* sy, long Xc,
                           long Yc, int v, float cutoff) {
   int w[SP_LANES];
@@ -246,23 +278,37 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
   MtaCache cache;
   cache.id = PMR_NO_KEY;
   for (int v = 0; v < views; ++v)
-    for (int k = first[v]; k < first[v] + count[v]; ++k) {
-      const int n = sid[k];
-      if (debug) {
-        const size_t at = (size_t)(ch.i0 + n / width) * (size_t)(3 * Wd) + (size_t)(ch.s0 + n % width);
-        dbg_key[at] = best_key[k];
-        dbg_depth[at] = best_depth[k];
+    for (int k0 = first[v]; k0 < first[v] + count[v]; k0 += SW) {
+      /* SW samples of view v at a time, one per lane */
+      const int kn = min(SW, first[v] + count[v] - k0);
+      int todo[SW], ids[SW];
+      for (int l = 0; l < SW; ++l) {
+        const int k = k0 + l;
+        todo[l] = l < kn && best_key[k] != PMR_NO_KEY ? -1 : 0;
+        ids[l] = todo[l] ? (int)best_mta[k] : 0;
+        if (l >= kn) continue;
+        const int n = sid[k];
+        if (debug) {
+          const size_t at = (size_t)(ch.i0 + n / width) * (size_t)(3 * Wd) + (size_t)(ch.s0 + n % width);
+          dbg_key[at] = best_key[k];
+          dbg_depth[at] = best_depth[k];
+        }
+        if (!todo[l]) value[n] = 0, covered[n] = 0;
       }
-      if (best_key[k] == PMR_NO_KEY) {
-        value[n] = 0;
-        covered[n] = 0;
-        continue;
+      const sint act = vload_s(0, todo);
+      if (!any(act)) continue;
+      LaneWinners L;
+      sp_winners(&in, mtas, &cache, ids, act, sx + k0, sy + k0, Xc, Yc, v, &L);
+      float c[3][SW];
+      s3_store(shade_lanes(&in, &L, light, v), c[0], c[1], c[2]);
+      for (int l = 0; l < kn; ++l) {
+        if (!todo[l]) continue;
+        const int k = k0 + l, n = sid[k];
+        ushort h;
+        vstore_half(c[channel[k]][l], 0, (half*)&h);
+        value[n] = h;
+        covered[n] = 1;
       }
-      const float4 c = shade_mta_at(&in, cached_mta(&cache, mtas, best_mta[k]), light, Xc + sx[k], Yc + sy[k], v);
-      ushort h;
-      vstore_half(channel[k] == 0 ? c.x : (channel[k] == 1 ? c.y : c.z), 0, (half*)&h);
-      value[n] = h;
-      covered[n] = 1;
     }
 
   /* 4. The display pixels: whole ones with their alpha (the three subpixels' mean coverage, as

@@ -3,11 +3,19 @@
  * Lambert with one directional light, or glTF metallic-roughness (cl/brdf.h) with the material's
  * metallic-roughness, normal, occlusion and emissive maps, seen from each view's own camera, lit by the
  * frame's light table (the file's punctual lights or the default light) and the uniform default
- * environment or an environment image (cl/environment.h). */
+ * environment or an environment image (cl/environment.h).
+ *
+ * Shading goes SW voxels (or samples) at a time, one per lane (cl/lanes.h), each lane with its own
+ * winning MTA: the caller loads each winning MTA's triangle, vertices and material once and blends them
+ * into the lanes it won (LaneWinners); the barycentrics, normals, base colour, BRDF and lights then run
+ * on all lanes at once, and the texture, split-sum and environment lookups are gathered lane by lane.
+ * Each lane's result is a function of its own voxel alone, so it depends neither on the other lanes,
+ * nor on the tile shape, nor on the path. */
 #ifndef PMR_CL_SHADE_H
 #define PMR_CL_SHADE_H
 
 #include "common.h"
+#include "lanes.h"
 #include "brdf.h"
 #include "environment.h"
 
@@ -48,17 +56,6 @@ inline float4 sample_texture(global const uchar4* texels, global const float* sr
   return top + (bottom - top) * ay;
 }
 
-/* Barycentrics of voxel point in the SOURCE triangle, perspective-correct. e[k] are the (sign-
- * corrected, non-negative) edge functions opposite MTA vertex k. */
-inline float3 source_barycentrics(const PmrMta* m, const long* e) {
-  const float pa = (float)e[0] * m->inv_w[0], pb = (float)e[1] * m->inv_w[1], pc = (float)e[2] * m->inv_w[2];
-  const float inv = 1.0f / (pa + pb + pc);
-  const float la = pa * inv, lb = pb * inv, lc = pc * inv;
-  const float b1 = la * m->bary[0][0] + lb * m->bary[1][0] + lc * m->bary[2][0];
-  const float b2 = la * m->bary[0][1] + lb * m->bary[1][1] + lc * m->bary[2][1];
-  return (float3)(1.0f - b1 - b2, b1, b2);
-}
-
 typedef struct {
   global const PmrTriangle* tris;
   global const PmrVertexAttr* attrs;
@@ -77,19 +74,8 @@ typedef struct {
   global const PmrLight* lights;   /* P->num_lights punctual lights, world space (pbr)           */
 } ShadeInputs;
 
-/* The split-sum table's bilinear lookup, as pmr::split_sum (host/shading/environment.cpp) does it. */
-inline float2 split_sum(global const float2* t, float nv, float r) {
-  const int n = PMR_SPLIT_SUM_N;
-  const float x = sqrt(clamp(nv, 0.0f, 1.0f)) * (float)(n - 1), y = clamp(r, 0.0f, 1.0f) * (float)(n - 1);
-  const int x0 = min((int)x, n - 2), y0 = min((int)y, n - 2);
-  const float fx = x - (float)x0, fy = y - (float)y0;
-  const float2 a = t[y0 * n + x0], b = t[y0 * n + x0 + 1], c = t[(y0 + 1) * n + x0], d = t[(y0 + 1) * n + x0 + 1];
-  const float2 top = a + (b - a) * fx, bottom = c + (d - c) * fx;
-  return top + (bottom - top) * fy;
-}
-
-/* Material map `map` of triangle t at source barycentrics b: its TEXCOORD set interpolated, then its
- * KHR_texture_transform. */
+/* Material map `map` of triangle t at source barycentrics b (one lane): its TEXCOORD set interpolated,
+ * then its KHR_texture_transform. */
 inline float4 sample_map(const ShadeInputs* in, global const PmrTextureMap* map, const PmrTriangle* t, float3 b, bool srgb) {
   const uint set = map->texcoord * in->P->num_vertices;
   const float2 uv = b.x * in->texcoords[set + t->v[0]] + b.y * in->texcoords[set + t->v[1]] +
@@ -100,125 +86,363 @@ inline float4 sample_map(const ShadeInputs* in, global const PmrTextureMap* map,
   return sample_texture(in->texels, in->srgb_lut, &tex, u, v, srgb);
 }
 
-/* The normal map applied to the interpolated normal n (before any back-face flip): the interpolated
- * tangent made orthogonal to n, the bitangent sign(w) * cross(n, t), m = (2 s - 1) * (scale, scale, 1).
- * A vertex without a tangent (zero) leaves n as it is. */
-inline float3 mapped_normal(const ShadeInputs* in, global const PmrMaterial* mat, const PmrTriangle* t, float3 b, float3 n) {
-  const float4 tw = b.x * in->tangents[t->v[0]] + b.y * in->tangents[t->v[1]] + b.z * in->tangents[t->v[2]];
-  float3 tangent = tw.xyz - n * dot(n, tw.xyz);
-  const float len = length(tangent);
-  if (!(len > 1e-12f)) return n;
-  tangent *= 1.0f / len;
-  const float3 bitangent = (tw.w < 0.0f ? -1.0f : 1.0f) * cross(n, tangent);
-  const float3 s = sample_map(in, &mat->maps[PMR_MAP_NORMAL], t, b, false).xyz;
-  const float3 m = (2.0f * s - 1.0f) * (float3)(mat->normal_scale, mat->normal_scale, 1.0f);
-  const float3 mapped = tangent * m.x + bitangent * m.y + n * m.z;
-  const float mlen = length(mapped);
-  return mlen > 0.0f ? mapped * (1.0f / mlen) : n;
+/* SW winners to shade, one per lane (a row of 8 voxels of a real model holds a few small triangles):
+ * what shading reads of each lane's MTA, triangle, vertices and material, as vectors. The caller fills
+ * it one MTA at a time (lanes_add): each value is loaded once per MTA and blended into the lanes the
+ * MTA won, in registers (a lane-by-lane gather through memory costs what the vector arithmetic saves). */
+typedef struct {
+  sint act;                /* -1: a winner to shade                                           */
+  sint back;               /* -1: seen from behind                                            */
+  sint smooth;             /* -1: vertex normals (else the face normal)                       */
+  sint unlit;              /* pbr: KHR_materials_unlit                                        */
+  sfloat3 e;               /* sign-corrected edge functions opposite MTA vertices 0, 1, 2     */
+  sfloat inv_w[3];         /* the MTA vertices' 1 / w                                         */
+  sfloat bary[3][2];       /* ... and barycentrics in the source triangle                     */
+  sfloat3 face, n[3];      /* face normal, vertex normals                                     */
+  sfloat3 c[3];            /* vertex colours (COLOR_0, RGB: alpha only decides alphaMode MASK) */
+  sfloat3 factor;          /* baseColorFactor (RGB)                                           */
+  sfloat3 p[3];            /* pbr: vertex positions, world space                              */
+  sfloat metallic, roughness;
+  sfloat3 emissive;
+  uint textured;           /* bit l: lane l's material has a texture                          */
+  uint tri[SW];            /* lane l's triangle, where textured                               */
+} LaneWinners;
+
+constant int shade_lane_index[SW] = {0, 1, 2, 3, 4, 5, 6, 7};
+
+/* No lanes yet; idle lanes keep finite values so that the vector arithmetic stays cheap. */
+inline void lanes_clear(LaneWinners* L) {
+  const sfloat zero = 0.0f, one = 1.0f;
+  L->act = L->back = L->smooth = L->unlit = (sint)(0);
+  L->e = s3(one, one, one);
+  L->face = s3(zero, zero, one);
+  for (int k = 0; k < 3; ++k) {
+    L->inv_w[k] = one, L->bary[k][0] = L->bary[k][1] = zero;
+    L->n[k] = L->face, L->c[k] = s3(one, one, one), L->p[k] = s3(zero, zero, zero);
+  }
+  L->factor = s3(zero, zero, zero);
+  L->metallic = L->roughness = zero;
+  L->emissive = s3(zero, zero, zero);
+  L->textured = 0u;
 }
 
-/* glTF metallic-roughness at source barycentrics b of triangle t with interpolated normal n (not yet
- * flipped for a back face) and base colour c, seen from view `view`'s camera: the material's maps
- * (metallic-roughness, normal, occlusion, emissive), the sum over the light table of f E n.l (the
- * file's punctual lights, or the default light, or none), the environment times the occlusion, plus the
- * emissive term; an unlit material is its base colour. The environment is the image's I(n) and
- * P(reflect(-v, n), r) when one is given, else the uniform default of radiance L, for which
- * I(n) = P = L and no table is read. */
-inline float3 shade_pbr(const ShadeInputs* in, const PmrTriangle* t, float3 b, float3 n, bool back, float3 base,
-                        int view) {
-  global const PmrParams* P = in->P;
-  /* a pointer, not a copy: most voxels read a few of its 192 bytes */
-  global const PmrMaterial* mat = &in->materials[t->material];
-  if (mat->unlit) return base;
-  float metallic = mat->metallic, roughness = mat->roughness;
-  if (mat->maps[PMR_MAP_METALLIC_ROUGHNESS].texture >= 0) {
-    const float4 s = sample_map(in, &mat->maps[PMR_MAP_METALLIC_ROUGHNESS], t, b, false);
-    metallic *= s.z, roughness *= s.y;
-  }
-  if (mat->maps[PMR_MAP_NORMAL].texture >= 0) n = mapped_normal(in, mat, t, b, n);
-  if (back) n = -n; /* t, b and n together */
-  float ao = 1.0f;
-  if (mat->maps[PMR_MAP_OCCLUSION].texture >= 0)
-    ao = 1.0f + mat->occlusion_strength * (sample_map(in, &mat->maps[PMR_MAP_OCCLUSION], t, b, false).x - 1.0f);
-  float3 emissive = vload3(0, mat->emissive);
-  if (mat->maps[PMR_MAP_EMISSIVE].texture >= 0) emissive *= sample_map(in, &mat->maps[PMR_MAP_EMISSIVE], t, b, true).xyz;
+inline sfloat blend(sfloat a, float b, sint take) { return select(a, (sfloat)(b), take); }
+inline sfloat3 blend3(sfloat3 a, float3 b, sint take) { return s3_select(a, s3_splat(b), take); }
 
-  const float3 p = b.x * vload3(t->v[0], in->positions) + b.y * vload3(t->v[1], in->positions) +
-                   b.z * vload3(t->v[2], in->positions);
-  const float3 v = normalize(in->eyes[view + (int)P->view_base].xyz - p);
-  const float r = pbr_roughness(roughness);
-  float3 direct = (float3)(0.0f);
+/* Lanes `take` (bits: the same as bits) are won by MTA m: its values blended into them (the edge
+ * functions are set apart, lanes_step_edges or lanes_set_edges). */
+inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, sint take, uint bits, bool pbr) {
+  L->act |= take;
+  if (m->flags & PMR_MTA_BACK) L->back |= take;
+  for (int k = 0; k < 3; ++k) {
+    L->inv_w[k] = blend(L->inv_w[k], m->inv_w[k], take);
+    L->bary[k][0] = blend(L->bary[k][0], m->bary[k][0], take);
+    L->bary[k][1] = blend(L->bary[k][1], m->bary[k][1], take);
+  }
+  const PmrTriangle t = in->tris[m->tri];
+  L->face = blend3(L->face, vload3(0, t.face_normal), take);
+  if (t.has_normals) L->smooth |= take;
+  global const PmrMaterial* mat = &in->materials[t.material];
+  for (int k = 0; k < 3; ++k) {
+    global const PmrVertexAttr* a = &in->attrs[t.v[k]];
+    if (t.has_normals) L->n[k] = blend3(L->n[k], vload3(0, a->normal), take);
+    L->c[k] = blend3(L->c[k], vload3(0, a->color), take);
+    if (pbr) L->p[k] = blend3(L->p[k], vload3(t.v[k], in->positions), take);
+  }
+  L->factor = blend3(L->factor, vload3(0, mat->base_color), take);
+  bool textured = mat->texture >= 0;
+  if (pbr) {
+    L->metallic = blend(L->metallic, mat->metallic, take);
+    L->roughness = blend(L->roughness, mat->roughness, take);
+    L->emissive = blend3(L->emissive, vload3(0, mat->emissive), take);
+    if (mat->unlit) L->unlit |= take;
+    for (int k = 0; k < PMR_MAPS; ++k) textured = textured || mat->maps[k].texture >= 0;
+  }
+  if (textured) {
+    L->textured |= bits;
+    for (uint b = bits; b != 0u; b &= b - 1u) L->tri[31 - (int)clz(b & (0u - b))] = m->tri;
+  }
+}
+
+/* The edge functions of lanes `take` along a row: E (exact, 64-bit, sign-corrected) at lane `first`
+ * plus (l - first) step. Summed in doubles, exact below 2^53, so rounding to float rounds the exact
+ * value, as for a lane evaluated on its own; beyond that, lane by lane in 64 bits. */
+inline void lanes_step_edges(LaneWinners* L, sint take, int first, const long* E, const long* step) {
+  const sint lane = vload_s(0, shade_lane_index);
+  sfloat e[3];
+  for (int k = 0; k < 3; ++k) {
+    const long far_end = (E[k] < 0 ? -E[k] : E[k]) + (long)SW * (step[k] < 0 ? -step[k] : step[k]);
+    if (far_end < (1L << 53)) {
+      e[k] = convert_float8((double8)((double)E[k]) + convert_double8(lane - first) * (double)step[k]);
+    } else {
+      float el[SW];
+      for (int l = 0; l < SW; ++l) el[l] = (float)(E[k] + (long)(l - first) * step[k]);
+      e[k] = vload_s(0, el);
+    }
+  }
+  L->e = s3_select(L->e, s3(e[0], e[1], e[2]), take);
+}
+
+/* The lanes of vector `take` as bits. */
+inline uint lane_bits(sint take) {
+  const sint bits = select((sint)(0), (sint)(1) << vload_s(0, shade_lane_index), take);
+  const int4 b4 = bits.lo | bits.hi;
+  const int2 b2 = b4.lo | b4.hi;
+  return (uint)(b2.x | b2.y);
+}
+
+/* The exact sign-corrected edge functions of MTA m at raster point (X, Y) (16.16 / 24.8) of view i. */
+inline void mta_edges_at(const PmrMta* m, long X, long Y, int i, long* E) {
+  E[0] = (long)m->sign * mta_edge(m, 1, 2, X, Y, i);
+  E[1] = (long)m->sign * mta_edge(m, 2, 0, X, Y, i);
+  E[2] = (long)m->sign * mta_edge(m, 0, 1, X, Y, i);
+}
+
+/* Their change per pixel column. */
+inline void mta_edge_steps(const PmrMta* m, long* step) {
+  step[0] = (long)m->sign * (long)(m->y[2] - m->y[1]) * PMR_X_ONE;
+  step[1] = (long)m->sign * (long)(m->y[0] - m->y[2]) * PMR_X_ONE;
+  step[2] = (long)m->sign * (long)(m->y[1] - m->y[0]) * PMR_X_ONE;
+}
+
+/* Barycentrics in the SOURCE triangle, perspective-correct, of every lane. */
+inline sfloat3 lane_barycentrics(const LaneWinners* L) {
+  const sfloat pa = L->e.x * L->inv_w[0], pb = L->e.y * L->inv_w[1], pc = L->e.z * L->inv_w[2];
+  const sfloat inv = 1.0f / (pa + pb + pc);
+  const sfloat la = pa * inv, lb = pb * inv, lc = pc * inv;
+  const sfloat b1 = la * L->bary[0][0] + lb * L->bary[1][0] + lc * L->bary[2][0];
+  const sfloat b2 = la * L->bary[0][1] + lb * L->bary[1][1] + lc * L->bary[2][1];
+  return s3(1.0f - b1 - b2, b1, b2);
+}
+
+inline sfloat3 s3_interp_lanes(sfloat3 b, const sfloat3* a) {
+  return s3_add(s3_add(s3_scale(a[0], b.x), s3_scale(a[1], b.y)), s3_scale(a[2], b.z));
+}
+
+/* The texture lookups of the textured lanes, lane by lane (they are gathers), as factors: base colour
+ * (RGB), metallic and roughness, occlusion, emissive; and the normal map's sample with the interpolated
+ * tangent, where there is one (mapped). Untextured lanes get factors of 1 and no normal map. */
+typedef struct {
+  float base[3][SW], metallic[SW], roughness[SW], ao[SW], emissive[3][SW];
+  int mapped[SW];
+  float s[3][SW], tw[4][SW], normal_scale[SW];
+} LaneTextures;
+
+inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b, bool pbr, LaneTextures* T) {
+  float bs[3][SW];
+  s3_store(b, bs[0], bs[1], bs[2]);
+  for (int l = 0; l < SW; ++l) {
+    for (int k = 0; k < 3; ++k) T->base[k][l] = 1.0f;
+    for (int k = 0; k < 4; ++k) T->tw[k][l] = 0.0f;
+    for (int k = 0; k < 3; ++k) T->emissive[k][l] = 1.0f, T->s[k][l] = 0.0f;
+    T->metallic[l] = T->roughness[l] = T->ao[l] = T->normal_scale[l] = 1.0f;
+    T->mapped[l] = 0;
+    if (!(L->textured & (1u << l))) continue;
+    const PmrTriangle t = in->tris[L->tri[l]];
+    global const PmrMaterial* mat = &in->materials[t.material];
+    const float3 bl = (float3)(bs[0][l], bs[1][l], bs[2][l]);
+    if (mat->texture >= 0) {
+      const PmrTexture tex = in->textures[mat->texture];
+      global const PmrVertexAttr* a0 = &in->attrs[t.v[0]];
+      global const PmrVertexAttr* a1 = &in->attrs[t.v[1]];
+      global const PmrVertexAttr* a2 = &in->attrs[t.v[2]];
+      const float u = bl.x * a0->uv[0] + bl.y * a1->uv[0] + bl.z * a2->uv[0];
+      const float v = bl.x * a0->uv[1] + bl.y * a1->uv[1] + bl.z * a2->uv[1];
+      const float4 c = sample_texture(in->texels, in->srgb_lut, &tex, u, v, true);
+      T->base[0][l] = c.x, T->base[1][l] = c.y, T->base[2][l] = c.z;
+    }
+    if (!pbr) continue;
+    if (mat->maps[PMR_MAP_METALLIC_ROUGHNESS].texture >= 0) {
+      const float4 m = sample_map(in, &mat->maps[PMR_MAP_METALLIC_ROUGHNESS], &t, bl, false);
+      T->metallic[l] = m.z, T->roughness[l] = m.y;
+    }
+    if (mat->maps[PMR_MAP_OCCLUSION].texture >= 0)
+      T->ao[l] = 1.0f + mat->occlusion_strength * (sample_map(in, &mat->maps[PMR_MAP_OCCLUSION], &t, bl, false).x - 1.0f);
+    if (mat->maps[PMR_MAP_EMISSIVE].texture >= 0) {
+      const float4 e = sample_map(in, &mat->maps[PMR_MAP_EMISSIVE], &t, bl, true);
+      T->emissive[0][l] = e.x, T->emissive[1][l] = e.y, T->emissive[2][l] = e.z;
+    }
+    if (mat->maps[PMR_MAP_NORMAL].texture >= 0) {
+      const float4 tw = bl.x * in->tangents[t.v[0]] + bl.y * in->tangents[t.v[1]] + bl.z * in->tangents[t.v[2]];
+      const float4 sn = sample_map(in, &mat->maps[PMR_MAP_NORMAL], &t, bl, false);
+      T->mapped[l] = -1;
+      T->normal_scale[l] = mat->normal_scale;
+      T->tw[0][l] = tw.x, T->tw[1][l] = tw.y, T->tw[2][l] = tw.z, T->tw[3][l] = tw.w;
+      T->s[0][l] = sn.x, T->s[1][l] = sn.y, T->s[2][l] = sn.z;
+    }
+  }
+}
+
+#define LANE3(a) s3(vload_s(0, (a)[0]), vload_s(0, (a)[1]), vload_s(0, (a)[2]))
+
+/* The normal map applied to the unit normals n (before any back-face flip), in the lanes that have
+ * one: the interpolated tangent made orthogonal to n, the bitangent sign(w) * cross(n, t),
+ * m = (2 s - 1) * (scale, scale, 1). A lane without a tangent (zero) keeps n. */
+inline sfloat3 mapped_normal(const LaneTextures* T, sfloat3 n) {
+  const sfloat3 tw = LANE3(T->tw);
+  sfloat3 tangent = s3_sub(tw, s3_scale(n, s3_dot(n, tw)));
+  const sfloat len = sqrt(s3_dot(tangent, tangent));
+  tangent = s3_scale(tangent, 1.0f / len);
+  const sfloat3 bitangent =
+      s3_scale(s3_cross(n, tangent), select((sfloat)(1.0f), (sfloat)(-1.0f), vload_s(0, T->tw[3]) < 0.0f));
+  const sfloat scale = vload_s(0, T->normal_scale);
+  const sfloat3 s = LANE3(T->s);
+  const sfloat3 m = s3((2.0f * s.x - 1.0f) * scale, (2.0f * s.y - 1.0f) * scale, 2.0f * s.z - 1.0f);
+  const sfloat3 mapped = s3_add(s3_add(s3_scale(tangent, m.x), s3_scale(bitangent, m.y)), s3_scale(n, m.z));
+  const sfloat mlen = sqrt(s3_dot(mapped, mapped));
+  return s3_select(n, s3_scale(mapped, 1.0f / mlen), vload_s(0, T->mapped) & (len > 1e-12f) & (mlen > 0.0f));
+}
+
+/* The environment's I(n) and P(reflect(-v, n), r) per lane where `act` (cl/environment.h), or the
+ * uniform default of radiance L, for which I(n) = P = L and no table is read. I is not needed (0) where
+ * metallic is 1 (c_diff = 0). */
+inline void environment_lanes(const ShadeInputs* in, sfloat3 n, sfloat3 v, sfloat nv, sfloat metallic, sfloat r,
+                              sint act, sfloat3* irradiance, sfloat3* prefiltered) {
+  if (in->env->level_count == 0) {
+    *irradiance = *prefiltered = s3_splat((float3)(in->P->env_radiance));
+    return;
+  }
+  float nx[SW], ny[SW], nz[SW], dx[SW], dy[SW], dz[SW], ms[SW], rs[SW], c[6][SW];
+  int acts[SW];
+  s3_store(n, nx, ny, nz);
+  s3_store(s3_sub(s3_scale(n, 2.0f * nv), v), dx, dy, dz); /* reflect(-v, n) */
+  vstore_s(metallic, 0, ms);
+  vstore_s(r, 0, rs);
+  vstore_s(act, 0, acts);
+  for (int l = 0; l < SW; ++l) {
+    float3 irr = (float3)(0.0f), pre = (float3)(0.0f);
+    if (acts[l]) {
+      const float4 uv = env_uv(in->env, (float3)(nx[l], ny[l], nz[l]), (float3)(dx[l], dy[l], dz[l]));
+      if (ms[l] < 1.0f) irr = env_irradiance(in->env, in->env_data, uv.xy);
+      pre = env_prefiltered(in->env, in->env_data, uv.zw, rs[l]);
+    }
+    c[0][l] = irr.x, c[1][l] = irr.y, c[2][l] = irr.z, c[3][l] = pre.x, c[4][l] = pre.y, c[5][l] = pre.z;
+  }
+  *irradiance = LANE3(c);
+  *prefiltered = LANE3(c + 3);
+}
+
+/* The split-sum table's bilinear lookup for every lane, as pmr::split_sum (host/shading/environment.cpp)
+ * does it: the index arithmetic
+ * in vectors, the four taps gathered lane by lane. */
+inline void split_sum_lanes(global const float2* t, sfloat nv, sfloat r, sfloat* A, sfloat* B) {
+  const int n = PMR_SPLIT_SUM_N;
+  const sfloat x = sqrt(clamp(nv, 0.0f, 1.0f)) * (float)(n - 1), y = clamp(r, 0.0f, 1.0f) * (float)(n - 1);
+  const sint x0 = min(convert_int8(x), n - 2), y0 = min(convert_int8(y), n - 2);
+  const sfloat fx = x - convert_float8(x0), fy = y - convert_float8(y0);
+  int at[SW];
+  vstore_s(y0 * n + x0, 0, at);
+  float tap[8][SW];
+  for (int l = 0; l < SW; ++l) {
+    const float4 top = vload4(0, (global const float*)(t + at[l])), bottom = vload4(0, (global const float*)(t + at[l] + n));
+    tap[0][l] = top.x, tap[1][l] = top.y, tap[2][l] = top.z, tap[3][l] = top.w;
+    tap[4][l] = bottom.x, tap[5][l] = bottom.y, tap[6][l] = bottom.z, tap[7][l] = bottom.w;
+  }
+  /* taps a = (x0, y0), b = (x0 + 1, y0), c = (x0, y0 + 1), d = (x0 + 1, y0 + 1), each (A, B) */
+  for (int k = 0; k < 2; ++k) {
+    const sfloat a = vload_s(0, tap[k]), b = vload_s(0, tap[2 + k]), c = vload_s(0, tap[4 + k]), d = vload_s(0, tap[6 + k]);
+    const sfloat top = a + (b - a) * fx, bottom = c + (d - c) * fx;
+    const sfloat v = top + (bottom - top) * fy;
+    if (k == 0) *A = v; else *B = v;
+  }
+}
+
+/* glTF metallic-roughness of the lanes with unit normals n (already flipped for back faces, normal map
+ * applied) and base colours `base`, seen from view `view`'s camera: the sum over the light table of
+ * f E n.l (the file's punctual lights, or the default light, or none), the environment times the
+ * occlusion, plus the emissive term; an unlit material is its base colour. */
+inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const LaneTextures* T, bool textured, sfloat3 b,
+                         sfloat3 n, sfloat3 base, int view) {
+  global const PmrParams* P = in->P;
+  const sfloat3 p = s3_interp_lanes(b, L->p);
+  sfloat metallic = L->metallic, roughness = L->roughness, ao = 1.0f;
+  sfloat3 emissive = L->emissive;
+  if (textured) {
+    metallic *= vload_s(0, T->metallic), roughness *= vload_s(0, T->roughness), ao = vload_s(0, T->ao);
+    emissive = s3_mul(emissive, LANE3(T->emissive));
+  }
+  const sfloat3 to_eye = s3_sub(s3_splat(in->eyes[view + (int)P->view_base].xyz), p);
+  const sfloat3 v = s3_scale(to_eye, 1.0f / sqrt(s3_dot(to_eye, to_eye)));
+  const sfloat r = pbr_roughness(roughness);
+  sfloat3 direct = s3_splat((float3)(0.0f));
   const uint num_lights = P->num_lights;
   for (uint i = 0; i < num_lights; ++i) {
     global const PmrLight* light = &in->lights[i];
-    float3 l;
-    const float3 E = light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
-                                      vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, p, &l);
-    direct += brdf_cos(base, metallic, r, n, v, l) * E;
+    sfloat3 l;
+    const sfloat3 E = light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
+                                       vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, p, &l);
+    direct = s3_add(direct, s3_mul(brdf_cos(base, metallic, r, n, v, l), E));
   }
-  const float nv = dot(n, v);
-  const float2 ab = split_sum(in->split_sum, clamp(nv, 0.0f, 1.0f), r);
-  float3 irradiance, prefiltered;
-  if (in->env->level_count == 0) {
-    irradiance = prefiltered = (float3)(P->env_radiance);
-  } else {
-    const float4 uv = env_uv(in->env, n, 2.0f * nv * n - v); /* n and reflect(-v, n) */
-    irradiance = metallic < 1.0f ? env_irradiance(in->env, in->env_data, uv.xy) : (float3)(0.0f); /* c_diff = 0 */
-    prefiltered = env_prefiltered(in->env, in->env_data, uv.zw, r);
-  }
-  const float3 ambient = ao * (base * (1.0f - metallic) * irradiance + (pbr_f0(base, metallic) * ab.x + ab.y) * prefiltered);
-  return direct + ambient + emissive;
+  const sfloat nv = s3_dot(n, v);
+  sfloat A, B;
+  split_sum_lanes(in->split_sum, nv, r, &A, &B);
+  sfloat3 irradiance, prefiltered;
+  environment_lanes(in, n, v, nv, metallic, r, L->act, &irradiance, &prefiltered);
+  const sfloat3 f0 = pbr_f0(base, metallic);
+  const sfloat kd = 1.0f - metallic;
+  const sfloat3 ambient = s3(ao * (base.x * kd * irradiance.x + (f0.x * A + B) * prefiltered.x),
+                             ao * (base.y * kd * irradiance.y + (f0.y * A + B) * prefiltered.y),
+                             ao * (base.z * kd * irradiance.z + (f0.z * A + B) * prefiltered.z));
+  const sfloat3 lit = s3_add(s3_add(direct, ambient), emissive);
+  return s3_select(lit, base, L->unlit);
 }
 
-/* Unlit base colour (RGBA) at source barycentrics b of triangle `tri`. */
-inline float4 base_color(const ShadeInputs* in, uint tri, float3 b) {
-  const PmrTriangle t = in->tris[tri];
-  global const PmrMaterial* mat = &in->materials[t.material];
-  global const PmrVertexAttr* a0 = &in->attrs[t.v[0]];
-  global const PmrVertexAttr* a1 = &in->attrs[t.v[1]];
-  global const PmrVertexAttr* a2 = &in->attrs[t.v[2]];
-  float4 c = (float4)(mat->base_color[0], mat->base_color[1], mat->base_color[2], mat->base_color[3]);
-  const float4 vc = b.x * vload4(0, a0->color) + b.y * vload4(0, a1->color) + b.z * vload4(0, a2->color);
-  c *= vc;
-  if (mat->texture >= 0) {
-    const PmrTexture tex = in->textures[mat->texture];
-    const float u = b.x * a0->uv[0] + b.y * a1->uv[0] + b.z * a2->uv[0];
-    const float v = b.x * a0->uv[1] + b.y * a1->uv[1] + b.z * a2->uv[1];
-    c *= sample_texture(in->texels, in->srgb_lut, &tex, u, v, true);
-  }
-  return c;
+/* Base colours (RGB): baseColorFactor x COLOR_0 x the base colour texture. */
+inline sfloat3 lane_base_color(const LaneWinners* L, const LaneTextures* T, bool textured, sfloat3 b) {
+  const sfloat3 c = s3_mul(L->factor, s3_interp_lanes(b, L->c));
+  return textured ? s3_mul(c, LANE3(T->base)) : c;
 }
 
-/* Lit colour in view `view` of the pass (the volume's view + P->view_base); alpha is coverage (1).
- * `light`: the unit direction toward Lambert's one light (pbr reads the light table instead). */
-inline float4 shade(const ShadeInputs* in, float3 light, uint tri, float3 b, bool back, int view) {
-  const PmrTriangle t = in->tris[tri];
-  float3 n;
-  if (t.has_normals) {
-    n = b.x * vload3(0, in->attrs[t.v[0]].normal) + b.y * vload3(0, in->attrs[t.v[1]].normal) +
-        b.z * vload3(0, in->attrs[t.v[2]].normal);
-    const float len = length(n);
-    n = len > 0.0f ? n * (1.0f / len) : vload3(0, t.face_normal);
-  } else {
-    n = vload3(0, t.face_normal);
-  }
-  const float4 c = base_color(in, tri, b);
+/* Lit colours (RGB; alpha is coverage, 1) of the winners L in view `view` of the pass (the volume's
+ * view + P->view_base). `light`: the unit direction toward Lambert's one light (pbr reads the light
+ * table instead). Each lane's value depends on its own winner and voxel alone. */
+inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 light, int view) {
+  const bool pbr = in->P->shading == PMR_SHADING_PBR;
+  const sfloat3 b = lane_barycentrics(L);
+  LaneTextures T;
+  const bool textured = L->textured != 0u;
+  if (textured) sample_lanes(in, L, b, pbr, &T);
+  const sfloat3 base = lane_base_color(L, &T, textured, b);
+  const sfloat3 ni = s3_interp_lanes(b, L->n);
+  const sfloat len = sqrt(s3_dot(ni, ni));
+  sfloat3 n = s3_select(L->face, s3_scale(ni, 1.0f / len), L->smooth & (len > 0.0f));
   const float exposure = in->P->exposure;
-  if (in->P->shading == PMR_SHADING_PBR) {
-    const float3 rgb = shade_pbr(in, &t, b, n, back, c.xyz, view) * exposure;
-    return (float4)(rgb, 1.0f);
+  if (pbr) {
+    if (textured) n = mapped_normal(&T, n);
+    n = s3_select(n, s3_neg(n), L->back); /* t, b and n together */
+    return s3_scale(shade_pbr(in, L, &T, textured, b, n, base, view), exposure);
   }
-  if (back) n = -n;
-  const float lambert = 0.2f + 0.8f * max(0.0f, dot(n, light));
-  return (float4)(c.x * lambert * exposure, c.y * lambert * exposure, c.z * lambert * exposure, 1.0f);
+  n = s3_select(n, s3_neg(n), L->back);
+  const sfloat lambert = 0.2f + 0.8f * max(s3_dot(n, s3_splat(light)), 0.0f);
+  return s3(base.x * lambert * exposure, base.y * lambert * exposure, base.z * lambert * exposure);
 }
 
-/* alphaMode MASK: the MTA's base colour alpha at raster point (X, Y) of view `view` passes the cutoff
- * (barycentrics from its exact edge functions there). */
+/* alphaMode MASK: the base colour alpha of MTA m at raster point (X, Y) of view `view` passes the cutoff:
+ * one voxel, scalar (the raster asks this of a few candidate voxels; its inputs are the same as the
+ * lanes' base colour). */
 inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, long Y, int view, float cutoff) {
   const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, view), m->sign * mta_edge(m, 2, 0, X, Y, view),
                      m->sign * mta_edge(m, 0, 1, X, Y, view)};
-  return base_color(in, m->tri, source_barycentrics(m, e)).w >= cutoff;
+  const float pa = (float)e[0] * m->inv_w[0], pb = (float)e[1] * m->inv_w[1], pc = (float)e[2] * m->inv_w[2];
+  const float inv = 1.0f / (pa + pb + pc);
+  const float la = pa * inv, lb = pb * inv, lc = pc * inv;
+  const float b1 = la * m->bary[0][0] + lb * m->bary[1][0] + lc * m->bary[2][0];
+  const float b2 = la * m->bary[0][1] + lb * m->bary[1][1] + lc * m->bary[2][1];
+  const float3 b = (float3)(1.0f - b1 - b2, b1, b2);
+  const PmrTriangle t = in->tris[m->tri];
+  global const PmrMaterial* mat = &in->materials[t.material];
+  float alpha = mat->base_color[3] * (b.x * in->attrs[t.v[0]].color[3] + b.y * in->attrs[t.v[1]].color[3] +
+                                      b.z * in->attrs[t.v[2]].color[3]);
+  if (mat->texture >= 0) {
+    const PmrTexture tex = in->textures[mat->texture];
+    global const PmrVertexAttr* a0 = &in->attrs[t.v[0]];
+    global const PmrVertexAttr* a1 = &in->attrs[t.v[1]];
+    global const PmrVertexAttr* a2 = &in->attrs[t.v[2]];
+    const float u = b.x * a0->uv[0] + b.y * a1->uv[0] + b.z * a2->uv[0];
+    const float v = b.x * a0->uv[1] + b.y * a1->uv[1] + b.z * a2->uv[1];
+    alpha *= sample_texture(in->texels, in->srgb_lut, &tex, u, v, true).w;
+  }
+  return alpha >= cutoff;
 }
 
 /* The MTA loaded last for shading: neighbouring voxels and samples mostly share their winner, and an
@@ -234,14 +458,6 @@ inline const PmrMta* cached_mta(MtaCache* c, global const PmrMta* mtas, uint id)
     c->m = mtas[id];
   }
   return &c->m;
-}
-
-/* Lit colour of MTA m at raster point (X, Y) (16.16 / 24.8) of view `view`: barycentrics from its exact
- * edge functions there. */
-inline float4 shade_mta_at(const ShadeInputs* in, const PmrMta* m, float3 light, long X, long Y, int view) {
-  const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, view), m->sign * mta_edge(m, 2, 0, X, Y, view),
-                     m->sign * mta_edge(m, 0, 1, X, Y, view)};
-  return shade(in, light, m->tri, source_barycentrics(m, e), (m->flags & PMR_MTA_BACK) != 0, view);
 }
 
 #endif

@@ -83,8 +83,12 @@ TEST(Framing, TheBoundingSphereFitsBothDirections) {
     const glm::dvec4 c_view = rig.center_view * glm::dvec4(kCenter, 1.0);
     EXPECT_NEAR(-c_view.z, rig.focal, 1e-12);
     // the portrait display frames by its width, the wide one by its height
-    if (w < h) EXPECT_NEAR(reach.x, 1.0, 1e-12);
-    if (w > h) EXPECT_NEAR(reach.y, 1.0, 1e-12);
+    if (w < h) {
+      EXPECT_NEAR(reach.x, 1.0, 1e-12);
+    }
+    if (w > h) {
+      EXPECT_NEAR(reach.y, 1.0, 1e-12);
+    }
     // near and far enclose the sphere
     EXPECT_GT(rig.near, 0.0);
     EXPECT_LE(rig.near, rig.focal - kRadius);

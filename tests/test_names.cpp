@@ -19,16 +19,11 @@ namespace {
 namespace fs = std::filesystem;
 using test::CliRun;
 using test::expect_one_error_line;
+using test::listing;
 using test::run;
 using test::temp_dir;
 
 const std::string kSmall = " --views 4 --view-size 64x32 --display 240x135 ";
-
-std::set<std::string> listing(const std::string& dir) {
-  std::set<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
-  return names;
-}
 
 nlohmann::json sidecar(const std::string& path) {
   std::ifstream in(path);

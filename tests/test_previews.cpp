@@ -94,11 +94,8 @@ TEST(Previews, SquarePixelsStretchOneAxis) {
 TEST(Previews, CenterPngHasSquarePixelsQuiltPngRecordsTheAspect) {
   const std::string out = temp_dir("previews");
   fs::create_directories(out);
-  Scene square = test::empty_scene(true);
-  test::add_triangle(square, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0});
-  test::add_triangle(square, {-1, -1, 0}, {1, 1, 0}, {-1, 1, 0});
   const std::string scene = out + "/square.glb";
-  save_glb(square, scene);
+  test::save_square_glb(scene);
   // 16:9 display, 80x90 views: pixels 16/9 * 90/80 = 2 times as wide as tall
   const CliRun r = run("render '" + scene + "' --views 4 --view-size 80x90 --display 320x180 --display-size 160x90 "
                        "--write quilt --quilt 2x2 --preview --out " + out);

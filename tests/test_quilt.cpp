@@ -104,11 +104,8 @@ TEST(Quilt, TilesHoldTheirViewsFromTheBottomLeft) {
 TEST(Quilt, CliQuiltDepthAndPreviews) {
   const std::string out = temp_dir("quilt");
   fs::create_directories(out);
-  Scene square = test::empty_scene(true);
-  test::add_triangle(square, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0});
-  test::add_triangle(square, {-1, -1, 0}, {1, 1, 0}, {-1, 1, 0});
   const std::string scene = out + "/square.glb";
-  save_glb(square, scene);
+  test::save_square_glb(scene);
   const CliRun r = run("render '" + scene + "' --views 6 --view-size 96x48 --display 480x270 --write encoded,views,quilt,depth --quilt 3x2 "
                        "--preview --name f%02d --out " + out);
   ASSERT_EQ(r.status, 0) << r.output;

@@ -28,6 +28,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::CliRun;
 using test::expect_one_error_line;
+using test::listing;
 using test::run;
 using test::temp_dir;
 
@@ -38,12 +39,6 @@ std::string read_text(const std::string& path) {
   std::stringstream ss;
   ss << in.rdbuf();
   return ss.str();
-}
-
-std::set<std::string> listing(const std::string& dir) {
-  std::set<std::string> names;
-  for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
-  return names;
 }
 
 std::vector<uint16_t> pixels(const std::string& path) {

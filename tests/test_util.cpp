@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <cstdlib>
@@ -190,6 +191,19 @@ size_t count_entries(const std::string& dir) {
   if (fscanf(p, "%zu", &n) != 1) n = 0;
   pclose(p);
   return n;
+}
+
+std::set<std::string> listing(const std::string& dir) {
+  std::set<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) names.insert(e.path().filename().string());
+  return names;
+}
+
+void save_square_glb(const std::string& path) {
+  Scene square = empty_scene(true);
+  add_triangle(square, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0});
+  add_triangle(square, {-1, -1, 0}, {1, 1, 0}, {-1, 1, 0});
+  save_glb(square, path);
 }
 
 void expect_one_error_line(const CliRun& r, const std::string& fragment) {

@@ -3,6 +3,7 @@
 #pragma once
 #include <cstdint>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,9 @@ std::string temp_dir(const std::string& name);
 bool exists(const std::string& path);
 std::string read_file(const std::string& path);
 size_t count_entries(const std::string& dir);  // including hidden ones
+std::set<std::string> listing(const std::string& dir);  // the entries' names
+// A double-sided 2x2 square in the z = 0 plane, centered on the origin (facing +z), saved as a .glb.
+void save_square_glb(const std::string& path);
 // The error is one line starting with "pmr: error:" (warnings may precede it), exit code 1.
 void expect_one_error_line(const CliRun& r, const std::string& fragment);
 }  // namespace pmr::test

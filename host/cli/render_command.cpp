@@ -28,6 +28,44 @@ std::string exe_dir() {
   return s.substr(0, s.rfind('/'));
 }
 
+// The job the options describe (the compression name checked here, before anything else).
+SequenceJob sequence_job(const RenderOptions& o) {
+  SequenceJob job;
+  job.compression = parse_exr_compression(o.compression);
+  job.scene = o.scene;
+  job.input_limits = o.input_limits;
+  job.environment_file = o.environment_file;
+  job.environment_rotation_deg = o.environment_rotation_deg;
+  job.rig = o.rig;
+  job.display = o.display;
+  job.display_source = o.display_source;
+  if (o.has_calibration) job.calibration = o.calibration;
+  job.pipeline = o.pipeline;
+  job.products.out_dir = o.out_dir;
+  job.products.name = o.name;
+  job.products.encoded = o.write_encoded;
+  job.products.views = o.write_views;
+  job.products.quilt = o.write_quilt;
+  job.products.depth = o.write_depth;
+  job.products.preview = o.preview;
+  job.quilt_layout = o.quilt;
+  job.frames = o.frames;
+  job.fps = o.fps;
+  job.animation = o.animation;
+  job.turntable = o.turntable;
+  job.turntable_deg = o.turntable_deg;
+  job.turntable_frames = o.turntable_frames;
+  job.shard = o.shard;
+  job.shard_count = o.shard_count;
+  job.shard_first = o.shard_first;
+  job.resume = o.resume;
+  job.overwrite = o.overwrite;
+  job.quiet = o.quiet;
+  job.verbose = o.verbose;
+  job.warnings = o.option_warnings;
+  return job;
+}
+
 }  // namespace
 
 std::string default_scene_path() {
@@ -53,7 +91,7 @@ int run_render(const std::vector<std::string>& args) {
   }
   finalize_render_options(o);
   if (o.scene.empty()) o.scene = default_scene_path();
-  return run_sequence(o);
+  return run_sequence(sequence_job(o));
 }
 
 }  // namespace pmr

@@ -15,7 +15,7 @@
 #include <filesystem>
 #include <utility>
 
-#include "cli/options.h"
+#include "sequence/frame_names.h"
 #include "pmr/error.h"
 #include "pmr/output.h"
 #include "sequence/frame_files.h"

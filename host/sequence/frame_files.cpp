@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pmr/output.h"
+#include "sequence/frame_names.h"
 
 namespace pmr {
 
@@ -20,20 +21,20 @@ std::vector<std::string> FramePaths::images() const {
   return all;
 }
 
-FramePaths frame_paths(const RenderOptions& o, long frame, const QuiltLayout& quilt, double aspect) {
+FramePaths frame_paths(const FrameProducts& o, long frame, const QuiltLayout& quilt, double aspect) {
   const std::string stem = frame_stem(o.name, frame);
   const std::string base = (fs::path(o.out_dir) / stem).string();
   FramePaths p;
   p.sidecar = base + ".json";
-  if (o.write_encoded) p.encoded = base + ".exr";
-  if (o.write_views) p.views = base + ".views.exr";
-  if (o.write_quilt || o.preview) {
+  if (o.encoded) p.encoded = base + ".exr";
+  if (o.views) p.views = base + ".views.exr";
+  if (o.quilt || o.preview) {
     const std::string quilt_base = (fs::path(o.out_dir) / quilt_stem(stem, quilt, aspect)).string();
-    if (o.write_quilt) p.quilt = quilt_base + ".exr";
-    if (o.preview && o.write_quilt) p.quilt_png = quilt_base + ".png";
+    if (o.quilt) p.quilt = quilt_base + ".exr";
+    if (o.preview && o.quilt) p.quilt_png = quilt_base + ".png";
   }
   if (o.preview) {
-    if (o.write_encoded) p.encoded_png = base + ".png";
+    if (o.encoded) p.encoded_png = base + ".png";
     p.center_png = base + ".center.png";
   }
   return p;

@@ -9,8 +9,7 @@
 #include <limits>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <memory>
 
 #include "output/checksum.h"
 #include "output/interrupt.h"
@@ -21,6 +20,7 @@
 #include "sequence/folder_guard.h"
 #include "sequence/frame_files.h"
 #include "sequence/frame_list.h"
+#include "sequence/frame_names.h"
 #include "sequence/frame_renderer.h"
 #include "sequence/frame_writer.h"
 #include "sequence/progress.h"
@@ -41,112 +41,153 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-}  // namespace
+void warn(const std::string& w) { std::fprintf(stderr, "pmr: warning: %s\n", w.c_str()); }
 
-int run_sequence(const RenderOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const ExrCompression compression = parse_exr_compression(o.compression);
-  std::vector<long> frames;
-  if (o.frames != "all") frames = parse_frame_list(o.frames);  // before the long work: fail early
-  check_name_covers_frames(o.name, frames.size());
-  // Everything that can be checked cheaply is checked before the long work starts.
-  prepare_output_dir(o.out_dir);
-  make_encode_params(o.display, o.rig.views, o.rig.view_w, o.rig.view_h);
+// One run of a job, step by step (run()).
+class SequenceRun {
+ public:
+  explicit SequenceRun(const SequenceJob& job) : job_(job), products_(job.products) {}
+  int run();
 
-  for (const auto& w : o.option_warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
-  // The environment image, prefiltered once for every frame (before the scene: a bad file fails fast).
-  std::shared_ptr<const Environment> environment;
-  std::string environment_checksum;
-  if (!o.environment_file.empty()) {
-    environment = std::make_shared<const Environment>(Environment::make(
-        {o.environment_file, o.environment_rotation_deg, o.pipeline.environment_intensity}));
-    environment_checksum = checksum_file(o.environment_file);
-    if (o.verbose) {
+ private:
+  void check_before_loading();
+  void load_inputs();
+  void choose_frames();
+  void prepare_frames();
+  SidecarInfo frame_info(long frame, const FramePaths& p, double angle, std::vector<SceneLight> lights) const;
+  std::string expected_sidecar(long frame, const FramePaths& p) const {
+    return sidecar_json(renderer_->rig(), job_.display, frame_info(frame, p, 0.0, renderer_->frame_lights(frame, pc_)));
+  }
+  FramePaths paths(long f) const { return frame_paths(products_, f, quilt_, renderer_->rig().aspect); }
+  void print_header() const;
+  int render_frames();
+  FrameFiles frame_files(long f, const FrameRenderer::Frame& fr, Pipeline& pipeline, FrameWriter& writer) const;
+  void print_frame_stages(long f, const FrameRenderer::Frame& fr, const Pipeline& pipeline, Progress& progress) const;
+  void print_summary(const FrameWriter& writer) const;
+
+  const SequenceJob& job_;
+  const FrameProducts& products_;
+  const std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
+  PipelineConfig pc_;  // the job's, with the environment: the sidecars a resumed run expects need it too
+  std::string environment_checksum_;
+  Scene scene_;
+  SequenceSpec spec_;
+  std::vector<long> frames_;      // this shard's frames, in job order
+  std::vector<long> job_frames_;  // every shard's frames (the folder guard's "this job"); empty: no shards
+  std::unique_ptr<FrameRenderer> renderer_;
+  std::vector<std::string> rig_warnings_;
+  QuiltLayout quilt_;
+  int center_view_ = 0;
+  bool need_volume_ = false;
+  SidecarInfo info_;              // what every frame's sidecar shares
+  ResumePlan plan_;
+  // the summary's sums
+  double render_s_ = 0.0, pose_s_ = 0.0, upload_s_ = 0.0, loop_s_ = 0.0;
+  long rendered_ = 0;
+};
+
+// Everything that can be checked cheaply, before the long work starts.
+void SequenceRun::check_before_loading() {
+  if (job_.frames != "all") frames_ = parse_frame_list(job_.frames);
+  check_name_covers_frames(products_.name, frames_.size());
+  prepare_output_dir(products_.out_dir);
+  make_encode_params(job_.display, job_.rig.views, job_.rig.view_w, job_.rig.view_h);
+  if (!job_.quilt_layout.empty() && !products_.quilt) throw Error("--quilt needs --write quilt");
+  for (const auto& w : job_.warnings) warn(w);
+}
+
+// The environment image, prefiltered once for every frame (before the scene: a bad file fails fast),
+// then the scene.
+void SequenceRun::load_inputs() {
+  pc_ = job_.pipeline;
+  if (!job_.environment_file.empty()) {
+    auto environment = std::make_shared<const Environment>(Environment::make(
+        {job_.environment_file, job_.environment_rotation_deg, job_.pipeline.environment_intensity}));
+    environment_checksum_ = checksum_file(job_.environment_file);
+    if (job_.verbose) {
       const PmrEnvironment& h = environment->tables().header;
       std::fprintf(stderr, "pmr: environment %s: %ux%u, prefiltered in %.2f s (%.1f MB of tables)\n",
-                   o.environment_file.c_str(), h.levels[0].width, h.levels[0].height, environment->prefilter_seconds(),
-                   double(environment->tables().data.size() * sizeof(float)) / 1e6);
+                   job_.environment_file.c_str(), h.levels[0].width, h.levels[0].height,
+                   environment->prefilter_seconds(), double(environment->tables().data.size() * sizeof(float)) / 1e6);
     }
+    pc_.environment = std::move(environment);
   }
-  // the pipeline's configuration: the sidecars a resumed run expects need it too (which lights)
-  PipelineConfig pc = o.pipeline;
-  pc.environment = environment;
-  const Scene scene = load_scene(o.scene, o.input_limits);
-  for (const auto& w : scene.warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
-  SequenceSpec spec;
-  select_animation(scene, o.animation, spec);
-  spec.fps = o.fps;
-  spec.turntable = o.turntable;
-  spec.turntable_deg = o.turntable_deg;
-  spec.turntable_frames = o.turntable ? o.turntable_frames : 1;
-  if (o.frames == "all") {
+  scene_ = load_scene(job_.scene, job_.input_limits);
+  for (const auto& w : scene_.warnings) warn(w);
+}
+
+// The animation, --frames all, this shard's part; then the framing (FrameRenderer) and the layout.
+void SequenceRun::choose_frames() {
+  select_animation(scene_, job_.animation, spec_);
+  spec_.fps = job_.fps;
+  spec_.turntable = job_.turntable;
+  spec_.turntable_deg = job_.turntable_deg;
+  spec_.turntable_frames = job_.turntable ? job_.turntable_frames : 1;
+  if (job_.frames == "all") {
     long first = 0, last = 0;
-    animation_frame_range(scene, spec, first, last);
+    animation_frame_range(scene_, spec_, first, last);
     if (last - first >= 10000000) throw Error("--frames all would be " + std::to_string(last - first + 1) + " frames; give a range");
     if (last > kMaxFrame)
       throw Error("--frames all would reach frame " + std::to_string(last) + ", beyond " + std::to_string(kMaxFrame));
-    for (long f = first; f <= last; ++f) frames.push_back(f);
-    check_name_covers_frames(o.name, frames.size());
+    for (long f = first; f <= last; ++f) frames_.push_back(f);
+    check_name_covers_frames(products_.name, frames_.size());
   }
-  std::vector<long> job_frames;  // every shard's frames (the folder guard's "this job")
-  if (!o.shard.empty()) {
-    job_frames = frames;
-    const Shard shard = parse_shard(o.shard, o.shard_count, o.shard_first, [](const char* n) { return std::getenv(n); });
-    const size_t all = frames.size();
-    frames = shard_frames(frames, shard);
-    if (!o.quiet)
+  if (!job_.shard.empty()) {
+    job_frames_ = frames_;
+    const Shard shard =
+        parse_shard(job_.shard, job_.shard_count, job_.shard_first, [](const char* n) { return std::getenv(n); });
+    const size_t all = frames_.size();
+    frames_ = shard_frames(frames_, shard);
+    if (!job_.quiet)
       std::fprintf(stderr, "pmr: %s: shard %ld of %ld, %zu of %zu frame(s)\n", shard.source.c_str(), shard.index,
-                   shard.count, frames.size(), all);
+                   shard.count, frames_.size(), all);
   }
-  std::vector<std::string> warnings;
-  FrameRenderer renderer(scene, spec, o.rig, o.display, &warnings);
-  for (const auto& w : warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
-  if (const std::string w = frames_outside_animation(scene, spec, frames, o.frames == "all"); !w.empty())
-    std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
-  const Rig& rig = renderer.rig();
-  const bool need_volume = o.write_views || o.write_quilt || o.preview;
-  QuiltLayout quilt;
-  if (o.write_quilt)
-    quilt = o.quilt.empty() ? choose_quilt_layout(rig.views, rig.view_w, rig.view_h)
-                            : parse_quilt_layout(o.quilt, rig.views, rig.view_w, rig.view_h);
-  else if (!o.quilt.empty())
-    throw Error("--quilt needs --write quilt");
-  const int center_view = rig.views / 2;
-  auto paths = [&](long f) { return frame_paths(o, f, quilt, rig.aspect); };
+  renderer_ = std::make_unique<FrameRenderer>(scene_, spec_, job_.rig, job_.display, &rig_warnings_);
+  for (const auto& w : rig_warnings_) warn(w);
+  if (const std::string w = frames_outside_animation(scene_, spec_, frames_, job_.frames == "all"); !w.empty()) warn(w);
+  const Rig& rig = renderer_->rig();
+  need_volume_ = products_.views || products_.quilt || products_.preview;
+  if (products_.quilt)
+    quilt_ = job_.quilt_layout.empty() ? choose_quilt_layout(rig.views, rig.view_w, rig.view_h)
+                                       : parse_quilt_layout(job_.quilt_layout, rig.views, rig.view_w, rig.view_h);
+  center_view_ = rig.views / 2;
+}
 
-  SidecarInfo info;
-  info.scene = o.scene;
-  info.tile_x = o.pipeline.tile_x;
-  info.tile_y = o.pipeline.tile_y;
-  info.tile_v = o.pipeline.tile_v;
-  info.method = to_string(o.pipeline.method);
-  info.sampling = to_string(o.pipeline.sampling);
-  info.shading = to_string(o.pipeline.shading);
-  info.exposure_ev = o.pipeline.exposure_ev;
-  info.environment_intensity = o.pipeline.environment_intensity;
-  info.environment_file = o.environment_file;
-  info.environment_checksum = environment_checksum;
-  info.environment_rotation_deg = o.environment_rotation_deg;
-  info.camera = o.rig.camera;
+// What every frame's sidecar shares.
+void SequenceRun::prepare_frames() {
+  SidecarInfo& info = info_;
+  info.scene = job_.scene;
+  info.tile_x = job_.pipeline.tile_x;
+  info.tile_y = job_.pipeline.tile_y;
+  info.tile_v = job_.pipeline.tile_v;
+  info.method = to_string(job_.pipeline.method);
+  info.sampling = to_string(job_.pipeline.sampling);
+  info.shading = to_string(job_.pipeline.shading);
+  info.exposure_ev = job_.pipeline.exposure_ev;
+  info.environment_intensity = job_.pipeline.environment_intensity;
+  info.environment_file = job_.environment_file;
+  info.environment_checksum = environment_checksum_;
+  info.environment_rotation_deg = job_.environment_rotation_deg;
+  info.camera = job_.rig.camera;
   info.has_bounds = true;
-  info.bounds_lo = renderer.bounds_lo();
-  info.bounds_hi = renderer.bounds_hi();
-  info.compression = to_string(compression);
-  info.warnings = scene.warnings;
-  info.warnings.insert(info.warnings.end(), warnings.begin(), warnings.end());
-  info.fps = spec.fps;
-  info.animation = spec.animation;
-  info.animation_name = spec.animation_label;
-  info.turntable = spec.turntable;
-  info.turntable_deg = spec.turntable_deg;
-  info.turntable_frames = spec.turntable ? spec.turntable_frames : 0;
-  info.pivot = renderer.pivot();
-  info.display_source = o.display_source;
-  info.scene_checksum = scene.source_checksum;
-  for (const SceneInputFile& f : scene.input_files) info.scene_files.push_back({f.path, f.checksum});
-  info.allow_outside_scene_folder = o.input_limits.allow_outside_scene_folder;
-  if (o.has_calibration) {
-    const LookingGlassCalibration& c = o.calibration;
+  info.bounds_lo = renderer_->bounds_lo();
+  info.bounds_hi = renderer_->bounds_hi();
+  info.compression = to_string(job_.compression);
+  info.warnings = scene_.warnings;
+  info.warnings.insert(info.warnings.end(), rig_warnings_.begin(), rig_warnings_.end());
+  info.fps = spec_.fps;
+  info.animation = spec_.animation;
+  info.animation_name = spec_.animation_label;
+  info.turntable = spec_.turntable;
+  info.turntable_deg = spec_.turntable_deg;
+  info.turntable_frames = spec_.turntable ? spec_.turntable_frames : 0;
+  info.pivot = renderer_->pivot();
+  info.display_source = job_.display_source;
+  info.scene_checksum = scene_.source_checksum;
+  for (const SceneInputFile& f : scene_.input_files) info.scene_files.push_back({f.path, f.checksum});
+  info.allow_outside_scene_folder = job_.input_limits.allow_outside_scene_folder;
+  if (job_.calibration) {
+    const LookingGlassCalibration& c = *job_.calibration;
     info.display_config_checksum = c.checksum;
     info.calibration_serial = c.serial;
     info.calibration = {{"pitch", c.pitch},         {"slope", c.slope},       {"center", c.center},
@@ -155,54 +196,122 @@ int run_sequence(const RenderOptions& o) {
                         {"flipImageY", c.flip_y},   {"flipSubp", c.flip_subp}, {"invView", c.inv_view},
                         {"CellPatternMode", c.cell_pattern}, {"subpixelCells", double(c.cells.size())}};
   }
-  auto frame_info = [&](long frame, const FramePaths& p, double angle, std::vector<SceneLight> lights) {
-    SidecarInfo i = info;
-    i.frame = int(frame);
-    i.time = double(frame) / spec.fps;
-    i.turntable_angle = angle;
-    i.lights = std::move(lights);
-    const std::pair<const char*, const std::string*> kinds[] = {
-        {"encoded", &p.encoded}, {"views", &p.views}, {"quilt", &p.quilt}, {"preview_encoded", &p.encoded_png},
-        {"preview_center", &p.center_png}, {"preview_quilt", &p.quilt_png}};
-    for (const auto& [kind, path] : kinds)
-      if (!path->empty()) i.outputs.push_back({kind, base_name(*path)});
-    if (o.write_quilt) i.quilt_columns = quilt.columns, i.quilt_rows = quilt.rows;
-    if (o.preview) i.center_view = center_view;
-    i.depth = o.write_depth;
-    return i;
-  };
+}
 
+SidecarInfo SequenceRun::frame_info(long frame, const FramePaths& p, double angle, std::vector<SceneLight> lights) const {
+  SidecarInfo i = info_;
+  i.frame = int(frame);
+  i.time = double(frame) / spec_.fps;
+  i.turntable_angle = angle;
+  i.lights = std::move(lights);
+  const std::pair<const char*, const std::string*> kinds[] = {
+      {"encoded", &p.encoded}, {"views", &p.views}, {"quilt", &p.quilt}, {"preview_encoded", &p.encoded_png},
+      {"preview_center", &p.center_png}, {"preview_quilt", &p.quilt_png}};
+  for (const auto& [kind, path] : kinds)
+    if (!path->empty()) i.outputs.push_back({kind, base_name(*path)});
+  if (products_.quilt) i.quilt_columns = quilt_.columns, i.quilt_rows = quilt_.rows;
+  if (products_.preview) i.center_view = center_view_;
+  i.depth = products_.depth;
+  return i;
+}
+
+void SequenceRun::print_header() const {
+  if (job_.quiet) return;
+  const Rig& rig = renderer_->rig();
+  std::fprintf(stderr, "pmr: %s: %zu triangles, %d views of %dx%d -> %dx%d display%s; %zu frame(s)%s\n",
+               job_.scene.c_str(), scene_.triangles.size(), rig.views, rig.view_w, rig.view_h, job_.display.width,
+               job_.display.height, job_.pipeline.sampling == Sampling::Subpixel ? " (subpixel sampling)" : "",
+               plan_.todo.size(), plan_.kept ? (", " + std::to_string(plan_.kept) + " already complete").c_str() : "");
+}
+
+int SequenceRun::run() {
+  check_before_loading();
+  load_inputs();
+  choose_frames();
+  prepare_frames();
   // One folder, one configuration: no other configuration rendering into it now, none left beside
   // this run's frames (folder_guard.h). Held until the end of the run.
-  const FolderGuard folder_guard(o.out_dir, o.name, o.shard.empty() ? frames : job_frames,
-                                 sidecar_json(rig, o.display, frame_info(0, paths(0), 0.0, renderer.frame_lights(0, pc))),
-                                 o.overwrite, o.quiet);
-
-  const ResumePlan plan = plan_resume(frames, o.resume, o.overwrite, paths, [&](long f, const FramePaths& p) {
-    return sidecar_json(rig, o.display, frame_info(f, p, 0.0, renderer.frame_lights(f, pc)));
-  });
-  // --quiet: errors and warnings only
-  if (!o.quiet)
-    for (const std::string& note : plan.notes) std::fprintf(stderr, "pmr: %s\n", note.c_str());
-  const std::vector<long>& todo = plan.todo;
-  const long skipped = plan.kept;
-  const long total = long(todo.size());
-  if (!o.quiet)
-    std::fprintf(stderr, "pmr: %s: %zu triangles, %d views of %dx%d -> %dx%d display%s; %ld frame(s)%s\n",
-                 o.scene.c_str(), scene.triangles.size(), rig.views, rig.view_w, rig.view_h, o.display.width,
-                 o.display.height, o.pipeline.sampling == Sampling::Subpixel ? " (subpixel sampling)" : "", total,
-                 skipped ? (", " + std::to_string(skipped) + " already complete").c_str() : "");
-  if (todo.empty()) {
-    if (!o.quiet) std::fprintf(stderr, "pmr: nothing to do\n");
+  const FolderGuard folder_guard(products_.out_dir, products_.name, job_frames_.empty() ? frames_ : job_frames_,
+                                 expected_sidecar(0, paths(0)), job_.overwrite, job_.quiet);
+  plan_ = plan_resume(frames_, job_.resume, job_.overwrite, [&](long f) { return paths(f); },
+                      [&](long f, const FramePaths& p) { return expected_sidecar(f, p); });
+  if (!job_.quiet)  // --quiet: errors and warnings only
+    for (const std::string& note : plan_.notes) std::fprintf(stderr, "pmr: %s\n", note.c_str());
+  print_header();
+  if (plan_.todo.empty()) {
+    if (!job_.quiet) std::fprintf(stderr, "pmr: nothing to do\n");
     return 0;
   }
+  return render_frames();
+}
 
+// The products of a rendered frame, read back from the device into buffers the writer gave back.
+FrameFiles SequenceRun::frame_files(long f, const FrameRenderer::Frame& fr, Pipeline& pipeline,
+                                    FrameWriter& writer) const {
+  const FramePaths p = paths(f);
+  const Rig& rig = renderer_->rig();
+  FrameFiles files;
+  files.frame = f;
+  files.compression = job_.compression;
+  files.sidecar_path = p.sidecar;
+  files.sidecar_text = sidecar_json(fr.rig, job_.display, frame_info(f, p, fr.angle, fr.lights));
+  files.has_meta = true;  // the EXR header attributes (docs/OUTPUTS.md)
+  files.meta.frame = f, files.meta.time = double(f) / spec_.fps, files.meta.fps = spec_.fps;
+  files.meta.sidecar = base_name(p.sidecar), files.meta.rig = fr.rig;
+  files.meta.center_view = center_view_, files.meta.quilt = quilt_;
+  if (products_.encoded) {
+    files.encoded_path = p.encoded;
+    files.display_w = job_.display.width, files.display_h = job_.display.height;
+    files.display = writer.spare_buffer();
+    if (renderer_->has_geometry()) pipeline.read_display(files.display);
+    else files.display.assign(size_t(job_.display.width) * job_.display.height * 4, 0);
+  }
+  files.encoded_png = p.encoded_png;
+  if (need_volume_) {
+    files.views_path = p.views;
+    files.quilt_path = p.quilt;
+    files.quilt_png = p.quilt_png;
+    files.center_png = p.center_png;
+    files.quilt = quilt_;
+    files.center_view = center_view_;
+    files.view_w = rig.view_w, files.view_h = rig.view_h, files.views = rig.views;
+    // pixels of a view are non-square: the view spans the display's aspect A
+    files.pixel_aspect = float(rig.aspect * rig.view_h / rig.view_w);
+    files.volume = writer.spare_buffer();
+    if (renderer_->has_geometry()) pipeline.read_volume(files.volume);
+    else files.volume.assign(size_t(rig.views) * rig.view_w * rig.view_h * 4, 0);
+    if (products_.depth) {
+      files.near = fr.rig.near_eff, files.far = fr.rig.far;
+      std::vector<uint32_t> keys, count;
+      if (renderer_->has_geometry()) pipeline.read_debug(keys, files.depth, count);
+      else files.depth.assign(size_t(rig.views) * rig.view_w * rig.view_h, std::numeric_limits<float>::infinity());
+    }
+  }
+  return files;
+}
+
+void SequenceRun::print_frame_stages(long f, const FrameRenderer::Frame& fr, const Pipeline& pipeline,
+                                     Progress& progress) const {
+  // the fused path and --sampling subpixel write the display image from the fine raster's tiles
+  const bool subpixel = pc_.sampling == Sampling::Subpixel, tiled_encode = pipeline.fused() || subpixel;
+  const char* encode_label = subpixel ? " + subpixel samples" : " + encode (fused)";
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "pmr: frame %ld: pose %.2f ms, upload %.2f ms; stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, "
+                "fine raster%s %.2f, %s %.2f; %u MTAs, %llu tile-queue entries, %d queue regrowth(s)",
+                f, fr.pose_ms, fr.upload_ms, fr.times.vertex, fr.times.setup, fr.times.bin, tiled_encode ? encode_label : "",
+                fr.times.fine, tiled_encode ? "straddling alpha" : "encode", fr.times.encode, fr.times.mtas,
+                (unsigned long long)fr.times.bin_entries, fr.times.retries);
+  progress.message(line);
+}
+
+int SequenceRun::render_frames() {
   ClRuntime runtime;
-  pc.fuse_encode = !need_volume;  // the volume is only kept when a product needs it
-  pc.debug_outputs = o.write_depth;  // per-voxel depth
-  Pipeline pipeline(runtime, pc);
-  renderer.attach(pipeline, o.write_encoded ? &o.display : nullptr);  // builds every kernel the frames use
-  if (o.verbose) {
+  pc_.fuse_encode = !need_volume_;   // the volume is only kept when a product needs it
+  pc_.debug_outputs = products_.depth;  // per-voxel depth
+  Pipeline pipeline(runtime, pc_);
+  renderer_->attach(pipeline, products_.encoded ? &job_.display : nullptr);  // builds every kernel the frames use
+  if (job_.verbose) {
     std::string variants;
     for (const std::string& v : pipeline.kernel_variants()) variants += (variants.empty() ? "" : ", ") + v;
     std::fprintf(stderr, "pmr: device %s; kernels built in %.2f s (%zu work-group functions: %s)\n",
@@ -212,72 +321,21 @@ int run_sequence(const RenderOptions& o) {
 
   install_interrupt_handlers();
   FrameWriter writer(2);
-  Progress progress(total, o.quiet);
-  double render_s = 0.0, pose_s = 0.0, upload_s = 0.0;
-  long rendered = 0;
+  const long total = long(plan_.todo.size());
+  Progress progress(total, job_.quiet);
   const auto t_loop = std::chrono::steady_clock::now();
-  for (long f : todo) {
+  for (long f : plan_.todo) {
     if (interrupt_signal()) break;
-    const FramePaths p = paths(f);
-    const FrameRenderer::Frame fr = renderer.render(f);
+    const FrameRenderer::Frame fr = renderer_->render(f);
     if (interrupt_signal()) break;  // the frame in flight is abandoned
-    render_s += fr.times.wall / 1000.0;
-    pose_s += fr.pose_ms / 1000.0;
-    upload_s += fr.upload_ms / 1000.0;
+    render_s_ += fr.times.wall / 1000.0;
+    pose_s_ += fr.pose_ms / 1000.0;
+    upload_s_ += fr.upload_ms / 1000.0;
     if (!fr.visible) progress.message("pmr: warning: frame " + std::to_string(f) + ": nothing visible, written as a transparent image");
-    if (o.verbose) {
-      // the fused path and --sampling subpixel write the display image from the fine raster's tiles
-      const bool subpixel = pc.sampling == Sampling::Subpixel, tiled_encode = pipeline.fused() || subpixel;
-      const char* encode_label = subpixel ? " + subpixel samples" : " + encode (fused)";
-      char line[320];
-      std::snprintf(line, sizeof line,
-                    "pmr: frame %ld: pose %.2f ms, upload %.2f ms; stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, "
-                    "fine raster%s %.2f, %s %.2f; %u MTAs, %llu tile-queue entries, %d queue regrowth(s)",
-                    f, fr.pose_ms, fr.upload_ms, fr.times.vertex, fr.times.setup, fr.times.bin, tiled_encode ? encode_label : "",
-                    fr.times.fine, tiled_encode ? "straddling alpha" : "encode", fr.times.encode, fr.times.mtas,
-                    (unsigned long long)fr.times.bin_entries, fr.times.retries);
-      progress.message(line);
-    }
-    FrameFiles files;
-    files.frame = f;
-    files.compression = compression;
-    files.sidecar_path = p.sidecar;
-    files.sidecar_text = sidecar_json(fr.rig, o.display, frame_info(f, p, fr.angle, fr.lights));
-    files.has_meta = true;  // the EXR header attributes (docs/OUTPUTS.md)
-    files.meta.frame = f, files.meta.time = double(f) / spec.fps, files.meta.fps = spec.fps;
-    files.meta.sidecar = base_name(p.sidecar), files.meta.rig = fr.rig;
-    files.meta.center_view = center_view, files.meta.quilt = quilt;
-    if (o.write_encoded) {
-      files.encoded_path = p.encoded;
-      files.display_w = o.display.width, files.display_h = o.display.height;
-      files.display = writer.spare_buffer();
-      if (renderer.has_geometry()) pipeline.read_display(files.display);
-      else files.display.assign(size_t(o.display.width) * o.display.height * 4, 0);
-    }
-    files.encoded_png = p.encoded_png;
-    if (need_volume) {
-      files.views_path = p.views;
-      files.quilt_path = p.quilt;
-      files.quilt_png = p.quilt_png;
-      files.center_png = p.center_png;
-      files.quilt = quilt;
-      files.center_view = center_view;
-      files.view_w = rig.view_w, files.view_h = rig.view_h, files.views = rig.views;
-      // pixels of a view are non-square: the view spans the display's aspect A
-      files.pixel_aspect = float(rig.aspect * rig.view_h / rig.view_w);
-      files.volume = writer.spare_buffer();
-      if (renderer.has_geometry()) pipeline.read_volume(files.volume);
-      else files.volume.assign(size_t(rig.views) * rig.view_w * rig.view_h * 4, 0);
-      if (o.write_depth) {
-        files.near = fr.rig.near_eff, files.far = fr.rig.far;
-        std::vector<uint32_t> keys, count;
-        if (renderer.has_geometry()) pipeline.read_debug(keys, files.depth, count);
-        else files.depth.assign(size_t(rig.views) * rig.view_w * rig.view_h, std::numeric_limits<float>::infinity());
-      }
-    }
-    writer.submit(std::move(files));
-    ++rendered;
-    progress.frame_done(rendered, f, fr.times.wall);
+    if (job_.verbose) print_frame_stages(f, fr, pipeline, progress);
+    writer.submit(frame_files(f, fr, pipeline, writer));
+    ++rendered_;
+    progress.frame_done(rendered_, f, fr.times.wall);
   }
   try {
     writer.finish();
@@ -286,26 +344,36 @@ int run_sequence(const RenderOptions& o) {
     throw;
   }
   progress.close();
+  loop_s_ = seconds_since(t_loop);
   const long written = writer.frames_written();
   if (const int sig = interrupt_signal(); sig && written < total) {
     std::fprintf(stderr, "pmr: interrupted by %s: %ld of %ld frame(s) written (%ld already complete); nothing partial "
                  "was left: rerun with --resume to finish\n",
-                 sig == SIGTERM ? "SIGTERM" : "SIGINT", written, total, skipped);
+                 sig == SIGTERM ? "SIGTERM" : "SIGINT", written, total, plan_.kept);
     return 128 + sig;
   }
-  const double wall = seconds_since(t_loop);
-  const double n = double(std::max(1L, rendered));
-  if (!o.quiet)
-    std::fprintf(stderr,
-                 "pmr: %ld frame(s) in %.2f s (%.2f s/frame; %ld skipped): render %.0f ms/frame (+ pose %.1f, upload %.1f), write %.0f "
-                 "ms/frame on the writer thread (%s, %.1f MB/frame); total %.2f s\n",
-                 rendered, wall, wall / n, skipped, 1000.0 * render_s / n, 1000.0 * pose_s / n, 1000.0 * upload_s / n,
-                 1000.0 * writer.write_seconds() / n, to_string(compression), double(writer.bytes_written()) / n / 1e6,
-                 seconds_since(t0));
-  if (!o.quiet && rendered == 1)
-    for (const std::string& path : paths(todo[0]).images()) std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());
-  if (!o.quiet && rendered == 1) std::fprintf(stderr, "pmr: wrote %s\n", paths(todo[0]).sidecar.c_str());
+  print_summary(writer);
   return 0;
 }
+
+void SequenceRun::print_summary(const FrameWriter& writer) const {
+  if (job_.quiet) return;
+  const double n = double(std::max(1L, rendered_));
+  std::fprintf(stderr,
+               "pmr: %ld frame(s) in %.2f s (%.2f s/frame; %ld skipped): render %.0f ms/frame (+ pose %.1f, upload %.1f), write %.0f "
+               "ms/frame on the writer thread (%s, %.1f MB/frame); total %.2f s\n",
+               rendered_, loop_s_, loop_s_ / n, plan_.kept, 1000.0 * render_s_ / n, 1000.0 * pose_s_ / n,
+               1000.0 * upload_s_ / n, 1000.0 * writer.write_seconds() / n, to_string(job_.compression),
+               double(writer.bytes_written()) / n / 1e6, seconds_since(t0_));
+  if (rendered_ == 1) {
+    const FramePaths p = paths(plan_.todo[0]);
+    for (const std::string& path : p.images()) std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());
+    std::fprintf(stderr, "pmr: wrote %s\n", p.sidecar.c_str());
+  }
+}
+
+}  // namespace
+
+int run_sequence(const SequenceJob& job) { return SequenceRun(job).run(); }
 
 }  // namespace pmr

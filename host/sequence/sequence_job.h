@@ -1,11 +1,52 @@
-// `pmr render`: a sequence of frames (one frame is a sequence of one) from loading to the summary.
+// A sequence job (one frame is a sequence of one) from loading to the summary: what to render, with
+// which rig, display and pipeline, into which files. The command line fills it in (cli/); the frame
+// loop knows nothing of the command line.
 #pragma once
-#include "cli/options.h"
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pipeline/pipeline.h"
+#include "pmr/display_presets.h"
+#include "pmr/input_files.h"
+#include "pmr/output.h"
+#include "pmr/rig.h"
+#include "sequence/frame_files.h"
 
 namespace pmr {
 
+struct SequenceJob {
+  // inputs
+  std::string scene;                  // the glTF or GLB file
+  InputLimits input_limits;           // budgets and folder confinement (docs/SECURITY.md)
+  std::string environment_file;       // pbr: equirectangular radiance image; "" = uniform
+  double environment_rotation_deg = 0.0;
+  // cameras, display, pipeline
+  RigConfig rig;
+  Display display;
+  std::string display_source;         // what the display came from (sidecar)
+  std::optional<LookingGlassCalibration> calibration;  // a calibration file's values (sidecar)
+  PipelineConfig pipeline;
+  // products: which files per frame (FrameProducts), the quilt layout ("" = chosen), compression
+  FrameProducts products;
+  std::string quilt_layout;
+  ExrCompression compression = ExrCompression::Zip;
+  // frames: a --frames list or "all" (the animation's key range, or one turn of a turntable)
+  std::string frames = "0";
+  double fps = 24.0;
+  std::string animation;              // name, index, "all" or "none"; "" = the first animation
+  bool turntable = false;
+  double turntable_deg = 0.0;
+  long turntable_frames = 0;
+  std::string shard;                  // "K/N" or "auto"; "" = every frame
+  long shard_count = 0, shard_first = 0;
+  bool resume = false, overwrite = false;
+  bool quiet = false, verbose = false;
+  std::vector<std::string> warnings;  // printed before the work starts (e.g. from the options)
+};
+
 // Runs the job; returns the process exit code (0, or 128 + signal when interrupted). Throws pmr::Error
 // with one line on bad input or a failed write.
-int run_sequence(const RenderOptions& options);
+int run_sequence(const SequenceJob& job);
 
 }  // namespace pmr

@@ -4,9 +4,16 @@
 
 #include <filesystem>
 #include <fstream>
+#include <cstdio>
 #include <map>
+#include <sstream>
+
+#include <xxhash.h>
+
+#include <nlohmann/json.hpp>
 
 #include "pmr/error.h"
+#include "pmr/output.h"
 #include "sequence/frame_list.h"
 #include "sequence/shard.h"
 #include "test_util.h"
@@ -42,6 +49,48 @@ std::vector<long> range(long a, long b) {
   std::vector<long> v;
   for (long f = a; f <= b; ++f) v.push_back(f);
   return v;
+}
+
+std::string read_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void write_file(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+// XXH3-64 of a file as xxhsum -H3 prints it (the library directly, not pmr's checksum code).
+std::string xxh3(const std::string& path) {
+  const std::string bytes = read_file(path);
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", (unsigned long long)XXH3_64bits(bytes.data(), bytes.size()));
+  return hex;
+}
+
+// The byte offset of a single-part EXR's chunk table: after magic, version and the header's attributes
+// (name, type name, 32-bit size, value), which end with an empty name.
+size_t exr_chunk_table_offset(const std::string& b) {
+  size_t at = 8;
+  auto cstr = [&] {
+    const size_t end = b.find('\0', at);
+    const std::string s = b.substr(at, end - at);
+    at = end + 1;
+    return s;
+  };
+  while (!cstr().empty()) {
+    cstr();
+    uint32_t size = 0;
+    for (int k = 0; k < 4; ++k) size |= uint32_t(uint8_t(b[at + size_t(k)])) << (8 * k);
+    at += 4 + size;
+  }
+  return at;
+}
+
+void put64(std::string& b, size_t at, uint64_t v) {
+  for (int k = 0; k < 8; ++k) b[at + size_t(k)] = char(v >> (8 * k));
 }
 
 }  // namespace
@@ -110,6 +159,103 @@ TEST(Shard, BadEnvironmentsFailWithOneLine) {
 
 // pmr verify on a sequence folder: complete, then with a frame missing, an EXR cut short, a sidecar
 // from another configuration; the printed list is what to resubmit, and --resume redoes exactly those.
+TEST(Verify, SidecarRecordsEveryOutputsSizeAndChecksum) {
+  const std::string out = test::temp_dir("verify_sums");
+  ASSERT_EQ(test::run("render --frames 0:1 -q --views 4 --view-size 64x32 --display 240x135 --write encoded,quilt "
+                      "--preview --out " + out).status, 0);
+  const nlohmann::json j = nlohmann::json::parse(read_file(out + "/frame_0001.json"));
+  ASSERT_TRUE(j.contains("output_checksums")) << j.dump(2);
+  EXPECT_EQ(j["output_checksums"]["algorithm"], "XXH3-64");
+  const nlohmann::json& files = j["output_checksums"]["files"];
+  ASSERT_EQ(files.size(), j["outputs"].size());  // every output, nothing else
+  for (auto it = j["outputs"].begin(); it != j["outputs"].end(); ++it) {
+    const std::string name = it.value().get<std::string>();
+    ASSERT_TRUE(files.contains(name)) << name;
+    EXPECT_EQ(files[name]["bytes"].get<uint64_t>(), uint64_t(fs::file_size(out + "/" + name))) << name;
+    EXPECT_EQ(files[name]["checksum"].get<std::string>(), xxh3(out + "/" + name)) << name;
+  }
+}
+
+TEST(Verify, QuickCheckFindsChangedAndDamagedFilesWithoutDecoding) {
+  const std::string out = test::temp_dir("verify_quick");
+  const std::string args = " --views 4 --view-size 64x32 --display 240x135 --turntable 360:6 --out " + out;
+  ASSERT_EQ(test::run("render --frames 0:5 -q" + args).status, 0);
+  // frame 1: one byte of the first chunk's pixel data changed, size and chunk table intact
+  std::string b = read_file(out + "/frame_0001.exr");
+  {
+    const size_t t = exr_chunk_table_offset(b);
+    size_t first = 0;
+    for (int k = 0; k < 8; ++k) first |= size_t(uint8_t(b[t + size_t(k)])) << (8 * k);
+    b[first + 8 + 20] = char(b[first + 8 + 20] ^ 0x10);  // after its y and size
+  }
+  write_file(out + "/frame_0001.exr", b);
+  // frame 2: a chunk-table entry past the end of the file, and the sidecar's record updated to match,
+  // so that only the structure check can see it
+  b = read_file(out + "/frame_0002.exr");
+  put64(b, exr_chunk_table_offset(b) + 8, uint64_t(b.size()) + 1000);
+  write_file(out + "/frame_0002.exr", b);
+  nlohmann::json j = nlohmann::json::parse(read_file(out + "/frame_0002.json"));
+  j["output_checksums"]["files"]["frame_0002.exr"]["checksum"] = xxh3(out + "/frame_0002.exr");
+  write_file(out + "/frame_0002.json", j.dump(2));
+  // frame 3: two chunk-table entries pointing at the same chunk (overlap), record updated
+  b = read_file(out + "/frame_0003.exr");
+  {
+    const size_t t = exr_chunk_table_offset(b);
+    uint64_t first = 0;
+    for (int k = 0; k < 8; ++k) first |= uint64_t(uint8_t(b[t + size_t(k)])) << (8 * k);
+    put64(b, t + 8, first);
+  }
+  write_file(out + "/frame_0003.exr", b);
+  j = nlohmann::json::parse(read_file(out + "/frame_0003.json"));
+  j["output_checksums"]["files"]["frame_0003.exr"]["checksum"] = xxh3(out + "/frame_0003.exr");
+  write_file(out + "/frame_0003.json", j.dump(2));
+  // frame 4: cut short
+  fs::resize_file(out + "/frame_0004.exr", fs::file_size(out + "/frame_0004.exr") - 1);
+  test::CliRun v = test::run("verify " + out + " --frames 0:5");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frame 1: frame_0001.exr is not the file its sidecar records (its checksum differs)"),
+            std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("frame 2: frame_0002.exr is truncated or damaged"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("frame 3: frame_0003.exr"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("frame 4: frame_0004.exr is truncated"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("\n1:4\n"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("2 of 6 frame(s) complete"), std::string::npos) << v.output;
+  // --resume renders exactly those frames again
+  test::CliRun r = test::run("render --frames 0:5 --resume" + args);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("4 frame(s) in"), std::string::npos) << r.output;
+  EXPECT_EQ(test::run("verify " + out + " --frames 0:5").status, 0);
+}
+
+TEST(Verify, DeepDecodesEveryPixelAndOldSidecarsAreDecoded) {
+  const std::string out = test::temp_dir("verify_deep");
+  const std::string args = " --views 4 --view-size 64x32 --display 240x135 --turntable 360:3 --out " + out;
+  ASSERT_EQ(test::run("render --frames 0:2 -q" + args).status, 0);
+  // frame 1: compressed data garbled, the record updated: whole to the quick check, not to a decode
+  std::string b = read_file(out + "/frame_0001.exr");
+  const size_t t = exr_chunk_table_offset(b);
+  for (size_t i = t + 2000; i < t + 2400 && i < b.size(); ++i) b[i] = char(0x5a);
+  write_file(out + "/frame_0001.exr", b);
+  nlohmann::json j = nlohmann::json::parse(read_file(out + "/frame_0001.json"));
+  j["output_checksums"]["files"]["frame_0001.exr"]["checksum"] = xxh3(out + "/frame_0001.exr");
+  write_file(out + "/frame_0001.json", j.dump(2));
+  EXPECT_EQ(test::run("verify " + out + " --frames 0:2").status, 0);
+  test::CliRun v = test::run("verify " + out + " --frames 0:2 --deep");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frame 1: frame_0001.exr is truncated or unreadable"), std::string::npos) << v.output;
+  // a sidecar without checksums (an older pmr): its images are decoded
+  j.erase("output_checksums");
+  write_file(out + "/frame_0001.json", j.dump(2));
+  v = test::run("verify " + out + " --frames 0:2");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frame 1: frame_0001.exr is truncated or unreadable"), std::string::npos) << v.output;
+  j = nlohmann::json::parse(read_file(out + "/frame_0002.json"));
+  j.erase("output_checksums");
+  write_file(out + "/frame_0002.json", j.dump(2));
+  v = test::run("verify " + out + " --frames 0:2");
+  EXPECT_NE(v.output.find("2 of 3 frame(s) complete"), std::string::npos) << v.output;
+}
+
 TEST(Verify, ReportsMissingAndBrokenFramesAsAFramesList) {
   const std::string out = test::temp_dir("verify");
   const std::string args = " --turntable 360:8 --views 4 --view-size 64x32 --display 240x135 --out " + out;

@@ -27,13 +27,15 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string verify_help() {
-  return "usage: pmr verify DIR --frames LIST [--write LIST] [--name PATTERN] [--preview]\n"
+  return "usage: pmr verify DIR --frames LIST [--write LIST] [--name PATTERN] [--preview] [--deep]\n"
          "Checks that every listed frame in DIR is complete: its sidecar names the frame and its time, was\n"
          "rendered from the same scene as the folder's other frames (the scene checksums it records; the\n"
          "scene most frames show counts as the folder's) and with the same configuration, and every output\n"
-         "it lists exists as a regular file in DIR and opens completely. --write LIST (and --preview for the\n"
-         "PNGs) checks just those kinds of output instead. Prints the missing or broken frames on stdout as\n"
-         "a --frames list to resubmit (with --resume); exit code 1 if there are any.\n";
+         "it lists exists as a regular file in DIR and is the file the sidecar records: its size and checksum,\n"
+         "and for an EXR its chunk table, without decoding pixels. --deep decodes every pixel as well (as\n"
+         "for frames whose sidecar records no checksums, written by an older pmr). --write LIST (and --preview\n"
+         "for the PNGs) checks just those kinds of output instead. Prints the missing or broken frames on\n"
+         "stdout as a --frames list to resubmit (with --resume); exit code 1 if there are any.\n";
 }
 
 // A listed output must be a plain file name in the frame's folder.
@@ -64,7 +66,7 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
     const std::string path = sidecar_path(dir, o, f);
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) continue;
-    const std::string text = read_text_file(path);
+    const std::string text = read_sidecar_text(path);
     try {
       if (!nlohmann::json::parse(text).is_object()) continue;
     } catch (const std::exception&) {
@@ -82,19 +84,19 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
       folder.scene = scene;
       folder.reference_frame = count_first.second;
     }
-  if (folder.reference_frame >= 0) folder.reference_text = read_text_file(sidecar_path(dir, o, folder.reference_frame));
+  if (folder.reference_frame >= 0) folder.reference_text = read_sidecar_text(sidecar_path(dir, o, folder.reference_frame));
   return folder;
 }
 
 // What is wrong with one frame ("" if nothing), given what the folder's frames were rendered from.
 // explicit_kinds: --write / --preview were given, check those kinds; else every output the sidecar lists.
-std::string check_frame(const std::string& dir, const RenderOptions& o, bool explicit_kinds, long f,
+std::string check_frame(const std::string& dir, const RenderOptions& o, bool explicit_kinds, bool deep, long f,
                         const FolderScene& folder) {
   const std::string stem = frame_stem(o.name, f);
   const std::string sidecar = sidecar_path(dir, o, f);
   std::error_code ec;
   if (!fs::is_regular_file(sidecar, ec)) return stem + ".json is missing";
-  const std::string text = read_text_file(sidecar);
+  const std::string text = read_sidecar_text(sidecar);
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(text);
@@ -104,7 +106,7 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
   if (!j.is_object() || !j.contains("frame") || j["frame"] != f)
     return stem + ".json does not describe frame " + std::to_string(f);
   if (!j.contains("fps") || !j.contains("time") || !j["fps"].is_number() || !j["time"].is_number() ||
-      std::fabs(j["time"].get<double>() - double(f) / j["fps"].get<double>()) > 1e-9)
+      !(j["fps"].get<double>() > 0.0) || std::fabs(j["time"].get<double>() - double(f) / j["fps"].get<double>()) > 1e-9)
     return stem + ".json has a time that is not frame / fps";
   const SidecarProvenance prov = sidecar_provenance(text);
   const std::string reference_name = frame_stem(o.name, folder.reference_frame) + ".json";
@@ -150,13 +152,14 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
     images.push_back(path.string());
   }
   // frame_problem names the files by their (plain, but maybe not ASCII) names
-  return printable_text(frame_problem(sidecar, images), std::string::npos);
+  return printable_text(frame_problem(sidecar, images, deep), std::string::npos);
 }
 
 }  // namespace
 
 int run_verify(const std::vector<std::string>& args) {
   std::string dir;
+  bool deep = false;
   std::vector<std::string> rest;  // --frames, --write, --name, --preview go through render's parser
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -170,6 +173,8 @@ int run_verify(const std::vector<std::string>& args) {
       rest.push_back(args[++i]);
     } else if (a == "--preview") {
       rest.push_back(a);
+    } else if (a == "--deep") {
+      deep = true;
     } else if (!a.empty() && a[0] == '-') {
       throw Error("unknown option " + a + " (see pmr verify --help)");
     } else if (dir.empty()) {
@@ -193,7 +198,7 @@ int run_verify(const std::vector<std::string>& args) {
   const FolderScene folder = folder_scene(dir, o, frames);
   std::vector<long> bad;
   for (long f : frames) {
-    const std::string problem = check_frame(dir, o, explicit_kinds, f, folder);
+    const std::string problem = check_frame(dir, o, explicit_kinds, deep, f, folder);
     if (problem.empty()) continue;
     bad.push_back(f);
     std::fprintf(stderr, "pmr verify: frame %ld: %s\n", f, problem.c_str());

@@ -10,6 +10,7 @@
 #include <ImfStdIO.h>
 #include <ImfVersion.h>
 #include <libdeflate.h>
+#include <time.h>
 
 #include <algorithm>
 #include <atomic>
@@ -101,6 +102,14 @@ struct Scratch {
   std::vector<unsigned char> split, pre, packed;
 };
 
+std::atomic<uint64_t> helper_cpu_ns{0};
+
+uint64_t thread_cpu_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return uint64_t(t.tv_sec) * 1000000000u + uint64_t(t.tv_nsec);
+}
+
 std::mutex scratch_mutex;
 std::vector<std::unique_ptr<Scratch>> scratch_pool;
 
@@ -118,6 +127,8 @@ void give_back(std::unique_ptr<Scratch> s) {
 }
 
 }  // namespace
+
+double exr_zip_helper_cpu_seconds() { return 1e-9 * double(helper_cpu_ns.load()); }
 
 void write_zip_exr(const std::string& path, const std::string& shown_path, const Imf::Header& header,
                    const std::vector<ExrZipChannel>& channels, int level, int threads) {
@@ -186,7 +197,11 @@ void write_zip_exr(const std::string& path, const std::string& shown_path, const
   if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
   threads = std::max(1, std::min(threads, chunks));
   std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  for (int t = 1; t < threads; ++t)
+    pool.emplace_back([&] {
+      work();
+      helper_cpu_ns += thread_cpu_ns();  // a fresh thread: all its CPU time was this work
+    });
   work();
   for (std::thread& t : pool) t.join();
   if (failed) throw Error("cannot write " + shown_path + ": out of memory for the ZIP compressor");

@@ -25,4 +25,8 @@ struct ExrZipChannel {
 void write_zip_exr(const std::string& path, const std::string& shown_path, const Imf::Header& header,
                    const std::vector<ExrZipChannel>& channels, int level, int threads);
 
+// The CPU time (seconds, summed since the process started) of the threads write_zip_exr starts besides
+// the calling one, whose own time the caller can measure.
+double exr_zip_helper_cpu_seconds();
+
 }  // namespace pmr

@@ -142,6 +142,11 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   json outputs = json::object();
   for (const auto& [kind, file] : info.outputs) outputs[kind] = file;
   j["outputs"] = outputs;
+  if (!info.output_checksums.empty()) {
+    json files = json::object();
+    for (const OutputChecksum& o : info.output_checksums) files[o.file] = {{"bytes", o.bytes}, {"checksum", o.checksum}};
+    j["output_checksums"] = {{"algorithm", kChecksumAlgorithm}, {"files", files}};
+  }
   if (info.quilt_columns > 0)
     j["quilt"] = {{"columns", info.quilt_columns},
                   {"rows", info.quilt_rows},

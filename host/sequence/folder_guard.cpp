@@ -250,7 +250,7 @@ FolderGuard::FolderGuard(const std::string& dir, const std::string& pattern, con
     long others = 0;
     std::string first_name, first_diff;
     for (const auto& [frame, name] : sidecars) {
-      const std::string diff = difference(read_text_file((fs::path(dir) / name).string()));
+      const std::string diff = difference(read_sidecar_text((fs::path(dir) / name).string()));
       // unreadable: a broken frame, not a configuration (pmr verify reports it)
       if (diff.empty() || diff == "unreadable") continue;
       if (others++ == 0) first_name = name, first_diff = diff;

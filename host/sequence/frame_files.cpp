@@ -3,16 +3,19 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "output/checksum.h"
 #include "pmr/output.h"
 #include "sequence/frame_names.h"
 
 namespace pmr {
 
 namespace fs = std::filesystem;
+using json = nlohmann::json;
 
 std::vector<std::string> FramePaths::images() const {
   std::vector<std::string> all;
@@ -40,6 +43,8 @@ FramePaths frame_paths(const FrameProducts& o, long frame, const QuiltLayout& qu
   return p;
 }
 
+namespace {
+
 std::string read_text_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream ss;
@@ -47,33 +52,89 @@ std::string read_text_file(const std::string& path) {
   return ss.str();
 }
 
-std::string frame_problem(const std::string& sidecar, const std::vector<std::string>& images) {
+}  // namespace
+
+std::string read_sidecar_text(const std::string& path) {
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (ec || size > kMaxSidecarBytes) return "";
+  return read_text_file(path);
+}
+
+namespace {
+
+// What the sidecar records of the files written before it (name -> bytes, checksum); empty when it
+// records none (written before pmr recorded them) or with another algorithm.
+std::map<std::string, OutputChecksum> recorded_outputs(const nlohmann::json& sidecar) {
+  std::map<std::string, OutputChecksum> out;
+  const auto c = sidecar.find("output_checksums");
+  if (c == sidecar.end() || !c->is_object() || c->value("algorithm", json()) != kChecksumAlgorithm) return out;
+  const auto files = c->find("files");
+  if (files == c->end() || !files->is_object()) return out;
+  for (auto it = files->begin(); it != files->end(); ++it) {
+    const json& v = it.value();
+    if (!v.is_object() || !v.contains("bytes") || !v["bytes"].is_number_unsigned() || !v.contains("checksum") ||
+        !v["checksum"].is_string())
+      continue;
+    out[it.key()] = {it.key(), v["bytes"].get<uint64_t>(), v["checksum"].get<std::string>()};
+  }
+  return out;
+}
+
+bool is_png(const std::string& p) { return p.size() > 4 && p.compare(p.size() - 4, 4, ".png") == 0; }
+
+// The full check: every pixel decoded.
+bool decodes(const std::string& p) {
+  if (!is_png(p)) return exr_is_complete(p);
+  try {
+    int w = 0, h = 0;
+    std::vector<uint8_t> px;
+    read_png_rgba8(p, w, h, px);
+    return true;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+}  // namespace
+
+std::string frame_problem(const std::string& sidecar, const std::vector<std::string>& images, bool deep) {
   std::error_code ec;
   auto name = [](const std::string& p) { return fs::path(p).filename().string(); };
-  for (const std::string* p : {&sidecar})
-    if (!fs::is_regular_file(*p, ec)) return name(*p) + " is missing";
+  if (!fs::is_regular_file(sidecar, ec)) return name(sidecar) + " is missing";
   for (const std::string& p : images)
     if (!fs::is_regular_file(p, ec)) return name(p) + " is missing";
+  json j;
   try {
-    if (!nlohmann::json::parse(read_text_file(sidecar)).is_object()) return name(sidecar) + " is not a sidecar";
+    j = json::parse(read_sidecar_text(sidecar));
   } catch (const std::exception&) {
     return name(sidecar) + " is truncated or unreadable";
   }
+  if (!j.is_object()) return name(sidecar) + " is not a sidecar";
+  const std::map<std::string, OutputChecksum> recorded = recorded_outputs(j);
   for (const std::string& p : images) {
-    const bool png = p.size() > 4 && p.compare(p.size() - 4, 4, ".png") == 0;
-    bool ok = true;
-    if (png) {
+    const auto r = recorded.find(name(p));
+    if (r != recorded.end()) {  // the quick check: size, structure, checksum
+      const auto size = fs::file_size(p, ec);
+      if (ec) return name(p) + " cannot be read";
+      if (uint64_t(size) < r->second.bytes)
+        return name(p) + " is truncated (" + std::to_string(size) + " of " + std::to_string(r->second.bytes) + " bytes)";
+      if (uint64_t(size) != r->second.bytes)
+        return name(p) + " is not the file its sidecar records (" + std::to_string(size) + " bytes, recorded " +
+               std::to_string(r->second.bytes) + ")";
+      if (!is_png(p))
+        if (const std::string problem = exr_chunk_problem(p); !problem.empty()) return problem;
+      std::string sum;
       try {
-        int w = 0, h = 0;
-        std::vector<uint8_t> px;
-        read_png_rgba8(p, w, h, px);
+        sum = checksum_file(p);
       } catch (const std::exception&) {
-        ok = false;
+        return name(p) + " cannot be read";
       }
-    } else {
-      ok = exr_is_complete(p);
+      if (sum != r->second.checksum) return name(p) + " is not the file its sidecar records (its checksum differs)";
+      if (!deep) continue;
     }
-    if (!ok) return name(p) + " is truncated or unreadable";
+    // older sidecars record no checksums: decode every pixel (and always with `deep`)
+    if (!decodes(p)) return name(p) + " is truncated or unreadable";
   }
   return "";
 }

@@ -1,6 +1,7 @@
 // A frame's files on disk: their names (from the options) and whether they make a complete frame.
 // Shared by the sequence job (--resume) and `pmr verify`.
 #pragma once
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -27,11 +28,16 @@ struct FramePaths {
 
 FramePaths frame_paths(const FrameProducts& o, long frame, const QuiltLayout& quilt, double aspect);
 
-// "" when the frame is whole (the sidecar parses as a JSON object, every EXR is complete, every PNG
-// decodes), else what is wrong with it, e.g. "frame_0003.exr is missing", "frame_0003.exr is truncated
-// or unreadable".
-std::string frame_problem(const std::string& sidecar, const std::vector<std::string>& images);
+// "" when the frame is whole, else what is wrong with it, e.g. "frame_0003.exr is missing". Whole: the
+// sidecar (written last) parses as a JSON object, and every image is the file the sidecar records
+// (its size and checksum: output_checksums) with an intact EXR chunk table, without decoding a pixel.
+// With `deep`, or for an image its sidecar records no checksum of (written by an older pmr), every
+// pixel is decoded as well.
+std::string frame_problem(const std::string& sidecar, const std::vector<std::string>& images, bool deep = false);
 
-std::string read_text_file(const std::string& path);
+// A sidecar is a few kB; a larger file is not read (read_sidecar_text returns "").
+constexpr uint64_t kMaxSidecarBytes = uint64_t(16) << 20;
+std::string read_sidecar_text(const std::string& path);
+
 
 }  // namespace pmr

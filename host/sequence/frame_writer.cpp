@@ -1,5 +1,6 @@
 #include "sequence/frame_writer.h"
 
+#include <time.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -8,6 +9,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "output/checksum.h"
+#include "output/exr_zip.h"
 #include "output/interrupt.h"
 #include "pmr/error.h"
 
@@ -19,6 +22,12 @@ uint64_t file_size(const std::string& path) {
   std::error_code ec;
   const auto n = std::filesystem::file_size(path, ec);
   return ec ? 0 : uint64_t(n);
+}
+
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 // Thrown inside write() when an interrupt arrives between two files of a frame.
@@ -72,6 +81,10 @@ double FrameWriter::write_seconds() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return seconds_;
 }
+double FrameWriter::cpu_seconds() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return cpu_seconds_;
+}
 uint64_t FrameWriter::bytes_written() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return bytes_;
@@ -89,6 +102,7 @@ void FrameWriter::run() {
       busy_ = true;
     }
     const auto t0 = std::chrono::steady_clock::now();
+    const double cpu0 = thread_cpu_seconds(), helpers0 = exr_zip_helper_cpu_seconds();
     std::exception_ptr error;
     uint64_t bytes = 0;
     bool done = false;
@@ -103,12 +117,13 @@ void FrameWriter::run() {
       error = std::current_exception();
     }
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double cpu = thread_cpu_seconds() - cpu0 + exr_zip_helper_cpu_seconds() - helpers0;
     {
       std::lock_guard<std::mutex> lock(mutex_);
       busy_ = false;
       if (error && !error_) error_ = error;
       if (interrupt_signal()) queue_.clear();  // nothing more is written after an interrupt
-      if (done) ++written_, seconds_ += s, bytes_ += bytes;
+      if (done) ++written_, seconds_ += s, cpu_seconds_ += cpu, bytes_ += bytes;
       for (std::vector<uint16_t>* b : {&f.display, &f.volume})
         if (!b->empty() && spare_.size() < 4) spare_.push_back(std::move(*b));
     }
@@ -144,9 +159,6 @@ void FrameWriter::write(FrameFiles& f) {
   auto done = [&](const std::string& path) { committed.push_back(path); };
   const ExrMetadata* meta = f.has_meta ? &f.meta : nullptr;
   try {
-    check();
-    write_text_atomic(f.sidecar_path, f.sidecar_text);
-    done(f.sidecar_path);
     if (!f.encoded_path.empty()) {
       check();
       write_rgba_exr(f.encoded_path, f.display_w, f.display_h, f.display.data(), f.compression, exr_threads_, nullptr,
@@ -196,6 +208,17 @@ void FrameWriter::write(FrameFiles& f) {
       write_png_preview(f.quilt_png, qw, qh, quilt.data(), f.pixel_aspect);  // tiles as rendered
       done(f.quilt_png);
     }
+    // last, the sidecar with what was written: from here on the frame is complete
+    check();
+    for (const std::string& path : committed) {
+      OutputChecksum c;
+      c.file = std::filesystem::path(path).filename().string();
+      c.bytes = file_size(path);
+      c.checksum = checksum_file(path);  // from the page cache: a few ms for a paper-8k EXR
+      f.sidecar.output_checksums.push_back(std::move(c));
+    }
+    write_sidecar(f.sidecar_path, f.sidecar_rig, f.sidecar_display, f.sidecar);
+    done(f.sidecar_path);
   } catch (const Abandoned&) {
     throw;
   } catch (...) {

@@ -1,7 +1,7 @@
 // Writes finished frames on a background thread while the next frame renders: a bounded queue of one
 // frame (so memory stays at two or three frames) feeding one writer thread, which lets OpenEXR
-// compress with its own thread pool. Per frame the sidecar is committed first, then the images, each
-// through AtomicFile, so an image never exists without its sidecar. An interrupt (output/interrupt.h)
+// compress with its own thread pool. Per frame the images are committed first, each through AtomicFile,
+// then the sidecar with their sizes and checksums: a frame is complete when its sidecar is there. An interrupt (output/interrupt.h)
 // abandons the frame being written and removes what of it was already committed, so a frame is either
 // complete or absent. The first error stops the writer; the next submit() or finish() rethrows it.
 #pragma once
@@ -24,7 +24,11 @@ namespace pmr {
 // and encoded on the writer thread, the depth converted there too.
 struct FrameFiles {
   long frame = 0;
-  std::string sidecar_path, sidecar_text;  // the JSON, prepared by the frame loop
+  // The sidecar: written last, from this description plus the checksums of the files written before it.
+  std::string sidecar_path;
+  SidecarInfo sidecar;
+  Rig sidecar_rig;
+  Display sidecar_display;
   std::string encoded_path, encoded_png;
   std::vector<uint16_t> display;           // half RGBA, display_w x display_h
   int display_w = 0, display_h = 0;
@@ -61,6 +65,7 @@ class FrameWriter {
 
   long frames_written() const;
   double write_seconds() const;  // summed time the writer spent on frames
+  double cpu_seconds() const;    // summed CPU time of the writer thread and the threads compressing for it
   uint64_t bytes_written() const;
 
  private:
@@ -76,7 +81,7 @@ class FrameWriter {
   std::exception_ptr error_;
   std::vector<std::vector<uint16_t>> spare_;
   long written_ = 0;
-  double seconds_ = 0.0;
+  double seconds_ = 0.0, cpu_seconds_ = 0.0;
   uint64_t bytes_ = 0;
   std::thread thread_;
 };

@@ -44,7 +44,7 @@ ResumePlan plan_resume(const std::vector<long>& frames, bool resume, bool overwr
     // complete = every file present and readable (a node may have died during a rename on a network
     // file system); anything less is rendered again
     if (resume && frame_problem(p.sidecar, p.images()).empty()) {
-      const std::string existing = read_text_file(p.sidecar);
+      const std::string existing = read_sidecar_text(p.sidecar);
       if (!records_frame(existing, f)) {  // a --name without a frame field: another frame's files
         plan.todo.push_back(f);
         continue;

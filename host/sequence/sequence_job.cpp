@@ -2,6 +2,8 @@
 // the writer thread compresses and writes the previous one; progress, clean interruption, a summary.
 #include "sequence/sequence_job.h"
 
+#include <time.h>
+
 #include <csignal>
 #include <algorithm>
 #include <chrono>
@@ -39,6 +41,12 @@ std::string base_name(const std::string& path) { return fs::path(path).filename(
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+double process_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 void warn(const std::string& w) { std::fprintf(stderr, "pmr: warning: %s\n", w.c_str()); }
@@ -82,7 +90,7 @@ class SequenceRun {
   SidecarInfo info_;              // what every frame's sidecar shares
   ResumePlan plan_;
   // the summary's sums
-  double render_s_ = 0.0, pose_s_ = 0.0, upload_s_ = 0.0, loop_s_ = 0.0;
+  double render_s_ = 0.0, pose_s_ = 0.0, upload_s_ = 0.0, loop_s_ = 0.0, loop_cpu_s_ = 0.0;
   long rendered_ = 0;
 };
 
@@ -254,7 +262,9 @@ FrameFiles SequenceRun::frame_files(long f, const FrameRenderer::Frame& fr, Pipe
   files.frame = f;
   files.compression = job_.compression;
   files.sidecar_path = p.sidecar;
-  files.sidecar_text = sidecar_json(fr.rig, job_.display, frame_info(f, p, fr.angle, fr.lights));
+  files.sidecar = frame_info(f, p, fr.angle, fr.lights);
+  files.sidecar_rig = fr.rig;
+  files.sidecar_display = job_.display;
   files.has_meta = true;  // the EXR header attributes (docs/OUTPUTS.md)
   files.meta.frame = f, files.meta.time = double(f) / spec_.fps, files.meta.fps = spec_.fps;
   files.meta.sidecar = base_name(p.sidecar), files.meta.rig = fr.rig;
@@ -324,6 +334,7 @@ int SequenceRun::render_frames() {
   const long total = long(plan_.todo.size());
   Progress progress(total, job_.quiet);
   const auto t_loop = std::chrono::steady_clock::now();
+  const double cpu0 = process_cpu_seconds();
   for (long f : plan_.todo) {
     if (interrupt_signal()) break;
     const FrameRenderer::Frame fr = renderer_->render(f);
@@ -345,6 +356,7 @@ int SequenceRun::render_frames() {
   }
   progress.close();
   loop_s_ = seconds_since(t_loop);
+  loop_cpu_s_ = process_cpu_seconds() - cpu0;
   const long written = writer.frames_written();
   if (const int sig = interrupt_signal(); sig && written < total) {
     std::fprintf(stderr, "pmr: interrupted by %s: %ld of %ld frame(s) written (%ld already complete); nothing partial "
@@ -359,12 +371,16 @@ int SequenceRun::render_frames() {
 void SequenceRun::print_summary(const FrameWriter& writer) const {
   if (job_.quiet) return;
   const double n = double(std::max(1L, rendered_));
+  // the process's CPU in the frame loop, less the writer's: the renderer's (its OpenCL threads included)
+  const double writer_cpu = writer.cpu_seconds();
   std::fprintf(stderr,
                "pmr: %ld frame(s) in %.2f s (%.2f s/frame; %ld skipped): render %.0f ms/frame (+ pose %.1f, upload %.1f), write %.0f "
-               "ms/frame on the writer thread (%s, %.1f MB/frame); total %.2f s\n",
+               "ms/frame on the writer thread (%s, %.1f MB/frame); CPU per frame: renderer %.0f ms, writer %.0f ms; "
+               "total %.2f s\n",
                rendered_, loop_s_, loop_s_ / n, plan_.kept, 1000.0 * render_s_ / n, 1000.0 * pose_s_ / n,
                1000.0 * upload_s_ / n, 1000.0 * writer.write_seconds() / n, to_string(job_.compression),
-               double(writer.bytes_written()) / n / 1e6, seconds_since(t0_));
+               double(writer.bytes_written()) / n / 1e6, 1000.0 * std::max(0.0, loop_cpu_s_ - writer_cpu) / n,
+               1000.0 * writer_cpu / n, seconds_since(t0_));
   if (rendered_ == 1) {
     const FramePaths p = paths(plan_.todo[0]);
     for (const std::string& path : p.images()) std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());

@@ -96,6 +96,12 @@ void write_views_exr(const std::string& path, int width, int height, int views, 
 // complete). Never throws.
 bool exr_is_complete(const std::string& path);
 
+// The quick check of an EXR file, without decoding a pixel: every part's header reads, its chunk table
+// is complete, and every chunk lies inside the file, after the header, at the scanline the table puts it,
+// with a packed size no larger than its unpacked one, none overlapping another. "" when it holds, else
+// what does not. Never throws.
+std::string exr_chunk_problem(const std::string& path);
+
 // Readers (used by the tests). They return the data window's size and the pixels row 0 at the top,
 // RGBA half bits; a missing alpha channel reads as 1.0, missing colour channels as 0.
 void read_rgba_exr(const std::string& path, int& width, int& height, std::vector<uint16_t>& rgba_half);
@@ -124,6 +130,14 @@ void read_png_rgba8(const std::string& path, int& width, int& height, std::vecto
 // The sRGB transfer curve (IEC 61966-2-1) of a linear value, clamped to [0, 1].
 double srgb_encode(double linear);
 
+// A file the frame wrote, as its sidecar records it: name, size and checksum (output/checksum.h), so
+// that --resume and `pmr verify` can check the frame without decoding it.
+struct OutputChecksum {
+  std::string file;
+  uint64_t bytes = 0;
+  std::string checksum;
+};
+
 // What the sidecar records besides the rig and the display.
 struct SidecarInfo {
   std::string scene;            // the scene file as given (empty = the bundled default scene)
@@ -141,6 +155,7 @@ struct SidecarInfo {
   std::string compression;      // EXR compression of the images ("" = not recorded)
   // Files written for this frame, as (kind, file name) pairs, e.g. {"encoded", "frame_0000.exr"}.
   std::vector<std::pair<std::string, std::string>> outputs;
+  std::vector<OutputChecksum> output_checksums;  // of the written outputs (the sidecar is written last)
   std::vector<std::string> warnings;   // e.g. "near plane raised ..."
   // The frame's place in a sequence (DESIGN section 7), so any frame can be reproduced alone.
   double time = 0.0;                   // seconds: frame / fps

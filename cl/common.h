@@ -164,4 +164,10 @@ inline ushort4 encode_pixel(ushort4 s0, ushort4 s1, ushort4 s2) {
   return (ushort4)(s0.x, s1.y, s2.z, alpha);
 }
 
+/* Each subpixel's own alpha, beside the display image: sub_alpha[3 * pixel + k] holds subpixel k's
+ * (half bits), stored as the EXR channels AR, AG, AB (docs/OUTPUTS.md). */
+inline void store_sub_alpha(global ushort* sub_alpha, size_t pixel, ushort4 s0, ushort4 s1, ushort4 s2) {
+  vstore3((ushort3)(s0.w, s1.w, s2.w), pixel, sub_alpha);
+}
+
 #endif

@@ -2,7 +2,8 @@
  * y = row i). Subpixel k of pixel (j, i) shows view v = floor(N t) mod N, sampled at normalized position
  * ((j + (k + 0.5) / 3) / W_d, (i + 0.5) / H_d) of that view. The view index is exact and division-free
  * through per-column and per-row tables (PmrEncodeColumn / PmrEncodeRow), which keeps the kernel
- * branch-free so that it vectorizes across work-items. Alpha is the mean coverage of the three samples. */
+ * branch-free so that it vectorizes across work-items. Alpha is the mean coverage of the three samples;
+ * each sample's own alpha goes to sub_alpha (store_sub_alpha). */
 #include "common.h"
 
 /* Bilinear sample of view v at normalized position (u, t), all four channels. */
@@ -26,7 +27,8 @@ inline float4 sample_bilinear(global const PmrEncodeParams* E, global const half
  * conversions would dominate the stage. Separate kernels for nearest and bilinear sampling, because
  * a branch between them would be flattened when the kernel is vectorized across work-items. */
 kernel void encode_nearest(global const PmrEncodeParams* E, global const PmrEncodeColumn* all_columns,
-                           global const PmrEncodeRow* rows, global const half* volume, global half* display) {
+                           global const PmrEncodeRow* rows, global const half* volume, global half* display,
+                           global ushort* sub_alpha) {
   const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
   if (j0 >= E->display_w || i >= E->display_h) return;
   global const PmrEncodeColumn* columns = row_columns(E, all_columns, i);
@@ -43,6 +45,7 @@ kernel void encode_nearest(global const PmrEncodeParams* E, global const PmrEnco
     const ushort4 s1 = vload4((size_t)encode_view(E->views, E->reversed, &c1, &row) * plane + row_off + (size_t)c1.px, bits);
     const ushort4 s2 = vload4((size_t)encode_view(E->views, E->reversed, &c2, &row) * plane + row_off + (size_t)c2.px, bits);
     vstore4(encode_pixel(s0, s1, s2), (size_t)i * E->display_w + j, (global ushort*)display);
+    store_sub_alpha(sub_alpha, (size_t)i * E->display_w + j, s0, s1, s2);
   }
 }
 
@@ -50,7 +53,8 @@ kernel void encode_nearest(global const PmrEncodeParams* E, global const PmrEnco
  * last view stands in for v + 1 = N) mixed by the fraction of the phase, N t - floor(N t), sampled at
  * its own position. The fraction comes from the tables' float remainders: a weight, not a decision. */
 kernel void encode_blend(global const PmrEncodeParams* E, global const PmrEncodeColumn* all_columns,
-                         global const PmrEncodeRow* rows, global const half* volume, global half* display) {
+                         global const PmrEncodeRow* rows, global const half* volume, global half* display,
+                           global ushort* sub_alpha) {
   const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
   if (j0 >= E->display_w || i >= E->display_h) return;
   global const PmrEncodeColumn* columns = row_columns(E, all_columns, i);
@@ -59,7 +63,7 @@ kernel void encode_blend(global const PmrEncodeParams* E, global const PmrEncode
   const size_t plane = (size_t)E->view_h * (size_t)E->view_w;
   const size_t row_off = (size_t)row.py * (size_t)E->view_w;
   for (int j = j0; j < j1; ++j) {
-    float rgb[3], alpha = 0.0f;
+    float rgb[3], sub[3], alpha = 0.0f;
     for (int k = 0; k < 3; ++k) {
       const PmrEncodeColumn col = columns[3 * j + k];
       const int v0 = encode_view(E->views, 0, &col, &row), v1 = min(v0 + 1, E->views - 1);
@@ -70,14 +74,17 @@ kernel void encode_blend(global const PmrEncodeParams* E, global const PmrEncode
       const float4 c1 = vload_half4((size_t)b * plane + row_off + (size_t)col.px, volume);
       const float4 c = c0 + (c1 - c0) * w;
       rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
+      sub[k] = c.w;
       alpha += c.w;
     }
     vstore_half4((float4)(rgb[0], rgb[1], rgb[2], alpha / 3.0f), (size_t)i * E->display_w + j, display);
+    vstore_half3((float3)(sub[0], sub[1], sub[2]), (size_t)i * E->display_w + j, (global half*)sub_alpha);
   }
 }
 
 kernel void encode_bilinear(global const PmrEncodeParams* E, global const PmrEncodeColumn* all_columns,
-                            global const PmrEncodeRow* rows, global const half* volume, global half* display) {
+                            global const PmrEncodeRow* rows, global const half* volume, global half* display,
+                           global ushort* sub_alpha) {
   const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
   if (j0 >= E->display_w || i >= E->display_h) return;
   global const PmrEncodeColumn* columns = row_columns(E, all_columns, i);
@@ -85,14 +92,16 @@ kernel void encode_bilinear(global const PmrEncodeParams* E, global const PmrEnc
   const PmrEncodeRow row = rows[i];
   const float t = ((float)i + 0.5f) / (float)E->display_h;
   for (int j = j0; j < j1; ++j) {
-    float rgb[3], alpha = 0.0f;
+    float rgb[3], sub[3], alpha = 0.0f;
     for (int k = 0; k < 3; ++k) {
       const PmrEncodeColumn col = columns[3 * j + k];
       const float4 c = sample_bilinear(E, volume, encode_view(E->views, E->reversed, &col, &row),
                                        ((float)j + ((float)k + 0.5f) / 3.0f) / (float)E->display_w, t);
       rgb[k] = k == 0 ? c.x : (k == 1 ? c.y : c.z);
+      sub[k] = c.w;
       alpha += c.w;
     }
     vstore_half4((float4)(rgb[0], rgb[1], rgb[2], alpha / 3.0f), (size_t)i * E->display_w + j, display);
+    vstore_half3((float3)(sub[0], sub[1], sub[2]), (size_t)i * E->display_w + j, (global half*)sub_alpha);
   }
 }

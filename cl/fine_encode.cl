@@ -40,7 +40,8 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
                         global const PmrEncodeParams* E, global const int* column_soa,
                         global const PmrEncodeRow* rows, global const int* column_start,
                         global const int* row_start, global const int* straddle_slot, uint straddle_slots,
-                        global uchar* straddle_cov, global half* display, global const PmrEnvironment* env,
+                        global uchar* straddle_cov, global half* display, global ushort* sub_alpha,
+                        global const PmrEnvironment* env,
                         global const float4* env_data, global const PmrLight* lights) {
   const uint tile_xy = pmr_item_id();
   const uint tiles_x = (uint)P->tiles_x, tiles_y = (uint)P->tiles_y;
@@ -116,6 +117,8 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
       for (int l = 0; l < 8; ++l) {
         const ulong c0 = colour_bits[idx[0][l]], c1 = colour_bits[idx[1][l]], c2 = colour_bits[idx[2][l]];
         row_bits[j + l] = as_ulong(encode_pixel(as_ushort4(c0), as_ushort4(c1), as_ushort4(c2)));
+        store_sub_alpha(sub_alpha, (size_t)i * (size_t)width + (size_t)(j + l), as_ushort4(c0), as_ushort4(c1),
+                        as_ushort4(c2));
       }
     }
     /* the rest one at a time: a partly owned pixel at each end, wholly owned ones after the last eight */
@@ -133,6 +136,7 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
         const ushort4 b = colour[fused_voxel(encode_view(views, reversed, &c1, &row), ly, c1.px - x0)];
         const ushort4 c = colour[fused_voxel(encode_view(views, reversed, &c2, &row), ly, c2.px - x0)];
         vstore4(encode_pixel(a, b, c), pixel, bits);
+        store_sub_alpha(sub_alpha, pixel, a, b, c);
         continue;
       }
       const size_t slot = ((size_t)i * straddle_slots + (size_t)straddle_slot[jj]) * 3;
@@ -143,6 +147,7 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
         const ushort4 a = colour[fused_voxel(encode_view(views, reversed, &col, &row), ly, col.px - x0)];
         bits[pixel * 4 + (size_t)k] = k == 0 ? a.x : (k == 1 ? a.y : a.z);
         straddle_cov[slot + (size_t)k] = a.w != 0 ? 1 : 0;
+        sub_alpha[pixel * 3 + (size_t)k] = a.w; /* this subpixel's own: written by its tile alone */
       }
     }
   }

@@ -103,7 +103,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
                           global const int* column_a, global const int* column_b, global const PmrEncodeRow* rows,
                           global const int* sample_x, global const int* sample_y,
                           global const PmrSampleChunk* chunks, uint num_chunks, global const int* straddle_slot,
-                          uint straddle_slots, global uchar* straddle_cov, global half* display,
+                          uint straddle_slots, global uchar* straddle_cov, global half* display, global ushort* sub_alpha,
                           uint debug, global uint* dbg_key, global float* dbg_depth,
                           global const PmrEnvironment* env, global const float4* env_data,
                           global const PmrLight* lights) {
@@ -326,6 +326,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
         const ushort4 b = (ushort4)(0, value[n + 1], 0, covered[n + 1] ? one : 0);
         const ushort4 c = (ushort4)(0, 0, value[n + 2], covered[n + 2] ? one : 0);
         vstore4(encode_pixel(a, b, c), pixel, bits);
+        store_sub_alpha(sub_alpha, pixel, a, b, c);
         continue;
       }
       const size_t slot = ((size_t)i * straddle_slots + (size_t)straddle_slot[j]) * 3;
@@ -334,6 +335,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
         if (s < ch.s0 || s >= ch.s1) continue;
         bits[pixel * 4 + (size_t)k] = value[r + s];
         straddle_cov[slot + (size_t)k] = covered[r + s];
+        sub_alpha[pixel * 3 + (size_t)k] = covered[r + s] ? one : 0; /* its own: written by its chunk alone */
       }
     }
   }

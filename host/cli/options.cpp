@@ -115,6 +115,7 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
       o.rig = p.rig;
       o.rig.angular_spacing = p.name != "paper-8k";  // Looking Glass software spaces its cameras angularly
       o.display_source = "preset " + p.name;
+      o.quilt_preview_opaque = p.name != "paper-8k";  // Looking Glass tools show quilts opaque
     } else if (args[i] == "--display-config") {
       o.calibration = read_looking_glass_calibration(args[i + 1], &o.option_warnings, o.input_limits.file_bytes);
       o.has_calibration = true;
@@ -124,6 +125,7 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
       o.rig = rig_for_serial(o.calibration, quilt);
       o.rig.angular_spacing = true;
       o.display_source = "calibration " + args[i + 1];
+      o.quilt_preview_opaque = true;
     }
   }
   int sources = 0;
@@ -239,6 +241,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     }
     else if (a == "--limit") parse_limits(value(), o.input_limits);
     else if (a == "--allow-outside-scene-folder") o.input_limits.allow_outside_scene_folder = true;
+    else if (a == "--background") o.background = parse_background(value());
     else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see pmr render --help)");
     else if (o.scene.empty()) o.scene = a;
     else throw Error("more than one scene given ('" + o.scene + "' and '" + a + "')");
@@ -345,6 +348,10 @@ std::string render_help() {
          "                         renders with --method multipass for now\n"
          "  --camera K             use the scene's glTF camera K (pose and field of view) instead of framing\n"
          "                         the scene's bounding sphere\n"
+         "  --background R,G,B[,A] a linear colour behind the encoded image, views, quilt and previews (default\n"
+         "                         transparent black; A defaults to 1). The encoded image is composited per\n"
+         "                         subpixel; its PNG preview is always opaque (over black). With a Looking Glass\n"
+         "                         preset or --display-config the quilt PNG is opaque black by default\n"
          "  --zoom F               the scene appears F times larger (default 1: its bounding sphere fits the\n"
          "                         view's height and width); the camera moves closer, the zero-parallax plane\n"
          "                         stays through the sphere's center. Not with --camera\n"

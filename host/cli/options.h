@@ -6,6 +6,7 @@
 #include "pipeline/pipeline.h"
 #include "pmr/input_files.h"
 #include "pmr/display_presets.h"
+#include "output/background.h"
 #include "pmr/rig.h"
 #include "sequence/frame_names.h"
 
@@ -63,6 +64,8 @@ struct RenderOptions {
   // --limit KEY=VALUE,... and --allow-outside-scene-folder (docs/SECURITY.md)
   InputLimits input_limits;
   bool zoom_given = false;     // --zoom was on the command line (rig.zoom)
+  Background background;       // --background R,G,B[,A]; transparent black by default
+  bool quilt_preview_opaque = false;  // the quilt PNG over opaque black (Looking Glass presets)
 };
 
 // Parses the arguments after `render`. Throws pmr::Error with one line on bad input.

@@ -63,6 +63,8 @@ SequenceJob sequence_job(const RenderOptions& o) {
   job.quiet = o.quiet;
   job.verbose = o.verbose;
   job.warnings = o.option_warnings;
+  job.background = o.background;
+  job.quilt_preview_opaque = o.quilt_preview_opaque;
   return job;
 }
 

@@ -70,6 +70,9 @@ void set_compression(Imf::Header& h, ExrCompression c, const std::string& path) 
 }
 
 // The deflate level of our ZIP writer (libdeflate's scale, 1-12): see docs/SEQUENCES.md for sizes and times.
+// OpenEXR's per-channel alpha names for R, G, B
+const char* const kSubpixelAlpha[3] = {"AR", "AG", "AB"};
+
 int zip_level(ExrCompression c) { return c == ExrCompression::ZipFast ? 1 : 4; }
 
 void check_image(const std::string& path, int width, int height, int layers, const void* data) {
@@ -137,7 +140,7 @@ std::string view_part_name(int i, int views) {
 
 void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half,
                     ExrCompression c, int threads, const float* depth, float pixel_aspect, const ExrMetadata* meta,
-                    ExrImage image) {
+                    ExrImage image, const uint16_t* subpixel_alpha) {
   check_image(path, width, height, 1, rgba_half);
   if (!(pixel_aspect > 0.0f) || !std::isfinite(pixel_aspect))
     throw Error("cannot write " + path + ": invalid pixel aspect ratio " + std::to_string(pixel_aspect));
@@ -158,17 +161,34 @@ void write_rgba_exr(const std::string& path, int width, int height, const uint16
         header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
         channels.push_back({"Z", reinterpret_cast<const char*>(depth), sizeof(float), sizeof(float) * size_t(width)});
       }
+      if (subpixel_alpha) {
+        const char* sa = reinterpret_cast<const char*>(subpixel_alpha);
+        const size_t sx = 3 * sizeof(uint16_t), sy = sx * size_t(width);
+        for (int k = 0; k < 3; ++k) {
+          header.channels().insert(kSubpixelAlpha[k], Imf::Channel(Imf::HALF));
+          channels.push_back({kSubpixelAlpha[k], sa + 2 * k, sx, sy});
+        }
+      }
       write_zip_exr(file.temp_path(), path, header, channels, zip_level(c), threads);
       return;
     }
-    if (depth) {  // half RGBA plus a float Z channel: the general interface
+    if (depth || subpixel_alpha) {  // half RGBA plus Z or AR, AG, AB: the general interface
       for (const char* ch : {"R", "G", "B", "A"}) header.channels().insert(ch, Imf::Channel(Imf::HALF));
-      header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
-      Imf::OutputFile out(file.temp_path().c_str(), header);
       Imf::FrameBuffer fb;
       insert_half_rgba(fb, rgba_half, width);
-      char* z = const_cast<char*>(reinterpret_cast<const char*>(depth));
-      fb.insert("Z", Imf::Slice(Imf::FLOAT, z, sizeof(float), sizeof(float) * size_t(width)));
+      if (depth) {
+        header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+        char* z = const_cast<char*>(reinterpret_cast<const char*>(depth));
+        fb.insert("Z", Imf::Slice(Imf::FLOAT, z, sizeof(float), sizeof(float) * size_t(width)));
+      }
+      if (subpixel_alpha) {
+        char* sa = const_cast<char*>(reinterpret_cast<const char*>(subpixel_alpha));
+        for (int k = 0; k < 3; ++k) {
+          header.channels().insert(kSubpixelAlpha[k], Imf::Channel(Imf::HALF));
+          fb.insert(kSubpixelAlpha[k], Imf::Slice(Imf::HALF, sa + 2 * k, 3 * sizeof(uint16_t), 3 * sizeof(uint16_t) * size_t(width)));
+        }
+      }
+      Imf::OutputFile out(file.temp_path().c_str(), header);
       out.setFrameBuffer(fb);
       out.writePixels(height);
       return;

@@ -142,6 +142,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   json outputs = json::object();
   for (const auto& [kind, file] : info.outputs) outputs[kind] = file;
   j["outputs"] = outputs;
+  if (!info.background.empty()) j["background"] = info.background;
   if (!info.output_checksums.empty()) {
     json files = json::object();
     for (const OutputChecksum& o : info.output_checksums) files[o.file] = {{"bytes", o.bytes}, {"checksum", o.checksum}};
@@ -297,6 +298,7 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   // sidecars written before --sampling existed sampled the views
   auto sampling = [&](const json& o) { return get(o, "sampling").is_null() ? json("view") : get(o, "sampling"); };
   if (sampling(a) != sampling(b)) return "sampling";
+  if (get(a, "background") != get(b, "background")) return "background";  // absent: transparent
   // the lights: their poses follow the frame, so other frames' (pmr verify, the folder scan) are compared
   // without them; they follow from the scene file (its lights, or the default light when it has none and
   // no environment image lights it)

@@ -90,7 +90,7 @@ struct Pipeline::Impl {
   bool mta_capacity_fixed = false;
   ClBuffer tile_counts, tile_offsets, tile_queue;
   size_t tile_queue_capacity = 0;
-  ClBuffer volume, display, encode_columns, encode_rows;
+  ClBuffer volume, display, sub_alpha, encode_columns, encode_rows;
   ClBuffer dbg_key, dbg_depth, dbg_count;
   // fused raster + encode (cl/fine_encode.cl), built per view count
   cl_program fused_program = nullptr;
@@ -377,7 +377,7 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   }
 
   const size_t vol = m.keep_volume ? volume_bytes() : 0;
-  const size_t disp = display_bytes();
+  const size_t disp = display_bytes() + display_bytes() / 4 * 3;  // RGBA and the subpixels' alpha
   const size_t voxels = size_t(rig.views) * rig.view_w * rig.view_h;
   m.debug_entries = !config_.debug_outputs ? 1 : m.keep_volume ? voxels : size_t(3) * display->width * display->height;
   const size_t dbg = config_.debug_outputs ? m.debug_entries * 12 : 0;
@@ -386,7 +386,8 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
                 std::to_string(disp >> 20) + " MiB) do not fit in the device's memory (" +
                 std::to_string(rt.global_mem_bytes() >> 20) + " MiB)");
   m.volume = rt.buffer(std::max<size_t>(vol, 16), "view volume");
-  m.display = rt.buffer(std::max<size_t>(disp, 16), "display image");
+  m.display = rt.buffer(std::max<size_t>(display_bytes(), 16), "display image");
+  m.sub_alpha = rt.buffer(std::max<size_t>(display_bytes() / 4 * 3, 16), "display subpixel alpha");
   m.tile_counts = rt.buffer(size_t(m.num_tiles + 1) * sizeof(uint32_t), "tile counters");
   rt.fill_zero(m.tile_counts);
   m.tile_offsets = rt.buffer(size_t(m.num_tiles + 1) * sizeof(uint32_t), "tile offsets");
@@ -501,7 +502,7 @@ void Pipeline::Impl::encode_stage(Events& ev) {
   const PmrEncodeParams nothing{};  // warming: a display of 0 x 0
   rt.write(encode_buf, warming ? &nothing : &encode_params, sizeof encode_params);
   ClKernel& k = encode_params.blend ? k_encode_blend : encode_params.bilinear ? k_encode_bilinear : k_encode;
-  k.args(encode_buf, encode_columns, encode_rows, volume, display);
+  k.args(encode_buf, encode_columns, encode_rows, volume, display, sub_alpha);
   const size_t runs = (size_t(encode_params.display_w) + PMR_ENCODE_RUN - 1) / PMR_ENCODE_RUN;
   ev.add(kEncode, launch_2d(k, runs, size_t(encode_params.display_h), 8, 1));
 }
@@ -590,7 +591,7 @@ void Pipeline::Impl::subpixel_stage(Events& ev) {
   k_fine_subpixel.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents,
                        encode_buf, column_a, column_b, encode_rows, sample_x, sample_y, chunks, warming ? 0u : num_chunks,
                        straddle_slot, straddle_slots,
-                       straddle_cov, display, cl_uint(subpixel_debug), dbg_key, dbg_depth, env, env_data, lights);
+                       straddle_cov, display, sub_alpha, cl_uint(subpixel_debug), dbg_key, dbg_depth, env, env_data, lights);
   ev.add(kFine, launch(k_fine_subpixel, num_chunks, 1));
   straddle_alpha_stage(k_subpixel_straddle, ev);
 }
@@ -599,7 +600,7 @@ void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
   rt.write(encode_buf, &encode_params, sizeof encode_params);
   k_fine_encode.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents,
                      encode_buf, column_soa, encode_rows, column_start, row_start, straddle_slot, straddle_slots,
-                     straddle_cov, display, env, env_data, lights);
+                     straddle_cov, display, sub_alpha, env, env_data, lights);
   const size_t screen_tiles = size_t(P.tiles_x) * P.tiles_y;
   ev.add(kFine, launch(k_fine_encode, screen_tiles, 1));
   straddle_alpha_stage(k_straddle_alpha, ev);
@@ -713,6 +714,12 @@ void Pipeline::read_display(std::vector<uint16_t>& out) const {
   impl_->rt.read(impl_->display, out.data(), display_bytes());
 }
 
+void Pipeline::read_sub_alpha(std::vector<uint16_t>& out) const {
+  if (!impl_->encode) throw Error("internal error: no display configured");
+  out.resize(display_bytes() / 8 * 3);
+  impl_->rt.read(impl_->sub_alpha, out.data(), display_bytes() / 4 * 3);
+}
+
 void Pipeline::read_debug(std::vector<uint32_t>& keys, std::vector<float>& depth, std::vector<uint32_t>& count) const {
   if (!config_.debug_outputs) throw Error("internal error: debug outputs are off");
   const size_t n = impl_->debug_entries;
@@ -729,7 +736,7 @@ size_t Pipeline::device_bytes() const {
   size_t total = 0;
   for (const ClBuffer* b : {&m.positions, &m.attrs, &m.tris, &m.materials, &m.textures, &m.texels, &m.lut, &m.params_buf,
                             &m.encode_buf, &m.vertices, &m.pmr_vertices, &m.mtas, &m.mta_counter, &m.tile_counts,
-                            &m.tile_offsets, &m.tile_queue, &m.volume, &m.display, &m.encode_columns, &m.encode_rows, &m.dbg_key, &m.dbg_depth, &m.dbg_count,
+                            &m.tile_offsets, &m.tile_queue, &m.volume, &m.display, &m.sub_alpha, &m.encode_columns, &m.encode_rows, &m.dbg_key, &m.dbg_depth, &m.dbg_count,
                             &m.column_start, &m.column_soa, &m.row_start, &m.straddle_slot, &m.straddle_columns, &m.straddle_cov,
                             &m.chunks, &m.sample_x, &m.sample_y, &m.column_a, &m.column_b, &m.eyes, &m.split_sum, &m.env, &m.env_data,
                             &m.lights})

@@ -125,6 +125,8 @@ class Pipeline {
   // Read-back of the last frame. Volume: [view][y][x][RGBA] halves. Display: [y][x][RGBA] halves.
   void read_volume(std::vector<uint16_t>& out) const;
   void read_display(std::vector<uint16_t>& out) const;
+  // Each display subpixel's own alpha: [y][x][k] halves, k = 0, 1, 2 (the EXR's AR, AG, AB).
+  void read_sub_alpha(std::vector<uint16_t>& out) const;
   // Requires debug_outputs: per voxel the winning key (PMR_NO_KEY if empty), depth and coverage count
   // (with --sampling subpixel and no view volume: per display subpixel, and no count).
   void read_debug(std::vector<uint32_t>& keys, std::vector<float>& depth, std::vector<uint32_t>& count) const;

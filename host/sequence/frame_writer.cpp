@@ -124,8 +124,8 @@ void FrameWriter::run() {
       if (error && !error_) error_ = error;
       if (interrupt_signal()) queue_.clear();  // nothing more is written after an interrupt
       if (done) ++written_, seconds_ += s, cpu_seconds_ += cpu, bytes_ += bytes;
-      for (std::vector<uint16_t>* b : {&f.display, &f.volume})
-        if (!b->empty() && spare_.size() < 4) spare_.push_back(std::move(*b));
+      for (std::vector<uint16_t>* b : {&f.display, &f.volume, &f.sub_alpha})
+        if (!b->empty() && spare_.size() < 6) spare_.push_back(std::move(*b));
     }
     changed_.notify_all();
   }
@@ -159,10 +159,12 @@ void FrameWriter::write(FrameFiles& f) {
   auto done = [&](const std::string& path) { committed.push_back(path); };
   const ExrMetadata* meta = f.has_meta ? &f.meta : nullptr;
   try {
+    if (!f.display.empty()) composite_encoded(f.display.data(), f.sub_alpha.data(), f.display.size() / 4, f.background);
+    if (!f.volume.empty()) composite_rgba(f.volume.data(), f.volume.size() / 4, f.background);
     if (!f.encoded_path.empty()) {
       check();
       write_rgba_exr(f.encoded_path, f.display_w, f.display_h, f.display.data(), f.compression, exr_threads_, nullptr,
-                     1.0f, meta, ExrImage::Encoded);
+                     1.0f, meta, ExrImage::Encoded, f.sub_alpha.empty() ? nullptr : f.sub_alpha.data());
       done(f.encoded_path);
     }
     if (!f.depth.empty()) {
@@ -205,7 +207,7 @@ void FrameWriter::write(FrameFiles& f) {
     }
     if (!f.quilt_png.empty()) {
       check();
-      write_png_preview(f.quilt_png, qw, qh, quilt.data(), f.pixel_aspect);  // tiles as rendered
+      write_png_preview(f.quilt_png, qw, qh, quilt.data(), f.pixel_aspect, f.quilt_png_opaque);  // tiles as rendered
       done(f.quilt_png);
     }
     // last, the sidecar with what was written: from here on the frame is complete

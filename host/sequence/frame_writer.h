@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "output/background.h"
 #include "pmr/output.h"
 #include "pmr/quilt.h"
 #include "pmr/rig.h"
@@ -31,6 +32,7 @@ struct FrameFiles {
   Display sidecar_display;
   std::string encoded_path, encoded_png;
   std::vector<uint16_t> display;           // half RGBA, display_w x display_h
+  std::vector<uint16_t> sub_alpha;         // each display subpixel's alpha: [y][x][3] halves (AR, AG, AB)
   int display_w = 0, display_h = 0;
   std::string views_path, quilt_path, quilt_png, center_png;
   std::vector<uint16_t> volume;            // half RGBA, views x view_h x view_w
@@ -46,6 +48,10 @@ struct FrameFiles {
   // The frame's EXR header attributes (docs/OUTPUTS.md): every EXR of the frame gets them when
   // has_meta; the writer builds each header from it (a rig and a few numbers, no image data).
   bool has_meta = false;
+  // Composited over this before anything is written (output/background.h); the quilt PNG is made opaque
+  // (over black) with quilt_png_opaque.
+  Background background;
+  bool quilt_png_opaque = false;
   ExrMetadata meta;
 };
 

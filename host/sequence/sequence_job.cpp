@@ -194,6 +194,8 @@ void SequenceRun::prepare_frames() {
   info.scene_checksum = scene_.source_checksum;
   for (const SceneInputFile& f : scene_.input_files) info.scene_files.push_back({f.path, f.checksum});
   info.allow_outside_scene_folder = job_.input_limits.allow_outside_scene_folder;
+  if (!job_.background.transparent())
+    info.background = {job_.background.r, job_.background.g, job_.background.b, job_.background.a};
   if (job_.calibration) {
     const LookingGlassCalibration& c = *job_.calibration;
     info.display_config_checksum = c.checksum;
@@ -266,6 +268,8 @@ FrameFiles SequenceRun::frame_files(long f, const FrameRenderer::Frame& fr, Pipe
   files.sidecar_rig = fr.rig;
   files.sidecar_display = job_.display;
   files.has_meta = true;  // the EXR header attributes (docs/OUTPUTS.md)
+  files.background = job_.background;
+  files.quilt_png_opaque = job_.quilt_preview_opaque && job_.background.transparent();
   files.meta.frame = f, files.meta.time = double(f) / spec_.fps, files.meta.fps = spec_.fps;
   files.meta.sidecar = base_name(p.sidecar), files.meta.rig = fr.rig;
   files.meta.center_view = center_view_, files.meta.quilt = quilt_;
@@ -273,8 +277,14 @@ FrameFiles SequenceRun::frame_files(long f, const FrameRenderer::Frame& fr, Pipe
     files.encoded_path = p.encoded;
     files.display_w = job_.display.width, files.display_h = job_.display.height;
     files.display = writer.spare_buffer();
-    if (renderer_->has_geometry()) pipeline.read_display(files.display);
-    else files.display.assign(size_t(job_.display.width) * job_.display.height * 4, 0);
+    files.sub_alpha = writer.spare_buffer();
+    if (renderer_->has_geometry()) {
+      pipeline.read_display(files.display);
+      pipeline.read_sub_alpha(files.sub_alpha);
+    } else {
+      files.display.assign(size_t(job_.display.width) * job_.display.height * 4, 0);
+      files.sub_alpha.assign(size_t(job_.display.width) * job_.display.height * 3, 0);
+    }
   }
   files.encoded_png = p.encoded_png;
   if (need_volume_) {

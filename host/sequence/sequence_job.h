@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "output/background.h"
 #include "pipeline/pipeline.h"
 #include "pmr/display_presets.h"
 #include "pmr/input_files.h"
@@ -43,6 +44,8 @@ struct SequenceJob {
   bool resume = false, overwrite = false;
   bool quiet = false, verbose = false;
   std::vector<std::string> warnings;  // printed before the work starts (e.g. from the options)
+  Background background;              // behind every output (output/background.h)
+  bool quilt_preview_opaque = false;  // the quilt PNG over opaque black when no background is given
 };
 
 // Runs the job; returns the process exit code (0, or 128 + signal when interrupted). Throws pmr::Error

@@ -71,10 +71,13 @@ struct ExrMetadata {
 // threads > 0 sets OpenEXR's global thread count used for compression (Imf::setGlobalThreadCount).
 // depth (optional, [y][x] floats) adds a FLOAT channel "Z"; pixel_aspect is the header's
 // pixelAspectRatio (a quilt of non-square view pixels). meta (optional) adds the frame's attributes for
-// an image of kind `image` (Encoded or Quilt).
+// an image of kind `image` (Encoded or Quilt). subpixel_alpha (optional, [y][x][3] halves) adds the
+// half channels AR, AG, AB: OpenEXR's per-channel alpha, each colour channel's own coverage (the
+// encoded image: each subpixel's; docs/OUTPUTS.md).
 void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half,
                     ExrCompression c, int threads = 0, const float* depth = nullptr, float pixel_aspect = 1.0f,
-                    const ExrMetadata* meta = nullptr, ExrImage image = ExrImage::Encoded);
+                    const ExrMetadata* meta = nullptr, ExrImage image = ExrImage::Encoded,
+                    const uint16_t* subpixel_alpha = nullptr);
 
 
 // The name of part i of a views file with `views` parts: view_000, view_001, ... with 3 digits, or as
@@ -184,6 +187,7 @@ struct SidecarInfo {
   std::string environment_file, environment_checksum;
   double environment_rotation_deg = 0.0;
   bool allow_outside_scene_folder = false;  // --allow-outside-scene-folder: recorded only when given
+  std::vector<double> background;     // --background as linear R, G, B, A; empty: transparent (not recorded)
 };
 
 // The sidecar's JSON text (pretty printed, doubles with round-trip precision).

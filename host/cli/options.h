@@ -62,6 +62,9 @@ struct RenderOptions {
   // --limit KEY=VALUE,... and --allow-outside-scene-folder (docs/SECURITY.md)
   InputLimits input_limits;
   bool zoom_given = false;     // --zoom was on the command line (rig.zoom)
+  // --sampling was on the command line; else pipeline.sampling is the preset's default, and subpixel
+  // sampling gives way to view sampling (with a notice) where other options need the views
+  bool sampling_given = false;
 };
 
 // Parses the arguments after `render`. Throws pmr::Error with one line on bad input.

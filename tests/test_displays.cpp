@@ -243,6 +243,11 @@ TEST(Displays, CliRendersForALookingGlassPanel) {
   const Display want = display_from_calibration(read_looking_glass_calibration(dir + "/visual.json", nullptr));
   const std::string sidecar = test::read_file(dir + "/o/frame_0000.json");
   EXPECT_NE(sidecar.find("\"offset_fraction\": \"" + to_string(want.offset) + "\""), std::string::npos) << sidecar;
+  // an LKG-P panel renders as its preset does: angular spacing through PMR, subpixel sampling
+  EXPECT_NE(sidecar.find("\"camera_spacing\": \"angular\""), std::string::npos);
+  EXPECT_NE(sidecar.find("\"method\": \"pmr\""), std::string::npos);
+  EXPECT_NE(sidecar.find("\"sampling\": \"subpixel\""), std::string::npos);
+  EXPECT_EQ(r.output.find("multipass"), std::string::npos) << r.output;
   const test::CliRun pr = test::run("render --preset lg-portrait --view-size 42x56 --out " + dir + "/p");
   ASSERT_EQ(pr.status, 0) << pr.output;
   EXPECT_NE(test::read_file(dir + "/p/frame_0000.json")

@@ -307,6 +307,27 @@ TEST(SubpixelSampling, CommandLine) {
   EXPECT_NE(sidecar.find("\"sampling\": \"subpixel\""), std::string::npos);
   EXPECT_NE(sidecar.find("\"camera_spacing\": \"angular\""), std::string::npos);
   EXPECT_NE(sidecar.find("\"method\": \"pmr\""), std::string::npos);
+  // lg-portrait defaults to subpixel sampling; options that need the views turn the default (not an
+  // explicit --sampling subpixel) back to view sampling, with one line of notice
+  const std::string lg_small = " --preset lg-portrait --views 6 --view-size 42x56 --display 153x204 --out ";
+  const test::CliRun def = test::run("render" + lg_small + lg + "/default");
+  ASSERT_EQ(def.status, 0) << def.output;
+  EXPECT_NE(test::read_file(lg + "/default/frame_0000.json").find("\"sampling\": \"subpixel\""), std::string::npos);
+  for (const std::string opt : {"--bilinear", "--blend-views", "--method multipass"}) {
+    const std::string dir = lg + "/fallback" + std::to_string(opt.size());
+    const test::CliRun f = test::run("render " + opt + lg_small + dir);
+    ASSERT_EQ(f.status, 0) << f.output;
+    EXPECT_NE(f.output.find("warning: " + opt + " samples the rendered views: --sampling view instead"), std::string::npos)
+        << f.output;
+    EXPECT_NE(test::read_file(dir + "/frame_0000.json").find("\"sampling\": \"view\""), std::string::npos) << opt;
+    test::expect_one_error_line(test::run("render --sampling subpixel " + opt + lg_small + dir + "x"),
+                                opt == "--method multipass" ? "--method pmr" : opt);
+  }
+  // pmr bench --preset measures the preset as a user gets it: angular spacing, subpixel sampling
+  const test::CliRun b = test::run("bench --preset lg-portrait --views 2 --view-size 42x56 --frames 1 --no-check --method pmr");
+  ASSERT_EQ(b.status, 0) << b.output;
+  EXPECT_NE(b.output.find("pmr        subpixel"), std::string::npos) << b.output;
+  EXPECT_EQ(b.output.find("pmr        view"), std::string::npos) << b.output;
   // --resume keeps frames of the same sampling and refuses another
   EXPECT_EQ(test::run("render --sampling subpixel --write encoded,views --resume" + small).status, 0);
   test::expect_one_error_line(test::run("render --write encoded,views --resume" + small), "sampling differs");

@@ -15,32 +15,35 @@
 inline long min3l(long a, long b, long c) { return min(a, min(b, c)); }
 inline long max3l(long a, long b, long c) { return max(a, max(b, c)); }
 
-/* Max over the 8 corners of sign * E_ab - bias (>= 0 means the tile may hold a covered voxel).
+/* Max over the 8 corners of sign * E_ab - bias (>= 0 means the tile may hold a covered voxel); i0 and
+ * i1 are the view coordinates of the slab's end views (E is multilinear in the view coordinate, which
+ * grows with the view index), f_lo that of the MTA's first view.
  * sign * E is linear in X with the coefficient sign * dy, the same at every corner, and for a fixed
  * view linear in Y with the coefficient -sign * dx(i): so the maximum over the box is at X1 or X0 by
  * the sign of the first, and per end view at Y1 or Y0 by the sign of the second. Two evaluations
  * instead of eight, the same answer. */
-inline bool edge_may_pass(const PmrMta* m, int a, int b, long X0, long X1, long Y0, long Y1, int i0, int i1) {
-  const long bias = mta_edge_bias(m, a, b);
+inline bool edge_may_pass(const PmrMta* m, int a, int b, long X0, long X1, long Y0, long Y1, long i0, long i1,
+                          long f_lo) {
+  const long bias = mta_edge_bias(m, a, b, f_lo);
   const long s = m->sign;
   const long X = s * (long)(m->y[b] - m->y[a]) >= 0 ? X1 : X0;
-  const long dx0 = (long)m->x0[b] + (long)i0 * m->dx[b] - (long)m->x0[a] - (long)i0 * m->dx[a];
-  const long dx1 = (long)m->x0[b] + (long)i1 * m->dx[b] - (long)m->x0[a] - (long)i1 * m->dx[a];
+  const long dx0 = (long)m->x0[b] + i0 * m->dx[b] - (long)m->x0[a] - i0 * m->dx[a];
+  const long dx1 = (long)m->x0[b] + i1 * m->dx[b] - (long)m->x0[a] - i1 * m->dx[a];
   const long best = max(s * mta_edge(m, a, b, X, -s * dx0 >= 0 ? Y1 : Y0, i0),
                         s * mta_edge(m, a, b, X, -s * dx1 >= 0 ? Y1 : Y0, i1));
   return best >= bias;
 }
 
-/* The MTA's x extent [lo, hi] in view i. */
-inline void x_extent(const PmrMta* m, int i, long* lo, long* hi) {
-  const long xa = (long)m->x0[0] + (long)i * m->dx[0], xb = (long)m->x0[1] + (long)i * m->dx[1];
-  const long xc = (long)m->x0[2] + (long)i * m->dx[2];
+/* The MTA's x extent [lo, hi] in the view with view coordinate i. */
+inline void x_extent(const PmrMta* m, long i, long* lo, long* hi) {
+  const long xa = (long)m->x0[0] + i * m->dx[0], xb = (long)m->x0[1] + i * m->dx[1];
+  const long xc = (long)m->x0[2] + i * m->dx[2];
   *lo = min3l(xa, xb, xc);
   *hi = max3l(xa, xb, xc);
 }
 
-/* The MTA's x extent in view i reaches the sample range [X0, X1]. */
-inline bool in_view(const PmrMta* m, int i, long X0, long X1) {
+/* The MTA's x extent in the view with view coordinate i reaches the sample range [X0, X1]. */
+inline bool in_view(const PmrMta* m, long i, long X0, long X1) {
   long lo, hi;
   x_extent(m, i, &lo, &hi);
   return hi >= X0 && lo <= X1;
@@ -51,11 +54,12 @@ inline bool in_view(const PmrMta* m, int i, long X0, long X1) {
   for (int tv = (m).view_lo / PMR_TILE_V; tv <= (m).view_hi / PMR_TILE_V; ++tv) {                   \
     const int i0 = max((m).view_lo, tv * PMR_TILE_V);                                                \
     const int i1 = min((m).view_hi, tv * PMR_TILE_V + PMR_TILE_V - 1);                               \
-    /* x range over the slab: each vertex's x is linear in the view, so the extremes are at its end \
-     * views; per view only when the views are more than a tile apart (in_view below) */             \
+    const long f0 = view_coord((P), i0), f1 = view_coord((P), i1), f_lo = view_coord((P), (m).view_lo); \
+    /* x range over the slab: each vertex's x is linear in the view coordinate, so the extremes are at \
+     * its end views; per view only when the views are more than a tile apart (in_view below) */      \
     long lo0, hi0, lo1, hi1;                                                                         \
-    x_extent(&(m), i0, &lo0, &hi0);                                                                  \
-    x_extent(&(m), i1, &lo1, &hi1);                                                                  \
+    x_extent(&(m), f0, &lo0, &hi0);                                                                  \
+    x_extent(&(m), f1, &lo1, &hi1);                                                                  \
     const long xlo = min(lo0, lo1), xhi = max(hi0, hi1);                                             \
     const bool sheared = (xhi - xlo) - (hi0 - lo0) > (long)PMR_TILE_X * PMR_X_ONE;                   \
     const long ylo = min3l((m).y[0], (m).y[1], (m).y[2]), yhi = max3l((m).y[0], (m).y[1], (m).y[2]); \
@@ -76,11 +80,11 @@ inline bool in_view(const PmrMta* m, int i, long X0, long X1) {
         const long X1 = (long)min(px1, tx * PMR_TILE_X + PMR_TILE_X - 1) * PMR_X_ONE + shi_x;        \
         bool in_some_view = !sheared;                                                                \
         for (int i = i0; i <= i1 && !in_some_view; ++i)                                              \
-          in_some_view = in_view(&(m), i, X0, X1);                                                   \
+          in_some_view = in_view(&(m), view_coord((P), i), X0, X1);                                  \
         if (in_some_view &&                                                                          \
-            edge_may_pass(&(m), 1, 2, X0, X1, Y0, Y1, i0, i1) &&                                     \
-            edge_may_pass(&(m), 2, 0, X0, X1, Y0, Y1, i0, i1) &&                                     \
-            edge_may_pass(&(m), 0, 1, X0, X1, Y0, Y1, i0, i1)) {                                     \
+            edge_may_pass(&(m), 1, 2, X0, X1, Y0, Y1, f0, f1, f_lo) &&                               \
+            edge_may_pass(&(m), 2, 0, X0, X1, Y0, Y1, f0, f1, f_lo) &&                               \
+            edge_may_pass(&(m), 0, 1, X0, X1, Y0, Y1, f0, f1, f_lo)) {                               \
           BIN_EMIT(((uint)tv * (P)->tiles_y + (uint)ty) * (P)->tiles_x + (uint)tx);                  \
         }                                                                                            \
       }                                                                                              \

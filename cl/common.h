@@ -66,9 +66,11 @@ inline void project_vertex(global const PmrParams* P, double xv, double yv, doub
   const double x_center = (xc / w + 1.0) * half_w;
   double x_first = x_center, d = 0.0;
   if (P->views > 1) {
+    /* x at view coordinate 0 (view 0 if linear: anchor -1/2; the center camera if angular: anchor 0)
+     * and the disparity per view coordinate unit */
     const double delta = P->disparity_k * (1.0 - P->focal / w); /* Delta(w), px */
-    x_first = x_center - 0.5 * delta;
-    d = delta / (double)(P->views - 1);
+    x_first = x_center + P->view_anchor * delta;
+    d = delta / P->view_scale;
   }
   const double y = (1.0 - yc / w) * half_h;
   out->x0 = (int)clamp(floor(x_first * (double)PMR_X_ONE + 0.5), -2.0e9, 2.0e9);
@@ -78,29 +80,42 @@ inline void project_vertex(global const PmrParams* P, double xv, double yv, doub
   out->inv_w = (float)(1.0 / w);
 }
 
-/* Edge function of edge (a -> b) of an MTA at raster point (X, Y) (16.16 / 24.8) in view i:
- *   E = (yb - ya) (X - xa(i)) - (xb(i) - xa(i)) (Y - ya),   xa(i) = x0a + i * dxa.
- * Units are 2^-24 px^2. Multilinear in (X, Y, i). */
-inline long mta_edge(const PmrMta* m, int a, int b, long X, long Y, int i) {
-  const long xa = (long)m->x0[a] + (long)i * (long)m->dx[a];
-  const long xb = (long)m->x0[b] + (long)i * (long)m->dx[b];
+/* The view coordinate F_i of view i (pmr/shared.h): x_i = x0 + F_i dx. F_i = i with linear spacing. */
+inline long view_coord(global const PmrParams* P, int i) { return (long)P->view_coord[i]; }
+
+/* The view coordinates of views ib .. ib + 15 relative to view ib's, lanes from `count` on clamped to
+ * the span of the first `count` (the table has slack past the last view, so the load stays inside). */
+inline int16 view_coord_lanes(global const PmrParams* P, int ib, int count, long* span) {
+  const int16 f = vload16(0, P->view_coord + ib) - (int16)(P->view_coord[ib]);
+  *span = (long)P->view_coord[ib + count - 1] - (long)P->view_coord[ib];
+  return min(f, (int16)((int)*span)); /* lanes past `count` never exceed the span */
+}
+
+/* Edge function of edge (a -> b) of an MTA at raster point (X, Y) (16.16 / 24.8) in the view with view
+ * coordinate f:
+ *   E = (yb - ya) (X - xa(f)) - (xb(f) - xa(f)) (Y - ya),   xa(f) = x0a + f * dxa.
+ * Units are 2^-24 px^2. Multilinear in (X, Y, f); the view coordinate grows with the view index, so
+ * over a range of views E's extremes are at the range's end views. */
+inline long mta_edge(const PmrMta* m, int a, int b, long X, long Y, long f) {
+  const long xa = (long)m->x0[a] + f * (long)m->dx[a];
+  const long xb = (long)m->x0[b] + f * (long)m->dx[b];
   return (long)(m->y[b] - m->y[a]) * (X - xa) - (xb - xa) * (Y - (long)m->y[a]);
 }
 
 /* Top-left fill rule. With the edge functions multiplied by m->sign the inside is >= 0; an edge owns
  * the pixel centers lying exactly on it only if it is a top or a left edge, so the test is
  * sign * E >= bias with bias 0 for top/left edges and 1 otherwise. Within one MTA the orientation is
- * constant, so the classification (evaluated at view_lo) holds for all its views. */
-inline long mta_edge_bias(const PmrMta* m, int a, int b) {
+ * constant, so the classification (evaluated at view_lo, view coordinate f_lo) holds for all its views. */
+inline long mta_edge_bias(const PmrMta* m, int a, int b, long f_lo) {
   const long dy = (long)(m->y[b] - m->y[a]) * m->sign;
-  const long i = m->view_lo;
+  const long i = f_lo;
   const long dx = ((long)m->x0[b] + i * (long)m->dx[b] - (long)m->x0[a] - i * (long)m->dx[a]) * m->sign;
   /* inside is where sign*E >= 0, i.e. the interior normal is (dy, -dx): a left edge has dy > 0,
    * a top edge (raster y grows downwards) is horizontal with dx < 0. */
   return (dy > 0 || (dy == 0 && dx < 0)) ? 0 : 1;
 }
 
-/* Depth plane of an MTA in view i. Depth is linear in screen space (DESIGN section 3); it is
+/* Depth plane of an MTA in view i (given by its view coordinate). Depth is linear in screen space (DESIGN section 3); it is
  * evaluated per voxel as a plane anchored at vertex 0's pixel (pr, qr), so that a row of voxels costs
  * one float multiply-add per voxel and the value depends on the MTA, the view and the voxel alone
  * (never on the tile that computes it):
@@ -115,7 +130,7 @@ typedef struct {
   int pr, qr; /* vertex 0's pixel */
 } DepthPlane;
 
-inline DepthPlane depth_plane(const PmrMta* m, int i) {
+inline DepthPlane depth_plane(const PmrMta* m, long i) { /* i: the view's view coordinate */
   const long x0 = (long)m->x0[0] + (long)i * m->dx[0];
   const long x1 = (long)m->x0[1] + (long)i * m->dx[1];
   const long x2 = (long)m->x0[2] + (long)i * m->dx[2];

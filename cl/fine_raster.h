@@ -64,23 +64,26 @@ inline vint mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, vint win, l
 /* Bit l set: in view ib + l (l < count) some pixel-center column of the tile (first center X0, nx
  * columns) lies within the MTA's x extent. Views failing it cannot hold a covered voxel; a sub-pixel
  * MTA passes in an irregular part of the views, so testing 16 views at once (lanes = views) replaces
- * 16 unpredictable branches. Vertex x relative to X0 in 32 bits when that provably fits, else every
- * view is passed on (the edge tests decide exactly either way). Arithmetic shifts floor. */
-inline uint view_pass_mask(const PmrMta* m, int ib, int count, long X0, int nx) {
+ * 16 unpredictable branches. Vertex x relative to X0 in 32 bits when that provably fits (base and
+ * disparity each below 2^29 over the views), else every view is passed on (the edge tests decide
+ * exactly either way). Arithmetic shifts floor. */
+inline uint view_pass_mask(global const PmrParams* P, const PmrMta* m, int ib, int count, long X0, int nx) {
   const uint all = (1u << count) - 1u; /* count <= 16 */
+  long span;
+  const int16 l = view_coord_lanes(P, ib, count, &span);
+  const long fib = view_coord(P, ib);
   long base[3];
   bool fits = true;
   for (int k = 0; k < 3; ++k) {
-    base[k] = (long)m->x0[k] + (long)ib * m->dx[k] - X0;
-    fits = fits && base[k] > -(1L << 29) && base[k] < (1L << 29) && abs(m->dx[k]) < (1 << 25);
+    base[k] = (long)m->x0[k] + fib * m->dx[k] - X0;
+    fits = fits && base[k] > -(1L << 29) && base[k] < (1L << 29) && (long)abs(m->dx[k]) * span < (1L << 29);
   }
   if (!fits) return all;
-  const int16 l = vload16(0, fine_lane_index);
   const int16 xa = (int16)((int)base[0]) + l * m->dx[0], xb = (int16)((int)base[1]) + l * m->dx[1];
   const int16 xc = (int16)((int)base[2]) + l * m->dx[2];
   const int16 kmax = max(xa, max(xb, xc)) >> PMR_X_FRAC_BITS;
   const int16 kmin = -((-min(xa, min(xb, xc))) >> PMR_X_FRAC_BITS);
-  const int16 bits = select((int16)(0), (int16)(1) << l, max(kmin, 0) <= min(kmax, nx - 1));
+  const int16 bits = select((int16)(0), (int16)(1) << vload16(0, fine_lane_index), max(kmin, 0) <= min(kmax, nx - 1));
   int8 r8 = bits.lo | bits.hi;
   int4 r4 = r8.lo | r8.hi;
   int2 r2 = r4.lo | r4.hi;
@@ -114,8 +117,10 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     long bias[3], G[3];
     bool narrow[3];
     vint ramp[3];
+    const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
+    const long f_lo = view_coord(in->P, i_lo), f_first = view_coord(in->P, m.view_lo);
     for (int e = 0; e < 3; ++e) {
-      bias[e] = mta_edge_bias(&m, ea[e], eb[e]);
+      bias[e] = mta_edge_bias(&m, ea[e], eb[e], f_first);
       G[e] = (long)m.sign * (long)(m.y[eb[e]] - m.y[ea[e]]) * PMR_Y_ONE;
       narrow[e] = (G[e] < 0 ? -G[e] : G[e]) * (VW - 1) < (long)INT_MAX;
       ramp[e] = narrow[e] ? (vint)((int)G[e]) * lane : (vint)(0);
@@ -124,17 +129,16 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));
     const int ly0 = (int)max(0L, -floor_div_l(Y0 - ylo, PMR_Y_ONE));
     const int ly1 = (int)min((long)ny - 1, floor_div_l(yhi - Y0, PMR_Y_ONE));
-    const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
     if (ly0 > ly1 || i_lo > i_hi) continue;
     const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
-    /* Every per-view quantity is linear in the view index i (x_k(i) = x0_k + i dx_k): the edge
+    /* Every per-view quantity is linear in the view coordinate f (x_k(f) = x0_k + f dx_k): the edge
      * functions at the tile's first row (row) and their row step (step_y) at view i are those at view
-     * i_lo plus (i - i_lo) exact integer increments. */
+     * i_lo plus (f_i - f_lo) exact integer increments. */
     const long Yfirst = Y0 + (long)ly0 * PMR_Y_ONE;
     long row_v[3], drow_v[3], step_y_v[3], dstep_y[3], step_c[3];
     for (int e = 0; e < 3; ++e) {
       const int a = ea[e], b = eb[e];
-      const long xa = (long)m.x0[a] + (long)i_lo * m.dx[a], xb = (long)m.x0[b] + (long)i_lo * m.dx[b];
+      const long xa = (long)m.x0[a] + f_lo * m.dx[a], xb = (long)m.x0[b] + f_lo * m.dx[b];
       const long dy = (long)(m.y[b] - m.y[a]), ddx = (long)m.dx[b] - (long)m.dx[a];
       row_v[e] = m.sign * (dy * (X0 - xa) - (xb - xa) * (Yfirst - (long)m.y[a]));
       drow_v[e] = -m.sign * (dy * (long)m.dx[a] + ddx * (Yfirst - (long)m.y[a]));
@@ -143,11 +147,11 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
       step_c[e] = m.sign * dy * ((long)PMR_X_ONE * VW);
     }
     for (int ib = i_lo; ib <= i_hi; ib += 16) {
-      uint pass = view_pass_mask(&m, ib, min(i_hi - ib + 1, 16), X0, nx);
+      uint pass = view_pass_mask(in->P, &m, ib, min(i_hi - ib + 1, 16), X0, nx);
       while (pass != 0) { /* the passing views, lowest first */
         const int i = ib + (31 - (int)clz(pass & (0u - pass)));
         pass &= pass - 1u;
-        const long di = (long)(i - i_lo);
+        const long fi = view_coord(in->P, i), di = fi - f_lo;
         long row[3] = {row_v[0] + di * drow_v[0], row_v[1] + di * drow_v[1], row_v[2] + di * drow_v[2]};
         const long step_y[3] = {step_y_v[0] + di * dstep_y[0], step_y_v[1] + di * dstep_y[1],
                                 step_y_v[2] + di * dstep_y[2]};
@@ -162,7 +166,7 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
             hit &= edge_lanes(row[1] + c * step_c[1], bias[1], G[1], ramp[1], narrow[1], lane);
             hit &= edge_lanes(row[2] + c * step_c[2], bias[2], G[2], ramp[2], narrow[2], lane);
             if (!any(hit)) continue;
-            if (!have_plane) dp = depth_plane(&m, i), have_plane = true;
+            if (!have_plane) dp = depth_plane(&m, fi), have_plane = true;
             if (!have_zrow) zrow = (float)(dp.zr + dp.gy * (double)(y0 + ly - dp.qr)), have_zrow = true;
             const vfloat z = (vfloat)(zrow) + (vfloat)(dp.gx) * convert_vfloat(lane + (x0 + c * VW - dp.pr));
             const int r = ((i - vbase) * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
@@ -210,7 +214,7 @@ inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, M
       const PmrMta* m = cached_mta(cache, mtas, id);
       lanes_add(&L, in, m, take, bits, pbr);
       long E[3], step[3];
-      mta_edges_at(m, (long)(px0 + h + f) * PMR_X_ONE + PMR_HALF_X, Y, view, E);
+      mta_edges_at(m, (long)(px0 + h + f) * PMR_X_ONE + PMR_HALF_X, Y, view_coord(in->P, view), E);
       mta_edge_steps(m, step);
       lanes_step_edges(&L, take, f, E, step);
     }

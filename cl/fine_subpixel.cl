@@ -28,13 +28,13 @@
 
 constant int sp_lane_index[SP_LANES] = {0, 1, 2, 3, 4, 5, 6, 7};
 
-/* The exact edge functions of MTA m at the samples (Xc + sx[l], Yc + sy[l]) of view v of the lanes in
- * `bits`, into e (per lane). */
-inline void sp_edges(const PmrMta* m, uint bits, const int* sx, const int* sy, long Xc, long Yc, int v, float (*e)[SW]) {
+/* The exact edge functions of MTA m at the samples (Xc + sx[l], Yc + sy[l]) of the view with view
+ * coordinate f of the lanes in `bits`, into e (per lane). */
+inline void sp_edges(const PmrMta* m, uint bits, const int* sx, const int* sy, long Xc, long Yc, long f, float (*e)[SW]) {
   for (uint b = bits; b != 0u; b &= b - 1u) {
     const int l = 31 - (int)clz(b & (0u - b));
     long E[3];
-    mta_edges_at(m, Xc + sx[l], Yc + sy[l], v, E);
+    mta_edges_at(m, Xc + sx[l], Yc + sy[l], f, E);
     e[0][l] = (float)E[0], e[1][l] = (float)E[1], e[2][l] = (float)E[2];
   }
 }
@@ -55,7 +55,7 @@ inline void sp_winners(const ShadeInputs* in, global const PmrMta* mtas, MtaCach
     todo &= ~bits;
     const PmrMta* m = cached_mta(cache, mtas, (uint)ids[f]);
     lanes_add(L, in, m, take, bits, pbr);
-    sp_edges(m, bits, sx, sy, Xc, Yc, v, e);
+    sp_edges(m, bits, sx, sy, Xc, Yc, view_coord(in->P, v), e);
   }
   L->e = LANE3(e);
 }
@@ -72,22 +72,24 @@ inline int8 sp_mask_alpha(const ShadeInputs* in, const PmrMta* m, int8 win, cons
 }
 
 /* Bit l set: in view ib + l (l < n <= 16) the MTA's x extent reaches the chunk's samples, [0, span]
- * relative to the chunk's first sample. Vertex x in 32 bits when that provably fits, else every view
- * passes (the edge tests decide exactly either way). */
-inline uint sp_view_mask(const PmrMta* m, int ib, int n, long Xc, long span) {
+ * relative to the chunk's first sample. Vertex x in 32 bits when that provably fits (base and disparity
+ * each below 2^29 over the views), else every view passes (the edge tests decide exactly either way). */
+inline uint sp_view_mask(global const PmrParams* P, const PmrMta* m, int ib, int n, long Xc, long span) {
   const uint all = (1u << n) - 1u;
+  long fspan;
+  const int16 l = view_coord_lanes(P, ib, n, &fspan);
+  const long fib = view_coord(P, ib);
   long base[3];
   bool fits = span < (1L << 29);
   for (int k = 0; k < 3; ++k) {
-    base[k] = (long)m->x0[k] + (long)ib * m->dx[k] - Xc;
-    fits = fits && base[k] > -(1L << 29) && base[k] < (1L << 29) && abs(m->dx[k]) < (1 << 25);
+    base[k] = (long)m->x0[k] + fib * m->dx[k] - Xc;
+    fits = fits && base[k] > -(1L << 29) && base[k] < (1L << 29) && (long)abs(m->dx[k]) * fspan < (1L << 29);
   }
   if (!fits) return all;
-  const int16 l = (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
   const int16 xa = (int16)((int)base[0]) + l * m->dx[0], xb = (int16)((int)base[1]) + l * m->dx[1];
   const int16 xc = (int16)((int)base[2]) + l * m->dx[2];
   const int16 pass = (max(xa, max(xb, xc)) >= (int16)(0)) & (min(xa, min(xb, xc)) <= (int16)((int)span));
-  const int16 bits = select((int16)(0), (int16)(1) << l, pass);
+  const int16 bits = select((int16)(0), (int16)(1) << (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15), pass);
   const int8 r8 = bits.lo | bits.hi;
   const int4 r4 = r8.lo | r8.hi;
   const int2 r2 = r4.lo | r4.hi;
@@ -198,31 +200,33 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
       const int i_lo = max(v0, m.view_lo), i_hi = min(v1, m.view_hi);
       const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
       /* per edge: sign * dy, and bias - sign * E(Xc, Yc, v) and -sign * dx_ab(v) at view i_lo with their
-       * exact per-view increments (both are linear in v) */
+       * exact increments per unit of view coordinate (both are linear in it) */
+      const long f_lo = view_coord(P, i_lo), f_first = view_coord(P, m.view_lo);
       long t_lo[3], dt[3], dx_lo[3], ddx[3];
       double dy[3];
       for (int e = 0; e < 3; ++e) {
         const int a = ea[e], b = eb[e];
         const long sg = m.sign, d_y = (long)(m.y[b] - m.y[a]), d_dx = (long)m.dx[b] - (long)m.dx[a];
-        t_lo[e] = mta_edge_bias(&m, a, b) - sg * mta_edge(&m, a, b, Xc, Yc, i_lo);
+        t_lo[e] = mta_edge_bias(&m, a, b, f_first) - sg * mta_edge(&m, a, b, Xc, Yc, f_lo);
         dt[e] = sg * (d_y * (long)m.dx[a] + d_dx * (Yc - (long)m.y[a]));
-        dx_lo[e] = -sg * ((long)m.x0[b] - (long)m.x0[a] + (long)i_lo * d_dx);
+        dx_lo[e] = -sg * ((long)m.x0[b] - (long)m.x0[a] + f_lo * d_dx);
         ddx[e] = -sg * d_dx;
         dy[e] = (double)(sg * d_y);
       }
       const long my0 = ylo - Yc, my1 = yhi - Yc;
       for (int ib = i_lo; ib <= i_hi; ib += 16) {
-        uint pass = sp_view_mask(&m, ib, min(i_hi - ib + 1, 16), Xc, Xl - Xc);
+        uint pass = sp_view_mask(P, &m, ib, min(i_hi - ib + 1, 16), Xc, Xl - Xc);
         while (pass != 0) { /* the passing views, lowest first */
           const int v = ib + (31 - (int)clz(pass & (0u - pass)));
           pass &= pass - 1u;
           const int k0 = first[v], k1 = k0 + count[v];
           if (k0 == k1) continue;
           long xv[3];
-          for (int k = 0; k < 3; ++k) xv[k] = (long)m.x0[k] + (long)v * (long)m.dx[k];
+          const long fv = view_coord(P, v);
+          for (int k = 0; k < 3; ++k) xv[k] = (long)m.x0[k] + fv * (long)m.dx[k];
           const long mx0 = min(xv[0], min(xv[1], xv[2])) - Xc, mx1 = max(xv[0], max(xv[1], xv[2])) - Xc;
           double dx[3], T[3];
-          const long di = (long)(v - i_lo);
+          const long di = fv - f_lo;
           for (int e = 0; e < 3; ++e) {
             T[e] = (double)clamp(t_lo[e] + di * dt[e], -(1L << 48), 1L << 48);
             dx[e] = (double)(dx_lo[e] + di * ddx[e]);

@@ -41,4 +41,6 @@ kernel void layout_probe(global uint* out) {
   PROBE(41, PmrEnvironment, intensity);
   PROBE(42, PmrEnvironment, levels);
   out[43] = sizeof(PmrEnvLevel);
+  PROBE(44, PmrParams, view_anchor);
+  PROBE(45, PmrParams, view_coord);
 }

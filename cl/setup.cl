@@ -1,7 +1,7 @@
 /* Stage 2, primitive setup: one work-item per triangle. Culls conservatively against the union of the
  * N frusta, clips ONCE for all views (near, far and the guard band; all are linear in view space, so a
  * clipped vertex keeps an affine disparity), splits the view range by orientation (twice the signed
- * area is affine in the view index, so it flips at most once), and appends one MTA per (fan triangle,
+ * area is affine in the view coordinate, which grows with the view index, so it flips at most once), and appends one MTA per (fan triangle,
  * orientation) to the global MTA queue. A full queue is counted, not written: the host compares the
  * counter with the capacity, grows the queue and runs the frame again. */
 #include "common.h"
@@ -9,19 +9,34 @@
 #define CULL_BITS (PMR_CULL_LEFT | PMR_CULL_RIGHT | PMR_CULL_BOTTOM | PMR_CULL_TOP | PMR_CULL_NEAR | PMR_CULL_FAR)
 #define CLIP_BITS (PMR_CLIP_NEAR | PMR_CLIP_FAR | PMR_CLIP_GUARD)
 
-/* Views v in [0, n) with a0 + v a1 > 0, as [*lo, *hi] (empty when *lo > *hi). */
-inline void positive_views(long a0, long a1, int n, int* lo, int* hi) {
+/* The first view whose view coordinate is at least f (n if none): the coordinates increase with the
+ * view index. */
+inline int first_view_from(global const PmrParams* P, long f) {
+  int lo = 0, hi = P->views; /* the answer lies in [lo, hi] */
+  while (lo < hi) {
+    const int mid = (lo + hi) / 2;
+    if (view_coord(P, mid) >= f)
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  return lo;
+}
+
+/* Views v with a0 + F_v a1 > 0 (F_v the view coordinate), as [*lo, *hi] (empty when *lo > *hi): the
+ * coordinates where the affine function is positive form one interval, and so do its views. */
+inline void positive_views(global const PmrParams* P, long a0, long a1, int* lo, int* hi) {
+  const int n = P->views;
   *lo = 0;
   *hi = n - 1;
   if (a1 == 0) {
     if (a0 <= 0) *lo = n;
   } else if (a1 > 0) {
-    const long first = floor_div_l(-a0, a1) + 1;
-    if (first > *lo) *lo = first > n ? n : (int)first;
+    *lo = first_view_from(P, floor_div_l(-a0, a1) + 1);
   } else {
-    const long b = -a1; /* a0 - v b > 0  <=>  v < a0 / b */
+    const long b = -a1; /* a0 - f b > 0  <=>  f < a0 / b */
     const long last = -floor_div_l(-a0, b) - 1; /* ceil(a0 / b) - 1 */
-    if (last < *hi) *hi = last < -1 ? -1 : (int)last;
+    *hi = first_view_from(P, last + 1) - 1;
   }
 }
 
@@ -64,17 +79,17 @@ inline void emit_triangle(global const PmrParams* P, global PmrMta* mtas, volati
   }
   m.tri = tri;
   m.key = (tri << PMR_KEY_SUB_BITS) | sub;
-  /* Twice the signed area in view i, A(i) = E_ab(c) = a0 + i a1; A > 0 is counter-clockwise in NDC
-   * (raster y points down), i.e. front-facing. */
+  /* Twice the signed area at view coordinate f, A(f) = E_ab(c) = a0 + f a1; A > 0 is counter-clockwise
+   * in NDC (raster y points down), i.e. front-facing. */
   const long ya = m.y[0], yb = m.y[1], yc = m.y[2];
   const long a0 = (yb - ya) * ((long)m.x0[2] - m.x0[0]) - ((long)m.x0[1] - m.x0[0]) * (yc - ya);
   const long a1 = (yb - ya) * ((long)m.dx[2] - m.dx[0]) - ((long)m.dx[1] - m.dx[0]) * (yc - ya);
   const uint mflag = mask ? PMR_MTA_MASK : 0u;
   int lo, hi;
-  positive_views(a0, a1, P->views, &lo, &hi);
+  positive_views(P, a0, a1, &lo, &hi);
   emit_mta(P, mtas, counter, &m, lo, hi, 1, mflag);
   if (double_sided) {
-    positive_views(-a0, -a1, P->views, &lo, &hi);
+    positive_views(P, -a0, -a1, &lo, &hi);
     emit_mta(P, mtas, counter, &m, lo, hi, -1, mflag | PMR_MTA_BACK);
   }
 }

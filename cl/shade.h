@@ -191,8 +191,9 @@ inline uint lane_bits(sint take) {
   return (uint)(b2.x | b2.y);
 }
 
-/* The exact sign-corrected edge functions of MTA m at raster point (X, Y) (16.16 / 24.8) of view i. */
-inline void mta_edges_at(const PmrMta* m, long X, long Y, int i, long* E) {
+/* The exact sign-corrected edge functions of MTA m at raster point (X, Y) (16.16 / 24.8) of the view
+ * with view coordinate i. */
+inline void mta_edges_at(const PmrMta* m, long X, long Y, long i, long* E) {
   E[0] = (long)m->sign * mta_edge(m, 1, 2, X, Y, i);
   E[1] = (long)m->sign * mta_edge(m, 2, 0, X, Y, i);
   E[2] = (long)m->sign * mta_edge(m, 0, 1, X, Y, i);
@@ -421,8 +422,9 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
  * one voxel, scalar (the raster asks this of a few candidate voxels; its inputs are the same as the
  * lanes' base colour). */
 inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, long Y, int view, float cutoff) {
-  const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, view), m->sign * mta_edge(m, 2, 0, X, Y, view),
-                     m->sign * mta_edge(m, 0, 1, X, Y, view)};
+  const long f = view_coord(in->P, view);
+  const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, f), m->sign * mta_edge(m, 2, 0, X, Y, f),
+                     m->sign * mta_edge(m, 0, 1, X, Y, f)};
   const float pa = (float)e[0] * m->inv_w[0], pb = (float)e[1] * m->inv_w[1], pc = (float)e[2] * m->inv_w[2];
   const float inv = 1.0f / (pa + pb + pc);
   const float la = pa * inv, lb = pb * inv, lc = pc * inv;

@@ -16,14 +16,15 @@ kernel void vertex_transform(global const PmrParams* P, global const float* posi
   out[v] = r;
 }
 
-/* Test mode of the multipass baseline: view `view`'s snapped positions taken from PMR's vertex records
- * (x = x0 + view * dx, no disparity), so that a single-view pass sees exactly PMR's positions. */
-kernel void vertex_select_view(global const PmrParams* P, global const PmrVertex* pmr_verts, int view,
+/* Test mode of the multipass baseline: a view's snapped positions taken from PMR's vertex records
+ * (x = x0 + F dx with the view's view coordinate F, no disparity), so that a single-view pass sees
+ * exactly PMR's positions. */
+kernel void vertex_select_view(global const PmrParams* P, global const PmrVertex* pmr_verts, int coord,
                                global PmrVertex* out) {
   const uint v = pmr_item_id();
   if (v >= P->num_vertices) return;
   PmrVertex r = pmr_verts[v];
-  r.x0 += view * r.dx;
+  r.x0 = (int)((long)r.x0 + (long)coord * (long)r.dx);
   r.dx = 0;
   out[v] = r;
 }

@@ -1,5 +1,6 @@
 // Coverage properties of the whole pipeline: watertightness, the fill rule on exact pixel-center
-// hits, clipping (near plane, guard band, huge triangles), tile bins, and determinism.
+// hits, clipping (near plane, guard band, huge triangles), tile bins, and determinism, for linear and
+// angular camera spacing.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -31,8 +32,9 @@ size_t expect_matches_reference(const Scene& scene, const Rig& rig, const test::
 // A mesh of shared-edge triangles covering the whole screen in every view, vertices at varying depths:
 // every voxel of every view is covered exactly once.
 TEST(Coverage, WatertightMeshCoversEveryVoxelExactlyOnce) {
+  for (bool angular : test::kSpacings)
   for (int views : {1, 7, 96}) {
-    const Rig rig = test::small_rig(views, 61, 37);
+    const Rig rig = test::small_rig(views, 61, 37, angular);
     Scene s = test::empty_scene();
     const int G = 10;  // cells per side
     std::mt19937 rng(7);
@@ -78,7 +80,7 @@ TEST(Coverage, WatertightMeshCoversEveryVoxelExactlyOnce) {
     const test::Rendered out = test::render(s, rig);
     size_t bad = 0;
     for (size_t v = 0; v < out.count.size(); ++v) bad += out.count[v] != 1;
-    EXPECT_EQ(bad, 0u) << "voxels not covered exactly once with N = " << views;
+    EXPECT_EQ(bad, 0u) << "voxels not covered exactly once with N = " << views << ", " << test::spacing_name(angular);
     expect_matches_reference(s, rig, out);
   }
 }
@@ -87,7 +89,9 @@ TEST(Coverage, WatertightMeshCoversEveryVoxelExactlyOnce) {
 // so the positions are exact in every view): horizontal and vertical edges, shared edges, a fan
 // around a pixel center, sub-pixel and degenerate triangles.
 TEST(Coverage, FillRuleOnPixelCentersMatchesReference) {
-  const Rig rig = test::small_rig(5, 32, 16);
+  for (bool angular : test::kSpacings) {
+  SCOPED_TRACE(test::spacing_name(angular));
+  const Rig rig = test::small_rig(5, 32, 16, angular);
   Scene s = test::empty_scene();
   auto P = [&](double x, double y) { return test::focal_point(rig, x, y); };
   // a square split along its diagonal, corners on pixel centers
@@ -114,12 +118,15 @@ TEST(Coverage, FillRuleOnPixelCentersMatchesReference) {
   for (size_t v = 0; v < out.count.size(); ++v) EXPECT_LE(out.count[v], 1u) << "voxel " << v;
   // the fan covers its center pixel
   for (int i = 0; i < 5; ++i) EXPECT_EQ(out.count[(size_t(i) * 16 + 8) * 32 + 16], 1u);
+  }
 }
 
 // Near-plane crossing, behind-the-camera and guard-band-sized triangles against the reference.
 TEST(Coverage, ClippedTrianglesMatchReference) {
+  for (bool angular : test::kSpacings)
   for (int views : {1, 8, 96}) {
-    const Rig rig = test::small_rig(views, 40, 24);
+    SCOPED_TRACE(test::spacing_name(angular));
+    const Rig rig = test::small_rig(views, 40, 24, angular);
     Scene s = test::empty_scene(true);
     const float D = float(rig.focal);
     // a floor from behind the camera to beyond the far plane
@@ -139,8 +146,10 @@ TEST(Coverage, ClippedTrianglesMatchReference) {
 // Every tile that holds a covered voxel has the covering MTA in its queue.
 TEST(Coverage, TileBinsContainEveryCoveredVoxel) {
   const Scene scene = test::random_scene(50, 99, true);
+  for (bool angular : test::kSpacings)
   for (auto tile : {std::array<int, 3>{4, 4, 4}, std::array<int, 3>{8, 2, 3}, std::array<int, 3>{1, 1, 1}}) {
-    const Rig rig = test::small_rig(9, 37, 21);
+    SCOPED_TRACE(test::spacing_name(angular));
+    const Rig rig = test::small_rig(9, 37, 21, angular);
     PipelineConfig pc;
     pc.tile_x = tile[0], pc.tile_y = tile[1], pc.tile_v = tile[2];
     pc.debug_outputs = true;
@@ -186,7 +195,9 @@ TEST(Coverage, DeterministicAcrossRunsAndTileSizes) {
     PmrTriangle t = scene.triangles[size_t(i)];
     scene.triangles.push_back(t);
   }
-  const Rig rig = test::small_rig(12, 45, 27);
+  for (bool angular : test::kSpacings) {
+  SCOPED_TRACE(test::spacing_name(angular));
+  const Rig rig = test::small_rig(12, 45, 27, angular);
   const test::Rendered a = test::render(scene, rig, 4, 4, 4);
   const test::Rendered b = test::render(scene, rig, 4, 4, 4);
   const test::Rendered c = test::render(scene, rig, 8, 2, 3);
@@ -200,6 +211,7 @@ TEST(Coverage, DeterministicAcrossRunsAndTileSizes) {
   size_t nonempty = 0;
   for (uint32_t k : a.key) nonempty += k != PMR_NO_KEY;
   EXPECT_GT(nonempty, a.key.size() / 10);
+  }
 }
 
 }  // namespace

@@ -243,6 +243,11 @@ TEST(Displays, CliRendersForALookingGlassPanel) {
   const Display want = display_from_calibration(read_looking_glass_calibration(dir + "/visual.json", nullptr));
   const std::string sidecar = test::read_file(dir + "/o/frame_0000.json");
   EXPECT_NE(sidecar.find("\"offset_fraction\": \"" + to_string(want.offset) + "\""), std::string::npos) << sidecar;
+  // an LKG-P panel renders as its preset does: angular spacing through PMR, subpixel sampling
+  EXPECT_NE(sidecar.find("\"camera_spacing\": \"angular\""), std::string::npos);
+  EXPECT_NE(sidecar.find("\"method\": \"pmr\""), std::string::npos);
+  EXPECT_NE(sidecar.find("\"sampling\": \"subpixel\""), std::string::npos);
+  EXPECT_EQ(r.output.find("multipass"), std::string::npos) << r.output;
   const test::CliRun pr = test::run("render --preset lg-portrait --view-size 42x56 --out " + dir + "/p");
   ASSERT_EQ(pr.status, 0) << pr.output;
   EXPECT_NE(test::read_file(dir + "/p/frame_0000.json")
@@ -295,8 +300,9 @@ TEST(Displays, Gen3CalibrationRendersFusedAndSeparateAlike) {
 namespace pmr {
 
 // Angular camera spacing (the Looking Glass convention): the offsets are D tan(cone ((i + 1/2) / N -
-// 1/2)), and every rendered view (multipass: each view with its own matrices) puts a small square
-// where that view's sidecar matrices project it, in front of and behind the focal plane.
+// 1/2)) moved onto the view-coordinate grid (at most 1/(2Q) of a view spacing), and every rendered view
+// (PMR, and multipass with each view's own matrices) puts a small square where that view's sidecar
+// matrices project it, in front of and behind the focal plane.
 TEST(Displays, AngularSpacingViewsMatchTheirMatrices) {
   Scene s = test::empty_scene(true);
   const float h = 0.1f;
@@ -310,11 +316,19 @@ TEST(Displays, AngularSpacingViewsMatchTheirMatrices) {
   rc.angular_spacing = true;
   const Display d;
   const Rig rig = make_rig(rc, d, glm::dvec3(-1), glm::dvec3(1));
-  for (int i = 0; i < rig.views; ++i)
-    EXPECT_DOUBLE_EQ(rig.camera_offset(i), rig.focal * std::tan(rig.cone * ((i + 0.5) / 8.0 - 0.5)));
-  EXPECT_THROW(test::render(s, rig), Error);  // PMR itself needs evenly spaced views (for now)
+  const double spacing = rig.baseline() / (rig.views - 1);
+  ASSERT_GT(rig.spacing_q, 1);
+  for (int i = 0; i < rig.views; ++i) {
+    const double exact = rig.focal * std::tan(rig.cone * ((i + 0.5) / 8.0 - 0.5));
+    EXPECT_DOUBLE_EQ(rig.angular_offset(i), exact);
+    EXPECT_LE(std::abs(rig.camera_offset(i) - exact), spacing / (2.0 * rig.spacing_q) * (1 + 1e-9)) << "view " << i;
+    EXPECT_DOUBLE_EQ(rig.camera_offset(i), spacing * rig.view_coord(i) / rig.spacing_q);
+    EXPECT_DOUBLE_EQ(rig.camera_offset(rig.views - 1 - i), -rig.camera_offset(i));  // symmetric
+  }
+  for (Method method : {Method::Pmr, Method::Multipass}) {
+  SCOPED_TRACE(to_string(method));
   PipelineConfig pc;
-  pc.method = Method::Multipass;
+  pc.method = method;
   Pipeline p(test::runtime(), pc);
   p.set_scene(s);
   p.configure(rig, nullptr);
@@ -343,6 +357,55 @@ TEST(Displays, AngularSpacingViewsMatchTheirMatrices) {
       if (i == rig.views - 1) shift += std::abs(px - first_px[x > 0]);
     }
   EXPECT_GT(shift, 1.0);  // the squares off the focal plane do move between views
+  }
+}
+
+}  // namespace pmr
+
+namespace pmr {
+
+// Angular spacing on fixed-point view coordinates: for every preset framing a scene as the CLI does,
+// each camera lies within 1/(2Q) of a view spacing of its exact Looking Glass position, and that moves
+// no point of the depth range [near, far] by more than kSpacingErrorPx view pixels of disparity
+// (checked here from the cameras themselves: the disparity of the worst camera at both ends of the
+// range); the view coordinates increase and stay within PMR_MAX_VIEW_COORD. Linear spacing is exact.
+TEST(Displays, AngularSpacingQuantizationStaysWithinTheBound) {
+  for (const DisplayPreset& preset : display_presets())
+    for (bool angular : test::kSpacings) {
+      SCOPED_TRACE(preset.name + ", " + test::spacing_name(angular));
+      RigConfig rc = preset.rig;
+      rc.angular_spacing = angular;
+      const Rig rig = make_rig(rc, preset.display, glm::dvec3(-1.0, -0.5, -2.0), glm::dvec3(1.5, 0.5, 1.0));
+      const double spacing = rig.baseline() / (rig.views - 1);
+      double worst = 0.0;
+      for (int i = 0; i < rig.views; ++i) {
+        const double moved = std::abs(rig.camera_offset(i) - (angular ? rig.angular_offset(i) : (double(i) / (rig.views - 1) - 0.5) * rig.baseline()));
+        EXPECT_LE(moved, spacing / (2.0 * rig.spacing_q) * (1.0 + 1e-9)) << "view " << i;
+        worst = std::max(worst, moved / spacing);
+        EXPECT_LE(std::abs(rig.view_coord(i)), PMR_MAX_VIEW_COORD);
+        if (i > 0) {
+          EXPECT_GT(rig.view_coord(i), rig.view_coord(i - 1));
+        }
+        if (!angular) {
+          EXPECT_EQ(rig.view_coord(i), i);
+        }
+      }
+      // a camera moved by m view spacings shifts a point at depth w by m Delta(w) / (N - 1) view pixels
+      const double px = worst * std::max(std::abs(rig.disparity_px(rig.near_eff)), std::abs(rig.disparity_px(rig.far))) /
+                        (rig.views - 1);
+      EXPECT_LE(px, kSpacingErrorPx);
+      EXPECT_NEAR(spacing_error(rig).view_px, px, 1e-12);
+      if (!angular) {
+        EXPECT_EQ(rig.spacing_q, 1);
+      }
+      if (angular) {
+        EXPECT_GT(worst, 0.0) << "the exact angular positions are not on the grid";
+        // the numbers the docs quote: view spacings, and display pixels at the cone's edge
+        const double display_px = px * double(preset.display.width) / rig.view_w;
+        std::printf("  %-16s Q %4d, |F| <= %5d: cameras moved <= %.5f view spacings = %.4f view px = %.4f display px\n",
+                    preset.name.c_str(), rig.spacing_q, rig.view_coord(rig.views - 1), worst, px, display_px);
+      }
+    }
 }
 
 }  // namespace pmr

@@ -17,6 +17,7 @@ struct FusedCase {
   const char *lens, *slant, *offset;
   bool reversed;
   int tile[3];
+  bool angular = false;
 };
 
 std::vector<uint16_t> encode(const Scene& scene, const Rig& rig, const Display& d, const int* tile, bool fuse,
@@ -42,6 +43,7 @@ TEST_P(FusedEncode, EqualsRasterThenEncodeBitForBit) {
   d.reversed = c.reversed;
   RigConfig rc;
   rc.views = c.views, rc.view_w = c.view_w, rc.view_h = c.view_h;
+  rc.angular_spacing = c.angular;
   const Rig rig = make_rig(rc, d, glm::dvec3(-1.0), glm::dvec3(1.0));
   bool fused = false, unfused = true;
   const std::vector<uint16_t> want = encode(scene, rig, d, c.tile, false, &unfused);
@@ -71,7 +73,10 @@ INSTANTIATE_TEST_SUITE_P(
         // one view, tiny tiles that split every display pixel
         FusedCase{"one_view", 1, 40, 20, 31, 17, "5", "0", "0", false, {1, 1, 1}},
         // wide tile rows (two vectors per row), reversed views
-        FusedCase{"wide_tiles", 12, 96, 40, 200, 90, "9", "1/9", "-1/24", true, {32, 4, 5}}),
+        FusedCase{"wide_tiles", 12, 96, 40, 200, 90, "9", "1/9", "-1/24", true, {32, 4, 5}},
+        // angular camera spacing (Looking Glass): the paper lens and the straddling tiles again
+        FusedCase{"paper_lens_angular", 96, 64, 32, 480, 270, "16", "1/18", "-1/12", false, {16, 2, 4}, true},
+        FusedCase{"straddling_angular", 24, 50, 30, 333, 101, "4.6667", "-1/7", "0.25", true, {5, 3, 4}, true}),
     [](const ::testing::TestParamInfo<FusedCase>& i) { return std::string(i.param.name); });
 
 }  // namespace

@@ -35,6 +35,9 @@ TEST(Layout, DeviceStructsMatchHost) {
   EXPECT_EQ(got[41], offsetof(PmrEnvironment, intensity));
   EXPECT_EQ(got[42], offsetof(PmrEnvironment, levels));
   EXPECT_EQ(got[43], sizeof(PmrEnvLevel));
+  // the view coordinates at the end of the frame parameters (probes 44, 45)
+  EXPECT_EQ(got[44], offsetof(PmrParams, view_anchor));
+  EXPECT_EQ(got[45], offsetof(PmrParams, view_coord));
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // Kernels against the C++ reference: vertex records, setup records (MTAs), tile bins, and fine raster
-// coverage, depth and visibility, bit for bit, for random triangles and N in {1, 2, 7, 96}.
+// coverage, depth and visibility, bit for bit, for random triangles and N in {1, 2, 7, 48, 96}, with
+// linear and angular camera spacing.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,7 +15,7 @@ namespace {
 
 struct Case {
   int views, w, h, tris;
-  bool double_sided;
+  bool double_sided, angular = false;
 };
 
 class RasterReference : public ::testing::TestWithParam<Case> {};
@@ -22,7 +23,7 @@ class RasterReference : public ::testing::TestWithParam<Case> {};
 TEST_P(RasterReference, MatchesReferenceBitForBit) {
   const Case c = GetParam();
   const Scene scene = test::random_scene(c.tris, 1234u + c.views, c.double_sided);
-  const Rig rig = test::small_rig(c.views, c.w, c.h);
+  const Rig rig = test::small_rig(c.views, c.w, c.h, c.angular);
   const test::Rendered out = test::render(scene, rig);
   const PmrParams P = test::params_for(rig);
 
@@ -52,9 +53,12 @@ TEST_P(RasterReference, MatchesReferenceBitForBit) {
 
 INSTANTIATE_TEST_SUITE_P(Views, RasterReference,
                          ::testing::Values(Case{1, 67, 33, 60, false}, Case{2, 64, 32, 60, true},
-                                           Case{7, 53, 29, 60, false}, Case{96, 48, 24, 40, true}),
+                                           Case{7, 53, 29, 60, false}, Case{96, 48, 24, 40, true},
+                                           Case{2, 64, 32, 60, true, true}, Case{7, 53, 29, 60, false, true},
+                                           Case{48, 56, 28, 50, true, true}, Case{96, 48, 24, 40, true, true}),
                          [](const ::testing::TestParamInfo<Case>& i) {
-                           return "N" + std::to_string(i.param.views) + (i.param.double_sided ? "_double" : "_single");
+                           return "N" + std::to_string(i.param.views) + (i.param.double_sided ? "_double" : "_single") +
+                                  (i.param.angular ? "_angular" : "");
                          });
 
 }  // namespace

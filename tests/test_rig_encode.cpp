@@ -12,11 +12,14 @@
 namespace pmr {
 namespace {
 
-// x_i = x_0 + i d: the snapped per-view position equals the projection with view i's own matrices
-// (the ones in the sidecar) up to the fixed-point rounding of x_0 and d.
+// x_i = x_0 + F_i d: the snapped per-view position equals the projection with view i's own matrices
+// (the ones in the sidecar; with angular spacing the quantized cameras) up to the fixed-point rounding
+// of x_0 and d.
 TEST(Rig, SnappedPositionsMatchEachViewsMatrices) {
+  for (bool angular : test::kSpacings)
   for (int views : {1, 2, 7, 96}) {
-    const Rig rig = test::small_rig(views, 1024, 512);
+    SCOPED_TRACE(test::spacing_name(angular));
+    const Rig rig = test::small_rig(views, 1024, 512, angular);
     Scene s = test::empty_scene();
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
@@ -32,9 +35,10 @@ TEST(Rig, SnappedPositionsMatchEachViewsMatrices) {
         const glm::dvec4 clip = rig.projection(i) * rig.view_matrix(i) * world;
         const double x = (clip.x / clip.w + 1.0) * 0.5 * rig.view_w;
         const double y = (1.0 - clip.y / clip.w) * 0.5 * rig.view_h;
-        const double xs = (double(verts[v].x0) + double(i) * verts[v].dx) / PMR_X_ONE;
-        // rounding of x0 and of d (times i), plus double-precision noise
-        const double tol_x = (0.5 + 0.5 * i) / PMR_X_ONE + 1e-7;
+        const double f = rig.view_coord(i);
+        const double xs = (double(verts[v].x0) + f * verts[v].dx) / PMR_X_ONE;
+        // rounding of x0 and of d (times F_i), plus double-precision noise
+        const double tol_x = (0.5 + 0.5 * std::abs(f)) / PMR_X_ONE + 1e-7;
         ASSERT_NEAR(xs, x, tol_x) << "vertex " << v << " view " << i << " of " << views;
         ASSERT_NEAR(double(verts[v].y) / PMR_Y_ONE, y, 0.5 / PMR_Y_ONE + 1e-7);
         ASSERT_NEAR(verts[v].z, (clip.z / clip.w + 1.0) * 0.5, 1e-6);

@@ -4,7 +4,8 @@
 // display pixels), every subpixel's winning key and depth equal the C++ reference rasterizer evaluated
 // at that one sample in that one view, bit for bit; its colour channel equals the double-precision
 // shading reference at that sample within the half-float tolerance of test_shading.cpp; its alpha is
-// the exact mean coverage. The display image does not depend on the tile shape.
+// the exact mean coverage. The display image does not depend on the tile shape. Trials alternate
+// linear and angular camera spacing.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -74,6 +75,7 @@ TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
     RigConfig rc;
     // one view; 700 views (over 512: the chunk capacity's other branch) with 64 px wide tiles
     rc.views = trial == 0 ? 1 : (trial == 10 ? 700 : views_d(rng));
+    rc.angular_spacing = trial % 2 == 1 || trial == 10;  // both camera spacings
     rc.view_w = vw(rng), rc.view_h = vh(rng);
     if (trial == 4) {  // Looking Glass conventions: gen3 subpixel cells (the column map changes with the
                        // row class), the shader's 1 - fract phase, BGR subpixel order
@@ -94,7 +96,7 @@ TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
     SCOPED_TRACE("trial " + std::to_string(trial) + ": " + std::to_string(rc.views) + " views of " +
                  std::to_string(rc.view_w) + "x" + std::to_string(rc.view_h) + ", display " + std::to_string(d.width) +
                  "x" + std::to_string(d.height) + ", tile " + std::to_string(tile[0]) + "x" + std::to_string(tile[1]) +
-                 "x" + std::to_string(tile[2]));
+                 "x" + std::to_string(tile[2]) + ", " + test::spacing_name(rc.angular_spacing));
     const SubpixelRender got = render_subpixels(scene, rig, d, tile);
 
     const PmrParams P = test::params_for(rig);
@@ -129,7 +131,7 @@ TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
         ADD_FAILURE() << "no MTA for key " << want.key[at];
         continue;
       }
-      const glm::dvec3 b = ref::source_barycentrics_at(*m, want.x[at], want.y[at], view);
+      const glm::dvec3 b = ref::source_barycentrics_at(*m, want.x[at], want.y[at], P.view_coord[view]);
       const double c = ref::shade(scene, m->tri, b, (m->flags & PMR_MTA_BACK) != 0, light)[int(at % 3)];
       if (std::abs(double(float(value)) - c) > std::ldexp(std::abs(c), -10) + 1e-4 && ++colour_bad <= 5)
         ADD_FAILURE() << "subpixel " << at << ": " << float(value) << ", reference " << c;
@@ -280,8 +282,6 @@ TEST(SubpixelSampling, CommandLine) {
   test::expect_one_error_line(test::run("render --sampling pixel --out " + out), "unknown sampling 'pixel'");
   test::expect_one_error_line(test::run("render --sampling subpixel --bilinear --out " + out), "--bilinear");
   test::expect_one_error_line(test::run("render --sampling subpixel --method multipass --out " + out), "--method pmr");
-  test::expect_one_error_line(test::run("render --sampling subpixel --preset lg-portrait --out " + out),
-                              "--camera-spacing linear");
   test::expect_one_error_line(test::run("render --sampling subpixel --blend-views --out " + out), "--blend-views");
   EXPECT_EQ(test::count_entries(out), 0u) << "nothing written on bad options";
   test::expect_one_error_line(test::run("bench --sampling subpixel --method multipass --views 2"), "--method pmr");
@@ -298,6 +298,36 @@ TEST(SubpixelSampling, CommandLine) {
   EXPECT_TRUE(test::exists(out + "/frame_0000.exr"));
   EXPECT_TRUE(test::exists(out + "/frame_0000.views.exr"));
   EXPECT_NE(test::read_file(out + "/frame_0000.json").find("\"sampling\": \"subpixel\""), std::string::npos);
+  // angular camera spacing (a Looking Glass preset's) renders subpixel sampling with PMR
+  const std::string lg = test::temp_dir("subpixel_angular");
+  const test::CliRun a = test::run("render --sampling subpixel --preset lg-portrait --views 6 --view-size 42x56 "
+                                   "--display 153x204 --out " + lg);
+  ASSERT_EQ(a.status, 0) << a.output;
+  const std::string sidecar = test::read_file(lg + "/frame_0000.json");
+  EXPECT_NE(sidecar.find("\"sampling\": \"subpixel\""), std::string::npos);
+  EXPECT_NE(sidecar.find("\"camera_spacing\": \"angular\""), std::string::npos);
+  EXPECT_NE(sidecar.find("\"method\": \"pmr\""), std::string::npos);
+  // lg-portrait defaults to subpixel sampling; options that need the views turn the default (not an
+  // explicit --sampling subpixel) back to view sampling, with one line of notice
+  const std::string lg_small = " --preset lg-portrait --views 6 --view-size 42x56 --display 153x204 --out ";
+  const test::CliRun def = test::run("render" + lg_small + lg + "/default");
+  ASSERT_EQ(def.status, 0) << def.output;
+  EXPECT_NE(test::read_file(lg + "/default/frame_0000.json").find("\"sampling\": \"subpixel\""), std::string::npos);
+  for (const std::string opt : {"--bilinear", "--blend-views", "--method multipass"}) {
+    const std::string dir = lg + "/fallback" + std::to_string(opt.size());
+    const test::CliRun f = test::run("render " + opt + lg_small + dir);
+    ASSERT_EQ(f.status, 0) << f.output;
+    EXPECT_NE(f.output.find("warning: " + opt + " samples the rendered views: --sampling view instead"), std::string::npos)
+        << f.output;
+    EXPECT_NE(test::read_file(dir + "/frame_0000.json").find("\"sampling\": \"view\""), std::string::npos) << opt;
+    test::expect_one_error_line(test::run("render --sampling subpixel " + opt + lg_small + dir + "x"),
+                                opt == "--method multipass" ? "--method pmr" : opt);
+  }
+  // pmr bench --preset measures the preset as a user gets it: angular spacing, subpixel sampling
+  const test::CliRun b = test::run("bench --preset lg-portrait --views 2 --view-size 42x56 --frames 1 --no-check --method pmr");
+  ASSERT_EQ(b.status, 0) << b.output;
+  EXPECT_NE(b.output.find("pmr        subpixel"), std::string::npos) << b.output;
+  EXPECT_EQ(b.output.find("pmr        view"), std::string::npos) << b.output;
   // --resume keeps frames of the same sampling and refuses another
   EXPECT_EQ(test::run("render --sampling subpixel --write encoded,views --resume" + small).status, 0);
   test::expect_one_error_line(test::run("render --write encoded,views --resume" + small), "sampling differs");

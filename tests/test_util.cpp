@@ -83,11 +83,12 @@ Rig sidecar_rig() {
   return rig;
 }
 
-Rig small_rig(int views, int w, int h) {
+Rig small_rig(int views, int w, int h, bool angular) {
   RigConfig rc;
   rc.views = views;
   rc.view_w = w;
   rc.view_h = h;
+  rc.angular_spacing = angular;
   return make_rig(rc, Display{}, glm::dvec3(-1.0), glm::dvec3(1.0));
 }
 

@@ -24,8 +24,12 @@ void add_triangle(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t mate
 // `n` random triangles inside the box [-1,1]^3, sizes from sub-pixel to a good part of the screen.
 Scene random_scene(int n, uint32_t seed, bool double_sided);
 
-// The default rig (paper-8k display, framing the unit box [-1,1]^3) with a small view raster.
-Rig small_rig(int views, int w, int h);
+// The default rig (paper-8k display, framing the unit box [-1,1]^3) with a small view raster, with
+// linear or angular camera spacing.
+Rig small_rig(int views, int w, int h, bool angular = false);
+// Both camera spacings, for the exactness tests that must hold for either.
+constexpr bool kSpacings[] = {false, true};
+inline const char* spacing_name(bool angular) { return angular ? "angular" : "linear"; }
 // A fixed rig (3 views of 64x32, a camera at (3, 2, 4) looking at (0, 0.5, 0)) for sidecar tests.
 Rig sidecar_rig();
 

@@ -30,6 +30,7 @@ struct BenchOptions {
   std::vector<int> views = {1, 2, 4, 8, 16, 32, 48, 64, 96};
   std::vector<Method> methods = {Method::Pmr, Method::Multipass, Method::Duplicate};
   std::vector<Sampling> samplings = {Sampling::View};  // subpixel applies to pmr only
+  bool samplings_given = false;  // else the preset's default sampling (view for methods other than pmr)
   Shading shading = Shading::Pbr;
   double exposure_ev = 0.0, environment_intensity = 1.0;
   bool views_given = false;
@@ -87,6 +88,7 @@ BenchOptions parse(const std::vector<std::string>& args) {
       for (const auto& m : split(value())) o.methods.push_back(parse_method(m));
     } else if (a == "--sampling") {
       o.samplings.clear();
+      o.samplings_given = true;
       for (const auto& m : split(value())) o.samplings.push_back(parse_sampling(m));
     } else if (a == "--shading") {
       o.shading = parse_shading(value());
@@ -123,7 +125,7 @@ BenchOptions parse(const std::vector<std::string>& args) {
     else if (a == "--no-check") o.check = false;
     else if (a == "--view-size" || a == "--display" || a == "--tile" || a == "--lens-pitch" || a == "--tan-slant" ||
              a == "--offset" || a == "--cone" || a == "--yfov" || a == "--display-size" || a == "--animation" ||
-             a == "--fps" || a == "--turntable" || a == "--preset") {
+             a == "--fps" || a == "--turntable" || a == "--preset" || a == "--camera-spacing") {
       rest.push_back(a);
       rest.push_back(value());
     } else if (a == "--bilinear" || a == "--reverse-views") {
@@ -138,9 +140,9 @@ BenchOptions parse(const std::vector<std::string>& args) {
   }
   RenderOptions r = parse_render_options(rest);
   o.view_w = r.rig.view_w, o.view_h = r.rig.view_h;
-  o.rig = r.rig;
-  o.rig.angular_spacing = false;  // PMR renders evenly spaced views
+  o.rig = r.rig;  // a Looking Glass preset's angular camera spacing included
   if (!o.views_given && std::find(rest.begin(), rest.end(), "--preset") != rest.end()) o.views = {r.rig.views};
+  if (!o.samplings_given) o.samplings = {r.pipeline.sampling};  // the preset's default
   o.display = r.display;
   o.offset_given = r.offset_given;
   o.tile[0] = r.pipeline.tile_x, o.tile[1] = r.pipeline.tile_y, o.tile[2] = r.pipeline.tile_v;
@@ -228,8 +230,11 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
     const double subpixels = 3.0 * display.width * display.height;
     std::vector<uint16_t> reference[2];  // per sampling: the first method's image
     for (Method method : o.methods)
-      for (Sampling sampling : o.samplings) {
-      if (sampling == Sampling::Subpixel && method != Method::Pmr) continue;  // PMR only (help says so)
+      for (Sampling asked : o.samplings) {
+      // subpixel sampling is PMR's: asked for, the other methods skip it; as a preset's default they
+      // render with view sampling, as pmr render does
+      if (asked == Sampling::Subpixel && method != Method::Pmr && o.samplings_given) continue;
+      const Sampling sampling = method == Method::Pmr ? asked : Sampling::View;
       // samples per frame: the voxels, or each display subpixel once
       const double samples = sampling == Sampling::Subpixel ? subpixels : voxels;
       // the least a frame must move: every sample written once, the display image written once (half RGBA)
@@ -303,8 +308,8 @@ std::string bench_help() {
          "  --method LIST       pmr, multipass, duplicate (default all three)\n"
          "  --shading S, --exposure EV, --environment FILE, --environment-rotation DEG,\n"
          "  --environment-intensity X   as for pmr render (default pbr)\n"
-         "  --sampling LIST     view, subpixel (default view; subpixel with pmr only): samples per frame are\n"
-         "                      the voxels, or each display subpixel once\n"
+         "  --sampling LIST     view, subpixel (subpixel with pmr only; default view, or a --preset's\n"
+         "                      default): samples per frame are the voxels, or each display subpixel once\n"
          "  --frames K          timed frames per point after one warm-up frame (default 5)\n"
          "  --csv FILE          write one row per point\n"
          "  --keep view|total   view: every view is --view-size (default 1024x512); total: the total voxel\n"
@@ -319,8 +324,9 @@ std::string bench_help() {
          "  --no-check          skip comparing the methods' images\n"
          "  --limit KEY=VALUE[,...], --allow-outside-scene-folder  budgets and confinement for SCENE's\n"
          "                      files, as for pmr render (docs/SECURITY.md)\n"
-         "  --preset, --view-size, --display, --tile and the display options are as for pmr render (a\n"
-         "  preset's view count unless --views; views evenly spaced), and so are\n"
+         "  --preset, --camera-spacing, --view-size, --display, --tile and the display options are as for\n"
+         "  pmr render (a preset as a user gets it: its view count, camera spacing and default sampling\n"
+         "  unless --views, --camera-spacing, --sampling), and so are\n"
          "  --animation, --fps and --turntable: the timed frames are then frames 0..K-1 of that sequence.\n"
          "Per point it prints the frame time, the per-stage device times, and the floor: the bytes a frame\n"
          "must move (each voxel written once, the display image written once) at the measured copy bandwidth.\n";

@@ -76,9 +76,9 @@ std::vector<int> parse_dims(const std::string& text, const std::string& opt, siz
 
 namespace {
 
-// The rig a Looking Glass panel's serial prefix recommends (the preset of that model), or 48 views of the
-// panel's aspect for an unknown one.
-RigConfig rig_for_serial(const LookingGlassCalibration& c, std::string& quilt) {
+// The rig a Looking Glass panel's serial prefix recommends (the preset of that model, whose default
+// sampling `subpixel` receives), or 48 views of the panel's aspect for an unknown one.
+RigConfig rig_for_serial(const LookingGlassCalibration& c, std::string& quilt, bool& subpixel) {
   const std::pair<const char*, const char*> models[] = {{"LKG-P", "lg-portrait"}, {"LKG-E", "lg-go"},
                                                         {"LKG-J", "lg-16"},       {"LKG-H", "lg-16-portrait"},
                                                         {"LKG-L", "lg-32"},       {"LKG-K", "lg-32-portrait"},
@@ -87,6 +87,7 @@ RigConfig rig_for_serial(const LookingGlassCalibration& c, std::string& quilt) {
     if (c.serial.rfind(prefix, 0) == 0) {
       const DisplayPreset& p = find_display_preset(preset);
       quilt = p.quilt;
+      subpixel = p.subpixel_sampling;
       RigConfig r = p.rig;
       r.cone_deg = c.view_cone;
       return r;
@@ -114,6 +115,7 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
       o.offset_given = p.name != "paper-8k";  // a panel's offset comes from its calibration
       o.rig = p.rig;
       o.rig.angular_spacing = p.name != "paper-8k";  // Looking Glass software spaces its cameras angularly
+      o.pipeline.sampling = p.subpixel_sampling ? Sampling::Subpixel : Sampling::View;
       o.display_source = "preset " + p.name;
       o.quilt_preview_opaque = p.name != "paper-8k";  // Looking Glass tools show quilts opaque
     } else if (args[i] == "--display-config") {
@@ -122,8 +124,10 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
       o.display = display_from_calibration(o.calibration);
       o.offset_given = true;  // the calibration's center decides it
       std::string quilt;
-      o.rig = rig_for_serial(o.calibration, quilt);
+      bool subpixel = false;
+      o.rig = rig_for_serial(o.calibration, quilt, subpixel);
       o.rig.angular_spacing = true;
+      o.pipeline.sampling = subpixel ? Sampling::Subpixel : Sampling::View;
       o.display_source = "calibration " + args[i + 1];
       o.quilt_preview_opaque = true;
     }
@@ -218,7 +222,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
     else if (a == "--quiet" || a == "-q") o.quiet = true;
     else if (a == "--verbose" || a == "-v") o.verbose = true;
     else if (a == "--method") o.pipeline.method = parse_method(value()), o.method_given = true;
-    else if (a == "--sampling") o.pipeline.sampling = parse_sampling(value());
+    else if (a == "--sampling") o.pipeline.sampling = parse_sampling(value()), o.sampling_given = true;
     else if (a == "--shading") o.pipeline.shading = parse_shading(value());
     else if (a == "--exposure") o.pipeline.exposure_ev = parse_exposure(value());
     else if (a == "--environment-intensity") o.pipeline.environment_intensity = parse_environment_intensity(value());
@@ -255,21 +259,27 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
 
 void finalize_render_options(RenderOptions& o) {
   check_environment_options(o.environment_file, o.environment_rotation_given, o.pipeline.shading, o.option_warnings);
+  if (o.pipeline.sampling == Sampling::Subpixel && !o.sampling_given) {
+    // the preset's default: options that need the views rendered on their grids take precedence
+    const std::string needs_views = o.pipeline.method != Method::Pmr ? "--method " + std::string(to_string(o.pipeline.method))
+                                    : o.display.bilinear             ? "--bilinear"
+                                    : o.display.blend_views          ? "--blend-views"
+                                                                     : "";
+    if (!needs_views.empty()) {
+      o.pipeline.sampling = Sampling::View;
+      o.option_warnings.push_back(needs_views + " samples the rendered views: --sampling view instead of the "
+                                  "display's default, subpixel");
+    } else if (!o.write_encoded) {
+      o.pipeline.sampling = Sampling::View;  // no encoded image: nothing to sample by subpixel
+    }
+  }
   if (o.pipeline.sampling == Sampling::Subpixel) {
-    if (o.rig.angular_spacing)
-      throw Error("--sampling subpixel rasterizes with PMR, which needs evenly spaced views: add --camera-spacing linear");
     check_subpixel_sampling(o.pipeline.method, o.display);  // pmr unless --method says otherwise
     if (!o.write_encoded) {  // the views are rendered on their grids in either case
       o.pipeline.sampling = Sampling::View;
       o.option_warnings.push_back("--sampling subpixel samples the encoded image, which --write does not ask for: "
                                   "ignored");
     }
-  }
-  if (o.rig.angular_spacing && !o.method_given) {
-    // PMR needs evenly spaced views; one conventional pass per view takes any spacing
-    o.pipeline.method = Method::Multipass;
-    o.option_warnings.push_back("angular camera spacing (the Looking Glass convention): rendering with --method "
-                                "multipass; --camera-spacing linear renders with PMR, several times faster");
   }
   if (!o.offset_given) {
     o.display.offset = default_offset(o.display.lens_pitch, o.rig.views);
@@ -344,8 +354,8 @@ std::string render_help() {
          "  --cone DEG             view cone (default 80)\n"
          "  --yfov DEG             vertical field of view (default from the display: 2 atan(46.5 / 200))\n"
          "  --camera-spacing S     linear (PMR's, default for paper-8k) or angular (Looking Glass: D tan(cone\n"
-         "                         ((i + 1/2) / N - 1/2)), default for the Looking Glass presets; angular\n"
-         "                         renders with --method multipass for now\n"
+         "                         ((i + 1/2) / N - 1/2)), default for the Looking Glass presets; each\n"
+         "                         angular camera moves onto a fine fixed-point grid (docs/DESIGN.md)\n"
          "  --camera K             use the scene's glTF camera K (pose and field of view) instead of framing\n"
          "                         the scene's bounding sphere\n"
          "  --background R,G,B[,A] a linear colour behind the encoded image, views, quilt and previews (default\n"
@@ -373,7 +383,9 @@ std::string render_help() {
          "                         (every triangle copied per view into a 2D-tiled view atlas)\n"
          "  --sampling S           view (default): the views rendered on their grids, each subpixel reading\n"
          "                         its view's nearest pixel; subpixel: every display subpixel rasterized at\n"
-         "                         its own sample in its own view (docs/SAMPLING.md)\n"
+         "                         its own sample in its own view (docs/SAMPLING.md; the default of the\n"
+         "                         presets listed there, which --bilinear, --blend-views or a --method\n"
+         "                         other than pmr turn back to view sampling with a notice)\n"
          "shading (docs/SHADING.md):\n"
          "  --shading S            pbr (default): glTF metallic-roughness with every material map, seen from\n"
          "                         each view's own camera, so highlights move across the views; lit by the\n"

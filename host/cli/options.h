@@ -66,6 +66,9 @@ struct RenderOptions {
   bool zoom_given = false;     // --zoom was on the command line (rig.zoom)
   Background background;       // --background R,G,B[,A]; transparent black by default
   bool quilt_preview_opaque = false;  // the quilt PNG over opaque black (Looking Glass presets)
+  // --sampling was on the command line; else pipeline.sampling is the preset's default, and subpixel
+  // sampling gives way to view sampling (with a notice) where other options need the views
+  bool sampling_given = false;
 };
 
 // Parses the arguments after `render`. Throws pmr::Error with one line on bad input.

@@ -19,7 +19,8 @@ std::string quality_help() {
          "RMSE over every subpixel's colour (linear) and the fraction of subpixels differing by more than\n"
          "1/256. --also-view-size adds --sampling view at another view size (repeatable).\n"
          "The rig and display options are those of pmr render (--preset, --views, --view-size, ...);\n"
-         "views are evenly spaced; the sampling options (--sampling, --bilinear, --blend-views) are set by\n"
+         "the cameras are spaced as render spaces them (a Looking Glass preset: angularly); the sampling\n"
+         "options (--sampling, --bilinear, --blend-views) are set by\n"
          "the command itself, and nothing is written. See docs/SAMPLING.md.\n";
 }
 
@@ -50,7 +51,6 @@ int run_quality(const std::vector<std::string>& args) {
     rest.push_back(args[i]);
   }
   RenderOptions o = parse_render_options(rest);
-  o.rig.angular_spacing = false;  // subpixel sampling renders evenly spaced views with PMR
   finalize_render_options(o);
   if (o.scene.empty()) o.scene = default_scene_path();
   const Scene scene = load_scene(o.scene);

@@ -140,7 +140,7 @@ struct Pipeline::Impl {
 
   // Each stage enqueues its kernel(s) for the parameters P (written to params_buf here).
   void vertex_stage(const PmrParams& P, Events& ev);
-  void select_view_stage(const PmrParams& P, int view, Events& ev);
+  void select_view_stage(const PmrParams& P, int coord, Events& ev);
   void setup_stage(PmrParams& P, Events& ev, StageTimes& t);
   void bin_stage(Events& ev, StageTimes& t);
   void fine_stage(Events& ev);
@@ -338,9 +338,6 @@ size_t Pipeline::display_bytes() const {
 
 void Pipeline::configure(const Rig& rig, const Display* display) {
   Impl& m = *impl_;
-  if (rig.angular && config_.method != Method::Multipass)
-    throw Error("angular camera spacing renders with --method multipass for now: PMR's multi-view triangles "
-                "need evenly spaced views (or use --camera-spacing linear)");
   const ClRuntime& rt = m.rt;
   m.params = make_params(rig);
   tiles_x_ = (rig.view_w + tile_[0] - 1) / tile_[0];
@@ -436,9 +433,9 @@ void Pipeline::Impl::vertex_stage(const PmrParams& P, Events& ev) {
   ev.add(kVertex, launch(k_vertex, num_vertices, kItemGroup));
 }
 
-void Pipeline::Impl::select_view_stage(const PmrParams& P, int view, Events& ev) {
+void Pipeline::Impl::select_view_stage(const PmrParams& P, int coord, Events& ev) {
   rt.write(params_buf, &P, sizeof P);
-  k_vertex_select.args(params_buf, pmr_vertices, view, vertices);
+  k_vertex_select.args(params_buf, pmr_vertices, coord, vertices);
   ev.add(kVertex, launch(k_vertex_select, num_vertices, kItemGroup));
 }
 
@@ -616,6 +613,9 @@ StageTimes Pipeline::render(const Rig& rig) {
   const PmrParams fresh = make_params(rig);  // the camera may move between frames
   std::copy(fresh.view, fresh.view + 16, P.view);
   std::copy(fresh.light_world, fresh.light_world + 4, P.light_world);
+  P.view_anchor = fresh.view_anchor;
+  P.view_scale = fresh.view_scale;
+  std::copy(std::begin(fresh.view_coord), std::end(fresh.view_coord), P.view_coord);
   P.tiles_x = tiles_x_;
   P.tiles_y = tiles_y_;
   P.tiles_v = tiles_v_;
@@ -669,8 +669,9 @@ StageTimes Pipeline::render(const Rig& rig) {
       Q.disparity_k = 0.0;
       Q.ndc_offset_x = rig.camera_offset(i) / a;
       Q.view_base = uint32_t(i);
+      std::fill(std::begin(Q.view_coord), std::end(Q.view_coord), 0);  // the pass's one view
       if (config_.multipass_snapped)
-        m.select_view_stage(Q, i, ev);
+        m.select_view_stage(Q, rig.view_coord(i), ev);
       else
         m.vertex_stage(Q, ev);
       m.setup_stage(Q, ev, times);

@@ -1,7 +1,9 @@
 // The camera rig (DESIGN section 2): N off-axis cameras sharing one window on the focal plane.
 #include "pmr/rig.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -11,11 +13,22 @@ namespace pmr {
 
 double Rig::baseline() const { return 2.0 * focal * std::tan(cone / 2.0); }
 
+double Rig::angular_offset(int i) const { return focal * std::tan(cone * ((double(i) + 0.5) / double(views) - 0.5)); }
+
 double Rig::camera_offset(int i) const {
-  if (angular) return focal * std::tan(cone * ((double(i) + 0.5) / double(views) - 0.5));
   if (views <= 1) return 0.0;
+  if (angular) return baseline() * double(view_coord(i)) / view_scale();
   return (double(i) / double(views - 1) - 0.5) * baseline();
 }
+
+int Rig::view_coord(int i) const {
+  if (!angular || views <= 1) return angular ? 0 : i;
+  return int(std::lround(double(spacing_q) * angular_offset(i) / baseline() * double(views - 1)));
+}
+
+double Rig::view_anchor() const { return angular ? 0.0 : -0.5; }
+
+double Rig::view_scale() const { return double(views - 1) * double(angular ? spacing_q : 1); }
 
 glm::dmat4 Rig::view_matrix(int i) const {
   return glm::translate(glm::dmat4(1.0), glm::dvec3(-camera_offset(i), 0.0, 0.0)) * center_view;
@@ -54,13 +67,44 @@ void check_positive(double v, const char* what) {
   if (!(v > 0.0) || !std::isfinite(v)) throw Error(std::string("invalid ") + what + ": must be positive");
 }
 
+// The largest disparity per view spacing B / (N - 1) over the rig's depth range, in view pixels.
+double disparity_per_spacing(const Rig& rig) {
+  const double worst = std::max(std::abs(rig.disparity_px(rig.near_eff)), std::abs(rig.disparity_px(rig.far)));
+  return worst / double(rig.views - 1);
+}
+
+// Angular spacing on fixed-point view coordinates: camera i moves from g_i to F_i / Q view spacings
+// (F_i = round(Q g_i)), at most 1 / (2Q) of a spacing, which shifts a point by at most
+// disparity_per_spacing / (2Q) view pixels. The smallest Q that keeps this within kSpacingErrorPx and the
+// coordinates strictly increasing; at most what keeps |F_i| <= PMR_MAX_VIEW_COORD (the snapping error of
+// x_0 + F_i d grows with |F_i|, pmr/shared.h).
+void choose_spacing_q(Rig& rig, std::vector<std::string>* warnings) {
+  const double per_spacing = disparity_per_spacing(rig);
+  const double g_max = std::abs(rig.angular_offset(0)) / rig.baseline() * double(rig.views - 1);
+  const int q_max = std::max(1, int(std::floor((PMR_MAX_VIEW_COORD - 0.5) / g_max)));
+  int q = int(std::min<double>(q_max, std::max(1.0, std::ceil(per_spacing / (2.0 * kSpacingErrorPx)))));
+  for (;; ++q) {
+    rig.spacing_q = q;
+    // the view coordinates increase, and no camera leaves the baseline (the guard band's clipping
+    // planes are those of the cameras at its ends, pmr/shared.h)
+    bool ok = 2 * int64_t(std::abs(rig.view_coord(0))) <= int64_t(q) * (rig.views - 1);
+    for (int i = 1; i < rig.views && ok; ++i) ok = rig.view_coord(i) > rig.view_coord(i - 1);
+    if (ok) break;
+    if (q >= q_max) throw Error("internal error: no fixed-point view coordinates for angular camera spacing");
+  }
+  const SpacingError e = spacing_error(rig);
+  if (warnings && e.view_px > kSpacingErrorPx)
+    warnings->push_back("angular camera spacing: the cameras sit up to " + std::to_string(e.view_px) +
+                        " view pixels of disparity from their exact positions (the depth range is very deep)");
+}
+
 }  // namespace
 
 Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo,
              const glm::dvec3& hi, const glm::dmat4* camera_pose, double camera_yfov,
              std::vector<std::string>* warnings) {
   if (config.views < 1) throw Error("invalid --views: need at least 1 view");
-  if (config.views > 4096) throw Error("invalid --views: at most 4096 views are supported");
+  if (config.views > PMR_MAX_VIEWS) throw Error("invalid --views: at most " + std::to_string(PMR_MAX_VIEWS) + " views are supported");
   if (config.view_w < 1 || config.view_h < 1 || config.view_w > PMR_MAX_RASTER ||
       config.view_h > PMR_MAX_RASTER)
     throw Error("invalid --view-size: each side must be 1.." + std::to_string(PMR_MAX_RASTER));
@@ -125,7 +169,18 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
     }
   }
   if (!(rig.near_eff < rig.far)) throw Error("near plane is not in front of the far plane");
+  if (rig.angular && rig.views > 1) choose_spacing_q(rig, warnings);
   return rig;
+}
+
+SpacingError spacing_error(const Rig& rig) {
+  SpacingError e;
+  if (!rig.angular || rig.views <= 1) return e;
+  const double spacing = rig.baseline() / double(rig.views - 1);
+  for (int i = 0; i < rig.views; ++i)
+    e.view_spacings = std::max(e.view_spacings, std::abs(rig.camera_offset(i) - rig.angular_offset(i)) / spacing);
+  e.view_px = e.view_spacings * disparity_per_spacing(rig);
+  return e;
 }
 
 PmrParams make_params(const Rig& rig) {
@@ -141,6 +196,9 @@ PmrParams make_params(const Rig& rig) {
   p.far = rig.far;
   p.guard_ndc_x = guard_ndc(rig.view_w);
   p.guard_ndc_y = guard_ndc(rig.view_h);
+  p.view_anchor = rig.view_anchor();
+  p.view_scale = rig.view_scale();
+  for (int i = 0; i < PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK; ++i) p.view_coord[i] = rig.view_coord(std::min(i, rig.views - 1));
   const glm::dvec3 l = rig.light_world();
   p.light_world[0] = float(l.x);
   p.light_world[1] = float(l.y);

@@ -55,7 +55,8 @@ struct RigConfig {
   double yfov_deg = 0.0;   // 0 = from the display: 2 atan(size_h / 2 / viewing_distance)
   int camera = -1;         // glTF camera index, -1 = frame the scene's bounding sphere
   // Camera spacing along the baseline: linear (DESIGN section 2, PMR's evenly spaced views) or
-  // angular as Looking Glass software places them, D tan(cone ((i + 1/2) / N - 1/2)).
+  // angular as Looking Glass software places them, D tan(cone ((i + 1/2) / N - 1/2)), each camera
+  // moved onto a fixed-point view coordinate (make_rig).
   bool angular_spacing = false;
   // The scene appears `zoom` times larger: D = D_fit / zoom, the focal plane still through the
   // sphere's center (only when framing the bounding sphere, camera < 0).
@@ -74,8 +75,19 @@ struct Rig {
   glm::dmat4 center_view{1.0};    // world -> center view space
   double zoom = 1.0;              // RigConfig::zoom (1 with a glTF camera)
 
+  // Angular spacing's view-coordinate resolution Q (1 with linear spacing): camera i sits at
+  // view_coord(i) / Q view spacings B / (N - 1) from the center camera (make_rig chooses Q).
+  int spacing_q = 1;
+
   double baseline() const;                    // B = 2 D tan(theta / 2)
-  double camera_offset(int i) const;          // s_i (linear or angular spacing)
+  double camera_offset(int i) const;          // s_i (linear, or angular as quantized: the cameras rendered)
+  // Angular spacing's exact Looking Glass offset D tan(theta ((i + 1/2) / N - 1/2)), before quantization.
+  double angular_offset(int i) const;
+  // The integer view coordinate F_i of view i (pmr/shared.h): i with linear spacing, round(Q g_i) with
+  // angular spacing, g_i = angular_offset(i) / B * (N - 1). x_i = x_0 + F_i d in every kernel.
+  int view_coord(int i) const;
+  double view_anchor() const;                 // camera offset at view coordinate 0 over B: -1/2 or 0
+  double view_scale() const;                  // view coordinate units per baseline: (N - 1) Q
   glm::dmat4 view_matrix(int i) const;        // V_i = T(-s_i, 0, 0) V
   glm::dmat4 projection(int i) const;         // glFrustum(l_i, r_i, b, t, near_eff, far)
   double disparity_k() const;                 // W tan(theta/2) / (A tan(phi/2))
@@ -83,6 +95,17 @@ struct Rig {
   glm::dvec3 light_view() const;              // normalize(0.3, 0.5, 1.0)
   glm::dvec3 light_world() const;             // the same direction in world space
 };
+
+// Angular spacing: the largest distance between a camera and its exact Looking Glass position, in view
+// spacings, and the disparity it causes, in view pixels, at the nearest or farthest depth of the rig's
+// range [near_eff, far] (whichever has more disparity). 0 with linear spacing.
+struct SpacingError {
+  double view_spacings = 0, view_px = 0;
+};
+SpacingError spacing_error(const Rig& rig);
+// The bound make_rig keeps spacing_error(rig).view_px within (unless a view-coordinate range of
+// +-PMR_MAX_VIEW_COORD cannot hold it; make_rig warns then).
+constexpr double kSpacingErrorPx = 0.01;
 
 // Builds the rig for a scene whose world bounds are [lo, hi]. `camera_pose` (world_from_camera) and
 // `camera_yfov` are used when config.camera >= 0. Throws pmr::Error on an impossible configuration.

@@ -13,6 +13,14 @@
  * x gets more fractional bits than y because the per-view disparity d is snapped on the same grid and
  * multiplied by up to N - 1 views: 16 bits keep x_0 + i*d within 0.002 px of the exact projection at
  * i = 95.
+ *
+ * View coordinates (host/rig/rig.cpp, docs/DESIGN.md): view i's x is x_0 + F_i d with an integer F_i
+ * (PmrParams.view_coord). Linear spacing has F_i = i. Angular spacing has F_i = round(Q g_i), where g_i
+ * is camera i's offset from the center camera in view spacings B / (N - 1); x_0 is then the center
+ * camera's x and d the disparity per 1/Q view spacing. Every x_0 + F_i d, F_i of a real view, is a
+ * vertex x in that view, inside the guard band, so the edge-function bound above holds as it is; the
+ * view coordinate only adds the products F_i d (|F_i| <= PMR_MAX_VIEW_COORD, |d| < 2^31: below 2^45).
+ * The snapping error of x_0 + F_i d is at most (1 + |F_i|) 2^-17 px, so at most 1/8 px.
  */
 #ifndef PMR_SHARED_H
 #define PMR_SHARED_H
@@ -37,6 +45,13 @@ typedef int64_t pmr_i64;
  * (and |y_raster - H/2| <= PMR_GUARD_PX), so |x| < 2^15 px fits 16.16 in int32 for W, H <= 2^13. */
 #define PMR_GUARD_PX 16384.0
 #define PMR_MAX_RASTER 8192
+
+/* Views of a rig, and the largest |view coordinate| (see above). PmrParams.view_coord has
+ * PMR_VIEW_COORD_SLACK entries past the last view (copies of the last one), so that a 16-view vector
+ * load at any view stays inside the struct. */
+#define PMR_MAX_VIEWS 4096
+#define PMR_MAX_VIEW_COORD (1 << 14)
+#define PMR_VIEW_COORD_SLACK 16
 
 /* A triangle clipped by near, far and the six guard-band planes has at most 3 + 8 vertices, i.e. a fan
  * of 9 triangles; a double-sided one whose orientation flips across the views splits once more. */
@@ -126,14 +141,18 @@ typedef struct {
   float env_radiance;     /* pbr: radiance of the uniform default environment (0.2 x intensity) */
   pmr_u32 num_lights;     /* pbr: entries of the light table (PmrLight), the kernels' last argument */
   pmr_u32 pad_params;
+  double view_anchor;     /* camera offset at view coordinate 0 over the baseline: -1/2 linear, 0 angular */
+  double view_scale;      /* view coordinate units per baseline: N - 1 linear, Q (N - 1) angular */
+  pmr_i32 view_coord[PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK]; /* F_i, strictly increasing in i (a
+                             multipass pass: its one view at 0) */
 } PmrParams;
 
 /* Vertex-stage output, one per scene vertex. Producer: cl/vertex.cl. */
 typedef struct {
   double pos_view[3];     /* position in center-camera view space (used by the clipper)      */
   double pad;
-  pmr_i32 x0;             /* snapped raster x in view 0, 16.16                               */
-  pmr_i32 dx;             /* snapped disparity per view, 16.16: x_i = x0 + i * dx            */
+  pmr_i32 x0;             /* snapped raster x at view coordinate 0, 16.16 (view 0 if linear)  */
+  pmr_i32 dx;             /* snapped disparity per view coordinate, 16.16: x_i = x0 + F_i dx  */
   pmr_i32 y;              /* snapped raster y, 24.8                                          */
   pmr_u32 outcode;        /* PMR_CLIP_* | PMR_CULL_* bits                                    */
   float z;                /* window depth in [0, 1] (glFrustum depth mapped from NDC)         */
@@ -144,8 +163,8 @@ typedef struct {
 /* Multi-view triangle: one (possibly clipped) triangle over a contiguous view range with constant
  * orientation. Producer: cl/setup.cl. Consumers: cl/bin.cl, cl/fine.cl. */
 typedef struct {
-  pmr_i32 x0[3];          /* vertex raster x in view 0, 16.16                                */
-  pmr_i32 dx[3];          /* per-view disparity, 16.16                                       */
+  pmr_i32 x0[3];          /* vertex raster x at view coordinate 0, 16.16                     */
+  pmr_i32 dx[3];          /* disparity per view coordinate, 16.16                            */
   pmr_i32 y[3];           /* raster y, 24.8                                                  */
   float z[3];             /* window depth                                                    */
   float inv_w[3];         /* 1 / w                                                           */

@@ -41,8 +41,8 @@ PmrVertex project(const PmrParams& P, double xv, double yv, double zv) {
   double x_first = x_center, d = 0.0;
   if (P.views > 1) {
     const double delta = P.disparity_k * (1.0 - P.focal / w);
-    x_first = x_center - 0.5 * delta;
-    d = delta / double(P.views - 1);
+    x_first = x_center + P.view_anchor * delta;  // at view coordinate 0
+    d = delta / P.view_scale;                      // per view coordinate unit
   }
   const double y = (1.0 - yc / w) * half_h;
   auto snap = [](double v) { return int32_t(std::min(std::max(std::floor(v + 0.5), -2.0e9), 2.0e9)); };
@@ -182,7 +182,7 @@ std::vector<PmrMta> make_mtas(const PmrParams& P, const std::vector<ClippedTrian
       int lo = -1, hi = -1;
       for (int i = 0; i < P.views; ++i) {
         int64_t xs[3];
-        for (int k = 0; k < 3; ++k) xs[k] = int64_t(m.x0[k]) + int64_t(i) * m.dx[k];
+        for (int k = 0; k < 3; ++k) xs[k] = int64_t(m.x0[k]) + int64_t(P.view_coord[i]) * m.dx[k];
         const int64_t area = int64_t(m.y[1] - m.y[0]) * (xs[2] - xs[0]) - (xs[1] - xs[0]) * int64_t(m.y[2] - m.y[0]);
         if (sign * area > 0) {
           if (lo < 0) lo = i;
@@ -218,7 +218,7 @@ RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& t
     for (const ClippedTriangle& c : tris) {
       int64_t x[3], y[3];
       for (int k = 0; k < 3; ++k) {
-        x[k] = int64_t(c.v[k].x0) + int64_t(i) * c.v[k].dx;
+        x[k] = int64_t(c.v[k].x0) + int64_t(P.view_coord[i]) * c.v[k].dx;
         y[k] = c.v[k].y;
       }
       // twice the signed area; > 0 is counter-clockwise in NDC (front) because raster y points down
@@ -274,7 +274,7 @@ SubpixelResult rasterize_subpixels(const PmrParams& P, const std::vector<Clipped
       const int64_t X = (int64_t(2 * s + 1) * P.view_w * PMR_X_ONE) / (int64_t(6) * display_w);
       const int64_t Y = (int64_t(2 * i + 1) * P.view_h * PMR_Y_ONE) / (int64_t(2) * display_h);
       r.x[at] = X, r.y[at] = Y;
-      const int64_t v = view_of[at];
+      const int64_t v = P.view_coord[view_of[at]];
       for (const ClippedTriangle& c : tris) {
         int64_t x[3], y[3];
         for (int k = 0; k < 3; ++k) {

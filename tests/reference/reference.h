@@ -1,7 +1,8 @@
 // Plain C++ references for the kernels. They are written the obvious, slow way (per view, per pixel)
 // so that the tiled multi-view kernels can be checked against them: the snapping and clipping are the
 // definitions of DESIGN sections 2-3 transcribed in scalar double arithmetic, the rasterizer is a
-// conventional single-view rasterizer fed each view's snapped positions x0 + i * dx.
+// conventional single-view rasterizer fed each view's snapped positions x0 + F_i * dx (F_i the view's
+// view coordinate, P.view_coord[i]: i with linear spacing).
 #pragma once
 #include <cstdint>
 #include <vector>

@@ -9,7 +9,8 @@
 
 namespace pmr::ref {
 
-// Perspective-correct barycentrics of voxel (px, py, view) in the MTA's SOURCE triangle.
+// Perspective-correct barycentrics of voxel (px, py, view) in the MTA's SOURCE triangle; `view` is the
+// view's view coordinate (PmrParams.view_coord: its index with linear spacing).
 glm::dvec3 source_barycentrics(const PmrMta& m, int px, int py, int view);
 // The same at raster point (X, Y) in fixed point (16.16, 24.8): a --sampling subpixel sample.
 glm::dvec3 source_barycentrics_at(const PmrMta& m, int64_t sample_x, int64_t sample_y, int view);

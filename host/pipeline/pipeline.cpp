@@ -117,6 +117,7 @@ struct Pipeline::Impl {
   std::vector<std::string> variants;
 
   explicit Impl(const ClRuntime& r) : rt(r) {}
+  uint64_t tile_queue_limit = UINT64_MAX;  // PipelineConfig::tile_queue_limit
 
   // Every stage launches through these: the real grid, or while warming one work-group of the same
   // local size on a frame in which every count is zero (the kernels return at once).
@@ -228,6 +229,7 @@ void upload_environment(Pipeline::Impl& m, const PipelineConfig& config) {
 
 Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
     : impl_(new Impl(runtime)), config_(config) {
+  impl_->tile_queue_limit = config.tile_queue_limit;
   tile_[0] = config.tile_x, tile_[1] = config.tile_y, tile_[2] = config.tile_v;
   if (config.method != Method::Pmr && config.tile_v != 1) tile_[0] = 8, tile_[1] = 8, tile_[2] = 1;
   const int tx = tile_[0], ty = tile_[1], tv = tile_[2];
@@ -476,6 +478,9 @@ void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
     total += c;
     if (total >= 0xffffffffull) throw Error("the tile queues would exceed 4 G entries; use larger --tile or fewer views");
   }
+  if (t.bin_entries + total > tile_queue_limit)  // (multipass: every pass of the frame counts)
+    throw Error("the frame's tile raster produces " + std::to_string(t.bin_entries + total) + " tile-queue entries, more than the "
+                "tile-queue limit of " + std::to_string(tile_queue_limit) + " (raise it with --limit tile-queue=N)");
   counts[num_tiles] = uint32_t(total);
   rt.write(tile_offsets, counts.data(), bytes_of(counts));
   if (total > tile_queue_capacity) {

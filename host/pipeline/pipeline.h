@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "pmr/input_files.h"
 #include "pmr/rig.h"
 #include "pmr/scene.h"
 #include "pmr/shared.h"
@@ -72,6 +73,9 @@ struct PipelineConfig {
   // It replaces the uniform default and turns the default light off (host/shading/lights.h; the file's
   // lights stay). Null: the uniform default.
   std::shared_ptr<const Environment> environment;
+  // --limit tile-queue: a frame whose tile raster produces more entries is refused (before the queue
+  // grows to hold them), naming the budget.
+  uint64_t tile_queue_limit = InputLimits().tile_queue;
 };
 
 struct StageTimes {  // milliseconds

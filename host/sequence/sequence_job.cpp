@@ -15,6 +15,7 @@
 #include "output/checksum.h"
 #include "output/interrupt.h"
 #include "pmr/error.h"
+#include "pmr/memory_budget.h"
 #include "pmr/output.h"
 #include "pmr/quilt.h"
 #include "runtime/cl_runtime.h"
@@ -45,6 +46,7 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 
 int run_sequence(const RenderOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
+  set_memory_budget(o.input_limits.memory);
   const ExrCompression compression = parse_exr_compression(o.compression);
   std::vector<long> frames;
   if (o.frames != "all") frames = parse_frame_list(o.frames);  // before the long work: fail early
@@ -71,9 +73,11 @@ int run_sequence(const RenderOptions& o) {
   // the pipeline's configuration: the sidecars a resumed run expects need it too (which lights)
   PipelineConfig pc = o.pipeline;
   pc.environment = environment;
+  pc.tile_queue_limit = o.input_limits.tile_queue;
   const Scene scene = load_scene(o.scene, o.input_limits);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
   SequenceSpec spec;
+  spec.framing_work = o.input_limits.framing_work;
   select_animation(scene, o.animation, spec);
   spec.fps = o.fps;
   spec.turntable = o.turntable;
@@ -171,6 +175,21 @@ int run_sequence(const RenderOptions& o) {
     i.depth = o.write_depth;
     return i;
   };
+
+  // The images of a frame, checked against the memory budget before anything is created: the view
+  // volume on the device and, when written, up to three host copies (one read back, one queued, one
+  // being written) plus the encoder's output; the display image likewise; depth 12 bytes a voxel on the
+  // device and 4 per host copy. The device buffers are checked again as they are allocated.
+  {
+    const uint64_t voxels = uint64_t(rig.views) * uint64_t(rig.view_w) * uint64_t(rig.view_h);
+    const uint64_t display = o.write_encoded ? uint64_t(o.display.width) * uint64_t(o.display.height) * 8 : 0;
+    const uint64_t volume = need_volume ? voxels * 8 : 0;
+    const uint64_t depth = need_volume && o.write_depth ? voxels * (12 + 3 * 4) : 0;
+    const uint64_t bytes = 5 * volume + 5 * display + depth;
+    check_memory(bytes, std::to_string(rig.views) + " views of " + std::to_string(rig.view_w) + "x" +
+                            std::to_string(rig.view_h) + " (" + std::to_string(volume >> 20) +
+                            " MiB a view volume, on the device and in up to four copies being written)");
+  }
 
   // One folder, one configuration: no other configuration rendering into it now, none left beside
   // this run's frames (folder_guard.h). Held until the end of the run.

@@ -312,6 +312,32 @@ TEST_F(Budgets, ManyLargeTrianglesRenderUnlessTheTileQueueBudgetSaysNo) {
   expect_no_frames(out);
 }
 
+// A frame still rendering after `slow_frame_seconds` reports how long it has run and its tile-queue
+// entries, again each interval (pmr render prints it); a frame done sooner reports nothing.
+TEST(SlowFrame, ReportsWhileTheFrameRenders) {
+  const Scene scene = random_scene(3000, 7, true);
+  const Rig rig = small_rig(16, 128, 64);
+  for (const double interval : {1e-5, 1000.0}) {
+    PipelineConfig pc;
+    std::vector<std::pair<double, uint64_t>> calls;
+    pc.slow_frame = [&](double s, uint64_t entries) { calls.push_back({s, entries}); };
+    pc.slow_frame_seconds = interval;
+    Pipeline p(runtime(), pc);
+    p.set_scene(scene);
+    p.configure(rig, nullptr);
+    const StageTimes t = p.render(rig);
+    ASSERT_GT(t.bin_entries, 0u);
+    if (interval > 1.0) {
+      EXPECT_TRUE(calls.empty()) << "a fast frame is not reported";
+      continue;
+    }
+    ASSERT_FALSE(calls.empty());
+    EXPECT_EQ(calls[0].second, t.bin_entries);
+    EXPECT_GE(calls[0].first, interval);
+    EXPECT_LE(calls.back().first, t.wall / 1000.0);
+  }
+}
+
 // ---- memory ---------------------------------------------------------------------------------------------
 
 // --views 1400 --write views: a 5.9 GB view volume, which PoCL once allocated lazily and then

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
 
 #include "pmr/error.h"
 
@@ -145,6 +147,8 @@ struct Pipeline::Impl {
   void setup_stage(PmrParams& P, Events& ev, StageTimes& t);
   void bin_stage(Events& ev, StageTimes& t);
   void fine_stage(Events& ev);
+  void wait_reporting(const Events& ev, const StageTimes& t, std::chrono::steady_clock::time_point start,
+                      double interval, const std::function<void(double, uint64_t)>& report);
   void encode_stage(Events& ev);
   void fused_stage(const PmrParams& P, Events& ev);
   void subpixel_stage(Events& ev);
@@ -496,6 +500,34 @@ void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
   ev.add(kBin, launch(k_bin_fill, last_mtas, kItemGroup));
 }
 
+// Waits for the frame's last command, calling `report` every `interval` seconds once the frame has
+// run that long. The event's completion callback wakes the wait, so a fast frame waits no longer than
+// finish() would.
+void Pipeline::Impl::wait_reporting(const Events& ev, const StageTimes& t, std::chrono::steady_clock::time_point start,
+                                    double interval, const std::function<void(double, uint64_t)>& report) {
+  const auto step = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(interval));
+  if (ev.all.empty()) return;
+  struct Done {
+    std::mutex mutex;
+    std::condition_variable changed;
+    bool done = false;
+  } d;
+  auto complete = [](cl_event, cl_int, void* user) {
+    auto* p = static_cast<Done*>(user);
+    std::lock_guard<std::mutex> lock(p->mutex);
+    p->done = true;
+    p->changed.notify_all();
+  };
+  if (clSetEventCallback(ev.all.back().second, CL_COMPLETE, complete, &d) != CL_SUCCESS) return;  // finish() waits
+  clFlush(rt.queue());
+  std::unique_lock<std::mutex> lock(d.mutex);
+  auto next = start + step;
+  while (!d.changed.wait_until(lock, next, [&] { return d.done; })) {
+    report(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), t.bin_entries);
+    next += step;
+  }
+}
+
 void Pipeline::Impl::fine_stage(Events& ev) {
   k_fine.args(params_buf, mtas, tile_offsets, tile_queue, tris, attrs, materials, textures, texels, lut, positions, eyes, split_sum, texcoords, tangents, volume,
               dbg_key, dbg_depth, dbg_count, env, env_data, lights);
@@ -684,6 +716,7 @@ StageTimes Pipeline::render(const Rig& rig) {
     if (config_.multipass_snapped) std::swap(m.vertices, m.pmr_vertices);
   }
   if (m.encode && !m.fused && !m.subpixel) m.encode_stage(ev);
+  if (config_.slow_frame && !m.warming) m.wait_reporting(ev, times, t_start, config_.slow_frame_seconds, config_.slow_frame);
   m.rt.finish();
   ev.collect(times);
   times.wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();

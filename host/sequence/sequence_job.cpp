@@ -74,6 +74,16 @@ int run_sequence(const RenderOptions& o) {
   PipelineConfig pc = o.pipeline;
   pc.environment = environment;
   pc.tile_queue_limit = o.input_limits.tile_queue;
+  // A frame still rendering after a few seconds says so (Pipeline::render calls this while waiting).
+  Progress* progress_line = nullptr;
+  long frame_in_flight = 0;
+  if (!o.quiet)
+    pc.slow_frame = [&](double seconds, uint64_t entries) {
+      if (progress_line)
+        progress_line->message("pmr: frame " + std::to_string(frame_in_flight) + ": rendering, " +
+                               std::to_string(long(seconds)) + " s so far (" + std::to_string(entries) +
+                               " tile-queue entries)");
+    };
   const Scene scene = load_scene(o.scene, o.input_limits);
   for (const auto& w : scene.warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
   SequenceSpec spec;
@@ -232,12 +242,14 @@ int run_sequence(const RenderOptions& o) {
   install_interrupt_handlers();
   FrameWriter writer(2);
   Progress progress(total, o.quiet);
+  progress_line = &progress;
   double render_s = 0.0, pose_s = 0.0, upload_s = 0.0;
   long rendered = 0;
   const auto t_loop = std::chrono::steady_clock::now();
   for (long f : todo) {
     if (interrupt_signal()) break;
     const FramePaths p = paths(f);
+    frame_in_flight = f;
     const FrameRenderer::Frame fr = renderer.render(f);
     if (interrupt_signal()) break;  // the frame in flight is abandoned
     render_s += fr.times.wall / 1000.0;

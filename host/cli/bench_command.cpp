@@ -12,6 +12,7 @@
 #include "cli/render_command.h"
 #include "pipeline/pipeline.h"
 #include "pmr/error.h"
+#include "pmr/memory_budget.h"
 #include "pmr/output.h"
 #include "pmr/scene.h"
 #include "runtime/cl_runtime.h"
@@ -201,6 +202,7 @@ double coverage_mismatch(const std::vector<uint16_t>& a, const std::vector<uint1
 void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Scene& scene,
                  const std::string& scene_name, std::ofstream* csv) {
   SequenceSpec spec;
+  spec.framing_work = o.limits.framing_work;
   select_animation(scene, o.animation, spec);
   spec.fps = o.fps;
   spec.turntable = o.turntable, spec.turntable_deg = o.turntable_deg, spec.turntable_frames = o.turntable_frames;
@@ -245,6 +247,7 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       pc.sampling = sampling;
       pc.shading = o.shading, pc.exposure_ev = o.exposure_ev, pc.environment_intensity = o.environment_intensity;
       pc.environment = o.environment;
+      pc.tile_queue_limit = o.limits.tile_queue;
       pc.tile_x = o.tile[0], pc.tile_y = o.tile[1], pc.tile_v = o.tile[2];
       pc.fuse_encode = true;  // the encoded-only job, as pmr render runs it
       Pipeline p(rt, pc);
@@ -357,6 +360,7 @@ int run_bench(const std::vector<std::string>& args) {
                 h.levels[0].width, h.levels[0].height, o.environment->prefilter_seconds(),
                 double(o.environment->tables().data.size() * sizeof(float)) / 1e6);
   }
+  set_memory_budget(o.limits.memory);
   ClRuntime rt;
   const double bw = copy_bandwidth(rt);
   if (csv)

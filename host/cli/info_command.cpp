@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "pmr/error.h"
+#include "pmr/memory_budget.h"
 #include "pmr/scene.h"
 #include "runtime/cl_runtime.h"
 #include "sequence/frame_files.h"
@@ -90,6 +91,7 @@ void describe_lights(const Scene& s) {
 
 // What a user needs to pick --camera and --animation, and to see what the loader made of the file.
 void describe_scene(const std::string& path, const InputLimits& limits) {
+  set_memory_budget(limits.memory);
   const Scene s = load_scene(path, limits);
   const SceneStructure& d = s.structure;
   std::printf("scene: %s%s\n", path.c_str(), d.generator.empty() ? "" : (" (generator: " + printable_text(d.generator, 120) + ")").c_str());

@@ -26,6 +26,13 @@ const LimitKey kLimitKeys[] = {
     {"file-bytes", &InputLimits::file_bytes, "bytes read from one file (the scene, each buffer and image it\n"
                                              "                         names, --display-config)"},
     {"texture-pixels", &InputLimits::texture_pixels, "pixels (width x height) of one decoded texture image"},
+    {"vertex-data", &InputLimits::vertex_data, "bytes of decoded vertex data, every instance and morph target\n"
+                                               "                         counted"},
+    {"animation-data", &InputLimits::animation_data, "bytes of decoded animation keys, every sampler counted"},
+    {"json-bytes", &InputLimits::json_bytes, "bytes of the scene's JSON (a .gltf file, a .glb's JSON chunk)"},
+    {"framing-work", &InputLimits::framing_work, "vertices x poses the framing of an animation may pose"},
+    {"tile-queue", &InputLimits::tile_queue, "tile-queue entries of one frame"},
+    {"memory", &InputLimits::memory, "bytes of memory for the large host and device allocations"},
 };
 
 // "4294967296", "4G", "256M": a positive integer, optionally times 1024^n.
@@ -108,9 +115,13 @@ void parse_limits(const std::string& text, InputLimits& limits) {
 std::string limit_help() {
   const InputLimits defaults;
   std::string out;
-  for (const LimitKey& k : kLimitKeys)
-    out += "                         " + std::string(k.name) + ": " + k.what + " (default " +
-           std::to_string(defaults.*(k.field)) + ")\n";
+  for (const LimitKey& k : kLimitKeys) {
+    const uint64_t v = defaults.*(k.field);
+    out += "                         " + std::string(k.name) + ": " + k.what +
+           (v ? " (default " + std::to_string(v) + ")\n"
+              : std::string("\n                         (default: the smallest of MemAvailable, the cgroup's memory.max "
+                            "and\n                         RLIMIT_AS, less a margin)\n"));
+  }
   return out;
 }
 

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
 
 #include "pmr/error.h"
 
@@ -117,6 +119,7 @@ struct Pipeline::Impl {
   std::vector<std::string> variants;
 
   explicit Impl(const ClRuntime& r) : rt(r) {}
+  uint64_t tile_queue_limit = UINT64_MAX;  // PipelineConfig::tile_queue_limit
 
   // Every stage launches through these: the real grid, or while warming one work-group of the same
   // local size on a frame in which every count is zero (the kernels return at once).
@@ -144,6 +147,8 @@ struct Pipeline::Impl {
   void setup_stage(PmrParams& P, Events& ev, StageTimes& t);
   void bin_stage(Events& ev, StageTimes& t);
   void fine_stage(Events& ev);
+  void wait_reporting(const Events& ev, const StageTimes& t, std::chrono::steady_clock::time_point start,
+                      double interval, const std::function<void(double, uint64_t)>& report);
   void encode_stage(Events& ev);
   void fused_stage(const PmrParams& P, Events& ev);
   void subpixel_stage(Events& ev);
@@ -228,6 +233,7 @@ void upload_environment(Pipeline::Impl& m, const PipelineConfig& config) {
 
 Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config)
     : impl_(new Impl(runtime)), config_(config) {
+  impl_->tile_queue_limit = config.tile_queue_limit;
   tile_[0] = config.tile_x, tile_[1] = config.tile_y, tile_[2] = config.tile_v;
   if (config.method != Method::Pmr && config.tile_v != 1) tile_[0] = 8, tile_[1] = 8, tile_[2] = 1;
   const int tx = tile_[0], ty = tile_[1], tv = tile_[2];
@@ -474,6 +480,9 @@ void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
     total += c;
     if (total >= 0xffffffffull) throw Error("the tile queues would exceed 4 G entries; use larger --tile or fewer views");
   }
+  if (t.bin_entries + total > tile_queue_limit)  // (multipass: every pass of the frame counts)
+    throw Error("the frame's tile raster produces " + std::to_string(t.bin_entries + total) + " tile-queue entries, more than the "
+                "tile-queue limit of " + std::to_string(tile_queue_limit) + " (raise it with --limit tile-queue=N)");
   counts[num_tiles] = uint32_t(total);
   rt.write(tile_offsets, counts.data(), bytes_of(counts));
   if (total > tile_queue_capacity) {
@@ -487,6 +496,34 @@ void Pipeline::Impl::bin_stage(Events& ev, StageTimes& t) {
   t.bin_entries += total;
   k_bin_fill.args(params_buf, mtas, last_mtas, tile_counts, tile_offsets, tile_queue);
   ev.add(kBin, launch(k_bin_fill, last_mtas, kItemGroup));
+}
+
+// Waits for the frame's last command, calling `report` every `interval` seconds once the frame has
+// run that long. The event's completion callback wakes the wait, so a fast frame waits no longer than
+// finish() would.
+void Pipeline::Impl::wait_reporting(const Events& ev, const StageTimes& t, std::chrono::steady_clock::time_point start,
+                                    double interval, const std::function<void(double, uint64_t)>& report) {
+  const auto step = std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(interval));
+  if (ev.all.empty()) return;
+  struct Done {
+    std::mutex mutex;
+    std::condition_variable changed;
+    bool done = false;
+  } d;
+  auto complete = [](cl_event, cl_int, void* user) {
+    auto* p = static_cast<Done*>(user);
+    std::lock_guard<std::mutex> lock(p->mutex);
+    p->done = true;
+    p->changed.notify_all();
+  };
+  if (clSetEventCallback(ev.all.back().second, CL_COMPLETE, complete, &d) != CL_SUCCESS) return;  // finish() waits
+  clFlush(rt.queue());
+  std::unique_lock<std::mutex> lock(d.mutex);
+  auto next = start + step;
+  while (!d.changed.wait_until(lock, next, [&] { return d.done; })) {
+    report(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), t.bin_entries);
+    next += step;
+  }
 }
 
 void Pipeline::Impl::fine_stage(Events& ev) {
@@ -681,6 +718,7 @@ StageTimes Pipeline::render(const Rig& rig) {
     if (config_.multipass_snapped) std::swap(m.vertices, m.pmr_vertices);
   }
   if (m.encode && !m.fused && !m.subpixel) m.encode_stage(ev);
+  if (config_.slow_frame && !m.warming) m.wait_reporting(ev, times, t_start, config_.slow_frame_seconds, config_.slow_frame);
   m.rt.finish();
   ev.collect(times);
   times.wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();

@@ -4,10 +4,12 @@
 // frame needs more, so no work is ever dropped.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "pmr/input_files.h"
 #include "pmr/rig.h"
 #include "pmr/scene.h"
 #include "pmr/shared.h"
@@ -72,6 +74,14 @@ struct PipelineConfig {
   // It replaces the uniform default and turns the default light off (host/shading/lights.h; the file's
   // lights stay). Null: the uniform default.
   std::shared_ptr<const Environment> environment;
+  // --limit tile-queue: a frame whose tile raster produces more entries is refused (before the queue
+  // grows to hold them), naming the budget.
+  uint64_t tile_queue_limit = InputLimits().tile_queue;
+  // Called every few seconds while a frame is still rendering after a few seconds (seconds so far,
+  // the frame's tile-queue entries), so that a slow frame (10^4 full-screen triangles take a minute)
+  // shows progress. Empty: render() just waits.
+  std::function<void(double seconds, uint64_t tile_queue_entries)> slow_frame;
+  double slow_frame_seconds = 5.0;  // the first call after this long, then one per this long
 };
 
 struct StageTimes {  // milliseconds

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "pmr/error.h"
+#include "pmr/memory_budget.h"
 
 namespace pmr {
 
@@ -36,11 +37,13 @@ const char* cl_error_name(cl_int code) {
 
 void cl_check(cl_int code, const std::string& what) {
   if (code == CL_SUCCESS) return;
-  std::string hint;
-  if (code == CL_MEM_OBJECT_ALLOCATION_FAILURE || code == CL_OUT_OF_RESOURCES ||
-      code == CL_OUT_OF_HOST_MEMORY || code == CL_INVALID_BUFFER_SIZE)
-    hint = " (the device ran out of memory: try fewer views or smaller views)";
-  throw Error(what + ": " + cl_error_name(code) + " (" + std::to_string(code) + ")" + hint);
+  // A failed allocation, wherever the device reports it (clCreateBuffer, or an enqueue that first
+  // touches the buffer), is the same out-of-memory error as a refusal by the memory budget.
+  if (code == CL_MEM_OBJECT_ALLOCATION_FAILURE || code == CL_OUT_OF_RESOURCES || code == CL_OUT_OF_HOST_MEMORY ||
+      code == CL_INVALID_BUFFER_SIZE)
+    throw Error("out of memory: " + what + ": " + cl_error_name(code) + " (" + std::to_string(code) +
+                "): the device could not allocate it; try fewer or smaller views");
+  throw Error(what + ": " + cl_error_name(code) + " (" + std::to_string(code) + ")");
 }
 
 namespace {
@@ -133,14 +136,15 @@ ClBuffer::ClBuffer(cl_context ctx, cl_mem_flags flags, size_t bytes, const std::
   cl_int err = CL_SUCCESS;
   mem_ = clCreateBuffer(ctx, flags, bytes == 0 ? 16 : bytes, nullptr, &err);
   cl_check(err, "allocating " + name + " (" + std::to_string(bytes >> 20) + " MiB)");
+  add_device_bytes(int64_t(bytes_));
 }
 ClBuffer::~ClBuffer() {
-  if (mem_) clReleaseMemObject(mem_);
+  if (mem_) clReleaseMemObject(mem_), add_device_bytes(-int64_t(bytes_));
 }
 ClBuffer::ClBuffer(ClBuffer&& o) noexcept : mem_(o.mem_), bytes_(o.bytes_) { o.mem_ = nullptr; }
 ClBuffer& ClBuffer::operator=(ClBuffer&& o) noexcept {
   if (this != &o) {
-    if (mem_) clReleaseMemObject(mem_);
+    if (mem_) clReleaseMemObject(mem_), add_device_bytes(-int64_t(bytes_));
     mem_ = o.mem_;
     bytes_ = o.bytes_;
     o.mem_ = nullptr;
@@ -242,6 +246,9 @@ ClBuffer ClRuntime::buffer(size_t bytes, const std::string& name, cl_mem_flags f
     throw Error("cannot allocate " + name + ": " + std::to_string(bytes >> 20) +
                 " MiB exceeds the device's largest allocation (" + std::to_string(max_alloc_bytes() >> 20) +
                 " MiB); use fewer or smaller views");
+  // PoCL allocates a buffer's memory when it is first used and asserts (an abort) if that fails:
+  // refuse it here, while the error can still be clean.
+  check_memory(bytes, name);
   return ClBuffer(context_, flags, bytes, name);
 }
 

@@ -240,6 +240,13 @@ const Rule& rule_for(Semantic semantic) {
 
 }  // namespace
 
+uint64_t decoded_bytes(const tinygltf::Model& m, int accessor) {
+  if (accessor < 0 || size_t(accessor) >= m.accessors.size()) return 0;
+  const tinygltf::Accessor& a = m.accessors[size_t(accessor)];
+  const int n = component_count(a.type);
+  return uint64_t(a.count) * uint64_t(n > 0 ? n : 16) * 4;  // MAT2 / MAT3 (never read) as MAT4
+}
+
 void check_accessor(const tinygltf::Model& m, int accessor, Semantic semantic, const std::string& what,
                     const std::string& file) {
   resolve(m, accessor, rule_for(semantic), what, file);

@@ -63,6 +63,10 @@ struct SourceFile {
     int uses = 0;
   };
   std::map<std::string, External> external;
+  // Buffers some accessor the loader reads uses (needed_buffers); the others are never read. Those
+  // with an external file are handed to tinygltf as one byte: their declared byteLength, per index.
+  std::set<int> needed_buffers;
+  std::map<int, uint64_t> unread_buffers;
 };
 SourceFile read_source(const std::string& path, const InputLimits& limits);
 
@@ -96,7 +100,9 @@ std::string decode_image(tinygltf::Image& image, const unsigned char* bytes, int
 // Checks every cross reference the loader follows (scene -> node -> mesh -> accessor / material ->
 // texture -> image / sampler, node -> camera), that each bufferView lies inside its buffer, and that
 // the nodes form a forest (no cycle, at most one parent). Returns each node's parent (-1 = root).
-std::vector<int> validate_model(const tinygltf::Model& model, const std::string& file);
+// Buffers in `unread_buffers` (SourceFile) are checked against their declared byteLength.
+std::vector<int> validate_model(const tinygltf::Model& model, const std::map<int, uint64_t>& unread_buffers,
+                                const std::string& file);
 
 // Root nodes of the scene to render: the default scene (scene 0 when none is named) or, with no
 // scenes at all, every node without a parent.
@@ -139,6 +145,10 @@ AttributeData read_attribute(const tinygltf::Model& model, int accessor, Semanti
 // that counts can be trusted before anything is allocated from them.
 void check_accessor(const tinygltf::Model& model, int accessor, Semantic semantic, const std::string& what,
                     const std::string& file);
+
+// Bytes the accessor takes decoded (4 per component: float, or uint32 for indices), from its count
+// alone; 0 for an index out of range.
+uint64_t decoded_bytes(const tinygltf::Model& model, int accessor);
 
 // A SCALAR u8 / u16 / u32 index accessor. Values are not range-checked here (the caller knows the
 // vertex count).

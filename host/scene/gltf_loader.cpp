@@ -14,6 +14,7 @@
 
 #include "output/checksum.h"
 #include "pmr/error.h"
+#include "pmr/memory_budget.h"
 #include "pmr/printable.h"
 #include "pmr/scene.h"
 #include "scene/gltf_internal.h"
@@ -147,6 +148,21 @@ void load_model(const std::string& path, SourceFile& src, tinygltf::Model& model
   files_read = std::move(fs.read);
 }
 
+// Animation keys are decoded per sampler, so samplers sharing one accessor each count in full: the
+// sum is checked before any is read.
+void check_animation_budget(const tinygltf::Model& model, const InputLimits& limits, const std::string& path) {
+  uint64_t bytes = 0;
+  for (const tinygltf::Animation& a : model.animations)
+    for (const tinygltf::AnimationSampler& smp : a.samplers)
+      for (const int accessor : {smp.input, smp.output})
+        if (__builtin_add_overflow(bytes, decoded_bytes(model, accessor), &bytes)) bytes = UINT64_MAX;
+  if (bytes > limits.animation_data)
+    fail(path, "the animations' samplers decode to " + std::to_string(bytes) + " bytes of keys (every sampler "
+               "counted), more than the animation-data limit of " + std::to_string(limits.animation_data) +
+               " (raise it with --limit animation-data=N)");
+  check_memory(bytes, "decoding the animations' keys");
+}
+
 // ---- materials and textures ---------------------------------------------------------------------------
 
 // uv' = T * R * S * uv (KHR_texture_transform). The extension's GLSL reads as
@@ -188,6 +204,7 @@ struct Loader {
   std::vector<std::vector<glm::dmat4>> rest_joints;  // per skin: joint matrices at rest
   std::vector<bool> moving, weights_animated;        // per node
   std::set<int> skins_without_joints;                // meshes: skinned nodes whose mesh lacks JOINTS_0
+  const InputLimits* limits = nullptr;               // the vertex-data budget
 
   void warn(const std::string& line) {
     if (seen.insert(line).second) scene.warnings.push_back(file + ": " + one_line(line));
@@ -767,25 +784,60 @@ std::pair<uint64_t, uint64_t> primitive_size(const Loader& L, int mesh, int inde
   return {triangles, triangles ? vertices : 0};
 }
 
+// Bytes decode_primitive allocates for a primitive of `triangles` triangles: every accessor it names
+// decoded (attributes, each morph target's, indices) and its triangle list. Each morph target counts
+// in full even when all of them name one accessor, as each is decoded into its own array.
+uint64_t primitive_data_bytes(const Loader& L, int mesh, int index, uint64_t triangles) {
+  if (triangles == 0) return 0;
+  const tinygltf::Primitive& p = L.model.meshes[size_t(mesh)].primitives[size_t(index)];
+  uint64_t bytes = 12 * triangles;
+  auto add = [&](uint64_t b) {
+    if (__builtin_add_overflow(bytes, b, &bytes)) bytes = UINT64_MAX;
+  };
+  for (const auto& [name, accessor] : p.attributes) add(decoded_bytes(L.model, accessor));
+  for (const auto& target : p.targets)
+    for (const auto& [name, accessor] : target) add(decoded_bytes(L.model, accessor));
+  if (p.indices >= 0) add(decoded_bytes(L.model, p.indices));
+  return bytes;
+}
+
 // Sums the whole scene before anything is decoded: a small file instancing a big mesh many times must
 // fail here, not after allocating gigabytes. The vertex cap is what the triangle cap can reference.
 void check_totals(Loader& L, const std::vector<Instance>& instances) {
-  std::map<int, std::pair<uint64_t, uint64_t>> mesh_size;  // per mesh: triangles, vertices
-  uint64_t triangles = 0, vertices = 0;
+  struct Size {
+    uint64_t triangles = 0, vertices = 0, data = 0;  // data: primitive_data_bytes
+  };
+  auto add = [](uint64_t& sum, uint64_t v) {
+    if (__builtin_add_overflow(sum, v, &sum)) sum = UINT64_MAX;
+  };
+  std::map<int, Size> mesh_size;
+  uint64_t triangles = 0, vertices = 0, data = 0;
   for (const Instance& inst : instances) {
     auto it = mesh_size.find(inst.mesh);
     if (it == mesh_size.end()) {
-      std::pair<uint64_t, uint64_t> sum{0, 0};
+      Size sum;
       for (size_t p = 0; p < L.model.meshes[size_t(inst.mesh)].primitives.size(); ++p) {
         const auto [t, v] = primitive_size(L, inst.mesh, int(p));
-        if (__builtin_add_overflow(sum.first, t, &sum.first)) sum.first = UINT64_MAX;
-        if (__builtin_add_overflow(sum.second, v, &sum.second)) sum.second = UINT64_MAX;
+        add(sum.triangles, t);
+        add(sum.vertices, v);
+        add(sum.data, primitive_data_bytes(L, inst.mesh, int(p), t));
       }
       it = mesh_size.emplace(inst.mesh, sum).first;
     }
-    if (__builtin_add_overflow(triangles, it->second.first, &triangles)) triangles = UINT64_MAX;
-    if (__builtin_add_overflow(vertices, it->second.second, &vertices)) vertices = UINT64_MAX;
+    add(triangles, it->second.triangles);
+    add(vertices, it->second.vertices);
+    add(data, it->second.data);  // per instance: each is emitted from its own decoded copy's worth
   }
+  if (data > L.limits->vertex_data)
+    fail(L.file, "the scene's meshes decode to " + std::to_string(data) + " bytes of vertex data (every instance and "
+                 "morph target counted), more than the vertex-data limit of " + std::to_string(L.limits->vertex_data) +
+                 " (raise it with --limit vertex-data=N)");
+  // What the flattened scene holds per vertex and triangle (positions, attributes, two texture
+  // coordinate sets, tangents; triangles), on top of the decoded data.
+  const uint64_t per_vertex = sizeof(glm::vec3) + sizeof(PmrVertexAttr) + 2 * sizeof(glm::vec2) + sizeof(glm::vec4);
+  uint64_t scene_bytes = data;
+  if (vertices < (uint64_t(1) << 40)) add(scene_bytes, vertices * per_vertex + triangles * sizeof(PmrTriangle));
+  else scene_bytes = UINT64_MAX;
   const uint64_t max_triangles = PMR_MAX_TRIANGLES - 1, max_vertices = 3 * max_triangles;
   if (triangles > max_triangles)
     fail(L.file, "the scene has " + std::to_string(triangles) + " triangles; the renderer supports at most " +
@@ -793,6 +845,7 @@ void check_totals(Loader& L, const std::vector<Instance>& instances) {
   if (vertices > max_vertices)
     fail(L.file, "the scene has " + std::to_string(vertices) + " vertices; the renderer supports at most " +
                      std::to_string(max_vertices));
+  check_memory(scene_bytes, "loading the scene's " + std::to_string(triangles) + " triangles");
   L.scene.triangles.reserve(size_t(triangles));
   L.scene.positions.reserve(size_t(vertices));
   L.scene.attributes.reserve(size_t(vertices));
@@ -913,11 +966,13 @@ Scene load_scene(const std::string& path, const InputLimits& limits) {
   images.max_pixels = limits.texture_pixels;
   std::map<std::string, std::string> files_read;
   load_model(path, src, model, images, files_read);
-  const std::vector<int> parent = validate_model(model, path);
+  check_animation_budget(model, limits, path);
+  const std::vector<int> parent = validate_model(model, src.unread_buffers, path);
   const std::vector<int> roots = scene_roots(model, parent, path);
 
   Scene scene;
   Loader L(model, path, images, scene);
+  L.limits = &limits;
   L.light_defs = &src.lights;
   L.node_light = &src.node_light;
   L.motion = read_motion(model, parent, path);

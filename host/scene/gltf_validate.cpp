@@ -10,6 +10,7 @@
 
 #include "output/checksum.h"
 #include "pmr/error.h"
+#include "pmr/memory_budget.h"
 #include "pmr/printable.h"
 #include "scene/gltf_internal.h"
 
@@ -43,6 +44,8 @@ namespace {
 // tinygltf's extras/extensions parser recurses once per nesting level, so a hostile file nested a
 // million levels deep would overflow the stack. Real glTF nests less than ten levels.
 constexpr int kMaxJsonDepth = 128;
+// Memory per JSON value once parsed by both parsers (see read_source).
+constexpr uint64_t kJsonBytesPerValue = 200;
 
 // Extensions we implement. KHR_mesh_quantization only widens the component types the generic accessor
 // reader already accepts; KHR_texture_transform is applied per texture slot; the material and light
@@ -107,9 +110,11 @@ std::string glb_json(const std::string& path, std::vector<unsigned char>& bytes,
   return std::string(reinterpret_cast<const char*>(&bytes[20]), size_t(json_length));
 }
 
-// Nesting depth of JSON text, counting brackets outside strings (cheap, no recursion).
-int json_depth(const std::string& text) {
+// Nesting depth of JSON text, counting brackets outside strings (cheap, no recursion), and an upper
+// bound of its values (separators and openings outside strings, plus one).
+int json_depth(const std::string& text, uint64_t& values) {
   int depth = 0, max_depth = 0;
+  values = 1;
   bool in_string = false, escaped = false;
   for (char c : text) {
     if (in_string) {
@@ -120,8 +125,11 @@ int json_depth(const std::string& text) {
       in_string = true;
     } else if (c == '[' || c == '{') {
       max_depth = std::max(max_depth, ++depth);
+      ++values;
     } else if (c == ']' || c == '}') {
       --depth;
+    } else if (c == ',' || c == ':') {
+      ++values;
     }
   }
   return max_depth;
@@ -308,6 +316,10 @@ void check_buffers(const std::string& path, const json& doc, SourceFile& src, in
       continue;  // tinygltf decodes it and checks the decoded size against byteLength
     }
     if (byte_length > uint64_t(INT64_MAX)) fail(path, name + " has an impossible byteLength");
+    if (!src.needed_buffers.count(int(i))) {  // no accessor the loader reads uses it: never opened
+      src.unread_buffers[int(i)] = byte_length;
+      continue;
+    }
     read_external(path, src, resolve_uri(src.base_dir, u), name + ": file '" + one_line(u) + "'", confine, limits,
                   int64_t(byte_length), false);
   }
@@ -351,6 +363,84 @@ std::set<int> sampled_images(const json& doc) {
     }
   }
   return images;
+}
+
+// The buffers the loader can read from: those of the bufferViews of every accessor a mesh primitive
+// (attributes, indices, morph targets), an animation sampler or a skin names, of their sparse parts,
+// and of the sampled images stored in bufferViews. Any other buffer is never read, however large.
+std::set<int> needed_buffers(const json& doc, const std::set<int>& sampled) {
+  const json* accessors = member(doc, "accessors");
+  const json* views = member(doc, "bufferViews");
+  std::set<int64_t> used_accessors, used_views;
+  auto use = [&](const json* index) {
+    if (const int64_t a = json_index(index); a >= 0) used_accessors.insert(a);
+  };
+  auto use_all = [&](const json* object) {
+    if (object && object->is_object())
+      for (const auto& [key, value] : object->items()) use(&value);
+  };
+  if (const json* meshes = member(doc, "meshes"); meshes && meshes->is_array())
+    for (const json& mesh : *meshes)
+      if (const json* prims = member(mesh, "primitives"); prims && prims->is_array())
+        for (const json& p : *prims) {
+          use_all(member(p, "attributes"));
+          use(member(p, "indices"));
+          if (const json* targets = member(p, "targets"); targets && targets->is_array())
+            for (const json& t : *targets) use_all(&t);
+        }
+  if (const json* animations = member(doc, "animations"); animations && animations->is_array())
+    for (const json& a : *animations)
+      if (const json* samplers = member(a, "samplers"); samplers && samplers->is_array())
+        for (const json& smp : *samplers) use(member(smp, "input")), use(member(smp, "output"));
+  if (const json* skins = member(doc, "skins"); skins && skins->is_array())
+    for (const json& skin : *skins) use(member(skin, "inverseBindMatrices"));
+  if (accessors && accessors->is_array())
+    for (int64_t a : used_accessors) {
+      if (size_t(a) >= accessors->size()) continue;
+      const json& acc = (*accessors)[size_t(a)];
+      if (const int64_t v = json_index(member(acc, "bufferView")); v >= 0) used_views.insert(v);
+      if (const json* sparse = member(acc, "sparse"))
+        for (const char* part : {"indices", "values"})
+          if (const json* p = member(*sparse, part))
+            if (const int64_t v = json_index(member(*p, "bufferView")); v >= 0) used_views.insert(v);
+    }
+  if (const json* images = member(doc, "images"); images && images->is_array())
+    for (int i : sampled)
+      if (i >= 0 && size_t(i) < images->size())
+        if (const int64_t v = json_index(member((*images)[size_t(i)], "bufferView")); v >= 0) used_views.insert(v);
+  std::set<int> buffers;
+  if (views && views->is_array())
+    for (int64_t v : used_views)
+      if (size_t(v) < views->size())
+        if (const int64_t b = json_index(member((*views)[size_t(v)], "buffer")); b >= 0) buffers.insert(int(b));
+  return buffers;
+}
+
+// tinygltf loads every buffer it is given. An unread one is handed over as one byte in a data URI
+// (validate_model checks its bufferViews against the length the file declares instead): the JSON
+// text, or the GLB's JSON chunk, is rewritten for it.
+void replace_unread_buffers(json& doc, SourceFile& src) {
+  for (const auto& [index, length] : src.unread_buffers)
+    doc["buffers"][size_t(index)] = {{"byteLength", 1}, {"uri", "data:application/octet-stream;base64,AA=="}};
+  std::string text = doc.dump();
+  if (!src.glb) {
+    src.bytes.assign(text.begin(), text.end());
+    return;
+  }
+  while (text.size() % 4) text += ' ';  // chunks are 4-byte aligned, JSON padded with spaces
+  const uint64_t old_json = read_u32le(&src.bytes[12]);
+  const size_t rest = size_t(20 + old_json);  // the BIN chunk (and anything after it), as it was
+  std::vector<unsigned char> out(src.bytes.begin(), src.bytes.begin() + 12);
+  auto put32 = [&](uint32_t v) {
+    for (int k = 0; k < 4; ++k) out.push_back(uint8_t(v >> (8 * k)));
+  };
+  put32(uint32_t(text.size()));
+  put32(0x4E4F534Au);
+  out.insert(out.end(), text.begin(), text.end());
+  out.insert(out.end(), src.bytes.begin() + long(rest), src.bytes.end());
+  const uint32_t total = uint32_t(out.size());
+  for (int k = 0; k < 4; ++k) out[size_t(8 + k)] = uint8_t(total >> (8 * k));
+  src.bytes = std::move(out);
 }
 
 bool is_data_uri(const std::string& uri) { return uri.rfind("data:", 0) == 0; }
@@ -442,7 +532,17 @@ SourceFile read_source(const std::string& path, const InputLimits& limits) {
   int64_t bin_length = -1;
   const std::string text = src.glb ? glb_json(path, src.bytes, bin_length)
                                    : std::string(src.bytes.begin(), src.bytes.end());
-  if (json_depth(text) > kMaxJsonDepth)
+  if (text.size() > limits.json_bytes)
+    fail(path, "the JSON " + std::string(src.glb ? "chunk" : "text") + " has " + std::to_string(text.size()) +
+                   " bytes, more than the json-bytes limit of " + std::to_string(limits.json_bytes) +
+                   " (raise it with --limit json-bytes=N)");
+  uint64_t values = 0;
+  const int depth = json_depth(text, values);
+  // Parsed, the JSON is held twice (here and by tinygltf, whose values for extras are larger still):
+  // about 200 bytes a value where the text has two, as measured on a 40 MB array of numbers.
+  check_memory(values * kJsonBytesPerValue + 2 * uint64_t(text.size()),
+               "parsing the scene's JSON (" + std::to_string(values) + " values)");
+  if (depth > kMaxJsonDepth)
     fail(path, "invalid JSON: nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
   json doc;
   try {
@@ -467,11 +567,13 @@ SourceFile read_source(const std::string& path, const InputLimits& limits) {
     confine = real_folder(src.base_dir);
     if (confine.empty()) fail(path, "cannot resolve the scene's folder " + one_line(src.base_dir));
   }
+  src.sampled_images = sampled_images(doc);
+  src.needed_buffers = needed_buffers(doc, src.sampled_images);
   check_buffers(path, doc, src, bin_length, confine, limits);
   read_lights(path, doc, src);
-  src.sampled_images = sampled_images(doc);
   src.unused_image_files = unused_image_files(doc, src.base_dir, src.sampled_images);
   read_sampled_images(path, doc, src, confine, limits);
+  if (!src.unread_buffers.empty()) replace_unread_buffers(doc, src);
   return src;
 }
 
@@ -489,12 +591,13 @@ std::string ref_error(const std::string& owner, const char* kind, int index, siz
          std::to_string(count) + ")";
 }
 
-void check_buffer_views(const tinygltf::Model& m, const std::string& file) {
+void check_buffer_views(const tinygltf::Model& m, const std::map<int, uint64_t>& unread, const std::string& file) {
   for (size_t i = 0; i < m.bufferViews.size(); ++i) {
     const tinygltf::BufferView& bv = m.bufferViews[i];
     const std::string name = "bufferView " + std::to_string(i);
     if (!in_range(bv.buffer, m.buffers)) fail(file, ref_error(name, "buffer", bv.buffer, m.buffers.size()));
-    const uint64_t size = m.buffers[size_t(bv.buffer)].data.size();
+    const auto declared = unread.find(bv.buffer);
+    const uint64_t size = declared != unread.end() ? declared->second : m.buffers[size_t(bv.buffer)].data.size();
     uint64_t end = 0;
     if (__builtin_add_overflow(uint64_t(bv.byteOffset), uint64_t(bv.byteLength), &end) || end > size)
       fail(file, name + " (byteOffset " + std::to_string(bv.byteOffset) + ", byteLength " +
@@ -620,8 +723,9 @@ void check_animation_data(const tinygltf::Model& m, const std::string& file) {
 
 }  // namespace
 
-std::vector<int> validate_model(const tinygltf::Model& model, const std::string& file) {
-  check_buffer_views(model, file);
+std::vector<int> validate_model(const tinygltf::Model& model, const std::map<int, uint64_t>& unread_buffers,
+                                const std::string& file) {
+  check_buffer_views(model, unread_buffers, file);
   check_meshes(model, file);
   check_materials(model, file);
   check_animation_data(model, file);

@@ -134,6 +134,13 @@ FrameRenderer::FrameRenderer(const Scene& rest, const SequenceSpec& spec, const 
     long first = 0, last = -1;
     animation_key_frames(rest, spec, first, last);
     std::vector<double> times{start, end};
+    const uint64_t poses = uint64_t(2 + std::max(0L, last - first + 1));
+    const uint64_t vertices = std::max<uint64_t>(1, rest.positions.size());
+    if (poses > spec.framing_work / vertices)
+      throw Error("framing the animation poses the scene's " + std::to_string(rest.positions.size()) + " vertices " +
+                  std::to_string(poses) + " times (every frame of its keys at " + std::to_string(spec.fps) +
+                  " fps), more than the framing-work limit of " + std::to_string(spec.framing_work) +
+                  " vertex-poses (raise it with --limit framing-work=N)");
     for (long f = first; f <= last; ++f) times.push_back(double(f) / spec.fps);
     Scene posed;
     for (double t : times) {

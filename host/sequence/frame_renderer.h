@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pipeline/pipeline.h"
+#include "pmr/input_files.h"
 #include "pmr/rig.h"
 #include "pmr/scene.h"
 
@@ -20,6 +21,9 @@ struct SequenceSpec {
   bool turntable = false;
   double turntable_deg = 0.0;     // DEG of DEG:FRAMES
   long turntable_frames = 1;      // FRAMES of DEG:FRAMES
+  // --limit framing-work: the framing poses the scene at every frame of the animation before the first
+  // frame renders; poses x the scene's vertices above this are refused (FrameRenderer).
+  uint64_t framing_work = InputLimits().framing_work;
 };
 
 // Resolves --animation (NAME, INDEX, all, or none = the rest pose; empty = the first animation if there

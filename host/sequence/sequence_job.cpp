@@ -16,6 +16,7 @@
 #include "output/checksum.h"
 #include "output/interrupt.h"
 #include "pmr/error.h"
+#include "pmr/memory_budget.h"
 #include "pmr/output.h"
 #include "pmr/quilt.h"
 #include "runtime/cl_runtime.h"
@@ -61,6 +62,7 @@ class SequenceRun {
   void check_before_loading();
   void load_inputs();
   void choose_frames();
+  void check_frame_memory() const;
   void prepare_frames();
   SidecarInfo frame_info(long frame, const FramePaths& p, double angle, std::vector<SceneLight> lights) const;
   std::string expected_sidecar(long frame, const FramePaths& p) const {
@@ -92,10 +94,13 @@ class SequenceRun {
   // the summary's sums
   double render_s_ = 0.0, pose_s_ = 0.0, upload_s_ = 0.0, loop_s_ = 0.0, loop_cpu_s_ = 0.0;
   long rendered_ = 0;
+  Progress* progress_ = nullptr;  // while frames render: for the slow-frame notice
+  long frame_in_flight_ = 0;
 };
 
 // Everything that can be checked cheaply, before the long work starts.
 void SequenceRun::check_before_loading() {
+  set_memory_budget(job_.input_limits.memory);
   if (job_.frames != "all") frames_ = parse_frame_list(job_.frames);
   check_name_covers_frames(products_.name, frames_.size());
   prepare_output_dir(products_.out_dir);
@@ -108,6 +113,15 @@ void SequenceRun::check_before_loading() {
 // then the scene.
 void SequenceRun::load_inputs() {
   pc_ = job_.pipeline;
+  pc_.tile_queue_limit = job_.input_limits.tile_queue;
+  // A frame still rendering after a few seconds says so (Pipeline::render calls this while waiting).
+  if (!job_.quiet)
+    pc_.slow_frame = [this](double seconds, uint64_t entries) {
+      if (progress_)
+        progress_->message("pmr: frame " + std::to_string(frame_in_flight_) + ": rendering, " +
+                           std::to_string(long(seconds)) + " s so far (" + std::to_string(entries) +
+                           " tile-queue entries)");
+    };
   if (!job_.environment_file.empty()) {
     auto environment = std::make_shared<const Environment>(Environment::make(
         {job_.environment_file, job_.environment_rotation_deg, job_.pipeline.environment_intensity}));
@@ -126,6 +140,7 @@ void SequenceRun::load_inputs() {
 
 // The animation, --frames all, this shard's part; then the framing (FrameRenderer) and the layout.
 void SequenceRun::choose_frames() {
+  spec_.framing_work = job_.input_limits.framing_work;
   select_animation(scene_, job_.animation, spec_);
   spec_.fps = job_.fps;
   spec_.turntable = job_.turntable;
@@ -159,6 +174,23 @@ void SequenceRun::choose_frames() {
     quilt_ = job_.quilt_layout.empty() ? choose_quilt_layout(rig.views, rig.view_w, rig.view_h)
                                        : parse_quilt_layout(job_.quilt_layout, rig.views, rig.view_w, rig.view_h);
   center_view_ = rig.views / 2;
+  check_frame_memory();
+}
+
+// The images of a frame, checked against the memory budget before anything is created: the view
+// volume on the device and, when written, up to three host copies (one read back, one queued, one
+// being written) plus the encoder's output; the display image (RGBA and the subpixels' alpha)
+// likewise; depth 12 bytes a voxel on the device and 4 per host copy. The device buffers are checked
+// again as they are allocated.
+void SequenceRun::check_frame_memory() const {
+  const Rig& rig = renderer_->rig();
+  const uint64_t voxels = uint64_t(rig.views) * uint64_t(rig.view_w) * uint64_t(rig.view_h);
+  const uint64_t display = products_.encoded ? uint64_t(job_.display.width) * uint64_t(job_.display.height) * 14 : 0;
+  const uint64_t volume = need_volume_ ? voxels * 8 : 0;
+  const uint64_t depth = need_volume_ && products_.depth ? voxels * (12 + 3 * 4) : 0;
+  check_memory(5 * volume + 5 * display + depth,
+               std::to_string(rig.views) + " views of " + std::to_string(rig.view_w) + "x" + std::to_string(rig.view_h) +
+                   " (" + std::to_string(volume >> 20) + " MiB a view volume, on the device and in up to four copies being written)");
 }
 
 // What every frame's sidecar shares.
@@ -343,10 +375,12 @@ int SequenceRun::render_frames() {
   FrameWriter writer(2);
   const long total = long(plan_.todo.size());
   Progress progress(total, job_.quiet);
+  progress_ = &progress;
   const auto t_loop = std::chrono::steady_clock::now();
   const double cpu0 = process_cpu_seconds();
   for (long f : plan_.todo) {
     if (interrupt_signal()) break;
+    frame_in_flight_ = f;
     const FrameRenderer::Frame fr = renderer_->render(f);
     if (interrupt_signal()) break;  // the frame in flight is abandoned
     render_s_ += fr.times.wall / 1000.0;
@@ -365,6 +399,7 @@ int SequenceRun::render_frames() {
     throw;
   }
   progress.close();
+  progress_ = nullptr;
   loop_s_ = seconds_since(t_loop);
   loop_cpu_s_ = process_cpu_seconds() - cpu0;
   const long written = writer.frames_written();

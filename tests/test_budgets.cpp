@@ -1,0 +1,412 @@
+// The budgets of docs/SECURITY.md beyond the files (vertex data, animation keys, JSON size, framing
+// work, tile-queue entries, memory) and the buffers no accessor uses, each against the crafted input of
+// issue 21 that once cost gigabytes or hours. Every input is generated here; where memory is the
+// point the child runs under `prlimit --as` (RLIMIT_AS), so that a regression fails the test instead
+// of eating the machine.
+#include <sys/stat.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "gltf_builder.h"
+#include "pmr/input_files.h"
+#include "pmr/memory_budget.h"
+#include "test_util.h"
+
+namespace pmr::test {
+namespace {
+
+constexpr uint64_t kGiB = uint64_t(1) << 30;
+
+// `pmr ARGS` with its address space capped at `as_bytes` (RLIMIT_AS).
+CliRun run_capped(uint64_t as_bytes, const std::string& args) {
+  const std::string cmd = "prlimit --as=" + std::to_string(as_bytes) + " " + std::string(PMR_BINARY) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int st = pclose(p);
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// A GLB of `doc` (its buffers as given) and `bin` as the BIN chunk.
+std::vector<uint8_t> glb_of(const json& doc, std::vector<uint8_t> bin) {
+  std::string text = doc.dump();
+  while (text.size() % 4) text += ' ';
+  while (bin.size() % 4) bin.push_back(0);
+  std::vector<uint8_t> out = {'g', 'l', 'T', 'F'};
+  put_le32(out, 2);
+  put_le32(out, uint32_t(12 + 8 + text.size() + 8 + bin.size()));
+  put_le32(out, uint32_t(text.size()));
+  put_le32(out, 0x4E4F534Au);
+  out.insert(out.end(), text.begin(), text.end());
+  put_le32(out, uint32_t(bin.size()));
+  put_le32(out, 0x004E4942u);
+  out.insert(out.end(), bin.begin(), bin.end());
+  return out;
+}
+
+// One triangle in the file's buffer, drawn by node 0.
+GltfFile one_triangle() {
+  GltfFile g;
+  const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
+  g.mesh(json::array({{{"attributes", {{"POSITION", pos}}}}}));
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  return g;
+}
+
+// A mesh whose POSITION is an accessor without a bufferView: `count` zero vertices from a few bytes.
+GltfFile implicit_mesh(uint64_t count) {
+  GltfFile g;
+  const int pos = g.accessor(-1, kFloat, "VEC3", count);
+  g.mesh(json::array({{{"attributes", {{"POSITION", pos}}}}}));
+  return g;
+}
+
+class Budgets : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(temp_dir(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    fs::remove_all(dir_);
+    set_memory_budget(0);
+  }
+  std::string write(const GltfFile& g, const std::string& name) {
+    std::ofstream(dir_ / name) << g.finished("").dump();
+    return (dir_ / name).string();
+  }
+  // No frame of a render was written into `out`.
+  void expect_no_frames(const fs::path& out) {
+    if (!fs::exists(out)) return;
+    for (const auto& e : fs::directory_iterator(out)) {
+      const std::string ext = e.path().extension().string();
+      EXPECT_TRUE(ext != ".exr" && ext != ".json" && ext != ".png") << "written: " << e.path();
+    }
+  }
+  fs::path dir_;
+};
+
+// ---- buffers no accessor uses -----------------------------------------------------------------------
+
+// A 5 GiB buffer (a sparse file) that no accessor reads, beside the one that is drawn: never opened,
+// in a .gltf and in a .glb (whose JSON chunk is rewritten for tinygltf). A bufferView that overruns
+// it is still an error, against the length the file declares.
+TEST_F(Budgets, BuffersNoAccessorUsesAreNotRead) {
+  const uint64_t five_gib = 5 * kGiB;
+  {
+    std::ofstream(dir_ / "unused.bin", std::ios::binary).put('x');
+    fs::resize_file(dir_ / "unused.bin", five_gib);
+  }
+  GltfFile g = one_triangle();
+  g.doc["bufferViews"].push_back({{"buffer", 1}, {"byteLength", 4096}, {"byteOffset", five_gib - 4096}});
+  g.accessor(1, kFloat, "VEC3", 10);  // names the big buffer, but no mesh uses it
+  json doc = g.finished("small.bin");
+  doc["buffers"].push_back({{"uri", "unused.bin"}, {"byteLength", five_gib}});
+  write_bytes(dir_ / "small.bin", g.bin);
+  std::ofstream(dir_ / "scene.gltf") << doc.dump();
+  json glb_doc = g.finished("");
+  glb_doc["buffers"].push_back({{"uri", "unused.bin"}, {"byteLength", five_gib}});
+  write_bytes(dir_ / "scene.glb", glb_of(glb_doc, g.bin));
+  for (const char* name : {"scene.gltf", "scene.glb"}) {
+    SCOPED_TRACE(name);
+    const auto t0 = std::chrono::steady_clock::now();
+    const CliRun r = run_capped(2 * kGiB, "info " + (dir_ / name).string());
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(contains(r.output, "triangles: 1,")) << r.output;
+    EXPECT_LT(seconds_since(t0), 10.0);
+    const Scene s = load_scene((dir_ / name).string(), InputLimits());
+    for (const SceneInputFile& f : s.input_files) EXPECT_NE(f.path, "unused.bin");
+  }
+  doc["bufferViews"][1]["byteOffset"] = five_gib - 100;
+  std::ofstream(dir_ / "overrun.gltf") << doc.dump();
+  expect_one_error_line(run("info " + (dir_ / "overrun.gltf").string()),
+                        "bufferView 1 (byteOffset 5368709020, byteLength 4096) overruns buffer 1, which has 5368709120 bytes");
+}
+
+// ---- vertex data ----------------------------------------------------------------------------------------
+
+// 1000 morph targets all naming one implicit POSITION accessor of 2^24 vertices: a 30 kB file that
+// needed about 200 GB. Each target counts in full: refused by the vertex-data budget, from the counts.
+TEST_F(Budgets, MorphTargetsOnOneImplicitAccessorAreCountedEach) {
+  GltfFile g = implicit_mesh(uint64_t(1) << 24);
+  json targets = json::array();
+  for (int k = 0; k < 1000; ++k) targets.push_back({{"POSITION", 0}});
+  g.doc["meshes"][0]["primitives"][0]["targets"] = targets;
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  const std::string scene = write(g, "morph.gltf");
+  EXPECT_LT(fs::file_size(scene), 40000u);
+  const auto t0 = std::chrono::steady_clock::now();
+  const CliRun r = run_capped(kGiB, "info " + scene);
+  expect_one_error_line(r, "the scene's meshes decode to 201595027452 bytes of vertex data (every instance and morph "
+                           "target counted), more than the vertex-data limit of 68719476736 (raise it with --limit "
+                           "vertex-data=N)");
+  EXPECT_LT(seconds_since(t0), 10.0);
+  // The budget is the key: 2 morph targets of 2^24 vertices pass the default and not 400 MB.
+  g.doc["meshes"][0]["primitives"][0]["targets"] = json::array({{{"POSITION", 0}}, {{"POSITION", 0}}});
+  const std::string small = write(g, "two.gltf");
+  expect_one_error_line(run("info " + small + " --limit vertex-data=400M"),
+                        "decode to 671088636 bytes of vertex data");
+}
+
+// An implicit 2^24-vertex mesh instanced by 23 nodes: 600 bytes, 128 M triangles (under the
+// renderer's triangle cap), about 22 GB to flatten. Refused by the memory budget before allocating:
+// here the address space of 2 GiB decides it, and says so.
+TEST_F(Budgets, ImplicitVerticesInstancedByManyNodesAreRefusedByTheMemoryBudget) {
+  GltfFile g = implicit_mesh(uint64_t(1) << 24);
+  std::vector<int> roots;
+  for (int n = 0; n < 23; ++n) roots.push_back(g.add("nodes", {{"mesh", 0}}));
+  g.scene(roots);
+  const std::string scene = write(g, "instances.gltf");
+  EXPECT_LT(fs::file_size(scene), 1000u);
+  const auto t0 = std::chrono::steady_clock::now();
+  CliRun r = run_capped(2 * kGiB, "info " + scene);
+  expect_one_error_line(r, "out of memory: loading the scene's 128625315 triangles needs ");
+  EXPECT_TRUE(contains(r.output, "(RLIMIT_AS, less a margin) (raise it with --limit memory=N)")) << r.output;
+  EXPECT_LT(seconds_since(t0), 10.0);
+  // the budget given by --limit memory, the same refusal on any machine
+  r = run("info " + scene + " --limit memory=1G");
+  expect_one_error_line(r, "but the memory budget of 1024 MiB (set by --limit memory) (raise it with --limit memory=N)");
+}
+
+// ---- animation keys -------------------------------------------------------------------------------------
+
+// 200 samplers sharing one accessor of 2^18 key times (and one implicit output): 1 MB of data, 800 MB
+// decoded, once per sampler. Refused by the animation-data budget.
+TEST_F(Budgets, SamplersSharingOneAccessorAreCountedEach) {
+  GltfFile g = one_triangle();
+  const uint32_t keys = 1u << 18;
+  std::vector<float> times(keys);
+  for (uint32_t k = 0; k < keys; ++k) times[k] = float(k) / 1024.0f;
+  const int input = g.data<float>(times, kFloat, "SCALAR");
+  g.doc["accessors"][size_t(input)]["min"] = {0.0};
+  g.doc["accessors"][size_t(input)]["max"] = {times.back()};
+  const int output = g.accessor(-1, kFloat, "VEC3", keys);
+  for (int a = 0; a < 200; ++a)
+    g.add("animations", {{"samplers", json::array({{{"input", input}, {"output", output}}})},
+                         {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}});
+  const std::string scene = g.write(dir_, "samplers");
+  const auto t0 = std::chrono::steady_clock::now();
+  const CliRun r = run_capped(kGiB, "info " + scene);
+  expect_one_error_line(r, "the animations' samplers decode to 838860800 bytes of keys (every sampler counted), more "
+                           "than the animation-data limit of 268435456 (raise it with --limit animation-data=N)");
+  EXPECT_LT(seconds_since(t0), 10.0);
+  EXPECT_EQ(run("info " + scene + " --limit animation-data=800M").status, 0);
+}
+
+// ---- JSON -----------------------------------------------------------------------------------------------
+
+// A 40 MB `extras` array of zeros once took 3.85 GB to parse: refused by its size before parsing. A
+// smaller one is parsed only when the memory budget holds what parsing it takes.
+TEST_F(Budgets, JsonIsBoundedBySizeAndByWhatParsingItTakes) {
+  auto extras = [&](size_t zeros, const std::string& name) {
+    std::string text = R"({"asset":{"version":"2.0"},"extras":[)";
+    text.reserve(2 * zeros + 64);
+    for (size_t i = 0; i + 1 < zeros; ++i) text += "0,";
+    text += "0]}";
+    std::ofstream(dir_ / name) << text;
+    return (dir_ / name).string();
+  };
+  const std::string big = extras(20000000, "big.gltf");
+  const auto t0 = std::chrono::steady_clock::now();
+  expect_one_error_line(run_capped(kGiB, "info " + big),
+                        "the JSON text has 40000038 bytes, more than the json-bytes limit of 33554432 (raise it with "
+                        "--limit json-bytes=N)");
+  EXPECT_LT(seconds_since(t0), 10.0);
+  const std::string dense = extras(4000000, "dense.gltf");  // 8 MB, 4 M values: about 800 MB parsed
+  expect_one_error_line(run("info " + dense + " --limit memory=256M"),
+                        "out of memory: parsing the scene's JSON (4000007 values) needs ");
+  const std::string glb = (dir_ / "chunk.glb").string();
+  write_bytes(glb, one_triangle().glb());
+  expect_one_error_line(run("info " + glb + " --limit json-bytes=64"), "the JSON chunk has ");
+}
+
+// ---- framing ----------------------------------------------------------------------------------------------
+
+// The 994-byte hang: implicit vertices and a translation 41,666 s long. The framing would pose the
+// scene at each of a million frames before the first one renders; refused at once, nothing written.
+// (2^20 vertices here rather than 2^24: the load stays quick, the work is still 10^12 vertex-poses.)
+TEST_F(Budgets, FramingWorkIsBounded) {
+  GltfFile g = implicit_mesh(uint64_t(1) << 20);
+  const int input = g.data<float>({0.0f, 41666.0f}, kFloat, "SCALAR");
+  g.doc["accessors"][size_t(input)]["min"] = {0.0};
+  g.doc["accessors"][size_t(input)]["max"] = {41666.0};
+  const int output = g.data<float>({0, 0, 0, 1, 0, 0}, kFloat, "VEC3");
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  g.add("animations", {{"samplers", json::array({{{"input", input}, {"output", output}}})},
+                       {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}});
+  const std::string scene = g.write(dir_, "hang");
+  const fs::path out = dir_ / "out";
+  const std::string render = "render --views 2 --view-size 32x16 --display 64x36 --frames 0 -q --out " + out.string() + " ";
+  const auto t0 = std::chrono::steady_clock::now();
+  expect_one_error_line(run(render + scene),
+                        "framing the animation poses the scene's 1048576 vertices 999987 times (every frame of its keys "
+                        "at 24.000000 fps), more than the framing-work limit of 17179869184 vertex-poses (raise it "
+                        "with --limit framing-work=N)");
+  EXPECT_LT(seconds_since(t0), 20.0);
+  expect_no_frames(out);
+  // At the edge: a triangle moving for 1 s at 24 fps is posed 27 times (frames 0..24, and the first
+  // and last key), 81 vertex-poses: framed and rendered at 81, refused at 80.
+  GltfFile t = one_triangle();
+  const int in1 = t.data<float>({0.0f, 1.0f}, kFloat, "SCALAR");
+  t.doc["accessors"][size_t(in1)]["min"] = {0.0};
+  t.doc["accessors"][size_t(in1)]["max"] = {1.0};
+  const int out1 = t.data<float>({0, 0, 0, 1, 0, 0}, kFloat, "VEC3");
+  t.add("animations", {{"samplers", json::array({{{"input", in1}, {"output", out1}}})},
+                       {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}});
+  const std::string moving = t.write(dir_, "moving");
+  expect_one_error_line(run(render + moving + " --limit framing-work=80"),
+                        "poses the scene's 3 vertices 27 times (every frame of its keys at 24.000000 fps), more than "
+                        "the framing-work limit of 80 vertex-poses");
+  expect_no_frames(out);
+  const CliRun ok = run(render + moving + " --limit framing-work=81");
+  EXPECT_EQ(ok.status, 0) << ok.output;
+  EXPECT_TRUE(exists((out / "frame_0000.json").string()));
+}
+
+// ---- tile queue -----------------------------------------------------------------------------------------
+
+// 10^4 large overlapping triangles are a legal scene: rendered, each covering most tiles of every
+// view. The tile-queue budget refuses a frame that would need more entries, naming the key.
+TEST_F(Budgets, ManyLargeTrianglesRenderUnlessTheTileQueueBudgetSaysNo) {
+  GltfFile g;
+  std::vector<float> pos;
+  for (int i = 0; i < 10000; ++i) {
+    const float z = -0.0001f * float(i);
+    pos.insert(pos.end(), {-1, -1, z, 1, -1, z, 0, 1, z});
+  }
+  const int p = g.data<float>(pos, kFloat, "VEC3");
+  g.mesh(json::array({{{"attributes", {{"POSITION", p}}}, {"material", 0}}}));
+  g.add("materials", {{"doubleSided", true}});
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  const std::string scene = g.write(dir_, "overlap");
+  const fs::path out = dir_ / "out";
+  const std::string render = "render --views 8 --view-size 64x32 --display 64x36 --frames 0 -q --out " + out.string() + " ";
+  const CliRun r = run("render --views 8 --view-size 64x32 --display 64x36 --frames 0 -v --out " + out.string() + " " + scene);
+  ASSERT_EQ(r.status, 0) << r.output;
+  // the entries the frame took, as --verbose reports them
+  const size_t at = r.output.find(" tile-queue entries");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  const size_t start = r.output.rfind(' ', at - 1) + 1;
+  const uint64_t entries = std::stoull(r.output.substr(start, at - start));
+  EXPECT_GT(entries, 10000u * 4u) << "each triangle covers many tiles";
+  fs::remove_all(out);
+  expect_one_error_line(run(render + scene + " --limit tile-queue=" + std::to_string(entries - 1)),
+                        "the frame's tile raster produces " + std::to_string(entries) + " tile-queue entries, more "
+                        "than the tile-queue limit of " + std::to_string(entries - 1) +
+                        " (raise it with --limit tile-queue=N)");
+  expect_no_frames(out);
+}
+
+// A frame still rendering after `slow_frame_seconds` reports how long it has run and its tile-queue
+// entries, again each interval (pmr render prints it); a frame done sooner reports nothing.
+TEST(SlowFrame, ReportsWhileTheFrameRenders) {
+  const Scene scene = random_scene(3000, 7, true);
+  const Rig rig = small_rig(16, 128, 64);
+  for (const double interval : {1e-5, 1000.0}) {
+    PipelineConfig pc;
+    std::vector<std::pair<double, uint64_t>> calls;
+    pc.slow_frame = [&](double s, uint64_t entries) { calls.push_back({s, entries}); };
+    pc.slow_frame_seconds = interval;
+    Pipeline p(runtime(), pc);
+    p.set_scene(scene);
+    p.configure(rig, nullptr);
+    const StageTimes t = p.render(rig);
+    ASSERT_GT(t.bin_entries, 0u);
+    if (interval > 1.0) {
+      EXPECT_TRUE(calls.empty()) << "a fast frame is not reported";
+      continue;
+    }
+    ASSERT_FALSE(calls.empty());
+    EXPECT_EQ(calls[0].second, t.bin_entries);
+    EXPECT_GE(calls[0].first, interval);
+    EXPECT_LE(calls.back().first, t.wall / 1000.0);
+  }
+}
+
+// ---- memory ---------------------------------------------------------------------------------------------
+
+// --views 1400 --write views: a 5.9 GB view volume, which PoCL once allocated lazily and then
+// aborted on. Checked against the memory budget before anything is created or allocated.
+TEST_F(Budgets, ViewVolumeBeyondTheMemoryBudgetIsRefusedBeforeAllocating) {
+  const fs::path out = dir_ / "out";
+  const std::string scene = std::string(PMR_SOURCE_DIR) + "/data/default_scene.glb";
+  CliRun r = run_capped(3 * kGiB, "render " + scene + " --views 1400 --write views --out " + out.string());
+  expect_one_error_line(r, "out of memory: 1400 views of 1024x512 (5600 MiB a view volume, on the device and in up to "
+                           "four copies being written) needs ");
+  EXPECT_TRUE(contains(r.output, "(RLIMIT_AS, less a margin)")) << r.output;
+  expect_no_frames(out);
+  r = run("render " + scene + " --views 1400 --write views --limit memory=4G --out " + out.string());
+  expect_one_error_line(r, "but the memory budget of 4096 MiB (set by --limit memory)");
+  expect_no_frames(out);
+}
+
+// Device buffers are checked as they are allocated, counting those alive.
+TEST_F(Budgets, DeviceBuffersAreCheckedAgainstTheMemoryBudget) {
+  set_memory_budget(uint64_t(1) << 20);
+  try {
+    runtime().buffer(uint64_t(2) << 20, "test buffer");
+    ADD_FAILURE() << "allocated beyond the budget";
+  } catch (const Error& e) {
+    EXPECT_TRUE(contains(e.what(), "out of memory: test buffer needs 2 MiB, but the memory budget of 1 MiB (set by "
+                                   "--limit memory)")) << e.what();
+  }
+  set_memory_budget(uint64_t(64) << 20);
+  const uint64_t before = device_bytes_in_use();
+  {
+    const ClBuffer b = runtime().buffer(uint64_t(2) << 20, "test buffer");
+    EXPECT_EQ(device_bytes_in_use(), before + (uint64_t(2) << 20));
+  }
+  EXPECT_EQ(device_bytes_in_use(), before);
+}
+
+// The automatic budget: the smallest of what the machine, the cgroup and the address space leave, less
+// an eighth and 64 MiB.
+TEST(MemoryBudget, AutomaticBudgetIsTheSmallestLimitLessAMargin) {
+  MemoryFacts f;
+  f.mem_available = 16 * kGiB;
+  std::string source;
+  EXPECT_EQ(automatic_memory_budget(f, &source), 14 * kGiB - (uint64_t(64) << 20));
+  EXPECT_EQ(source, "MemAvailable, less a margin");
+  f.cgroup_left = 8 * kGiB;
+  EXPECT_EQ(automatic_memory_budget(f, &source), 7 * kGiB - (uint64_t(64) << 20));
+  EXPECT_EQ(source, "the cgroup's memory.max, less a margin");
+  f.address_left = 2 * kGiB;
+  EXPECT_EQ(automatic_memory_budget(f, &source), (uint64_t(7) << 28) - (uint64_t(64) << 20));
+  EXPECT_EQ(source, "RLIMIT_AS, less a margin");
+  // read from this process: MemAvailable at least
+  EXPECT_GT(read_memory_facts().mem_available, 0u);
+}
+
+// --help lists every key with its default; every key is accepted by --limit.
+TEST(BudgetKeys, HelpListsEveryKey) {
+  const CliRun r = run("render --help");
+  for (const char* key : {"file-bytes:", "texture-pixels:", "vertex-data:", "animation-data:", "json-bytes:",
+                          "framing-work:", "tile-queue:", "memory:"})
+    EXPECT_TRUE(contains(r.output, key)) << key << " in " << r.output;
+  InputLimits l;
+  parse_limits("vertex-data=1G,animation-data=2M,json-bytes=3K,framing-work=4,tile-queue=5,memory=6G", l);
+  EXPECT_EQ(l.vertex_data, kGiB);
+  EXPECT_EQ(l.animation_data, uint64_t(2) << 20);
+  EXPECT_EQ(l.json_bytes, 3072u);
+  EXPECT_EQ(l.framing_work, 4u);
+  EXPECT_EQ(l.tile_queue, 5u);
+  EXPECT_EQ(l.memory, 6 * kGiB);
+}
+
+}  // namespace
+}  // namespace pmr::test

@@ -1,5 +1,6 @@
 #include "sequence/frame_files.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -7,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pmr/error.h"
 #include "pmr/output.h"
 
 namespace pmr {
@@ -75,6 +77,23 @@ std::string frame_problem(const std::string& sidecar, const std::vector<std::str
     if (!ok) return name(p) + " is truncated or unreadable";
   }
   return "";
+}
+
+void check_frame_file_names(const RenderOptions& o, const std::vector<long>& frames, const QuiltLayout& quilt,
+                            double aspect) {
+  if (frames.empty()) return;
+  // the frame number is the only part that varies: the largest frame makes the longest names
+  const FramePaths p = frame_paths(o, *std::max_element(frames.begin(), frames.end()), quilt, aspect);
+  std::vector<std::string> files = p.images();
+  files.push_back(p.sidecar);
+  std::string name;  // the longest
+  for (const std::string& file : files)
+    if (const std::string n = fs::path(file).filename().string(); n.size() > name.size()) name = n;
+  const size_t limit = max_output_file_name();
+  if (name.size() > limit)
+    throw UsageError("invalid --name '" + o.name + "': it makes the file name " + name + " of " +
+                     std::to_string(name.size()) + " bytes, and pmr can write at most " + std::to_string(limit) +
+                     " (the file system's 255, less what the temporary name it writes first adds)");
 }
 
 }  // namespace pmr

@@ -25,4 +25,10 @@ std::string frame_problem(const std::string& sidecar, const std::vector<std::str
 
 std::string read_text_file(const std::string& path);
 
+// Throws a UsageError naming --name when a file of these frames would have a name longer than the file
+// system takes (max_output_file_name: its temporary name must fit too), so that a long --name fails
+// before anything is rendered or created.
+void check_frame_file_names(const RenderOptions& o, const std::vector<long>& frames, const QuiltLayout& quilt,
+                            double aspect);
+
 }  // namespace pmr

@@ -45,12 +45,14 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 
 int run_sequence(const RenderOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
-  const ExrCompression compression = parse_exr_compression(o.compression);
+  // options given as text, checked here: a bad one is a usage error (exit 2)
+  const ExrCompression compression = as_usage([&] { return parse_exr_compression(o.compression); });
   std::vector<long> frames;
-  if (o.frames != "all") frames = parse_frame_list(o.frames);  // before the long work: fail early
-  check_name_covers_frames(o.name, frames.size());
-  // Everything that can be checked cheaply is checked before the long work starts.
-  prepare_output_dir(o.out_dir);
+  if (o.frames != "all") frames = as_usage([&] { return parse_frame_list(o.frames); });  // before the long work: fail early
+  as_usage([&] { check_name_covers_frames(o.name, frames.size()); });
+  // Everything that can be checked cheaply is checked before the long work starts; the output folder is
+  // created only once every input has been read and checked (below).
+  check_output_dir(o.out_dir);
   make_encode_params(o.display, o.rig.views, o.rig.view_w, o.rig.view_h);
 
   for (const auto& w : o.option_warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
@@ -86,7 +88,7 @@ int run_sequence(const RenderOptions& o) {
     if (last > kMaxFrame)
       throw Error("--frames all would reach frame " + std::to_string(last) + ", beyond " + std::to_string(kMaxFrame));
     for (long f = first; f <= last; ++f) frames.push_back(f);
-    check_name_covers_frames(o.name, frames.size());
+    as_usage([&] { check_name_covers_frames(o.name, frames.size()); });
   }
   std::vector<long> job_frames;  // every shard's frames (the folder guard's "this job")
   if (!o.shard.empty()) {
@@ -108,11 +110,12 @@ int run_sequence(const RenderOptions& o) {
   QuiltLayout quilt;
   if (o.write_quilt)
     quilt = o.quilt.empty() ? choose_quilt_layout(rig.views, rig.view_w, rig.view_h)
-                            : parse_quilt_layout(o.quilt, rig.views, rig.view_w, rig.view_h);
+                            : as_usage([&] { return parse_quilt_layout(o.quilt, rig.views, rig.view_w, rig.view_h); });
   else if (!o.quilt.empty())
-    throw Error("--quilt needs --write quilt");
+    throw UsageError("--quilt needs --write quilt");
   const int center_view = rig.views / 2;
   auto paths = [&](long f) { return frame_paths(o, f, quilt, rig.aspect); };
+  check_frame_file_names(o, frames, quilt, rig.aspect);  // not after the first frame was rendered
 
   SidecarInfo info;
   info.scene = o.scene;
@@ -172,6 +175,7 @@ int run_sequence(const RenderOptions& o) {
     return i;
   };
 
+  prepare_output_dir(o.out_dir);
   // One folder, one configuration: no other configuration rendering into it now, none left beside
   // this run's frames (folder_guard.h). Held until the end of the run.
   const FolderGuard folder_guard(o.out_dir, o.name, o.shard.empty() ? frames : job_frames,

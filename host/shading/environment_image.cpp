@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <new>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -211,6 +212,8 @@ EnvironmentImage read_exr(const std::string& path) {
       for (size_t t = 0; t < size_t(w) * size_t(h); ++t) img.rgb[3 * t + 1] = img.rgb[3 * t + 2] = img.rgb[3 * t];
   } catch (const Error&) {
     throw;
+  } catch (const std::bad_alloc&) {  // not the file's fault: not "not a readable OpenEXR file"
+    fail(path, "out of host memory while reading it");
   } catch (const std::exception& e) {  // Iex::BaseExc derives from std::exception
     std::string msg = e.what();
     for (size_t at = msg.find(path); !path.empty() && at != std::string::npos; at = msg.find(path))

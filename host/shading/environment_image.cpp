@@ -181,11 +181,53 @@ EnvironmentImage read_hdr(const std::string& path) {
 
 // ---- OpenEXR ----------------------------------------------------------------------------------------
 
+// OpenEXR (3.1) allocates each header attribute's declared size before reading its value, so a
+// 280-byte file declaring a 1.7 GB attribute cost 1.7 GB (found by fuzzing). Walks the header(s) as
+// OpenEXR reads them and returns what is wrong when an attribute declares more bytes than the file
+// holds after it; "" otherwise (OpenEXR then reports anything else).
+std::string check_exr_attribute_sizes(const std::string& path, uint64_t file_size) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char head[8];
+  if (!in.read(reinterpret_cast<char*>(head), 8) || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01)
+    return "";
+  const bool multipart = head[5] & 0x10;  // version flags, bit 12
+  uint64_t pos = 8;
+  auto read_name = [&](std::string& out) {  // a null-terminated name of at most 255 bytes
+    out.clear();
+    for (char c; in.get(c);) {
+      ++pos;
+      if (c == '\0') return true;
+      if (out.size() == 255) return false;
+      out += c;
+    }
+    return false;
+  };
+  for (;;) {  // headers: attributes until an empty name; multi-part files end with an empty header
+    std::string name, type;
+    if (!read_name(name)) return "";
+    if (name.empty()) {
+      if (!multipart || in.peek() == 0) return "";
+      continue;
+    }
+    unsigned char size[4];
+    if (!read_name(type) || !in.read(reinterpret_cast<char*>(size), 4)) return "";
+    pos += 4;
+    const uint32_t n = uint32_t(size[0]) | uint32_t(size[1]) << 8 | uint32_t(size[2]) << 16 | uint32_t(size[3]) << 24;
+    if (n > file_size - std::min(pos, file_size))
+      return "header attribute '" + printable(name.substr(0, 40)) + "' declares " + std::to_string(n) +
+             " bytes, more than the file holds";
+    in.seekg(std::streamoff(n), std::ios::cur);
+    pos += n;
+  }
+}
+
 EnvironmentImage read_exr(const std::string& path) {
   struct stat st {};
   if (stat(path.c_str(), &st) != 0) fail(path, std::strerror(errno));
   if (!S_ISREG(st.st_mode)) fail(path, "not a regular file");
   if (st.st_size == 0) fail(path, "the file is empty");
+  if (const std::string why = check_exr_attribute_sizes(path, uint64_t(st.st_size)); !why.empty())
+    fail(path, "not a readable OpenEXR file (" + why + ")");
   EnvironmentImage img;
   try {
     Imf::InputFile file(path.c_str());
@@ -197,6 +239,8 @@ EnvironmentImage read_exr(const std::string& path) {
     const bool rgb = ch.findChannel("R") && ch.findChannel("G") && ch.findChannel("B");
     const bool gray = !rgb && ch.findChannel("Y");
     if (!rgb && !gray) fail(path, "no R, G, B (or Y) channels");
+    // before the pixels are allocated: a 280-byte file claiming 2^25 texels cost 400 MB (found by fuzzing)
+    if (!file.isComplete()) fail(path, "the file is truncated (some pixel data is missing)");
     img.width = int(w), img.height = int(h);
     img.rgb.assign(size_t(w) * size_t(h) * 3, 0.0f);
     Imf::FrameBuffer fb;
@@ -206,7 +250,6 @@ EnvironmentImage read_exr(const std::string& path) {
       fb.insert(rgb ? names[c] : "Y",
                 Imf::Slice::Make(Imf::FLOAT, img.rgb.data() + c, dw, xs, ys));
     file.setFrameBuffer(fb);
-    if (!file.isComplete()) fail(path, "the file is truncated (some pixel data is missing)");
     file.readPixels(dw.min.y, dw.max.y);
     if (gray)
       for (size_t t = 0; t < size_t(w) * size_t(h); ++t) img.rgb[3 * t + 1] = img.rgb[3 * t + 2] = img.rgb[3 * t];

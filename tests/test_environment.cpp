@@ -547,19 +547,5 @@ TEST(EnvironmentFiles, BadFilesGiveOneClearError) {
     EXPECT_EQ(error_of(temp_path(f)).find('\n'), std::string::npos) << f;
 }
 
-// OpenEXR allocates a header attribute's declared size before reading it: an attribute declaring more
-// bytes than the file holds is refused before OpenEXR sees the file (a 280-byte file once cost 1.7 GB).
-TEST(EnvironmentFiles, ExrAttributeLargerThanTheFileIsRefusedFirst) {
-  const std::string path = temp_path("huge_attribute.exr");
-  std::string bytes = {'\x76', '\x2f', '\x31', '\x01', 2, 0, 0, 0};
-  bytes += std::string("blob") + '\0' + "opaque" + '\0';
-  bytes += {'\xff', '\xff', '\xff', '\x7f'};  // 2^31 - 1 bytes
-  bytes += std::string(64, 'x');
-  std::ofstream(path, std::ios::binary) << bytes;
-  EXPECT_NE(error_of(path).find("header attribute 'blob' declares 2147483647 bytes, more than the file holds"),
-            std::string::npos)
-      << error_of(path);
-}
-
 }  // namespace
 }  // namespace pmr

@@ -181,18 +181,21 @@ EnvironmentImage read_hdr(const std::string& path) {
 
 // ---- OpenEXR ----------------------------------------------------------------------------------------
 
-// OpenEXR (3.1) allocates each header attribute's declared size before reading its value, so a
-// 280-byte file declaring a 1.7 GB attribute cost 1.7 GB (found by fuzzing). Walks the header(s) as
-// OpenEXR reads them and returns what is wrong when an attribute declares more bytes than the file
-// holds after it; "" otherwise (OpenEXR then reports anything else).
-std::string check_exr_attribute_sizes(const std::string& path, uint64_t file_size) {
+// OpenEXR's C++ reader (3.1) allocates the declared size of a string, vector or unknown (opaque)
+// header attribute, and 4 w h bytes for a preview image, before reading it: a 280-byte file declaring a
+// 1.7 GB attribute cost 1.7 GB (found by fuzzing). Walks the header(s) as that reader does (Header::
+// readFrom: a channel list is read up to its terminating entry and the fixed-size types by their own
+// size, whatever size the file declares for them) and returns what is wrong when such an allocation
+// would exceed what the file holds after it; "" otherwise (OpenEXR then reports anything else).
+std::string check_exr_allocations(const std::string& path, uint64_t file_size) {
   std::ifstream in(path, std::ios::binary);
   unsigned char head[8];
   if (!in.read(reinterpret_cast<char*>(head), 8) || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01)
     return "";
   const bool multipart = head[5] & 0x10;  // version flags, bit 12
   uint64_t pos = 8;
-  auto read_name = [&](std::string& out) {  // a null-terminated name of at most 255 bytes
+  auto left = [&] { return file_size - std::min(pos, file_size); };
+  auto read_name = [&](std::string& out) {  // null-terminated, at most 255 bytes
     out.clear();
     for (char c; in.get(c);) {
       ++pos;
@@ -202,22 +205,65 @@ std::string check_exr_attribute_sizes(const std::string& path, uint64_t file_siz
     }
     return false;
   };
-  for (;;) {  // headers: attributes until an empty name; multi-part files end with an empty header
+  auto read_u32 = [&](uint32_t& v) {
+    unsigned char b[4];
+    if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
+    pos += 4;
+    v = uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+    return true;
+  };
+  auto skip = [&](uint64_t n) {
+    in.seekg(std::streamoff(n), std::ios::cur);
+    pos += n;
+  };
+  static const std::pair<const char*, uint64_t> kFixed[] = {
+      {"box2i", 16}, {"box2f", 16}, {"chromaticities", 32}, {"compression", 1}, {"double", 8}, {"envmap", 1},
+      {"float", 4}, {"int", 4}, {"keycode", 28}, {"lineOrder", 1}, {"m33f", 36}, {"m33d", 72}, {"m44f", 64},
+      {"m44d", 128}, {"rational", 8}, {"tiledesc", 9}, {"timecode", 8}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16},
+      {"v3i", 12}, {"v3f", 12}, {"v3d", 24}, {"deepImageState", 1}};
+  for (;;) {  // attributes until an empty name; a multi-part file's headers end with an empty one
     std::string name, type;
+    uint32_t size = 0;
     if (!read_name(name)) return "";
     if (name.empty()) {
       if (!multipart || in.peek() == 0) return "";
       continue;
     }
-    unsigned char size[4];
-    if (!read_name(type) || !in.read(reinterpret_cast<char*>(size), 4)) return "";
-    pos += 4;
-    const uint32_t n = uint32_t(size[0]) | uint32_t(size[1]) << 8 | uint32_t(size[2]) << 16 | uint32_t(size[3]) << 24;
-    if (n > file_size - std::min(pos, file_size))
-      return "header attribute '" + printable(name.substr(0, 40)) + "' declares " + std::to_string(n) +
+    if (!read_name(type) || !read_u32(size)) return "";
+    if (type == "chlist") {  // channels (name, 16 bytes) up to an empty name
+      std::string channel;
+      while (read_name(channel) && !channel.empty()) skip(16);
+      continue;
+    }
+    if (type == "preview") {
+      uint32_t w = 0, h = 0;
+      if (!read_u32(w) || !read_u32(h)) return "";
+      if (uint64_t(w) * h * 4 > left())
+        return "preview attribute '" + printable(name.substr(0, 40)) + "' of " + std::to_string(w) + "x" +
+               std::to_string(h) + " pixels is larger than the file";
+      skip(uint64_t(w) * h * 4);
+      continue;
+    }
+    if (type == "stringvector") {  // strings of their own length each, within the declared size
+      for (uint64_t read = 0; read < size;) {
+        uint32_t n = 0;
+        if (!read_u32(n)) return "";
+        if (n > left())
+          return "header attribute '" + printable(name.substr(0, 40)) + "' holds a string of " + std::to_string(n) +
+                 " bytes, more than the file holds";
+        skip(n);
+        read += 4 + uint64_t(n);
+      }
+      continue;
+    }
+    bool fixed = false;
+    for (const auto& [t, n] : kFixed)
+      if (type == t) skip(n), fixed = true;
+    if (fixed) continue;
+    if (size > left())  // string, stringvector, floatvector or an unknown type: size bytes allocated
+      return "header attribute '" + printable(name.substr(0, 40)) + "' declares " + std::to_string(size) +
              " bytes, more than the file holds";
-    in.seekg(std::streamoff(n), std::ios::cur);
-    pos += n;
+    skip(size);
   }
 }
 
@@ -226,7 +272,7 @@ EnvironmentImage read_exr(const std::string& path) {
   if (stat(path.c_str(), &st) != 0) fail(path, std::strerror(errno));
   if (!S_ISREG(st.st_mode)) fail(path, "not a regular file");
   if (st.st_size == 0) fail(path, "the file is empty");
-  if (const std::string why = check_exr_attribute_sizes(path, uint64_t(st.st_size)); !why.empty())
+  if (const std::string why = check_exr_allocations(path, uint64_t(st.st_size)); !why.empty())
     fail(path, "not a readable OpenEXR file (" + why + ")");
   EnvironmentImage img;
   try {

@@ -3,6 +3,7 @@
 // running out of memory is reported as such, never as "not a valid glTF file".
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <sys/wait.h>
@@ -94,6 +95,23 @@ TEST(MisleadingMessages, ExrAttributeLargerThanTheFileIsRefusedBeforeItIsAllocat
   expect_one_error_line(r, "sky.exr: not a readable OpenEXR file (");
   EXPECT_EQ(r.output.find("out of host memory"), std::string::npos) << r.output;
   EXPECT_FALSE(test::exists(dir + "/out"));
+}
+
+// Every environment input the fuzzer found (tests/fuzz/regressions/environment: header attributes and
+// a data window that made OpenEXR allocate 1.6 to 1.9 GB from a few hundred bytes) is refused as a bad
+// file with 1 GB of address space, not reported as running out of memory.
+TEST(MisleadingMessages, FuzzedEnvironmentFilesAreRefusedWithinAGigabyte) {
+  if (std::system("prlimit --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "prlimit not found";
+  const std::string out = temp_dir("fuzzed_environments") + "/out";
+  size_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(PMR_SOURCE_DIR) + "/tests/fuzz/regressions/environment")) {
+    ++files;
+    const CliRun r = run_capped(1000000000, "render --shading pbr --environment '" + e.path().string() + "' --out " + out);
+    expect_one_error_line(r, e.path().filename().string());
+    EXPECT_EQ(r.output.find("out of host memory"), std::string::npos) << r.output;
+  }
+  EXPECT_GE(files, 3u);
+  EXPECT_FALSE(test::exists(out));
 }
 
 // A glTF file whose JSON needs more memory than the process may have (a 16 MB extras array, hundreds

@@ -187,7 +187,16 @@ EnvironmentImage read_hdr(const std::string& path) {
 // readFrom: a channel list is read up to its terminating entry and the fixed-size types by their own
 // size, whatever size the file declares for them) and returns what is wrong when such an allocation
 // would exceed what the file holds after it; "" otherwise (OpenEXR then reports anything else).
-std::string check_exr_allocations(const std::string& path, uint64_t file_size) {
+// Opening the file also allocates line buffers of (bytes per pixel) x (data window width) x (lines per
+// chunk): the data window, the channels' bytes per pixel and the compression are returned for a check
+// of that before OpenEXR opens the file (a 414-byte file claiming 824203271 x 133687 cost 1.6 GB).
+struct ExrLayout {
+  bool has_window = false;
+  int64_t min_x = 0, min_y = 0, max_x = 0, max_y = 0;
+  uint64_t bytes_per_pixel = 0;
+  int compression = 0;
+};
+std::string check_exr_allocations(const std::string& path, uint64_t file_size, ExrLayout& layout) {
   std::ifstream in(path, std::ios::binary);
   unsigned char head[8];
   if (!in.read(reinterpret_cast<char*>(head), 8) || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01)
@@ -230,9 +239,26 @@ std::string check_exr_allocations(const std::string& path, uint64_t file_size) {
       continue;
     }
     if (!read_name(type) || !read_u32(size)) return "";
-    if (type == "chlist") {  // channels (name, 16 bytes) up to an empty name
+    if (type == "chlist") {  // channels (name, pixel type, 12 more bytes) up to an empty name
       std::string channel;
-      while (read_name(channel) && !channel.empty()) skip(16);
+      uint32_t pixel_type = 0;
+      while (read_name(channel) && !channel.empty() && read_u32(pixel_type)) {
+        layout.bytes_per_pixel += pixel_type == 1 ? 2 : 4;  // HALF, else UINT or FLOAT
+        skip(12);
+      }
+      continue;
+    }
+    if (type == "box2i" && name == "dataWindow") {
+      uint32_t v[4];
+      for (uint32_t& x : v)
+        if (!read_u32(x)) return "";
+      layout.has_window = true;
+      layout.min_x = int32_t(v[0]), layout.min_y = int32_t(v[1]), layout.max_x = int32_t(v[2]), layout.max_y = int32_t(v[3]);
+      continue;
+    }
+    if (type == "compression" && name == "compression") {
+      layout.compression = in.get();
+      ++pos;
       continue;
     }
     if (type == "preview") {
@@ -272,8 +298,19 @@ EnvironmentImage read_exr(const std::string& path) {
   if (stat(path.c_str(), &st) != 0) fail(path, std::strerror(errno));
   if (!S_ISREG(st.st_mode)) fail(path, "not a regular file");
   if (st.st_size == 0) fail(path, "the file is empty");
-  if (const std::string why = check_exr_allocations(path, uint64_t(st.st_size)); !why.empty())
+  ExrLayout layout;
+  if (const std::string why = check_exr_allocations(path, uint64_t(st.st_size), layout); !why.empty())
     fail(path, "not a readable OpenEXR file (" + why + ")");
+  if (layout.has_window) {  // the size limits, before OpenEXR sizes its line buffers by the window
+    const int64_t w = layout.max_x - layout.min_x + 1, h = layout.max_y - layout.min_y + 1;
+    if (w <= 0 || h <= 0) fail(path, "the image is empty");
+    check_size(path, uint64_t(w), uint64_t(h));
+    static const uint64_t kLinesPerChunk[10] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};  // by compression
+    const uint64_t lines = layout.compression >= 0 && layout.compression < 10 ? kLinesPerChunk[layout.compression] : 1;
+    if (layout.bytes_per_pixel * uint64_t(w) * lines > (uint64_t(1) << 30))
+      fail(path, "its " + std::to_string(layout.bytes_per_pixel) + " bytes per pixel in rows of " + std::to_string(w) +
+                     " need more than 1 GiB of line buffers to read");
+  }
   EnvironmentImage img;
   try {
     Imf::InputFile file(path.c_str());

@@ -25,6 +25,8 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -q
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q "${missing[@]}"
 fi
+# scripts/fuzz.sh needs the packages only (it builds with clang in its own folder)
+[ "${PMR_SETUP_PACKAGES_ONLY:-0}" = 1 ] && exit 0
 
 cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
 if [ ${#TARGETS[@]} -gt 0 ]; then

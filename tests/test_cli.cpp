@@ -25,6 +25,7 @@ using test::CliRun;
 using test::count_entries;
 using test::exists;
 using test::expect_one_error_line;
+using test::expect_usage_error;
 using test::run;
 using test::temp_dir;
 
@@ -58,16 +59,16 @@ TEST(Cli, InfoDescribesAScene) {
 
 TEST(Cli, BadOptionsFailWithOneLine) {
   const std::string out = temp_dir("badopts");
-  expect_one_error_line(run("render --views 0 --out " + out), "--views");
-  expect_one_error_line(run("render --view-size 100 --out " + out), "--view-size");
-  expect_one_error_line(run("render --tan-slant 1/0 --out " + out), "--tan-slant");
-  expect_one_error_line(run("render --lens-pitch -3 --out " + out), "--lens-pitch");
-  expect_one_error_line(run("render --frobnicate --out " + out), "--frobnicate");
-  expect_one_error_line(run("render --tile 4x4 --out " + out), "--tile");
-  expect_one_error_line(run("render --write pictures --out " + out), "--write");
-  expect_one_error_line(run("render --compression lzma --out " + out), "lzma");
-  expect_one_error_line(run("render --cone 200 --view-size 64x32 --display 64x36 --out " + out), "cone");
-  expect_one_error_line(run("frobnicate"), "unknown command");
+  expect_usage_error(run("render --views 0 --out " + out), "--views");
+  expect_usage_error(run("render --view-size 100 --out " + out), "--view-size");
+  expect_usage_error(run("render --tan-slant 1/0 --out " + out), "--tan-slant");
+  expect_usage_error(run("render --lens-pitch -3 --out " + out), "--lens-pitch");
+  expect_usage_error(run("render --frobnicate --out " + out), "--frobnicate");
+  expect_usage_error(run("render --tile 4x4 --out " + out), "--tile");
+  expect_usage_error(run("render --write pictures --out " + out), "--write");
+  expect_usage_error(run("render --compression lzma --out " + out), "lzma");
+  expect_usage_error(run("render --cone 200 --view-size 64x32 --display 64x36 --out " + out), "cone");
+  expect_usage_error(run("frobnicate"), "unknown command");
   EXPECT_EQ(count_entries(out), 0u) << "nothing written for bad options";
 }
 

@@ -257,8 +257,8 @@ TEST(Displays, CliRendersForALookingGlassPanel) {
   const test::CliRun h = test::run("render --preset help");
   EXPECT_EQ(h.status, 0);
   for (const DisplayPreset& p : display_presets()) EXPECT_NE(h.output.find(p.name), std::string::npos);
-  test::expect_one_error_line(test::run("render --preset lg-99 --out " + dir + "/o"), "lg-portrait");
-  test::expect_one_error_line(
+  test::expect_usage_error(test::run("render --preset lg-99 --out " + dir + "/o"), "lg-portrait");
+  test::expect_usage_error(
       test::run("render --preset lg-portrait --display-config " + dir + "/visual.json --out " + dir + "/o"), "once");
 }
 

@@ -288,7 +288,7 @@ TEST(Verify, ReportsMissingAndBrokenFramesAsAFramesList) {
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("3 frame(s) in"), std::string::npos) << r.output;
   EXPECT_EQ(test::run("verify " + out + " --frames 0:7").status, 0);
-  test::expect_one_error_line(test::run("verify " + out), "--frames");
+  test::expect_usage_error(test::run("verify " + out), "--frames");
   test::expect_one_error_line(test::run("verify /nonexistent --frames 0"), "not a folder");
 }
 

@@ -21,6 +21,7 @@ namespace {
 
 using test::CliRun;
 using test::expect_one_error_line;
+using test::expect_usage_error;
 using test::run;
 using test::temp_dir;
 
@@ -160,9 +161,9 @@ TEST(Framing, ZoomFromTheCommandLine) {
   EXPECT_NEAR(two["rig"]["focal_distance"].get<double>(), one["rig"]["focal_distance"].get<double>() / 2.0, 1e-9);
   expect_one_error_line(run("render --zoom 3 --resume" + small + "--out " + b), "different configuration (rig.zoom");
   const std::string c = temp_dir("zoom_refused");
-  expect_one_error_line(run("render --zoom 2 --camera 0" + small + "--out " + c), "--camera");
-  expect_one_error_line(run("render --zoom 0" + small + "--out " + c), "--zoom");
-  expect_one_error_line(run("render --zoom x" + small + "--out " + c), "--zoom");
+  expect_usage_error(run("render --zoom 2 --camera 0" + small + "--out " + c), "--camera");
+  expect_usage_error(run("render --zoom 0" + small + "--out " + c), "--zoom");
+  expect_usage_error(run("render --zoom x" + small + "--out " + c), "--zoom");
   EXPECT_FALSE(test::exists(c));
   EXPECT_NE(run("render --help").output.find("--zoom F"), std::string::npos);
 }

@@ -19,6 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::CliRun;
 using test::expect_one_error_line;
+using test::expect_usage_error;
 using test::listing;
 using test::run;
 using test::temp_dir;
@@ -94,11 +95,11 @@ TEST(Names, FromTheCommandLine) {
   EXPECT_EQ(listing(b), (std::set<std::string>{"shot_0003.exr", "shot_0003.json", "shot_0012.exr", "shot_0012.json"}));
 
   const std::string c = temp_dir("names_refused");
-  expect_one_error_line(run("render --name duck --frames 0:1" + kSmall + "--out " + c), "names one frame");
-  expect_one_error_line(run("render --name shot_%4d" + kSmall + "--out " + c), "use %04d");
-  expect_one_error_line(run("render --name shot_%x" + kSmall + "--out " + c), "e.g. --name shot_%04d");
+  expect_usage_error(run("render --name duck --frames 0:1" + kSmall + "--out " + c), "names one frame");
+  expect_usage_error(run("render --name shot_%4d" + kSmall + "--out " + c), "use %04d");
+  expect_usage_error(run("render --name shot_%x" + kSmall + "--out " + c), "e.g. --name shot_%04d");
   EXPECT_FALSE(test::exists(c)) << "nothing written for a refused name";
-  expect_one_error_line(run("verify " + a + " --frames 0:1 --name duck"), "names one frame");
+  expect_usage_error(run("verify " + a + " --frames 0:1 --name duck"), "names one frame");
   EXPECT_NE(run("render --help").output.find("-o DIR"), std::string::npos);
 }
 

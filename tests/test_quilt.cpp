@@ -183,10 +183,10 @@ TEST(Quilt, CliQuiltDepthAndPreviews) {
 
 TEST(Quilt, BadQuiltOptionsFailWithOneLine) {
   const std::string out = temp_dir("quilt_bad");
-  test::expect_one_error_line(run("render --write depth --out " + out), "depth");
-  test::expect_one_error_line(run("render --quilt 4x4 --views 8 --view-size 64x32 --display 240x135 --out " + out),
+  test::expect_usage_error(run("render --write depth --out " + out), "depth");
+  test::expect_usage_error(run("render --quilt 4x4 --views 8 --view-size 64x32 --display 240x135 --out " + out),
                               "--write quilt");
-  test::expect_one_error_line(
+  test::expect_usage_error(
       run("render --write quilt --quilt 3x2 --views 8 --view-size 64x32 --display 240x135 --out " + out), "6 tiles");
   test::expect_one_error_line(run("render --write quilt --views 96 --view-size 4096x2048 --out " + out), "16384");
 }

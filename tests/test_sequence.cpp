@@ -28,6 +28,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::CliRun;
 using test::expect_one_error_line;
+using test::expect_usage_error;
 using test::listing;
 using test::run;
 using test::temp_dir;
@@ -229,11 +230,11 @@ TEST(Sequence, AbsurdAnimationRangesAreRefused) {
 
 TEST(Sequence, BadSequenceOptionsFailWithOneLine) {
   const std::string out = temp_dir("seq_bad");
-  expect_one_error_line(run("render --frames 5:2 --out " + out), "--frames");
-  expect_one_error_line(run("render --fps 0 --out " + out), "--fps");
-  expect_one_error_line(run("render --turntable 360:0 --out " + out), "--turntable");
-  expect_one_error_line(run("render --name frame --frames 0:1 --out " + out), "--name");  // one name, two frames
-  expect_one_error_line(run("render --name a/%d --out " + out), "--name");
+  expect_usage_error(run("render --frames 5:2 --out " + out), "--frames");
+  expect_usage_error(run("render --fps 0 --out " + out), "--fps");
+  expect_usage_error(run("render --turntable 360:0 --out " + out), "--turntable");
+  expect_usage_error(run("render --name frame --frames 0:1 --out " + out), "--name");  // one name, two frames
+  expect_usage_error(run("render --name a/%d --out " + out), "--name");
   expect_one_error_line(run("render --animation walk" + kSmall + "--out " + out), "no animations");
 }
 

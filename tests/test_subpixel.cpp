@@ -279,13 +279,13 @@ TEST(SubpixelSampling, ViewsStillRenderedOnTheirGridsWhenAsked) {
 
 TEST(SubpixelSampling, CommandLine) {
   const std::string out = test::temp_dir("subpixel_cli");
-  test::expect_one_error_line(test::run("render --sampling pixel --out " + out), "unknown sampling 'pixel'");
-  test::expect_one_error_line(test::run("render --sampling subpixel --bilinear --out " + out), "--bilinear");
-  test::expect_one_error_line(test::run("render --sampling subpixel --method multipass --out " + out), "--method pmr");
-  test::expect_one_error_line(test::run("render --sampling subpixel --blend-views --out " + out), "--blend-views");
+  test::expect_usage_error(test::run("render --sampling pixel --out " + out), "unknown sampling 'pixel'");
+  test::expect_usage_error(test::run("render --sampling subpixel --bilinear --out " + out), "--bilinear");
+  test::expect_usage_error(test::run("render --sampling subpixel --method multipass --out " + out), "--method pmr");
+  test::expect_usage_error(test::run("render --sampling subpixel --blend-views --out " + out), "--blend-views");
   EXPECT_EQ(test::count_entries(out), 0u) << "nothing written on bad options";
-  test::expect_one_error_line(test::run("bench --sampling subpixel --method multipass --views 2"), "--method pmr");
-  test::expect_one_error_line(test::run("bench --sampling view,subpixel --bilinear --views 2"), "--bilinear");
+  test::expect_usage_error(test::run("bench --sampling subpixel --method multipass --views 2"), "--method pmr");
+  test::expect_usage_error(test::run("bench --sampling view,subpixel --bilinear --views 2"), "--bilinear");
   // without the encoded image there is nothing to sample per subpixel: a warning, the views as usual
   const std::string views_only = test::temp_dir("subpixel_views_only");
   const test::CliRun v = test::run("render --sampling subpixel --write views --views 4 --view-size 32x16 --display 96x54 --out " + views_only);

@@ -209,9 +209,9 @@ TEST_F(UntrustedInput, TexturePixelsBudgetIsConfigurable) {
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "base colour (texture 0 4x4")) << r.output;
   r = run("info " + scene + " --limit pixels=16");
-  expect_one_error_line(r, "invalid --limit 'pixels=16': expected KEY=VALUE with KEY one of file-bytes, texture-pixels");
+  expect_usage_error(r, "invalid --limit 'pixels=16': expected KEY=VALUE with KEY one of file-bytes, texture-pixels");
   r = run("info " + scene + " --limit texture-pixels=0");
-  expect_one_error_line(r, "invalid --limit 'texture-pixels=0'");
+  expect_usage_error(r, "invalid --limit 'texture-pixels=0'");
 }
 
 // ---- 2. files a scene names: confined, regular, within the budget --------------------------------------

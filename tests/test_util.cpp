@@ -207,8 +207,8 @@ void save_square_glb(const std::string& path) {
   save_glb(square, path);
 }
 
-void expect_one_error_line(const CliRun& r, const std::string& fragment) {
-  EXPECT_EQ(r.status, 1) << r.output;
+void expect_one_error_line(const CliRun& r, const std::string& fragment, int status) {
+  EXPECT_EQ(r.status, status) << r.output;
   const auto at = r.output.find("pmr: error: ");
   ASSERT_NE(at, std::string::npos) << r.output;
   const std::string line = r.output.substr(at);

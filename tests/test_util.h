@@ -84,8 +84,10 @@ size_t count_entries(const std::string& dir);  // including hidden ones
 std::set<std::string> listing(const std::string& dir);  // the entries' names
 // A double-sided 2x2 square in the z = 0 plane, centered on the origin (facing +z), saved as a .glb.
 void save_square_glb(const std::string& path);
-// The error is one line starting with "pmr: error:" (warnings may precede it), exit code 1.
-void expect_one_error_line(const CliRun& r, const std::string& fragment);
+// The error is one line starting with "pmr: error:" (warnings may precede it), exit code `status`: 1
+// for bad input or a runtime error, 2 for a usage error (expect_usage_error).
+void expect_one_error_line(const CliRun& r, const std::string& fragment, int status = 1);
+inline void expect_usage_error(const CliRun& r, const std::string& fragment) { expect_one_error_line(r, fragment, 2); }
 }  // namespace pmr::test
 
 namespace pmr::test {

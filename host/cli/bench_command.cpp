@@ -225,7 +225,8 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
       rc.view_w = 2 * rc.view_h;
     }
     Display display = o.display;
-    if (!o.offset_given) display.offset = default_offset(display.lens_pitch, N);  // else the panel's own
+    if (!o.offset_given)  // else the panel's own
+      display.offset = as_usage([&] { return default_offset(display.lens_pitch, N); });
     FrameRenderer renderer(scene, spec, rc, display, nullptr);
     const Rig& rig = renderer.rig();
     const double voxels = double(N) * rig.view_w * rig.view_h;
@@ -336,7 +337,7 @@ std::string bench_help() {
 }
 
 int run_bench(const std::vector<std::string>& args) {
-  BenchOptions o = parse(args);
+  BenchOptions o = as_usage([&] { return parse(args); });
   if (o.help) {
     std::fputs(bench_help().c_str(), stdout);
     return 0;

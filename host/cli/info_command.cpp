@@ -167,25 +167,25 @@ int run_info(const std::vector<std::string>& args) {
       return 0;
     }
     if (a == "--limit") {
-      if (i + 1 >= args.size()) throw Error("option --limit needs a value (see pmr info --help)");
-      parse_limits(args[++i], limits);
+      if (i + 1 >= args.size()) throw UsageError("option --limit needs a value (see pmr info --help)");
+      as_usage([&] { parse_limits(args[++i], limits); });
       options = true;
     } else if (a == "--allow-outside-scene-folder") {
       limits.allow_outside_scene_folder = true;
       options = true;
     } else if (!a.empty() && a[0] == '-') {
-      throw Error("unknown option " + a + " (see pmr info --help)");
+      throw UsageError("unknown option " + a + " (see pmr info --help)");
     } else if (scene.empty()) {
       scene = a;
     } else {
-      throw Error("pmr info takes at most one scene file");
+      throw UsageError("pmr info takes at most one scene file");
     }
   }
   if (!scene.empty()) {
     describe_scene(scene, limits);
     return 0;
   }
-  if (options) throw Error("--limit and --allow-outside-scene-folder apply to a scene: pmr info SCENE ...");
+  if (options) throw UsageError("--limit and --allow-outside-scene-folder apply to a scene: pmr info SCENE ...");
   for (const auto& line : describe_opencl_devices()) std::printf("%s\n", line.c_str());
   return 0;
 }

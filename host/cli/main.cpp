@@ -1,4 +1,6 @@
-// The `pmr` command line: turns every failure into one line on stderr and a non-zero exit status.
+// The `pmr` command line: turns every failure into one line on stderr and a non-zero exit status:
+// 1 for bad input, a runtime error or running out of memory, 2 for a usage error, 3 for an internal
+// error (a bug); a sequence stopped by signal N exits with 128 + N (sequence_job.cpp, interrupt.cpp).
 #include <cstdio>
 #include <new>
 #include <string>
@@ -32,7 +34,10 @@ int main(int argc, char** argv) {
     if (cmd == "quality") return pmr::run_quality(args);
     if (cmd == "info") return pmr::run_info(args);
     if (cmd == "verify") return pmr::run_verify(args);
-    throw pmr::Error("unknown command '" + cmd + "' (try pmr --help)");
+    throw pmr::UsageError("unknown command '" + cmd + "' (try pmr --help)");
+  } catch (const pmr::UsageError& e) {
+    std::fprintf(stderr, "pmr: error: %s\n", pmr::terminal_text(e.what()).c_str());
+    return 2;
   } catch (const pmr::Error& e) {
     // messages quote names from files: the last line of defence against escape sequences
     std::fprintf(stderr, "pmr: error: %s\n", pmr::terminal_text(e.what()).c_str());
@@ -42,6 +47,6 @@ int main(int argc, char** argv) {
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pmr: internal error: %s\n", pmr::terminal_text(e.what()).c_str());
-    return 2;
+    return 3;
   }
 }

@@ -103,14 +103,14 @@ RigConfig rig_for_serial(const LookingGlassCalibration& c, std::string& quilt, b
 // --preset and --display-config set the defaults that every other option then overrides.
 void apply_display_source(RenderOptions& o, const std::vector<std::string>& args) {
   for (size_t i = 0; i + 1 < args.size(); ++i)  // the calibration file is read under the file-bytes budget
-    if (args[i] == "--limit") parse_limits(args[i + 1], o.input_limits);
+    if (args[i] == "--limit") as_usage([&] { parse_limits(args[i + 1], o.input_limits); });
   for (size_t i = 0; i + 1 < args.size(); ++i) {
     if (args[i] == "--preset") {
       if (args[i + 1] == "help") {
         o.preset_help = true;
         return;
       }
-      const DisplayPreset& p = find_display_preset(args[i + 1]);
+      const DisplayPreset& p = as_usage([&]() -> const DisplayPreset& { return find_display_preset(args[i + 1]); });
       o.display = p.display;
       o.offset_given = p.name != "paper-8k";  // a panel's offset comes from its calibration
       o.rig = p.rig;
@@ -134,14 +134,11 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
   }
   int sources = 0;
   for (const std::string& a : args) sources += a == "--preset" || a == "--display-config";
-  if (sources > 1) throw Error("give one of --preset and --display-config, once");
+  if (sources > 1) throw UsageError("give one of --preset and --display-config, once");
 }
 
-}  // namespace
-
-RenderOptions parse_render_options(const std::vector<std::string>& args) {
-  RenderOptions o;
-  apply_display_source(o, args);
+// The options after apply_display_source: anything they throw is a usage error (they read no file).
+void parse_arguments(RenderOptions& o, const std::vector<std::string>& args) {
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> std::string {
@@ -165,9 +162,22 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
       o.display.size_w_cm = parse_double(v.substr(0, x), a);
       o.display.size_h_cm = parse_double(v.substr(x + 1), a);
     } else if (a == "--viewing-distance") o.display.viewing_distance_cm = parse_double(value(), a);
-    else if (a == "--cone") o.rig.cone_deg = parse_double(value(), a);
-    else if (a == "--yfov") o.rig.yfov_deg = parse_double(value(), a);
-    else if (a == "--lens-pitch") o.display.lens_pitch = parse_rational(value(), "--lens-pitch");
+    else if (a == "--cone") {
+      const std::string v = value();
+      o.rig.cone_deg = parse_double(v, a);
+      if (!(o.rig.cone_deg > 0.0 && o.rig.cone_deg < 180.0)) throw Error("invalid --cone '" + v + "': expected degrees in (0, 180)");
+    }
+    else if (a == "--yfov") {
+      const std::string v = value();
+      o.rig.yfov_deg = parse_double(v, a);
+      if (!(o.rig.yfov_deg > 0.0 && o.rig.yfov_deg < 180.0))  // 0 would silently mean "the display's default"
+        throw Error("invalid --yfov '" + v + "': expected degrees in (0, 180)");
+    }
+    else if (a == "--lens-pitch") {
+      const std::string v = value();
+      o.display.lens_pitch = parse_rational(v, "--lens-pitch");
+      if (o.display.lens_pitch.num <= 0) throw Error("invalid --lens-pitch '" + v + "': must be positive");
+    }
     else if (a == "--tan-slant") o.display.tan_slant = parse_rational(value(), "--tan-slant");
     else if (a == "--offset") {
       o.display.offset = parse_rational(value(), "--offset");
@@ -253,11 +263,21 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
   if (o.zoom_given && o.rig.camera >= 0)
     throw Error("--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own: "
                 "give one of them");
+}
+
+}  // namespace
+
+RenderOptions parse_render_options(const std::vector<std::string>& args) {
+  RenderOptions o;
+  apply_display_source(o, args);  // a bad --display-config file is bad input (exit 1), not a usage error
+  as_usage([&] { parse_arguments(o, args); });
   return o;
 }
 
 
-void finalize_render_options(RenderOptions& o) {
+namespace {
+
+void finalize_options(RenderOptions& o) {
   check_environment_options(o.environment_file, o.environment_rotation_given, o.pipeline.shading, o.option_warnings);
   if (o.pipeline.sampling == Sampling::Subpixel && !o.sampling_given) {
     // the preset's default: options that need the views rendered on their grids take precedence
@@ -286,6 +306,12 @@ void finalize_render_options(RenderOptions& o) {
   }
 }
 
+}  // namespace
+
+void finalize_render_options(RenderOptions& o) {
+  as_usage([&] { finalize_options(o); });  // combinations of options
+}
+
 std::string main_help() {
   return "pmr - multi-view light-field renderer (parallel multi-view polygon rasterization on OpenCL)\n"
          "\n"
@@ -297,7 +323,10 @@ std::string main_help() {
          "  pmr info SCENE                               what a scene holds (cameras, animations, ...)\n"
          "  pmr verify DIR --frames LIST                 which frames of a sequence are missing or broken\n"
          "  pmr --version                                the program version (as sidecars record it)\n"
-         "  pmr --help | pmr render --help\n";
+         "  pmr --help | pmr render --help\n"
+         "\n"
+         "exit status: 0 success; 1 bad input, runtime error or out of memory; 2 usage error (unknown option,\n"
+         "bad option value); 3 internal error; 128 + N when stopped by signal N (130 for Ctrl-C)\n";
 }
 
 std::string render_help() {

@@ -28,22 +28,22 @@ int run_quality(const std::vector<std::string>& args) {
   int scale = 4;
   std::vector<std::pair<int, int>> extra;
   std::vector<std::string> rest;
-  for (size_t i = 0; i < args.size(); ++i) {
+  for (size_t i = 0; i < args.size(); ++i) {  // usage errors (exit 2) but for --display-config's file
     if (args[i] == "-h" || args[i] == "--help") {
       std::fputs(quality_help().c_str(), stdout);
       return 0;
     }
     if (args[i] == "--scale") {
-      if (i + 1 >= args.size()) throw Error("option --scale needs a value (see pmr quality --help)");
+      if (i + 1 >= args.size()) throw UsageError("option --scale needs a value (see pmr quality --help)");
       const std::string v = args[++i];
       char* end = nullptr;
       const long k = std::strtol(v.c_str(), &end, 10);
-      if (v.empty() || *end != '\0' || k < 2 || k > 16) throw Error("invalid --scale '" + v + "': expected 2..16");
+      if (v.empty() || *end != '\0' || k < 2 || k > 16) throw UsageError("invalid --scale '" + v + "': expected 2..16");
       scale = int(k);
       continue;
     }
     if (args[i] == "--also-view-size") {  // checked as --view-size is
-      if (i + 1 >= args.size()) throw Error("option --also-view-size needs a value (see pmr quality --help)");
+      if (i + 1 >= args.size()) throw UsageError("option --also-view-size needs a value (see pmr quality --help)");
       const RenderOptions r = parse_render_options({"--view-size", args[++i]});
       extra.push_back({r.rig.view_w, r.rig.view_h});
       continue;

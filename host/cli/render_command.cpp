@@ -31,7 +31,7 @@ std::string exe_dir() {
 // The job the options describe (the compression name checked here, before anything else).
 SequenceJob sequence_job(const RenderOptions& o) {
   SequenceJob job;
-  job.compression = parse_exr_compression(o.compression);
+  job.compression = as_usage([&] { return parse_exr_compression(o.compression); });
   job.scene = o.scene;
   job.input_limits = o.input_limits;
   job.environment_file = o.environment_file;

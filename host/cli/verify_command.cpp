@@ -168,7 +168,7 @@ int run_verify(const std::vector<std::string>& args) {
       return 0;
     }
     if (a == "--frames" || a == "--write" || a == "--name") {
-      if (i + 1 >= args.size()) throw Error("option " + a + " needs a value (see pmr verify --help)");
+      if (i + 1 >= args.size()) throw UsageError("option " + a + " needs a value (see pmr verify --help)");
       rest.push_back(a);
       rest.push_back(args[++i]);
     } else if (a == "--preview") {
@@ -176,23 +176,23 @@ int run_verify(const std::vector<std::string>& args) {
     } else if (a == "--deep") {
       deep = true;
     } else if (!a.empty() && a[0] == '-') {
-      throw Error("unknown option " + a + " (see pmr verify --help)");
+      throw UsageError("unknown option " + a + " (see pmr verify --help)");
     } else if (dir.empty()) {
       dir = a;
     } else {
-      throw Error("more than one folder given");
+      throw UsageError("more than one folder given");
     }
   }
-  if (dir.empty()) throw Error("pmr verify needs the output folder (see pmr verify --help)");
+  if (dir.empty()) throw UsageError("pmr verify needs the output folder (see pmr verify --help)");
   bool frames_given = false;
   for (const std::string& r : rest) frames_given |= r == "--frames";
-  if (!frames_given) throw Error("pmr verify needs --frames LIST (the frames the job was asked for)");
+  if (!frames_given) throw UsageError("pmr verify needs --frames LIST (the frames the job was asked for)");
   const RenderOptions o = parse_render_options(rest);
-  if (o.frames == "all") throw Error("pmr verify needs the frames as a list (--frames all depends on the scene)");
+  if (o.frames == "all") throw UsageError("pmr verify needs the frames as a list (--frames all depends on the scene)");
+  const std::vector<long> frames = as_usage([&] { return parse_frame_list(o.frames); });
+  as_usage([&] { check_name_covers_frames(o.name, frames.size()); });
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw Error("cannot verify " + dir + ": not a folder");
-  const std::vector<long> frames = parse_frame_list(o.frames);
-  check_name_covers_frames(o.name, frames.size());
   bool explicit_kinds = false;
   for (const std::string& r : rest) explicit_kinds |= r == "--write" || r == "--preview";
   const FolderScene folder = folder_scene(dir, o, frames);

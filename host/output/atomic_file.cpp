@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <climits>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -30,6 +31,8 @@ int create_exclusive(const std::string& path) {
 }
 
 // "<dir>/.<name>.tmp-<pid>-<n>": hidden, in the same folder (so rename stays on one file system).
+// At most kTempNameExtra bytes longer than the name (pid_t and the counter have at most 10 digits).
+constexpr size_t kTempNameExtra = 1 + 5 + 10 + 1 + 10;
 std::string temp_name(const fs::path& final_path) {
   const std::string name = "." + final_path.filename().string() + ".tmp-" + std::to_string(::getpid()) +
                            "-" + std::to_string(g_counter.fetch_add(1));
@@ -107,5 +110,28 @@ void prepare_output_dir(const std::string& dir) {
   if (err != 0) throw Error(what + std::strerror(err));
   if (::unlink(probe.c_str()) != 0) throw Error(what + "cannot remove the probe file " + probe + ": " + std::strerror(errno));
 }
+
+void check_output_dir(const std::string& dir) {
+  const std::string what = "cannot write to output folder " + dir + ": ";
+  if (dir.empty()) throw Error("cannot write to output folder '': empty path");
+  std::error_code ec;
+  fs::path p(dir);
+  const fs::file_status st = fs::status(p, ec);
+  if (fs::exists(st)) {
+    if (!fs::is_directory(st)) throw Error(what + "exists and is not a folder");
+    return;
+  }
+  // the nearest existing ancestor must be a folder for create_directories to succeed
+  for (p = fs::absolute(p, ec).parent_path(); !p.empty(); p = p.parent_path()) {
+    const fs::file_status up = fs::status(p, ec);
+    if (fs::exists(up)) {
+      if (!fs::is_directory(up)) throw Error(what + p.string() + " is not a folder");
+      return;
+    }
+    if (p == p.root_path()) return;
+  }
+}
+
+size_t max_output_file_name() { return NAME_MAX - kTempNameExtra; }
 
 }  // namespace pmr

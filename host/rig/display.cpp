@@ -107,8 +107,15 @@ Rational parse_rational(const std::string& text, const std::string& what) {
 }
 
 Rational default_offset(const Rational& lens_pitch, int views) {
-  // -L / (2N): N t lands half-way between view boundaries (DESIGN section 5)
-  return reduced(-i128(lens_pitch.num), i128(2) * lens_pitch.den * views, "offset");
+  // -L / (2N): N t lands half-way between view boundaries (DESIGN section 5). Only the command line's
+  // lens pitch gets this default (presets and calibrations give their offset): reported as that option,
+  // not as an offset nobody gave.
+  try {
+    return reduced(-i128(lens_pitch.num), i128(2) * lens_pitch.den * views, "offset");
+  } catch (const Error&) {
+    throw Error("invalid --lens-pitch " + to_string(lens_pitch) + ": the default offset -L/(2N) for " +
+                std::to_string(views) + " views has too many digits to be exact; give --offset too");
+  }
 }
 
 std::string to_string(const Rational& r) {

@@ -1,6 +1,7 @@
 // Looking Glass calibration files (visual.json) and their mapping onto DESIGN section 5 (derivation in
 // docs/DISPLAYS.md).
 #include <cmath>
+#include <new>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -51,12 +52,15 @@ LookingGlassCalibration read_looking_glass_calibration(const std::string& path, 
   json doc;
   try {
     doc = json::parse(text);
+  } catch (const std::bad_alloc&) {  // not the file's fault
+    throw Error(path + ": out of host memory while parsing it (" + std::to_string(text.size()) + " bytes)");
   } catch (const std::exception& e) {
     throw Error(path + ": not a JSON calibration file (" + std::string(e.what()).substr(0, 120) + ")");
   }
   if (!doc.is_object()) throw Error(path + ": not a JSON calibration file (expected an object)");
   LookingGlassCalibration c;
   c.checksum = checksum_hex(text.data(), text.size());
+  c.path = path;
   if (doc.contains("serial") && doc["serial"].is_string()) c.serial = doc["serial"].get<std::string>();
   if (doc.contains("configVersion") && doc["configVersion"].is_string()) c.config_version = doc["configVersion"].get<std::string>();
   c.pitch = number_field(doc, "pitch", path, true, 0);
@@ -112,13 +116,29 @@ Display display_from_calibration(const LookingGlassCalibration& c) {
   const double sign = c.flip_x ? -1.0 : 1.0;
   const double pitch_px = c.pitch * W / c.dpi * std::cos(std::atan(1.0 / c.slope));
   const double tilt = H / (W * c.slope) * sign;
-  if (!(pitch_px > 0.0) || !std::isfinite(pitch_px) || !std::isfinite(tilt))
-    throw Error("the calibration gives no usable lens pitch");
   // DESIGN section 5 (derivation in docs/DISPLAYS.md).
   const long double L = 3.0L * W / (long double)pitch_px;
   const long double T = (long double)W * tilt / H;
   const long double O = -1.5L + (c.flip_x ? 2.0L : 0.0L) - 3.0L * W * (long double)tilt * (H - 0.5L) / H +
                         (long double)c.center * L;
+  // Each field is checked alone when read; together they must give an encoder that exact arithmetic
+  // holds (numerators and denominators below 2^62). Refused here, naming the file and its fields, not
+  // later as an option (--lens-pitch, --offset) the user never gave.
+  const std::string file = c.path.empty() ? std::string("the calibration") : c.path;
+  auto out_of_range = [&](const char* fields, const char* what, long double value, const char* range) {
+    char v[48];
+    std::snprintf(v, sizeof v, "%.6Lg", value);
+    throw Error(file + ": calibration fields " + fields + " give a " + what + " of " + v + ", outside " + range);
+  };
+  if (!(pitch_px > 0.0) || !std::isfinite(pitch_px) || !std::isfinite(tilt) || !(L >= 1e-3L && L <= 1e6L))
+    out_of_range("pitch, DPI, slope and screenW", "lens pitch (3 DPI / (pitch cos(atan(1 / slope))))", L,
+                 "0.001 to 1e6 subpixels");
+  if (!(std::fabs(T) <= 1e6L)) out_of_range("slope, screenW and screenH", "lens slant (1 / slope)", T, "-1e6 to 1e6");
+  // gen3 cells: the offset times 10^14 must fit 63 bits
+  const long double max_offset = c.cells.empty() ? 1e15L : 9e4L;
+  if (!(std::fabs(O) <= max_offset))
+    out_of_range("center, pitch, DPI and slope", "subpixel offset (center x lens pitch, and the slant's share)", O,
+                 c.cells.empty() ? "-1e15 to 1e15" : "-9e4 to 9e4 (with subpixelCells)");
   Display d;
   d.width = c.screen_w;
   d.height = c.screen_h;
@@ -155,7 +175,8 @@ Display display_from_calibration(const LookingGlassCalibration& c) {
           const long double o = -1.5L - 3.0L * dx - 3.0L * W * (long double)tilt * (H - 0.5L + dy) / H +
                                 (long double)c.center * L;
           const long double scaled = std::round(o * 1e14L);
-          if (!(std::fabs(scaled) < 9.0e18L)) throw Error("the calibration's offsets are too large for exact evaluation");
+          if (!(std::fabs(scaled) < 9.0e18L))
+            throw Error(file + ": calibration fields center and subpixelCells give offsets too large for exact evaluation");
           d.cell_offsets.push_back(int64_t(scaled));
         }
       }

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <new>
 #include <cstring>
 #include <limits>
 #include <map>
@@ -137,6 +138,8 @@ void load_model(const std::string& path, SourceFile& src, tinygltf::Model& model
     else
       ok = loader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(src.bytes.data()),
                                       unsigned(src.bytes.size()), src.base_dir);
+  } catch (const std::bad_alloc&) {  // not the file's fault: say so, not "not a valid glTF file"
+    fail(path, "out of host memory while parsing it (" + std::to_string(src.bytes.size()) + " bytes)");
   } catch (const std::exception& e) {  // nlohmann type errors on odd JSON
     fail(path, "not a valid glTF file: " + one_line(e.what()));
   }

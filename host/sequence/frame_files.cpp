@@ -1,5 +1,6 @@
 #include "sequence/frame_files.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "output/checksum.h"
+#include "pmr/error.h"
 #include "pmr/output.h"
 #include "sequence/frame_names.h"
 
@@ -137,6 +139,23 @@ std::string frame_problem(const std::string& sidecar, const std::vector<std::str
     if (!decodes(p)) return name(p) + " is truncated or unreadable";
   }
   return "";
+}
+
+void check_frame_file_names(const FrameProducts& o, const std::vector<long>& frames, const QuiltLayout& quilt,
+                            double aspect) {
+  if (frames.empty()) return;
+  // the frame number is the only part that varies: the largest frame makes the longest names
+  const FramePaths p = frame_paths(o, *std::max_element(frames.begin(), frames.end()), quilt, aspect);
+  std::vector<std::string> files = p.images();
+  files.push_back(p.sidecar);
+  std::string name;  // the longest
+  for (const std::string& file : files)
+    if (const std::string n = fs::path(file).filename().string(); n.size() > name.size()) name = n;
+  const size_t limit = max_output_file_name();
+  if (name.size() > limit)
+    throw UsageError("invalid --name '" + o.name + "': it makes the file name " + name + " of " +
+                     std::to_string(name.size()) + " bytes, and pmr can write at most " + std::to_string(limit) +
+                     " (the file system's 255, less what the temporary name it writes first adds)");
 }
 
 }  // namespace pmr

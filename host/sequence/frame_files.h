@@ -40,4 +40,10 @@ constexpr uint64_t kMaxSidecarBytes = uint64_t(16) << 20;
 std::string read_sidecar_text(const std::string& path);
 
 
+// Throws a UsageError naming --name when a file of these frames would have a name longer than the file
+// system takes (max_output_file_name: its temporary name must fit too), so that a long --name fails
+// before anything is rendered or created.
+void check_frame_file_names(const FrameProducts& o, const std::vector<long>& frames, const QuiltLayout& quilt,
+                            double aspect);
+
 }  // namespace pmr

@@ -101,11 +101,13 @@ class SequenceRun {
 // Everything that can be checked cheaply, before the long work starts.
 void SequenceRun::check_before_loading() {
   set_memory_budget(job_.input_limits.memory);
-  if (job_.frames != "all") frames_ = parse_frame_list(job_.frames);
-  check_name_covers_frames(products_.name, frames_.size());
-  prepare_output_dir(products_.out_dir);
+  // options given as text, checked here: a bad one is a usage error (exit 2)
+  if (job_.frames != "all") frames_ = as_usage([&] { return parse_frame_list(job_.frames); });
+  as_usage([&] { check_name_covers_frames(products_.name, frames_.size()); });
+  // the output folder is created only once every input has been read and checked (run())
+  check_output_dir(products_.out_dir);
   make_encode_params(job_.display, job_.rig.views, job_.rig.view_w, job_.rig.view_h);
-  if (!job_.quilt_layout.empty() && !products_.quilt) throw Error("--quilt needs --write quilt");
+  if (!job_.quilt_layout.empty() && !products_.quilt) throw UsageError("--quilt needs --write quilt");
   for (const auto& w : job_.warnings) warn(w);
 }
 
@@ -153,7 +155,7 @@ void SequenceRun::choose_frames() {
     if (last > kMaxFrame)
       throw Error("--frames all would reach frame " + std::to_string(last) + ", beyond " + std::to_string(kMaxFrame));
     for (long f = first; f <= last; ++f) frames_.push_back(f);
-    check_name_covers_frames(products_.name, frames_.size());
+    as_usage([&] { check_name_covers_frames(products_.name, frames_.size()); });
   }
   if (!job_.shard.empty()) {
     job_frames_ = frames_;
@@ -172,8 +174,11 @@ void SequenceRun::choose_frames() {
   need_volume_ = products_.views || products_.quilt || products_.preview;
   if (products_.quilt)
     quilt_ = job_.quilt_layout.empty() ? choose_quilt_layout(rig.views, rig.view_w, rig.view_h)
-                                       : parse_quilt_layout(job_.quilt_layout, rig.views, rig.view_w, rig.view_h);
+                                       : as_usage([&] {
+                                           return parse_quilt_layout(job_.quilt_layout, rig.views, rig.view_w, rig.view_h);
+                                         });
   center_view_ = rig.views / 2;
+  check_frame_file_names(products_, frames_, quilt_, rig.aspect);  // not after the first frame was rendered
   check_frame_memory();
 }
 
@@ -271,6 +276,7 @@ int SequenceRun::run() {
   load_inputs();
   choose_frames();
   prepare_frames();
+  prepare_output_dir(products_.out_dir);
   // One folder, one configuration: no other configuration rendering into it now, none left beside
   // this run's frames (folder_guard.h). Held until the end of the run.
   const FolderGuard folder_guard(products_.out_dir, products_.name, job_frames_.empty() ? frames_ : job_frames_,

@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <new>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -180,11 +181,136 @@ EnvironmentImage read_hdr(const std::string& path) {
 
 // ---- OpenEXR ----------------------------------------------------------------------------------------
 
+// OpenEXR's C++ reader (3.1) allocates the declared size of a string, vector or unknown (opaque)
+// header attribute, and 4 w h bytes for a preview image, before reading it: a 280-byte file declaring a
+// 1.7 GB attribute cost 1.7 GB (found by fuzzing). Walks the header(s) as that reader does (Header::
+// readFrom: a channel list is read up to its terminating entry and the fixed-size types by their own
+// size, whatever size the file declares for them) and returns what is wrong when such an allocation
+// would exceed what the file holds after it; "" otherwise (OpenEXR then reports anything else).
+// Opening the file also allocates line buffers of (bytes per pixel) x (data window width) x (lines per
+// chunk): the data window, the channels' bytes per pixel and the compression are returned for a check
+// of that before OpenEXR opens the file (a 414-byte file claiming 824203271 x 133687 cost 1.6 GB).
+struct ExrLayout {
+  bool has_window = false;
+  int64_t min_x = 0, min_y = 0, max_x = 0, max_y = 0;
+  uint64_t bytes_per_pixel = 0;
+  int compression = 0;
+};
+std::string check_exr_allocations(const std::string& path, uint64_t file_size, ExrLayout& layout) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char head[8];
+  if (!in.read(reinterpret_cast<char*>(head), 8) || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01)
+    return "";
+  const bool multipart = head[5] & 0x10;  // version flags, bit 12
+  uint64_t pos = 8;
+  auto left = [&] { return file_size - std::min(pos, file_size); };
+  auto read_name = [&](std::string& out) {  // null-terminated, at most 255 bytes
+    out.clear();
+    for (char c; in.get(c);) {
+      ++pos;
+      if (c == '\0') return true;
+      if (out.size() == 255) return false;
+      out += c;
+    }
+    return false;
+  };
+  auto read_u32 = [&](uint32_t& v) {
+    unsigned char b[4];
+    if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
+    pos += 4;
+    v = uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
+    return true;
+  };
+  auto skip = [&](uint64_t n) {
+    in.seekg(std::streamoff(n), std::ios::cur);
+    pos += n;
+  };
+  static const std::pair<const char*, uint64_t> kFixed[] = {
+      {"box2i", 16}, {"box2f", 16}, {"chromaticities", 32}, {"compression", 1}, {"double", 8}, {"envmap", 1},
+      {"float", 4}, {"int", 4}, {"keycode", 28}, {"lineOrder", 1}, {"m33f", 36}, {"m33d", 72}, {"m44f", 64},
+      {"m44d", 128}, {"rational", 8}, {"tiledesc", 9}, {"timecode", 8}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16},
+      {"v3i", 12}, {"v3f", 12}, {"v3d", 24}, {"deepImageState", 1}};
+  for (;;) {  // attributes until an empty name; a multi-part file's headers end with an empty one
+    std::string name, type;
+    uint32_t size = 0;
+    if (!read_name(name)) return "";
+    if (name.empty()) {
+      if (!multipart || in.peek() == 0) return "";
+      continue;
+    }
+    if (!read_name(type) || !read_u32(size)) return "";
+    if (type == "chlist") {  // channels (name, pixel type, 12 more bytes) up to an empty name
+      std::string channel;
+      uint32_t pixel_type = 0;
+      while (read_name(channel) && !channel.empty() && read_u32(pixel_type)) {
+        layout.bytes_per_pixel += pixel_type == 1 ? 2 : 4;  // HALF, else UINT or FLOAT
+        skip(12);
+      }
+      continue;
+    }
+    if (type == "box2i" && name == "dataWindow") {
+      uint32_t v[4];
+      for (uint32_t& x : v)
+        if (!read_u32(x)) return "";
+      layout.has_window = true;
+      layout.min_x = int32_t(v[0]), layout.min_y = int32_t(v[1]), layout.max_x = int32_t(v[2]), layout.max_y = int32_t(v[3]);
+      continue;
+    }
+    if (type == "compression" && name == "compression") {
+      layout.compression = in.get();
+      ++pos;
+      continue;
+    }
+    if (type == "preview") {
+      uint32_t w = 0, h = 0;
+      if (!read_u32(w) || !read_u32(h)) return "";
+      if (uint64_t(w) * h * 4 > left())
+        return "preview attribute '" + printable(name.substr(0, 40)) + "' of " + std::to_string(w) + "x" +
+               std::to_string(h) + " pixels is larger than the file";
+      skip(uint64_t(w) * h * 4);
+      continue;
+    }
+    if (type == "stringvector") {  // strings of their own length each, within the declared size
+      for (uint64_t read = 0; read < size;) {
+        uint32_t n = 0;
+        if (!read_u32(n)) return "";
+        if (n > left())
+          return "header attribute '" + printable(name.substr(0, 40)) + "' holds a string of " + std::to_string(n) +
+                 " bytes, more than the file holds";
+        skip(n);
+        read += 4 + uint64_t(n);
+      }
+      continue;
+    }
+    bool fixed = false;
+    for (const auto& [t, n] : kFixed)
+      if (type == t) skip(n), fixed = true;
+    if (fixed) continue;
+    if (size > left())  // string, stringvector, floatvector or an unknown type: size bytes allocated
+      return "header attribute '" + printable(name.substr(0, 40)) + "' declares " + std::to_string(size) +
+             " bytes, more than the file holds";
+    skip(size);
+  }
+}
+
 EnvironmentImage read_exr(const std::string& path) {
   struct stat st {};
   if (stat(path.c_str(), &st) != 0) fail(path, std::strerror(errno));
   if (!S_ISREG(st.st_mode)) fail(path, "not a regular file");
   if (st.st_size == 0) fail(path, "the file is empty");
+  ExrLayout layout;
+  if (const std::string why = check_exr_allocations(path, uint64_t(st.st_size), layout); !why.empty())
+    fail(path, "not a readable OpenEXR file (" + why + ")");
+  if (layout.has_window) {  // the size limits, before OpenEXR sizes its line buffers by the window
+    const int64_t w = layout.max_x - layout.min_x + 1, h = layout.max_y - layout.min_y + 1;
+    if (w <= 0 || h <= 0) fail(path, "the image is empty");
+    check_size(path, uint64_t(w), uint64_t(h));
+    static const uint64_t kLinesPerChunk[10] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};  // by compression
+    const uint64_t lines = layout.compression >= 0 && layout.compression < 10 ? kLinesPerChunk[layout.compression] : 1;
+    if (layout.bytes_per_pixel * uint64_t(w) * lines > (uint64_t(1) << 30))
+      fail(path, "its " + std::to_string(layout.bytes_per_pixel) + " bytes per pixel in rows of " + std::to_string(w) +
+                     " need more than 1 GiB of line buffers to read");
+  }
   EnvironmentImage img;
   try {
     Imf::InputFile file(path.c_str());
@@ -196,6 +322,8 @@ EnvironmentImage read_exr(const std::string& path) {
     const bool rgb = ch.findChannel("R") && ch.findChannel("G") && ch.findChannel("B");
     const bool gray = !rgb && ch.findChannel("Y");
     if (!rgb && !gray) fail(path, "no R, G, B (or Y) channels");
+    // before the pixels are allocated: a small file claiming a large data window costs nothing
+    if (!file.isComplete()) fail(path, "the file is truncated (some pixel data is missing)");
     img.width = int(w), img.height = int(h);
     img.rgb.assign(size_t(w) * size_t(h) * 3, 0.0f);
     Imf::FrameBuffer fb;
@@ -205,12 +333,13 @@ EnvironmentImage read_exr(const std::string& path) {
       fb.insert(rgb ? names[c] : "Y",
                 Imf::Slice::Make(Imf::FLOAT, img.rgb.data() + c, dw, xs, ys));
     file.setFrameBuffer(fb);
-    if (!file.isComplete()) fail(path, "the file is truncated (some pixel data is missing)");
     file.readPixels(dw.min.y, dw.max.y);
     if (gray)
       for (size_t t = 0; t < size_t(w) * size_t(h); ++t) img.rgb[3 * t + 1] = img.rgb[3 * t + 2] = img.rgb[3 * t];
   } catch (const Error&) {
     throw;
+  } catch (const std::bad_alloc&) {  // not the file's fault: not "not a readable OpenEXR file"
+    fail(path, "out of host memory while reading it");
   } catch (const std::exception& e) {  // Iex::BaseExc derives from std::exception
     std::string msg = e.what();
     for (size_t at = msg.find(path); !path.empty() && at != std::string::npos; at = msg.find(path))

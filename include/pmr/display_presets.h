@@ -21,6 +21,7 @@ struct LookingGlassCalibration {
   std::vector<std::array<double, 6>> cells;
   int cell_pattern = 0;
   std::string checksum;  // XXH3-64 of the file's bytes as read (output/checksum.h), 16 hex digits
+  std::string path;      // the file as given, for messages about values derived from it
 };
 
 // Reads and checks a visual.json: one clear pmr::Error naming the file and the field on anything
@@ -32,7 +33,8 @@ struct LookingGlassCalibration {
 LookingGlassCalibration read_looking_glass_calibration(const std::string& path, std::vector<std::string>* warnings,
                                                        uint64_t max_bytes = InputLimits().file_bytes);
 
-// The display in DESIGN terms for a calibration, following Looking Glass's current interlacing shader
+// The display in DESIGN terms for a calibration (pmr::Error naming the file and its fields when the
+// values, each plausible alone, give a lens pitch, slant or offset out of range), following Looking Glass's current interlacing shader
 // (looking-glass-webxr 0.6 / holoplay-core 0.0.11): pitch' = pitch W / DPI cos(atan(1 / slope)) and
 // tilt = H / (W slope) computed in double as LookingGlassConfig.ts does (both negated with flipImageX,
 // as is subp), then exactly: L = 3W / pitch', tan = W tilt / H, offset = -1.5 (+2 when flipped)

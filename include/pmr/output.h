@@ -23,6 +23,12 @@ const char* to_string(ExrCompression c);
 // Ensures the directory exists (creating it and its parents) and is writable (creates and removes a
 // probe file). Throws pmr::Error "cannot write to output folder X: <reason>". Call it before long work.
 void prepare_output_dir(const std::string& dir);
+// What prepare_output_dir can tell without creating anything: throws the same pmr::Error when `dir` is
+// empty, exists and is not a folder, or lies below something that is not a folder. For a check before
+// the inputs are read.
+void check_output_dir(const std::string& dir);
+// The longest file name an AtomicFile can write: NAME_MAX (255 bytes) less what its temporary name adds.
+size_t max_output_file_name();
 
 // A file written under a temporary name in the same folder as `final_path` and renamed into place by
 // commit(). The constructor creates the (empty) temporary file, so an unwritable or missing folder

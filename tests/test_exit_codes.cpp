@@ -1,0 +1,125 @@
+// Exit codes and what exists after a refusal (issue 21): 0 success, 1 bad input or runtime error or out
+// of memory, 2 usage, 128 + N for signal N; nothing is created before the inputs have been checked,
+// and a --name too long for the file system fails before the first frame.
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <string>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+
+namespace pmr {
+namespace {
+
+using test::CliRun;
+using test::exists;
+using test::expect_one_error_line;
+using test::expect_usage_error;
+using test::run;
+using test::temp_dir;
+
+const char* const kSmall = " --view-size 32x16 --display 64x36 --views 4";
+
+TEST(ExitCodes, UsageErrorsExitTwo) {
+  const std::string out = temp_dir("usage") + "/out";
+  expect_usage_error(run("frobnicate"), "unknown command");
+  expect_usage_error(run("render --frobnicate --out " + out), "--frobnicate");
+  expect_usage_error(run("render --views --out " + out), "--views");           // "--out" is not a count
+  expect_usage_error(run("render --views 0 --out " + out), "--views");
+  expect_usage_error(run("render --out"), "--out needs a value");
+  expect_usage_error(run("render --yfov 0 --out " + out), "--yfov");
+  expect_usage_error(run("render --yfov 180 --out " + out), "--yfov");
+  expect_usage_error(run("render --compression lzma --out " + out), "lzma");
+  expect_usage_error(run("render --frames 5:1 --out " + out), "5:1");
+  expect_usage_error(run("render --preset lg-99 --out " + out), "lg-99");
+  expect_usage_error(run("render --limit bogus=1 --out " + out), "bogus");
+  expect_usage_error(run("render --preset lg-go --preset lg-16 --out " + out), "one of --preset");
+  expect_usage_error(run("render --cone 180 --out " + out), "--cone");
+  expect_usage_error(run("render --environment env.hdr --shading lambert --out " + out), "--shading pbr");
+  expect_usage_error(run("render --quilt 4x1 --out " + out + kSmall), "--quilt needs --write quilt");
+  expect_usage_error(run("info --frobnicate"), "--frobnicate");
+  expect_usage_error(run("info --limit file-bytes=0 x.gltf"), "file-bytes");
+  expect_usage_error(run("verify"), "needs the output folder");
+  expect_usage_error(run("verify " + out + " --frames x"), "x");
+  expect_usage_error(run("bench --keep always"), "--keep");
+  expect_usage_error(run("quality --scale 1"), "--scale");
+  EXPECT_EQ(run("").status, 2) << "no command: the usage text, status 2";
+  EXPECT_FALSE(exists(out));
+}
+
+TEST(ExitCodes, BadInputExitsOne) {
+  const std::string dir = temp_dir("badinput");
+  const std::string out = dir + "/out";
+  expect_one_error_line(run("render /nonexistent/scene.gltf --out " + out), "scene.gltf");
+  expect_one_error_line(run("render --display-config /nonexistent/visual.json --out " + out), "visual.json");
+  expect_one_error_line(run("info /nonexistent/scene.gltf"), "file not found");
+  // --camera beyond the scene's cameras depends on the scene: bad input, not usage
+  expect_one_error_line(run("render --camera 3 --out " + out + kSmall), "--camera 3");
+  EXPECT_FALSE(exists(out));
+  EXPECT_EQ(run("render --out " + out + kSmall + " -q").status, 0);
+}
+
+// A render stopped by SIGTERM exits 128 + 15, as SIGINT exits 130 (test_sequence).
+TEST(ExitCodes, SignalNExits128PlusN) {
+  const std::string out = temp_dir("sigterm");
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string cmd = std::string(PMR_BINARY) + " render -q --turntable 360:50 --frames 0:49 --views 16 "
+                            "--view-size 256x128 --display 640x360 --out " + out + " > /dev/null 2>&1";
+    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), (char*)nullptr);
+    _exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (std::chrono::steady_clock::now() < deadline && !exists(out + "/frame_0000.exr"))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  if (WEXITSTATUS(status) != 0)  // a very fast machine may have finished all 50 frames first
+    EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM);
+}
+
+TEST(ExitCodes, NothingIsCreatedBeforeTheInputsAreChecked) {
+  const std::string dir = temp_dir("nothing_created");
+  const std::string out = dir + "/a/b/out";
+  std::system(("mkdir -p '" + dir + "'").c_str());
+  std::ofstream(dir + "/broken.gltf") << "{ \"asset\": {\"version\": \"2.0\"}, \"buffers\": [ {";
+  expect_one_error_line(run("render '" + dir + "/broken.gltf' --out " + out + kSmall), "broken.gltf");
+  EXPECT_FALSE(exists(dir + "/a")) << "the output folder was created for a scene that does not load";
+  std::ofstream(dir + "/bad.hdr") << "not an image";
+  expect_one_error_line(run("render --shading pbr --environment '" + dir + "/bad.hdr' --out " + out + kSmall), "bad.hdr");
+  EXPECT_FALSE(exists(dir + "/a"));
+  // a folder below a regular file is refused at once, before the scene is read
+  std::ofstream(dir + "/file") << "x";
+  expect_one_error_line(run("render '" + dir + "/broken.gltf' --out '" + dir + "/file/sub'" + kSmall), "is not a folder");
+}
+
+// File names hold 255 bytes; pmr writes each file under a temporary name first (27 bytes longer at
+// most), so the longest --name is checked against that before anything is rendered or created.
+TEST(ExitCodes, NameTooLongForTheFileSystemFailsBeforeRendering) {
+  const std::string out = temp_dir("long_name") + "/out";
+  const std::string name(244, 'n');
+  const CliRun r = run("render --name " + name + " --out " + out + kSmall);
+  expect_usage_error(r, "invalid --name");
+  EXPECT_NE(r.output.find(name + ".json of 249 bytes"), std::string::npos) << r.output;
+  EXPECT_FALSE(exists(out));
+  // the longest suffix decides: with --write views the views file is 5 bytes longer than the sidecar
+  const std::string fits(223, 'n');  // + ".json" = 228 bytes, the most pmr can write
+  const CliRun ok = run("render -q --name " + fits + " --out " + out + kSmall);
+  EXPECT_EQ(ok.status, 0) << ok.output;
+  EXPECT_TRUE(exists(out + "/" + fits + ".json"));
+  const CliRun views = run("render --write views --name " + fits + " --out " + out + "2" + kSmall);
+  expect_usage_error(views, fits + ".views.exr of 233 bytes");
+  EXPECT_FALSE(exists(out + "2"));
+}
+
+}  // namespace
+}  // namespace pmr

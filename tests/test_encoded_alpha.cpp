@@ -185,9 +185,9 @@ TEST(EncodedAlpha, BackgroundIsCompositedPerSubpixel) {
   test::CliRun r = test::run("render" + rig + " --name bg --background 0,0,0 --resume");
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("background"), std::string::npos) << r.output;
-  test::expect_one_error_line(test::run("render --background 1,2 --out " + out), "--background");
-  test::expect_one_error_line(test::run("render --background 0,0,0,2 --out " + out), "--background");
-  test::expect_one_error_line(test::run("render --background 0,nan,0 --out " + out), "--background");
+  test::expect_usage_error(test::run("render --background 1,2 --out " + out), "--background");
+  test::expect_usage_error(test::run("render --background 0,0,0,2 --out " + out), "--background");
+  test::expect_usage_error(test::run("render --background 0,nan,0 --out " + out), "--background");
 }
 
 // The Looking Glass presets' quilt PNG is opaque black unless a background is given; paper-8k's keeps

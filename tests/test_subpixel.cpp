@@ -320,8 +320,8 @@ TEST(SubpixelSampling, CommandLine) {
     EXPECT_NE(f.output.find("warning: " + opt + " samples the rendered views: --sampling view instead"), std::string::npos)
         << f.output;
     EXPECT_NE(test::read_file(dir + "/frame_0000.json").find("\"sampling\": \"view\""), std::string::npos) << opt;
-    test::expect_one_error_line(test::run("render --sampling subpixel " + opt + lg_small + dir + "x"),
-                                opt == "--method multipass" ? "--method pmr" : opt);
+    test::expect_usage_error(test::run("render --sampling subpixel " + opt + lg_small + dir + "x"),
+                             opt == "--method multipass" ? "--method pmr" : opt);
   }
   // pmr bench --preset measures the preset as a user gets it: angular spacing, subpixel sampling
   const test::CliRun b = test::run("bench --preset lg-portrait --views 2 --view-size 42x56 --frames 1 --no-check --method pmr");

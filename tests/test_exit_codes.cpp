@@ -6,12 +6,16 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <new>
+#include <stdexcept>
 #include <fstream>
 #include <string>
 #include <thread>
 
 #include <gtest/gtest.h>
 
+#include "cli/exit_status.h"
+#include "pmr/error.h"
 #include "test_util.h"
 
 namespace pmr {
@@ -47,6 +51,8 @@ TEST(ExitCodes, UsageErrorsExitTwo) {
   expect_usage_error(run("info --limit file-bytes=0 x.gltf"), "file-bytes");
   expect_usage_error(run("verify"), "needs the output folder");
   expect_usage_error(run("verify " + out + " --frames x"), "x");
+  expect_usage_error(run("render --blend-views --bilinear --out " + out + kSmall), "--blend-views");
+  expect_usage_error(run("render --shard 3/2 --out " + out + kSmall), "--shard");
   expect_usage_error(run("bench --keep always"), "--keep");
   expect_usage_error(run("quality --scale 1"), "--scale");
   EXPECT_EQ(run("").status, 2) << "no command: the usage text, status 2";
@@ -63,6 +69,22 @@ TEST(ExitCodes, BadInputExitsOne) {
   expect_one_error_line(run("render --camera 3 --out " + out + kSmall), "--camera 3");
   EXPECT_FALSE(exists(out));
   EXPECT_EQ(run("render --out " + out + kSmall + " -q").status, 0);
+}
+
+// The mapping itself, for the status no input should reach: an exception that is not a pmr::Error is
+// a bug, reported as an internal error with status 3 (and its message sanitized like every other).
+TEST(ExitCodes, EachKindOfFailureHasItsStatus) {
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(run_reporting_errors([] { return 0; }), 0);
+  EXPECT_EQ(run_reporting_errors([] { return 7; }), 7) << "a command's own status passes through";
+  EXPECT_EQ(run_reporting_errors([]() -> int { throw Error("bad input"); }), 1);
+  EXPECT_EQ(run_reporting_errors([]() -> int { throw UsageError("bad option"); }), 2);
+  EXPECT_EQ(run_reporting_errors([]() -> int { throw std::bad_alloc(); }), 1) << "out of memory is not a bug";
+  EXPECT_EQ(run_reporting_errors([]() -> int { throw std::logic_error("vector::at \x1b]0;owned\x07"); }), 3);
+  EXPECT_EQ(run_reporting_errors([]() -> int { throw 42; }), 3);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("pmr: internal error: vector::at"), std::string::npos) << err;
+  EXPECT_EQ(err.find('\x1b'), std::string::npos) << "escape sequences reach the terminal: " << err;
 }
 
 // A render stopped by SIGTERM exits 128 + 15, as SIGINT exits 130 (test_sequence).

@@ -278,6 +278,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
 namespace {
 
 void finalize_options(RenderOptions& o) {
+  if (o.display.blend_views && o.display.bilinear) throw UsageError("--blend-views and --bilinear cannot be combined");
   check_environment_options(o.environment_file, o.environment_rotation_given, o.pipeline.shading, o.option_warnings);
   if (o.pipeline.sampling == Sampling::Subpixel && !o.sampling_given) {
     // the preset's default: options that need the views rendered on their grids take precedence

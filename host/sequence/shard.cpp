@@ -51,7 +51,7 @@ Shard parse_shard(const std::string& text, long shard_count, long shard_first, c
     const auto slash = text.find('/');
     if (slash == std::string::npos || !read_long(text.substr(0, slash).c_str(), k) ||
         !read_long(text.substr(slash + 1).c_str(), n) || n < 1 || k < 0 || k >= n)
-      throw Error("invalid --shard '" + text + "': expected K/N with 0 <= K < N, or auto");
+      throw UsageError("invalid --shard '" + text + "': expected K/N with 0 <= K < N, or auto");
     return Shard{k, n, "--shard " + text};
   }
   bool has = false, h2 = false, h3 = false, h4 = false;

@@ -37,6 +37,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   pmr::InputLimits limits;
   limits.file_bytes = uint64_t(1) << 20;
   limits.texture_pixels = uint64_t(1) << 20;
+  limits.vertex_data = uint64_t(64) << 20;
+  limits.animation_data = uint64_t(16) << 20;
+  limits.json_bytes = uint64_t(1) << 20;
   try {
     const pmr::Scene scene = pmr::load_scene(path, limits);
     glm::dvec3 lo, hi;

@@ -394,9 +394,16 @@ inline sfloat3 lane_base_color(const LaneWinners* L, const LaneTextures* T, bool
   return textured ? s3_mul(c, LANE3(T->base)) : c;
 }
 
+/* Colours are stored as halves, whose largest finite value is 65504: a brighter value (the peak of a
+ * mirror-like highlight under a strong light) saturates there instead of becoming infinite. */
+inline sfloat3 s3_half_range(sfloat3 c) {
+  const sfloat m = (sfloat)(65504.0f);
+  return s3(fmin(c.x, m), fmin(c.y, m), fmin(c.z, m));
+}
+
 /* Lit colours (RGB; alpha is coverage, 1) of the winners L in view `view` of the pass (the volume's
- * view + P->view_base). `light`: the unit direction toward Lambert's one light (pbr reads the light
- * table instead). Each lane's value depends on its own winner and voxel alone. */
+ * view + P->view_base), at most 65504. `light`: the unit direction toward Lambert's one light (pbr
+ * reads the light table instead). Each lane's value depends on its own winner and voxel alone. */
 inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 light, int view) {
   const bool pbr = in->P->shading == PMR_SHADING_PBR;
   const sfloat3 b = lane_barycentrics(L);
@@ -411,11 +418,11 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
   if (pbr) {
     if (textured) n = mapped_normal(&T, n);
     n = s3_select(n, s3_neg(n), L->back); /* t, b and n together */
-    return s3_scale(shade_pbr(in, L, &T, textured, b, n, base, view), exposure);
+    return s3_half_range(s3_scale(shade_pbr(in, L, &T, textured, b, n, base, view), exposure));
   }
   n = s3_select(n, s3_neg(n), L->back);
   const sfloat lambert = 0.2f + 0.8f * max(s3_dot(n, s3_splat(light)), 0.0f);
-  return s3(base.x * lambert * exposure, base.y * lambert * exposure, base.z * lambert * exposure);
+  return s3_half_range(s3(base.x * lambert * exposure, base.y * lambert * exposure, base.z * lambert * exposure));
 }
 
 /* alphaMode MASK: the base colour alpha of MTA m at raster point (X, Y) of view `view` passes the cutoff:

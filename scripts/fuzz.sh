@@ -22,18 +22,8 @@ for t in "${TARGETS[@]}"; do
   case "$t" in gltf|environment|calibration|sidecar) ;; *) echo "fuzz.sh: unknown target '$t'" >&2; exit 2 ;; esac
 done
 
-PMR_SETUP_PACKAGES_ONLY=1 bash scripts/setup.sh  # the project's libraries
-PACKAGES=(clang-14 libclang-rt-14-dev)
-missing=()
-for p in "${PACKAGES[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "fuzz: installing ${missing[*]}"
-  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get update -q
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q "${missing[@]}"
-fi
+# the project's libraries, and clang with its sanitizer and libFuzzer runtimes
+PMR_SETUP_PACKAGES_ONLY=1 PMR_SETUP_EXTRA_PACKAGES="clang-14 libclang-rt-14-dev" bash scripts/setup.sh
 
 BUILD=build-fuzz
 # -O1 and line tables only: the sanitizers' usual setting, and a build several times faster than -O2 -g

@@ -15,6 +15,9 @@ PACKAGES=(
   libgtest-dev
   python3 python3-matplotlib
 )
+# more packages for one script's own needs (scripts/fuzz.sh: clang), installed the same way
+read -r -a EXTRA <<< "${PMR_SETUP_EXTRA_PACKAGES:-}"
+PACKAGES+=("${EXTRA[@]}")
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -24,14 +24,7 @@ constexpr uint64_t kGiB = uint64_t(1) << 30;
 
 // `pmr ARGS` with its address space capped at `as_bytes` (RLIMIT_AS).
 CliRun run_capped(uint64_t as_bytes, const std::string& args) {
-  const std::string cmd = "prlimit --as=" + std::to_string(as_bytes) + " " + std::string(PMR_BINARY) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
-  const int st = pclose(p);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, out};
+  return run_wrapped("prlimit --as=" + std::to_string(as_bytes), args);
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t) {

@@ -55,12 +55,8 @@ TEST(EncodedAlpha, EachSubpixelCarriesItsSamplesAlpha) {
   Display display;
   display.width = 96, display.height = 40;
   const int views = 7, vw = 32, vh = 10;
-  RigConfig rc;
-  rc.views = views, rc.view_w = vw, rc.view_h = vh;
-  const Rig rig = make_rig(rc, display, glm::dvec3(-1), glm::dvec3(1));
-  Pipeline p(test::runtime(), PipelineConfig{});
-  p.set_scene(test::random_scene(1, 1, false));
-  p.configure(rig, &display);
+  const std::unique_ptr<Pipeline> pipeline = test::encoder_pipeline(display, views, vw, vh);
+  Pipeline& p = *pipeline;
   const size_t plane = size_t(vw) * vh;
   std::vector<uint16_t> vol(plane * views * 4), enc, sub;
   auto alpha_of = [&](int v, int x, int y) { return float((v * 5 + x * 3 + y) % 4) / 4.0f; };  // 0, 1/4, 1/2, 3/4

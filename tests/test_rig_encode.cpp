@@ -109,12 +109,8 @@ TEST(Encode, ParsesFractionsExactly) {
 // The encoder kernel against a direct evaluation of DESIGN section 5: which view each subpixel shows
 // and which pixel of that view it samples.
 void check_encoder(const Display& display, int views, int vw, int vh, bool all_views_shown = true) {
-  RigConfig rc;
-  rc.views = views, rc.view_w = vw, rc.view_h = vh;
-  const Rig rig = make_rig(rc, display, glm::dvec3(-1), glm::dvec3(1));
-  Pipeline p(test::runtime(), PipelineConfig{});
-  p.set_scene(test::random_scene(1, 1, false));
-  p.configure(rig, &display);
+  const std::unique_ptr<Pipeline> pipeline = test::encoder_pipeline(display, views, vw, vh);
+  Pipeline& p = *pipeline;
   const size_t plane = size_t(vw) * vh;
   std::vector<uint16_t> vol(plane * views * 4), enc[3];
   for (int field = 0; field < 3; ++field) {  // every channel = view index, pixel x, pixel y

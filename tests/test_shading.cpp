@@ -7,6 +7,7 @@
 
 #include <map>
 
+#include "pmr/output.h"
 #include "reference/shade_reference.h"
 #include "test_util.h"
 
@@ -145,6 +146,44 @@ TEST(Shading, AlphaMaskDiscardsBelowCutoff) {
   EXPECT_GT(front, out.key.size() / 4);
   EXPECT_GT(behind, out.key.size() / 4);
   compare_shading(s, rig, out);
+}
+
+}  // namespace
+}  // namespace pmr
+
+namespace pmr {
+namespace {
+
+// Colours are halves: a value beyond the largest finite half (65504) saturates there instead of
+// becoming infinite (which would turn any blend, e.g. --bilinear, into NaN). Exposure 2^30 pushes every
+// lit voxel of the bundled scene far beyond it, in both shading models and every path that shades.
+TEST(Shading, BrightColoursSaturateAtTheLargestHalf) {
+  const std::string out = test::temp_dir("saturate");
+  const std::string small = " -q --views 4 --view-size 48x24 --display 96x54 --frames 0 --exposure 30 --out " + out;
+  for (const std::string& variant : {std::string("pbr_views --shading pbr --write views"),
+                                     std::string("lambert_views --shading lambert --write views"),
+                                     std::string("pbr_fused --shading pbr --write encoded"),
+                                     std::string("pbr_subpixel --shading pbr --write encoded --sampling subpixel"),
+                                     std::string("pbr_bilinear --shading pbr --write encoded --bilinear")}) {
+    const std::string name = variant.substr(0, variant.find(' '));
+    SCOPED_TRACE(name);
+    ASSERT_EQ(test::run("render" + small + " --name " + name + variant.substr(variant.find(' '))).status, 0);
+    std::vector<uint16_t> px;
+    int w = 0, h = 0;
+    if (variant.find("--write views") != std::string::npos)
+      read_views_exr_part(out + "/" + name + ".views.exr", 1, w, h, px);
+    else
+      read_rgba_exr(out + "/" + name + ".exr", w, h, px);
+    ASSERT_FALSE(px.empty());
+    size_t saturated = 0;
+    for (size_t i = 0; i < px.size(); ++i) {
+      if (i % 4 == 3) continue;
+      const uint16_t magnitude = px[i] & 0x7fffu;
+      ASSERT_LT(magnitude, 0x7c00u) << "an infinite or NaN half at value " << i;
+      saturated += magnitude == 0x7bffu;  // 65504
+    }
+    EXPECT_GT(saturated, px.size() / 40) << "the lit voxels should all saturate";
+  }
 }
 
 }  // namespace

@@ -389,7 +389,19 @@ TEST(SubpixelSampling, ImageDifferenceCountsColourChannelsOnly) {
   const std::vector<uint16_t> b = {half(0.0f).bits(), 0, half(0.25f + 1.0f / 512).bits(), 0, 0, 0, 0, half(1.0f).bits()};
   const ImageDifference d = compare_display_images(a, b);
   EXPECT_NEAR(d.rmse, std::sqrt((0.25 + 1.0 / (512.0 * 512.0)) / 6.0), 1e-9);
+  EXPECT_NEAR(d.rmse_shown, d.rmse, 1e-12) << "values within [0, 1] are shown as they are";
   EXPECT_DOUBLE_EQ(d.differing, 1.0 / 6.0);
+}
+
+// rmse_shown compares what a panel shows: values clamped to [0, 1], so a highlight of 10^4 or an
+// infinite half counts as 1.
+TEST(SubpixelSampling, ShownDifferenceClampsToTheDisplayRange) {
+  const uint16_t inf = 0x7c00u;
+  const std::vector<uint16_t> a = {half(1.0e4f).bits(), inf, half(-2.0f).bits(), 0, half(0.5f).bits(), 0, 0, 0};
+  const std::vector<uint16_t> b = {half(0.0f).bits(), half(1.0f).bits(), half(0.0f).bits(), 0, half(2.0f).bits(), 0, 0, 0};
+  const ImageDifference d = compare_display_images(a, b);
+  EXPECT_NEAR(d.rmse_shown, std::sqrt((1.0 + 0.25) / 6.0), 1e-12);
+  EXPECT_TRUE(std::isinf(d.rmse)) << "the linear RMSE keeps the infinite value";
 }
 
 }  // namespace

@@ -145,6 +145,16 @@ EncodedRender render_encoded(const Scene& scene, const Rig& rig, const Display& 
   return r;
 }
 
+std::unique_ptr<Pipeline> encoder_pipeline(const Display& display, int views, int vw, int vh) {
+  RigConfig rc;
+  rc.views = views, rc.view_w = vw, rc.view_h = vh;
+  const Rig rig = make_rig(rc, display, glm::dvec3(-1), glm::dvec3(1));
+  auto p = std::make_unique<Pipeline>(runtime(), PipelineConfig{});
+  p->set_scene(random_scene(1, 1, false));
+  p->configure(rig, &display);
+  return p;
+}
+
 PmrParams params_for(const Rig& rig, int tx, int ty, int tv) {
   PmrParams P = make_params(rig);
   P.tiles_x = (rig.view_w + tx - 1) / tx;
@@ -160,7 +170,11 @@ namespace pmr::test {
 CliRun run(const std::string& args) { return run_env("", args); }
 
 CliRun run_env(const std::string& env, const std::string& args) {
-  const std::string cmd = (env.empty() ? "" : "env " + env + " ") + std::string(PMR_BINARY) + " " + args + " 2>&1";
+  return run_wrapped(env.empty() ? "" : "env " + env, args);
+}
+
+CliRun run_wrapped(const std::string& wrapper, const std::string& args) {
+  const std::string cmd = (wrapper.empty() ? "" : wrapper + " ") + std::string(PMR_BINARY) + " " + args + " 2>&1";
   FILE* p = popen(cmd.c_str(), "r");
   std::string out;
   char buf[4096];

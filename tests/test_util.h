@@ -2,6 +2,7 @@
 // procedural scenes with known properties.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <random>
 #include <set>
 #include <string>
@@ -53,6 +54,9 @@ struct EncodedRender {
   bool fused = false, has_volume = false;
 };
 EncodedRender render_encoded(const Scene& scene, const Rig& rig, const Display& d, const PipelineConfig& pc);
+// A pipeline set up for `views` views of vw x vh (a one-triangle scene) and `display`, to drive the
+// encoder directly with a volume of the test's own (Pipeline::encode_volume).
+std::unique_ptr<Pipeline> encoder_pipeline(const Display& display, int views, int vw, int vh);
 
 // Path of the shared glTF corpus (PMR_SOURCE_DIR/../shared/gltf), empty if absent.
 std::string corpus_dir();
@@ -76,6 +80,8 @@ struct CliRun {
 CliRun run(const std::string& args);
 // The same with environment assignments for the process, e.g. "POCL_CACHE_DIR='/tmp/x'".
 CliRun run_env(const std::string& env, const std::string& args);
+// The same started through a wrapper command, e.g. "prlimit --as=1073741824" or "env X=1".
+CliRun run_wrapped(const std::string& wrapper, const std::string& args);
 // A fresh folder per test and process, so that two test runs on one machine cannot meet.
 std::string temp_dir(const std::string& name);
 bool exists(const std::string& path);

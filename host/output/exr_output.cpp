@@ -99,6 +99,24 @@ void insert_half_rgba(Imf::FrameBuffer& fb, const uint16_t* pixels, int width) {
   fb.insert("A", Imf::Slice(Imf::HALF, base + 3 * sizeof(uint16_t), xs, ys));
 }
 
+// The header channels R, G, B, A (half) and, with `depth`, Z (float), with their pixels for the ZIP
+// writer: interleaved half RGBA and a plane of floats, row 0 = EXR's top scanline.
+ExrZipPart zip_rgba_part(Imf::Header header, const uint16_t* pixels, const float* depth, int width) {
+  ExrZipPart part{std::move(header), {}};
+  const char* base = reinterpret_cast<const char*>(pixels);
+  const size_t xs = 4 * sizeof(uint16_t), ys = xs * size_t(width);
+  const char* const names[4] = {"R", "G", "B", "A"};
+  for (int k = 0; k < 4; ++k) {
+    part.header.channels().insert(names[k], Imf::Channel(Imf::HALF));
+    part.channels.push_back({names[k], base + k * sizeof(uint16_t), xs, ys});
+  }
+  if (depth) {
+    part.header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+    part.channels.push_back({"Z", reinterpret_cast<const char*>(depth), sizeof(float), sizeof(float) * size_t(width)});
+  }
+  return part;
+}
+
 void check_read_size(const std::string& path, const Imath::Box2i& dw, int& width, int& height) {
   const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
   if (w < 1 || h < 1 || w > (1 << 20) || h > (1 << 20) || w * h > (int64_t(1) << 32))
@@ -152,24 +170,16 @@ void write_rgba_exr(const std::string& path, int width, int height, const uint16
     set_compression(header, c, path);
     if (meta) add_exr_metadata(header, *meta, image, meta->center_view);
     if (c == ExrCompression::Zip || c == ExrCompression::ZipFast) {  // our own chunk writer (exr_zip.h)
-      for (const char* ch : {"R", "G", "B", "A"}) header.channels().insert(ch, Imf::Channel(Imf::HALF));
-      const char* base = reinterpret_cast<const char*>(rgba_half);
-      const size_t xs = 4 * sizeof(uint16_t), ys = xs * size_t(width);
-      std::vector<ExrZipChannel> channels = {
-          {"R", base, xs, ys}, {"G", base + 2, xs, ys}, {"B", base + 4, xs, ys}, {"A", base + 6, xs, ys}};
-      if (depth) {
-        header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
-        channels.push_back({"Z", reinterpret_cast<const char*>(depth), sizeof(float), sizeof(float) * size_t(width)});
-      }
+      ExrZipPart part = zip_rgba_part(header, rgba_half, depth, width);
       if (subpixel_alpha) {
         const char* sa = reinterpret_cast<const char*>(subpixel_alpha);
         const size_t sx = 3 * sizeof(uint16_t), sy = sx * size_t(width);
         for (int k = 0; k < 3; ++k) {
-          header.channels().insert(kSubpixelAlpha[k], Imf::Channel(Imf::HALF));
-          channels.push_back({kSubpixelAlpha[k], sa + 2 * k, sx, sy});
+          part.header.channels().insert(kSubpixelAlpha[k], Imf::Channel(Imf::HALF));
+          part.channels.push_back({kSubpixelAlpha[k], sa + 2 * k, sx, sy});
         }
       }
-      write_zip_exr(file.temp_path(), path, header, channels, zip_level(c), threads);
+      write_zip_exr(file.temp_path(), path, {part}, zip_level(c), threads);
       return;
     }
     if (depth || subpixel_alpha) {  // half RGBA plus Z or AR, AG, AB: the general interface
@@ -213,6 +223,7 @@ void write_views_exr(const std::string& path, int width, int height, int views, 
   AtomicFile file(path);
   guarded("cannot write", path, file.temp_path(), [&] {
     set_threads(threads);
+    const size_t plane = size_t(width) * size_t(height);
     std::vector<Imf::Header> headers;
     headers.reserve(size_t(views));
     for (int i = 0; i < views; ++i) {
@@ -220,13 +231,23 @@ void write_views_exr(const std::string& path, int width, int height, int views, 
       set_compression(h, c, path);
       h.setName(view_part_name(i, views));
       h.setType(Imf::SCANLINEIMAGE);
-      for (const char* ch : {"R", "G", "B", "A"}) h.channels().insert(ch, Imf::Channel(Imf::HALF));
-      if (depth) h.channels().insert("Z", Imf::Channel(Imf::FLOAT));
       if (meta) add_exr_metadata(h, *meta, ExrImage::Views, i);
       headers.push_back(std::move(h));
     }
+    if (c == ExrCompression::Zip || c == ExrCompression::ZipFast) {  // our own chunk writer (exr_zip.h)
+      std::vector<ExrZipPart> parts;
+      parts.reserve(size_t(views));
+      for (int i = 0; i < views; ++i)
+        parts.push_back(zip_rgba_part(std::move(headers[size_t(i)]), volume + size_t(i) * plane * 4,
+                                      depth ? depth + size_t(i) * plane : nullptr, width));
+      write_zip_exr(file.temp_path(), path, parts, zip_level(c), threads);
+      return;
+    }
+    for (Imf::Header& h : headers) {
+      for (const char* ch : {"R", "G", "B", "A"}) h.channels().insert(ch, Imf::Channel(Imf::HALF));
+      if (depth) h.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+    }
     Imf::MultiPartOutputFile out(file.temp_path().c_str(), headers.data(), views);
-    const size_t plane = size_t(width) * size_t(height);
     for (int i = 0; i < views; ++i) {
       Imf::OutputPart part(out, i);
       Imf::FrameBuffer fb;

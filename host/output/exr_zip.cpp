@@ -1,9 +1,11 @@
 // The ZIP-compressed scanline EXR writer (exr_zip.h). Layout of a single-part scanline file: magic and
-// version, the header's attributes (Imf::Header::writeTo), the offset table (one 64-bit file offset
-// per chunk), then per chunk its first y (int32), its data size (int32) and its data: for each of its
-// scanlines, each channel in name order, the scanline's values (little-endian). ZIP data is that
-// block preconditioned (exr_zip_precondition) and zlib-compressed; a chunk that does not shrink is
-// stored as it is, which readers recognise by its size.
+// version, the header's attributes (Imf::Header::writeTo, ending in an empty name), the offset table
+// (one 64-bit file offset per chunk), then per chunk its first y (int32), its data size (int32) and its
+// data: for each of its scanlines, each channel in name order, the scanline's values (little-endian).
+// A multi-part file (version flag MULTI_PART_FILE_FLAG) has every part's header, then one more empty
+// name, then every part's offset table in turn, and each chunk starts with its part number (int32).
+// ZIP data is the chunk's block preconditioned (precondition_chunk) and zlib-compressed; a chunk that
+// does not shrink is stored as it is, which readers recognise by its size.
 #include "output/exr_zip.h"
 
 #include <ImfChannelList.h>
@@ -14,6 +16,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -46,39 +49,104 @@ void put32(std::vector<unsigned char>& out, uint32_t v) {
   for (int k = 0; k < 4; ++k) out.push_back(static_cast<unsigned char>(v >> (8 * k)));
 }
 
+// How the preconditioner walks a scanline. A run of half channels interleaved in one pixel array (the
+// readback's R G B A, the encoder's AR AG AB) is split in one pass over the row; any other channel
+// alone. `dest` is each component's offset within the scanline's share of the even (or odd) bytes.
+struct SplitRun {
+  const char* base;  // component 0's first value
+  size_t x_stride, y_stride, bytes;  // bytes: 2 (half) or 4 (float, always alone)
+  int count = 1;                     // components: 1, or 3 or 4 interleaved halves (x_stride 2 * count)
+  size_t dest[4] = {};
+};
+
+// One pass of a row of 4 (or 3) interleaved halves into each one's low (e) and high (o) bytes. Fixed
+// counts and restrict pointers let the compiler vectorize the byte deinterleave.
+void split4(const unsigned char* __restrict p, int width, unsigned char* __restrict e0, unsigned char* __restrict e1,
+            unsigned char* __restrict e2, unsigned char* __restrict e3, unsigned char* __restrict o0,
+            unsigned char* __restrict o1, unsigned char* __restrict o2, unsigned char* __restrict o3) {
+  for (int x = 0; x < width; ++x, p += 8) {
+    e0[x] = p[0], o0[x] = p[1], e1[x] = p[2], o1[x] = p[3];
+    e2[x] = p[4], o2[x] = p[5], e3[x] = p[6], o3[x] = p[7];
+  }
+}
+
+void split3(const unsigned char* __restrict p, int width, unsigned char* __restrict e0, unsigned char* __restrict e1,
+            unsigned char* __restrict e2, unsigned char* __restrict o0, unsigned char* __restrict o1,
+            unsigned char* __restrict o2) {
+  for (int x = 0; x < width; ++x, p += 6) e0[x] = p[0], o0[x] = p[1], e1[x] = p[2], o1[x] = p[3], e2[x] = p[4], o2[x] = p[5];
+}
+
+// The runs of a part's channels (given in the header's name order) for a scanline of `width` values.
+std::vector<SplitRun> split_runs(const std::vector<ChunkChannel>& channels, int width) {
+  std::vector<size_t> dest(channels.size());
+  size_t at = 0;
+  for (size_t i = 0; i < channels.size(); ++i) dest[i] = at, at += size_t(width) * channels[i].bytes / 2;
+  std::vector<bool> taken(channels.size(), false);
+  std::vector<SplitRun> runs;
+  for (size_t i = 0; i < channels.size(); ++i) {
+    if (taken[i]) continue;
+    const ChunkChannel& c = channels[i];
+    SplitRun run{c.base, c.x_stride, c.y_stride, c.bytes};
+    run.dest[0] = dest[i];
+    taken[i] = true;
+    const int k = int(c.x_stride / 2);
+    if (c.bytes == 2 && (c.x_stride == 6 || c.x_stride == 8)) {
+      // the run's other components: halves at base + 2, + 4, ... with the same strides
+      std::vector<size_t> parts(size_t(k), channels.size());
+      for (size_t j = 0; j < channels.size(); ++j) {
+        const ChunkChannel& d = channels[j];
+        if (j == i || taken[j] || d.bytes != 2 || d.x_stride != c.x_stride || d.y_stride != c.y_stride) continue;
+        const ptrdiff_t off = d.base - c.base;
+        if (off > 0 && off < ptrdiff_t(c.x_stride) && off % 2 == 0) parts[size_t(off / 2)] = j;
+      }
+      parts[0] = i;
+      if (std::all_of(parts.begin(), parts.end(), [&](size_t j) { return j < channels.size(); })) {
+        run.count = k;
+        for (int m = 0; m < k; ++m) run.dest[m] = dest[parts[size_t(m)]], taken[parts[size_t(m)]] = true;
+      }
+    }
+    runs.push_back(run);
+  }
+  return runs;
+}
+
 // EXR's ZIP preconditioning (OpenEXR's ImfZip.cpp, which every reader inverts) of the raw bytes of the
 // scanlines [y0, y1), in two passes straight from the pixels: first the bytes at even raw offsets then
 // those at odd ones (split), then each byte as its difference from the previous one + 128 (out). Every
 // channel's scanline has an even number of bytes, so the parity of a value's bytes is their parity
 // within the value: a half's low byte is even, a float's bytes 0 and 2 are. Little-endian host.
-size_t precondition_chunk(const std::vector<ChunkChannel>& channels, int width, int y0, int y1, unsigned char* split,
-                          unsigned char* out) {
-  size_t n = 0;
-  for (const ChunkChannel& c : channels) n += size_t(width) * c.bytes;
-  n *= size_t(y1 - y0);
-  unsigned char* even = split;
-  unsigned char* odd = split + n / 2;
-  for (int y = y0; y < y1; ++y)
-    for (const ChunkChannel& c : channels) {
-      const char* row = c.base + size_t(y) * c.y_stride;
-      if (c.bytes == 2) {
+size_t precondition_chunk(const std::vector<SplitRun>& runs, size_t line_bytes, int width, int y0, int y1,
+                          unsigned char* split, unsigned char* out) {
+  const size_t n = line_bytes * size_t(y1 - y0), half_line = line_bytes / 2;
+  for (int y = y0; y < y1; ++y) {
+    unsigned char* even = split + size_t(y - y0) * half_line;
+    unsigned char* odd = even + n / 2;
+    for (const SplitRun& r : runs) {
+      const unsigned char* row = reinterpret_cast<const unsigned char*>(r.base) + size_t(y) * r.y_stride;
+      const size_t* d = r.dest;
+      if (r.count == 4) {
+        split4(row, width, even + d[0], even + d[1], even + d[2], even + d[3], odd + d[0], odd + d[1], odd + d[2], odd + d[3]);
+      } else if (r.count == 3) {
+        split3(row, width, even + d[0], even + d[1], even + d[2], odd + d[0], odd + d[1], odd + d[2]);
+      } else if (r.bytes == 2) {
         for (int x = 0; x < width; ++x) {
           uint16_t v;
-          std::memcpy(&v, row + size_t(x) * c.x_stride, 2);
-          even[x] = static_cast<unsigned char>(v);
-          odd[x] = static_cast<unsigned char>(v >> 8);
+          std::memcpy(&v, row + size_t(x) * r.x_stride, 2);
+          even[d[0] + size_t(x)] = static_cast<unsigned char>(v);
+          odd[d[0] + size_t(x)] = static_cast<unsigned char>(v >> 8);
         }
-        even += width, odd += width;
       } else {
         for (int x = 0; x < width; ++x) {
           uint32_t v;
-          std::memcpy(&v, row + size_t(x) * c.x_stride, 4);
-          even[2 * x] = static_cast<unsigned char>(v), even[2 * x + 1] = static_cast<unsigned char>(v >> 16);
-          odd[2 * x] = static_cast<unsigned char>(v >> 8), odd[2 * x + 1] = static_cast<unsigned char>(v >> 24);
+          std::memcpy(&v, row + size_t(x) * r.x_stride, 4);
+          unsigned char* e = even + d[0] + 2 * size_t(x);
+          unsigned char* o = odd + d[0] + 2 * size_t(x);
+          e[0] = static_cast<unsigned char>(v), e[1] = static_cast<unsigned char>(v >> 16);
+          o[0] = static_cast<unsigned char>(v >> 8), o[1] = static_cast<unsigned char>(v >> 24);
         }
-        even += 2 * size_t(width), odd += 2 * size_t(width);
       }
     }
+  }
   out[0] = split[0];
   for (size_t i = 1; i < n; ++i) out[i] = static_cast<unsigned char>(split[i] - split[i - 1] + 128u);
   return n;
@@ -130,8 +198,44 @@ void give_back(std::unique_ptr<Scratch> s) {
 
 double exr_zip_helper_cpu_seconds() { return 1e-9 * double(helper_cpu_ns.load()); }
 
-void write_zip_exr(const std::string& path, const std::string& shown_path, const Imf::Header& header,
-                   const std::vector<ExrZipChannel>& channels, int level, int threads) {
+namespace {
+
+// A part as the compressing threads see it: the channels in the header's (name) order.
+struct PartLayout {
+  std::vector<ChunkChannel> order;
+  std::vector<SplitRun> runs;
+  int width = 0, height = 0, min_y = 0, chunks = 0;
+  size_t line_bytes = 0;
+};
+
+PartLayout layout_of(const ExrZipPart& part, const std::string& shown_path) {
+  const Imf::Header& header = part.header;
+  if (header.compression() != Imf::ZIP_COMPRESSION)
+    throw Error("cannot write " + shown_path + ": internal error: write_zip_exr needs a ZIP header");
+  const Imath::Box2i dw = header.dataWindow();
+  PartLayout L;
+  L.width = dw.max.x - dw.min.x + 1, L.height = dw.max.y - dw.min.y + 1, L.min_y = dw.min.y;
+  L.chunks = (L.height + kLinesPerChunk - 1) / kLinesPerChunk;
+  for (auto c = header.channels().begin(); c != header.channels().end(); ++c) {
+    const auto given = std::find_if(part.channels.begin(), part.channels.end(),
+                                    [&](const ExrZipChannel& g) { return g.name == c.name(); });
+    if (given == part.channels.end() || (c.channel().type != Imf::HALF && c.channel().type != Imf::FLOAT) ||
+        c.channel().xSampling != 1 || c.channel().ySampling != 1)
+      throw Error("cannot write " + shown_path + ": internal error: no pixels for channel " + c.name());
+    const size_t bytes = c.channel().type == Imf::HALF ? 2 : 4;
+    L.order.push_back({given->base, given->x_stride, given->y_stride, bytes});
+    L.line_bytes += size_t(L.width) * bytes;
+  }
+  if (L.order.size() != part.channels.size())
+    throw Error("cannot write " + shown_path + ": internal error: pixels for a channel the header lacks");
+  L.runs = split_runs(L.order, L.width);
+  return L;
+}
+
+}  // namespace
+
+void write_zip_exr(const std::string& path, const std::string& shown_path, const std::vector<ExrZipPart>& parts,
+                   int level, int threads) {
   static_assert(sizeof(float) == 4, "EXR floats are 4 bytes");
   {
     const uint16_t probe = 1;
@@ -139,53 +243,53 @@ void write_zip_exr(const std::string& path, const std::string& shown_path, const
     std::memcpy(&first, &probe, 1);
     if (first != 1) throw Error("cannot write " + shown_path + ": the ZIP EXR writer needs a little-endian host");
   }
-  if (header.compression() != Imf::ZIP_COMPRESSION)
-    throw Error("cannot write " + shown_path + ": internal error: write_zip_exr needs a ZIP header");
-  header.sanityCheck();
-  const Imath::Box2i dw = header.dataWindow();
-  const int width = dw.max.x - dw.min.x + 1, height = dw.max.y - dw.min.y + 1;
-
-  // the channels in the header's (name) order, each matched to its pixels
-  std::vector<ChunkChannel> order;
-  size_t line_bytes = 0;
-  for (auto c = header.channels().begin(); c != header.channels().end(); ++c) {
-    const auto given = std::find_if(channels.begin(), channels.end(),
-                                    [&](const ExrZipChannel& g) { return g.name == c.name(); });
-    if (given == channels.end() || (c.channel().type != Imf::HALF && c.channel().type != Imf::FLOAT) ||
-        c.channel().xSampling != 1 || c.channel().ySampling != 1)
-      throw Error("cannot write " + shown_path + ": internal error: no pixels for channel " + c.name());
-    const size_t bytes = c.channel().type == Imf::HALF ? 2 : 4;
-    order.push_back({given->base, given->x_stride, given->y_stride, bytes});
-    line_bytes += size_t(width) * bytes;
+  if (parts.empty()) throw Error("cannot write " + shown_path + ": internal error: an EXR file without parts");
+  const bool multi = parts.size() > 1;
+  std::vector<Imf::Header> headers;
+  std::vector<PartLayout> layouts;
+  size_t max_raw = 0;
+  bool long_names = false;
+  for (const ExrZipPart& part : parts) {
+    layouts.push_back(layout_of(part, shown_path));
+    headers.push_back(part.header);
+    if (multi) headers.back().setChunkCount(layouts.back().chunks);  // required in a multi-part file
+    headers.back().sanityCheck(false, multi);
+    long_names = long_names || uses_long_names(part.header);
+    max_raw = std::max(max_raw, layouts.back().line_bytes * kLinesPerChunk);
   }
-  if (order.size() != channels.size())
-    throw Error("cannot write " + shown_path + ": internal error: pixels for a channel the header lacks");
 
-  // compress the chunks, each thread taking the next one
-  const int chunks = (height + kLinesPerChunk - 1) / kLinesPerChunk;
-  std::vector<std::vector<unsigned char>> data(static_cast<size_t>(chunks));
-  std::atomic<int> next{0};
+  // compress the chunks of every part, each thread taking the next one
+  struct Job {
+    int part, chunk;
+  };
+  std::vector<Job> jobs;
+  for (size_t p = 0; p < parts.size(); ++p)
+    for (int c = 0; c < layouts[p].chunks; ++c) jobs.push_back({int(p), c});
+  std::vector<std::vector<unsigned char>> data(jobs.size());
+  std::atomic<size_t> next{0};
   std::atomic<bool> failed{false};
   auto work = [&] {
     std::unique_ptr<Scratch> scratch = take_scratch();
     Scratch& S = *scratch;
     if (!S.z || S.level != level) S.z.reset(libdeflate_alloc_compressor(level)), S.level = level;
-    const size_t max_raw = line_bytes * kLinesPerChunk;
     if (S.z && S.split.size() < max_raw) {
       S.split.resize(max_raw), S.pre.resize(max_raw);
       S.packed.resize(libdeflate_zlib_compress_bound(S.z.get(), max_raw));
     }
     if (!S.z) failed = true;
-    for (int c; !failed && (c = next++) < chunks;) {
-      const int y0 = c * kLinesPerChunk, y1 = std::min(height, y0 + kLinesPerChunk);
-      const size_t n = precondition_chunk(order, width, y0, y1, S.split.data(), S.pre.data());
+    for (size_t j; !failed && (j = next++) < jobs.size();) {
+      const PartLayout& L = layouts[size_t(jobs[j].part)];
+      const int y0 = jobs[j].chunk * kLinesPerChunk, y1 = std::min(L.height, y0 + kLinesPerChunk);
+      const size_t n = precondition_chunk(L.runs, L.line_bytes, L.width, y0, y1, S.split.data(), S.pre.data());
       const size_t size = libdeflate_zlib_compress(S.z.get(), S.pre.data(), n, S.packed.data(), S.packed.size());
-      std::vector<unsigned char>& out = data[size_t(c)];
-      out.reserve(8 + (size == 0 || size >= n ? n : size));
-      put32(out, uint32_t(dw.min.y + y0));
-      if (size == 0 || size >= n) {  // stored: the scanlines' raw bytes (0: did not fit the bound, cannot happen)
+      const bool stored = size == 0 || size >= n;  // the scanlines' raw bytes (0: did not fit the bound, cannot happen)
+      std::vector<unsigned char>& out = data[j];
+      out.reserve(12 + (stored ? n : size));
+      if (multi) put32(out, uint32_t(jobs[j].part));
+      put32(out, uint32_t(L.min_y + y0));
+      if (stored) {
         put32(out, uint32_t(n));
-        raw_chunk(order, width, y0, y1, S.split.data());
+        raw_chunk(L.order, L.width, y0, y1, S.split.data());
         out.insert(out.end(), S.split.data(), S.split.data() + n);
       } else {
         put32(out, uint32_t(size));
@@ -195,7 +299,7 @@ void write_zip_exr(const std::string& path, const std::string& shown_path, const
     give_back(std::move(scratch));
   };
   if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-  threads = std::max(1, std::min(threads, chunks));
+  threads = int(std::max<size_t>(1, std::min(size_t(threads), jobs.size())));
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t)
     pool.emplace_back([&] {
@@ -206,19 +310,21 @@ void write_zip_exr(const std::string& path, const std::string& shown_path, const
   for (std::thread& t : pool) t.join();
   if (failed) throw Error("cannot write " + shown_path + ": out of memory for the ZIP compressor");
 
-  // magic, version, header, offset table, chunks
+  // magic, version, headers, offset tables, chunks (in job order: part by part)
   std::ofstream file(path, std::ios::binary | std::ios::trunc);
   if (!file) throw Error("cannot write " + shown_path + ": " + std::strerror(errno));
   {
     Imf::StdOFStream os(file, path.c_str());
     std::vector<unsigned char> head;
     put32(head, uint32_t(Imf::MAGIC));
-    put32(head, uint32_t(Imf::EXR_VERSION | (uses_long_names(header) ? Imf::LONG_NAMES_FLAG : 0)));
+    put32(head, uint32_t(Imf::EXR_VERSION | (multi ? Imf::MULTI_PART_FILE_FLAG : 0) |
+                         (long_names ? Imf::LONG_NAMES_FLAG : 0)));
     os.write(reinterpret_cast<const char*>(head.data()), int(head.size()));
-    header.writeTo(os);
-    uint64_t at = os.tellp() + uint64_t(chunks) * 8u;
+    for (const Imf::Header& h : headers) h.writeTo(os);
+    if (multi) os.write("", 1);  // the empty header that ends the list
+    uint64_t at = os.tellp() + uint64_t(jobs.size()) * 8u;
     std::vector<unsigned char> table;
-    table.reserve(size_t(chunks) * 8u);
+    table.reserve(jobs.size() * 8u);
     for (const std::vector<unsigned char>& d : data) {
       for (int k = 0; k < 8; ++k) table.push_back(static_cast<unsigned char>(at >> (8 * k)));
       at += d.size();

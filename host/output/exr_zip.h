@@ -1,6 +1,7 @@
-// The ZIP-compressed scanline EXR writer: the header from OpenEXR (Imf::Header::writeTo), the chunks
+// The ZIP-compressed scanline EXR writer: the headers from OpenEXR (Imf::Header::writeTo), the chunks
 // compressed here with libdeflate, in parallel, straight from the caller's pixels. The file is a
-// standard single-part ZIP_COMPRESSION EXR (16 scanlines per chunk) that every reader opens.
+// standard ZIP_COMPRESSION scanline EXR (16 scanlines per chunk), single-part or multi-part, that every
+// reader opens.
 #pragma once
 
 #include <ImfHeader.h>
@@ -19,11 +20,18 @@ struct ExrZipChannel {
   size_t x_stride, y_stride;
 };
 
-// Writes `header` (whose compression must be ZIP_COMPRESSION; its channels are the ones given, in any
-// order) and the pixels to the file `path`, compressing at zlib-style `level` (1-12; OpenEXR's default
-// is 4) on `threads` threads (0: the hardware's). Throws pmr::Error naming `shown_path`.
-void write_zip_exr(const std::string& path, const std::string& shown_path, const Imf::Header& header,
-                   const std::vector<ExrZipChannel>& channels, int level, int threads);
+// One part of the file: its header (compression ZIP_COMPRESSION; in a file of several parts, with a
+// unique name and the type scanlineimage) and the pixels of each of its channels, in any order.
+struct ExrZipPart {
+  Imf::Header header;
+  std::vector<ExrZipChannel> channels;
+};
+
+// Writes the parts (one: a single-part file; more: a multi-part file, each header given its chunkCount)
+// to the file `path`, compressing at zlib-style `level` (1-12; OpenEXR's default is 4) on `threads`
+// threads (0: the hardware's). Throws pmr::Error naming `shown_path`.
+void write_zip_exr(const std::string& path, const std::string& shown_path, const std::vector<ExrZipPart>& parts,
+                   int level, int threads);
 
 // The CPU time (seconds, summed since the process started) of the threads write_zip_exr starts besides
 // the calling one, whose own time the caller can measure.

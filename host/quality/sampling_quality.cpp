@@ -1,5 +1,6 @@
 #include "quality/sampling_quality.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <Imath/half.h>
@@ -12,7 +13,7 @@ namespace pmr {
 
 ImageDifference compare_display_images(const std::vector<uint16_t>& a, const std::vector<uint16_t>& b) {
   if (a.size() != b.size() || a.empty()) throw Error("internal error: comparing display images of different sizes");
-  double sum = 0.0;
+  double sum = 0.0, sum_shown = 0.0;
   size_t differing = 0, n = 0;
   for (size_t i = 0; i < a.size(); ++i) {
     if (i % 4 == 3) continue;  // alpha
@@ -21,11 +22,14 @@ ImageDifference compare_display_images(const std::vector<uint16_t>& a, const std
     hb.setBits(b[i]);
     const double d = double(float(ha)) - double(float(hb));
     sum += d * d;
+    const double shown = std::clamp(double(float(ha)), 0.0, 1.0) - std::clamp(double(float(hb)), 0.0, 1.0);
+    sum_shown += shown * shown;  // NaN clamps to NaN: a NaN stays visible
     differing += std::abs(d) > kDifferingThreshold;
     ++n;
   }
   ImageDifference r;
   r.rmse = std::sqrt(sum / double(n));
+  r.rmse_shown = std::sqrt(sum_shown / double(n));
   r.differing = double(differing) / double(n);
   return r;
 }

@@ -17,7 +17,9 @@ namespace pmr {
 // Differences between two encoded display images (half RGBA) over every subpixel's colour channel
 // (channel k of display pixel j is subpixel 3j + k; alpha is not compared), in linear units.
 struct ImageDifference {
-  double rmse = 0.0;       // root mean square difference
+  double rmse = 0.0;        // root mean square difference of the linear values
+  double rmse_shown = 0.0;  // the same with every value clamped to [0, 1], as a panel shows it: one
+                            // highlight of 10^4 (or an infinite half) cannot decide the comparison
   double differing = 0.0;  // fraction of subpixels differing by more than kDifferingThreshold
 };
 constexpr double kDifferingThreshold = 1.0 / 256.0;

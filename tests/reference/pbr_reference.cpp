@@ -55,9 +55,12 @@ glm::dvec3 light_irradiance(const PunctualLight& light, const glm::dvec3& p, glm
   return light.color_intensity * w;
 }
 
+// the largest finite half: brighter colours saturate there (cl/shade.h)
+constexpr double kHalfMax = 65504.0;
+
 glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& lights, const EnvironmentTerms& env,
                      double exposure) {
-  if (s.unlit) return exposure * s.base;
+  if (s.unlit) return glm::min(exposure * s.base, glm::dvec3(kHalfMax));
   const double r = std::min(1.0, std::max(0.03, s.roughness));
   const glm::dvec3 v = glm::normalize(s.eye - s.p);
   glm::dvec3 sum(0.0);
@@ -70,7 +73,7 @@ glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& li
   const glm::dvec2 ab = env.split_sum(clamp01(glm::dot(s.n, v)), r);
   const glm::dvec3 reflected = glm::reflect(-v, s.n);
   sum += s.ao * (c_diff * env.irradiance(s.n) + (f0 * ab.x + ab.y) * env.prefiltered(reflected, r));
-  return exposure * (sum + s.emissive);
+  return glm::min(exposure * (sum + s.emissive), glm::dvec3(kHalfMax));  // saturates like the kernels' halves
 }
 
 }  // namespace pmr::ref

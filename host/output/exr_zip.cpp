@@ -15,6 +15,7 @@
 #include <time.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -91,16 +92,24 @@ std::vector<SplitRun> split_runs(const std::vector<ChunkChannel>& channels, int 
     taken[i] = true;
     const int k = int(c.x_stride / 2);
     if (c.bytes == 2 && (c.x_stride == 6 || c.x_stride == 8)) {
-      // the run's other components: halves at base + 2, + 4, ... with the same strides
-      std::vector<size_t> parts(size_t(k), channels.size());
-      for (size_t j = 0; j < channels.size(); ++j) {
+      // the run's components: halves at origin, origin + 2, ... with the same strides, where origin is
+      // the lowest address among them (channels come in name order: A before R)
+      auto interleaved_with = [&](size_t j) {
         const ChunkChannel& d = channels[j];
-        if (j == i || taken[j] || d.bytes != 2 || d.x_stride != c.x_stride || d.y_stride != c.y_stride) continue;
-        const ptrdiff_t off = d.base - c.base;
-        if (off > 0 && off < ptrdiff_t(c.x_stride) && off % 2 == 0) parts[size_t(off / 2)] = j;
+        return !taken[j] && d.bytes == 2 && d.x_stride == c.x_stride && d.y_stride == c.y_stride &&
+               std::abs(d.base - c.base) < ptrdiff_t(c.x_stride) && (d.base - c.base) % 2 == 0;
+      };
+      const char* origin = c.base;
+      for (size_t j = 0; j < channels.size(); ++j)
+        if (interleaved_with(j)) origin = std::min(origin, channels[j].base);
+      std::vector<size_t> parts(size_t(k), channels.size());
+      parts[size_t((c.base - origin) / 2)] = i;
+      for (size_t j = 0; j < channels.size(); ++j) {
+        const ptrdiff_t off = channels[j].base - origin;
+        if (interleaved_with(j) && off < ptrdiff_t(c.x_stride)) parts[size_t(off / 2)] = j;
       }
-      parts[0] = i;
       if (std::all_of(parts.begin(), parts.end(), [&](size_t j) { return j < channels.size(); })) {
+        run.base = origin;
         run.count = k;
         for (int m = 0; m < k; ++m) run.dest[m] = dest[parts[size_t(m)]], taken[parts[size_t(m)]] = true;
       }

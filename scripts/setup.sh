@@ -11,7 +11,7 @@ PACKAGES=(
   g++ cmake make pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
-  libopenexr-dev openexr libpng-dev libxxhash-dev libdeflate-dev
+  libopenexr-dev openexr libpng-dev libxxhash-dev libdeflate-dev libisal-dev
   libgtest-dev
   python3 python3-matplotlib
 )

@@ -181,6 +181,9 @@ TEST(Displays, EveryPresetShowsEveryView) {
     for (int i = 0; i < p.rig.views; ++i) EXPECT_TRUE(seen[size_t(i)]) << "view " << i << " never shown";
     // and a rig can be built for it (guard band, cone)
     EXPECT_NO_THROW(make_rig(p.rig, p.display, glm::dvec3(-1), glm::dvec3(1)));
+    // the default sampling docs/SAMPLING.md chose from measurements ("Which default")
+    const bool chosen_subpixel = p.name == "lg-portrait" || p.name == "lg-go" || p.name == "lg-16" || p.name == "lg-16-portrait";
+    EXPECT_EQ(p.subpixel_sampling, chosen_subpixel);
   }
   EXPECT_THROW(find_display_preset("lg-99"), Error);
 }

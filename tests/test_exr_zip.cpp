@@ -218,7 +218,7 @@ TEST(ExrZip, PassesOpenExrsFileCheck) {
   std::filesystem::remove_all(dir);
 }
 
-// At the default level the files are no more than 5% larger than OpenEXR's ZIP (zlib level 4).
+// With zip the files are no more than 5% larger than OpenEXR's ZIP (zlib level 4).
 TEST(ExrZip, NoLargerThanOpenExrsZip) {
   const std::string dir = test::temp_dir("exr_zip_size");
   std::filesystem::create_directories(dir);
@@ -230,6 +230,13 @@ TEST(ExrZip, NoLargerThanOpenExrsZip) {
   const auto a = std::filesystem::file_size(ours), b = std::filesystem::file_size(theirs);
   std::printf("[ exr zip  ] ours %zu bytes, OpenEXR's %zu bytes\n", size_t(a), size_t(b));
   EXPECT_LE(double(a), 1.05 * double(b));
+  // zip-fast (ISA-L) trades size for time: about 12% larger on rendered frames, bounded here at 25%
+  const std::string fast = dir + "/fast.exr";
+  write_rgba_exr(fast, w, h, px.data(), ExrCompression::ZipFast, 2);
+  const auto f = std::filesystem::file_size(fast);
+  std::printf("[ exr zip  ] zip-fast %zu bytes\n", size_t(f));
+  EXPECT_LE(double(f), 1.25 * double(b));
+  EXPECT_LT(double(f), 0.5 * double(px.size() * 2)) << "zip-fast should still compress";
   std::filesystem::remove_all(dir);
 }
 

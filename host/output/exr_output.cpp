@@ -61,19 +61,18 @@ Imf::Compression to_imf(ExrCompression c, const std::string& path) {
   throw Error("cannot write " + path + ": invalid EXR compression value " + std::to_string(int(c)));
 }
 
-// The header's compression; zip-fast is ZIP at deflate level 1 (OpenEXR's default level is 4): on an
-// encoded paper-8k image 0.92 s instead of 1.44 s with 2 threads, 21.2 MB instead of 18.4 MB
-// (docs/SEQUENCES.md). Readers need nothing new: the level is not stored in the file.
+// The header's compression. zip and zip-fast are both ZIP; they differ in the encoder our writer uses
+// (zip_encoder). Readers need nothing new: neither the encoder nor its level is stored in the file.
 void set_compression(Imf::Header& h, ExrCompression c, const std::string& path) {
   h.compression() = to_imf(c, path);
-  if (c == ExrCompression::ZipFast) h.zipCompressionLevel() = 1;
 }
 
-// The deflate level of our ZIP writer (libdeflate's scale, 1-12): see docs/SEQUENCES.md for sizes and times.
 // OpenEXR's per-channel alpha names for R, G, B
 const char* const kSubpixelAlpha[3] = {"AR", "AG", "AB"};
 
-int zip_level(ExrCompression c) { return c == ExrCompression::ZipFast ? 1 : 4; }
+// zip: libdeflate at OpenEXR's level; zip-fast: ISA-L, about 8x less CPU for 12% larger files
+// (docs/SEQUENCES.md, "The ZIP writer").
+ZipEncoder zip_encoder(ExrCompression c) { return c == ExrCompression::ZipFast ? ZipEncoder::Fast : ZipEncoder::Default; }
 
 void check_image(const std::string& path, int width, int height, int layers, const void* data) {
   if (width < 1 || height < 1 || layers < 1)
@@ -179,7 +178,7 @@ void write_rgba_exr(const std::string& path, int width, int height, const uint16
           part.channels.push_back({kSubpixelAlpha[k], sa + 2 * k, sx, sy});
         }
       }
-      write_zip_exr(file.temp_path(), path, {part}, zip_level(c), threads);
+      write_zip_exr(file.temp_path(), path, {part}, zip_encoder(c), threads);
       return;
     }
     if (depth || subpixel_alpha) {  // half RGBA plus Z or AR, AG, AB: the general interface
@@ -240,7 +239,7 @@ void write_views_exr(const std::string& path, int width, int height, int views, 
       for (int i = 0; i < views; ++i)
         parts.push_back(zip_rgba_part(std::move(headers[size_t(i)]), volume + size_t(i) * plane * 4,
                                       depth ? depth + size_t(i) * plane : nullptr, width));
-      write_zip_exr(file.temp_path(), path, parts, zip_level(c), threads);
+      write_zip_exr(file.temp_path(), path, parts, zip_encoder(c), threads);
       return;
     }
     for (Imf::Header& h : headers) {

@@ -4,13 +4,15 @@
 // data: for each of its scanlines, each channel in name order, the scanline's values (little-endian).
 // A multi-part file (version flag MULTI_PART_FILE_FLAG) has every part's header, then one more empty
 // name, then every part's offset table in turn, and each chunk starts with its part number (int32).
-// ZIP data is the chunk's block preconditioned (precondition_chunk) and zlib-compressed; a chunk that
-// does not shrink is stored as it is, which readers recognise by its size.
+// ZIP data is the chunk's block preconditioned (precondition_chunk) and zlib-compressed (libdeflate,
+// or ISA-L for zip-fast); a chunk that does not shrink is stored as it is, which readers recognise by
+// its size.
 #include "output/exr_zip.h"
 
 #include <ImfChannelList.h>
 #include <ImfStdIO.h>
 #include <ImfVersion.h>
+#include <isa-l/igzip_lib.h>
 #include <libdeflate.h>
 #include <time.h>
 
@@ -174,10 +176,36 @@ void raw_chunk(const std::vector<ChunkChannel>& channels, int width, int y0, int
 // A compressing thread's buffers, kept from file to file: fresh ones would cost a page fault every
 // 4 kB on every frame.
 struct Scratch {
-  int level = 0;
   std::unique_ptr<libdeflate_compressor, void (*)(libdeflate_compressor*)> z{nullptr, libdeflate_free_compressor};
+  std::vector<uint8_t> isal_level_buf;  // ISA-L's per-level work area
   std::vector<unsigned char> split, pre, packed;
 };
+
+constexpr int kDefaultLevel = 4;  // libdeflate: OpenEXR's own zlib level
+constexpr uint32_t kFastLevel = 2, kFastLevelBuf = ISAL_DEF_LVL2_DEFAULT;  // ISA-L igzip
+
+// Room for the compressed chunk of `n` raw bytes; a chunk that needs more is stored raw.
+size_t packed_bound(size_t n) { return n + n / 8 + 1024; }
+
+// Compresses n bytes of `in` into S.packed as a zlib stream; returns its size, or 0 when it does not fit
+// (the caller then stores the chunk raw).
+size_t compress_chunk(Scratch& S, ZipEncoder encoder, unsigned char* in, size_t n) {
+  if (encoder == ZipEncoder::Default)
+    return libdeflate_zlib_compress(S.z.get(), in, n, S.packed.data(), S.packed.size());
+  isal_zstream s;
+  isal_deflate_stateless_init(&s);
+  s.next_in = in;
+  s.avail_in = uint32_t(n);
+  s.next_out = S.packed.data();
+  s.avail_out = uint32_t(S.packed.size());
+  s.level = kFastLevel;
+  s.level_buf = S.isal_level_buf.data();
+  s.level_buf_size = uint32_t(S.isal_level_buf.size());
+  s.end_of_stream = 1;
+  s.flush = NO_FLUSH;
+  s.gzip_flag = IGZIP_ZLIB;
+  return isal_deflate_stateless(&s) == COMP_OK ? size_t(s.total_out) : 0;
+}
 
 std::atomic<uint64_t> helper_cpu_ns{0};
 
@@ -244,7 +272,7 @@ PartLayout layout_of(const ExrZipPart& part, const std::string& shown_path) {
 }  // namespace
 
 void write_zip_exr(const std::string& path, const std::string& shown_path, const std::vector<ExrZipPart>& parts,
-                   int level, int threads) {
+                   ZipEncoder encoder, int threads) {
   static_assert(sizeof(float) == 4, "EXR floats are 4 bytes");
   {
     const uint16_t probe = 1;
@@ -280,18 +308,18 @@ void write_zip_exr(const std::string& path, const std::string& shown_path, const
   auto work = [&] {
     std::unique_ptr<Scratch> scratch = take_scratch();
     Scratch& S = *scratch;
-    if (!S.z || S.level != level) S.z.reset(libdeflate_alloc_compressor(level)), S.level = level;
-    if (S.z && S.split.size() < max_raw) {
-      S.split.resize(max_raw), S.pre.resize(max_raw);
-      S.packed.resize(libdeflate_zlib_compress_bound(S.z.get(), max_raw));
+    if (encoder == ZipEncoder::Default && !S.z) {
+      S.z.reset(libdeflate_alloc_compressor(kDefaultLevel));
+      if (!S.z) failed = true;
     }
-    if (!S.z) failed = true;
+    if (encoder == ZipEncoder::Fast && S.isal_level_buf.size() < kFastLevelBuf) S.isal_level_buf.resize(kFastLevelBuf);
+    if (S.split.size() < max_raw) S.split.resize(max_raw), S.pre.resize(max_raw), S.packed.resize(packed_bound(max_raw));
     for (size_t j; !failed && (j = next++) < jobs.size();) {
       const PartLayout& L = layouts[size_t(jobs[j].part)];
       const int y0 = jobs[j].chunk * kLinesPerChunk, y1 = std::min(L.height, y0 + kLinesPerChunk);
       const size_t n = precondition_chunk(L.runs, L.line_bytes, L.width, y0, y1, S.split.data(), S.pre.data());
-      const size_t size = libdeflate_zlib_compress(S.z.get(), S.pre.data(), n, S.packed.data(), S.packed.size());
-      const bool stored = size == 0 || size >= n;  // the scanlines' raw bytes (0: did not fit the bound, cannot happen)
+      const size_t size = compress_chunk(S, encoder, S.pre.data(), n);
+      const bool stored = size == 0 || size >= n;  // the scanlines' raw bytes (0: did not fit)
       std::vector<unsigned char>& out = data[j];
       out.reserve(12 + (stored ? n : size));
       if (multi) put32(out, uint32_t(jobs[j].part));

@@ -35,7 +35,6 @@ std::vector<DisplayPreset> make_presets() {
   // name, description, screen, DPI, pitch, slope, center, view cone, views, tile, quilt
   all.push_back(looking_glass("lg-portrait", "Looking Glass Portrait (LKG-P): 1536x2048, 7.9\", 48 views of 420x560",
                               1536, 2048, 324, 52, -7, 0.5, 40, 48, 420, 560, "8x6"));
-  all.back().subpixel_sampling = true;  // half the error for about 1.4x the time (docs/SAMPLING.md)
   all.push_back(looking_glass("lg-go", "Looking Glass Go (LKG-E): 1440x2560, 6\", 66 views of 372x682", 1440, 2560, 491,
                               80.7, -6.3, -0.3, 54, 66, 372, 682, "11x6"));
   all.push_back(looking_glass("lg-16", "Looking Glass 16\" Spatial, landscape (LKG-J; typical calibration without its "
@@ -52,6 +51,11 @@ std::vector<DisplayPreset> make_presets() {
                               283, 50, -7, 0.5, 40, 45, 819, 455, "5x9"));
   all.push_back(looking_glass("lg-32-gen2", "Looking Glass 32\" Gen2 (LKG-B): 7680x4320, 45 views of 1638x910", 7680, 4320,
                               280, 42, -6, 0.3, 40, 45, 1638, 910, "5x9"));
+  // Subpixel sampling by default where it halves the error of view sampling for at most 1.5x its time,
+  // both with the preset's angular spacing (measured: docs/SAMPLING.md, "Which default"). The panels
+  // with more subpixels per view voxel (the 32" and Gen2 ones) cost 1.7-2.5x and keep view sampling.
+  for (DisplayPreset& p : all)
+    p.subpixel_sampling = p.name == "lg-portrait" || p.name == "lg-go" || p.name == "lg-16" || p.name == "lg-16-portrait";
   return all;
 }
 

@@ -15,7 +15,7 @@
 namespace pmr {
 
 enum class ExrCompression { None, Zip, ZipFast, Piz, Rle };
-// "none", "zip", "zip-fast" (ZIP at deflate level 1), "piz", "rle" (lower case, as the CLI documents); pmr::Error otherwise.
+// "none", "zip", "zip-fast" (ZIP through a faster encoder), "piz", "rle" (lower case, as the CLI documents); pmr::Error otherwise.
 ExrCompression parse_exr_compression(const std::string& name);
 // The inverse of parse_exr_compression.
 const char* to_string(ExrCompression c);

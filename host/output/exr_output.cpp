@@ -14,6 +14,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <new>
 
 #include "output/exr_metadata.h"
 #include "output/exr_zip.h"
@@ -285,6 +286,8 @@ bool exr_is_complete(const std::string& path) {
       part.readPixels(dw.min.y, dw.max.y);
     }
     return in.parts() > 0;
+  } catch (const std::bad_alloc&) {
+    throw;  // out of memory is not an incomplete file
   } catch (...) {
     return false;
   }

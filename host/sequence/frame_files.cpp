@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <new>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -93,6 +94,8 @@ bool decodes(const std::string& p) {
     std::vector<uint8_t> px;
     read_png_rgba8(p, w, h, px);
     return true;
+  } catch (const std::bad_alloc&) {
+    throw;  // out of memory is not a damaged file
   } catch (const std::exception&) {
     return false;
   }
@@ -109,6 +112,8 @@ std::string frame_problem(const std::string& sidecar, const std::vector<std::str
   json j;
   try {
     j = json::parse(read_sidecar_text(sidecar));
+  } catch (const std::bad_alloc&) {
+    throw;
   } catch (const std::exception&) {
     return name(sidecar) + " is truncated or unreadable";
   }
@@ -129,6 +134,8 @@ std::string frame_problem(const std::string& sidecar, const std::vector<std::str
       std::string sum;
       try {
         sum = checksum_file(p);
+      } catch (const std::bad_alloc&) {
+        throw;
       } catch (const std::exception&) {
         return name(p) + " cannot be read";
       }

@@ -102,7 +102,7 @@ void write_views_exr(const std::string& path, int width, int height, int views, 
                      const ExrMetadata* meta = nullptr);
 
 // True when the EXR file opens and every part has all its pixel data (a truncated file is not
-// complete). Never throws.
+// complete). Throws only std::bad_alloc: running out of memory says nothing about the file.
 bool exr_is_complete(const std::string& path);
 
 // The quick check of an EXR file, without decoding a pixel: every part's header reads, its chunk table

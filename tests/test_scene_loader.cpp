@@ -324,6 +324,37 @@ TEST_F(SceneLoaderTest, MaterialsTexturesSamplersAndTextureTransform) {
 
 // The container is recognised by its magic bytes: a GLB named .gltf and JSON named .glb both load.
 // The GLB also stores an image in a bufferView.
+// An empty IDAT chunk is legal PNG and carries no data; first among the IDATs it once made the image
+// decoder pass a null buffer to memcpy (found by the glTF fuzzer). The image decodes as without it.
+TEST_F(SceneLoaderTest, EmptyIdatChunksDecodeAsWithoutThem) {
+  const std::vector<uint8_t> rgba = {255, 0, 0, 255, 0, 0, 255, 128, 9, 8, 7, 6, 5, 4, 3, 2};
+  const std::vector<uint8_t> plain = make_png(2, 2, 6, 8, rgba);
+  // 8-byte signature, then IHDR (12 + 13 bytes): an empty IDAT right before the real one, one after it
+  const size_t first_idat = 8 + 12 + 13;
+  std::vector<uint8_t> body = {'I', 'D', 'A', 'T'};
+  std::vector<uint8_t> empty = {0, 0, 0, 0, 'I', 'D', 'A', 'T'};
+  put_be32(empty, crc32(body.data(), body.size()));
+  std::vector<uint8_t> with_empty(plain.begin(), plain.begin() + long(first_idat));
+  with_empty.insert(with_empty.end(), empty.begin(), empty.end());
+  with_empty.insert(with_empty.end(), plain.begin() + long(first_idat), plain.end() - 12);
+  with_empty.insert(with_empty.end(), empty.begin(), empty.end());
+  with_empty.insert(with_empty.end(), plain.end() - 12, plain.end());  // IEND
+  for (const auto& png : {plain, with_empty}) {
+    GltfFile g;
+    const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 1, 1, 0}, kFloat, "VEC3");
+    const int uv = g.data<float>({0, 0, 1, 0, 1, 1}, kFloat, "VEC2");
+    g.add("images", {{"uri", png_uri(png)}});
+    g.add("textures", {{"source", 0}});
+    g.add("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+    g.mesh({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"material", 0}}});
+    g.add("nodes", {{"mesh", 0}});
+    g.scene({0});
+    const Scene s = load_scene(g.write(dir_, png.size() == plain.size() ? "plain" : "empty_idat"));
+    ASSERT_EQ(s.textures.size(), 1u) << "the image was not decoded";
+    EXPECT_EQ(s.textures[0].rgba, rgba);
+  }
+}
+
 TEST_F(SceneLoaderTest, GlbDetectedByContentNotExtension) {
   GltfFile g = unit_triangle();
   const std::vector<uint8_t> png = make_png(1, 1, 6, 8, {1, 2, 3, 4});

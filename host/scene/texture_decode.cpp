@@ -9,6 +9,7 @@
 #include <climits>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "scene/gltf_internal.h"
 
@@ -17,6 +18,37 @@
 #include "input/stb_image_static.h"
 
 namespace pmr::gltf {
+
+namespace {
+
+uint32_t be32(const unsigned char* p) { return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]; }
+
+// A copy of the PNG without its empty IDAT chunks (up to the first chunk that runs past the end, after
+// which the bytes are kept as they are), or an empty vector when it has none. Empty IDAT chunks are
+// legal and carry no data, but Debian's stb_image passes a null buffer to memcpy for one that comes
+// first (undefined behaviour that an optimizing compiler may turn into a skipped null check; found by
+// the fuzzer).
+std::vector<unsigned char> without_empty_idat(const unsigned char* bytes, size_t size) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (size < 8 || std::memcmp(bytes, kSignature, 8) != 0) return {};
+  std::vector<unsigned char> out(bytes, bytes + 8);
+  bool removed = false;
+  size_t at = 8;
+  for (; at + 12 <= size; ) {
+    const uint64_t length = be32(bytes + at);
+    if (length > size - at - 12) break;  // a chunk past the end: the rest as it is
+    if (length == 0 && std::memcmp(bytes + at + 4, "IDAT", 4) == 0)
+      removed = true;
+    else
+      out.insert(out.end(), bytes + at, bytes + at + 12 + length);
+    at += 12 + size_t(length);
+  }
+  if (!removed) return {};
+  out.insert(out.end(), bytes + at, bytes + size);
+  return out;
+}
+
+}  // namespace
 
 std::string decode_image(tinygltf::Image& image, const unsigned char* bytes, int size, uint64_t max_pixels,
                          bool& over_limit) {
@@ -37,6 +69,8 @@ std::string decode_image(tinygltf::Image& image, const unsigned char* bytes, int
   if (decoded > uint64_t(INT_MAX))
     return size_text + " decodes to " + std::to_string(decoded) +
            " bytes, more than the image decoder can address (2 GiB)";
+  const std::vector<unsigned char> cleaned = without_empty_idat(bytes, size_t(size));
+  if (!cleaned.empty()) bytes = cleaned.data(), size = int(cleaned.size());
   int dw = 0, dh = 0, dc = 0;
   void* data = sixteen ? static_cast<void*>(stbi_load_16_from_memory(bytes, size, &dw, &dh, &dc, 4))
                        : static_cast<void*>(stbi_load_from_memory(bytes, size, &dw, &dh, &dc, 4));

@@ -422,16 +422,19 @@ int SequenceRun::render_frames() {
 void SequenceRun::print_summary(const FrameWriter& writer) const {
   if (job_.quiet) return;
   const double n = double(std::max(1L, rendered_));
-  // the process's CPU in the frame loop, less the writer's: the renderer's (its OpenCL threads included)
+  // the process's CPU in the frame loop, less the writer's: the renderer's (its OpenCL threads included).
+  // zip and zip-fast compress on threads the writer starts and counts; the other compressions on
+  // OpenEXR's own pool, which cannot be told apart from the renderer's threads.
   const double writer_cpu = writer.cpu_seconds();
+  const bool ours = job_.compression == ExrCompression::Zip || job_.compression == ExrCompression::ZipFast;
   std::fprintf(stderr,
                "pmr: %ld frame(s) in %.2f s (%.2f s/frame; %ld skipped): render %.0f ms/frame (+ pose %.1f, upload %.1f), write %.0f "
-               "ms/frame on the writer thread (%s, %.1f MB/frame); CPU per frame: renderer %.0f ms, writer %.0f ms; "
+               "ms/frame on the writer thread (%s, %.1f MB/frame); CPU per frame: renderer%s %.0f ms, writer %.0f ms; "
                "total %.2f s\n",
                rendered_, loop_s_, loop_s_ / n, plan_.kept, 1000.0 * render_s_ / n, 1000.0 * pose_s_ / n,
                1000.0 * upload_s_ / n, 1000.0 * writer.write_seconds() / n, to_string(job_.compression),
-               double(writer.bytes_written()) / n / 1e6, 1000.0 * std::max(0.0, loop_cpu_s_ - writer_cpu) / n,
-               1000.0 * writer_cpu / n, seconds_since(t0_));
+               double(writer.bytes_written()) / n / 1e6, ours ? "" : " and OpenEXR's compressing threads",
+               1000.0 * std::max(0.0, loop_cpu_s_ - writer_cpu) / n, 1000.0 * writer_cpu / n, seconds_since(t0_));
   if (rendered_ == 1) {
     const FramePaths p = paths(plan_.todo[0]);
     for (const std::string& path : p.images()) std::fprintf(stderr, "pmr: wrote %s\n", path.c_str());

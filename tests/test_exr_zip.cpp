@@ -230,7 +230,7 @@ TEST(ExrZip, NoLargerThanOpenExrsZip) {
   const auto a = std::filesystem::file_size(ours), b = std::filesystem::file_size(theirs);
   std::printf("[ exr zip  ] ours %zu bytes, OpenEXR's %zu bytes\n", size_t(a), size_t(b));
   EXPECT_LE(double(a), 1.05 * double(b));
-  // zip-fast (ISA-L) trades size for time: about 12% larger on rendered frames, bounded here at 25%
+  // zip-fast (ISA-L) trades size for time: about 11% larger on rendered frames, bounded here at 25%
   const std::string fast = dir + "/fast.exr";
   write_rgba_exr(fast, w, h, px.data(), ExrCompression::ZipFast, 2);
   const auto f = std::filesystem::file_size(fast);

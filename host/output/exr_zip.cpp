@@ -17,10 +17,10 @@
 #include <time.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <memory>

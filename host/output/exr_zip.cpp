@@ -4,9 +4,9 @@
 // data: for each of its scanlines, each channel in name order, the scanline's values (little-endian).
 // A multi-part file (version flag MULTI_PART_FILE_FLAG) has every part's header, then one more empty
 // name, then every part's offset table in turn, and each chunk starts with its part number (int32).
-// ZIP data is the chunk's block preconditioned (precondition_chunk) and zlib-compressed (libdeflate,
-// or ISA-L for zip-fast); a chunk that does not shrink is stored as it is, which readers recognise by
-// its size.
+// ZIP data is the chunk's block preconditioned (precondition_chunk) and zlib-compressed (ISA-L, and for
+// zip libdeflate where it matters: compress_chunk); a chunk that does not shrink is stored as it is,
+// which readers recognise by its size.
 #include "output/exr_zip.h"
 
 #include <ImfChannelList.h>
@@ -183,15 +183,16 @@ struct Scratch {
 
 constexpr int kDefaultLevel = 4;  // libdeflate: OpenEXR's own zlib level
 constexpr uint32_t kFastLevel = 2, kFastLevelBuf = ISAL_DEF_LVL2_DEFAULT;  // ISA-L igzip
+// zip keeps ISA-L's stream of a chunk it shrinks at least this much: on such chunks (background,
+// alpha runs) libdeflate saves few bytes for 7-8x the time. Measured over three rendered paper-8k frames:
+// files 1.000-1.018x of libdeflate-only ones for 0.62-0.66x of its deflate time (docs/SEQUENCES.md).
+constexpr size_t kKeepFastRatio = 16;
 
 // Room for the compressed chunk of `n` raw bytes; a chunk that needs more is stored raw.
 size_t packed_bound(size_t n) { return n + n / 8 + 1024; }
 
-// Compresses n bytes of `in` into S.packed as a zlib stream; returns its size, or 0 when it does not fit
-// (the caller then stores the chunk raw).
-size_t compress_chunk(Scratch& S, ZipEncoder encoder, unsigned char* in, size_t n) {
-  if (encoder == ZipEncoder::Default)
-    return libdeflate_zlib_compress(S.z.get(), in, n, S.packed.data(), S.packed.size());
+// ISA-L's zlib stream of n bytes of `in` in S.packed: its size, or 0 when it does not fit.
+size_t compress_fast(Scratch& S, unsigned char* in, size_t n) {
   isal_zstream s;
   isal_deflate_stateless_init(&s);
   s.next_in = in;
@@ -205,6 +206,15 @@ size_t compress_chunk(Scratch& S, ZipEncoder encoder, unsigned char* in, size_t 
   s.flush = NO_FLUSH;
   s.gzip_flag = IGZIP_ZLIB;
   return isal_deflate_stateless(&s) == COMP_OK ? size_t(s.total_out) : 0;
+}
+
+// Compresses n bytes of `in` into S.packed as a zlib stream; returns its size, or 0 when it does not fit
+// (the caller then stores the chunk raw). zip-fast: ISA-L. zip: ISA-L first, then libdeflate for a
+// chunk ISA-L does not shrink kKeepFastRatio-fold.
+size_t compress_chunk(Scratch& S, ZipEncoder encoder, unsigned char* in, size_t n) {
+  const size_t fast = compress_fast(S, in, n);
+  if (encoder == ZipEncoder::Fast || (fast > 0 && fast * kKeepFastRatio <= n)) return fast;
+  return libdeflate_zlib_compress(S.z.get(), in, n, S.packed.data(), S.packed.size());
 }
 
 std::atomic<uint64_t> helper_cpu_ns{0};
@@ -312,7 +322,7 @@ void write_zip_exr(const std::string& path, const std::string& shown_path, const
       S.z.reset(libdeflate_alloc_compressor(kDefaultLevel));
       if (!S.z) failed = true;
     }
-    if (encoder == ZipEncoder::Fast && S.isal_level_buf.size() < kFastLevelBuf) S.isal_level_buf.resize(kFastLevelBuf);
+    if (S.isal_level_buf.size() < kFastLevelBuf) S.isal_level_buf.resize(kFastLevelBuf);
     if (S.split.size() < max_raw) S.split.resize(max_raw), S.pre.resize(max_raw), S.packed.resize(packed_bound(max_raw));
     for (size_t j; !failed && (j = next++) < jobs.size();) {
       const PartLayout& L = layouts[size_t(jobs[j].part)];

@@ -71,7 +71,8 @@ void set_compression(Imf::Header& h, ExrCompression c, const std::string& path) 
 // OpenEXR's per-channel alpha names for R, G, B
 const char* const kSubpixelAlpha[3] = {"AR", "AG", "AB"};
 
-// zip: libdeflate at OpenEXR's level; zip-fast: ISA-L, a fifth of zip's writer CPU for 11% larger files
+// zip: ISA-L and libdeflate at OpenEXR's level (exr_zip.h); zip-fast: ISA-L only, a third of zip's
+// writer CPU for files about 10% larger
 // (docs/SEQUENCES.md, "The ZIP writer").
 ZipEncoder zip_encoder(ExrCompression c) { return c == ExrCompression::ZipFast ? ZipEncoder::Fast : ZipEncoder::Default; }
 

@@ -30,7 +30,8 @@ struct ExrZipPart {
 // Which deflate encoder compresses the chunks. Both write standard zlib streams, so the file is the same
 // ZIP EXR either way; they trade size for time (docs/SEQUENCES.md, "The ZIP writer"):
 //   Default: ISA-L's igzip at level 2 for the chunks it shrinks 16-fold or more, libdeflate at level 4
-//     (OpenEXR's own level) for the others: files within 2-3% of OpenEXR's zlib ones.
+//     (OpenEXR's own level) for the others: a third of OpenEXR's writer CPU for files within 2% of its
+//     zlib ones.
 //   Fast: ISA-L's igzip at level 2 for every chunk: deflate 7x faster than libdeflate, files about 11%
 //     larger.
 enum class ZipEncoder { Default, Fast };

@@ -108,14 +108,14 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "pmr_exr_writer_bench: %s has no half R, G, B, A\n", argv[1]);
     return 1;
   }
-  const bool has_sub = index("AR") >= 0 && index("AG") >= 0 && index("AB") >= 0;
+  const int c4[4] = {R, G, B, A}, c3[3] = {index("AR"), index("AG"), index("AB")};
+  const bool has_sub = c3[0] >= 0 && c3[1] >= 0 && c3[2] >= 0;
   const size_t px = size_t(f.width) * size_t(f.height);
   std::vector<uint16_t> rgba(px * 4), sub(px * 3);
   for (size_t i = 0; i < px; ++i) {
-    const int c4[4] = {R, G, B, A};
     for (int k = 0; k < 4; ++k) rgba[4 * i + size_t(k)] = f.planes[size_t(c4[k])][i];
     if (has_sub)
-      for (int k = 0; k < 3; ++k) sub[3 * i + size_t(k)] = f.planes[size_t(index(k == 0 ? "AR" : k == 1 ? "AG" : "AB"))][i];
+      for (int k = 0; k < 3; ++k) sub[3 * i + size_t(k)] = f.planes[size_t(c3[k])][i];
   }
   std::printf("# %s: %dx%d; one thread, CPU seconds (best of %d), file or stream size in MB\n", argv[1], f.width, f.height,
               repeats);

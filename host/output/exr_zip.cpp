@@ -188,12 +188,20 @@ constexpr uint32_t kFastLevel = 2, kFastLevelBuf = ISAL_DEF_LVL2_DEFAULT;  // IS
 // files 1.000-1.018x of libdeflate-only ones for 0.62-0.66x of its deflate time (docs/SEQUENCES.md).
 constexpr size_t kKeepFastRatio = 16;
 
+constexpr size_t kInputSlack = 64;  // zeroed bytes after a chunk's input (compress_fast)
+
 // Room for the compressed chunk of `n` raw bytes; a chunk that needs more is stored raw.
 size_t packed_bound(size_t n) { return n + n / 8 + 1024; }
 
 // ISA-L's zlib stream of n bytes of `in` in S.packed: its size, or 0 when it does not fit.
 size_t compress_fast(Scratch& S, unsigned char* in, size_t n) {
+  // The same chunk must give the same bytes (files of two identical renders are identical, tested):
+  // ISA-L's work area is reused from chunk to chunk, so it starts cleared, and the bytes just past the
+  // input, which a hashing encoder may look at, are zeros rather than what the buffer held before.
+  std::memset(S.isal_level_buf.data(), 0, S.isal_level_buf.size());
+  std::memset(in + n, 0, kInputSlack);
   isal_zstream s;
+  std::memset(&s, 0, sizeof s);  // every field defined (hist_bits, flags), whatever the init below leaves
   isal_deflate_stateless_init(&s);
   s.next_in = in;
   s.avail_in = uint32_t(n);
@@ -323,7 +331,7 @@ void write_zip_exr(const std::string& path, const std::string& shown_path, const
       if (!S.z) failed = true;
     }
     if (S.isal_level_buf.size() < kFastLevelBuf) S.isal_level_buf.resize(kFastLevelBuf);
-    if (S.split.size() < max_raw) S.split.resize(max_raw), S.pre.resize(max_raw), S.packed.resize(packed_bound(max_raw));
+    if (S.split.size() < max_raw) S.split.resize(max_raw), S.pre.resize(max_raw + kInputSlack), S.packed.resize(packed_bound(max_raw));
     for (size_t j; !failed && (j = next++) < jobs.size();) {
       const PartLayout& L = layouts[size_t(jobs[j].part)];
       const int y0 = jobs[j].chunk * kLinesPerChunk, y1 = std::min(L.height, y0 + kLinesPerChunk);

@@ -795,11 +795,7 @@ TEST(PbrLights, TheDefaultLightOnlyWithoutSceneLights) {
   const SceneLight bulb = make_light(SceneLightType::Point, glm::dvec3(0.0, 0.0, 2.0), glm::dvec3(0, 0, -1), 4.0f);
   auto used = [&](const Scene& s, PipelineConfig pc) {
     pc.tile_x = 4, pc.tile_y = 4, pc.tile_v = 4;
-    Pipeline p(test::runtime(), pc);
-    p.set_scene(s);
-    p.configure(rig, nullptr);
-    p.render(rig);
-    return p.lights_used();
+    return describe_frame(rig, s.lights, pc).lights;
   };
   PipelineConfig pbr;
   pbr.shading = Shading::Pbr;
@@ -917,7 +913,7 @@ TEST(PbrLights, AnAnimatedLightMovesBetweenFrames) {
     want.position = glm::dvec3(f == 0 ? -1.0 : 1.0, 0.0, 1.0);
     ASSERT_EQ(fr.lights.size(), 1u);
     EXPECT_EQ(fr.lights[0].position, want.position);
-    const std::vector<SceneLight> expected = renderer.frame_lights(f, pc);
+    const std::vector<SceneLight> expected = renderer.describe(f, pc).lights;
     ASSERT_EQ(expected.size(), 1u);
     EXPECT_EQ(expected[0].position, fr.lights[0].position) << "the lights a resumed run expects";
     VoxelReference reference(s, renderer.rig(), out);

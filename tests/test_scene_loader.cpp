@@ -815,23 +815,30 @@ std::string corpus() {
 // Triangle counts from the corpus's own README table (one per model, the same for all its variants):
 // rows "| Model | variants | size | 97,240 | ...". Read from the file so that models added to the corpus
 // are checked without editing this test.
+// The README's tables: every table whose header has a "triangles" column gives its models' counts.
 std::map<std::string, size_t> corpus_triangles(const std::string& dir) {
   std::map<std::string, size_t> counts;
   std::ifstream in(dir + "/README.md");
   std::string line;
+  size_t column = 0;  // the current table's triangle column (0: none)
+  auto trim = [](std::string t) {
+    t.erase(0, t.find_first_not_of(' '));
+    t.erase(t.find_last_not_of(' ') + 1);
+    return t;
+  };
   while (std::getline(in, line)) {
     if (line.rfind("| ", 0) != 0) continue;
     std::vector<std::string> cells;
     std::stringstream ss(line.substr(1));
     std::string cell;
-    while (std::getline(ss, cell, '|')) cells.push_back(cell);
-    if (cells.size() < 4) continue;
-    auto trim = [](std::string t) {
-      t.erase(0, t.find_first_not_of(' '));
-      t.erase(t.find_last_not_of(' ') + 1);
-      return t;
-    };
-    std::string n = trim(cells[3]);
+    while (std::getline(ss, cell, '|')) cells.push_back(trim(cell));
+    if (!cells.empty() && cells[0] == "model") {
+      const auto at = std::find(cells.begin(), cells.end(), "triangles");
+      column = at == cells.end() ? 0 : size_t(at - cells.begin());
+      continue;
+    }
+    if (column == 0 || cells.size() <= column) continue;
+    std::string n = cells[column];
     n.erase(std::remove(n.begin(), n.end(), ','), n.end());
     if (n.empty() || n.find_first_not_of("0123456789") != std::string::npos) continue;
     counts[trim(cells[0])] = std::stoul(n);

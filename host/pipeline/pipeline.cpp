@@ -80,9 +80,8 @@ struct Pipeline::Impl {
   ClBuffer texcoords, tangents;  // the TEXCOORD sets the material maps sample; world tangents (pbr)
   bool has_tangents = false;
   ClBuffer env, env_data;    // pbr: the environment image's header and tables (level_count 0: none)
-  std::vector<SceneLight> scene_lights;  // the scene's lights as last given (set_scene, update_lights)
-  std::vector<SceneLight> used_lights;   // the last frame's resolved lights (pbr)
-  ClBuffer lights;                       // their table (PmrLight), uploaded every frame
+  std::vector<SceneLight> scene_lights;  // the scene's lights (set_scene), for render(const Rig&)
+  ClBuffer lights;                       // the frame's light table (PmrLight), uploaded every frame
   // frame
   PmrParams params{};
   PmrEncodeParams encode_params{};
@@ -158,6 +157,7 @@ struct Pipeline::Impl {
   void configure_subpixel(const std::string& options, int views, const int* tile,
                           const std::vector<PmrEncodeColumn>& columns, const std::vector<PmrEncodeRow>& rows);
   void upload_straddles(const TileOwnership& own);
+  void upload_frame(const FrameDescription& frame);
   void upload_table(ClBuffer& b, const std::vector<int32_t>& v, const char* name) {
     b = rt.buffer(std::max<size_t>(bytes_of(v), 16), name, CL_MEM_READ_ONLY);
     rt.write(b, v.data(), bytes_of(v));
@@ -329,9 +329,13 @@ void Pipeline::update_geometry(const Scene& posed) {
     m.rt.write(m.tangents, posed.tangents.data(), bytes_of(posed.tangents));
 }
 
-void Pipeline::update_lights(const std::vector<SceneLight>& lights) { impl_->scene_lights = lights; }
-
-const std::vector<SceneLight>& Pipeline::lights_used() const { return impl_->used_lights; }
+FrameDescription describe_frame(const Rig& rig, const std::vector<SceneLight>& scene_lights,
+                                const PipelineConfig& config) {
+  FrameDescription f;
+  f.rig = rig;
+  if (config.shading == Shading::Pbr) f.lights = resolve_lights(scene_lights, rig, !config.environment);
+  return f;
+}
 
 size_t Pipeline::volume_bytes() const {
   const PmrParams& p = impl_->params;
@@ -640,19 +644,16 @@ void Pipeline::Impl::fused_stage(const PmrParams& P, Events& ev) {
   straddle_alpha_stage(k_straddle_alpha, ev);
 }
 
-StageTimes Pipeline::render(const Rig& rig) {
-  Impl& m = *impl_;
-  const auto t_start = std::chrono::steady_clock::now();
-  if (!m.volume.get()) throw Error("internal error: Pipeline::render before configure");
-  StageTimes times;
-  Events ev;
-  PmrParams P = m.params;
-  const PmrParams fresh = make_params(rig);  // the camera may move between frames
-  std::copy(fresh.view, fresh.view + 16, P.view);
-  std::copy(fresh.light_world, fresh.light_world + 4, P.light_world);
-  P.view_anchor = fresh.view_anchor;
-  P.view_scale = fresh.view_scale;
-  std::copy(std::begin(fresh.view_coord), std::end(fresh.view_coord), P.view_coord);
+StageTimes Pipeline::render(const Rig& rig) { return render(describe_frame(rig, impl_->scene_lights, config_)); }
+
+// The kernels' parameters of one frame: everything the frame's rig gives (make_params), then what the
+// configuration fixes for the run.
+PmrParams Pipeline::frame_params(const FrameDescription& frame) const {
+  const Impl& m = *impl_;
+  const Rig& rig = frame.rig;
+  if (rig.views != m.params.views || rig.view_w != m.params.view_w || rig.view_h != m.params.view_h)
+    throw Error("internal error: a frame's rig differs in size from the configured one");
+  PmrParams P = make_params(rig);
   P.tiles_x = tiles_x_;
   P.tiles_y = tiles_y_;
   P.tiles_v = tiles_v_;
@@ -664,23 +665,33 @@ StageTimes Pipeline::render(const Rig& rig) {
   P.shading = config_.shading == Shading::Pbr ? PMR_SHADING_PBR : PMR_SHADING_LAMBERT;
   P.exposure = float(std::exp2(config_.exposure_ev));
   P.env_radiance = float(0.2 * config_.environment_intensity);
-  {  // the light table (pbr; the lights move with their nodes, and the default light with the camera;
-     // an environment image replaces the default light)
-    m.used_lights.clear();
-    if (config_.shading == Shading::Pbr) m.used_lights = resolve_lights(m.scene_lights, rig, !config_.environment);
-    std::vector<PmrLight> table;
-    for (const SceneLight& l : m.used_lights) table.push_back(device_light(l));
-    P.num_lights = uint32_t(table.size());
-    table.resize(std::max<size_t>(table.size(), 1));  // no empty buffers
-    if (m.lights.size() != bytes_of(table)) m.lights = m.rt.buffer(bytes_of(table), "lights", CL_MEM_READ_ONLY);
-    m.rt.write(m.lights, table.data(), bytes_of(table));
-  }
-  {  // each view's camera position in world space (the view vector of pbr; the camera may move)
-    std::vector<glm::vec4> eyes(size_t(rig.views));
-    for (int i = 0; i < rig.views; ++i) eyes[size_t(i)] = glm::vec4(glm::vec3(glm::inverse(rig.view_matrix(i))[3]), 1.0f);
-    if (m.eyes.size() != bytes_of(eyes)) m.eyes = m.rt.buffer(bytes_of(eyes), "camera positions", CL_MEM_READ_ONLY);
-    m.rt.write(m.eyes, eyes.data(), bytes_of(eyes));
-  }
+  P.num_lights = uint32_t(frame.lights.size());
+  return P;
+}
+
+// The frame's light table and each view's camera position in world space (the view vector of pbr).
+void Pipeline::Impl::upload_frame(const FrameDescription& frame) {
+  std::vector<PmrLight> table;
+  for (const SceneLight& l : frame.lights) table.push_back(device_light(l));
+  table.resize(std::max<size_t>(table.size(), 1));  // no empty buffers
+  if (lights.size() != bytes_of(table)) lights = rt.buffer(bytes_of(table), "lights", CL_MEM_READ_ONLY);
+  rt.write(lights, table.data(), bytes_of(table));
+  const Rig& rig = frame.rig;
+  std::vector<glm::vec4> at(size_t(rig.views));
+  for (int i = 0; i < rig.views; ++i) at[size_t(i)] = glm::vec4(glm::vec3(glm::inverse(rig.view_matrix(i))[3]), 1.0f);
+  if (eyes.size() != bytes_of(at)) eyes = rt.buffer(bytes_of(at), "camera positions", CL_MEM_READ_ONLY);
+  rt.write(eyes, at.data(), bytes_of(at));
+}
+
+StageTimes Pipeline::render(const FrameDescription& frame) {
+  Impl& m = *impl_;
+  const auto t_start = std::chrono::steady_clock::now();
+  if (!m.volume.get()) throw Error("internal error: Pipeline::render before configure");
+  const Rig& rig = frame.rig;
+  StageTimes times;
+  Events ev;
+  PmrParams P = frame_params(frame);
+  m.upload_frame(frame);
   if (m.warming) P.num_vertices = P.num_triangles = 0, P.tiles_x = P.tiles_y = P.tiles_v = 0;  // an empty frame
 
   if (config_.method != Method::Multipass) {

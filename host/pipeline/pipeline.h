@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/frame_description.h"
 #include "pmr/input_files.h"
 #include "pmr/rig.h"
 #include "pmr/scene.h"
@@ -103,16 +104,13 @@ class Pipeline {
   // Replaces positions, attributes and triangles (a posed frame of the scene given to set_scene: same
   // counts, same materials and textures). Only a copy: no buffer is reallocated.
   void update_geometry(const Scene& posed);
-  // Replaces the scene's lights (world space, posed: Scene::lights of a posed frame). set_scene takes the
-  // scene's own; every render() resolves them with its rig (resolve_lights) into the kernels' table.
-  void update_lights(const std::vector<SceneLight>& lights);
-  // The lights --shading pbr lit the last frame with (world space, the default light included); empty
-  // under lambert, whose one fixed light is the rig's.
-  const std::vector<SceneLight>& lights_used() const;
   // Allocates the per-configuration buffers (view volume, tile queues, display image). The display
   // may be null when only the view volume is needed.
   void configure(const Rig& rig, const Display* display);
-  // Renders one frame with the rig given to configure() (camera pose may change between frames).
+  // Renders one frame whole: its rig (sizes as given to configure(); the cameras may move from frame to
+  // frame) and its lights, uploaded once for the frame.
+  StageTimes render(const FrameDescription& frame);
+  // The same for a frame described by `rig` and the lights of the scene given to set_scene.
   StageTimes render(const Rig& rig);
   // Seconds spent building kernels: program builds and the work-group functions configure() compiles
   // ahead of the first frame (every launch has a fixed local size, so frames compile nothing).
@@ -155,6 +153,7 @@ class Pipeline {
 
  private:
   void build_kernels(const Rig& rig);
+  PmrParams frame_params(const FrameDescription& frame) const;
   std::unique_ptr<Impl> impl_;
   PipelineConfig config_;
   int tiles_x_ = 0, tiles_y_ = 0, tiles_v_ = 0;

@@ -7,7 +7,6 @@
 #include "pmr/error.h"
 #include "pmr/printable.h"
 #include "scene/motion.h"
-#include "shading/lights.h"
 
 namespace pmr {
 
@@ -191,34 +190,36 @@ FrameRenderer::Frame FrameRenderer::render(long frame) {
   const PoseRequest r = request(frame);
   out.time = r.time;
   out.angle = r.turntable_deg;
-  out.rig = rig_;
-  if (rest_.triangles.empty()) {  // nothing is rendered; the sidecar still records the lights
-    out.lights = frame_lights(frame, pipeline_->config());
+  if (rest_.triangles.empty()) {  // nothing is rendered; the sidecar still records the rig and lights
+    const FrameDescription d = describe(frame, pipeline_->config());
+    out.rig = d.rig, out.lights = d.lights;
     return out;
   }
   const auto t0 = std::chrono::steady_clock::now();
   if (moves_) {
     const bool changed = pose_scene(rest_, r, posed_);
-    if (camera_moves_) out.rig = rig_for(posed_, nullptr);
     out.pose_ms = ms_since(t0);
     const auto t1 = std::chrono::steady_clock::now();
     if (changed) pipeline_->update_geometry(posed_);
-    // the lights every frame: an animation may move a light and no geometry (changed is false then)
-    pipeline_->update_lights(posed_.lights);
     out.upload_ms = ms_since(t1);
   }
-  out.times = pipeline_->render(out.rig);
+  // the lights every frame: an animation may move a light and no geometry
+  const FrameDescription d = describe_posed(moves_ ? posed_ : rest_, pipeline_->config());
+  out.rig = d.rig, out.lights = d.lights;
+  out.times = pipeline_->render(d);
   out.visible = out.times.mtas > 0;
-  out.lights = pipeline_->lights_used();
   return out;
 }
 
-std::vector<SceneLight> FrameRenderer::frame_lights(long frame, const PipelineConfig& config) const {
-  if (config.shading != Shading::Pbr) return {};
-  if (!moves_) return resolve_lights(rest_.lights, rig_, !config.environment);
+FrameDescription FrameRenderer::describe_posed(const Scene& placed, const PipelineConfig& config) const {
+  return describe_frame(camera_moves_ ? rig_for(placed, nullptr) : rig_, placed.lights, config);
+}
+
+FrameDescription FrameRenderer::describe(long frame, const PipelineConfig& config) const {
+  if (!moves_) return describe_posed(rest_, config);
   Scene placed;
   pose_cameras_and_lights(rest_, request(frame), placed);
-  return resolve_lights(placed.lights, camera_moves_ ? rig_for(placed, nullptr) : rig_, !config.environment);
+  return describe_posed(placed, config);
 }
 
 }  // namespace pmr

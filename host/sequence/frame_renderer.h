@@ -63,14 +63,14 @@ class FrameRenderer {
     double pose_ms = 0.0;    // posing (animation sampling, morphing, skinning, turntable) on the host
     double upload_ms = 0.0;  // copying the posed geometry to the device
     bool visible = false;    // some MTA was produced (false: a transparent image)
-    // pbr: the lights the frame was shaded with (world space, posed; the default light when the scene
-    // has none), as the sidecar records them; empty under lambert
+    // pbr: the lights the frame was shaded with (FrameDescription::lights), as the sidecar records
+    // them; empty under lambert
     std::vector<SceneLight> lights;
   };
   Frame render(long frame);
-  // The lights render(frame) shades with under `config` (Frame::lights), without rendering it: posed
-  // lights and cameras only, for the sidecars --resume expects.
-  std::vector<SceneLight> frame_lights(long frame, const PipelineConfig& config) const;
+  // What render(frame) renders under `config` (its rig and lights), without rendering it: cameras and
+  // lights posed only. render() renders exactly this description; --resume compares sidecars with it.
+  FrameDescription describe(long frame, const PipelineConfig& config) const;
 
   const Rig& rig() const { return rig_; }
   const glm::dvec3& bounds_lo() const { return lo_; }
@@ -81,6 +81,8 @@ class FrameRenderer {
 
  private:
   Rig rig_for(const Scene& posed, std::vector<std::string>* warnings) const;
+  // The description of a frame whose cameras and lights are posed in `placed`.
+  FrameDescription describe_posed(const Scene& placed, const PipelineConfig& config) const;
   PoseRequest request(long frame) const;
 
   const Scene& rest_;

@@ -66,11 +66,13 @@ class SequenceRun {
   void prepare_frames();
   SidecarInfo frame_info(long frame, const FramePaths& p, double angle, std::vector<SceneLight> lights) const;
   std::string expected_sidecar(long frame, const FramePaths& p) const {
-    return sidecar_json(renderer_->rig(), job_.display, frame_info(frame, p, 0.0, renderer_->frame_lights(frame, pc_)));
+    const FrameDescription d = renderer_->describe(frame, pc_);
+    return sidecar_json(d.rig, job_.display, frame_info(frame, p, 0.0, d.lights));
   }
   FramePaths paths(long f) const { return frame_paths(products_, f, quilt_, renderer_->rig().aspect); }
   void print_header() const;
   int render_frames();
+  void finish_writing(FrameWriter& writer, Progress& progress);
   FrameFiles frame_files(long f, const FrameRenderer::Frame& fr, Pipeline& pipeline, FrameWriter& writer) const;
   void print_frame_stages(long f, const FrameRenderer::Frame& fr, const Pipeline& pipeline, Progress& progress) const;
   void print_summary(const FrameWriter& writer) const;
@@ -363,6 +365,19 @@ void SequenceRun::print_frame_stages(long f, const FrameRenderer::Frame& fr, con
   progress.message(line);
 }
 
+// Waits for the writer to write every frame submitted, and closes the progress display.
+void SequenceRun::finish_writing(FrameWriter& writer, Progress& progress) {
+  try {
+    writer.finish();
+  } catch (...) {
+    progress.close();
+    progress_ = nullptr;
+    throw;
+  }
+  progress.close();
+  progress_ = nullptr;
+}
+
 int SequenceRun::render_frames() {
   ClRuntime runtime;
   pc_.fuse_encode = !need_volume_;   // the volume is only kept when a product needs it
@@ -387,7 +402,13 @@ int SequenceRun::render_frames() {
   for (long f : plan_.todo) {
     if (interrupt_signal()) break;
     frame_in_flight_ = f;
-    const FrameRenderer::Frame fr = renderer_->render(f);
+    FrameRenderer::Frame fr;
+    try {
+      fr = renderer_->render(f);
+    } catch (...) {  // a frame that cannot render (a camera turned away): the frames before it are written
+      finish_writing(writer, progress);
+      throw;
+    }
     if (interrupt_signal()) break;  // the frame in flight is abandoned
     render_s_ += fr.times.wall / 1000.0;
     pose_s_ += fr.pose_ms / 1000.0;
@@ -398,14 +419,7 @@ int SequenceRun::render_frames() {
     ++rendered_;
     progress.frame_done(rendered_, f, fr.times.wall);
   }
-  try {
-    writer.finish();
-  } catch (...) {
-    progress.close();
-    throw;
-  }
-  progress.close();
-  progress_ = nullptr;
+  finish_writing(writer, progress);
   loop_s_ = seconds_since(t_loop);
   loop_cpu_s_ = process_cpu_seconds() - cpu0;
   const long written = writer.frames_written();

@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "pmr/error.h"
+#include "pmr/limits.h"
+#include "pmr/shared.h"
 
 namespace pmr {
 
@@ -143,7 +145,7 @@ struct Option {
   const char* name;   // "--out"
   const char* alias;  // "-o", or nullptr
   const char* arg;    // the value's placeholder in --help ("DIR"); nullptr for a flag
-  const char* help;   // the description, '\n' between its lines; nullptr: not listed (see the entry)
+  std::string help;   // the description, '\n' between its lines; empty: not listed (see the entry)
   // applies the option: `value` is empty for a flag, `name` the option's name for messages
   void (*set)(RenderOptions& o, const std::string& value, const std::string& name);
   std::string (*more_help)() = nullptr;  // lines --help prints verbatim after the description
@@ -178,7 +180,7 @@ void set_write(RenderOptions& o, const std::string& v, const std::string&) {
 }
 
 const Section kOutputOptions = {"output:", {
-  {"--help", "-h", nullptr, nullptr,  // not listed: the help itself
+  {"--help", "-h", nullptr, "",  // not listed: the help itself
    [](RenderOptions& o, const std::string&, const std::string&) { o.help = true; }},
   {"--out", "-o", "DIR", "output folder (created if missing; default: out)",
    [](RenderOptions& o, const std::string& v, const std::string&) { o.out_dir = v; }},
@@ -222,7 +224,7 @@ const Section kSequenceOptions = {
    "--turntable one turn, 0 to FRAMES-1, however long the animation; frame 0\n"
    "for a still scene. Frames outside the keys get a warning, except all",
    set_frames},
-  {"--frame", nullptr, "N", nullptr, set_frames},  // not listed: the singular reads better for one frame
+  {"--frame", nullptr, "N", "", set_frames},  // not listed: --frames in the singular
   {"--fps", nullptr, "F", "frames per second (default 24)",
    [](RenderOptions& o, const std::string& v, const std::string& name) {
      o.fps = parse_double(v, name);
@@ -260,11 +262,11 @@ const Section kSequenceOptions = {
    "(--shard-count N where the environment lacks the count, --shard-first F\n"
    "for PBS arrays not starting at 0); see docs/farm/README.md",
    [](RenderOptions& o, const std::string& v, const std::string&) { o.shard = v; }},
-  {"--shard-count", nullptr, "N", nullptr,  // not listed: --shard's description explains it
+  {"--shard-count", nullptr, "N", "",  // not listed: --shard's description explains it
    [](RenderOptions& o, const std::string& v, const std::string& name) {
      o.shard_count = parse_int(v, name, 1, 1 << 30);
    }},
-  {"--shard-first", nullptr, "F", nullptr,  // not listed: --shard's description explains it
+  {"--shard-first", nullptr, "F", "",  // not listed: --shard's description explains it
    [](RenderOptions& o, const std::string& v, const std::string& name) {
      o.shard_first = parse_int(v, name, 0, 1 << 30);
    }},
@@ -281,9 +283,10 @@ const Section kRigOptions = {"rig:", {
    applied_first},
   {"--views", nullptr, "N", "number of views (default 96)",
    [](RenderOptions& o, const std::string& v, const std::string& name) {
-     o.rig.views = parse_int(v, name, 1, 4096);
+     o.rig.views = parse_int(v, name, 1, PMR_MAX_VIEWS);
    }},
-  {"--view-size", nullptr, "WxH", "view raster in pixels (default 1024x512; each side <= 8192)",
+  {"--view-size", nullptr, "WxH",
+   "view raster in pixels (default 1024x512; each side <= " + std::to_string(PMR_MAX_RASTER) + ")",
    [](RenderOptions& o, const std::string& v, const std::string& name) {
      const auto d = parse_dims(v, name, 2, PMR_MAX_RASTER);
      o.rig.view_w = d[0], o.rig.view_h = d[1];
@@ -332,7 +335,7 @@ const Section kRigOptions = {"rig:", {
 const Section kDisplayOptions = {"display:", {
   {"--display", nullptr, "WxH", "display image in pixels (default 7680x4320)",
    [](RenderOptions& o, const std::string& v, const std::string& name) {
-     const auto d = parse_dims(v, name, 2, 16384);
+     const auto d = parse_dims(v, name, 2, kMaxDisplaySide);
      o.display.width = d[0], o.display.height = d[1];
    }},
   {"--display-size", nullptr, "WxH", "physical size in cm (default 166x93; sets the aspect A)",
@@ -373,7 +376,7 @@ const Section kDisplayOptions = {"display:", {
 const Section kPipelineOptions = {"pipeline:", {
   {"--tile", nullptr, "XxYxV", "3D tile of the tile/fine raster, voxels over x, y, view (default 16x2x16)",
    [](RenderOptions& o, const std::string& v, const std::string& name) {
-     const auto d = parse_dims(v, name, 3, 64);
+     const auto d = parse_dims(v, name, 3, kMaxTileSide);
      o.pipeline.tile_x = d[0], o.pipeline.tile_y = d[1], o.pipeline.tile_v = d[2];
    }},
   {"--method", nullptr, "M",
@@ -481,7 +484,7 @@ std::string option_help(const Option& opt) {
   const std::string arg = opt.arg ? std::string(" ") + opt.arg : "";
   std::string line = std::string("  ") + opt.name + arg + (opt.alias ? std::string(", ") + opt.alias + arg : "");
   line += line.size() < kColumn ? std::string(kColumn - line.size(), ' ') : "  ";
-  for (const char* c = opt.help; *c; ++c) line += *c == '\n' ? "\n" + std::string(kColumn, ' ') : std::string(1, *c);
+  for (char c : opt.help) line += c == '\n' ? "\n" + std::string(kColumn, ' ') : std::string(1, c);
   line += "\n";
   return opt.more_help ? line + opt.more_help() : line;
 }
@@ -561,7 +564,7 @@ std::string render_help() {
   for (const Section* section : kSections) {
     out += std::string(section->heading) + "\n";
     for (const Option& opt : section->options)
-      if (opt.help) out += option_help(opt);
+      if (!opt.help.empty()) out += option_help(opt);
   }
   return out +
          "Environment: PMR_DEVICE=substring selects the OpenCL device by name (default: first CPU device).\n"

@@ -16,6 +16,7 @@
 #include <numeric>
 
 #include "pmr/error.h"
+#include "pmr/limits.h"
 #include "pmr/rig.h"
 #include "rig/wide_int.h"
 
@@ -174,8 +175,8 @@ size_t phase_position(const Display& display, size_t s) { return display.subpixe
 }  // namespace
 
 PmrEncodeParams make_encode_params(const Display& display, int views, int view_w, int view_h) {
-  if (display.width < 1 || display.height < 1 || display.width > 16384 || display.height > 16384)  // encode.cl indexes in 32 bits
-    throw Error("invalid --display: each side must be 1..16384");
+  if (display.width < 1 || display.height < 1 || display.width > kMaxDisplaySide || display.height > kMaxDisplaySide)
+    throw Error("invalid --display: each side must be 1.." + std::to_string(kMaxDisplaySide));
   if (display.lens_pitch.num <= 0) throw Error("invalid --lens-pitch: must be positive");
   for (const Rational* r : {&display.lens_pitch, &display.tan_slant, &display.offset})
     if (r->den <= 0) throw InternalError("display fraction with a non-positive denominator");

@@ -163,19 +163,19 @@ void set_frames(RenderOptions& o, const std::string& v, const std::string&) { o.
 void applied_first(RenderOptions&, const std::string&, const std::string&) {}
 
 void set_write(RenderOptions& o, const std::string& v, const std::string&) {
-  o.write_encoded = o.write_views = o.write_quilt = o.write_depth = false;
+  o.products.encoded = o.products.views = o.products.quilt = o.products.depth = false;
   std::stringstream ss(v);
   std::string w;
   while (std::getline(ss, w, ',')) {
-    if (w == "encoded") o.write_encoded = true;
-    else if (w == "views") o.write_views = true;
-    else if (w == "quilt") o.write_quilt = true;
-    else if (w == "depth") o.write_depth = true;
+    if (w == "encoded") o.products.encoded = true;
+    else if (w == "views") o.products.views = true;
+    else if (w == "quilt") o.products.quilt = true;
+    else if (w == "depth") o.products.depth = true;
     else throw Error("invalid --write '" + w + "': expected a list of encoded, views, quilt, depth");
   }
-  if (!o.write_encoded && !o.write_views && !o.write_quilt)
+  if (!o.products.encoded && !o.products.views && !o.products.quilt)
     throw Error("invalid --write: nothing to write (depth is a channel of views or quilt)");
-  if (o.write_depth && !o.write_views && !o.write_quilt)
+  if (o.products.depth && !o.products.views && !o.products.quilt)
     throw Error("invalid --write: depth is a channel of the views or quilt EXR: add views or quilt");
 }
 
@@ -183,7 +183,7 @@ const Section kOutputOptions = {"output:", {
   {"--help", "-h", nullptr, "",  // not listed: the help itself
    [](RenderOptions& o, const std::string&, const std::string&) { o.help = true; }},
   {"--out", "-o", "DIR", "output folder (created if missing; default: out)",
-   [](RenderOptions& o, const std::string& v, const std::string&) { o.out_dir = v; }},
+   [](RenderOptions& o, const std::string& v, const std::string&) { o.products.out_dir = v; }},
   {"--write", nullptr, "LIST",
    "any of encoded, views, quilt, depth (default: encoded). DIR/frame_NNNN.exr is\n"
    "the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view,\n"
@@ -198,14 +198,14 @@ const Section kOutputOptions = {"output:", {
    "also 8-bit sRGB PNGs: the encoded image, the center view (N / 2; stretched to\n"
    "square pixels, as a view's pixels span the display's aspect) and the quilt\n"
    "(tiles as rendered; their pixel aspect in the PNG's pHYs chunk)",
-   [](RenderOptions& o, const std::string&, const std::string&) { o.preview = true; }},
+   [](RenderOptions& o, const std::string&, const std::string&) { o.products.preview = true; }},
   {"--name", nullptr, "PATTERN",
    "file stem (default frame_%04d); the frame number as %d, zero-padded %0Nd or\n"
    "Blender's #### (N '#': N digits), %% for a percent sign; without a frame\n"
    "number the stem of a single frame as given (--name duck: duck.exr)",
    [](RenderOptions& o, const std::string& v, const std::string&) {
      check_name_pattern(v);
-     o.name = v;
+     o.products.name = v;
    }},
   {"--compression", nullptr, "C",
    "EXR compression: none, zip, zip-fast (ZIP through ISA-L's igzip alone: a\n"
@@ -514,13 +514,13 @@ void finalize_options(RenderOptions& o) {
       o.pipeline.sampling = Sampling::View;
       o.option_warnings.push_back(needs_views + " samples the rendered views: --sampling view instead of the "
                                   "display's default, subpixel");
-    } else if (!o.write_encoded) {
+    } else if (!o.products.encoded) {
       o.pipeline.sampling = Sampling::View;  // no encoded image: nothing to sample by subpixel
     }
   }
   if (o.pipeline.sampling == Sampling::Subpixel) {
     check_subpixel_sampling(o.pipeline.method, o.display);  // pmr unless --method says otherwise
-    if (!o.write_encoded) {  // the views are rendered on their grids in either case
+    if (!o.products.encoded) {  // the views are rendered on their grids in either case
       o.pipeline.sampling = Sampling::View;
       o.option_warnings.push_back("--sampling subpixel samples the encoded image, which --write does not ask for: "
                                   "ignored");

@@ -41,13 +41,7 @@ SequenceJob sequence_job(const RenderOptions& o) {
   job.display_source = o.display_source;
   if (o.has_calibration) job.calibration = o.calibration;
   job.pipeline = o.pipeline;
-  job.products.out_dir = o.out_dir;
-  job.products.name = o.name;
-  job.products.encoded = o.write_encoded;
-  job.products.views = o.write_views;
-  job.products.quilt = o.write_quilt;
-  job.products.depth = o.write_depth;
-  job.products.preview = o.preview;
+  job.products = o.products;
   job.quilt_layout = o.quilt;
   job.frames = o.frames;
   job.fps = o.fps;

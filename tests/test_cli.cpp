@@ -11,8 +11,11 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <sstream>
 #include <string>
 
+#include "cli/options.h"
+#include "pmr/error.h"
 #include "pmr/output.h"
 #include "pmr/rig.h"
 #include "pmr/scene.h"
@@ -37,6 +40,25 @@ TEST(Cli, HelpAndInfo) {
   const CliRun info = run("info");
   EXPECT_EQ(info.status, 0);
   EXPECT_NE(info.output.find("device 0"), std::string::npos) << info.output;
+}
+
+// --help and the parser are made from one table (cli/options.cpp): every option --help lists is one the
+// parser takes (a value it refuses is fine here, an unknown option is not).
+TEST(Cli, RenderHelpListsOnlyOptionsTheParserTakes) {
+  std::istringstream lines(render_help());
+  std::string line;
+  int listed = 0;
+  while (std::getline(lines, line)) {
+    if (line.rfind("  -", 0) != 0) continue;
+    const std::string name = line.substr(2, line.find_first_of(" ,", 2) - 2);
+    ++listed;
+    try {
+      parse_render_options({name, "1"});
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).find("unknown option"), std::string::npos) << name << ": " << e.what();
+    }
+  }
+  EXPECT_GE(listed, 40) << "the test no longer finds the options in the help";
 }
 
 // pmr info SCENE: what the scene holds, without OpenCL; CesiumMan (corpus README: 19 joints, one

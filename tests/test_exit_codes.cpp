@@ -71,8 +71,9 @@ TEST(ExitCodes, BadInputExitsOne) {
   EXPECT_EQ(run("render --out " + out + kSmall + " -q").status, 0);
 }
 
-// The mapping itself, for the status no input should reach: an exception that is not a pmr::Error is
-// a bug, reported as an internal error with status 3 (and its message sanitized like every other).
+// The mapping itself, for the status no input should reach: a pmr::InternalError, or an exception that
+// is not a pmr::Error, is a bug, reported as an internal error with status 3 (and its message sanitized
+// like every other).
 TEST(ExitCodes, EachKindOfFailureHasItsStatus) {
   testing::internal::CaptureStderr();
   EXPECT_EQ(run_reporting_errors([] { return 0; }), 0);
@@ -82,9 +83,31 @@ TEST(ExitCodes, EachKindOfFailureHasItsStatus) {
   EXPECT_EQ(run_reporting_errors([]() -> int { throw std::bad_alloc(); }), 1) << "out of memory is not a bug";
   EXPECT_EQ(run_reporting_errors([]() -> int { throw std::logic_error("vector::at \x1b]0;owned\x07"); }), 3);
   EXPECT_EQ(run_reporting_errors([]() -> int { throw 42; }), 3);
+  EXPECT_EQ(run_reporting_errors([]() -> int { throw InternalError("an invariant \x1b[2J broke"); }), 3);
+  // as_usage turns a parser's pmr::Error into a usage error, never a bug
+  EXPECT_EQ(run_reporting_errors([]() -> int { return as_usage([]() -> int { throw InternalError("in a parser"); }); }), 3);
   const std::string err = testing::internal::GetCapturedStderr();
   EXPECT_NE(err.find("pmr: internal error: vector::at"), std::string::npos) << err;
+  EXPECT_NE(err.find("\npmr: internal error: an invariant"), std::string::npos) << "the prefix once: " << err;
+  EXPECT_NE(err.find("\npmr: internal error: in a parser\n"), std::string::npos) << err;
+  EXPECT_EQ(err.find("internal error: internal error"), std::string::npos) << err;
   EXPECT_EQ(err.find('\x1b'), std::string::npos) << "escape sequences reach the terminal: " << err;
+}
+
+// An internal error through the real binary (forced by its test hook, as no input should cause one):
+// status 3, one line saying it is an internal error, and no output folder.
+TEST(ExitCodes, InternalErrorExitsThreeAndWritesNothing) {
+  const std::string dir = temp_dir("internal"), out = dir + "/out";
+  const CliRun r = test::run_env("PMR_TEST_FORCE_INTERNAL_ERROR=render-options", "render --out " + out + kSmall);
+  EXPECT_EQ(r.status, 3) << r.output;
+  EXPECT_EQ(r.output.rfind("pmr: internal error: ", 0), 0u) << r.output;
+  EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << "exactly one line: " << r.output;
+  EXPECT_FALSE(exists(out));
+  EXPECT_FALSE(exists(dir)) << "not even the folder above --out";
+  // the hook names its stage: another name does not fire, and the same command then renders
+  const CliRun other = test::run_env("PMR_TEST_FORCE_INTERNAL_ERROR=no-such-stage", "render -q --out " + out + kSmall);
+  EXPECT_EQ(other.status, 0) << other.output;
+  EXPECT_TRUE(exists(out));
 }
 
 // A render stopped by SIGTERM exits 128 + 15, as SIGINT exits 130 (test_sequence).

@@ -12,6 +12,9 @@ namespace pmr {
 int run_reporting_errors(const std::function<int()>& command) {
   try {
     return command();
+  } catch (const InternalError& e) {  // its message starts with "internal error: "
+    std::fprintf(stderr, "pmr: %s\n", terminal_text(e.what()).c_str());
+    return 3;
   } catch (const UsageError& e) {
     std::fprintf(stderr, "pmr: error: %s\n", terminal_text(e.what()).c_str());
     return 2;

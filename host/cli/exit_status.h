@@ -1,7 +1,7 @@
 // How the `pmr` command line ends: every failure becomes one line on stderr and an exit status.
 //   0 success; 1 bad input, a runtime error or running out of memory; 2 a usage error (pmr::UsageError);
-//   3 an internal error (any other exception: a bug). A sequence stopped by signal N exits with 128 + N
-//   (sequence_job.cpp, interrupt.cpp).
+//   3 an internal error, a bug: pmr::InternalError (an invariant of pmr's own failed) or any exception that
+//   is not a pmr::Error. A sequence stopped by signal N exits with 128 + N (sequence_job.cpp, interrupt.cpp).
 #pragma once
 #include <functional>
 

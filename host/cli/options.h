@@ -8,6 +8,7 @@
 #include "pmr/display_presets.h"
 #include "output/background.h"
 #include "pmr/rig.h"
+#include "sequence/frame_files.h"
 #include "sequence/frame_names.h"
 
 namespace pmr {
@@ -25,7 +26,7 @@ void check_environment_options(const std::string& file, bool rotation_given, Sha
 
 struct RenderOptions {
   std::string scene;            // empty = the bundled default scene
-  std::string out_dir = "out";
+  FrameProducts products;       // --out, --name, --write, --preview
   RigConfig rig;
   Display display;
   std::string display_source = "preset paper-8k";  // what the display came from (sidecar)
@@ -34,18 +35,12 @@ struct RenderOptions {
   std::vector<std::string> option_warnings;         // e.g. calibration fields read but ignored
   bool offset_given = false;    // else offset = -L / (2N), which centres every subpixel in its view
   PipelineConfig pipeline;
-  bool write_encoded = true;
-  bool write_views = false;
-  bool write_quilt = false;     // Looking Glass quilt (EXR)
-  bool write_depth = false;     // a Z channel in the views and quilt EXRs
   std::string quilt;            // --quilt CxR; empty = chosen from the view count and size
-  bool preview = false;         // PNG previews of the encoded image, the center view and the quilt
   std::string compression = "zip";
   // Sequences (DESIGN section 7)
   std::string frames = "0";       // --frames LIST, or "all"
   double fps = 24.0;
   std::string animation;          // --animation NAME|INDEX|all; empty = the first animation
-  std::string name = "frame_%04d";  // --name: the file stem, with a frame field for sequences (NamePattern)
   bool turntable = false;
   double turntable_deg = 0.0;
   long turntable_frames = 0;

@@ -41,13 +41,7 @@ SequenceJob sequence_job(const RenderOptions& o) {
   job.display_source = o.display_source;
   if (o.has_calibration) job.calibration = o.calibration;
   job.pipeline = o.pipeline;
-  job.products.out_dir = o.out_dir;
-  job.products.name = o.name;
-  job.products.encoded = o.write_encoded;
-  job.products.views = o.write_views;
-  job.products.quilt = o.write_quilt;
-  job.products.depth = o.write_depth;
-  job.products.preview = o.preview;
+  job.products = o.products;
   job.quilt_layout = o.quilt;
   job.frames = o.frames;
   job.fps = o.fps;
@@ -66,6 +60,16 @@ SequenceJob sequence_job(const RenderOptions& o) {
   job.background = o.background;
   job.quilt_preview_opaque = o.quilt_preview_opaque;
   return job;
+}
+
+// Test-only: the tests cannot reach a real InternalError through valid input (that is the point of one),
+// so PMR_TEST_FORCE_INTERNAL_ERROR=<stage> makes the named stage throw one, to check the exit status,
+// the message and that nothing was written. The one stage so far is "render-options": the render
+// command once its options are parsed and checked, before the scene is read or any file is created.
+void test_hook_force_internal_error(const char* stage) {
+  const char* forced = std::getenv("PMR_TEST_FORCE_INTERNAL_ERROR");
+  if (forced && std::string(forced) == stage)
+    throw InternalError(std::string("forced at stage ") + stage + " (PMR_TEST_FORCE_INTERNAL_ERROR, a test hook)");
 }
 
 }  // namespace
@@ -92,6 +96,7 @@ int run_render(const std::vector<std::string>& args) {
     return 0;
   }
   finalize_render_options(o);
+  test_hook_force_internal_error("render-options");
   if (o.scene.empty()) o.scene = default_scene_path();
   return run_sequence(sequence_job(o));
 }

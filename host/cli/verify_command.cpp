@@ -56,7 +56,7 @@ struct FolderScene {
 };
 
 std::string sidecar_path(const std::string& dir, const RenderOptions& o, long f) {
-  return (fs::path(dir) / (frame_stem(o.name, f) + ".json")).string();
+  return (fs::path(dir) / (frame_stem(o.products.name, f) + ".json")).string();
 }
 
 FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const std::vector<long>& frames) {
@@ -92,7 +92,7 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
 // explicit_kinds: --write / --preview were given, check those kinds; else every output the sidecar lists.
 std::string check_frame(const std::string& dir, const RenderOptions& o, bool explicit_kinds, bool deep, long f,
                         const FolderScene& folder) {
-  const std::string stem = frame_stem(o.name, f);
+  const std::string stem = frame_stem(o.products.name, f);
   const std::string sidecar = sidecar_path(dir, o, f);
   std::error_code ec;
   if (!fs::is_regular_file(sidecar, ec)) return stem + ".json is missing";
@@ -109,7 +109,7 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
       !(j["fps"].get<double>() > 0.0) || std::fabs(j["time"].get<double>() - double(f) / j["fps"].get<double>()) > 1e-9)
     return stem + ".json has a time that is not frame / fps";
   const SidecarProvenance prov = sidecar_provenance(text);
-  const std::string reference_name = frame_stem(o.name, folder.reference_frame) + ".json";
+  const std::string reference_name = frame_stem(o.products.name, folder.reference_frame) + ".json";
   if (!prov.scene.empty() && prov.scene != folder.scene)
     return stem + ".json was rendered from another scene than " + reference_name +
            " and the folder's other frames (scene checksums differ)";
@@ -120,13 +120,13 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
   const nlohmann::json* outputs = j.contains("outputs") && j["outputs"].is_object() ? &j["outputs"] : nullptr;
   if (explicit_kinds) {
     std::vector<std::string> kinds;
-    if (o.write_encoded) kinds.push_back("encoded");
-    if (o.write_views) kinds.push_back("views");
-    if (o.write_quilt) kinds.push_back("quilt");
-    if (o.preview) {
+    if (o.products.encoded) kinds.push_back("encoded");
+    if (o.products.views) kinds.push_back("views");
+    if (o.products.quilt) kinds.push_back("quilt");
+    if (o.products.preview) {
       kinds.push_back("preview_center");
-      if (o.write_encoded) kinds.push_back("preview_encoded");
-      if (o.write_quilt) kinds.push_back("preview_quilt");
+      if (o.products.encoded) kinds.push_back("preview_encoded");
+      if (o.products.quilt) kinds.push_back("preview_quilt");
     }
     for (const std::string& kind : kinds) {
       if (!outputs || !outputs->contains(kind)) return stem + ".json lists no " + kind + " output";
@@ -190,7 +190,7 @@ int run_verify(const std::vector<std::string>& args) {
   const RenderOptions o = parse_render_options(rest);
   if (o.frames == "all") throw UsageError("pmr verify needs the frames as a list (--frames all depends on the scene)");
   const std::vector<long> frames = as_usage([&] { return parse_frame_list(o.frames); });
-  as_usage([&] { check_name_covers_frames(o.name, frames.size()); });
+  as_usage([&] { check_name_covers_frames(o.products.name, frames.size()); });
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw Error("cannot verify " + dir + ": not a folder");
   bool explicit_kinds = false;

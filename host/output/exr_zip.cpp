@@ -266,7 +266,7 @@ struct PartLayout {
 PartLayout layout_of(const ExrZipPart& part, const std::string& shown_path) {
   const Imf::Header& header = part.header;
   if (header.compression() != Imf::ZIP_COMPRESSION)
-    throw Error("cannot write " + shown_path + ": internal error: write_zip_exr needs a ZIP header");
+    throw InternalError("cannot write " + shown_path + ": write_zip_exr needs a ZIP header");
   const Imath::Box2i dw = header.dataWindow();
   PartLayout L;
   L.width = dw.max.x - dw.min.x + 1, L.height = dw.max.y - dw.min.y + 1, L.min_y = dw.min.y;
@@ -276,13 +276,13 @@ PartLayout layout_of(const ExrZipPart& part, const std::string& shown_path) {
                                     [&](const ExrZipChannel& g) { return g.name == c.name(); });
     if (given == part.channels.end() || (c.channel().type != Imf::HALF && c.channel().type != Imf::FLOAT) ||
         c.channel().xSampling != 1 || c.channel().ySampling != 1)
-      throw Error("cannot write " + shown_path + ": internal error: no pixels for channel " + c.name());
+      throw InternalError("cannot write " + shown_path + ": no pixels for channel " + c.name());
     const size_t bytes = c.channel().type == Imf::HALF ? 2 : 4;
     L.order.push_back({given->base, given->x_stride, given->y_stride, bytes});
     L.line_bytes += size_t(L.width) * bytes;
   }
   if (L.order.size() != part.channels.size())
-    throw Error("cannot write " + shown_path + ": internal error: pixels for a channel the header lacks");
+    throw InternalError("cannot write " + shown_path + ": pixels for a channel the header lacks");
   L.runs = split_runs(L.order, L.width);
   return L;
 }
@@ -298,7 +298,7 @@ void write_zip_exr(const std::string& path, const std::string& shown_path, const
     std::memcpy(&first, &probe, 1);
     if (first != 1) throw Error("cannot write " + shown_path + ": the ZIP EXR writer needs a little-endian host");
   }
-  if (parts.empty()) throw Error("cannot write " + shown_path + ": internal error: an EXR file without parts");
+  if (parts.empty()) throw InternalError("cannot write " + shown_path + ": an EXR file without parts");
   const bool multi = parts.size() > 1;
   std::vector<Imf::Header> headers;
   std::vector<PartLayout> layouts;

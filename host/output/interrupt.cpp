@@ -42,7 +42,6 @@ void install_interrupt_handlers() {
 }
 
 int interrupt_signal() { return g_signal.load(); }
-void reset_interrupt() { g_signal.store(0); }
 
 int register_temp_file(const std::string& path) {
   if (path.size() >= kPathMax) return -1;

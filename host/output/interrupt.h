@@ -12,8 +12,6 @@ namespace pmr {
 void install_interrupt_handlers();
 // 0 while running, else the first signal received (SIGINT or SIGTERM).
 int interrupt_signal();
-// For tests: forget a received signal.
-void reset_interrupt();
 
 // Temporary files open right now (AtomicFile). register returns a slot (-1 when all are busy: the file is
 // then only cleaned up by its destructor).

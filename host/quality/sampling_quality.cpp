@@ -12,7 +12,7 @@
 namespace pmr {
 
 ImageDifference compare_display_images(const std::vector<uint16_t>& a, const std::vector<uint16_t>& b) {
-  if (a.size() != b.size() || a.empty()) throw Error("internal error: comparing display images of different sizes");
+  if (a.size() != b.size() || a.empty()) throw InternalError("comparing display images of different sizes");
   double sum = 0.0, sum_shown = 0.0;
   size_t differing = 0, n = 0;
   for (size_t i = 0; i < a.size(); ++i) {

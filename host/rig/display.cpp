@@ -16,6 +16,7 @@
 #include <numeric>
 
 #include "pmr/error.h"
+#include "pmr/limits.h"
 #include "pmr/rig.h"
 #include "rig/wide_int.h"
 
@@ -174,12 +175,12 @@ size_t phase_position(const Display& display, size_t s) { return display.subpixe
 }  // namespace
 
 PmrEncodeParams make_encode_params(const Display& display, int views, int view_w, int view_h) {
-  if (display.width < 1 || display.height < 1 || display.width > 16384 || display.height > 16384)  // encode.cl indexes in 32 bits
-    throw Error("invalid --display: each side must be 1..16384");
+  if (display.width < 1 || display.height < 1 || display.width > kMaxDisplaySide || display.height > kMaxDisplaySide)
+    throw Error("invalid --display: each side must be 1.." + std::to_string(kMaxDisplaySide));
   if (display.lens_pitch.num <= 0) throw Error("invalid --lens-pitch: must be positive");
   for (const Rational* r : {&display.lens_pitch, &display.tan_slant, &display.offset})
-    if (r->den <= 0) throw Error("internal error: display fraction with a non-positive denominator");
-  if (display.phase_sign != 1 && display.phase_sign != -1) throw Error("internal error: phase sign must be +1 or -1");
+    if (r->den <= 0) throw InternalError("display fraction with a non-positive denominator");
+  if (display.phase_sign != 1 && display.phase_sign != -1) throw InternalError("phase sign must be +1 or -1");
   PmrEncodeParams p{};
   p.display_w = display.width;
   p.display_h = display.height;
@@ -192,7 +193,7 @@ PmrEncodeParams make_encode_params(const Display& display, int views, int view_w
   p.cell_rows = display.cell_offsets.empty() ? 1 : display.cell_rows;
   if (!display.cell_offsets.empty() &&
       (display.cell_rows < 1 || display.cell_rows > 4 || display.cell_offsets.size() != size_t(display.cell_rows) * 6))
-    throw Error("internal error: subpixel cell offsets do not match their row classes");
+    throw InternalError("subpixel cell offsets do not match their row classes");
   if (display.blend_views && display.bilinear) throw Error("--blend-views and --bilinear cannot be combined");
   return p;
 }

@@ -11,6 +11,7 @@
 #include "output/checksum.h"
 #include "pmr/display_presets.h"
 #include "pmr/error.h"
+#include "pmr/limits.h"
 
 namespace pmr {
 
@@ -78,8 +79,9 @@ LookingGlassCalibration read_looking_glass_calibration(const std::string& path, 
   if (!(c.pitch > 0.0)) absurd("pitch", "must be positive (lenticules per inch)");
   if (c.slope == 0.0 || std::fabs(c.slope) > 1e6) absurd("slope", "must be non-zero");
   if (!(c.dpi > 0.0)) absurd("DPI", "must be positive");
-  if (!(w >= 1 && w <= 16384 && w == std::floor(w))) absurd("screenW", "must be a whole number of pixels in 1..16384");
-  if (!(h >= 1 && h <= 16384 && h == std::floor(h))) absurd("screenH", "must be a whole number of pixels in 1..16384");
+  const std::string pixels = "must be a whole number of pixels in 1.." + std::to_string(kMaxDisplaySide);
+  if (!(w >= 1 && w <= kMaxDisplaySide && w == std::floor(w))) absurd("screenW", pixels);
+  if (!(h >= 1 && h <= kMaxDisplaySide && h == std::floor(h))) absurd("screenH", pixels);
   if (!(c.view_cone > 0.0 && c.view_cone < 180.0)) absurd("viewCone", "must be in (0, 180) degrees");
   c.screen_w = int(w), c.screen_h = int(h);
   if (doc.contains("subpixelCells") && !doc["subpixelCells"].is_null()) {

@@ -90,7 +90,7 @@ void choose_spacing_q(Rig& rig, std::vector<std::string>* warnings) {
     bool ok = 2 * int64_t(std::abs(rig.view_coord(0))) <= int64_t(q) * (rig.views - 1);
     for (int i = 1; i < rig.views && ok; ++i) ok = rig.view_coord(i) > rig.view_coord(i - 1);
     if (ok) break;
-    if (q >= q_max) throw Error("internal error: no fixed-point view coordinates for angular camera spacing");
+    if (q >= q_max) throw InternalError("no fixed-point view coordinates for angular camera spacing");
   }
   const SpacingError e = spacing_error(rig);
   if (warnings && e.view_px > kSpacingErrorPx)

@@ -5,7 +5,7 @@
 namespace pmr {
 
 namespace {
-[[noreturn]] void overflow() { throw Error("internal error: exact display arithmetic overflowed 320 bits"); }
+[[noreturn]] void overflow() { throw InternalError("exact display arithmetic overflowed 320 bits"); }
 }  // namespace
 
 WideInt::WideInt(int64_t v) {
@@ -100,7 +100,7 @@ int64_t WideInt::to_int64() const {
 }
 
 void WideInt::floor_divmod(const WideInt& d, WideInt& q, WideInt& r) const {
-  if (d.negative() || d.zero()) throw Error("internal error: WideInt division by a non-positive number");
+  if (d.negative() || d.zero()) throw InternalError("WideInt division by a non-positive number");
   // Binary long division of the magnitudes.
   WideInt qm, rm;
   for (int bit = kLimbs * 64 - 1; bit >= 0; --bit) {

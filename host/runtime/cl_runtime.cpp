@@ -88,7 +88,7 @@ void expand(const std::string& name, std::set<std::string>& seen, std::string& o
   if (!seen.insert(name).second) return;
   const auto& table = embedded_sources();
   auto it = table.find(name);
-  if (it == table.end()) throw Error("internal error: kernel source '" + name + "' is not embedded");
+  if (it == table.end()) throw InternalError("kernel source '" + name + "' is not embedded");
   std::istringstream in(it->second);
   std::string line;
   while (std::getline(in, line)) {
@@ -289,7 +289,7 @@ cl_event ClRuntime::launch(const ClKernel& k, size_t items, size_t local) const 
     cl_check(clEnqueueMarkerWithWaitList(queue_, 0, nullptr, &e), "clEnqueueMarkerWithWaitList");
     return e;
   }
-  if (local == 0 || local >= kSmallGridLimit) throw Error("internal error: launch of " + k.name() + " without a valid local size");
+  if (local == 0 || local >= kSmallGridLimit) throw InternalError("launch of " + k.name() + " without a valid local size");
   const size_t row = (kSmallGridLimit - 1) / local * local;
   const size_t rows = (items + row - 1) / row;
   if (rows >= kSmallGridLimit)
@@ -302,7 +302,7 @@ cl_event ClRuntime::launch(const ClKernel& k, size_t items, size_t local) const 
 cl_event ClRuntime::launch_2d(const ClKernel& k, size_t gx, size_t gy, size_t lx, size_t ly) const {
   const size_t global[2] = {(gx + lx - 1) / lx * lx, (gy + ly - 1) / ly * ly}, local[2] = {lx, ly};
   if (global[0] >= kSmallGridLimit || global[1] >= kSmallGridLimit)
-    throw Error("internal error: 2D launch of " + k.name() + " beyond the small-grid limit");
+    throw InternalError("2D launch of " + k.name() + " beyond the small-grid limit");
   return enqueue(queue_, k, 2, global, local);
 }
 

@@ -47,7 +47,8 @@ std::vector<long> parse_frame_list(const std::string& text) {
     if (step < 1) throw Error("invalid --frames item '" + item + "': the step must be at least 1");
     for (long f = first; f <= last; f += step) {
       if (seen.insert(f).second) frames.push_back(f);
-      if (frames.size() > 10000000) throw Error("invalid --frames '" + text + "': more than 10 million frames");
+      if (frames.size() > size_t(kMaxFramesPerRun))
+        throw Error("invalid --frames '" + text + "': more than " + std::to_string(kMaxFramesPerRun) + " frames");
     }
   }
   if (items == 0 || text.back() == ',') throw Error("invalid --frames '" + text + "': empty item");

@@ -6,11 +6,13 @@
 
 namespace pmr {
 
+// The largest frame number, and the most frames one run renders (a --frames list, or --frames all).
 constexpr long kMaxFrame = 9999999;
+constexpr long kMaxFramesPerRun = 10000000;
 
 // The frames in the order given, duplicates dropped (first occurrence kept). "all" is not handled here
 // (the caller knows the animation's range). Throws pmr::Error with one line on anything malformed,
-// reversed ranges, non-positive steps, frames outside 0..kMaxFrame or lists over 10 million frames.
+// reversed ranges, non-positive steps, frames outside 0..kMaxFrame or lists over kMaxFramesPerRun.
 std::vector<long> parse_frame_list(const std::string& text);
 
 // The shortest comma list of ranges and single frames that parse_frame_list reads back as `frames`

@@ -153,7 +153,7 @@ void SequenceRun::choose_frames() {
   if (job_.frames == "all") {
     long first = 0, last = 0;
     animation_frame_range(scene_, spec_, first, last);
-    if (last - first >= 10000000) throw Error("--frames all would be " + std::to_string(last - first + 1) + " frames; give a range");
+    if (last - first >= kMaxFramesPerRun) throw Error("--frames all would be " + std::to_string(last - first + 1) + " frames; give a range");
     if (last > kMaxFrame)
       throw Error("--frames all would reach frame " + std::to_string(last) + ", beyond " + std::to_string(kMaxFrame));
     for (long f = first; f <= last; ++f) frames_.push_back(f);

@@ -4,15 +4,9 @@
  * the debug outputs); the encoded-only job uses fine_encode.cl, which never writes the volume. */
 #include "fine_raster.h"
 
-kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
-                        global const uint* tile_offsets, global const uint* tile_queue,
-                        global const PmrTriangle* tris, global const PmrVertexAttr* attrs,
-                        global const PmrMaterial* materials, global const PmrTexture* textures,
-                        global const uchar4* texels, global const float* srgb_lut, global const float* positions,
-                        global const float4* eyes, global const float2* split_sum, global const float2* texcoords, global const float4* tangents,
-                        global half* volume, global uint* debug_key, global float* debug_depth,
-                        global uint* debug_count, global const PmrEnvironment* env,
-                        global const float4* env_data, global const PmrLight* lights) {
+kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
+                          global const uint* tile_queue, global half* volume, global uint* debug_key,
+                          global float* debug_depth, global uint* debug_count) {
   const uint tile = pmr_item_id();
   const uint tiles_xy = (uint)P->tiles_x * (uint)P->tiles_y;
   if (tile >= tiles_xy * (uint)P->tiles_v) return;
@@ -23,8 +17,7 @@ kernel void fine_raster(global const PmrParams* P, global const PmrMta* mtas,
   const int nv = min(PMR_TILE_V, P->views - v0);
   const bool debug = P->debug_outputs != 0;
 
-  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, env_data,
-                    lights};
+  ShadeInputs in = PMR_SHADE_INPUTS;
   vfloat best_depth[FINE_ROWS];
   vuint best_key[FINE_ROWS], best_mta[FINE_ROWS];
   vint covered[FINE_ROWS];

@@ -31,18 +31,12 @@ inline int fused_voxel(int view, int ly, int lx) {
   return ((view * PMR_TILE_Y + ly) * FINE_CHUNKS + lx / VW) * VW + lx % VW;
 }
 
-kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
-                        global const uint* tile_offsets, global const uint* tile_queue,
-                        global const PmrTriangle* tris, global const PmrVertexAttr* attrs,
-                        global const PmrMaterial* materials, global const PmrTexture* textures,
-                        global const uchar4* texels, global const float* srgb_lut, global const float* positions,
-                        global const float4* eyes, global const float2* split_sum, global const float2* texcoords, global const float4* tangents,
-                        global const PmrEncodeParams* E, global const int* column_soa,
-                        global const PmrEncodeRow* rows, global const int* column_start,
-                        global const int* row_start, global const int* straddle_slot, uint straddle_slots,
-                        global uchar* straddle_cov, global half* display, global ushort* sub_alpha,
-                        global const PmrEnvironment* env,
-                        global const float4* env_data, global const PmrLight* lights) {
+kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
+                          global const uint* tile_queue, global const PmrEncodeParams* E,
+                          global const int* column_soa, global const PmrEncodeRow* rows,
+                          global const int* column_start, global const int* row_start,
+                          global const int* straddle_slot, uint straddle_slots, global uchar* straddle_cov,
+                          global half* display, global ushort* sub_alpha) {
   const uint tile_xy = pmr_item_id();
   const uint tiles_x = (uint)P->tiles_x, tiles_y = (uint)P->tiles_y;
   if (tile_xy >= tiles_x * tiles_y) return;
@@ -50,8 +44,7 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
   const int nx = min(PMR_TILE_X, P->view_w - x0), ny = min(PMR_TILE_Y, P->view_h - y0);
   const int views = P->views;
 
-  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, env_data,
-                    lights};
+  ShadeInputs in = PMR_SHADE_INPUTS;
   vfloat best_depth[FUSED_ROWS];
   vuint best_key[FUSED_ROWS], best_mta[FUSED_ROWS];
   fine_clear_state(FUSED_ROWS, best_depth, best_key, best_mta);

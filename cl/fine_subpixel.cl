@@ -96,19 +96,14 @@ inline uint sp_view_mask(global const PmrParams* P, const PmrMta* m, int ib, int
   return (uint)(r2.x | r2.y) & all;
 }
 
-kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, global const uint* tile_offsets,
-                          global const uint* tile_queue, global const PmrTriangle* tris,
-                          global const PmrVertexAttr* attrs, global const PmrMaterial* materials,
-                          global const PmrTexture* textures, global const uchar4* texels,
-                          global const float* srgb_lut, global const float* positions,
-                        global const float4* eyes, global const float2* split_sum, global const float2* texcoords, global const float4* tangents, global const PmrEncodeParams* E,
-                          global const int* column_a, global const int* column_b, global const PmrEncodeRow* rows,
-                          global const int* sample_x, global const int* sample_y,
-                          global const PmrSampleChunk* chunks, uint num_chunks, global const int* straddle_slot,
-                          uint straddle_slots, global uchar* straddle_cov, global half* display, global ushort* sub_alpha,
-                          uint debug, global uint* dbg_key, global float* dbg_depth,
-                          global const PmrEnvironment* env, global const float4* env_data,
-                          global const PmrLight* lights) {
+kernel void fine_subpixel(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
+                            global const uint* tile_queue, global const PmrEncodeParams* E,
+                            global const int* column_a, global const int* column_b,
+                            global const PmrEncodeRow* rows, global const int* sample_x,
+                            global const int* sample_y, global const PmrSampleChunk* chunks, uint num_chunks,
+                            global const int* straddle_slot, uint straddle_slots, global uchar* straddle_cov,
+                            global half* display, global ushort* sub_alpha, uint debug, global uint* dbg_key,
+                            global float* dbg_depth) {
   const uint chunk = pmr_item_id();
   if (chunk >= num_chunks) return;
   const PmrSampleChunk ch = chunks[chunk];
@@ -183,8 +178,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
     }
 
   /* 2. Visibility: the tile's queues, every view slab. */
-  ShadeInputs in = {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, env_data,
-                    lights};
+  ShadeInputs in = PMR_SHADE_INPUTS;
   const double8 lane_d = convert_double8(lane);
   const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
   for (int tv = 0; tv < P->tiles_v; ++tv) {

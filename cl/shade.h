@@ -56,6 +56,18 @@ inline float4 sample_texture(global const uchar4* texels, global const float* sr
   return top + (bottom - top) * ay;
 }
 
+/* The shading inputs: the leading parameters of every kernel that shades, bound in this order by the
+ * host (SceneBuffers::bind_shading, host/pipeline/scene_buffers.cpp), and gathered into one ShadeInputs
+ * by PMR_SHADE_INPUTS. A new input is one entry in each of the three lists and in the struct. */
+#define PMR_SHADE_PARAMS                                                                                    \
+  global const PmrParams *P, global const PmrTriangle *tris, global const PmrVertexAttr *attrs,             \
+      global const PmrMaterial *materials, global const PmrTexture *textures, global const uchar4 *texels,  \
+      global const float *srgb_lut, global const float *positions, global const float4 *eyes,              \
+      global const float2 *split_sum, global const float2 *texcoords, global const float4 *tangents,        \
+      global const PmrEnvironment *env, global const float4 *env_data, global const PmrLight *lights
+#define PMR_SHADE_INPUTS \
+  {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, env_data, lights}
+
 typedef struct {
   global const PmrTriangle* tris;
   global const PmrVertexAttr* attrs;

@@ -15,7 +15,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 std::vector<float> run_probe(const char* kernel, const std::vector<float>& in, size_t per_case, size_t out_per_case) {
   const ClRuntime& rt = test::runtime();
-  cl_program program = rt.build_program({"brdf_probe.cl"}, "-cl-std=CL1.2");
+  const ClProgram program = rt.build_program({"brdf_probe.cl"}, "-cl-std=CL1.2", &test_kernel_sources());
   const size_t n = in.size() / per_case;
   std::vector<float> out(n * out_per_case);
   {
@@ -26,7 +26,6 @@ std::vector<float> run_probe(const char* kernel, const std::vector<float>& in, s
     clReleaseEvent(rt.launch(k, n, 64));
     rt.read(b, out.data(), out.size() * 4);
   }
-  clReleaseProgram(program);
   return out;
 }
 

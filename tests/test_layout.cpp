@@ -10,7 +10,7 @@ namespace {
 
 TEST(Layout, DeviceStructsMatchHost) {
   const ClRuntime& rt = test::runtime();
-  cl_program program = rt.build_program({"layout_probe.cl"}, "-cl-std=CL1.2");
+  const ClProgram program = rt.build_program({"layout_probe.cl"}, "-cl-std=CL1.2", &test_kernel_sources());
   ClKernel k(program, "layout_probe");
   ClBuffer out = rt.buffer(64 * 4, "probe");
   k.arg(0, out);
@@ -18,7 +18,6 @@ TEST(Layout, DeviceStructsMatchHost) {
   clReleaseEvent(e);
   uint32_t got[64] = {};
   rt.read(out, got, sizeof got);
-  clReleaseProgram(program);
   const uint32_t want[] = {
       sizeof(PmrParams), offsetof(PmrParams, ndc_scale_x), offsetof(PmrParams, light_world), offsetof(PmrParams, view_w),
       offsetof(PmrParams, debug_outputs), sizeof(PmrVertex), offsetof(PmrVertex, x0), offsetof(PmrVertex, z),

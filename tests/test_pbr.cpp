@@ -503,7 +503,7 @@ TEST(PbrEnvironment, KernelLookupsMatchTheHost) {
     in.insert(in.end(), {d.x, d.y, d.z, float(rs.back())});
   }
   const ClRuntime& rt = test::runtime();
-  cl_program program = rt.build_program({"environment_probe.cl"}, "-cl-std=CL1.2");
+  const ClProgram program = rt.build_program({"environment_probe.cl"}, "-cl-std=CL1.2", &test_kernel_sources());
   std::vector<float> out(6 * dirs.size());
   {
     ClKernel k(program, "environment_probe");
@@ -517,7 +517,6 @@ TEST(PbrEnvironment, KernelLookupsMatchTheHost) {
     clReleaseEvent(rt.launch(k, dirs.size(), 64));
     rt.read(b, out.data(), out.size() * 4);
   }
-  clReleaseProgram(program);
   double worst = 0.0;
   for (size_t i = 0; i < dirs.size(); ++i) {
     const glm::dvec3 d = glm::dvec3(glm::vec3(dirs[i]));  // the float direction the kernel saw

@@ -2,6 +2,7 @@
 // procedural scenes with known properties.
 #pragma once
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <random>
 #include <set>
@@ -12,6 +13,12 @@
 #include "pmr/rig.h"
 #include "pmr/scene.h"
 #include "runtime/cl_runtime.h"
+
+namespace pmr {
+// The tests' kernel probes (tests/probes), embedded into the test binary only; pass to
+// ClRuntime::build_program.
+const std::map<std::string, std::string>& test_kernel_sources();
+}  // namespace pmr
 
 namespace pmr::test {
 

@@ -30,7 +30,7 @@ MaterialTables make_material_tables(const Scene& scene) {
     d.width = tex.width, d.height = tex.height;
     d.wrap_s = tex.wrap_s, d.wrap_t = tex.wrap_t;
     if (tex.rgba.size() != size_t(tex.width) * size_t(tex.height) * 4)
-      throw Error("internal: a texture's texels do not match its size");
+      throw InternalError("a texture's texels do not match its size");
     total_texels += size_t(tex.width) * size_t(tex.height);
     if (total_texels >= (size_t(1) << 32)) throw Error("the scene's textures are too large (over 4 G texels)");
     t.textures.push_back(d);
@@ -40,7 +40,7 @@ MaterialTables make_material_tables(const Scene& scene) {
     std::copy(scene.textures[i].rgba.begin(), scene.textures[i].rgba.end(), t.texels.begin() + size_t(t.textures[i].offset) * 4);
 
   for (const std::vector<glm::vec2>& set : scene.texcoords)
-    if (set.size() != vertices) throw Error("internal: a TEXCOORD set does not have one entry per vertex");
+    if (set.size() != vertices) throw InternalError("a TEXCOORD set does not have one entry per vertex");
   t.texcoords.reserve(std::max<size_t>(1, scene.texcoords.size() * vertices));
   for (const std::vector<glm::vec2>& set : scene.texcoords) t.texcoords.insert(t.texcoords.end(), set.begin(), set.end());
   if (t.texcoords.empty()) t.texcoords.emplace_back(0.0f);
@@ -65,7 +65,7 @@ MaterialTables make_material_tables(const Scene& scene) {
       if (slot.texture < 0) continue;
       if (size_t(slot.texture) >= scene.textures.size() || slot.texcoord < 0 ||
           size_t(slot.texcoord) >= scene.texcoords.size())
-        throw Error("internal: material " + std::to_string(i) + "'s " + texture_slot_name(kMapSlot[k]) +
+        throw InternalError("material " + std::to_string(i) + "'s " + texture_slot_name(kMapSlot[k]) +
                     " names a texture or TEXCOORD set the scene does not have");
       if (k == PMR_MAP_NORMAL && !has_tangents) continue;
       PmrTextureMap& map = m.maps[k];

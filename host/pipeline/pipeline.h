@@ -1,8 +1,11 @@
 // The PMR pipeline on an OpenCL device: vertex transform -> primitive setup -> tile raster (bin) ->
-// fine raster -> pixel encoding. Buffers are allocated once per configuration and reused across frames;
-// the MTA queue and the tile queues are sized from the scene and grown (and the frame redone) when a
-// frame needs more, so no work is ever dropped.
+// fine raster -> pixel encoding. The pipeline only sequences its stages, each of which owns its buffers
+// and kernels (docs/ARCHITECTURE.md): the scene's buffers (scene_buffers.h), vertex + setup + tile raster
+// with their queues (geometry_stage.h), the fine raster's forms (fine_stage.h) and the display encoding
+// (encode_stage.h). Buffers are allocated once per configuration and reused across frames; a frame is
+// described once (FrameDescription) and rendered whole.
 #pragma once
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -19,6 +22,8 @@
 namespace pmr {
 
 class Environment;
+class FrameEvents;
+struct FinePaths;
 
 // How the N views are rasterized. All three produce the same images (see tests/test_methods.cpp).
 enum class Method {
@@ -152,13 +157,13 @@ class Pipeline {
  struct Impl;
 
  private:
-  void build_kernels(const Rig& rig);
-  PmrParams frame_params(const FrameDescription& frame) const;
+  FinePaths choose_paths(const Rig& rig, const Display* display) const;
+  PmrParams frame_params(const FrameDescription& frame, bool empty) const;
+  StageTimes render_frame(const FrameDescription& frame, bool empty);
+  void wait_reporting(const FrameEvents& ev, const StageTimes& t, std::chrono::steady_clock::time_point start);
   std::unique_ptr<Impl> impl_;
   PipelineConfig config_;
   int tiles_x_ = 0, tiles_y_ = 0, tiles_v_ = 0;
-  int tile_[3] = {4, 4, 4};  // effective tile for the method
-  std::string build_options_;  // kernel build options (the fused program is built per view count)
 };
 
 }  // namespace pmr

@@ -84,9 +84,11 @@ std::vector<cl_device_id> devices(cl_platform_id p) {
 }
 
 // Replaces `#include "name"` lines by embedded files, each at most once.
-void expand(const std::string& name, std::set<std::string>& seen, std::string& out) {
+using SourceTable = std::map<std::string, std::string>;
+
+void expand(const std::string& name, const SourceTable* extra, std::set<std::string>& seen, std::string& out) {
   if (!seen.insert(name).second) return;
-  const auto& table = embedded_sources();
+  const SourceTable& table = extra && extra->count(name) ? *extra : embedded_sources();
   auto it = table.find(name);
   if (it == table.end()) throw InternalError("kernel source '" + name + "' is not embedded");
   std::istringstream in(it->second);
@@ -98,7 +100,7 @@ void expand(const std::string& name, std::set<std::string>& seen, std::string& o
       std::string inc = line.substr(p + 10, q - p - 10);
       const auto slash = inc.rfind('/');
       if (slash != std::string::npos) inc = inc.substr(slash + 1);
-      expand(inc, seen, out);
+      expand(inc, extra, seen, out);
       out += "\n";
     } else {
       out += line;
@@ -152,9 +154,21 @@ ClBuffer& ClBuffer::operator=(ClBuffer&& o) noexcept {
   return *this;
 }
 
-ClKernel::ClKernel(cl_program program, const std::string& name) : name_(name) {
+ClProgram::~ClProgram() {
+  if (program_) clReleaseProgram(program_);
+}
+ClProgram& ClProgram::operator=(ClProgram&& o) noexcept {
+  if (this != &o) {
+    if (program_) clReleaseProgram(program_);
+    program_ = o.program_;
+    o.program_ = nullptr;
+  }
+  return *this;
+}
+
+ClKernel::ClKernel(const ClProgram& program, const std::string& name) : name_(name) {
   cl_int err = CL_SUCCESS;
-  kernel_ = clCreateKernel(program, name.c_str(), &err);
+  kernel_ = clCreateKernel(program.get(), name.c_str(), &err);
   cl_check(err, "clCreateKernel(" + name + ")");
 }
 ClKernel::~ClKernel() {
@@ -219,10 +233,11 @@ size_t ClRuntime::max_work_group_size() const {
   return v;
 }
 
-cl_program ClRuntime::build_program(const std::vector<std::string>& files, const std::string& options) const {
+ClProgram ClRuntime::build_program(const std::vector<std::string>& files, const std::string& options,
+                                   const SourceTable* extra) const {
   std::string source;
   std::set<std::string> seen;
-  for (const auto& f : files) expand(f, seen, source);
+  for (const auto& f : files) expand(f, extra, seen, source);
   const char* text = source.c_str();
   const size_t length = source.size();
   cl_int err = CL_SUCCESS;
@@ -238,7 +253,7 @@ cl_program ClRuntime::build_program(const std::vector<std::string>& files, const
     throw Error("OpenCL program build failed (" + std::string(cl_error_name(err)) + ") with options '" +
                 options + "':\n" + log);
   }
-  return program;
+  return ClProgram(program);
 }
 
 ClBuffer ClRuntime::buffer(size_t bytes, const std::string& name, cl_mem_flags flags) const {

@@ -35,10 +35,26 @@ class ClBuffer {
   size_t bytes_ = 0;
 };
 
+// An OpenCL program; released with its owner.
+class ClProgram {
+ public:
+  ClProgram() = default;
+  explicit ClProgram(cl_program program) : program_(program) {}
+  ~ClProgram();
+  ClProgram(ClProgram&& o) noexcept : program_(o.program_) { o.program_ = nullptr; }
+  ClProgram& operator=(ClProgram&& o) noexcept;
+  ClProgram(const ClProgram&) = delete;
+  ClProgram& operator=(const ClProgram&) = delete;
+  cl_program get() const { return program_; }
+
+ private:
+  cl_program program_ = nullptr;
+};
+
 class ClKernel {
  public:
   ClKernel() = default;
-  ClKernel(cl_program program, const std::string& name);
+  ClKernel(const ClProgram& program, const std::string& name);
   ~ClKernel();
   ClKernel(ClKernel&& o) noexcept;
   ClKernel& operator=(ClKernel&& o) noexcept;
@@ -52,7 +68,12 @@ class ClKernel {
   // Sets arguments 0, 1, 2, ... in order.
   template <typename... Args>
   void args(const Args&... values) {
-    cl_uint index = 0;
+    args_from(0, values...);
+  }
+  // Sets arguments first, first + 1, ... in order.
+  template <typename... Args>
+  void args_from(cl_uint first, const Args&... values) {
+    cl_uint index = first;
     (arg(index++, values), ...);
   }
 
@@ -82,7 +103,10 @@ class ClRuntime {
   // Builds a program from embedded sources: `files` are names from the embedded table, concatenated in
   // order, with `#include "x"` lines replaced by the embedded file x (once). Options are logged with
   // the build log on failure.
-  cl_program build_program(const std::vector<std::string>& files, const std::string& options) const;
+  // `extra`: more sources to look names up in first (the tests' kernel probes, which the shipped binary
+  // does not carry).
+  ClProgram build_program(const std::vector<std::string>& files, const std::string& options,
+                          const std::map<std::string, std::string>* extra = nullptr) const;
 
   ClBuffer buffer(size_t bytes, const std::string& name, cl_mem_flags flags = CL_MEM_READ_WRITE) const;
   void write(const ClBuffer& b, const void* data, size_t bytes, size_t offset = 0) const;

@@ -75,9 +75,9 @@ bool animation_key_frames(const Scene& scene, const SequenceSpec& spec, long& fi
   const double a = std::ceil(start * spec.fps - 1e-6), b = std::floor(end * spec.fps + 1e-6);
   // The framing poses every frame of the range: refuse absurd ranges (key times near float's
   // maximum, hours of animation) with one line instead of working for days or overflowing.
-  if (!(b - std::max(a, 0.0) < double(kMaxAnimationFrames)))
+  if (!(b - std::max(a, 0.0) < double(kMaxFramesPerRun)))
     throw Error("the animation's keys span " + std::to_string(start) + " to " + std::to_string(end) + " s, over " +
-                std::to_string(kMaxAnimationFrames) + " frames at " + std::to_string(spec.fps) + " fps");
+                std::to_string(kMaxFramesPerRun) + " frames at " + std::to_string(spec.fps) + " fps");
   first = std::max(0L, long(a));
   last = std::max(first - 1, long(b));
   return first <= last;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pipeline/pipeline.h"
+#include "sequence/frame_list.h"
 #include "pmr/input_files.h"
 #include "pmr/rig.h"
 #include "pmr/scene.h"
@@ -34,8 +35,8 @@ void select_animation(const Scene& scene, const std::string& choice, SequenceSpe
 // The frames whose times f / fps lie inside the chosen animation's key range: ceil(start * fps) to
 // floor(end * fps) (within 1e-6 of a frame: float key times). Outside it a frame repeats the first or
 // the last pose (glTF clamps). Returns false, with last < first, when no frame time lies inside, and
-// when no animation is chosen. Throws pmr::Error when the range exceeds kMaxAnimationFrames.
-constexpr long kMaxAnimationFrames = 1000000;
+// when no animation is chosen. Throws pmr::Error when the range exceeds kMaxFramesPerRun (the frames
+// --frames all would render; the framing poses every one of them).
 bool animation_key_frames(const Scene& scene, const SequenceSpec& spec, long& first, long& last);
 
 // The frames of --frames all: with a turntable one turn, 0..FRAMES-1 (an animation's time keeps

@@ -1,0 +1,85 @@
+#include "pipeline/encode_stage.h"
+
+#include <algorithm>
+
+#include "pmr/error.h"
+
+namespace pmr {
+
+ClBuffer upload_table(const ClRuntime& rt, const std::vector<int32_t>& v, const char* name) {
+  ClBuffer b = rt.buffer(std::max<size_t>(v.size() * sizeof(int32_t), 16), name, CL_MEM_READ_ONLY);
+  rt.write(b, v.data(), v.size() * sizeof(int32_t));
+  return b;
+}
+
+EncodeStage::EncodeStage(Launcher& launcher, const ClProgram& program)
+    : launcher_(launcher),
+      rt_(launcher.runtime()),
+      nearest_(program, "encode_nearest"),
+      bilinear_(program, "encode_bilinear"),
+      blend_(program, "encode_blend"),
+      straddle_(program, "encode_straddle_alpha") {
+  params_buf_ = rt_.buffer(sizeof(PmrEncodeParams), "encoder parameters", CL_MEM_READ_ONLY);
+}
+
+void EncodeStage::configure(const Display& display, int views, int w, int h) {
+  params_ = make_encode_params(display, views, w, h);
+  make_encode_tables(display, params_, columns_, rows_);
+  rt_.write(params_buf_, &params_, sizeof params_);
+  columns_buf_ = rt_.buffer(columns_.size() * sizeof(PmrEncodeColumn), "encoder columns", CL_MEM_READ_ONLY);
+  rt_.write(columns_buf_, columns_.data(), columns_.size() * sizeof(PmrEncodeColumn));
+  rows_buf_ = rt_.buffer(rows_.size() * sizeof(PmrEncodeRow), "encoder rows", CL_MEM_READ_ONLY);
+  rt_.write(rows_buf_, rows_.data(), rows_.size() * sizeof(PmrEncodeRow));
+  configured_ = true;
+  display_ = rt_.buffer(std::max<size_t>(display_bytes(), 16), "display image");
+  sub_alpha_ = rt_.buffer(std::max<size_t>(display_bytes() / 4 * 3, 16), "display subpixel alpha");
+}
+
+size_t EncodeStage::display_bytes() const {
+  return configured_ ? size_t(params_.display_w) * params_.display_h * 4 * sizeof(uint16_t) : 0;
+}
+
+// The straddling pixels' slots and coverage bytes (fused and subpixel paths).
+TileOwnership EncodeStage::own_by_tiles(int tile_x) {
+  TileOwnership own = tile_ownership(params_, columns_, rows_, tile_x);
+  straddle_slot_ = upload_table(rt_, own.straddle_slot, "straddle slots");
+  straddle_columns_ = upload_table(rt_, own.straddling, "straddle columns");
+  straddle_slots_ = uint32_t(own.straddling.size());
+  straddle_cov_ = rt_.buffer(std::max<size_t>(size_t(straddle_slots_) * params_.display_h * 3, 16), "straddle coverage");
+  return own;
+}
+
+void EncodeStage::encode(const ClBuffer& volume, FrameEvents& ev) {
+  ClKernel& k = params_.blend ? blend_ : params_.bilinear ? bilinear_ : nearest_;
+  k.args(params_buf_, columns_buf_, rows_buf_, volume, display_, sub_alpha_);
+  const size_t runs = (size_t(params_.display_w) + PMR_ENCODE_RUN - 1) / PMR_ENCODE_RUN;
+  ev.add(kEncode, launcher_.launch_2d(k, runs, size_t(params_.display_h), 8, 1));
+}
+
+void EncodeStage::straddle_alpha(FrameEvents& ev) {
+  if (straddle_slots_ == 0) return;
+  straddle_.args(params_buf_, straddle_columns_, straddle_slots_, straddle_cov_, display_);
+  ev.add(kEncode, launcher_.launch_2d(straddle_, straddle_slots_, size_t(params_.display_h), 1, 8));
+}
+
+void EncodeStage::read_display(std::vector<uint16_t>& out) const {
+  if (!configured_) throw InternalError("no display configured");
+  out.resize(display_bytes() / 2);
+  rt_.read(display_, out.data(), display_bytes());
+}
+
+void EncodeStage::read_sub_alpha(std::vector<uint16_t>& out) const {
+  if (!configured_) throw InternalError("no display configured");
+  out.resize(display_bytes() / 8 * 3);
+  rt_.read(sub_alpha_, out.data(), display_bytes() / 4 * 3);
+}
+
+size_t EncodeStage::device_bytes() const {
+  size_t total = 0;
+  for (const ClBuffer* b : {&params_buf_, &columns_buf_, &rows_buf_, &display_, &sub_alpha_, &straddle_slot_,
+                            &straddle_columns_, &straddle_cov_})
+    total += b->size();
+  return total;
+}
+
+}  // namespace pmr

@@ -1,0 +1,46 @@
+// The run-wide choices of a pipeline (pipeline.h): method, sampling and shading names.
+#include "pipeline/pipeline.h"
+
+#include "pmr/error.h"
+
+namespace pmr {
+
+Method parse_method(const std::string& name) {
+  if (name == "pmr") return Method::Pmr;
+  if (name == "multipass") return Method::Multipass;
+  if (name == "duplicate") return Method::Duplicate;
+  throw Error("unknown method '" + name + "' (expected pmr, multipass or duplicate)");
+}
+
+const char* to_string(Method m) {
+  switch (m) {
+    case Method::Multipass: return "multipass";
+    case Method::Duplicate: return "duplicate";
+    default: return "pmr";
+  }
+}
+
+Sampling parse_sampling(const std::string& name) {
+  if (name == "view") return Sampling::View;
+  if (name == "subpixel") return Sampling::Subpixel;
+  throw Error("unknown sampling '" + name + "' (expected view or subpixel)");
+}
+
+const char* to_string(Sampling s) { return s == Sampling::Subpixel ? "subpixel" : "view"; }
+
+Shading parse_shading(const std::string& name) {
+  if (name == "lambert") return Shading::Lambert;
+  if (name == "pbr") return Shading::Pbr;
+  throw Error("unknown shading '" + name + "' (expected lambert or pbr)");
+}
+
+const char* to_string(Shading s) { return s == Shading::Pbr ? "pbr" : "lambert"; }
+
+void check_subpixel_sampling(Method method, const Display& display) {
+  if (method != Method::Pmr) throw Error("--sampling subpixel renders with --method pmr");
+  if (display.bilinear || display.blend_views)
+    throw Error("--sampling subpixel computes every subpixel at its own sample: --bilinear and --blend-views "
+                "apply to --sampling view only");
+}
+
+}  // namespace pmr

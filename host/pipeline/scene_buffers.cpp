@@ -1,0 +1,132 @@
+#include "pipeline/scene_buffers.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pipeline/material_tables.h"
+#include "pipeline/pipeline.h"
+#include "pmr/error.h"
+#include "shading/environment.h"
+#include "shading/lights.h"
+
+namespace pmr {
+
+namespace {
+
+std::vector<float> srgb_lut() {
+  std::vector<float> lut(256);
+  for (int c = 0; c < 256; ++c) {
+    const double v = c / 255.0;
+    lut[c] = float(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+  }
+  return lut;
+}
+
+template <typename T>
+size_t bytes_of(const std::vector<T>& v) {
+  return v.size() * sizeof(T);
+}
+
+// A read-only buffer holding `v` (at least `min_bytes`: OpenCL has no empty buffers).
+template <typename T>
+ClBuffer upload(const ClRuntime& rt, const std::vector<T>& v, const char* name, size_t min_bytes = 1) {
+  ClBuffer b = rt.buffer(std::max(bytes_of(v), min_bytes), name, CL_MEM_READ_ONLY);
+  rt.write(b, v.data(), bytes_of(v));
+  return b;
+}
+
+// Rewrites `b` with `v`, reallocating only when the size changes (per-frame tables).
+template <typename T>
+void rewrite(const ClRuntime& rt, ClBuffer& b, const std::vector<T>& v, const char* name) {
+  if (b.size() != bytes_of(v)) b = rt.buffer(bytes_of(v), name, CL_MEM_READ_ONLY);
+  rt.write(b, v.data(), bytes_of(v));
+}
+
+}  // namespace
+
+SceneBuffers::SceneBuffers(const ClRuntime& rt, const PipelineConfig& config) : rt_(rt) {
+  lut_ = upload(rt, srgb_lut(), "sRGB table");
+  // the split-sum table (pbr only: computing it costs about 0.5 s of CPU once per process)
+  static_assert(kEnvSplitSumSize == PMR_SPLIT_SUM_N, "the kernels' split-sum table size");
+  const std::vector<float> none(2, 0.0f);
+  split_sum_ = upload(rt, config.shading == Shading::Pbr ? split_sum_table() : none, "split-sum table");
+  upload_environment(config);
+}
+
+// The environment image's tables, uploaded once per pipeline (the Environment is prefiltered once per
+// process and shared); without one, an empty header (level_count 0) selects the uniform default.
+void SceneBuffers::upload_environment(const PipelineConfig& config) {
+  const Environment* e = config.environment.get();
+  if (e && config.shading != Shading::Pbr) throw Error("an environment image needs --shading pbr");
+  if (e && e->tables().header.intensity != float(config.environment_intensity))
+    throw InternalError("the environment's intensity differs from the configuration's");
+  const std::vector<PmrEnvironment> header(1, e ? e->tables().header : PmrEnvironment{});
+  const std::vector<float> no_data(4, 0.0f);
+  const std::vector<float>& data = e ? e->tables().data : no_data;
+  if (bytes_of(data) > rt_.max_alloc_bytes())
+    throw Error("the environment's tables need " + std::to_string(bytes_of(data) >> 20) + " MiB, more than the device "
+                "can allocate at once (" + std::to_string(rt_.max_alloc_bytes() >> 20) + " MiB): use a smaller image");
+  env_ = upload(rt_, header, "environment header");
+  env_data_ = upload(rt_, data, "environment tables");
+}
+
+void SceneBuffers::set_scene(const Scene& scene) {
+  if (scene.triangles.size() >= PMR_MAX_TRIANGLES)
+    throw Error("the scene has " + std::to_string(scene.triangles.size()) + " triangles; at most " +
+                std::to_string(PMR_MAX_TRIANGLES - 1) + " are supported");
+  num_vertices_ = uint32_t(scene.positions.size());
+  num_triangles_ = uint32_t(scene.triangles.size());
+  const MaterialTables tables = make_material_tables(scene);
+  has_tangents_ = scene.tangents.size() == scene.positions.size() && !scene.positions.empty();
+  const std::vector<glm::vec4> no_tangents(1, glm::vec4(0.0f));
+  scene_lights_ = scene.lights;
+  positions_ = upload(rt_, scene.positions, "vertex positions");
+  attrs_ = upload(rt_, scene.attributes, "vertex attributes");
+  tris_ = upload(rt_, scene.triangles, "triangles");
+  materials_ = upload(rt_, tables.materials, "materials");
+  textures_ = upload(rt_, tables.textures, "texture table", 16);
+  texels_ = upload(rt_, tables.texels, "texels", 16);
+  texcoords_ = upload(rt_, tables.texcoords, "texture coordinates");
+  tangents_ = upload(rt_, has_tangents_ ? scene.tangents : no_tangents, "tangents");
+}
+
+void SceneBuffers::update_geometry(const Scene& posed) {
+  if (posed.positions.size() != num_vertices_ || posed.triangles.size() != num_triangles_ ||
+      posed.attributes.size() != posed.positions.size())
+    throw InternalError("update_geometry: the posed scene does not match the scene given to set_scene");
+  if (posed.triangles.empty()) return;
+  rt_.write(positions_, posed.positions.data(), bytes_of(posed.positions));
+  rt_.write(attrs_, posed.attributes.data(), bytes_of(posed.attributes));
+  rt_.write(tris_, posed.triangles.data(), bytes_of(posed.triangles));
+  if (has_tangents_ && posed.tangents.size() == posed.positions.size())
+    rt_.write(tangents_, posed.tangents.data(), bytes_of(posed.tangents));
+}
+
+void SceneBuffers::upload_frame(const FrameDescription& frame) {
+  std::vector<PmrLight> table;
+  for (const SceneLight& l : frame.lights) table.push_back(device_light(l));
+  table.resize(std::max<size_t>(table.size(), 1));  // no empty buffers
+  rewrite(rt_, lights_, table, "lights");
+  const Rig& rig = frame.rig;
+  std::vector<glm::vec4> eyes(size_t(rig.views));
+  for (int i = 0; i < rig.views; ++i) eyes[size_t(i)] = glm::vec4(glm::vec3(glm::inverse(rig.view_matrix(i))[3]), 1.0f);
+  rewrite(rt_, eyes_, eyes, "camera positions");
+}
+
+cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params) const {
+  const ClBuffer* inputs[] = {&params, &tris_,  &attrs_, &materials_, &textures_, &texels_, &lut_,      &positions_,
+                              &eyes_,  &split_sum_, &texcoords_, &tangents_, &env_, &env_data_, &lights_};
+  cl_uint i = 0;
+  for (const ClBuffer* b : inputs) k.arg(i++, *b);
+  return i;
+}
+
+size_t SceneBuffers::device_bytes() const {
+  size_t total = 0;
+  for (const ClBuffer* b : {&positions_, &attrs_, &tris_, &materials_, &textures_, &texels_, &texcoords_, &tangents_,
+                            &lut_, &split_sum_, &env_, &env_data_, &lights_, &eyes_})
+    total += b->size();
+  return total;
+}
+
+}  // namespace pmr

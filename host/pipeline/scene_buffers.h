@@ -1,0 +1,50 @@
+// The scene on the device, and everything shading reads: geometry and materials (set_scene), the posed
+// geometry of a frame (update_geometry), the frame's lights and camera positions (upload_frame), and the
+// run's tables (sRGB decoding, the split-sum table, the environment image). Shading kernels take these
+// as their leading arguments in one order (cl/shade.h, PMR_SHADE_PARAMS), bound by bind_shading alone.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "pipeline/frame_description.h"
+#include "pmr/scene.h"
+#include "runtime/cl_runtime.h"
+
+namespace pmr {
+
+struct PipelineConfig;
+
+class SceneBuffers {
+ public:
+  // The run's tables: sRGB decoding, the split-sum table (pbr) and the environment image (pbr).
+  SceneBuffers(const ClRuntime& rt, const PipelineConfig& config);
+  void set_scene(const Scene& scene);
+  // The posed geometry of a frame of the scene given to set_scene (same counts): copied, not reallocated.
+  void update_geometry(const Scene& posed);
+  // The frame's light table and each view's camera position in world space (the view vector of pbr).
+  void upload_frame(const FrameDescription& frame);
+  // Binds the frame parameters `params` and the shading inputs as arguments 0 .. of `k` (the order of
+  // PMR_SHADE_PARAMS); returns the index of the kernel's next argument.
+  cl_uint bind_shading(ClKernel& k, const ClBuffer& params) const;
+
+  uint32_t num_vertices() const { return num_vertices_; }
+  uint32_t num_triangles() const { return num_triangles_; }
+  const ClBuffer& positions() const { return positions_; }
+  const ClBuffer& triangles() const { return tris_; }
+  const ClBuffer& materials() const { return materials_; }
+  const std::vector<SceneLight>& scene_lights() const { return scene_lights_; }  // as in the file, rest pose
+  size_t device_bytes() const;
+
+ private:
+  void upload_environment(const PipelineConfig& config);
+
+  const ClRuntime& rt_;
+  uint32_t num_vertices_ = 0, num_triangles_ = 0;
+  bool has_tangents_ = false;
+  std::vector<SceneLight> scene_lights_;
+  ClBuffer positions_, attrs_, tris_, materials_, textures_, texels_, texcoords_, tangents_;
+  ClBuffer lut_, split_sum_, env_, env_data_;  // the run's tables
+  ClBuffer lights_, eyes_;                     // the frame's
+};
+
+}  // namespace pmr

@@ -287,70 +287,86 @@ PartLayout layout_of(const ExrZipPart& part, const std::string& shown_path) {
   return L;
 }
 
-}  // namespace
-
-void write_zip_exr(const std::string& path, const std::string& shown_path, const std::vector<ExrZipPart>& parts,
-                   ZipEncoder encoder, int threads) {
+void check_little_endian(const std::string& shown_path) {
   static_assert(sizeof(float) == 4, "EXR floats are 4 bytes");
-  {
-    const uint16_t probe = 1;
-    unsigned char first;
-    std::memcpy(&first, &probe, 1);
-    if (first != 1) throw Error("cannot write " + shown_path + ": the ZIP EXR writer needs a little-endian host");
-  }
-  if (parts.empty()) throw InternalError("cannot write " + shown_path + ": an EXR file without parts");
-  const bool multi = parts.size() > 1;
-  std::vector<Imf::Header> headers;
-  std::vector<PartLayout> layouts;
-  size_t max_raw = 0;
-  bool long_names = false;
-  for (const ExrZipPart& part : parts) {
-    layouts.push_back(layout_of(part, shown_path));
-    headers.push_back(part.header);
-    if (multi) headers.back().setChunkCount(layouts.back().chunks);  // required in a multi-part file
-    headers.back().sanityCheck(false, multi);
-    long_names = long_names || uses_long_names(part.header);
-    max_raw = std::max(max_raw, layouts.back().line_bytes * kLinesPerChunk);
-  }
+  const uint16_t probe = 1;
+  unsigned char first;
+  std::memcpy(&first, &probe, 1);
+  if (first != 1) throw Error("cannot write " + shown_path + ": the ZIP EXR writer needs a little-endian host");
+}
 
-  // compress the chunks of every part, each thread taking the next one
-  struct Job {
-    int part, chunk;
-  };
-  std::vector<Job> jobs;
-  for (size_t p = 0; p < parts.size(); ++p)
-    for (int c = 0; c < layouts[p].chunks; ++c) jobs.push_back({int(p), c});
+struct FileLayout {
+  bool multi = false, long_names = false;
+  std::vector<Imf::Header> headers;  // as written: a multi-part file's with their chunk counts
+  std::vector<PartLayout> parts;
+  size_t max_raw = 0;  // the largest chunk's raw bytes: the size of every thread's buffers
+};
+
+FileLayout file_layout(const std::vector<ExrZipPart>& parts, const std::string& shown_path) {
+  if (parts.empty()) throw InternalError("cannot write " + shown_path + ": an EXR file without parts");
+  FileLayout F;
+  F.multi = parts.size() > 1;
+  for (const ExrZipPart& part : parts) {
+    F.parts.push_back(layout_of(part, shown_path));
+    F.headers.push_back(part.header);
+    if (F.multi) F.headers.back().setChunkCount(F.parts.back().chunks);  // required in a multi-part file
+    F.headers.back().sanityCheck(false, F.multi);
+    F.long_names = F.long_names || uses_long_names(part.header);
+    F.max_raw = std::max(F.max_raw, F.parts.back().line_bytes * kLinesPerChunk);
+  }
+  return F;
+}
+
+struct ChunkJob {
+  int part, chunk;
+};
+
+// false when the compressor cannot be allocated.
+bool prepare_scratch(Scratch& S, ZipEncoder encoder, size_t max_raw) {
+  if (encoder == ZipEncoder::Default && !S.z) {
+    S.z.reset(libdeflate_alloc_compressor(kDefaultLevel));
+    if (!S.z) return false;
+  }
+  if (S.isal_level_buf.size() < kFastLevelBuf) S.isal_level_buf.resize(kFastLevelBuf);
+  if (S.split.size() < max_raw) S.split.resize(max_raw), S.pre.resize(max_raw + kInputSlack), S.packed.resize(packed_bound(max_raw));
+  return true;
+}
+
+// A chunk as stored in the file: its part number (multi-part files), first y, data size and data.
+std::vector<unsigned char> encode_chunk(Scratch& S, const FileLayout& F, ChunkJob job, ZipEncoder encoder) {
+  const PartLayout& L = F.parts[size_t(job.part)];
+  const int y0 = job.chunk * kLinesPerChunk, y1 = std::min(L.height, y0 + kLinesPerChunk);
+  const size_t n = precondition_chunk(L.runs, L.line_bytes, L.width, y0, y1, S.split.data(), S.pre.data());
+  const size_t size = compress_chunk(S, encoder, S.pre.data(), n);
+  const bool stored = size == 0 || size >= n;  // the scanlines' raw bytes (0: did not fit)
+  std::vector<unsigned char> out;
+  out.reserve(12 + (stored ? n : size));
+  if (F.multi) put32(out, uint32_t(job.part));
+  put32(out, uint32_t(L.min_y + y0));
+  if (stored) {
+    put32(out, uint32_t(n));
+    raw_chunk(L.order, L.width, y0, y1, S.split.data());
+    out.insert(out.end(), S.split.data(), S.split.data() + n);
+  } else {
+    put32(out, uint32_t(size));
+    out.insert(out.end(), S.packed.data(), S.packed.data() + size);
+  }
+  return out;
+}
+
+// Every part's chunks in job order (part by part), each thread taking the next one.
+std::vector<std::vector<unsigned char>> encode_chunks(const FileLayout& F, ZipEncoder encoder, int threads,
+                                                      const std::string& shown_path) {
+  std::vector<ChunkJob> jobs;
+  for (size_t p = 0; p < F.parts.size(); ++p)
+    for (int c = 0; c < F.parts[p].chunks; ++c) jobs.push_back({int(p), c});
   std::vector<std::vector<unsigned char>> data(jobs.size());
   std::atomic<size_t> next{0};
   std::atomic<bool> failed{false};
   auto work = [&] {
     std::unique_ptr<Scratch> scratch = take_scratch();
-    Scratch& S = *scratch;
-    if (encoder == ZipEncoder::Default && !S.z) {
-      S.z.reset(libdeflate_alloc_compressor(kDefaultLevel));
-      if (!S.z) failed = true;
-    }
-    if (S.isal_level_buf.size() < kFastLevelBuf) S.isal_level_buf.resize(kFastLevelBuf);
-    if (S.split.size() < max_raw) S.split.resize(max_raw), S.pre.resize(max_raw + kInputSlack), S.packed.resize(packed_bound(max_raw));
-    for (size_t j; !failed && (j = next++) < jobs.size();) {
-      const PartLayout& L = layouts[size_t(jobs[j].part)];
-      const int y0 = jobs[j].chunk * kLinesPerChunk, y1 = std::min(L.height, y0 + kLinesPerChunk);
-      const size_t n = precondition_chunk(L.runs, L.line_bytes, L.width, y0, y1, S.split.data(), S.pre.data());
-      const size_t size = compress_chunk(S, encoder, S.pre.data(), n);
-      const bool stored = size == 0 || size >= n;  // the scanlines' raw bytes (0: did not fit)
-      std::vector<unsigned char>& out = data[j];
-      out.reserve(12 + (stored ? n : size));
-      if (multi) put32(out, uint32_t(jobs[j].part));
-      put32(out, uint32_t(L.min_y + y0));
-      if (stored) {
-        put32(out, uint32_t(n));
-        raw_chunk(L.order, L.width, y0, y1, S.split.data());
-        out.insert(out.end(), S.split.data(), S.split.data() + n);
-      } else {
-        put32(out, uint32_t(size));
-        out.insert(out.end(), S.packed.data(), S.packed.data() + size);
-      }
-    }
+    if (!prepare_scratch(*scratch, encoder, F.max_raw)) failed = true;
+    for (size_t j; !failed && (j = next++) < jobs.size();) data[j] = encode_chunk(*scratch, F, jobs[j], encoder);
     give_back(std::move(scratch));
   };
   if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
@@ -364,31 +380,44 @@ void write_zip_exr(const std::string& path, const std::string& shown_path, const
   work();
   for (std::thread& t : pool) t.join();
   if (failed) throw Error("cannot write " + shown_path + ": out of memory for the ZIP compressor");
+  return data;
+}
 
-  // magic, version, headers, offset tables, chunks (in job order: part by part)
+// Magic, version, headers, offset tables, chunks.
+void write_file(const std::string& path, const std::string& shown_path, const FileLayout& F,
+                const std::vector<std::vector<unsigned char>>& chunks) {
   std::ofstream file(path, std::ios::binary | std::ios::trunc);
   if (!file) throw Error("cannot write " + shown_path + ": " + std::strerror(errno));
   {
     Imf::StdOFStream os(file, path.c_str());
     std::vector<unsigned char> head;
     put32(head, uint32_t(Imf::MAGIC));
-    put32(head, uint32_t(Imf::EXR_VERSION | (multi ? Imf::MULTI_PART_FILE_FLAG : 0) |
-                         (long_names ? Imf::LONG_NAMES_FLAG : 0)));
+    put32(head, uint32_t(Imf::EXR_VERSION | (F.multi ? Imf::MULTI_PART_FILE_FLAG : 0) |
+                         (F.long_names ? Imf::LONG_NAMES_FLAG : 0)));
     os.write(reinterpret_cast<const char*>(head.data()), int(head.size()));
-    for (const Imf::Header& h : headers) h.writeTo(os);
-    if (multi) os.write("", 1);  // the empty header that ends the list
-    uint64_t at = os.tellp() + uint64_t(jobs.size()) * 8u;
+    for (const Imf::Header& h : F.headers) h.writeTo(os);
+    if (F.multi) os.write("", 1);  // the empty header that ends the list
+    uint64_t at = os.tellp() + uint64_t(chunks.size()) * 8u;
     std::vector<unsigned char> table;
-    table.reserve(jobs.size() * 8u);
-    for (const std::vector<unsigned char>& d : data) {
+    table.reserve(chunks.size() * 8u);
+    for (const std::vector<unsigned char>& d : chunks) {
       for (int k = 0; k < 8; ++k) table.push_back(static_cast<unsigned char>(at >> (8 * k)));
       at += d.size();
     }
     os.write(reinterpret_cast<const char*>(table.data()), int(table.size()));
-    for (const std::vector<unsigned char>& d : data) os.write(reinterpret_cast<const char*>(d.data()), int(d.size()));
+    for (const std::vector<unsigned char>& d : chunks) os.write(reinterpret_cast<const char*>(d.data()), int(d.size()));
   }
   file.flush();
   if (!file) throw Error("cannot write " + shown_path + ": " + std::strerror(errno));
+}
+
+}  // namespace
+
+void write_zip_exr(const std::string& path, const std::string& shown_path, const std::vector<ExrZipPart>& parts,
+                   ZipEncoder encoder, int threads) {
+  check_little_endian(shown_path);
+  const FileLayout layout = file_layout(parts, shown_path);
+  write_file(path, shown_path, layout, encode_chunks(layout, encoder, threads, shown_path));
 }
 
 }  // namespace pmr

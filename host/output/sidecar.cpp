@@ -111,67 +111,52 @@ json shading_json(const SidecarInfo& info) {
 
 double degrees(double rad) { return rad * (180.0 / glm::pi<double>()); }
 
-}  // namespace
-
-std::string sidecar_json(const Rig& rig, const Display& display, const SidecarInfo& info) {
-  json j;
-  j["format"] = "pmr-sidecar-1";
-  j["program_version"] = program_version();
-  j["scene"] = info.scene;
-  if (!info.scene_checksum.empty() || !info.display_config_checksum.empty()) {
-    json c;
-    c["algorithm"] = kChecksumAlgorithm;
-    if (!info.scene_checksum.empty()) {
-      c["scene"] = info.scene_checksum;
-      json files = json::object();
-      for (const auto& [file, sum] : info.scene_files) files[file] = sum;
-      c["scene_files"] = files;
-    }
-    if (!info.display_config_checksum.empty()) c["display_config"] = info.display_config_checksum;
-    j["checksums"] = c;
-  }
-  j["frame"] = info.frame;
-  j["method"] = info.method;
-  j["sampling"] = info.sampling;
-  j["shading"] = shading_json(info);
-  j["tile"] = {{"x", info.tile_x}, {"y", info.tile_y}, {"v", info.tile_v}};
-  j["camera"] = info.camera;
-  if (info.has_bounds)
-    j["scene_bounds"] = {{"min", vec3_json(info.bounds_lo)}, {"max", vec3_json(info.bounds_hi)}};
-  if (!info.compression.empty()) j["compression"] = info.compression;
-  json outputs = json::object();
-  for (const auto& [kind, file] : info.outputs) outputs[kind] = file;
-  j["outputs"] = outputs;
-  if (!info.background.empty()) j["background"] = info.background;
-  if (!info.output_checksums.empty()) {
+// What the render read, so that --resume and pmr verify notice a changed input.
+json checksums_json(const SidecarInfo& info) {
+  json c;
+  c["algorithm"] = kChecksumAlgorithm;
+  if (!info.scene_checksum.empty()) {
+    c["scene"] = info.scene_checksum;
     json files = json::object();
-    for (const OutputChecksum& o : info.output_checksums) files[o.file] = {{"bytes", o.bytes}, {"checksum", o.checksum}};
-    j["output_checksums"] = {{"algorithm", kChecksumAlgorithm}, {"files", files}};
+    for (const auto& [file, sum] : info.scene_files) files[file] = sum;
+    c["scene_files"] = files;
   }
-  if (info.quilt_columns > 0)
-    j["quilt"] = {{"columns", info.quilt_columns},
-                  {"rows", info.quilt_rows},
-                  {"aspect", rig.aspect},
-                  {"tile_width", rig.view_w},
-                  {"tile_height", rig.view_h},
-                  {"order", "view 0 in the bottom-left tile, then left to right, then upward"}};
-  if (info.center_view >= 0) j["preview_center_view"] = info.center_view;
-  j["depth_channel"] = info.depth;
-  // the scene's files were read without confinement to its folder (docs/SECURITY.md)
-  if (info.allow_outside_scene_folder) j["allow_outside_scene_folder"] = true;
-  j["warnings"] = info.warnings;
-  j["time"] = info.time;
-  j["fps"] = info.fps;
-  if (info.animation == -1) j["animation"] = nullptr;
-  else j["animation"] = {{"index", info.animation}, {"name", info.animation_name}};
-  if (info.turntable)
-    j["turntable"] = {{"degrees", info.turntable_deg},
-                      {"frames", info.turntable_frames},
-                      {"angle_deg", info.turntable_angle},
-                      {"pivot", vec3_json(info.pivot)},
-                      {"axis", vec3_json(glm::dvec3(0, 1, 0))}};
-  else j["turntable"] = nullptr;
+  if (!info.display_config_checksum.empty()) c["display_config"] = info.display_config_checksum;
+  return c;
+}
 
+json output_checksums_json(const SidecarInfo& info) {
+  json files = json::object();
+  for (const OutputChecksum& o : info.output_checksums) files[o.file] = {{"bytes", o.bytes}, {"checksum", o.checksum}};
+  return {{"algorithm", kChecksumAlgorithm}, {"files", files}};
+}
+
+json quilt_json(const Rig& rig, const SidecarInfo& info) {
+  return {{"columns", info.quilt_columns},
+          {"rows", info.quilt_rows},
+          {"aspect", rig.aspect},
+          {"tile_width", rig.view_w},
+          {"tile_height", rig.view_h},
+          {"order", "view 0 in the bottom-left tile, then left to right, then upward"}};
+}
+
+// null, not absent, when the frame has no animation or turntable: sidecar_config_difference requires
+// both keys.
+json animation_json(const SidecarInfo& info) {
+  if (info.animation == -1) return nullptr;
+  return {{"index", info.animation}, {"name", info.animation_name}};
+}
+
+json turntable_json(const SidecarInfo& info) {
+  if (!info.turntable) return nullptr;
+  return {{"degrees", info.turntable_deg},
+          {"frames", info.turntable_frames},
+          {"angle_deg", info.turntable_angle},
+          {"pivot", vec3_json(info.pivot)},
+          {"axis", vec3_json(glm::dvec3(0, 1, 0))}};
+}
+
+json display_json(const Display& display, const SidecarInfo& info) {
   json d;
   d["width"] = display.width;
   d["height"] = display.height;
@@ -200,8 +185,10 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   }
   d["sampling"] = display.bilinear ? "bilinear" : "nearest";
   d["view_blend"] = display.blend_views;
-  j["display"] = d;
+  return d;
+}
 
+json rig_json(const Rig& rig) {
   json r;
   r["views"] = rig.views;
   r["view_width"] = rig.view_w;
@@ -221,21 +208,22 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   const double k = rig.disparity_k();
   r["disparity_px_at_infinity"] = rig.views > 1 ? k : 0.0;  // Delta(inf): view 0 to view N-1
   r["disparity_px_per_view_at_infinity"] = rig.views > 1 ? k / double(rig.views - 1) : 0.0;
-  j["rig"] = r;
+  return r;
+}
 
-  j["center_view"] = matrix_json(rig.center_view);
-  j["light_dir_view"] = vec3_json(rig.light_view());
-  j["light_dir_world"] = vec3_json(rig.light_world());
-
+json views_json(const Rig& rig) {
   json views = json::array();
   for (int i = 0; i < rig.views; ++i)
     views.push_back({{"index", i},
                      {"offset", rig.camera_offset(i)},
                      {"view", matrix_json(rig.view_matrix(i))},
                      {"proj", matrix_json(rig.projection(i))}});
-  j["views"] = views;
+  return views;
+}
 
-  j["conventions"] = {
+// How to read the numbers above without pmr's source at hand.
+json conventions_json() {
+  return {
       {"coordinates", "glTF: right-handed, +Y up, cameras look along -Z, +X right; rig distances in scene units"},
       {"raster", "row 0 is the top row; pixel (px, py) counts px from the left and py from the top, its center is "
                  "(px + 0.5, py + 0.5)"},
@@ -260,6 +248,47 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
                    "per display.sampling); subpixel: view v rasterized at that position itself, truncated to the "
                    "raster's 16.16 / 24.8 fixed point (docs/SAMPLING.md)"},
   };
+}
+
+}  // namespace
+
+std::string sidecar_json(const Rig& rig, const Display& display, const SidecarInfo& info) {
+  json j;
+  j["format"] = "pmr-sidecar-1";
+  j["program_version"] = program_version();
+  j["scene"] = info.scene;
+  if (!info.scene_checksum.empty() || !info.display_config_checksum.empty()) j["checksums"] = checksums_json(info);
+  j["frame"] = info.frame;
+  j["method"] = info.method;
+  j["sampling"] = info.sampling;
+  j["shading"] = shading_json(info);
+  j["tile"] = {{"x", info.tile_x}, {"y", info.tile_y}, {"v", info.tile_v}};
+  j["camera"] = info.camera;
+  if (info.has_bounds)
+    j["scene_bounds"] = {{"min", vec3_json(info.bounds_lo)}, {"max", vec3_json(info.bounds_hi)}};
+  if (!info.compression.empty()) j["compression"] = info.compression;
+  json outputs = json::object();
+  for (const auto& [kind, file] : info.outputs) outputs[kind] = file;
+  j["outputs"] = outputs;
+  if (!info.background.empty()) j["background"] = info.background;
+  if (!info.output_checksums.empty()) j["output_checksums"] = output_checksums_json(info);
+  if (info.quilt_columns > 0) j["quilt"] = quilt_json(rig, info);
+  if (info.center_view >= 0) j["preview_center_view"] = info.center_view;
+  j["depth_channel"] = info.depth;
+  // the scene's files were read without confinement to its folder (docs/SECURITY.md)
+  if (info.allow_outside_scene_folder) j["allow_outside_scene_folder"] = true;
+  j["warnings"] = info.warnings;
+  j["time"] = info.time;
+  j["fps"] = info.fps;
+  j["animation"] = animation_json(info);
+  j["turntable"] = turntable_json(info);
+  j["display"] = display_json(display, info);
+  j["rig"] = rig_json(rig);
+  j["center_view"] = matrix_json(rig.center_view);
+  j["light_dir_view"] = vec3_json(rig.light_view());
+  j["light_dir_world"] = vec3_json(rig.light_world());
+  j["views"] = views_json(rig);
+  j["conventions"] = conventions_json();
   std::string text;
   emit(j, 0, text);
   return text + "\n";

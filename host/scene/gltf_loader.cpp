@@ -549,6 +549,150 @@ const int* attribute(const tinygltf::Primitive& p, const std::string& name) {
   return it == p.attributes.end() ? nullptr : &it->second;
 }
 
+// decode_primitive's reads: every attribute, and every morph target's, must hold one value per POSITION
+// vertex, as the deformer indexes them all by vertex.
+struct PrimitiveAttributes {
+  Loader& L;
+  const tinygltf::Primitive& p;
+  const std::string& where;
+  size_t vertices;
+
+  // Empty when absent.
+  std::vector<float> read_from(const std::map<std::string, int>& attributes, const std::string& name,
+                               Semantic semantic, const std::string& label) const {
+    const auto it = attributes.find(name);
+    if (it == attributes.end()) return {};
+    const int a = it->second;
+    AttributeData data = read_attribute(L.model, a, semantic, label, L.file);
+    if (data.count != vertices)
+      fail(L.file, "accessor " + std::to_string(a) + " (" + label + ") has " + std::to_string(data.count) +
+                       " elements but POSITION has " + std::to_string(vertices));
+    return std::move(data.values);
+  }
+
+  std::vector<float> read(const std::string& name, Semantic semantic) const {
+    std::vector<float> values = read_from(p.attributes, name, semantic, name + " of " + where);
+    if (values.empty()) return values;
+    if (semantic == Semantic::Color && values.size() == vertices * 3) {  // RGB -> RGBA, alpha 1
+      std::vector<float> rgba(vertices * 4, 1.0f);
+      for (size_t v = 0; v < vertices; ++v) std::copy_n(&values[3 * v], 3, &rgba[4 * v]);
+      return rgba;
+    }
+    return values;
+  }
+
+  std::vector<float> read_target(size_t k, const std::string& name) const {
+    return read_from(p.targets[k], name, Semantic::MorphDelta, name + " of " + where + " morph target " + std::to_string(k));
+  }
+};
+
+// JOINTS_0 / WEIGHTS_0, then _1: four influences each, merged per vertex (non-finite or negative
+// weights count as 0).
+void read_skin_influences(const PrimitiveAttributes& attrs, DeformSource& geo) {
+  for (int set = 0; set < 2; ++set) {
+    const std::string n = std::to_string(set);
+    std::vector<float> joints = attrs.read("JOINTS_" + n, Semantic::Joints),
+                       weights = attrs.read("WEIGHTS_" + n, Semantic::Weights);
+    if (joints.empty() || weights.empty()) break;
+    const int k = geo.influences + 4;
+    std::vector<uint16_t> j(geo.vertices * size_t(k));
+    std::vector<float> w(geo.vertices * size_t(k));
+    for (size_t v = 0; v < geo.vertices; ++v)
+      for (int i = 0; i < k; ++i) {
+        const bool old = i < geo.influences;
+        j[v * size_t(k) + size_t(i)] = old ? geo.joints[v * size_t(geo.influences) + size_t(i)] : uint16_t(joints[4 * v + size_t(i - geo.influences)]);
+        const float wv = old ? geo.weights[v * size_t(geo.influences) + size_t(i)] : weights[4 * v + size_t(i - geo.influences)];
+        w[v * size_t(k) + size_t(i)] = std::isfinite(wv) && wv > 0.0f ? wv : 0.0f;
+      }
+    geo.joints = std::move(j), geo.weights = std::move(w), geo.influences = k;
+  }
+}
+
+// Every set a texture slot of the material samples, untransformed (Scene::texcoords); each must exist.
+// Returns the normal texture's set (-1: none).
+int read_texcoord_sets(const PrimitiveAttributes& attrs, int mesh, int index, Decoded& d) {
+  Loader& L = attrs.L;
+  const tinygltf::Primitive& p = attrs.p;
+  d.sets.resize(size_t(L.texcoord_sets));
+  if (p.material < 0) return -1;
+  const std::array<int, kTextureSlots>& sets = L.slot_sets[size_t(p.material)];
+  for (int slot = 0; slot < kTextureSlots; ++slot) {
+    const int k = sets[size_t(slot)];
+    if (k < 0 || !d.sets[size_t(k)].empty()) continue;
+    d.sets[size_t(k)] = attrs.read("TEXCOORD_" + std::to_string(k), Semantic::Texcoord);
+    if (d.sets[size_t(k)].empty()) {
+      const std::string& mesh_name = L.model.meshes[size_t(mesh)].name;
+      const std::string& mat_name = L.model.materials[size_t(p.material)].name;
+      fail(L.file, "material " + std::to_string(p.material) + (mat_name.empty() ? "" : " '" + one_line(mat_name, true) + "'") +
+                       " " + texture_slot_name(slot) + " samples TEXCOORD_" + std::to_string(k) + ", which mesh " +
+                       std::to_string(mesh) + (mesh_name.empty() ? "" : " '" + one_line(mesh_name, true) + "'") +
+                       " primitive " + std::to_string(index) + " does not have");
+    }
+  }
+  return sets[kSlotNormal];
+}
+
+// The base colour texture's UVs (PmrVertexAttr::uv), with its KHR_texture_transform applied.
+std::vector<float> read_base_colour_uv(const PrimitiveAttributes& attrs) {
+  const int material = attrs.p.material;
+  const MaterialUv uv = material >= 0 ? attrs.L.material_uv[size_t(material)] : MaterialUv{};
+  std::vector<float> values = attrs.read("TEXCOORD_" + std::to_string(uv.set), Semantic::Texcoord);
+  if (uv.transform.active) {
+    const UvTransform& t = uv.transform;
+    for (size_t v = 0; v < values.size(); v += 2) {
+      const double u0 = values[v], v0 = values[v + 1];
+      values[v] = float(t.a * u0 + t.b * v0 + t.tx);
+      values[v + 1] = float(t.c * u0 + t.d * v0 + t.ty);
+    }
+  }
+  return values;
+}
+
+// 3 vertex indices per triangle, strips and fans unrolled, each index checked against POSITION.
+std::vector<uint32_t> triangle_list(Loader& L, const tinygltf::Primitive& p, int mode, const std::string& where,
+                                    size_t vertices) {
+  std::vector<uint32_t> indices;
+  if (p.indices >= 0) {
+    const std::string what = "indices of " + where;
+    indices = read_indices(L.model, p.indices, what, L.file);
+    for (uint32_t i : indices)
+      if (i >= vertices)
+        fail(L.file, "accessor " + std::to_string(p.indices) + " (" + what + ") reads index " + std::to_string(i) +
+                         " but POSITION has " + std::to_string(vertices) + " vertices");
+  }
+  const size_t n = p.indices >= 0 ? indices.size() : vertices;
+  auto at = [&](size_t k) { return p.indices >= 0 ? indices[k] : uint32_t(k); };
+  const size_t triangles = mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : n >= 3 ? n - 2 : 0;  // < 2^27: check_totals
+  std::vector<uint32_t> tris;
+  tris.reserve(3 * triangles);
+  for (size_t k = 0; k < triangles; ++k) {
+    uint32_t t[3];
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      t[0] = at(3 * k), t[1] = at(3 * k + 1), t[2] = at(3 * k + 2);
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {  // every other triangle is reversed to stay CCW
+      t[0] = at(k), t[1] = at(k + 1 + k % 2), t[2] = at(k + 2 - k % 2);
+    } else {  // fan around vertex 0, in the spec's order
+      t[0] = at(k + 1), t[1] = at(k + 2), t[2] = at(0);
+    }
+    tris.insert(tris.end(), t, t + 3);
+  }
+  if (mode == TINYGLTF_MODE_TRIANGLES && n % 3 != 0) ++L.leftover_indices;
+  return tris;
+}
+
+// Tangents for a normal texture: the file's (morphed by its TANGENT targets), else generated from the
+// normal texture's UV set at the rest shape.
+void read_tangents(const PrimitiveAttributes& attrs, Decoded& d, int normal_set) {
+  DeformSource& geo = *d.geo;
+  geo.tan = attrs.read("TANGENT", Semantic::Tangent);
+  if (!geo.tan.empty()) {
+    for (size_t k = 0; k < attrs.p.targets.size(); ++k) geo.target_tan.push_back(attrs.read_target(k, "TANGENT"));
+  } else {
+    geo.tan = generate_tangents(geo.pos, geo.nrm, d.sets[size_t(normal_set)], d.tris);
+    ++attrs.L.generated_tangents;
+  }
+}
+
 Decoded decode_primitive(Loader& L, int mesh, int index) {
   const tinygltf::Primitive& p = L.model.meshes[size_t(mesh)].primitives[size_t(index)];
   const std::string where = "mesh " + std::to_string(mesh) + " primitive " + std::to_string(index);
@@ -570,119 +714,18 @@ Decoded decode_primitive(Loader& L, int mesh, int index) {
   DeformSource& geo = *d.geo;
   geo.vertices = pos.count;
   geo.pos = std::move(pos.values);
-  auto read_from = [&](const std::map<std::string, int>& attributes, const std::string& name, Semantic semantic,
-                       const std::string& label) -> std::vector<float> {
-    const auto it = attributes.find(name);
-    if (it == attributes.end()) return {};
-    const int a = it->second;
-    AttributeData data = read_attribute(L.model, a, semantic, label, L.file);
-    if (data.count != geo.vertices)
-      fail(L.file, "accessor " + std::to_string(a) + " (" + label + ") has " + std::to_string(data.count) +
-                       " elements but POSITION has " + std::to_string(geo.vertices));
-    return std::move(data.values);
-  };
-  auto read = [&](const std::string& name, Semantic semantic) -> std::vector<float> {
-    std::vector<float> values = read_from(p.attributes, name, semantic, name + " of " + where);
-    if (values.empty()) return values;
-    if (semantic == Semantic::Color && values.size() == geo.vertices * 3) {  // RGB -> RGBA, alpha 1
-      std::vector<float> rgba(geo.vertices * 4, 1.0f);
-      for (size_t v = 0; v < geo.vertices; ++v) std::copy_n(&values[3 * v], 3, &rgba[4 * v]);
-      return rgba;
-    }
-    return values;
-  };
-  geo.nrm = read("NORMAL", Semantic::Normal);
+  const PrimitiveAttributes attrs{L, p, where, geo.vertices};
+  geo.nrm = attrs.read("NORMAL", Semantic::Normal);
   for (size_t k = 0; k < p.targets.size(); ++k) {
-    const std::string t = " of " + where + " morph target " + std::to_string(k);
-    geo.target_pos.push_back(read_from(p.targets[k], "POSITION", Semantic::MorphDelta, "POSITION" + t));
-    geo.target_nrm.push_back(read_from(p.targets[k], "NORMAL", Semantic::MorphDelta, "NORMAL" + t));
+    geo.target_pos.push_back(attrs.read_target(k, "POSITION"));
+    geo.target_nrm.push_back(attrs.read_target(k, "NORMAL"));
   }
-  for (int set = 0; set < 2; ++set) {  // JOINTS_0 / WEIGHTS_0, then _1: four influences each
-    const std::string n = std::to_string(set);
-    std::vector<float> joints = read("JOINTS_" + n, Semantic::Joints), weights = read("WEIGHTS_" + n, Semantic::Weights);
-    if (joints.empty() || weights.empty()) break;
-    const int k = geo.influences + 4;
-    std::vector<uint16_t> j(geo.vertices * size_t(k));
-    std::vector<float> w(geo.vertices * size_t(k));
-    for (size_t v = 0; v < geo.vertices; ++v)
-      for (int i = 0; i < k; ++i) {
-        const bool old = i < geo.influences;
-        j[v * size_t(k) + size_t(i)] = old ? geo.joints[v * size_t(geo.influences) + size_t(i)] : uint16_t(joints[4 * v + size_t(i - geo.influences)]);
-        const float wv = old ? geo.weights[v * size_t(geo.influences) + size_t(i)] : weights[4 * v + size_t(i - geo.influences)];
-        w[v * size_t(k) + size_t(i)] = std::isfinite(wv) && wv > 0.0f ? wv : 0.0f;
-      }
-    geo.joints = std::move(j), geo.weights = std::move(w), geo.influences = k;
-  }
-  // Every set a texture slot of the material samples, untransformed (Scene::texcoords); each must exist.
-  d.sets.resize(size_t(L.texcoord_sets));
-  int normal_set = -1;
-  if (p.material >= 0) {
-    const std::array<int, kTextureSlots>& sets = L.slot_sets[size_t(p.material)];
-    for (int slot = 0; slot < kTextureSlots; ++slot) {
-      const int k = sets[size_t(slot)];
-      if (k < 0 || !d.sets[size_t(k)].empty()) continue;
-      d.sets[size_t(k)] = read("TEXCOORD_" + std::to_string(k), Semantic::Texcoord);
-      if (d.sets[size_t(k)].empty()) {
-        const std::string& mesh_name = L.model.meshes[size_t(mesh)].name;
-        const std::string& mat_name = L.model.materials[size_t(p.material)].name;
-        fail(L.file, "material " + std::to_string(p.material) + (mat_name.empty() ? "" : " '" + one_line(mat_name, true) + "'") +
-                         " " + texture_slot_name(slot) + " samples TEXCOORD_" + std::to_string(k) + ", which mesh " +
-                         std::to_string(mesh) + (mesh_name.empty() ? "" : " '" + one_line(mesh_name, true) + "'") +
-                         " primitive " + std::to_string(index) + " does not have");
-      }
-    }
-    normal_set = sets[kSlotNormal];
-  }
-  const MaterialUv uv = p.material >= 0 ? L.material_uv[size_t(p.material)] : MaterialUv{};
-  d.uv = read("TEXCOORD_" + std::to_string(uv.set), Semantic::Texcoord);
-  if (uv.transform.active) {
-    const UvTransform& t = uv.transform;
-    for (size_t v = 0; v < d.uv.size(); v += 2) {
-      const double u0 = d.uv[v], v0 = d.uv[v + 1];
-      d.uv[v] = float(t.a * u0 + t.b * v0 + t.tx);
-      d.uv[v + 1] = float(t.c * u0 + t.d * v0 + t.ty);
-    }
-  }
-  d.col = read("COLOR_0", Semantic::Color);
-
-  std::vector<uint32_t> indices;
-  if (p.indices >= 0) {
-    const std::string what = "indices of " + where;
-    indices = read_indices(L.model, p.indices, what, L.file);
-    for (uint32_t i : indices)
-      if (i >= geo.vertices)
-        fail(L.file, "accessor " + std::to_string(p.indices) + " (" + what + ") reads index " + std::to_string(i) +
-                         " but POSITION has " + std::to_string(geo.vertices) + " vertices");
-  }
-  const size_t n = p.indices >= 0 ? indices.size() : geo.vertices;
-  auto at = [&](size_t k) { return p.indices >= 0 ? indices[k] : uint32_t(k); };
-  const size_t triangles = mode == TINYGLTF_MODE_TRIANGLES ? n / 3 : n >= 3 ? n - 2 : 0;  // < 2^27: check_totals
-  d.tris.reserve(3 * triangles);
-  for (size_t k = 0; k < triangles; ++k) {
-    uint32_t t[3];
-    if (mode == TINYGLTF_MODE_TRIANGLES) {
-      t[0] = at(3 * k), t[1] = at(3 * k + 1), t[2] = at(3 * k + 2);
-    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {  // every other triangle is reversed to stay CCW
-      t[0] = at(k), t[1] = at(k + 1 + k % 2), t[2] = at(k + 2 - k % 2);
-    } else {  // fan around vertex 0, in the spec's order
-      t[0] = at(k + 1), t[1] = at(k + 2), t[2] = at(0);
-    }
-    d.tris.insert(d.tris.end(), t, t + 3);
-  }
-  if (mode == TINYGLTF_MODE_TRIANGLES && n % 3 != 0) ++L.leftover_indices;
-  // Tangents where a normal texture needs them: the file's (morphed by its TANGENT targets), else
-  // generated from the normal texture's UV set at the rest shape.
-  if (normal_set >= 0) {
-    geo.tan = read("TANGENT", Semantic::Tangent);
-    if (!geo.tan.empty()) {
-      for (size_t k = 0; k < p.targets.size(); ++k)
-        geo.target_tan.push_back(read_from(p.targets[k], "TANGENT", Semantic::MorphDelta,
-                                           "TANGENT of " + where + " morph target " + std::to_string(k)));
-    } else {
-      geo.tan = generate_tangents(geo.pos, geo.nrm, d.sets[size_t(normal_set)], d.tris);
-      ++L.generated_tangents;
-    }
-  }
+  read_skin_influences(attrs, geo);
+  const int normal_set = read_texcoord_sets(attrs, mesh, index, d);
+  d.uv = read_base_colour_uv(attrs);
+  d.col = attrs.read("COLOR_0", Semantic::Color);
+  d.tris = triangle_list(L, p, mode, where, geo.vertices);
+  if (normal_set >= 0) read_tangents(attrs, d, normal_set);
   return d;
 }
 

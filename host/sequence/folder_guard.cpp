@@ -117,6 +117,134 @@ std::string read_fd(int fd) {
   return text;
 }
 
+// The configuration difference of a sidecar from this run's, compared without its view matrices (most
+// of a sidecar with many views; 48 views: 1.3 -> 0.23 ms per comparison). A cut that does not parse (a
+// sidecar not laid out as pmr writes them) is compared whole.
+class ConfigDifference {
+ public:
+  explicit ConfigDifference(const std::string& expected)
+      : expected_(expected), expected_config_(without_view_matrices(expected)) {}
+
+  std::string operator()(const std::string& text) const {
+    const std::string diff = sidecar_config_difference(without_view_matrices(text), expected_config_);
+    return diff == "unreadable" ? sidecar_config_difference(text, expected_) : diff;
+  }
+
+ private:
+  const std::string& expected_;
+  const std::string expected_config_;
+};
+
+// 1. This run's lock: shared with every process of the same configuration. Returns its descriptor, or
+// -1 with lock_path cleared when the file system cannot lock (the run goes on unguarded).
+int take_own_lock(const std::string& dir, const std::string& own_name, const std::string& expected,
+                  std::string& lock_path) {
+  int held = -1;
+  for (int attempt = 0; attempt < 20 && held < 0; ++attempt) {
+    struct stat st;
+    if (::stat(lock_path.c_str(), &st) != 0) {
+      if (const int err = create_lock_file(lock_path, expected))
+        throw Error("cannot lock output folder " + dir + ": cannot create " + own_name + ": " + std::strerror(err));
+    }
+    const int fd = open_lock(lock_path);
+    if (fd < 0) {
+      if (errno == ENOENT) continue;  // removed as stale by another process meanwhile
+      throw Error("cannot lock output folder " + dir + ": cannot open " + own_name + ": " + std::strerror(errno));
+    }
+    int rc;
+    while ((rc = ::flock(fd, LOCK_SH)) != 0 && errno == EINTR) {
+    }
+    if (rc != 0) {  // e.g. ENOLCK: an NFS mount without lock support
+      std::fprintf(stderr, "pmr: warning: cannot lock output folder %s (%s): another configuration rendering into it "
+                   "at the same time would not be noticed\n", dir.c_str(), std::strerror(errno));
+      ::close(fd);
+      ::unlink(lock_path.c_str());
+      lock_path.clear();
+      return -1;
+    }
+    if (same_file(fd, lock_path)) held = fd;
+    else ::close(fd);  // the name was removed (stale) after we opened it: take the new one
+  }
+  if (held < 0) throw Error("cannot lock output folder " + dir + ": " + own_name + " keeps being replaced");
+  return held;
+}
+
+struct FolderContents {
+  std::vector<std::string> locks;                      // of the same --name pattern, besides this run's
+  std::vector<std::pair<long, std::string>> sidecars;  // the pattern names, outside the job; by frame
+};
+
+// One pass over the folder for both.
+FolderContents scan_folder(const std::string& dir, const std::string& pattern, std::vector<long> job,
+                           const std::string& own_name) {
+  const std::string same_pattern = own_name.substr(0, kLockPrefix.size() + kHexDigits + 1);
+  FolderContents found;
+  std::sort(job.begin(), job.end());
+  DIR* d = ::opendir(dir.c_str());
+  if (!d) throw Error("cannot read output folder " + dir + ": " + std::strerror(errno));
+  while (const dirent* e = ::readdir(d)) {
+    const std::string name = e->d_name;
+    if (name[0] == '.') {
+      if (name != own_name && name.compare(0, same_pattern.size(), same_pattern) == 0 && is_lock_name(name))
+        found.locks.push_back(name);
+      continue;
+    }
+    const long f = sidecar_frame(pattern, name);
+    if (f >= 0 && !std::binary_search(job.begin(), job.end(), f)) found.sidecars.emplace_back(f, name);
+  }
+  ::closedir(d);
+  std::sort(found.sidecars.begin(), found.sidecars.end());
+  return found;
+}
+
+// 2. Other configurations' locks: held = a process renders into this folder right now.
+void refuse_running_configurations(const std::string& dir, const std::vector<std::string>& locks,
+                                   const ConfigDifference& difference) {
+  for (const std::string& name : locks) {
+    const std::string path = (fs::path(dir) / name).string();
+    const int fd = open_lock(path);
+    if (fd < 0) continue;  // gone
+    if (::flock(fd, LOCK_EX | LOCK_NB) == 0) {
+      if (same_file(fd, path)) ::unlink(path.c_str());  // nobody holds it: stale
+      ::close(fd);
+      continue;
+    }
+    const bool held = errno == EWOULDBLOCK;
+    const std::string text = held ? read_fd(fd) : std::string();
+    ::close(fd);
+    if (!held) continue;  // cannot tell (e.g. a read-only file over NFS)
+    const std::string diff = difference(text);
+    if (diff.empty()) continue;  // the same configuration under another fingerprint (e.g. other --write)
+    throw Error(dir + " is being rendered right now by a pmr process with another configuration (" +
+                (diff == "unreadable" ? std::string("unrecorded") : diff + " differs") + "; it holds " + name +
+                "); wait for it, use another --out, or delete " + name + " if no such process is running");
+  }
+}
+
+// 3. Finished frames outside this job (every shard's frames count as this job's).
+void check_finished_frames(const std::string& dir, const std::vector<std::pair<long, std::string>>& sidecars,
+                           const ConfigDifference& difference, bool overwrite, bool quiet) {
+  if (sidecars.size() >= 10000 && !quiet)  // about 0.3 ms each (48 views): say why the start takes a while
+    std::fprintf(stderr, "pmr: comparing the configuration of %zu frame(s) outside --frames in %s\n", sidecars.size(),
+                 dir.c_str());
+  long others = 0;
+  std::string first_name, first_diff;
+  for (const auto& [frame, name] : sidecars) {
+    const std::string diff = difference(read_sidecar_text((fs::path(dir) / name).string()));
+    // unreadable: a broken frame, not a configuration (pmr verify reports it)
+    if (diff.empty() || diff == "unreadable") continue;
+    if (others++ == 0) first_name = name, first_diff = diff;
+    if (!overwrite) break;  // one is enough to refuse
+  }
+  if (others > 0 && !overwrite)
+    throw Error(dir + " holds " + first_name + " rendered with another configuration (" + first_diff +
+                " differs) that this run would not replace; use another --out, render those frames too, or "
+                "--overwrite");
+  if (others > 0)
+    std::fprintf(stderr, "pmr: warning: --overwrite: %s keeps %ld frame(s) of another configuration that this run "
+                 "does not replace (%s: %s differs)\n", dir.c_str(), others, first_name.c_str(), first_diff.c_str());
+}
+
 }  // namespace
 
 std::string without_view_matrices(const std::string& sidecar) {
@@ -159,110 +287,13 @@ long sidecar_frame(const std::string& pattern, const std::string& file_name) {
 FolderGuard::FolderGuard(const std::string& dir, const std::string& pattern, const std::vector<long>& job_frames,
                          const std::string& expected, bool overwrite, bool quiet) {
   const std::string own_name = folder_lock_name(pattern, expected);
-  const std::string expected_config = without_view_matrices(expected);
-  // The configuration difference of a sidecar, compared without its view matrices (most of a sidecar
-  // with many views; 48 views: 1.3 -> 0.23 ms per comparison). A cut that does not parse (a sidecar not
-  // laid out as pmr writes them) is compared whole.
-  auto difference = [&](const std::string& text) {
-    const std::string diff = sidecar_config_difference(without_view_matrices(text), expected_config);
-    return diff == "unreadable" ? sidecar_config_difference(text, expected) : diff;
-  };
-  const std::string same_pattern = own_name.substr(0, kLockPrefix.size() + kHexDigits + 1);
+  const ConfigDifference difference(expected);
   lock_path_ = (fs::path(dir) / own_name).string();
-
-  // 1. This run's lock: shared with every process of the same configuration.
-  for (int attempt = 0; attempt < 20 && fd_ < 0; ++attempt) {
-    struct stat st;
-    if (::stat(lock_path_.c_str(), &st) != 0) {
-      if (const int err = create_lock_file(lock_path_, expected))
-        throw Error("cannot lock output folder " + dir + ": cannot create " + own_name + ": " + std::strerror(err));
-    }
-    const int fd = open_lock(lock_path_);
-    if (fd < 0) {
-      if (errno == ENOENT) continue;  // removed as stale by another process meanwhile
-      throw Error("cannot lock output folder " + dir + ": cannot open " + own_name + ": " + std::strerror(errno));
-    }
-    int rc;
-    while ((rc = ::flock(fd, LOCK_SH)) != 0 && errno == EINTR) {
-    }
-    if (rc != 0) {  // e.g. ENOLCK: an NFS mount without lock support
-      std::fprintf(stderr, "pmr: warning: cannot lock output folder %s (%s): another configuration rendering into it "
-                   "at the same time would not be noticed\n", dir.c_str(), std::strerror(errno));
-      ::close(fd);
-      ::unlink(lock_path_.c_str());
-      lock_path_.clear();
-      break;
-    }
-    if (same_file(fd, lock_path_)) fd_ = fd;
-    else ::close(fd);  // the name was removed (stale) after we opened it: take the new one
-  }
-  if (fd_ < 0 && !lock_path_.empty())
-    throw Error("cannot lock output folder " + dir + ": " + own_name + " keeps being replaced");
-
+  fd_ = take_own_lock(dir, own_name, expected, lock_path_);
   try {
-    // One pass over the folder: lock files of the same --name pattern, and sidecars the pattern names.
-    std::vector<std::string> locks;
-    std::vector<std::pair<long, std::string>> sidecars;
-    std::vector<long> job = job_frames;
-    std::sort(job.begin(), job.end());
-    if (DIR* d = ::opendir(dir.c_str())) {
-      while (const dirent* e = ::readdir(d)) {
-        const std::string name = e->d_name;
-        if (name[0] == '.') {
-          if (name != own_name && name.compare(0, same_pattern.size(), same_pattern) == 0 && is_lock_name(name))
-            locks.push_back(name);
-          continue;
-        }
-        const long f = sidecar_frame(pattern, name);
-        if (f >= 0 && !std::binary_search(job.begin(), job.end(), f)) sidecars.emplace_back(f, name);
-      }
-      ::closedir(d);
-    } else {
-      throw Error("cannot read output folder " + dir + ": " + std::strerror(errno));
-    }
-
-    // 2. Other configurations' locks: held = a process renders into this folder right now.
-    for (const std::string& name : locks) {
-      const std::string path = (fs::path(dir) / name).string();
-      const int fd = open_lock(path);
-      if (fd < 0) continue;  // gone
-      if (::flock(fd, LOCK_EX | LOCK_NB) == 0) {
-        if (same_file(fd, path)) ::unlink(path.c_str());  // nobody holds it: stale
-        ::close(fd);
-        continue;
-      }
-      const bool held = errno == EWOULDBLOCK;
-      const std::string text = held ? read_fd(fd) : std::string();
-      ::close(fd);
-      if (!held) continue;  // cannot tell (e.g. a read-only file over NFS)
-      const std::string diff = difference(text);
-      if (diff.empty()) continue;  // the same configuration under another fingerprint (e.g. other --write)
-      throw Error(dir + " is being rendered right now by a pmr process with another configuration (" +
-                  (diff == "unreadable" ? std::string("unrecorded") : diff + " differs") + "; it holds " + name +
-                  "); wait for it, use another --out, or delete " + name + " if no such process is running");
-    }
-
-    // 3. Finished frames outside this job (every shard's frames count as this job's).
-    std::sort(sidecars.begin(), sidecars.end());
-    if (sidecars.size() >= 10000 && !quiet)  // about 0.3 ms each (48 views): say why the start takes a while
-      std::fprintf(stderr, "pmr: comparing the configuration of %zu frame(s) outside --frames in %s\n", sidecars.size(),
-                   dir.c_str());
-    long others = 0;
-    std::string first_name, first_diff;
-    for (const auto& [frame, name] : sidecars) {
-      const std::string diff = difference(read_sidecar_text((fs::path(dir) / name).string()));
-      // unreadable: a broken frame, not a configuration (pmr verify reports it)
-      if (diff.empty() || diff == "unreadable") continue;
-      if (others++ == 0) first_name = name, first_diff = diff;
-      if (!overwrite) break;  // one is enough to refuse
-    }
-    if (others > 0 && !overwrite)
-      throw Error(dir + " holds " + first_name + " rendered with another configuration (" + first_diff +
-                  " differs) that this run would not replace; use another --out, render those frames too, or "
-                  "--overwrite");
-    if (others > 0)
-      std::fprintf(stderr, "pmr: warning: --overwrite: %s keeps %ld frame(s) of another configuration that this run "
-                   "does not replace (%s: %s differs)\n", dir.c_str(), others, first_name.c_str(), first_diff.c_str());
+    const FolderContents found = scan_folder(dir, pattern, job_frames, own_name);
+    refuse_running_configurations(dir, found.locks, difference);
+    check_finished_frames(dir, found.sidecars, difference, overwrite, quiet);
   } catch (...) {
     release();  // a throwing constructor runs no destructor
     throw;

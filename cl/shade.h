@@ -108,8 +108,6 @@ typedef struct {
   uint tri[SW];            /* lane l's triangle, where textured                               */
 } LaneWinners;
 
-constant int shade_lane_index[SW] = {0, 1, 2, 3, 4, 5, 6, 7};
-
 /* No lanes yet; idle lanes keep finite values so that the vector arithmetic stays cheap. */
 inline void lanes_clear(LaneWinners* L) {
   const sfloat zero = 0.0f, one = 1.0f;
@@ -168,7 +166,7 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
  * plus (l - first) step. Summed in doubles, exact below 2^53, so rounding to float rounds the exact
  * value, as for a lane evaluated on its own; beyond that, lane by lane in 64 bits. */
 inline void lanes_step_edges(LaneWinners* L, sint take, int first, const long* E, const long* step) {
-  const sint lane = vload_s(0, shade_lane_index);
+  const sint lane = vload_s(0, lane_index);
   sfloat e[3];
   for (int k = 0; k < 3; ++k) {
     const long far_end = (E[k] < 0 ? -E[k] : E[k]) + (long)SW * (step[k] < 0 ? -step[k] : step[k]);
@@ -185,7 +183,7 @@ inline void lanes_step_edges(LaneWinners* L, sint take, int first, const long* E
 
 /* The lanes of vector `take` as bits. */
 inline uint lane_bits(sint take) {
-  const sint bits = select((sint)(0), (sint)(1) << vload_s(0, shade_lane_index), take);
+  const sint bits = select((sint)(0), (sint)(1) << vload_s(0, lane_index), take);
   const int4 b4 = bits.lo | bits.hi;
   const int2 b2 = b4.lo | b4.hi;
   return (uint)(b2.x | b2.y);

@@ -15,6 +15,11 @@
  * PoCL compiles exactly one work-group function per (kernel, local size). */
 inline uint pmr_item_id(void) { return (uint)(get_global_id(1) * get_global_size(0) + get_global_id(0)); }
 
+/* For a helper that runs in a kernel's per-voxel, per-sample or per-MTA loop: PoCL's inliner leaves large
+ * functions out of line even when they have one caller, and a call there costs its arguments' trips
+ * through memory (structs and arrays cannot stay in registers across it). */
+#define PMR_HOT inline __attribute__((always_inline))
+
 #define PMR_HALF_X (PMR_X_ONE / 2)
 #define PMR_HALF_Y (PMR_Y_ONE / 2)
 

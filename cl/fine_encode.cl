@@ -64,7 +64,6 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
 
   /* the winners' colours as half bits, background zero */
   const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
-  const uint* key_of = (const uint*)best_key;
   ushort4 colour[FUSED_ROWS * VW];
   MtaCache cache;
   cache.id = PMR_NO_KEY;
@@ -72,16 +71,8 @@ kernel void fine_encode(global const PmrParams* P, global const PmrMta* mtas,
     for (int ly = 0; ly < ny; ++ly)
       for (int c = 0; c * VW < nx; ++c) {
         const int r = (view * PMR_TILE_Y + ly) * FINE_CHUNKS + c; /* fused_voxel(view, ly, c * VW) / VW */
-        float rgb[3 * VW];
         fine_shade_chunk(&in, mtas, &cache, light, best_mta[r], best_key[r] != (vuint)(PMR_NO_KEY), x0 + c * VW, y0 + ly,
-                         view, rgb);
-        for (int l = 0; l < VW; ++l) {
-          const int k = r * VW + l;
-          if (key_of[k] != PMR_NO_KEY)
-            vstore_half4((float4)(rgb[3 * l], rgb[3 * l + 1], rgb[3 * l + 2], 1.0f), k, (half*)colour);
-          else
-            colour[k] = (ushort4)(0);
-        }
+                         view, colour + r * VW);
       }
 
   /* the display pixels this tile owns, whole or in part */

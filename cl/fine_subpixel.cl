@@ -21,80 +21,10 @@
  * vertex 0, z = (float)(z_0 + (g_x (X - x_0) + g_y (Y - y_0))): a function of the MTA, the view and the
  * sample alone, so the result does not depend on chunks, tiles or threads. Visibility is the (depth,
  * key) order as everywhere. */
-#include "shade.h"
+#include "fine_core.h"
 
 #define SP_LANES 8
 #define SP_SLOTS PMR_SUBPIXEL_SLOTS /* the host keeps area + (SP_LANES - 1) * min(views, area) within */
-
-constant int sp_lane_index[SP_LANES] = {0, 1, 2, 3, 4, 5, 6, 7};
-
-/* The exact edge functions of MTA m at the samples (Xc + sx[l], Yc + sy[l]) of the view with view
- * coordinate f of the lanes in `bits`, into e (per lane). */
-inline void sp_edges(const PmrMta* m, uint bits, const int* sx, const int* sy, long Xc, long Yc, long f, float (*e)[SW]) {
-  for (uint b = bits; b != 0u; b &= b - 1u) {
-    const int l = 31 - (int)clz(b & (0u - b));
-    long E[3];
-    mta_edges_at(m, Xc + sx[l], Yc + sy[l], f, E);
-    e[0][l] = (float)E[0], e[1][l] = (float)E[1], e[2][l] = (float)E[2];
-  }
-}
-
-/* The winners of the samples (Xc + sx[l], Yc + sy[l]) of view v, l < SW: MTA ids[l] where `act`. */
-inline void sp_winners(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, const int* ids, sint act,
-                       const int* sx, const int* sy, long Xc, long Yc, int v, LaneWinners* L) {
-  const bool pbr = in->P->shading == PMR_SHADING_PBR;
-  lanes_clear(L);
-  float e[3][SW];
-  for (int l = 0; l < SW; ++l) e[0][l] = e[1][l] = e[2][l] = 1.0f;
-  const sint lane_ids = vload_s(0, ids);
-  uint todo = lane_bits(act);
-  while (todo != 0u) {
-    const int f = 31 - (int)clz(todo & (0u - todo));
-    const sint take = act & (lane_ids == (sint)(ids[f]));
-    const uint bits = lane_bits(take);
-    todo &= ~bits;
-    const PmrMta* m = cached_mta(cache, mtas, (uint)ids[f]);
-    lanes_add(L, in, m, take, bits, pbr);
-    sp_edges(m, bits, sx, sy, Xc, Yc, view_coord(in->P, v), e);
-  }
-  L->e = LANE3(e);
-}
-
-/* alphaMode MASK: of the lanes in `win` (samples (Xc + sx[l], Yc + sy[l]) of view v), those whose base
- * colour alpha passes the cutoff (rare path, one lane at a time with the exact edge functions). */
-inline int8 sp_mask_alpha(const ShadeInputs* in, const PmrMta* m, int8 win, const int* sx, const int* sy, long Xc,
-                          long Yc, int v, float cutoff) {
-  int w[SP_LANES];
-  vstore8(win, 0, w);
-  for (int l = 0; l < SP_LANES; ++l)
-    if (w[l] && !mta_alpha_passes(in, m, Xc + sx[l], Yc + sy[l], v, cutoff)) w[l] = 0;
-  return vload8(0, w);
-}
-
-/* Bit l set: in view ib + l (l < n <= 16) the MTA's x extent reaches the chunk's samples, [0, span]
- * relative to the chunk's first sample. Vertex x in 32 bits when that provably fits (base and disparity
- * each below 2^29 over the views), else every view passes (the edge tests decide exactly either way). */
-inline uint sp_view_mask(global const PmrParams* P, const PmrMta* m, int ib, int n, long Xc, long span) {
-  const uint all = (1u << n) - 1u;
-  long fspan;
-  const int16 l = view_coord_lanes(P, ib, n, &fspan);
-  const long fib = view_coord(P, ib);
-  long base[3];
-  bool fits = span < (1L << 29);
-  for (int k = 0; k < 3; ++k) {
-    base[k] = (long)m->x0[k] + fib * m->dx[k] - Xc;
-    fits = fits && base[k] > -(1L << 29) && base[k] < (1L << 29) && (long)abs(m->dx[k]) * fspan < (1L << 29);
-  }
-  if (!fits) return all;
-  const int16 xa = (int16)((int)base[0]) + l * m->dx[0], xb = (int16)((int)base[1]) + l * m->dx[1];
-  const int16 xc = (int16)((int)base[2]) + l * m->dx[2];
-  const int16 pass = (max(xa, max(xb, xc)) >= (int16)(0)) & (min(xa, min(xb, xc)) <= (int16)((int)span));
-  const int16 bits = select((int16)(0), (int16)(1) << (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15), pass);
-  const int8 r8 = bits.lo | bits.hi;
-  const int4 r4 = r8.lo | r8.hi;
-  const int2 r2 = r4.lo | r4.hi;
-  return (uint)(r2.x | r2.y) & all;
-}
 
 kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, global const uint* tile_offsets,
                           global const uint* tile_queue, global const PmrTriangle* tris,
@@ -171,7 +101,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
   /* each vector's bounding box (x0, x1, y0, y1): an MTA skips the vectors it cannot reach; x0 and x1
    * do not decrease along a run */
   int4 box[SP_SLOTS / SP_LANES];
-  const int8 lane = vload8(0, sp_lane_index);
+  const int8 lane = vload8(0, lane_index);
   for (int v = 0; v < views; ++v)
     for (int k = first[v]; k < first[v] + count[v]; k += SP_LANES) {
       const int8 valid = lane < (int8)(first[v] + count[v] - k); /* padding lanes repeat lane 0 */
@@ -215,7 +145,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
       }
       const long my0 = ylo - Yc, my1 = yhi - Yc;
       for (int ib = i_lo; ib <= i_hi; ib += 16) {
-        uint pass = sp_view_mask(P, &m, ib, min(i_hi - ib + 1, 16), Xc, Xl - Xc);
+        uint pass = view_pass_mask(P, &m, ib, min(i_hi - ib + 1, 16), Xc, 0, Xl - Xc);
         while (pass != 0) { /* the passing views, lowest first */
           const int v = ib + (31 - (int)clz(pass & (0u - pass)));
           pass &= pass - 1u;
@@ -264,8 +194,13 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
             const float8 bd = vload8(0, best_depth + k);
             const uint8 bk = vload8(0, best_key + k);
             int8 win = convert_int8(hit) & ((z < bd) | ((z == bd) & ((uint8)(m.key) < bk)));
-            if ((m.flags & PMR_MTA_MASK) && any(win))
-              win = sp_mask_alpha(&in, &m, win, sx + k, sy + k, Xc, Yc, v, cutoff);
+            if ((m.flags & PMR_MTA_MASK) && any(win)) {
+              int w[SP_LANES];
+              vstore8(win, 0, w);
+              const SampleLanes S = offset_samples(Xc, Yc, sx + k, sy + k);
+              mask_alpha_lanes(&in, &m, w, SP_LANES, &S, v, cutoff);
+              win = vload8(0, w);
+            }
             vstore8(select(bd, z, win), 0, best_depth + k);
             vstore8(select(bk, (uint8)(m.key), as_uint8(win)), 0, best_key + k);
             vstore8(select(vload8(0, best_mta + k), (uint8)(id), as_uint8(win)), 0, best_mta + k);
@@ -301,8 +236,9 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
       }
       const sint act = vload_s(0, todo);
       if (!any(act)) continue;
+      const SampleLanes S = offset_samples(Xc, Yc, sx + k0, sy + k0);
       LaneWinners L;
-      sp_winners(&in, mtas, &cache, ids, act, sx + k0, sy + k0, Xc, Yc, v, &L);
+      lanes_gather(&in, mtas, &cache, act, vload_s(0, ids), &S, v, &L);
       float c[3][SW];
       s3_store(shade_lanes(&in, &L, light, v), c[0], c[1], c[2]);
       for (int l = 0; l < kn; ++l) {

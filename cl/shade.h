@@ -128,7 +128,7 @@ inline sfloat blend(sfloat a, float b, sint take) { return select(a, (sfloat)(b)
 inline sfloat3 blend3(sfloat3 a, float3 b, sint take) { return s3_select(a, s3_splat(b), take); }
 
 /* Lanes `take` (bits: the same as bits) are won by MTA m: its values blended into them (the edge
- * functions are set apart, lanes_step_edges or lanes_set_edges). */
+ * functions are set apart: lanes_gather in fine_core.h). */
 inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, sint take, uint bits, bool pbr) {
   L->act |= take;
   if (m->flags & PMR_MTA_BACK) L->back |= take;

@@ -164,6 +164,14 @@ inline int encode_view(int views, int reversed, const PmrEncodeColumn* col, cons
   return reversed ? views - 1 - v : v;
 }
 
+/* encode_view of 8 subpixels at once, from their columns' a_mod_n and b (vectors loaded from the column
+ * tables' planes): the same map in vector arithmetic, which PoCL compiles to SIMD. */
+inline int8 encode_view8(int views, int reversed, int8 a_mod_n, int8 b, const PmrEncodeRow* row) {
+  int8 v = a_mod_n - (int8)(row->q_mod_n) + (b < (int8)(row->s)); /* a true comparison is -1 */
+  v = select(v, v + (int8)(views), v < (int8)(0));
+  return reversed ? (int8)(views - 1) - v : v;
+}
+
 /* The column table of display row i: with subpixel cells, one block of 3 W_d columns per row class. */
 inline global const PmrEncodeColumn* row_columns(global const PmrEncodeParams* E, global const PmrEncodeColumn* columns,
                                                  int i) {

@@ -56,10 +56,7 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
     const PmrEncodeRow row = rows[i];
     for (int s = ch.s0; s < ch.s1; s += 8, n += 8) {
       const int8 a = vload8(0, column_a + block + s), b = vload8(0, column_b + block + s);
-      int8 v = a - (int8)(row.q_mod_n) + (b < (int8)(row.s)); /* a true comparison is -1 */
-      v = select(v, v + (int8)(views), v < (int8)(0));
-      if (E->reversed) v = (int8)(views - 1) - v;
-      vstore8(convert_ushort8(v), 0, view_of + n);
+      vstore8(convert_ushort8(encode_view8(views, E->reversed, a, b, &row)), 0, view_of + n);
     }
     n -= (8 - width % 8) % 8; /* the last vector's lanes past the chunk are overwritten by the next row */
   }
@@ -251,32 +248,20 @@ kernel void fine_subpixel(global const PmrParams* P, global const PmrMta* mtas, 
       }
     }
 
-  /* 4. The display pixels: whole ones with their alpha (the three subpixels' mean coverage, as
-   * encode_pixel computes it), cut ones (their subpixels in other tiles too) channel by channel with
-   * their coverage left for encode_straddle_alpha. */
-  global ushort* bits = (global ushort*)display;
+  /* 4. The display pixels (write_display_pixel): a sample's half RGBA bits are its value in every
+   * channel (the pixel takes channel k from subpixel k) and its coverage as alpha. */
+  const DisplayOut D = {(global ushort*)display, sub_alpha, straddle_cov, straddle_slot, straddle_slots, Wd};
   const ushort one = 0x3c00; /* 1.0 as a half */
   for (int i = ch.i0; i < ch.i1; ++i) {
-    const int r = (i - ch.i0) * width - ch.s0;
+    const int r = (i - ch.i0) * width - ch.s0; /* sample index of subpixel s: r + s */
     for (int j = ch.s0 / 3; 3 * j < ch.s1; ++j) {
-      const size_t pixel = (size_t)i * (size_t)Wd + (size_t)j;
-      if (3 * j >= ch.s0 && 3 * j + 3 <= ch.s1) {
-        const int n = r + 3 * j;
-        const ushort4 a = (ushort4)(value[n], 0, 0, covered[n] ? one : 0);
-        const ushort4 b = (ushort4)(0, value[n + 1], 0, covered[n + 1] ? one : 0);
-        const ushort4 c = (ushort4)(0, 0, value[n + 2], covered[n + 2] ? one : 0);
-        vstore4(encode_pixel(a, b, c), pixel, bits);
-        store_sub_alpha(sub_alpha, pixel, a, b, c);
-        continue;
-      }
-      const size_t slot = ((size_t)i * straddle_slots + (size_t)straddle_slot[j]) * 3;
+      ushort4 s[3];
       for (int k = 0; k < 3; ++k) {
-        const int s = 3 * j + k;
-        if (s < ch.s0 || s >= ch.s1) continue;
-        bits[pixel * 4 + (size_t)k] = value[r + s];
-        straddle_cov[slot + (size_t)k] = covered[r + s];
-        sub_alpha[pixel * 3 + (size_t)k] = covered[r + s] ? one : 0; /* its own: written by its chunk alone */
+        const int n = r + 3 * j + k;
+        const bool own = 3 * j + k >= ch.s0 && 3 * j + k < ch.s1;
+        s[k] = own ? (ushort4)(value[n], value[n], value[n], covered[n] ? one : 0) : (ushort4)(0);
       }
+      write_display_pixel(&D, i, j, ch.s0, ch.s1, s[0], s[1], s[2]);
     }
   }
 }

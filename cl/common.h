@@ -15,6 +15,11 @@
  * PoCL compiles exactly one work-group function per (kernel, local size). */
 inline uint pmr_item_id(void) { return (uint)(get_global_id(1) * get_global_size(0) + get_global_id(0)); }
 
+/* For a helper that runs in a kernel's per-voxel, per-sample or per-MTA loop: PoCL's inliner leaves large
+ * functions out of line even when they have one caller, and a call there costs its arguments' trips
+ * through memory (structs and arrays cannot stay in registers across it). */
+#define PMR_HOT inline __attribute__((always_inline))
+
 #define PMR_HALF_X (PMR_X_ONE / 2)
 #define PMR_HALF_Y (PMR_Y_ONE / 2)
 
@@ -157,6 +162,14 @@ inline int encode_view(int views, int reversed, const PmrEncodeColumn* col, cons
   int v = col->a_mod_n - row->q_mod_n - (col->b < row->s ? 1 : 0);
   v = v < 0 ? v + views : v;
   return reversed ? views - 1 - v : v;
+}
+
+/* encode_view of 8 subpixels at once, from their columns' a_mod_n and b (vectors loaded from the column
+ * tables' planes): the same map in vector arithmetic, which PoCL compiles to SIMD. */
+inline int8 encode_view8(int views, int reversed, int8 a_mod_n, int8 b, const PmrEncodeRow* row) {
+  int8 v = a_mod_n - (int8)(row->q_mod_n) + (b < (int8)(row->s)); /* a true comparison is -1 */
+  v = select(v, v + (int8)(views), v < (int8)(0));
+  return reversed ? (int8)(views - 1) - v : v;
 }
 
 /* The column table of display row i: with subpixel cells, one block of 3 W_d columns per row class. */

@@ -39,16 +39,13 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
       for (int c = 0; c * VW < nx; ++c) {
         const int r = (lv * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
         const int view = v0 + lv, py = y0 + ly;
-        float rgb[3 * VW];
+        ushort4 colour[VW];
         fine_shade_chunk(&in, mtas, &cache, light, best_mta[r], best_key[r] != (vuint)(PMR_NO_KEY), x0 + c * VW, py, view,
-                         rgb);
+                         colour);
         for (int l = 0; l < VW && c * VW + l < nx; ++l) {
           const int k = r * VW + l, px = x0 + c * VW + l;
           const size_t voxel = (((size_t)view + view_base) * H + (size_t)py) * W + (size_t)px;
-          if (key_of[k] != PMR_NO_KEY)
-            vstore_half4((float4)(rgb[3 * l], rgb[3 * l + 1], rgb[3 * l + 2], 1.0f), voxel, volume);
-          else
-            vstore4((ushort4)(0), voxel, (global ushort*)volume); /* background */
+          vstore4(colour[l], voxel, (global ushort*)volume);
           if (debug) {
             debug_key[voxel] = key_of[k];
             debug_depth[voxel] = depth_of[k];

@@ -10,25 +10,72 @@
  * column's and row's first subpixel and display row). A display pixel whose three subpixels belong to
  * different tiles ("straddling", a column property the host lists) gets each colour channel from the
  * subpixel's owner and its alpha, the mean coverage, from encode_straddle_alpha once all tiles are
- * done: the owners leave one coverage byte per subpixel in straddle_cov. */
+ * done: the owners leave one coverage byte per subpixel in straddle_cov (write_display_pixel in
+ * fine_core.h, which fine_subpixel.cl's display pixels go through too). */
 #include "fine_raster.h"
 
 #define FUSED_ROWS (PMR_TILE_Y * PMR_FUSED_VIEWS * FINE_CHUNKS)
 
-/* Subpixel s's entry of the encoder column table, from its planes (see the display scan below). */
-inline PmrEncodeColumn soa_column(global const int* column_soa, int width, int s) {
-  const int j = s / 3, k = s % 3;
+/* The tile's shaded voxels (half RGBA bits, background zero) and what maps a display subpixel to one:
+ * the column table's planes column_soa[(field * 3 + k) * width + j] for subpixel s = 3 j + k, fields
+ * a_mod_n, b, px (so that eight columns load as vectors). */
+typedef struct {
+  const ushort4* colour;
+  global const int* column_soa;
+  int width, views, reversed, x0;
+} FusedTile;
+
+/* colour[] index of voxel (view, ly, lx): view * FUSED_VIEW_STRIDE + ly * FUSED_ROW_STRIDE + lx, the
+ * visibility state's order (fine_raster_queue). */
+#define FUSED_ROW_STRIDE (FINE_CHUNKS * VW)
+#define FUSED_VIEW_STRIDE (PMR_TILE_Y * FINE_CHUNKS * VW)
+
+/* The colour display subpixel s of row `row` (view row ly of the tile) samples. */
+PMR_HOT ushort4 fused_subpixel(const FusedTile* T, const PmrEncodeRow* row, int ly, int s) {
+  global const int* plane = T->column_soa + (size_t)(s % 3) * T->width + s / 3;
   PmrEncodeColumn c;
-  c.a_mod_n = column_soa[k * width + j];
-  c.b = column_soa[(3 + k) * width + j];
-  c.px = column_soa[(6 + k) * width + j];
-  c.phase_frac = 0.0f;  /* (only view blending reads it; the fused path does not blend) */
-  return c;
+  c.a_mod_n = plane[0];
+  c.b = plane[3 * T->width];
+  c.px = plane[6 * T->width];
+  c.phase_frac = 0.0f; /* (only view blending reads it; the fused path does not blend) */
+  const int view = encode_view(T->views, T->reversed, &c, row);
+  return T->colour[view * FUSED_VIEW_STRIDE + ly * FUSED_ROW_STRIDE + c.px - T->x0];
 }
 
-/* Index of voxel (view, ly, lx) in the visibility state and colour arrays. */
-inline int fused_voxel(int view, int ly, int lx) {
-  return ((view * PMR_TILE_Y + ly) * FINE_CHUNKS + lx / VW) * VW + lx % VW;
+/* Display pixel j of row i, of whose subpixels the tile owns [s_lo, s_hi). */
+PMR_HOT void fused_pixel(const DisplayOut* D, const FusedTile* T, const PmrEncodeRow* row, int i, int ly, int j,
+                        int s_lo, int s_hi) {
+  ushort4 s[3];
+  for (int k = 0; k < 3; ++k)
+    s[k] = 3 * j + k >= s_lo && 3 * j + k < s_hi ? fused_subpixel(T, row, ly, 3 * j + k) : (ushort4)(0);
+  write_display_pixel(D, i, j, s_lo, s_hi, s[0], s[1], s[2]);
+}
+
+/* Eight wholly owned display pixels j .. j + 7 of row i: each subpixel's view and colour index in 8-lane
+ * vector arithmetic on the column planes (encode_view8), then the colours fetched one by one. */
+PMR_HOT void fused_pixels8(const DisplayOut* D, const FusedTile* T, const PmrEncodeRow* row, int i, int ly, int j) {
+  const int8 base = (int8)(ly * FUSED_ROW_STRIDE - T->x0);
+  int idx[3][8];
+  for (int k = 0; k < 3; ++k) {
+    global const int* plane = T->column_soa + (size_t)k * T->width + j;
+    const int8 a = vload8(0, plane), b = vload8(0, plane + 3 * T->width), px = vload8(0, plane + 6 * T->width);
+    vstore8(encode_view8(T->views, T->reversed, a, b, row) * FUSED_VIEW_STRIDE + base + px, 0, idx[k]);
+  }
+  const ulong* colour_bits = (const ulong*)T->colour;
+  for (int l = 0; l < 8; ++l)
+    write_display_pixel(D, i, j + l, 3 * (j + l), 3 * (j + l) + 3, as_ushort4(colour_bits[idx[0][l]]),
+                        as_ushort4(colour_bits[idx[1][l]]), as_ushort4(colour_bits[idx[2][l]]));
+}
+
+/* The display pixels of row i (view row ly of the tile) with a subpixel in [s_lo, s_hi), the tile's. */
+inline void fused_display_row(const DisplayOut* D, const FusedTile* T, const PmrEncodeRow* row, int i, int ly,
+                              int s_lo, int s_hi) {
+  const int j_a = (s_lo + 2) / 3, j_b = s_hi / 3; /* wholly owned: [j_a, j_b) */
+  int j = j_a;
+  for (; j + 8 <= j_b; j += 8) fused_pixels8(D, T, row, i, ly, j);
+  /* the rest one at a time: a partly owned pixel at each end, wholly owned ones after the last eight */
+  if (s_lo % 3 != 0 && s_lo < s_hi) fused_pixel(D, T, row, i, ly, s_lo / 3, s_lo, s_hi);
+  for (; 3 * j < s_hi; ++j) fused_pixel(D, T, row, i, ly, j, s_lo, s_hi);
 }
 
 kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
@@ -57,91 +104,24 @@ kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
 
   /* the winners' colours as half bits, background zero */
   const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
-  const uint* key_of = (const uint*)best_key;
   ushort4 colour[FUSED_ROWS * VW];
   MtaCache cache;
   cache.id = PMR_NO_KEY;
   for (int view = 0; view < views; ++view)
     for (int ly = 0; ly < ny; ++ly)
       for (int c = 0; c * VW < nx; ++c) {
-        const int r = (view * PMR_TILE_Y + ly) * FINE_CHUNKS + c; /* fused_voxel(view, ly, c * VW) / VW */
-        float rgb[3 * VW];
+        const int r = (view * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
         fine_shade_chunk(&in, mtas, &cache, light, best_mta[r], best_key[r] != (vuint)(PMR_NO_KEY), x0 + c * VW, y0 + ly,
-                         view, rgb);
-        for (int l = 0; l < VW; ++l) {
-          const int k = r * VW + l;
-          if (key_of[k] != PMR_NO_KEY)
-            vstore_half4((float4)(rgb[3 * l], rgb[3 * l + 1], rgb[3 * l + 2], 1.0f), k, (half*)colour);
-          else
-            colour[k] = (ushort4)(0);
-        }
+                         view, colour + r * VW);
       }
 
   /* the display pixels this tile owns, whole or in part */
-  const int width = E->display_w, reversed = E->reversed;
+  const DisplayOut D = {(global ushort*)display, sub_alpha, straddle_cov, straddle_slot, straddle_slots, E->display_w};
+  const FusedTile T = {colour, column_soa, E->display_w, views, E->reversed, x0};
   const int s_lo = column_start[x0], s_hi = column_start[x0 + nx];
   const int i_lo = row_start[y0], i_hi = row_start[y0 + ny];
-  global ushort* bits = (global ushort*)display;
-  /* colour[] index of voxel (view, ly, lx) = view * VIEW_STRIDE + ly * ROW_STRIDE + lx (fused_voxel) */
-  const int ROW_STRIDE = FINE_CHUNKS * VW, VIEW_STRIDE = PMR_TILE_Y * FINE_CHUNKS * VW;
-  const ulong* colour_bits = (const ulong*)colour;
-  /* display pixels wholly owned: j in [j_a, j_b) */
-  const int j_a = (s_lo + 2) / 3, j_b = s_hi / 3;
   for (int i = i_lo; i < i_hi; ++i) {
     const PmrEncodeRow row = rows[i];
-    const int ly = row.py - y0;
-    global ulong* row_bits = (global ulong*)display + (size_t)i * (size_t)width;
-    /* Eight wholly owned pixels at a time: the view and colour index of each subpixel as 8-lane vector
-     * arithmetic on the column tables' planes (column_soa[(field * 3 + k) * width + j], fields a_mod_n,
-     * b, px), then the colours fetched one by one. Same map as encode_view. */
-    const int8 q = (int8)(row.q_mod_n), srow = (int8)(row.s), base = (int8)(ly * ROW_STRIDE - x0);
-    int j = j_a;
-    for (; j + 8 <= j_b; j += 8) {
-      int idx[3][8];
-      for (int k = 0; k < 3; ++k) {
-        const int8 a = vload8(0, column_soa + (size_t)(0 * 3 + k) * width + j);
-        const int8 b = vload8(0, column_soa + (size_t)(1 * 3 + k) * width + j);
-        const int8 px = vload8(0, column_soa + (size_t)(2 * 3 + k) * width + j);
-        int8 v = a - q + (b < srow); /* a true comparison is -1 */
-        v = select(v, v + views, v < 0);
-        if (reversed) v = (int8)(views - 1) - v;
-        vstore8(v * VIEW_STRIDE + base + px, 0, idx[k]);
-      }
-      for (int l = 0; l < 8; ++l) {
-        const ulong c0 = colour_bits[idx[0][l]], c1 = colour_bits[idx[1][l]], c2 = colour_bits[idx[2][l]];
-        row_bits[j + l] = as_ulong(encode_pixel(as_ushort4(c0), as_ushort4(c1), as_ushort4(c2)));
-        store_sub_alpha(sub_alpha, (size_t)i * (size_t)width + (size_t)(j + l), as_ushort4(c0), as_ushort4(c1),
-                        as_ushort4(c2));
-      }
-    }
-    /* the rest one at a time: a partly owned pixel at each end, wholly owned ones after the last eight */
-    for (int jj = s_lo / 3; 3 * jj < s_hi; ++jj) {
-      if (jj == j_a && j > j_a) { /* skip the pixels done eight at a time */
-        jj = j - 1;
-        continue;
-      }
-      const size_t pixel = (size_t)i * (size_t)width + (size_t)jj;
-      if (3 * jj >= s_lo && 3 * jj + 3 <= s_hi) {
-        const PmrEncodeColumn c0 = soa_column(column_soa, width, 3 * jj);
-        const PmrEncodeColumn c1 = soa_column(column_soa, width, 3 * jj + 1);
-        const PmrEncodeColumn c2 = soa_column(column_soa, width, 3 * jj + 2);
-        const ushort4 a = colour[fused_voxel(encode_view(views, reversed, &c0, &row), ly, c0.px - x0)];
-        const ushort4 b = colour[fused_voxel(encode_view(views, reversed, &c1, &row), ly, c1.px - x0)];
-        const ushort4 c = colour[fused_voxel(encode_view(views, reversed, &c2, &row), ly, c2.px - x0)];
-        vstore4(encode_pixel(a, b, c), pixel, bits);
-        store_sub_alpha(sub_alpha, pixel, a, b, c);
-        continue;
-      }
-      const size_t slot = ((size_t)i * straddle_slots + (size_t)straddle_slot[jj]) * 3;
-      for (int k = 0; k < 3; ++k) {
-        const int s = 3 * jj + k;
-        if (s < s_lo || s >= s_hi) continue;
-        const PmrEncodeColumn col = soa_column(column_soa, width, s);
-        const ushort4 a = colour[fused_voxel(encode_view(views, reversed, &col, &row), ly, col.px - x0)];
-        bits[pixel * 4 + (size_t)k] = k == 0 ? a.x : (k == 1 ? a.y : a.z);
-        straddle_cov[slot + (size_t)k] = a.w != 0 ? 1 : 0;
-        sub_alpha[pixel * 3 + (size_t)k] = a.w; /* this subpixel's own: written by its tile alone */
-      }
-    }
+    fused_display_row(&D, &T, &row, i, row.py - y0, s_lo, s_hi);
   }
 }

@@ -1,7 +1,8 @@
 #ifndef PMR_CL_FINE_RASTER_H
 #define PMR_CL_FINE_RASTER_H
-/* The fine raster's inner loop, shared by the stage kernels that write the view volume (fine.cl)
- * and that write the display image directly (fine_encode.cl).
+/* The pixel-center fine raster, shared by the stage kernels that write the view volume (fine.cl) and
+ * that write the display image directly (fine_encode.cl); fine_core.h holds what it shares with the
+ * subpixel raster too.
  *
  * A work-item walks a tile's queue once. Per MTA and view it sets up the exact edge functions at
  * the tile's first pixel center in 64-bit integers, and per tile row it turns each edge into a 32-bit
@@ -20,7 +21,7 @@
  * When |G| (PMR_VW - 1) < 2^31 - 1 ("narrow" edges: up to ~2000 px tall at 16 lanes), G lx fits in
  * 32 bits and T can be clamped to 32 bits without changing the outcome; taller edges use an exact
  * 64-bit division per row instead. */
-#include "shade.h"
+#include "fine_core.h"
 
 #define PMR_CAT_(a, b) a##b
 #define PMR_CAT(a, b) PMR_CAT_(a, b)
@@ -40,8 +41,6 @@ typedef PMR_CAT(float, PMR_VW) vfloat;
 /* Queue entries between an MTA's prefetch and its use. */
 #define FINE_PREFETCH 4
 
-constant int fine_lane_index[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
-
 /* Lanes of a row chunk inside one edge: G lx >= T (see the head of this file). */
 inline vint edge_lanes(long F, long bias, long G, vint ramp, bool narrow, vint lane) {
   const long T = (bias - F + 255) >> 8; /* ceil((bias - F) / 2^8) */
@@ -51,43 +50,34 @@ inline vint edge_lanes(long F, long bias, long G, vint ramp, bool narrow, vint l
   return (vint)(T <= 0 ? -1 : 0);
 }
 
-/* alphaMode MASK: of the lanes in `win` (the row chunk from raster point (X, Y) of view i), those whose
- * base colour alpha passes the cutoff. Rare path, one lane at a time with the exact edge functions. */
-inline vint mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, vint win, long X, long Y, int i, float cutoff) {
-  int w[VW];
-  vstore_vint(win, 0, w);
-  for (int k = 0; k < VW; ++k)
-    if (w[k] && !mta_alpha_passes(in, m, X + (long)k * PMR_X_ONE, Y, i, cutoff)) w[k] = 0;
-  return vload_vint(0, w);
-}
+/* An MTA's three edges over a tile's rows: the fill-rule bias, the threshold slope G with its lane ramp
+ * (see the head of this file), and the edge function at pixel center (X0, Yfirst) of view i_lo (row),
+ * its step per row (step_y) and per row chunk (step_c). Every per-view quantity is linear in the view
+ * coordinate f (x_k(f) = x0_k + f dx_k): at view i, row and step_y are those at view i_lo plus
+ * (f_i - f_lo) exact integer increments drow and dstep_y. */
+typedef struct {
+  long bias[3], G[3];
+  bool narrow[3];
+  vint ramp[3];
+  long row[3], drow[3], step_y[3], dstep_y[3], step_c[3];
+} RowEdges;
 
-/* Bit l set: in view ib + l (l < count) some pixel-center column of the tile (first center X0, nx
- * columns) lies within the MTA's x extent. Views failing it cannot hold a covered voxel; a sub-pixel
- * MTA passes in an irregular part of the views, so testing 16 views at once (lanes = views) replaces
- * 16 unpredictable branches. Vertex x relative to X0 in 32 bits when that provably fits (base and
- * disparity each below 2^29 over the views), else every view is passed on (the edge tests decide
- * exactly either way). Arithmetic shifts floor. */
-inline uint view_pass_mask(global const PmrParams* P, const PmrMta* m, int ib, int count, long X0, int nx) {
-  const uint all = (1u << count) - 1u; /* count <= 16 */
-  long span;
-  const int16 l = view_coord_lanes(P, ib, count, &span);
-  const long fib = view_coord(P, ib);
-  long base[3];
-  bool fits = true;
-  for (int k = 0; k < 3; ++k) {
-    base[k] = (long)m->x0[k] + fib * m->dx[k] - X0;
-    fits = fits && base[k] > -(1L << 29) && base[k] < (1L << 29) && (long)abs(m->dx[k]) * span < (1L << 29);
+PMR_HOT void row_edges(const PmrMta* m, long f_first, long f_lo, long X0, long Yfirst, vint lane, RowEdges* R) {
+  const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
+  for (int e = 0; e < 3; ++e) {
+    const int a = ea[e], b = eb[e];
+    R->bias[e] = mta_edge_bias(m, a, b, f_first);
+    R->G[e] = (long)m->sign * (long)(m->y[b] - m->y[a]) * PMR_Y_ONE;
+    R->narrow[e] = (R->G[e] < 0 ? -R->G[e] : R->G[e]) * (VW - 1) < (long)INT_MAX;
+    R->ramp[e] = R->narrow[e] ? (vint)((int)R->G[e]) * lane : (vint)(0);
+    const long xa = (long)m->x0[a] + f_lo * m->dx[a], xb = (long)m->x0[b] + f_lo * m->dx[b];
+    const long dy = (long)(m->y[b] - m->y[a]), ddx = (long)m->dx[b] - (long)m->dx[a];
+    R->row[e] = m->sign * (dy * (X0 - xa) - (xb - xa) * (Yfirst - (long)m->y[a]));
+    R->drow[e] = -m->sign * (dy * (long)m->dx[a] + ddx * (Yfirst - (long)m->y[a]));
+    R->step_y[e] = -m->sign * (xb - xa) * PMR_Y_ONE;
+    R->dstep_y[e] = -m->sign * ddx * PMR_Y_ONE;
+    R->step_c[e] = m->sign * dy * ((long)PMR_X_ONE * VW);
   }
-  if (!fits) return all;
-  const int16 xa = (int16)((int)base[0]) + l * m->dx[0], xb = (int16)((int)base[1]) + l * m->dx[1];
-  const int16 xc = (int16)((int)base[2]) + l * m->dx[2];
-  const int16 kmax = max(xa, max(xb, xc)) >> PMR_X_FRAC_BITS;
-  const int16 kmin = -((-min(xa, min(xb, xc))) >> PMR_X_FRAC_BITS);
-  const int16 bits = select((int16)(0), (int16)(1) << vload16(0, fine_lane_index), max(kmin, 0) <= min(kmax, nx - 1));
-  int8 r8 = bits.lo | bits.hi;
-  int4 r4 = r8.lo | r8.hi;
-  int2 r2 = r4.lo | r4.hi;
-  return (uint)(r2.x | r2.y) & all;
 }
 
 /* Rasterizes the queue entries [q0, q1) of the 3D tile at (x0, y0, v0) (nx x ny x nv voxels inside
@@ -100,7 +90,7 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
                               int nv, int vbase, vfloat* best_depth, vuint* best_key, vuint* best_mta,
                               vint* covered) {
   const long X0 = (long)x0 * PMR_X_ONE + PMR_HALF_X, Y0 = (long)y0 * PMR_Y_ONE + PMR_HALF_Y;
-  const vint lane = vload_vint(0, fine_lane_index);
+  const vint lane = vload_vint(0, lane_index);
   vint in_tile[FINE_CHUNKS]; /* lanes inside the raster (edge tiles are narrower) */
   for (int c = 0; c < FINE_CHUNKS; ++c) in_tile[c] = (lane + c * VW) < (vint)(nx);
   for (uint q = q0; q < q1; ++q) {
@@ -113,48 +103,25 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     }
     const uint id = tile_queue[q];
     const PmrMta m = mtas[id];
-    const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
-    long bias[3], G[3];
-    bool narrow[3];
-    vint ramp[3];
     const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
-    const long f_lo = view_coord(in->P, i_lo), f_first = view_coord(in->P, m.view_lo);
-    for (int e = 0; e < 3; ++e) {
-      bias[e] = mta_edge_bias(&m, ea[e], eb[e], f_first);
-      G[e] = (long)m.sign * (long)(m.y[eb[e]] - m.y[ea[e]]) * PMR_Y_ONE;
-      narrow[e] = (G[e] < 0 ? -G[e] : G[e]) * (VW - 1) < (long)INT_MAX;
-      ramp[e] = narrow[e] ? (vint)((int)G[e]) * lane : (vint)(0);
-    }
     /* the tile rows whose centers lie within the MTA's y extent (the same in every view) */
     const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));
     const int ly0 = (int)max(0L, -floor_div_l(Y0 - ylo, PMR_Y_ONE));
     const int ly1 = (int)min((long)ny - 1, floor_div_l(yhi - Y0, PMR_Y_ONE));
     if (ly0 > ly1 || i_lo > i_hi) continue;
     const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
-    /* Every per-view quantity is linear in the view coordinate f (x_k(f) = x0_k + f dx_k): the edge
-     * functions at the tile's first row (row) and their row step (step_y) at view i are those at view
-     * i_lo plus (f_i - f_lo) exact integer increments. */
-    const long Yfirst = Y0 + (long)ly0 * PMR_Y_ONE;
-    long row_v[3], drow_v[3], step_y_v[3], dstep_y[3], step_c[3];
-    for (int e = 0; e < 3; ++e) {
-      const int a = ea[e], b = eb[e];
-      const long xa = (long)m.x0[a] + f_lo * m.dx[a], xb = (long)m.x0[b] + f_lo * m.dx[b];
-      const long dy = (long)(m.y[b] - m.y[a]), ddx = (long)m.dx[b] - (long)m.dx[a];
-      row_v[e] = m.sign * (dy * (X0 - xa) - (xb - xa) * (Yfirst - (long)m.y[a]));
-      drow_v[e] = -m.sign * (dy * (long)m.dx[a] + ddx * (Yfirst - (long)m.y[a]));
-      step_y_v[e] = -m.sign * (xb - xa) * PMR_Y_ONE;
-      dstep_y[e] = -m.sign * ddx * PMR_Y_ONE;
-      step_c[e] = m.sign * dy * ((long)PMR_X_ONE * VW);
-    }
+    const long f_lo = view_coord(in->P, i_lo);
+    RowEdges R;
+    row_edges(&m, view_coord(in->P, m.view_lo), f_lo, X0, Y0 + (long)ly0 * PMR_Y_ONE, lane, &R);
     for (int ib = i_lo; ib <= i_hi; ib += 16) {
-      uint pass = view_pass_mask(in->P, &m, ib, min(i_hi - ib + 1, 16), X0, nx);
+      uint pass = view_pass_mask(in->P, &m, ib, min(i_hi - ib + 1, 16), X0, PMR_X_FRAC_BITS, nx - 1);
       while (pass != 0) { /* the passing views, lowest first */
         const int i = ib + (31 - (int)clz(pass & (0u - pass)));
         pass &= pass - 1u;
         const long fi = view_coord(in->P, i), di = fi - f_lo;
-        long row[3] = {row_v[0] + di * drow_v[0], row_v[1] + di * drow_v[1], row_v[2] + di * drow_v[2]};
-        const long step_y[3] = {step_y_v[0] + di * dstep_y[0], step_y_v[1] + di * dstep_y[1],
-                                step_y_v[2] + di * dstep_y[2]};
+        long row[3] = {R.row[0] + di * R.drow[0], R.row[1] + di * R.drow[1], R.row[2] + di * R.drow[2]};
+        const long step_y[3] = {R.step_y[0] + di * R.dstep_y[0], R.step_y[1] + di * R.dstep_y[1],
+                                R.step_y[2] + di * R.dstep_y[2]};
         DepthPlane dp;
         bool have_plane = false; /* set up on the first covered voxel: tiny MTAs often cover none */
         for (int ly = ly0; ly <= ly1; ++ly) {
@@ -162,9 +129,9 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
           bool have_zrow = false;
           for (int c = 0; c < FINE_CHUNKS; ++c) {
             vint hit = in_tile[c];
-            hit &= edge_lanes(row[0] + c * step_c[0], bias[0], G[0], ramp[0], narrow[0], lane);
-            hit &= edge_lanes(row[1] + c * step_c[1], bias[1], G[1], ramp[1], narrow[1], lane);
-            hit &= edge_lanes(row[2] + c * step_c[2], bias[2], G[2], ramp[2], narrow[2], lane);
+            hit &= edge_lanes(row[0] + c * R.step_c[0], R.bias[0], R.G[0], R.ramp[0], R.narrow[0], lane);
+            hit &= edge_lanes(row[1] + c * R.step_c[1], R.bias[1], R.G[1], R.ramp[1], R.narrow[1], lane);
+            hit &= edge_lanes(row[2] + c * R.step_c[2], R.bias[2], R.G[2], R.ramp[2], R.narrow[2], lane);
             if (!any(hit)) continue;
             if (!have_plane) dp = depth_plane(&m, fi), have_plane = true;
             if (!have_zrow) zrow = (float)(dp.zr + dp.gy * (double)(y0 + ly - dp.qr)), have_zrow = true;
@@ -172,8 +139,13 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
             const int r = ((i - vbase) * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
             if (covered) covered[r] -= hit;
             vint win = hit & ((z < best_depth[r]) | ((z == best_depth[r]) & ((vuint)(m.key) < best_key[r])));
-            if ((m.flags & PMR_MTA_MASK) && any(win))
-              win = mask_alpha_lanes(in, &m, win, X0 + (long)c * VW * PMR_X_ONE, Y0 + (long)ly * PMR_Y_ONE, i, cutoff);
+            if ((m.flags & PMR_MTA_MASK) && any(win)) {
+              int w[VW];
+              vstore_vint(win, 0, w);
+              const SampleLanes S = row_samples(X0 + (long)c * VW * PMR_X_ONE, Y0 + (long)ly * PMR_Y_ONE);
+              mask_alpha_lanes(in, &m, w, VW, &S, i, cutoff);
+              win = vload_vint(0, w);
+            }
             best_depth[r] = select(best_depth[r], z, win);
             best_key[r] = select(best_key[r], (vuint)(m.key), win);
             best_mta[r] = select(best_mta[r], (vuint)(id), win);
@@ -187,41 +159,28 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
   }
 }
 
-/* Lit colours of a row chunk's winners: lane l is voxel (px0 + l, py) of view `view`, won by MTA mta[l]
- * where `won`. Written to rgb[3 l + channel] for those lanes only. SW lanes at a time: each winning
- * MTA of the block is loaded once and blended into its lanes, then shade_lanes shades them all. */
+/* The winners of a row chunk shaded, as half RGBA bits: lane l is voxel (px0 + l, py) of view `view`,
+ * won by MTA mta[l] where `won`, and out[l] gets its lit colour with alpha 1, or zero (background). SW
+ * lanes at a time (lanes_gather, shade_lanes). */
 inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                             vuint mta, vint won, int px0, int py, int view, float* rgb) {
+                             vuint mta, vint won, int px0, int py, int view, ushort4* out) {
+  for (int l = 0; l < VW; ++l) out[l] = (ushort4)(0);
   if (!any(won)) return; /* background */
   int ids[VW + SW], w[VW + SW];
   vstore_vint(as_vint(mta), 0, ids);
   vstore_vint(won, 0, w);
   for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = 0;
   const long Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
-  const bool pbr = in->P->shading == PMR_SHADING_PBR;
   for (int h = 0; h < VW; h += SW) {
-    const sint block_won = vload_s(0, w + h) != 0, block_ids = vload_s(0, ids + h);
-    uint todo = lane_bits(block_won);
-    if (todo == 0u) continue;
+    const sint block_won = vload_s(0, w + h) != 0;
+    if (!any(block_won)) continue;
+    const SampleLanes S = row_samples((long)(px0 + h) * PMR_X_ONE + PMR_HALF_X, Y);
     LaneWinners L;
-    lanes_clear(&L);
-    while (todo != 0u) {
-      const int f = 31 - (int)clz(todo & (0u - todo));
-      const uint id = (uint)ids[h + f];
-      const sint take = block_won & (block_ids == (sint)((int)id));
-      const uint bits = lane_bits(take);
-      todo &= ~bits;
-      const PmrMta* m = cached_mta(cache, mtas, id);
-      lanes_add(&L, in, m, take, bits, pbr);
-      long E[3], step[3];
-      mta_edges_at(m, (long)(px0 + h + f) * PMR_X_ONE + PMR_HALF_X, Y, view_coord(in->P, view), E);
-      mta_edge_steps(m, step);
-      lanes_step_edges(&L, take, f, E, step);
-    }
+    lanes_gather(in, mtas, cache, block_won, vload_s(0, ids + h), &S, view, &L);
     float c[3][SW];
     s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
     for (int l = 0; l < SW && h + l < VW; ++l)
-      if (w[h + l]) rgb[3 * (h + l)] = c[0][l], rgb[3 * (h + l) + 1] = c[1][l], rgb[3 * (h + l) + 2] = c[2][l];
+      if (w[h + l]) vstore_half4((float4)(c[0][l], c[1][l], c[2][l], 1.0f), h + l, (half*)out);
   }
 }
 

@@ -15,85 +15,304 @@
  * with |dy| < 2^24 and |dx_ab| < 2^32 (the guard band), so both products are integers below 2^46 and
  * their difference below 2^47: every double operation on the left is exact, and T, clamped to
  * +-2^48 (beyond which the comparison cannot change), converts exactly. So the outcome is the integer
- * one, bit for bit, in 4-wide vector doubles.
+ * one, bit for bit, in vectors of SP_LANES doubles.
  *
  * Depth at a sample: the plane through the MTA's three vertices in view v, in double and anchored at
  * vertex 0, z = (float)(z_0 + (g_x (X - x_0) + g_y (Y - y_0))): a function of the MTA, the view and the
  * sample alone, so the result does not depend on chunks, tiles or threads. Visibility is the (depth,
  * key) order as everywhere. */
-#include "shade.h"
+#include "fine_core.h"
 
-#define SP_LANES 8
+#define SP_LANES PMR_SUBPIXEL_LANES
 #define SP_SLOTS PMR_SUBPIXEL_SLOTS /* the host keeps area + (SP_LANES - 1) * min(views, area) within */
 
-constant int sp_lane_index[SP_LANES] = {0, 1, 2, 3, 4, 5, 6, 7};
+/* A chunk's samples sorted by view: run v holds count[v] samples from first[v], padded to whole vectors
+ * of SP_LANES; per sample its offset from the chunk's first sample (Xc, Yc) (fixed point), its index
+ * n = (i - i0) * width + (s - s0) in the chunk and its channel k (s = 3 j + k); per vector its bounding
+ * box (x0, x1, y0, y1); and the visibility state per sample (best_mta is read only where best_key says
+ * drawn). */
+typedef struct {
+  long Xc, Yc, Xl, Yl; /* the chunk's first and last sample */
+  int first[PMR_SUBPIXEL_VIEWS + 1], count[PMR_SUBPIXEL_VIEWS];
+  int sx[SP_SLOTS], sy[SP_SLOTS];
+  ushort sid[SP_SLOTS];
+  uchar channel[SP_SLOTS];
+  int4 box[SP_SLOTS / SP_LANES];
+  float best_depth[SP_SLOTS];
+  uint best_key[SP_SLOTS], best_mta[SP_SLOTS];
+} SpChunk;
 
-/* The exact edge functions of MTA m at the samples (Xc + sx[l], Yc + sy[l]) of the view with view
- * coordinate f of the lanes in `bits`, into e (per lane). */
-inline void sp_edges(const PmrMta* m, uint bits, const int* sx, const int* sy, long Xc, long Yc, long f, float (*e)[SW]) {
-  for (uint b = bits; b != 0u; b &= b - 1u) {
-    const int l = 31 - (int)clz(b & (0u - b));
-    long E[3];
-    mta_edges_at(m, Xc + sx[l], Yc + sy[l], f, E);
-    e[0][l] = (float)E[0], e[1][l] = (float)E[1], e[2][l] = (float)E[2];
+/* The view of each of the chunk's samples, by sample index n (row by row), eight columns at a time from
+ * the column table's planes (a_mod_n, b); each row's last vector may run past the chunk, into lanes the
+ * next row overwrites. */
+inline void sp_sample_views(global const PmrEncodeParams* E, global const int* column_a, global const int* column_b,
+                            global const PmrEncodeRow* rows, const PmrSampleChunk* ch, int views, ushort* view_of) {
+  const int width = ch->s1 - ch->s0;
+  for (int i = ch->i0, n = 0; i < ch->i1; ++i) {
+    const size_t block =
+        (size_t)(E->cell_rows > 1 ? (E->display_h - 1 - i) % E->cell_rows : 0) * (size_t)(3 * E->display_w);
+    const PmrEncodeRow row = rows[i];
+    for (int s = ch->s0; s < ch->s1; s += 8, n += 8) {
+      const int8 a = vload8(0, column_a + block + s), b = vload8(0, column_b + block + s);
+      vstore8(convert_ushort8(encode_view8(views, E->reversed, a, b, &row)), 0, view_of + n);
+    }
+    n -= (8 - width % 8) % 8;
   }
 }
 
-/* The winners of the samples (Xc + sx[l], Yc + sy[l]) of view v, l < SW: MTA ids[l] where `act`. */
-inline void sp_winners(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, const int* ids, sint act,
-                       const int* sx, const int* sy, long Xc, long Yc, int v, LaneWinners* L) {
-  const bool pbr = in->P->shading == PMR_SHADING_PBR;
-  lanes_clear(L);
-  float e[3][SW];
-  for (int l = 0; l < SW; ++l) e[0][l] = e[1][l] = e[2][l] = 1.0f;
-  const sint lane_ids = vload_s(0, ids);
-  uint todo = lane_bits(act);
-  while (todo != 0u) {
-    const int f = 31 - (int)clz(todo & (0u - todo));
-    const sint take = act & (lane_ids == (sint)(ids[f]));
-    const uint bits = lane_bits(take);
-    todo &= ~bits;
-    const PmrMta* m = cached_mta(cache, mtas, (uint)ids[f]);
-    lanes_add(L, in, m, take, bits, pbr);
-    sp_edges(m, bits, sx, sy, Xc, Yc, view_coord(in->P, v), e);
+/* Step 1: the chunk's samples by view (a counting sort), with a clear visibility state. */
+inline void sp_sort_samples(global const PmrEncodeParams* E, global const int* column_a, global const int* column_b,
+                            global const PmrEncodeRow* rows, global const int* sample_x, global const int* sample_y,
+                            const PmrSampleChunk* ch, int views, SpChunk* C) {
+  const int width = ch->s1 - ch->s0;
+  C->Xc = sample_x[ch->s0], C->Yc = sample_y[ch->i0], C->Xl = sample_x[ch->s1 - 1], C->Yl = sample_y[ch->i1 - 1];
+  ushort view_of[PMR_SUBPIXEL_CAP + 8];
+  sp_sample_views(E, column_a, column_b, rows, ch, views, view_of);
+  for (int v = 0; v < views; ++v) C->count[v] = 0;
+  for (int n = 0; n < width * (ch->i1 - ch->i0); ++n) ++C->count[view_of[n]];
+  int run = 0;
+  for (int v = 0; v < views; ++v) {
+    C->first[v] = run;
+    run += (C->count[v] + SP_LANES - 1) / SP_LANES * SP_LANES;
   }
-  L->e = LANE3(e);
+  C->first[views] = run;
+  for (int k = 0; k < run; k += 8) {
+    vstore8((float8)(INFINITY), 0, C->best_depth + k);
+    vstore8((uint8)(PMR_NO_KEY), 0, C->best_key + k);
+    vstore8((int8)(0), 0, C->sx + k); /* padding lanes: any value, masked by the run's length */
+    vstore8((int8)(0), 0, C->sy + k);
+  }
+  int fill[PMR_SUBPIXEL_VIEWS];
+  for (int v = 0; v < views; ++v) fill[v] = C->first[v];
+  /* column by column: a vector's samples then lie close together in x (all rows of a few columns),
+   * which the bounding boxes exploit */
+  for (int s = ch->s0; s < ch->s1; ++s) {
+    const int x = (int)(sample_x[s] - C->Xc);
+    const uchar c = (uchar)(s % 3);
+    for (int i = ch->i0, n = s - ch->s0; i < ch->i1; ++i, n += width) {
+      const int k = fill[view_of[n]]++;
+      C->sx[k] = x;
+      C->sy[k] = (int)(sample_y[i] - C->Yc);
+      C->sid[k] = (ushort)n;
+      C->channel[k] = c;
+    }
+  }
 }
 
-/* alphaMode MASK: of the lanes in `win` (samples (Xc + sx[l], Yc + sy[l]) of view v), those whose base
- * colour alpha passes the cutoff (rare path, one lane at a time with the exact edge functions). */
-inline int8 sp_mask_alpha(const ShadeInputs* in, const PmrMta* m, int8 win, const int* sx, const int* sy, long Xc,
-                          long Yc, int v, float cutoff) {
-  int w[SP_LANES];
-  vstore8(win, 0, w);
-  for (int l = 0; l < SP_LANES; ++l)
-    if (w[l] && !mta_alpha_passes(in, m, Xc + sx[l], Yc + sy[l], v, cutoff)) w[l] = 0;
-  return vload8(0, w);
+/* Each vector's bounding box: an MTA skips the vectors it cannot reach; x0 and x1 do not decrease along a
+ * run. */
+inline void sp_boxes(int views, SpChunk* C) {
+  const int8 lane = vload8(0, lane_index);
+  for (int v = 0; v < views; ++v)
+    for (int k = C->first[v]; k < C->first[v] + C->count[v]; k += SP_LANES) {
+      const int8 valid = lane < (int8)(C->first[v] + C->count[v] - k); /* padding lanes repeat lane 0 */
+      const int8 x = select((int8)(C->sx[k]), vload8(0, C->sx + k), valid);
+      const int8 y = select((int8)(C->sy[k]), vload8(0, C->sy + k), valid);
+      const int4 x0 = min(x.lo, x.hi), x1 = max(x.lo, x.hi), y0 = min(y.lo, y.hi), y1 = max(y.lo, y.hi);
+      const int2 a = min(x0.lo, x0.hi), b = max(x1.lo, x1.hi), c = min(y0.lo, y0.hi), d = max(y1.lo, y1.hi);
+      C->box[k / SP_LANES] = (int4)(min(a.x, a.y), max(b.x, b.y), min(c.x, c.y), max(d.x, d.y));
+    }
 }
 
-/* Bit l set: in view ib + l (l < n <= 16) the MTA's x extent reaches the chunk's samples, [0, span]
- * relative to the chunk's first sample. Vertex x in 32 bits when that provably fits (base and disparity
- * each below 2^29 over the views), else every view passes (the edge tests decide exactly either way). */
-inline uint sp_view_mask(global const PmrParams* P, const PmrMta* m, int ib, int n, long Xc, long span) {
-  const uint all = (1u << n) - 1u;
-  long fspan;
-  const int16 l = view_coord_lanes(P, ib, n, &fspan);
-  const long fib = view_coord(P, ib);
-  long base[3];
-  bool fits = span < (1L << 29);
-  for (int k = 0; k < 3; ++k) {
-    base[k] = (long)m->x0[k] + fib * m->dx[k] - Xc;
-    fits = fits && base[k] > -(1L << 29) && base[k] < (1L << 29) && (long)abs(m->dx[k]) * fspan < (1L << 29);
+/* An MTA's edges relative to the chunk's first sample (see the head of this file): per edge sign * dy,
+ * and bias - sign * E(Xc, Yc, v) and -sign * dx_ab(v) at view coordinate f_lo with their exact
+ * increments per unit of view coordinate (both are linear in it); and the MTA's y extent relative to
+ * Yc. */
+typedef struct {
+  long f_lo, t_lo[3], dt[3], dx_lo[3], ddx[3];
+  double dy[3];
+  long my0, my1;
+} SpEdges;
+
+PMR_HOT void sp_edges(global const PmrParams* P, const PmrMta* m, int i_lo, const SpChunk* C, SpEdges* S) {
+  const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
+  const long f_first = view_coord(P, m->view_lo);
+  S->f_lo = view_coord(P, i_lo);
+  for (int e = 0; e < 3; ++e) {
+    const int a = ea[e], b = eb[e];
+    const long sg = m->sign, d_y = (long)(m->y[b] - m->y[a]), d_dx = (long)m->dx[b] - (long)m->dx[a];
+    S->t_lo[e] = mta_edge_bias(m, a, b, f_first) - sg * mta_edge(m, a, b, C->Xc, C->Yc, S->f_lo);
+    S->dt[e] = sg * (d_y * (long)m->dx[a] + d_dx * (C->Yc - (long)m->y[a]));
+    S->dx_lo[e] = -sg * ((long)m->x0[b] - (long)m->x0[a] + S->f_lo * d_dx);
+    S->ddx[e] = -sg * d_dx;
+    S->dy[e] = (double)(sg * d_y);
   }
-  if (!fits) return all;
-  const int16 xa = (int16)((int)base[0]) + l * m->dx[0], xb = (int16)((int)base[1]) + l * m->dx[1];
-  const int16 xc = (int16)((int)base[2]) + l * m->dx[2];
-  const int16 pass = (max(xa, max(xb, xc)) >= (int16)(0)) & (min(xa, min(xb, xc)) <= (int16)((int)span));
-  const int16 bits = select((int16)(0), (int16)(1) << (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15), pass);
-  const int8 r8 = bits.lo | bits.hi;
-  const int4 r4 = r8.lo | r8.hi;
-  const int2 r2 = r4.lo | r4.hi;
-  return (uint)(r2.x | r2.y) & all;
+  S->my0 = min(m->y[0], min(m->y[1], m->y[2])) - C->Yc;
+  S->my1 = max(m->y[0], max(m->y[1], m->y[2])) - C->Yc;
+}
+
+/* The depth plane of an MTA in a view (see the head of this file) at offset (x, y) from the chunk's
+ * first sample: z = (float)(z0 + (gx (bx + x) + gy (by + y))), (bx, by) = (Xc, Yc) - vertex 0. xv: the
+ * vertices' x in the view. */
+typedef struct {
+  double z0, gx, gy, bx, by;
+} SpPlane;
+
+PMR_HOT SpPlane sp_plane(const PmrMta* m, const long* xv, const SpChunk* C) {
+  const long y0 = m->y[0], y1 = m->y[1], y2 = m->y[2];
+  const long area = (y1 - y0) * (xv[2] - xv[0]) - (xv[1] - xv[0]) * (y2 - y0);
+  const double inv = 1.0 / (double)area;
+  const double dz1 = (double)m->z[1] - (double)m->z[0], dz2 = (double)m->z[2] - (double)m->z[0];
+  SpPlane p;
+  p.gx = (dz1 * (double)(y0 - y2) + dz2 * (double)(y1 - y0)) * inv;
+  p.gy = (dz1 * (double)(xv[2] - xv[0]) - dz2 * (double)(xv[1] - xv[0])) * inv;
+  p.z0 = (double)m->z[0];
+  p.bx = (double)(C->Xc - xv[0]);
+  p.by = (double)(C->Yc - y0);
+  return p;
+}
+
+/* MTA m (queue entry id) in view v against the view's run of samples, SP_LANES at a time, into the
+ * visibility state. */
+PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, const SpEdges* S, int v, float cutoff,
+                           SpChunk* C) {
+  const int k0 = C->first[v], k1 = k0 + C->count[v];
+  if (k0 == k1) return;
+  long xv[3];
+  const long fv = view_coord(in->P, v);
+  for (int k = 0; k < 3; ++k) xv[k] = (long)m->x0[k] + fv * (long)m->dx[k];
+  const long mx0 = min(xv[0], min(xv[1], xv[2])) - C->Xc, mx1 = max(xv[0], max(xv[1], xv[2])) - C->Xc;
+  double dx[3], T[3];
+  const long di = fv - S->f_lo;
+  for (int e = 0; e < 3; ++e) {
+    T[e] = (double)clamp(S->t_lo[e] + di * S->dt[e], -(1L << 48), 1L << 48);
+    dx[e] = (double)(S->dx_lo[e] + di * S->ddx[e]);
+  }
+  const double8 lane_d = convert_double8(vload8(0, lane_index));
+  bool have_plane = false;
+  SpPlane p;
+  for (int k = k0; k < k1; k += SP_LANES) {
+    const int4 b = C->box[k / SP_LANES];
+    if (b.x > mx1) break; /* a run's vectors go left to right (sorted by column) */
+    if (b.y < mx0 || b.w < S->my0 || b.z > S->my1) continue;
+    const double8 x = convert_double8(vload8(0, C->sx + k)), y = convert_double8(vload8(0, C->sy + k));
+    long8 hit = ((double8)(S->dy[0]) * x + (double8)(dx[0]) * y >= (double8)(T[0])) &
+                ((double8)(S->dy[1]) * x + (double8)(dx[1]) * y >= (double8)(T[1])) &
+                ((double8)(S->dy[2]) * x + (double8)(dx[2]) * y >= (double8)(T[2]));
+    if (k1 - k < SP_LANES) hit &= lane_d < (double8)(k1 - k); /* the run's padding */
+    /* any(hit) as an OR of the lanes (a true lane is -1): any() on long8 compiles to a slow sequence of
+     * branches here */
+    const long4 h4 = hit.lo | hit.hi;
+    const long2 h2 = h4.lo | h4.hi;
+    if ((h2.x | h2.y) == 0) continue;
+    if (!have_plane) p = sp_plane(m, xv, C), have_plane = true; /* tiny MTAs often cover no sample */
+    const float8 z = convert_float8((double8)(p.z0) + ((double8)(p.gx) * ((double8)(p.bx) + x) +
+                                                       (double8)(p.gy) * ((double8)(p.by) + y)));
+    const float8 bd = vload8(0, C->best_depth + k);
+    const uint8 bk = vload8(0, C->best_key + k);
+    int8 win = convert_int8(hit) & ((z < bd) | ((z == bd) & ((uint8)(m->key) < bk)));
+    if ((m->flags & PMR_MTA_MASK) && any(win)) {
+      int w[SP_LANES];
+      vstore8(win, 0, w);
+      const SampleLanes L = offset_samples(C->Xc, C->Yc, C->sx + k, C->sy + k);
+      mask_alpha_lanes(in, m, w, SP_LANES, &L, v, cutoff);
+      win = vload8(0, w);
+    }
+    vstore8(select(bd, z, win), 0, C->best_depth + k);
+    vstore8(select(bk, (uint8)(m->key), as_uint8(win)), 0, C->best_key + k);
+    vstore8(select(vload8(0, C->best_mta + k), (uint8)(id), as_uint8(win)), 0, C->best_mta + k);
+  }
+}
+
+/* Step 2, visibility: the queues of the chunk's screen tile, every view slab; per MTA the views whose
+ * x extent can reach the chunk's samples. */
+inline void sp_visibility(const ShadeInputs* in, global const PmrMta* mtas, global const uint* tile_offsets,
+                          global const uint* tile_queue, int tile_xy, SpChunk* C) {
+  global const PmrParams* P = in->P;
+  const int views = P->views;
+  for (int tv = 0; tv < P->tiles_v; ++tv) {
+    const int v0 = tv * PMR_TILE_V, v1 = min(views, v0 + PMR_TILE_V) - 1;
+    if (C->first[v1 + 1] == C->first[v0]) continue; /* no sample of the chunk shows these views */
+    const uint tile = ((uint)tv * (uint)P->tiles_y) * (uint)P->tiles_x + (uint)tile_xy;
+    const uint q1 = tile_offsets[tile + 1];
+    for (uint q = tile_offsets[tile]; q < q1; ++q) {
+      const uint id = tile_queue[q];
+      const PmrMta m = mtas[id];
+      const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));
+      if (yhi < C->Yc || ylo > C->Yl) continue;
+      const int i_lo = max(v0, m.view_lo), i_hi = min(v1, m.view_hi);
+      const float cutoff = (m.flags & PMR_MTA_MASK) ? in->materials[in->tris[m.tri].material].alpha_cutoff : 0.0f;
+      SpEdges S;
+      sp_edges(P, &m, i_lo, C, &S);
+      for (int ib = i_lo; ib <= i_hi; ib += 16) {
+        uint pass = view_pass_mask(P, &m, ib, min(i_hi - ib + 1, 16), C->Xc, 0, C->Xl - C->Xc);
+        while (pass != 0) { /* the passing views, lowest first */
+          const int v = ib + (31 - (int)clz(pass & (0u - pass)));
+          pass &= pass - 1u;
+          sp_raster_view(in, &m, id, &S, v, cutoff, C);
+        }
+      }
+    }
+  }
+}
+
+/* Step 3, the winners shaded at their samples, SW samples of a view at a time, one per lane: channel k
+ * of subpixel s = 3 j + k as half bits into value[n] and covered[n] (0: background), by sample index. */
+inline void sp_shade(const ShadeInputs* in, global const PmrMta* mtas, const SpChunk* C, ushort* value,
+                     uchar* covered) {
+  global const PmrParams* P = in->P;
+  const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
+  MtaCache cache;
+  cache.id = PMR_NO_KEY;
+  for (int v = 0; v < P->views; ++v)
+    for (int k0 = C->first[v]; k0 < C->first[v] + C->count[v]; k0 += SW) {
+      const int kn = min(SW, C->first[v] + C->count[v] - k0);
+      int todo[SW], ids[SW];
+      for (int l = 0; l < SW; ++l) {
+        const int k = k0 + l;
+        todo[l] = l < kn && C->best_key[k] != PMR_NO_KEY ? -1 : 0;
+        ids[l] = todo[l] ? (int)C->best_mta[k] : 0;
+        if (l < kn && !todo[l]) value[C->sid[k]] = 0, covered[C->sid[k]] = 0;
+      }
+      const sint act = vload_s(0, todo);
+      if (!any(act)) continue;
+      const SampleLanes S = offset_samples(C->Xc, C->Yc, C->sx + k0, C->sy + k0);
+      LaneWinners L;
+      lanes_gather(in, mtas, &cache, act, vload_s(0, ids), &S, v, &L);
+      float c[3][SW];
+      s3_store(shade_lanes(in, &L, light, v), c[0], c[1], c[2]);
+      for (int l = 0; l < kn; ++l) {
+        if (!todo[l]) continue;
+        const int k = k0 + l, n = C->sid[k];
+        ushort h;
+        vstore_half(c[C->channel[k]][l], 0, (half*)&h);
+        value[n] = h;
+        covered[n] = 1;
+      }
+    }
+}
+
+/* The debug outputs: each sample's winning key and depth, at its subpixel (display row i, column s). */
+inline void sp_write_debug(const PmrSampleChunk* ch, int views, int display_w, const SpChunk* C, global uint* dbg_key,
+                           global float* dbg_depth) {
+  const int width = ch->s1 - ch->s0;
+  for (int v = 0; v < views; ++v)
+    for (int k = C->first[v]; k < C->first[v] + C->count[v]; ++k) {
+      const int n = C->sid[k];
+      const size_t at = (size_t)(ch->i0 + n / width) * (size_t)(3 * display_w) + (size_t)(ch->s0 + n % width);
+      dbg_key[at] = C->best_key[k];
+      dbg_depth[at] = C->best_depth[k];
+    }
+}
+
+/* Step 4, the chunk's display pixels (write_display_pixel): a sample's half RGBA bits are its value in
+ * every channel (the pixel takes channel k from subpixel k) and its coverage as alpha. */
+inline void sp_write_display(const DisplayOut* D, const PmrSampleChunk* ch, const ushort* value,
+                             const uchar* covered) {
+  const ushort one = 0x3c00; /* 1.0 as a half */
+  const int width = ch->s1 - ch->s0;
+  for (int i = ch->i0; i < ch->i1; ++i) {
+    const int r = (i - ch->i0) * width - ch->s0; /* sample index of subpixel s: r + s */
+    for (int j = ch->s0 / 3; 3 * j < ch->s1; ++j) {
+      ushort4 s[3];
+      for (int k = 0; k < 3; ++k) {
+        const int n = r + 3 * j + k;
+        const bool own = 3 * j + k >= ch->s0 && 3 * j + k < ch->s1;
+        s[k] = own ? (ushort4)(value[n], value[n], value[n], covered[n] ? one : 0) : (ushort4)(0);
+      }
+      write_display_pixel(D, i, j, ch->s0, ch->s1, s[0], s[1], s[2]);
+    }
+  }
 }
 
 kernel void fine_subpixel(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
@@ -107,234 +326,15 @@ kernel void fine_subpixel(PMR_SHADE_PARAMS, global const PmrMta* mtas, global co
   const uint chunk = pmr_item_id();
   if (chunk >= num_chunks) return;
   const PmrSampleChunk ch = chunks[chunk];
-  const int views = P->views, width = ch.s1 - ch.s0;
-  const int Wd = E->display_w;
-  const long Xc = sample_x[ch.s0], Yc = sample_y[ch.i0], Xl = sample_x[ch.s1 - 1], Yl = sample_y[ch.i1 - 1];
-
-  /* 1. The samples by view: run v holds count[v] samples from first[v], padded to whole vectors. */
-  int first[PMR_SUBPIXEL_VIEWS + 1], count[PMR_SUBPIXEL_VIEWS];
-  ushort view_of[PMR_SUBPIXEL_CAP + 8];
-  for (int v = 0; v < views; ++v) count[v] = 0;
-  for (int i = ch.i0, n = 0; i < ch.i1; ++i) {
-    /* encode_view for 8 columns at a time from the column table's planes (a_mod_n, b) */
-    const size_t block = (size_t)(E->cell_rows > 1 ? (E->display_h - 1 - i) % E->cell_rows : 0) * (size_t)(3 * Wd);
-    const PmrEncodeRow row = rows[i];
-    for (int s = ch.s0; s < ch.s1; s += 8, n += 8) {
-      const int8 a = vload8(0, column_a + block + s), b = vload8(0, column_b + block + s);
-      int8 v = a - (int8)(row.q_mod_n) + (b < (int8)(row.s)); /* a true comparison is -1 */
-      v = select(v, v + (int8)(views), v < (int8)(0));
-      if (E->reversed) v = (int8)(views - 1) - v;
-      vstore8(convert_ushort8(v), 0, view_of + n);
-    }
-    n -= (8 - width % 8) % 8; /* the last vector's lanes past the chunk are overwritten by the next row */
-  }
-  for (int n = 0; n < width * (ch.i1 - ch.i0); ++n) ++count[view_of[n]];
-  int run = 0;
-  for (int v = 0; v < views; ++v) {
-    first[v] = run;
-    run += (count[v] + SP_LANES - 1) / SP_LANES * SP_LANES;
-  }
-  first[views] = run;
-  int sx[SP_SLOTS], sy[SP_SLOTS];     /* sample offsets from (Xc, Yc), fixed point */
-  ushort sid[SP_SLOTS];               /* sample index (i - i0) * width + (s - s0) */
-  uchar channel[SP_SLOTS];            /* k of the sample's subpixel s = 3j + k */
-  float best_depth[SP_SLOTS];
-  uint best_key[SP_SLOTS], best_mta[SP_SLOTS]; /* best_mta is read only where best_key says drawn */
-  for (int k = 0; k < run; k += 8) {
-    vstore8((float8)(INFINITY), 0, best_depth + k);
-    vstore8((uint8)(PMR_NO_KEY), 0, best_key + k);
-    vstore8((int8)(0), 0, sx + k); /* padding lanes: any value, masked by the run's length */
-    vstore8((int8)(0), 0, sy + k);
-  }
-  {
-    int fill[PMR_SUBPIXEL_VIEWS];
-    for (int v = 0; v < views; ++v) fill[v] = first[v];
-    /* column by column: a vector's samples then lie close together in x (all rows of a few columns),
-     * which the bounding boxes below exploit */
-    for (int s = ch.s0; s < ch.s1; ++s) {
-      const int x = (int)(sample_x[s] - Xc);
-      const uchar c = (uchar)(s % 3);
-      for (int i = ch.i0, n = s - ch.s0; i < ch.i1; ++i, n += width) {
-        const int k = fill[view_of[n]]++;
-        sx[k] = x;
-        sy[k] = (int)(sample_y[i] - Yc);
-        sid[k] = (ushort)n;
-        channel[k] = c;
-      }
-    }
-  }
-  /* each vector's bounding box (x0, x1, y0, y1): an MTA skips the vectors it cannot reach; x0 and x1
-   * do not decrease along a run */
-  int4 box[SP_SLOTS / SP_LANES];
-  const int8 lane = vload8(0, sp_lane_index);
-  for (int v = 0; v < views; ++v)
-    for (int k = first[v]; k < first[v] + count[v]; k += SP_LANES) {
-      const int8 valid = lane < (int8)(first[v] + count[v] - k); /* padding lanes repeat lane 0 */
-      const int8 x = select((int8)(sx[k]), vload8(0, sx + k), valid);
-      const int8 y = select((int8)(sy[k]), vload8(0, sy + k), valid);
-      const int4 x0 = min(x.lo, x.hi), x1 = max(x.lo, x.hi), y0 = min(y.lo, y.hi), y1 = max(y.lo, y.hi);
-      const int2 a = min(x0.lo, x0.hi), b = max(x1.lo, x1.hi), c = min(y0.lo, y0.hi), d = max(y1.lo, y1.hi);
-      box[k / SP_LANES] = (int4)(min(a.x, a.y), max(b.x, b.y), min(c.x, c.y), max(d.x, d.y));
-    }
-
-  /* 2. Visibility: the tile's queues, every view slab. */
+  SpChunk C;
+  sp_sort_samples(E, column_a, column_b, rows, sample_x, sample_y, &ch, P->views, &C);
+  sp_boxes(P->views, &C);
   ShadeInputs in = PMR_SHADE_INPUTS;
-  const double8 lane_d = convert_double8(lane);
-  const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
-  for (int tv = 0; tv < P->tiles_v; ++tv) {
-    const int v0 = tv * PMR_TILE_V, v1 = min(views, v0 + PMR_TILE_V) - 1;
-    if (first[v1 + 1] == first[v0]) continue; /* no sample of the chunk shows these views */
-    const uint tile = ((uint)tv * (uint)P->tiles_y) * (uint)P->tiles_x + (uint)ch.tile;
-    const uint q1 = tile_offsets[tile + 1];
-    for (uint q = tile_offsets[tile]; q < q1; ++q) {
-      const uint id = tile_queue[q];
-      const PmrMta m = mtas[id];
-      const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));
-      if (yhi < Yc || ylo > Yl) continue;
-      const int i_lo = max(v0, m.view_lo), i_hi = min(v1, m.view_hi);
-      const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
-      /* per edge: sign * dy, and bias - sign * E(Xc, Yc, v) and -sign * dx_ab(v) at view i_lo with their
-       * exact increments per unit of view coordinate (both are linear in it) */
-      const long f_lo = view_coord(P, i_lo), f_first = view_coord(P, m.view_lo);
-      long t_lo[3], dt[3], dx_lo[3], ddx[3];
-      double dy[3];
-      for (int e = 0; e < 3; ++e) {
-        const int a = ea[e], b = eb[e];
-        const long sg = m.sign, d_y = (long)(m.y[b] - m.y[a]), d_dx = (long)m.dx[b] - (long)m.dx[a];
-        t_lo[e] = mta_edge_bias(&m, a, b, f_first) - sg * mta_edge(&m, a, b, Xc, Yc, f_lo);
-        dt[e] = sg * (d_y * (long)m.dx[a] + d_dx * (Yc - (long)m.y[a]));
-        dx_lo[e] = -sg * ((long)m.x0[b] - (long)m.x0[a] + f_lo * d_dx);
-        ddx[e] = -sg * d_dx;
-        dy[e] = (double)(sg * d_y);
-      }
-      const long my0 = ylo - Yc, my1 = yhi - Yc;
-      for (int ib = i_lo; ib <= i_hi; ib += 16) {
-        uint pass = sp_view_mask(P, &m, ib, min(i_hi - ib + 1, 16), Xc, Xl - Xc);
-        while (pass != 0) { /* the passing views, lowest first */
-          const int v = ib + (31 - (int)clz(pass & (0u - pass)));
-          pass &= pass - 1u;
-          const int k0 = first[v], k1 = k0 + count[v];
-          if (k0 == k1) continue;
-          long xv[3];
-          const long fv = view_coord(P, v);
-          for (int k = 0; k < 3; ++k) xv[k] = (long)m.x0[k] + fv * (long)m.dx[k];
-          const long mx0 = min(xv[0], min(xv[1], xv[2])) - Xc, mx1 = max(xv[0], max(xv[1], xv[2])) - Xc;
-          double dx[3], T[3];
-          const long di = fv - f_lo;
-          for (int e = 0; e < 3; ++e) {
-            T[e] = (double)clamp(t_lo[e] + di * dt[e], -(1L << 48), 1L << 48);
-            dx[e] = (double)(dx_lo[e] + di * ddx[e]);
-          }
-          bool have_plane = false;
-          double z0 = 0.0, gx = 0.0, gy = 0.0, bx = 0.0, by = 0.0;
-          for (int k = k0; k < k1; k += SP_LANES) {
-            const int4 b = box[k / SP_LANES];
-            if (b.x > mx1) break; /* a run's vectors go left to right (sorted by column) */
-            if (b.y < mx0 || b.w < my0 || b.z > my1) continue;
-            const double8 x = convert_double8(vload8(0, sx + k)), y = convert_double8(vload8(0, sy + k));
-            long8 hit = ((double8)(dy[0]) * x + (double8)(dx[0]) * y >= (double8)(T[0])) &
-                        ((double8)(dy[1]) * x + (double8)(dx[1]) * y >= (double8)(T[1])) &
-                        ((double8)(dy[2]) * x + (double8)(dx[2]) * y >= (double8)(T[2]));
-            if (k1 - k < SP_LANES) hit &= lane_d < (double8)(k1 - k); /* the run's padding */
-            /* any(hit) as an OR of the lanes (a true lane is -1): any() on long8 compiles to a slow
-             * sequence of branches here */
-            const long4 h4 = hit.lo | hit.hi;
-            const long2 h2 = h4.lo | h4.hi;
-            if ((h2.x | h2.y) == 0) continue;
-            if (!have_plane) { /* set up on the first covered sample: tiny MTAs often cover none */
-              const long y0 = m.y[0], y1 = m.y[1], y2 = m.y[2];
-              const long area = (y1 - y0) * (xv[2] - xv[0]) - (xv[1] - xv[0]) * (y2 - y0);
-              const double inv = 1.0 / (double)area;
-              const double dz1 = (double)m.z[1] - (double)m.z[0], dz2 = (double)m.z[2] - (double)m.z[0];
-              gx = (dz1 * (double)(y0 - y2) + dz2 * (double)(y1 - y0)) * inv;
-              gy = (dz1 * (double)(xv[2] - xv[0]) - dz2 * (double)(xv[1] - xv[0])) * inv;
-              z0 = (double)m.z[0];
-              bx = (double)(Xc - xv[0]);
-              by = (double)(Yc - y0);
-              have_plane = true;
-            }
-            const float8 z = convert_float8((double8)(z0) + ((double8)(gx) * ((double8)(bx) + x) +
-                                                             (double8)(gy) * ((double8)(by) + y)));
-            const float8 bd = vload8(0, best_depth + k);
-            const uint8 bk = vload8(0, best_key + k);
-            int8 win = convert_int8(hit) & ((z < bd) | ((z == bd) & ((uint8)(m.key) < bk)));
-            if ((m.flags & PMR_MTA_MASK) && any(win))
-              win = sp_mask_alpha(&in, &m, win, sx + k, sy + k, Xc, Yc, v, cutoff);
-            vstore8(select(bd, z, win), 0, best_depth + k);
-            vstore8(select(bk, (uint8)(m.key), as_uint8(win)), 0, best_key + k);
-            vstore8(select(vload8(0, best_mta + k), (uint8)(id), as_uint8(win)), 0, best_mta + k);
-          }
-        }
-      }
-    }
-  }
-
-  /* 3. The winners shaded at their samples: channel k of subpixel s = 3j + k, half bits, by sample. */
-  const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
+  sp_visibility(&in, mtas, tile_offsets, tile_queue, ch.tile, &C);
+  if (debug) sp_write_debug(&ch, P->views, E->display_w, &C, dbg_key, dbg_depth);
   ushort value[PMR_SUBPIXEL_CAP];
   uchar covered[PMR_SUBPIXEL_CAP];
-  MtaCache cache;
-  cache.id = PMR_NO_KEY;
-  for (int v = 0; v < views; ++v)
-    for (int k0 = first[v]; k0 < first[v] + count[v]; k0 += SW) {
-      /* SW samples of view v at a time, one per lane */
-      const int kn = min(SW, first[v] + count[v] - k0);
-      int todo[SW], ids[SW];
-      for (int l = 0; l < SW; ++l) {
-        const int k = k0 + l;
-        todo[l] = l < kn && best_key[k] != PMR_NO_KEY ? -1 : 0;
-        ids[l] = todo[l] ? (int)best_mta[k] : 0;
-        if (l >= kn) continue;
-        const int n = sid[k];
-        if (debug) {
-          const size_t at = (size_t)(ch.i0 + n / width) * (size_t)(3 * Wd) + (size_t)(ch.s0 + n % width);
-          dbg_key[at] = best_key[k];
-          dbg_depth[at] = best_depth[k];
-        }
-        if (!todo[l]) value[n] = 0, covered[n] = 0;
-      }
-      const sint act = vload_s(0, todo);
-      if (!any(act)) continue;
-      LaneWinners L;
-      sp_winners(&in, mtas, &cache, ids, act, sx + k0, sy + k0, Xc, Yc, v, &L);
-      float c[3][SW];
-      s3_store(shade_lanes(&in, &L, light, v), c[0], c[1], c[2]);
-      for (int l = 0; l < kn; ++l) {
-        if (!todo[l]) continue;
-        const int k = k0 + l, n = sid[k];
-        ushort h;
-        vstore_half(c[channel[k]][l], 0, (half*)&h);
-        value[n] = h;
-        covered[n] = 1;
-      }
-    }
-
-  /* 4. The display pixels: whole ones with their alpha (the three subpixels' mean coverage, as
-   * encode_pixel computes it), cut ones (their subpixels in other tiles too) channel by channel with
-   * their coverage left for encode_straddle_alpha. */
-  global ushort* bits = (global ushort*)display;
-  const ushort one = 0x3c00; /* 1.0 as a half */
-  for (int i = ch.i0; i < ch.i1; ++i) {
-    const int r = (i - ch.i0) * width - ch.s0;
-    for (int j = ch.s0 / 3; 3 * j < ch.s1; ++j) {
-      const size_t pixel = (size_t)i * (size_t)Wd + (size_t)j;
-      if (3 * j >= ch.s0 && 3 * j + 3 <= ch.s1) {
-        const int n = r + 3 * j;
-        const ushort4 a = (ushort4)(value[n], 0, 0, covered[n] ? one : 0);
-        const ushort4 b = (ushort4)(0, value[n + 1], 0, covered[n + 1] ? one : 0);
-        const ushort4 c = (ushort4)(0, 0, value[n + 2], covered[n + 2] ? one : 0);
-        vstore4(encode_pixel(a, b, c), pixel, bits);
-        store_sub_alpha(sub_alpha, pixel, a, b, c);
-        continue;
-      }
-      const size_t slot = ((size_t)i * straddle_slots + (size_t)straddle_slot[j]) * 3;
-      for (int k = 0; k < 3; ++k) {
-        const int s = 3 * j + k;
-        if (s < ch.s0 || s >= ch.s1) continue;
-        bits[pixel * 4 + (size_t)k] = value[r + s];
-        straddle_cov[slot + (size_t)k] = covered[r + s];
-        sub_alpha[pixel * 3 + (size_t)k] = covered[r + s] ? one : 0; /* its own: written by its chunk alone */
-      }
-    }
-  }
+  sp_shade(&in, mtas, &C, value, covered);
+  const DisplayOut D = {(global ushort*)display, sub_alpha, straddle_cov, straddle_slot, straddle_slots, E->display_w};
+  sp_write_display(&D, &ch, value, covered);
 }

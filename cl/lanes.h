@@ -16,6 +16,9 @@ typedef struct {
   sfloat x, y, z;
 } sfloat3;
 
+/* Lane l holds l: the lane numbers of a vector of up to 16 lanes (vload from here). */
+constant int lane_index[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+
 inline sfloat3 s3(sfloat x, sfloat y, sfloat z) {
   sfloat3 r = {x, y, z};
   return r;
@@ -34,12 +37,6 @@ inline sfloat3 s3_cross(sfloat3 a, sfloat3 b) {
 inline sfloat3 s3_select(sfloat3 a, sfloat3 b, sint take) {
   return s3(select(a.x, b.x, take), select(a.y, b.y, take), select(a.z, b.z, take));
 }
-/* b.x a0 + b.y a1 + b.z a2: a vertex attribute interpolated with barycentrics b */
-inline sfloat3 s3_interp(sfloat3 b, float3 a0, float3 a1, float3 a2) {
-  return s3(b.x * a0.x + b.y * a1.x + b.z * a2.x, b.x * a0.y + b.y * a1.y + b.z * a2.y,
-            b.x * a0.z + b.y * a1.z + b.z * a2.z);
-}
-inline sfloat s_interp(sfloat3 b, float a0, float a1, float a2) { return b.x * a0 + b.y * a1 + b.z * a2; }
 
 /* A vector of 3D values stored per lane (arrays of SW). */
 inline void s3_store(sfloat3 a, float* x, float* y, float* z) {

@@ -120,8 +120,6 @@ typedef struct {
   uint tri[SW];            /* lane l's triangle, where textured                               */
 } LaneWinners;
 
-constant int shade_lane_index[SW] = {0, 1, 2, 3, 4, 5, 6, 7};
-
 /* No lanes yet; idle lanes keep finite values so that the vector arithmetic stays cheap. */
 inline void lanes_clear(LaneWinners* L) {
   const sfloat zero = 0.0f, one = 1.0f;
@@ -142,7 +140,7 @@ inline sfloat blend(sfloat a, float b, sint take) { return select(a, (sfloat)(b)
 inline sfloat3 blend3(sfloat3 a, float3 b, sint take) { return s3_select(a, s3_splat(b), take); }
 
 /* Lanes `take` (bits: the same as bits) are won by MTA m: its values blended into them (the edge
- * functions are set apart, lanes_step_edges or lanes_set_edges). */
+ * functions are set apart: lanes_gather in fine_core.h). */
 inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, sint take, uint bits, bool pbr) {
   L->act |= take;
   if (m->flags & PMR_MTA_BACK) L->back |= take;
@@ -180,7 +178,7 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
  * plus (l - first) step. Summed in doubles, exact below 2^53, so rounding to float rounds the exact
  * value, as for a lane evaluated on its own; beyond that, lane by lane in 64 bits. */
 inline void lanes_step_edges(LaneWinners* L, sint take, int first, const long* E, const long* step) {
-  const sint lane = vload_s(0, shade_lane_index);
+  const sint lane = vload_s(0, lane_index);
   sfloat e[3];
   for (int k = 0; k < 3; ++k) {
     const long far_end = (E[k] < 0 ? -E[k] : E[k]) + (long)SW * (step[k] < 0 ? -step[k] : step[k]);
@@ -197,7 +195,7 @@ inline void lanes_step_edges(LaneWinners* L, sint take, int first, const long* E
 
 /* The lanes of vector `take` as bits. */
 inline uint lane_bits(sint take) {
-  const sint bits = select((sint)(0), (sint)(1) << vload_s(0, shade_lane_index), take);
+  const sint bits = select((sint)(0), (sint)(1) << vload_s(0, lane_index), take);
   const int4 b4 = bits.lo | bits.hi;
   const int2 b2 = b4.lo | b4.hi;
   return (uint)(b2.x | b2.y);

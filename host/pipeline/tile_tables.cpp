@@ -43,8 +43,8 @@ std::vector<int32_t> subpixel_sample_rows(const PmrEncodeParams& E) {
 
 int subpixel_chunk_capacity(int views) {
   // area + (lanes - 1) * min(views, area) <= slots
-  const int area = kSubpixelSlots - (kSubpixelLanes - 1) * views;
-  return area >= views ? area : kSubpixelSlots / kSubpixelLanes;
+  const int area = kSubpixelSlots - (PMR_SUBPIXEL_LANES - 1) * views;
+  return area >= views ? area : kSubpixelSlots / PMR_SUBPIXEL_LANES;
 }
 
 std::vector<PmrSampleChunk> subpixel_chunks(const TileOwnership& own, int tile_x, int tile_y, int capacity) {

@@ -32,7 +32,6 @@ std::vector<int32_t> subpixel_sample_rows(const PmrEncodeParams& E);     // H_d 
 // 8192 slots make a work-item's private arrays about 230 KB: fine for PoCL's CPU devices, which run the
 // kernel with one work-item per work-group (measured best of 2048 to 16384 at paper-8k).
 constexpr int kSubpixelSlots = 8192;
-constexpr int kSubpixelLanes = 8;  // SP_LANES in cl/fine_subpixel.cl
 int subpixel_chunk_capacity(int views);
 // Every display subpixel in exactly one chunk; a chunk lies in one screen tile, holds at most
 // `capacity` subpixels and is cut from its neighbours in the same tile at display-pixel boundaries.

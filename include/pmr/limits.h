@@ -1,14 +1,13 @@
 // Size limits that more than one module checks (the command line, calibration files, the encoder, the
-// pipeline), each defined once so that the checks and their messages agree. The kernels' own limits
-// (views, view raster) are in pmr/shared.h.
+// pipeline), as C++ constants. Every limit is defined once, in pmr/shared.h, which host and kernels
+// share, so that the checks, their messages and the kernels agree.
 #pragma once
+
+#include "pmr/shared.h"
 
 namespace pmr {
 
-// A display image's side in pixels: the encode kernels index its subpixels in 32 bits.
-constexpr int kMaxDisplaySide = 16384;
-// A side of the 3D tile (--tile XxYxV): the fine raster keeps a tile's x offsets in 16.16 below 2^22
-// (fine_subpixel.cl).
-constexpr int kMaxTileSide = 64;
+constexpr int kMaxDisplaySide = PMR_MAX_DISPLAY_SIDE;
+constexpr int kMaxTileSide = PMR_MAX_TILE_SIDE;
 
 }  // namespace pmr

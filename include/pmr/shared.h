@@ -28,12 +28,10 @@
 #ifdef __OPENCL_VERSION__
 typedef int pmr_i32;
 typedef uint pmr_u32;
-typedef long pmr_i64;
 #else
 #include <cstdint>
 typedef int32_t pmr_i32;
 typedef uint32_t pmr_u32;
-typedef int64_t pmr_i64;
 #endif
 
 #define PMR_X_FRAC_BITS 16
@@ -46,6 +44,15 @@ typedef int64_t pmr_i64;
 #define PMR_GUARD_PX 16384.0
 #define PMR_MAX_RASTER 8192
 
+/* A display image's side in pixels: the encode kernels index its subpixels in 32 bits. */
+#define PMR_MAX_DISPLAY_SIDE 16384
+/* A side of the 3D tile (--tile XxYxV): the subpixel raster keeps a tile's x offsets in 16.16 below
+ * 2^22 (cl/fine_subpixel.cl). */
+#define PMR_MAX_TILE_SIDE 64
+/* --sampling subpixel tests a view's samples this many at a time (one vector of doubles); the host pads
+ * each view's run of samples to whole vectors when it sizes the chunks (host/pipeline/tile_tables.cpp). */
+#define PMR_SUBPIXEL_LANES 8
+
 /* Views of a rig, and the largest |view coordinate| (see above). PmrParams.view_coord has
  * PMR_VIEW_COORD_SLACK entries past the last view (copies of the last one), so that a 16-view vector
  * load at any view stays inside the struct. */
@@ -54,9 +61,8 @@ typedef int64_t pmr_i64;
 #define PMR_VIEW_COORD_SLACK 16
 
 /* A triangle clipped by near, far and the six guard-band planes has at most 3 + 8 vertices, i.e. a fan
- * of 9 triangles; a double-sided one whose orientation flips across the views splits once more. */
+ * of 9 triangles (the visibility key's sub-triangle index). */
 #define PMR_MAX_CLIP_VERTS 11
-#define PMR_MAX_MTA_PER_TRI 18
 /* Visibility key = (triangle index << PMR_KEY_SUB_BITS) | sub-triangle index; lower key wins ties. */
 #define PMR_KEY_SUB_BITS 5
 #define PMR_MAX_TRIANGLES (1u << (32 - PMR_KEY_SUB_BITS))

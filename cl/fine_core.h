@@ -1,0 +1,148 @@
+#ifndef PMR_CL_FINE_CORE_H
+#define PMR_CL_FINE_CORE_H
+/* The fine raster's core, shared by its three entry points: fine.cl (writes the view volume),
+ * fine_encode.cl (writes the display image from the same pixel-center raster, fine_raster.h) and
+ * fine_subpixel.cl (rasterizes every display subpixel at its own sample). They differ in where their
+ * samples lie, so the routines here take the samples' positions: the pixel centers of a row, or
+ * per-lane offsets from a base point. Every test is exact either way (integer edge functions), so a
+ * sample's outcome depends on the MTA, the view and the sample alone. */
+#include "shade.h"
+
+/* Where a vector's lanes sample the raster (16.16 / 24.8): lane l at (X + sx[l], Y + sy[l]), or, when
+ * sx is null, along the pixel-center row (X + l PMR_X_ONE, Y). */
+typedef struct {
+  long X, Y;
+  const int* sx;
+  const int* sy;
+} SampleLanes;
+
+inline SampleLanes row_samples(long X, long Y) {
+  const SampleLanes S = {X, Y, 0, 0};
+  return S;
+}
+
+inline SampleLanes offset_samples(long X, long Y, const int* sx, const int* sy) {
+  const SampleLanes S = {X, Y, sx, sy};
+  return S;
+}
+
+inline long sample_lane_x(const SampleLanes* S, int l) { return S->sx ? S->X + S->sx[l] : S->X + (long)l * PMR_X_ONE; }
+inline long sample_lane_y(const SampleLanes* S, int l) { return S->sx ? S->Y + S->sy[l] : S->Y; }
+
+/* Bit l set: in view ib + l (l < count <= 16) some sample x of the form X0 + k 2^shift, 0 <= k <= last,
+ * lies within the MTA's x extent: a tile's pixel-center columns (shift PMR_X_FRAC_BITS, last = columns
+ * - 1), or any raster x of a span (shift 0). Views failing it cannot hold a covered sample; a sub-pixel
+ * MTA passes in an irregular part of the views, so testing 16 views at once (lanes = views) replaces 16
+ * unpredictable branches. Vertex x relative to X0 in 32 bits when that provably fits (base, disparity
+ * over the views and `last` each below 2^29), else every view is passed on (the edge tests decide
+ * exactly either way). Arithmetic shifts floor. */
+PMR_HOT uint view_pass_mask(global const PmrParams* P, const PmrMta* m, int ib, int count, long X0, int shift,
+                           long last) {
+  const uint all = (1u << count) - 1u; /* count <= 16 */
+  long span;
+  const int16 l = view_coord_lanes(P, ib, count, &span);
+  const long fib = view_coord(P, ib);
+  long base[3];
+  bool fits = last < (1L << 29);
+  for (int k = 0; k < 3; ++k) {
+    base[k] = (long)m->x0[k] + fib * m->dx[k] - X0;
+    fits = fits && base[k] > -(1L << 29) && base[k] < (1L << 29) && (long)abs(m->dx[k]) * span < (1L << 29);
+  }
+  if (!fits) return all;
+  const int16 xa = (int16)((int)base[0]) + l * m->dx[0], xb = (int16)((int)base[1]) + l * m->dx[1];
+  const int16 xc = (int16)((int)base[2]) + l * m->dx[2];
+  const int16 kmax = max(xa, max(xb, xc)) >> shift;
+  const int16 kmin = -((-min(xa, min(xb, xc))) >> shift);
+  const int16 pass = max(kmin, 0) <= min(kmax, (int16)((int)last));
+  const int16 bits = select((int16)(0), (int16)(1) << vload16(0, lane_index), pass);
+  const int8 r8 = bits.lo | bits.hi;
+  const int4 r4 = r8.lo | r8.hi;
+  const int2 r2 = r4.lo | r4.hi;
+  return (uint)(r2.x | r2.y) & all;
+}
+
+/* alphaMode MASK: of the lanes l < n with w[l] set (candidate winners at samples S of view `view`), clears
+ * those whose base colour alpha fails the cutoff. Rare path, one lane at a time with the exact edge
+ * functions. */
+inline void mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, int* w, int n, const SampleLanes* S, int view,
+                             float cutoff) {
+  for (int l = 0; l < n; ++l)
+    if (w[l] && !mta_alpha_passes(in, m, sample_lane_x(S, l), sample_lane_y(S, l), view, cutoff)) w[l] = 0;
+}
+
+/* The winners of SW samples S of view `view` for shade_lanes, one per lane: MTA ids[l] where `act`. Each
+ * distinct winning MTA is loaded once (through the cache) and blended into the lanes it won (lanes_add).
+ * The lanes' edge functions: along a pixel-center row stepped from the MTA's first lane
+ * (lanes_step_edges), else each lane's own; both round the same exact values to float. */
+PMR_HOT void lanes_gather(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, sint act, sint ids,
+                         const SampleLanes* S, int view, LaneWinners* L) {
+  const bool pbr = in->P->shading == PMR_SHADING_PBR;
+  const long f = view_coord(in->P, view);
+  int id_of[SW];
+  vstore_s(ids, 0, id_of);
+  float e[3][SW]; /* per-lane edge functions (samples off a row); idle lanes 1, as lanes_clear's */
+  for (int l = 0; l < SW; ++l) e[0][l] = e[1][l] = e[2][l] = 1.0f;
+  lanes_clear(L);
+  uint todo = lane_bits(act);
+  while (todo != 0u) {
+    const int first = 31 - (int)clz(todo & (0u - todo));
+    const sint take = act & (ids == (sint)(id_of[first]));
+    const uint bits = lane_bits(take);
+    todo &= ~bits;
+    const PmrMta* m = cached_mta(cache, mtas, (uint)id_of[first]);
+    lanes_add(L, in, m, take, bits, pbr);
+    long E[3];
+    if (!S->sx) {
+      long step[3];
+      mta_edges_at(m, sample_lane_x(S, first), S->Y, f, E);
+      mta_edge_steps(m, step);
+      lanes_step_edges(L, take, first, E, step);
+      continue;
+    }
+    for (uint b = bits; b != 0u; b &= b - 1u) {
+      const int l = 31 - (int)clz(b & (0u - b));
+      mta_edges_at(m, sample_lane_x(S, l), sample_lane_y(S, l), f, E);
+      e[0][l] = (float)E[0], e[1][l] = (float)E[1], e[2][l] = (float)E[2];
+    }
+  }
+  if (S->sx) L->e = LANE3(e);
+}
+
+/* Where the kernels that write the display image from screen tiles (fine_encode.cl, fine_subpixel.cl)
+ * write it: the image (half RGBA bits), each subpixel's own alpha (store_sub_alpha), and, for display
+ * pixels whose subpixels belong to different tiles ("straddling"; straddle_slot[j] is column j's slot
+ * among them), a coverage byte per subpixel for encode_straddle_alpha (straddle_alpha.cl). */
+typedef struct {
+  global ushort* bits;
+  global ushort* sub_alpha;
+  global uchar* straddle_cov;
+  global const int* straddle_slot;
+  uint straddle_slots;
+  int width; /* display pixels per row */
+} DisplayOut;
+
+/* Display pixel (j, i) from the half RGBA bits of its subpixels' samples s0, s1, s2 (channel k from
+ * subpixel k, alpha its coverage), of which the calling tile owns subpixels s_lo <= 3 j + k < s_hi (the
+ * others' values are not read). Wholly owned: the pixel, its alpha the mean coverage, and each
+ * subpixel's alpha. Straddling: the owned channels, their own alpha (written by this tile alone), and
+ * their coverage bytes, from which encode_straddle_alpha sets the pixel's alpha once all tiles are
+ * done. */
+PMR_HOT void write_display_pixel(const DisplayOut* D, int i, int j, int s_lo, int s_hi, ushort4 s0, ushort4 s1,
+                                ushort4 s2) {
+  const size_t pixel = (size_t)i * (size_t)D->width + (size_t)j;
+  const int k_lo = max(s_lo - 3 * j, 0), k_hi = min(s_hi - 3 * j, 3);
+  if (k_lo == 0 && k_hi == 3) {
+    vstore4(encode_pixel(s0, s1, s2), pixel, D->bits);
+    store_sub_alpha(D->sub_alpha, pixel, s0, s1, s2);
+    return;
+  }
+  const size_t slot = ((size_t)i * D->straddle_slots + (size_t)D->straddle_slot[j]) * 3;
+  for (int k = k_lo; k < k_hi; ++k) {
+    const ushort4 s = k == 0 ? s0 : (k == 1 ? s1 : s2);
+    D->bits[pixel * 4 + (size_t)k] = k == 0 ? s.x : (k == 1 ? s.y : s.z);
+    D->straddle_cov[slot + (size_t)k] = s.w != 0 ? 1 : 0;
+    D->sub_alpha[pixel * 3 + (size_t)k] = s.w;
+  }
+}
+
+#endif

@@ -148,7 +148,8 @@ BenchOptions parse(const std::vector<std::string>& args) {
   o.offset_given = r.offset_given;
   o.tile[0] = r.pipeline.tile_x, o.tile[1] = r.pipeline.tile_y, o.tile[2] = r.pipeline.tile_v;
   o.animation = r.animation, o.fps = r.fps;
-  o.turntable = r.turntable, o.turntable_deg = r.turntable_deg, o.turntable_frames = r.turntable ? r.turntable_frames : 1;
+  o.turntable = r.turntable, o.turntable_deg = r.turntable_deg,
+  o.turntable_frames = r.turntable ? r.turntable_frames : 1;
   if (o.methods.empty() || o.views.empty() || o.samplings.empty()) throw Error("nothing to measure");
   std::vector<std::string> warnings;
   check_environment_options(o.environment_file, o.environment_rotation_given, o.shading, warnings);
@@ -159,7 +160,8 @@ BenchOptions parse(const std::vector<std::string>& args) {
     const bool pmr = std::find(o.methods.begin(), o.methods.end(), Method::Pmr) != o.methods.end();
     check_subpixel_sampling(pmr ? Method::Pmr : o.methods[0], o.display);
   }
-  if (!o.generator.empty() && !o.scene.empty()) throw Error("give a SCENE or a generator (--synthetic, --objects), not both");
+  if (!o.generator.empty() && !o.scene.empty())
+    throw Error("give a SCENE or a generator (--synthetic, --objects), not both");
   if (!o.save_scene.empty() && o.triangle_counts.size() != 1)
     throw Error("--save-scene needs exactly one generated scene (--synthetic TRIS or --objects TRIS)");
   return o;
@@ -199,6 +201,19 @@ double coverage_mismatch(const std::vector<uint16_t>& a, const std::vector<uint1
 }
 
 // One scene: every view count and method of the options, a table row (and CSV row) per point.
+// The pipeline of one bench row: the encoded-only job, as pmr render runs it.
+PipelineConfig bench_config(const BenchOptions& o, Method method, Sampling sampling) {
+  PipelineConfig pc;
+  pc.method = method;
+  pc.sampling = sampling;
+  pc.shading = o.shading, pc.exposure_ev = o.exposure_ev, pc.environment_intensity = o.environment_intensity;
+  pc.environment = o.environment;
+  pc.tile_queue_limit = o.limits.tile_queue;
+  pc.tile_x = o.tile[0], pc.tile_y = o.tile[1], pc.tile_v = o.tile[2];
+  pc.fuse_encode = true;
+  return pc;
+}
+
 void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Scene& scene,
                  const std::string& scene_name, std::ofstream* csv) {
   SequenceSpec spec;
@@ -234,67 +249,61 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
     std::vector<uint16_t> reference[2];  // per sampling: the first method's image
     for (Method method : o.methods)
       for (Sampling asked : o.samplings) {
-      // subpixel sampling is PMR's: asked for, the other methods skip it; as a preset's default they
-      // render with view sampling, as pmr render does
-      if (asked == Sampling::Subpixel && method != Method::Pmr && o.samplings_given) continue;
-      const Sampling sampling = method == Method::Pmr ? asked : Sampling::View;
-      // samples per frame: the voxels, or each display subpixel once
-      const double samples = sampling == Sampling::Subpixel ? subpixels : voxels;
-      // the least a frame must move: every sample written once, the display image written once (half RGBA)
-      const double floor_bytes = (sampling == Sampling::Subpixel ? 0.0 : voxels * 8.0) + double(display.width) * display.height * 8.0;
-      const double floor_ms = floor_bytes / bw * 1e3;
-      PipelineConfig pc;
-      pc.method = method;
-      pc.sampling = sampling;
-      pc.shading = o.shading, pc.exposure_ev = o.exposure_ev, pc.environment_intensity = o.environment_intensity;
-      pc.environment = o.environment;
-      pc.tile_queue_limit = o.limits.tile_queue;
-      pc.tile_x = o.tile[0], pc.tile_y = o.tile[1], pc.tile_v = o.tile[2];
-      pc.fuse_encode = true;  // the encoded-only job, as pmr render runs it
-      Pipeline p(rt, pc);
-      renderer.attach(p, &display);
-      renderer.render(0);  // warm-up: first-touch of buffers, queue growth
-      std::vector<double> wall, setup, tile, fine, encode, pose, upload;
-      for (int f = 0; f < o.frames; ++f) {
-        const FrameRenderer::Frame fr = renderer.render(f);
-        const StageTimes& t = fr.times;
-        wall.push_back(t.wall);
-        pose.push_back(fr.pose_ms);
-        upload.push_back(fr.upload_ms);
-        setup.push_back(t.vertex + t.setup);
-        tile.push_back(t.bin);
-        fine.push_back(t.fine);
-        encode.push_back(t.encode);
-      }
-      double mismatch = 0.0;
-      if (o.check) {
-        std::vector<uint16_t> image;
-        p.read_display(image);
-        std::vector<uint16_t>& first = reference[sampling == Sampling::Subpixel];
-        if (first.empty()) first.swap(image);
-        else mismatch = coverage_mismatch(first, image);
-        if (mismatch > 0.001)
-          std::fprintf(stderr, "pmr: warning: %s at N = %d differs from %s on %.3f%% of display pixels\n", to_string(method), N,
-                       to_string(o.methods[0]), 100.0 * mismatch);
-      }
-      const double med = median(wall), mn = *std::min_element(wall.begin(), wall.end());
-      const double msmp = samples / (med * 1e-3) * 1e-6;
-      const double mem_mb = double(p.device_bytes()) / (1 << 20);
-      char view[32];
-      std::snprintf(view, sizeof view, "%dx%d", rig.view_w, rig.view_h);
-      std::printf("%-10s %-8s %5d %9s %9.2f %9.1f %9.1f %8.1f %8.1f %8.1f %8.1f %9.0f %8.0f %7.1f %8.5f\n",
-                  to_string(method), to_string(sampling), N, view, samples * 1e-6, med, mn, median(setup), median(tile),
-                  median(fine), median(encode), msmp, floor_bytes / 1e6, med / floor_ms, mismatch);
-      if (median(pose) > 0.0)
-        std::printf("#   on the host per frame (not in ms_median): pose %.2f ms, upload %.2f ms\n", median(pose),
-                    median(upload));
-      std::fflush(stdout);
-      if (csv)
-        *csv << scene_name << ',' << to_string(method) << ',' << N << ',' << rig.view_w << ',' << rig.view_h << ','
-             << display.width << ',' << display.height << ',' << scene.triangles.size() << ',' << o.frames << ',' << med
-             << ',' << mn << ',' << median(setup) << ',' << median(tile) << ',' << median(fine) << ',' << median(encode)
-             << ',' << (sampling == Sampling::Subpixel ? 0.0 : voxels / (med * 1e-3) * 1e-6) << ',' << mem_mb << ',' << floor_bytes / 1e6 << ',' << floor_ms << ','
-             << med / floor_ms << ',' << mismatch << ',' << to_string(sampling) << ',' << samples << ',' << msmp << '\n';
+        // subpixel sampling is PMR's: asked for, the other methods skip it; as a preset's default they
+        // render with view sampling, as pmr render does
+        if (asked == Sampling::Subpixel && method != Method::Pmr && o.samplings_given) continue;
+        const Sampling sampling = method == Method::Pmr ? asked : Sampling::View;
+        // samples per frame: the voxels, or each display subpixel once
+        const double samples = sampling == Sampling::Subpixel ? subpixels : voxels;
+        // the least a frame must move: every sample written once, the display image written once (half RGBA)
+        const double floor_bytes =
+            (sampling == Sampling::Subpixel ? 0.0 : voxels * 8.0) + double(display.width) * display.height * 8.0;
+        const double floor_ms = floor_bytes / bw * 1e3;
+        Pipeline p(rt, bench_config(o, method, sampling));
+        renderer.attach(p, &display);
+        renderer.render(0);  // warm-up: first-touch of buffers, queue growth
+        std::vector<double> wall, setup, tile, fine, encode, pose, upload;
+        for (int f = 0; f < o.frames; ++f) {
+          const FrameRenderer::Frame fr = renderer.render(f);
+          const StageTimes& t = fr.times;
+          wall.push_back(t.wall);
+          pose.push_back(fr.pose_ms);
+          upload.push_back(fr.upload_ms);
+          setup.push_back(t.vertex + t.setup);
+          tile.push_back(t.bin);
+          fine.push_back(t.fine);
+          encode.push_back(t.encode);
+        }
+        double mismatch = 0.0;
+        if (o.check) {
+          std::vector<uint16_t> image;
+          p.read_display(image);
+          std::vector<uint16_t>& first = reference[sampling == Sampling::Subpixel];
+          if (first.empty()) first.swap(image);
+          else mismatch = coverage_mismatch(first, image);
+          if (mismatch > 0.001)
+            std::fprintf(stderr, "pmr: warning: %s at N = %d differs from %s on %.3f%% of display pixels\n",
+                         to_string(method), N, to_string(o.methods[0]), 100.0 * mismatch);
+        }
+        const double med = median(wall), mn = *std::min_element(wall.begin(), wall.end());
+        const double msmp = samples / (med * 1e-3) * 1e-6;
+        const double mem_mb = double(p.device_bytes()) / (1 << 20);
+        char view[32];
+        std::snprintf(view, sizeof view, "%dx%d", rig.view_w, rig.view_h);
+        std::printf("%-10s %-8s %5d %9s %9.2f %9.1f %9.1f %8.1f %8.1f %8.1f %8.1f %9.0f %8.0f %7.1f %8.5f\n",
+                    to_string(method), to_string(sampling), N, view, samples * 1e-6, med, mn, median(setup),
+                    median(tile), median(fine), median(encode), msmp, floor_bytes / 1e6, med / floor_ms, mismatch);
+        if (median(pose) > 0.0)
+          std::printf("#   on the host per frame (not in ms_median): pose %.2f ms, upload %.2f ms\n", median(pose),
+                      median(upload));
+        std::fflush(stdout);
+        if (csv)
+          *csv << scene_name << ',' << to_string(method) << ',' << N << ',' << rig.view_w << ',' << rig.view_h << ','
+               << display.width << ',' << display.height << ',' << scene.triangles.size() << ',' << o.frames << ','
+               << med << ',' << mn << ',' << median(setup) << ',' << median(tile) << ',' << median(fine) << ','
+               << median(encode) << ',' << (sampling == Sampling::Subpixel ? 0.0 : voxels / (med * 1e-3) * 1e-6) << ','
+               << mem_mb << ',' << floor_bytes / 1e6 << ',' << floor_ms << ',' << med / floor_ms << ',' << mismatch
+               << ',' << to_string(sampling) << ',' << samples << ',' << msmp << '\n';
       }
   }
 }

@@ -29,8 +29,8 @@ inline bool edge_may_pass(const PmrMta* m, int a, int b, long X0, long X1, long 
   const long X = s * (long)(m->y[b] - m->y[a]) >= 0 ? X1 : X0;
   const long dx0 = (long)m->x0[b] + i0 * m->dx[b] - (long)m->x0[a] - i0 * m->dx[a];
   const long dx1 = (long)m->x0[b] + i1 * m->dx[b] - (long)m->x0[a] - i1 * m->dx[a];
-  const long best = max(s * mta_edge(m, a, b, X, -s * dx0 >= 0 ? Y1 : Y0, i0),
-                        s * mta_edge(m, a, b, X, -s * dx1 >= 0 ? Y1 : Y0, i1));
+  const long best =
+      max(s * mta_edge(m, a, b, X, -s * dx0 >= 0 ? Y1 : Y0, i0), s * mta_edge(m, a, b, X, -s * dx1 >= 0 ? Y1 : Y0, i1));
   return best >= bias;
 }
 
@@ -50,45 +50,43 @@ inline bool in_view(const PmrMta* m, long i, long X0, long X1) {
 }
 
 /* Calls BIN_EMIT(tile) for every tile the MTA may cover. */
-#define BIN_ENUMERATE(P, m)                                                                          \
-  for (int tv = (m).view_lo / PMR_TILE_V; tv <= (m).view_hi / PMR_TILE_V; ++tv) {                   \
-    const int i0 = max((m).view_lo, tv * PMR_TILE_V);                                                \
-    const int i1 = min((m).view_hi, tv * PMR_TILE_V + PMR_TILE_V - 1);                               \
-    const long f0 = view_coord((P), i0), f1 = view_coord((P), i1), f_lo = view_coord((P), (m).view_lo); \
+#define BIN_ENUMERATE(P, m)                                                                                       \
+  for (int tv = (m).view_lo / PMR_TILE_V; tv <= (m).view_hi / PMR_TILE_V; ++tv) {                                 \
+    const int i0 = max((m).view_lo, tv * PMR_TILE_V);                                                             \
+    const int i1 = min((m).view_hi, tv * PMR_TILE_V + PMR_TILE_V - 1);                                            \
+    const long f0 = view_coord((P), i0), f1 = view_coord((P), i1), f_lo = view_coord((P), (m).view_lo);           \
     /* x range over the slab: each vertex's x is linear in the view coordinate, so the extremes are at \
-     * its end views; per view only when the views are more than a tile apart (in_view below) */      \
-    long lo0, hi0, lo1, hi1;                                                                         \
-    x_extent(&(m), f0, &lo0, &hi0);                                                                  \
-    x_extent(&(m), f1, &lo1, &hi1);                                                                  \
-    const long xlo = min(lo0, lo1), xhi = max(hi0, hi1);                                             \
-    const bool sheared = (xhi - xlo) - (hi0 - lo0) > (long)PMR_TILE_X * PMR_X_ONE;                   \
-    const long ylo = min3l((m).y[0], (m).y[1], (m).y[2]), yhi = max3l((m).y[0], (m).y[1], (m).y[2]); \
+     * its end views; per view only when the views are more than a tile apart (in_view below) */          \
+    long lo0, hi0, lo1, hi1;                                                                                      \
+    x_extent(&(m), f0, &lo0, &hi0);                                                                               \
+    x_extent(&(m), f1, &lo1, &hi1);                                                                               \
+    const long xlo = min(lo0, lo1), xhi = max(hi0, hi1);                                                          \
+    const bool sheared = (xhi - xlo) - (hi0 - lo0) > (long)PMR_TILE_X * PMR_X_ONE;                                \
+    const long ylo = min3l((m).y[0], (m).y[1], (m).y[2]), yhi = max3l((m).y[0], (m).y[1], (m).y[2]);              \
     /* a pixel's samples lie in [X + slo_x, X + shi_x] x [Y + slo_y, Y + shi_y] (X, Y its corner): its \
-     * center, or the whole pixel with --sampling subpixel; the pixels whose samples meet the box */  \
-    const bool whole = (P)->sample_area == PMR_SAMPLES_PIXEL;                                        \
-    const long slo_x = whole ? 0 : PMR_HALF_X, shi_x = whole ? PMR_X_ONE - 1 : PMR_HALF_X;           \
-    const long slo_y = whole ? 0 : PMR_HALF_Y, shi_y = whole ? PMR_Y_ONE - 1 : PMR_HALF_Y;           \
-    const int px0 = (int)max(0L, -floor_div_l(shi_x - xlo, PMR_X_ONE));                             \
-    const int px1 = (int)min((long)(P)->view_w - 1, floor_div_l(xhi - slo_x, PMR_X_ONE));           \
-    const int py0 = (int)max(0L, -floor_div_l(shi_y - ylo, PMR_Y_ONE));                             \
-    const int py1 = (int)min((long)(P)->view_h - 1, floor_div_l(yhi - slo_y, PMR_Y_ONE));           \
-    for (int ty = py0 / PMR_TILE_Y; py0 <= py1 && ty <= py1 / PMR_TILE_Y; ++ty) {                  \
-      const long Y0 = (long)max(py0, ty * PMR_TILE_Y) * PMR_Y_ONE + slo_y;                           \
-      const long Y1 = (long)min(py1, ty * PMR_TILE_Y + PMR_TILE_Y - 1) * PMR_Y_ONE + shi_y;          \
-      for (int tx = px0 / PMR_TILE_X; px0 <= px1 && tx <= px1 / PMR_TILE_X; ++tx) {                \
-        const long X0 = (long)max(px0, tx * PMR_TILE_X) * PMR_X_ONE + slo_x;                         \
-        const long X1 = (long)min(px1, tx * PMR_TILE_X + PMR_TILE_X - 1) * PMR_X_ONE + shi_x;        \
-        bool in_some_view = !sheared;                                                                \
-        for (int i = i0; i <= i1 && !in_some_view; ++i)                                              \
-          in_some_view = in_view(&(m), view_coord((P), i), X0, X1);                                  \
-        if (in_some_view &&                                                                          \
-            edge_may_pass(&(m), 1, 2, X0, X1, Y0, Y1, f0, f1, f_lo) &&                               \
-            edge_may_pass(&(m), 2, 0, X0, X1, Y0, Y1, f0, f1, f_lo) &&                               \
-            edge_may_pass(&(m), 0, 1, X0, X1, Y0, Y1, f0, f1, f_lo)) {                               \
-          BIN_EMIT(((uint)tv * (P)->tiles_y + (uint)ty) * (P)->tiles_x + (uint)tx);                  \
-        }                                                                                            \
-      }                                                                                              \
-    }                                                                                                \
+     * center, or the whole pixel with --sampling subpixel; the pixels whose samples meet the box */          \
+    const bool whole = (P)->sample_area == PMR_SAMPLES_PIXEL;                                                     \
+    const long slo_x = whole ? 0 : PMR_HALF_X, shi_x = whole ? PMR_X_ONE - 1 : PMR_HALF_X;                        \
+    const long slo_y = whole ? 0 : PMR_HALF_Y, shi_y = whole ? PMR_Y_ONE - 1 : PMR_HALF_Y;                        \
+    const int px0 = (int)max(0L, -floor_div_l(shi_x - xlo, PMR_X_ONE));                                           \
+    const int px1 = (int)min((long)(P)->view_w - 1, floor_div_l(xhi - slo_x, PMR_X_ONE));                         \
+    const int py0 = (int)max(0L, -floor_div_l(shi_y - ylo, PMR_Y_ONE));                                           \
+    const int py1 = (int)min((long)(P)->view_h - 1, floor_div_l(yhi - slo_y, PMR_Y_ONE));                         \
+    for (int ty = py0 / PMR_TILE_Y; py0 <= py1 && ty <= py1 / PMR_TILE_Y; ++ty) {                                 \
+      const long Y0 = (long)max(py0, ty * PMR_TILE_Y) * PMR_Y_ONE + slo_y;                                        \
+      const long Y1 = (long)min(py1, ty * PMR_TILE_Y + PMR_TILE_Y - 1) * PMR_Y_ONE + shi_y;                       \
+      for (int tx = px0 / PMR_TILE_X; px0 <= px1 && tx <= px1 / PMR_TILE_X; ++tx) {                               \
+        const long X0 = (long)max(px0, tx * PMR_TILE_X) * PMR_X_ONE + slo_x;                                      \
+        const long X1 = (long)min(px1, tx * PMR_TILE_X + PMR_TILE_X - 1) * PMR_X_ONE + shi_x;                     \
+        bool in_some_view = !sheared;                                                                             \
+        for (int i = i0; i <= i1 && !in_some_view; ++i) in_some_view = in_view(&(m), view_coord((P), i), X0, X1); \
+        if (in_some_view && edge_may_pass(&(m), 1, 2, X0, X1, Y0, Y1, f0, f1, f_lo) &&                            \
+            edge_may_pass(&(m), 2, 0, X0, X1, Y0, Y1, f0, f1, f_lo) &&                                            \
+            edge_may_pass(&(m), 0, 1, X0, X1, Y0, Y1, f0, f1, f_lo)) {                                            \
+          BIN_EMIT(((uint)tv * (P)->tiles_y + (uint)ty) * (P)->tiles_x + (uint)tx);                               \
+        }                                                                                                         \
+      }                                                                                                           \
+    }                                                                                                             \
   }
 
 kernel void bin_count(global const PmrParams* P, global const PmrMta* mtas, uint num_mtas,
@@ -102,8 +100,7 @@ kernel void bin_count(global const PmrParams* P, global const PmrMta* mtas, uint
 }
 
 kernel void bin_fill(global const PmrParams* P, global const PmrMta* mtas, uint num_mtas,
-                     volatile global uint* tile_counts, global const uint* tile_offsets,
-                     global uint* tile_queue) {
+                     volatile global uint* tile_counts, global const uint* tile_offsets, global uint* tile_queue) {
   const uint id = pmr_item_id();
   if (id >= num_mtas) return;
   const PmrMta m = mtas[id];

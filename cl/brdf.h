@@ -15,7 +15,8 @@ inline sfloat pbr_roughness(sfloat r) { return clamp(r, 0.03f, 1.0f); }
 
 /* F0 = mix(0.04, base, metallic) per channel */
 inline sfloat3 pbr_f0(sfloat3 base, sfloat metallic) {
-  return s3(0.04f + (base.x - 0.04f) * metallic, 0.04f + (base.y - 0.04f) * metallic, 0.04f + (base.z - 0.04f) * metallic);
+  return s3(0.04f + (base.x - 0.04f) * metallic, 0.04f + (base.y - 0.04f) * metallic,
+            0.04f + (base.z - 0.04f) * metallic);
 }
 
 /* GGX normal distribution D for cos(n, h) = nh and a2 = alpha^2. */

@@ -34,11 +34,11 @@ inline long floor_div_l(long a, long b) { /* b > 0 */
  * alone. */
 inline void project_vertex(global const PmrParams* P, double xv, double yv, double zv, PmrVertex* out) {
   const double w = -zv;
-  const double kk = P->disparity_k / (double)P->view_w; /* NDC disparity per unit (1 - D/w) / 2 */
+  const double kk = P->disparity_k / (double)P->view_w;        /* NDC disparity per unit (1 - D/w) / 2 */
   const double xc = P->ndc_scale_x * xv + P->ndc_offset_x * w; /* x_ndc(center) * w */
-  const double xfirst = xc - kk * (w - P->focal);        /* x_ndc(view 0) * w */
-  const double xlast = xc + kk * (w - P->focal);         /* x_ndc(view N-1) * w */
-  const double yc = P->ndc_scale_y * yv;                 /* y_ndc * w */
+  const double xfirst = xc - kk * (w - P->focal);              /* x_ndc(view 0) * w */
+  const double xlast = xc + kk * (w - P->focal);               /* x_ndc(view N-1) * w */
+  const double yc = P->ndc_scale_y * yv;                       /* y_ndc * w */
   const double gx = P->guard_ndc_x * w, gy = P->guard_ndc_y * w;
   uint oc = 0;
   if (w < P->near_eff) oc |= PMR_CLIP_NEAR | PMR_CULL_NEAR;
@@ -186,7 +186,8 @@ inline ushort4 encode_pixel(ushort4 s0, ushort4 s1, ushort4 s2) {
   ushort alpha = s0.w;
   if (s1.w != s0.w || s2.w != s0.w) {
     const ushort a[3] = {s0.w, s1.w, s2.w};
-    const float mean = (vload_half(0, (const half*)a) + vload_half(1, (const half*)a) + vload_half(2, (const half*)a)) / 3.0f;
+    const float mean =
+        (vload_half(0, (const half*)a) + vload_half(1, (const half*)a) + vload_half(2, (const half*)a)) / 3.0f;
     vstore_half(mean, 0, (half*)&alpha);
   }
   return (ushort4)(s0.x, s1.y, s2.z, alpha);

@@ -41,9 +41,12 @@ kernel void encode_nearest(global const PmrEncodeParams* E, global const PmrEnco
     /* the three subpixels unrolled into scalars: small private arrays written by element and read
      * back as a vector stall the CPU's store forwarding, which cost more than all the rest */
     const PmrEncodeColumn c0 = columns[3 * j], c1 = columns[3 * j + 1], c2 = columns[3 * j + 2];
-    const ushort4 s0 = vload4((size_t)encode_view(E->views, E->reversed, &c0, &row) * plane + row_off + (size_t)c0.px, bits);
-    const ushort4 s1 = vload4((size_t)encode_view(E->views, E->reversed, &c1, &row) * plane + row_off + (size_t)c1.px, bits);
-    const ushort4 s2 = vload4((size_t)encode_view(E->views, E->reversed, &c2, &row) * plane + row_off + (size_t)c2.px, bits);
+    const ushort4 s0 =
+        vload4((size_t)encode_view(E->views, E->reversed, &c0, &row) * plane + row_off + (size_t)c0.px, bits);
+    const ushort4 s1 =
+        vload4((size_t)encode_view(E->views, E->reversed, &c1, &row) * plane + row_off + (size_t)c1.px, bits);
+    const ushort4 s2 =
+        vload4((size_t)encode_view(E->views, E->reversed, &c2, &row) * plane + row_off + (size_t)c2.px, bits);
     vstore4(encode_pixel(s0, s1, s2), (size_t)i * E->display_w + j, (global ushort*)display);
     store_sub_alpha(sub_alpha, (size_t)i * E->display_w + j, s0, s1, s2);
   }
@@ -54,7 +57,7 @@ kernel void encode_nearest(global const PmrEncodeParams* E, global const PmrEnco
  * its own position. The fraction comes from the tables' float remainders: a weight, not a decision. */
 kernel void encode_blend(global const PmrEncodeParams* E, global const PmrEncodeColumn* all_columns,
                          global const PmrEncodeRow* rows, global const half* volume, global half* display,
-                           global ushort* sub_alpha) {
+                         global ushort* sub_alpha) {
   const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
   if (j0 >= E->display_w || i >= E->display_h) return;
   global const PmrEncodeColumn* columns = row_columns(E, all_columns, i);
@@ -84,7 +87,7 @@ kernel void encode_blend(global const PmrEncodeParams* E, global const PmrEncode
 
 kernel void encode_bilinear(global const PmrEncodeParams* E, global const PmrEncodeColumn* all_columns,
                             global const PmrEncodeRow* rows, global const half* volume, global half* display,
-                           global ushort* sub_alpha) {
+                            global ushort* sub_alpha) {
   const int j0 = (int)get_global_id(0) * PMR_ENCODE_RUN, i = (int)get_global_id(1);
   if (j0 >= E->display_w || i >= E->display_h) return;
   global const PmrEncodeColumn* columns = row_columns(E, all_columns, i);

@@ -64,7 +64,7 @@ inline float4 env_log2(float4 x) {
   float4 m = as_float4((bits & 0x007fffff) | 0x3f800000); /* [1, 2) */
   const int4 big = m > (float4)(1.41421356f);
   m = select(m, m * 0.5f, big);
-  e -= big; /* -1 where true: e + 1 */
+  e -= big;                              /* -1 where true: e + 1 */
   const float4 z = m - 1.0f, z2 = z * z; /* z in [-0.29, 0.42): ln(1 + z) */
   float4 p = (float4)(7.0376836292e-2f);
   p = p * z - 1.1514610310e-1f;

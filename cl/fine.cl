@@ -5,8 +5,8 @@
 #include "fine_raster.h"
 
 kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
-                          global const uint* tile_queue, global half* volume, global uint* debug_key,
-                          global float* debug_depth, global uint* debug_count) {
+                        global const uint* tile_queue, global half* volume, global uint* debug_key,
+                        global float* debug_depth, global uint* debug_count) {
   const uint tile = pmr_item_id();
   const uint tiles_xy = (uint)P->tiles_x * (uint)P->tiles_y;
   if (tile >= tiles_xy * (uint)P->tiles_v) return;
@@ -23,8 +23,8 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
   vint covered[FINE_ROWS];
   fine_clear_state(FINE_ROWS, best_depth, best_key, best_mta);
   for (int r = 0; r < FINE_ROWS; ++r) covered[r] = (vint)(0);
-  fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], &in, tris, materials, x0, y0,
-                    v0, nx, ny, nv, v0, best_depth, best_key, best_mta, debug ? covered : 0);
+  fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], &in, tris, materials, x0, y0, v0, nx,
+                    ny, nv, v0, best_depth, best_key, best_mta, debug ? covered : 0);
 
   /* frame constants in registers: stores through the output pointers could alias P */
   const size_t W = (size_t)P->view_w, H = (size_t)P->view_h, view_base = (size_t)P->view_base;
@@ -40,8 +40,8 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
         const int r = (lv * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
         const int view = v0 + lv, py = y0 + ly;
         ushort4 colour[VW];
-        fine_shade_chunk(&in, mtas, &cache, light, best_mta[r], best_key[r] != (vuint)(PMR_NO_KEY), x0 + c * VW, py, view,
-                         colour);
+        fine_shade_chunk(&in, mtas, &cache, light, best_mta[r], best_key[r] != (vuint)(PMR_NO_KEY), x0 + c * VW, py,
+                         view, colour);
         for (int l = 0; l < VW && c * VW + l < nx; ++l) {
           const int k = r * VW + l, px = x0 + c * VW + l;
           const size_t voxel = (((size_t)view + view_base) * H + (size_t)py) * W + (size_t)px;

@@ -37,7 +37,7 @@ inline long sample_lane_y(const SampleLanes* S, int l) { return S->sx ? S->Y + S
  * over the views and `last` each below 2^29), else every view is passed on (the edge tests decide
  * exactly either way). Arithmetic shifts floor. */
 PMR_HOT uint view_pass_mask(global const PmrParams* P, const PmrMta* m, int ib, int count, long X0, int shift,
-                           long last) {
+                            long last) {
   const uint all = (1u << count) - 1u; /* count <= 16 */
   long span;
   const int16 l = view_coord_lanes(P, ib, count, &span);
@@ -75,7 +75,7 @@ inline void mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, int* w, int
  * The lanes' edge functions: along a pixel-center row stepped from the MTA's first lane
  * (lanes_step_edges), else each lane's own; both round the same exact values to float. */
 PMR_HOT void lanes_gather(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, sint act, sint ids,
-                         const SampleLanes* S, int view, LaneWinners* L) {
+                          const SampleLanes* S, int view, LaneWinners* L) {
   const bool pbr = in->P->shading == PMR_SHADING_PBR;
   const long f = view_coord(in->P, view);
   int id_of[SW];
@@ -128,7 +128,7 @@ typedef struct {
  * their coverage bytes, from which encode_straddle_alpha sets the pixel's alpha once all tiles are
  * done. */
 PMR_HOT void write_display_pixel(const DisplayOut* D, int i, int j, int s_lo, int s_hi, ushort4 s0, ushort4 s1,
-                                ushort4 s2) {
+                                 ushort4 s2) {
   const size_t pixel = (size_t)i * (size_t)D->width + (size_t)j;
   const int k_lo = max(s_lo - 3 * j, 0), k_hi = min(s_hi - 3 * j, 3);
   if (k_lo == 0 && k_hi == 3) {

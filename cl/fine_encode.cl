@@ -44,7 +44,7 @@ PMR_HOT ushort4 fused_subpixel(const FusedTile* T, const PmrEncodeRow* row, int 
 
 /* Display pixel j of row i, of whose subpixels the tile owns [s_lo, s_hi). */
 PMR_HOT void fused_pixel(const DisplayOut* D, const FusedTile* T, const PmrEncodeRow* row, int i, int ly, int j,
-                        int s_lo, int s_hi) {
+                         int s_lo, int s_hi) {
   ushort4 s[3];
   for (int k = 0; k < 3; ++k)
     s[k] = 3 * j + k >= s_lo && 3 * j + k < s_hi ? fused_subpixel(T, row, ly, 3 * j + k) : (ushort4)(0);
@@ -68,8 +68,8 @@ PMR_HOT void fused_pixels8(const DisplayOut* D, const FusedTile* T, const PmrEnc
 }
 
 /* The display pixels of row i (view row ly of the tile) with a subpixel in [s_lo, s_hi), the tile's. */
-inline void fused_display_row(const DisplayOut* D, const FusedTile* T, const PmrEncodeRow* row, int i, int ly,
-                              int s_lo, int s_hi) {
+inline void fused_display_row(const DisplayOut* D, const FusedTile* T, const PmrEncodeRow* row, int i, int ly, int s_lo,
+                              int s_hi) {
   const int j_a = (s_lo + 2) / 3, j_b = s_hi / 3; /* wholly owned: [j_a, j_b) */
   int j = j_a;
   for (; j + 8 <= j_b; j += 8) fused_pixels8(D, T, row, i, ly, j);
@@ -79,11 +79,10 @@ inline void fused_display_row(const DisplayOut* D, const FusedTile* T, const Pmr
 }
 
 kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
-                          global const uint* tile_queue, global const PmrEncodeParams* E,
-                          global const int* column_soa, global const PmrEncodeRow* rows,
-                          global const int* column_start, global const int* row_start,
-                          global const int* straddle_slot, uint straddle_slots, global uchar* straddle_cov,
-                          global half* display, global ushort* sub_alpha) {
+                        global const uint* tile_queue, global const PmrEncodeParams* E, global const int* column_soa,
+                        global const PmrEncodeRow* rows, global const int* column_start, global const int* row_start,
+                        global const int* straddle_slot, uint straddle_slots, global uchar* straddle_cov,
+                        global half* display, global ushort* sub_alpha) {
   const uint tile_xy = pmr_item_id();
   const uint tiles_x = (uint)P->tiles_x, tiles_y = (uint)P->tiles_y;
   if (tile_xy >= tiles_x * tiles_y) return;
@@ -98,8 +97,8 @@ kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
   for (int tv = 0; tv < P->tiles_v; ++tv) {
     const uint tile = ((uint)tv * tiles_y) * tiles_x + tile_xy;
     const int v0 = tv * PMR_TILE_V;
-    fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], &in, tris, materials, x0, y0,
-                      v0, nx, ny, min(PMR_TILE_V, views - v0), 0, best_depth, best_key, best_mta, 0);
+    fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], &in, tris, materials, x0, y0, v0,
+                      nx, ny, min(PMR_TILE_V, views - v0), 0, best_depth, best_key, best_mta, 0);
   }
 
   /* the winners' colours as half bits, background zero */
@@ -111,8 +110,8 @@ kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
     for (int ly = 0; ly < ny; ++ly)
       for (int c = 0; c * VW < nx; ++c) {
         const int r = (view * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
-        fine_shade_chunk(&in, mtas, &cache, light, best_mta[r], best_key[r] != (vuint)(PMR_NO_KEY), x0 + c * VW, y0 + ly,
-                         view, colour + r * VW);
+        fine_shade_chunk(&in, mtas, &cache, light, best_mta[r], best_key[r] != (vuint)(PMR_NO_KEY), x0 + c * VW,
+                         y0 + ly, view, colour + r * VW);
       }
 
   /* the display pixels this tile owns, whole or in part */

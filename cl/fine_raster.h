@@ -86,9 +86,8 @@ PMR_HOT void row_edges(const PmrMta* m, long f_first, long f_lo, long X0, long Y
  * PMR_TILE_Y + ly) * FINE_CHUNKS + chunk holds VW lanes. */
 inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile_queue, uint q0, uint q1,
                               const ShadeInputs* in, global const PmrTriangle* tris,
-                              global const PmrMaterial* materials, int x0, int y0, int v0, int nx, int ny,
-                              int nv, int vbase, vfloat* best_depth, vuint* best_key, vuint* best_mta,
-                              vint* covered) {
+                              global const PmrMaterial* materials, int x0, int y0, int v0, int nx, int ny, int nv,
+                              int vbase, vfloat* best_depth, vuint* best_key, vuint* best_mta, vint* covered) {
   const long X0 = (long)x0 * PMR_X_ONE + PMR_HALF_X, Y0 = (long)y0 * PMR_Y_ONE + PMR_HALF_Y;
   const vint lane = vload_vint(0, lane_index);
   vint in_tile[FINE_CHUNKS]; /* lanes inside the raster (edge tiles are narrower) */
@@ -162,8 +161,8 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
 /* The winners of a row chunk shaded, as half RGBA bits: lane l is voxel (px0 + l, py) of view `view`,
  * won by MTA mta[l] where `won`, and out[l] gets its lit colour with alpha 1, or zero (background). SW
  * lanes at a time (lanes_gather, shade_lanes). */
-inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                             vuint mta, vint won, int px0, int py, int view, ushort4* out) {
+inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, vuint mta,
+                             vint won, int px0, int py, int view, ushort4* out) {
   for (int l = 0; l < VW; ++l) out[l] = (ushort4)(0);
   if (!any(won)) return; /* background */
   int ids[VW + SW], w[VW + SW];

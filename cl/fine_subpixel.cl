@@ -165,7 +165,7 @@ PMR_HOT SpPlane sp_plane(const PmrMta* m, const long* xv, const SpChunk* C) {
 /* MTA m (queue entry id) in view v against the view's run of samples, SP_LANES at a time, into the
  * visibility state. */
 PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, const SpEdges* S, int v, float cutoff,
-                           SpChunk* C) {
+                            SpChunk* C) {
   const int k0 = C->first[v], k1 = k0 + C->count[v];
   if (k0 == k1) return;
   long xv[3];
@@ -196,8 +196,8 @@ PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, con
     const long2 h2 = h4.lo | h4.hi;
     if ((h2.x | h2.y) == 0) continue;
     if (!have_plane) p = sp_plane(m, xv, C), have_plane = true; /* tiny MTAs often cover no sample */
-    const float8 z = convert_float8((double8)(p.z0) + ((double8)(p.gx) * ((double8)(p.bx) + x) +
-                                                       (double8)(p.gy) * ((double8)(p.by) + y)));
+    const float8 z = convert_float8(
+        (double8)(p.z0) + ((double8)(p.gx) * ((double8)(p.bx) + x) + (double8)(p.gy) * ((double8)(p.by) + y)));
     const float8 bd = vload8(0, C->best_depth + k);
     const uint8 bk = vload8(0, C->best_key + k);
     int8 win = convert_int8(hit) & ((z < bd) | ((z == bd) & ((uint8)(m->key) < bk)));
@@ -297,8 +297,7 @@ inline void sp_write_debug(const PmrSampleChunk* ch, int views, int display_w, c
 
 /* Step 4, the chunk's display pixels (write_display_pixel): a sample's half RGBA bits are its value in
  * every channel (the pixel takes channel k from subpixel k) and its coverage as alpha. */
-inline void sp_write_display(const DisplayOut* D, const PmrSampleChunk* ch, const ushort* value,
-                             const uchar* covered) {
+inline void sp_write_display(const DisplayOut* D, const PmrSampleChunk* ch, const ushort* value, const uchar* covered) {
   const ushort one = 0x3c00; /* 1.0 as a half */
   const int width = ch->s1 - ch->s0;
   for (int i = ch->i0; i < ch->i1; ++i) {
@@ -316,13 +315,12 @@ inline void sp_write_display(const DisplayOut* D, const PmrSampleChunk* ch, cons
 }
 
 kernel void fine_subpixel(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
-                            global const uint* tile_queue, global const PmrEncodeParams* E,
-                            global const int* column_a, global const int* column_b,
-                            global const PmrEncodeRow* rows, global const int* sample_x,
-                            global const int* sample_y, global const PmrSampleChunk* chunks, uint num_chunks,
-                            global const int* straddle_slot, uint straddle_slots, global uchar* straddle_cov,
-                            global half* display, global ushort* sub_alpha, uint debug, global uint* dbg_key,
-                            global float* dbg_depth) {
+                          global const uint* tile_queue, global const PmrEncodeParams* E, global const int* column_a,
+                          global const int* column_b, global const PmrEncodeRow* rows, global const int* sample_x,
+                          global const int* sample_y, global const PmrSampleChunk* chunks, uint num_chunks,
+                          global const int* straddle_slot, uint straddle_slots, global uchar* straddle_cov,
+                          global half* display, global ushort* sub_alpha, uint debug, global uint* dbg_key,
+                          global float* dbg_depth) {
   const uint chunk = pmr_item_id();
   if (chunk >= num_chunks) return;
   const PmrSampleChunk ch = chunks[chunk];

@@ -15,10 +15,8 @@ inline int first_view_from(global const PmrParams* P, long f) {
   int lo = 0, hi = P->views; /* the answer lies in [lo, hi] */
   while (lo < hi) {
     const int mid = (lo + hi) / 2;
-    if (view_coord(P, mid) >= f)
-      hi = mid;
-    else
-      lo = mid + 1;
+    if (view_coord(P, mid) >= f) hi = mid;
+    else lo = mid + 1;
   }
   return lo;
 }
@@ -34,14 +32,14 @@ inline void positive_views(global const PmrParams* P, long a0, long a1, int* lo,
   } else if (a1 > 0) {
     *lo = first_view_from(P, floor_div_l(-a0, a1) + 1);
   } else {
-    const long b = -a1; /* a0 - f b > 0  <=>  f < a0 / b */
+    const long b = -a1;                         /* a0 - f b > 0  <=>  f < a0 / b */
     const long last = -floor_div_l(-a0, b) - 1; /* ceil(a0 / b) - 1 */
     *hi = first_view_from(P, last + 1) - 1;
   }
 }
 
-inline void emit_mta(global const PmrParams* P, global PmrMta* mtas, volatile global uint* counter,
-                     PmrMta* m, int lo, int hi, int sign, uint flags) {
+inline void emit_mta(global const PmrParams* P, global PmrMta* mtas, volatile global uint* counter, PmrMta* m, int lo,
+                     int hi, int sign, uint flags) {
   if (lo > hi) return;
   m->sign = sign;
   m->flags = flags;
@@ -62,9 +60,9 @@ inline void emit_mta(global const PmrParams* P, global PmrMta* mtas, volatile gl
 
 /* One (possibly clipped) triangle: its orientation ranges become MTAs. */
 inline void emit_triangle(global const PmrParams* P, global PmrMta* mtas, volatile global uint* counter,
-                          const PmrVertex* a, const PmrVertex* b, const PmrVertex* c,
-                          const double* bary_a, const double* bary_b, const double* bary_c,
-                          uint tri, uint sub, uint double_sided, uint mask) {
+                          const PmrVertex* a, const PmrVertex* b, const PmrVertex* c, const double* bary_a,
+                          const double* bary_b, const double* bary_c, uint tri, uint sub, uint double_sided,
+                          uint mask) {
   PmrMta m;
   const PmrVertex* v[3] = {a, b, c};
   const double* bary[3] = {bary_a, bary_b, bary_c};
@@ -100,14 +98,22 @@ inline double plane_value(global const PmrParams* P, int k, const double* p) {
   const double kk = P->disparity_k / (double)P->view_w;
   const double xc = P->ndc_scale_x * p[0] + P->ndc_offset_x * w;
   switch (k) {
-    case 0: return w - P->near_eff;
-    case 1: return P->far - w;
-    case 2: return P->guard_ndc_x * w - (xc - kk * (w - P->focal));
-    case 3: return P->guard_ndc_x * w + (xc - kk * (w - P->focal));
-    case 4: return P->guard_ndc_x * w - (xc + kk * (w - P->focal));
-    case 5: return P->guard_ndc_x * w + (xc + kk * (w - P->focal));
-    case 6: return P->guard_ndc_y * w - P->ndc_scale_y * p[1];
-    default: return P->guard_ndc_y * w + P->ndc_scale_y * p[1];
+    case 0:
+      return w - P->near_eff;
+    case 1:
+      return P->far - w;
+    case 2:
+      return P->guard_ndc_x * w - (xc - kk * (w - P->focal));
+    case 3:
+      return P->guard_ndc_x * w + (xc - kk * (w - P->focal));
+    case 4:
+      return P->guard_ndc_x * w - (xc + kk * (w - P->focal));
+    case 5:
+      return P->guard_ndc_x * w + (xc + kk * (w - P->focal));
+    case 6:
+      return P->guard_ndc_y * w - P->ndc_scale_y * p[1];
+    default:
+      return P->guard_ndc_y * w + P->ndc_scale_y * p[1];
   }
 }
 
@@ -120,14 +126,13 @@ inline bool point_before(const double* p, const double* q) {
 }
 
 typedef struct {
-  double p[3];   /* view space */
-  double b[2];   /* barycentrics (b1, b2) in the source triangle */
-  int src;       /* 0..2: an original vertex, -1: created by clipping */
+  double p[3]; /* view space */
+  double b[2]; /* barycentrics (b1, b2) in the source triangle */
+  int src;     /* 0..2: an original vertex, -1: created by clipping */
 } ClipVertex;
 
-kernel void setup_triangles(global const PmrParams* P, global const PmrTriangle* tris,
-                            global const PmrVertex* verts, global const PmrMaterial* materials,
-                            global PmrMta* mtas, volatile global uint* counter) {
+kernel void setup_triangles(global const PmrParams* P, global const PmrTriangle* tris, global const PmrVertex* verts,
+                            global const PmrMaterial* materials, global PmrMta* mtas, volatile global uint* counter) {
   const uint t = pmr_item_id();
   if (t >= P->num_triangles) return;
   const PmrTriangle tri = tris[t];
@@ -181,12 +186,10 @@ kernel void setup_triangles(global const PmrParams* P, global const PmrTriangle*
   PmrVertex pv[PMR_MAX_CLIP_VERTS];
   for (int k = 0; k < n; ++k) {
     const ClipVertex* c = &poly[cur][k];
-    if (c->src >= 0)
-      pv[k] = v[c->src];
-    else
-      project_vertex(P, c->p[0], c->p[1], c->p[2], &pv[k]);
+    if (c->src >= 0) pv[k] = v[c->src];
+    else project_vertex(P, c->p[0], c->p[1], c->p[2], &pv[k]);
   }
   for (int k = 1; k + 1 < n; ++k)
-    emit_triangle(P, mtas, counter, &pv[0], &pv[k], &pv[k + 1], poly[cur][0].b, poly[cur][k].b,
-                  poly[cur][k + 1].b, t, (uint)(k - 1), ds, mask);
+    emit_triangle(P, mtas, counter, &pv[0], &pv[k], &pv[k + 1], poly[cur][0].b, poly[cur][k].b, poly[cur][k + 1].b, t,
+                  (uint)(k - 1), ds, mask);
 }

@@ -59,14 +59,17 @@ inline float4 sample_texture(global const uchar4* texels, global const float* sr
 /* The shading inputs: the leading parameters of every kernel that shades, bound in this order by the
  * host (SceneBuffers::bind_shading, host/pipeline/scene_buffers.cpp), and gathered into one ShadeInputs
  * by PMR_SHADE_INPUTS. A new input is one entry in each of the three lists and in the struct. */
-#define PMR_SHADE_PARAMS                                                                                    \
-  global const PmrParams *P, global const PmrTriangle *tris, global const PmrVertexAttr *attrs,             \
-      global const PmrMaterial *materials, global const PmrTexture *textures, global const uchar4 *texels,  \
+#define PMR_SHADE_PARAMS                                                                                   \
+  global const PmrParams *P, global const PmrTriangle *tris, global const PmrVertexAttr *attrs,            \
+      global const PmrMaterial *materials, global const PmrTexture *textures, global const uchar4 *texels, \
       global const float *srgb_lut, global const float *positions, global const float4 *eyes,              \
-      global const float2 *split_sum, global const float2 *texcoords, global const float4 *tangents,        \
+      global const float2 *split_sum, global const float2 *texcoords, global const float4 *tangents,       \
       global const PmrEnvironment *env, global const float4 *env_data, global const PmrLight *lights
-#define PMR_SHADE_INPUTS \
-  {tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, env_data, lights}
+#define PMR_SHADE_INPUTS                                                                                         \
+  {                                                                                                              \
+    tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, \
+        env_data, lights                                                                                         \
+  }
 
 typedef struct {
   global const PmrTriangle* tris;
@@ -76,22 +79,23 @@ typedef struct {
   global const uchar4* texels;
   global const float* srgb_lut;
   global const PmrParams* P;
-  global const float* positions;   /* world space, 3 floats per vertex: the surface point (pbr)  */
-  global const float4* eyes;       /* each view's camera position, world space (pbr)            */
-  global const float2* split_sum;  /* PMR_SPLIT_SUM_N^2 (A, B) (see PMR_SPLIT_SUM_N)             */
-  global const float2* texcoords;  /* TEXCOORD set k of vertex v at k * num_vertices + v (pbr maps) */
-  global const float4* tangents;   /* world tangent per vertex (w: bitangent sign), pbr normal maps */
+  global const float* positions;    /* world space, 3 floats per vertex: the surface point (pbr)  */
+  global const float4* eyes;        /* each view's camera position, world space (pbr)            */
+  global const float2* split_sum;   /* PMR_SPLIT_SUM_N^2 (A, B) (see PMR_SPLIT_SUM_N)             */
+  global const float2* texcoords;   /* TEXCOORD set k of vertex v at k * num_vertices + v (pbr maps) */
+  global const float4* tangents;    /* world tangent per vertex (w: bitangent sign), pbr normal maps */
   global const PmrEnvironment* env; /* pbr: the environment image's tables, level_count 0 = none */
   global const float4* env_data;    /* ... their data (cl/environment.h)                        */
-  global const PmrLight* lights;   /* P->num_lights punctual lights, world space (pbr)           */
+  global const PmrLight* lights;    /* P->num_lights punctual lights, world space (pbr)           */
 } ShadeInputs;
 
 /* Material map `map` of triangle t at source barycentrics b (one lane): its TEXCOORD set interpolated,
  * then its KHR_texture_transform. */
-inline float4 sample_map(const ShadeInputs* in, global const PmrTextureMap* map, const PmrTriangle* t, float3 b, bool srgb) {
+inline float4 sample_map(const ShadeInputs* in, global const PmrTextureMap* map, const PmrTriangle* t, float3 b,
+                         bool srgb) {
   const uint set = map->texcoord * in->P->num_vertices;
-  const float2 uv = b.x * in->texcoords[set + t->v[0]] + b.y * in->texcoords[set + t->v[1]] +
-                    b.z * in->texcoords[set + t->v[2]];
+  const float2 uv =
+      b.x * in->texcoords[set + t->v[0]] + b.y * in->texcoords[set + t->v[1]] + b.z * in->texcoords[set + t->v[2]];
   const float u = map->uv_transform[0] * uv.x + map->uv_transform[1] * uv.y + map->uv_transform[2];
   const float v = map->uv_transform[3] * uv.x + map->uv_transform[4] * uv.y + map->uv_transform[5];
   const PmrTexture tex = in->textures[map->texture];
@@ -103,21 +107,21 @@ inline float4 sample_map(const ShadeInputs* in, global const PmrTextureMap* map,
  * it one MTA at a time (lanes_add): each value is loaded once per MTA and blended into the lanes the
  * MTA won, in registers (a lane-by-lane gather through memory costs what the vector arithmetic saves). */
 typedef struct {
-  sint act;                /* -1: a winner to shade                                           */
-  sint back;               /* -1: seen from behind                                            */
-  sint smooth;             /* -1: vertex normals (else the face normal)                       */
-  sint unlit;              /* pbr: KHR_materials_unlit                                        */
-  sfloat3 e;               /* sign-corrected edge functions opposite MTA vertices 0, 1, 2     */
-  sfloat inv_w[3];         /* the MTA vertices' 1 / w                                         */
-  sfloat bary[3][2];       /* ... and barycentrics in the source triangle                     */
-  sfloat3 face, n[3];      /* face normal, vertex normals                                     */
-  sfloat3 c[3];            /* vertex colours (COLOR_0, RGB: alpha only decides alphaMode MASK) */
-  sfloat3 factor;          /* baseColorFactor (RGB)                                           */
-  sfloat3 p[3];            /* pbr: vertex positions, world space                              */
+  sint act;           /* -1: a winner to shade                                           */
+  sint back;          /* -1: seen from behind                                            */
+  sint smooth;        /* -1: vertex normals (else the face normal)                       */
+  sint unlit;         /* pbr: KHR_materials_unlit                                        */
+  sfloat3 e;          /* sign-corrected edge functions opposite MTA vertices 0, 1, 2     */
+  sfloat inv_w[3];    /* the MTA vertices' 1 / w                                         */
+  sfloat bary[3][2];  /* ... and barycentrics in the source triangle                     */
+  sfloat3 face, n[3]; /* face normal, vertex normals                                     */
+  sfloat3 c[3];       /* vertex colours (COLOR_0, RGB: alpha only decides alphaMode MASK) */
+  sfloat3 factor;     /* baseColorFactor (RGB)                                           */
+  sfloat3 p[3];       /* pbr: vertex positions, world space                              */
   sfloat metallic, roughness;
   sfloat3 emissive;
-  uint textured;           /* bit l: lane l's material has a texture                          */
-  uint tri[SW];            /* lane l's triangle, where textured                               */
+  uint textured; /* bit l: lane l's material has a texture                          */
+  uint tri[SW];  /* lane l's triangle, where textured                               */
 } LaneWinners;
 
 /* No lanes yet; idle lanes keep finite values so that the vector arithmetic stays cheap. */
@@ -268,7 +272,8 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
       T->metallic[l] = m.z, T->roughness[l] = m.y;
     }
     if (mat->maps[PMR_MAP_OCCLUSION].texture >= 0)
-      T->ao[l] = 1.0f + mat->occlusion_strength * (sample_map(in, &mat->maps[PMR_MAP_OCCLUSION], &t, bl, false).x - 1.0f);
+      T->ao[l] =
+          1.0f + mat->occlusion_strength * (sample_map(in, &mat->maps[PMR_MAP_OCCLUSION], &t, bl, false).x - 1.0f);
     if (mat->maps[PMR_MAP_EMISSIVE].texture >= 0) {
       const float4 e = sample_map(in, &mat->maps[PMR_MAP_EMISSIVE], &t, bl, true);
       T->emissive[0][l] = e.x, T->emissive[1][l] = e.y, T->emissive[2][l] = e.z;
@@ -345,16 +350,19 @@ inline void split_sum_lanes(global const float2* t, sfloat nv, sfloat r, sfloat*
   vstore_s(y0 * n + x0, 0, at);
   float tap[8][SW];
   for (int l = 0; l < SW; ++l) {
-    const float4 top = vload4(0, (global const float*)(t + at[l])), bottom = vload4(0, (global const float*)(t + at[l] + n));
+    const float4 top = vload4(0, (global const float*)(t + at[l])),
+                 bottom = vload4(0, (global const float*)(t + at[l] + n));
     tap[0][l] = top.x, tap[1][l] = top.y, tap[2][l] = top.z, tap[3][l] = top.w;
     tap[4][l] = bottom.x, tap[5][l] = bottom.y, tap[6][l] = bottom.z, tap[7][l] = bottom.w;
   }
   /* taps a = (x0, y0), b = (x0 + 1, y0), c = (x0, y0 + 1), d = (x0 + 1, y0 + 1), each (A, B) */
   for (int k = 0; k < 2; ++k) {
-    const sfloat a = vload_s(0, tap[k]), b = vload_s(0, tap[2 + k]), c = vload_s(0, tap[4 + k]), d = vload_s(0, tap[6 + k]);
+    const sfloat a = vload_s(0, tap[k]), b = vload_s(0, tap[2 + k]), c = vload_s(0, tap[4 + k]),
+                 d = vload_s(0, tap[6 + k]);
     const sfloat top = a + (b - a) * fx, bottom = c + (d - c) * fx;
     const sfloat v = top + (bottom - top) * fy;
-    if (k == 0) *A = v; else *B = v;
+    if (k == 0) *A = v;
+    else *B = v;
   }
 }
 
@@ -380,8 +388,9 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
   for (uint i = 0; i < num_lights; ++i) {
     global const PmrLight* light = &in->lights[i];
     sfloat3 l;
-    const sfloat3 E = light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
-                                       vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, p, &l);
+    const sfloat3 E =
+        light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
+                         vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, p, &l);
     direct = s3_add(direct, s3_mul(brdf_cos(base, metallic, r, n, v, l), E));
   }
   const sfloat nv = s3_dot(n, v);

@@ -2,8 +2,7 @@
  * and projected to its view-0 raster x, per-view disparity, raster y, depth and 1/w. */
 #include "common.h"
 
-kernel void vertex_transform(global const PmrParams* P, global const float* positions,
-                             global PmrVertex* out) {
+kernel void vertex_transform(global const PmrParams* P, global const float* positions, global PmrVertex* out) {
   const uint v = pmr_item_id();
   if (v >= P->num_vertices) return;
   const double px = positions[3 * v], py = positions[3 * v + 1], pz = positions[3 * v + 2];

@@ -94,7 +94,9 @@ inline std::vector<uint8_t> make_png(int w, int h, int color_type, int depth, co
 
 inline std::string png_uri(const std::vector<uint8_t>& png) { return "data:image/png;base64," + base64(png); }
 
-inline int components(const std::string& type) { return type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : 4; }
+inline int components(const std::string& type) {
+  return type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : 4;
+}
 
 // Builds a glTF document and its single binary buffer.
 struct GltfFile {
@@ -144,7 +146,8 @@ struct GltfFile {
   // Writes name.gltf (+ name.bin unless embedded as a data URI); returns the .gltf path.
   std::string write(const fs::path& dir, const std::string& name, bool embed = false) const {
     const std::string uri = embed ? "data:application/octet-stream;base64," + base64(bin) : name + ".bin";
-    if (!embed && !bin.empty()) std::ofstream(dir / (name + ".bin"), std::ios::binary).write((const char*)bin.data(), long(bin.size()));
+    if (!embed && !bin.empty())
+      std::ofstream(dir / (name + ".bin"), std::ios::binary).write((const char*)bin.data(), long(bin.size()));
     std::ofstream(dir / (name + ".gltf")) << finished(uri).dump(1);
     return (dir / (name + ".gltf")).string();
   }

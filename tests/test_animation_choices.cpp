@@ -31,22 +31,25 @@ const std::string kSmall = " --views 4 --view-size 64x32 --display 240x135 ";
 // pose, at the origin, is no pose of the clip).
 std::string slide_gltf(const std::string& dir, const std::string& name, bool animated, float t0, float t1) {
   fs::create_directories(dir);
-  const float data[] = {0, 0, 0, 1, 0, 0, 0, 1, 0,  // positions
-                        t0, t1,                     // key times
-                        1, 0, 0, 2, 0, 0};          // translations
+  const float data[] = {0,  0,  0, 1, 0, 0, 0, 1, 0,  // positions
+                        t0, t1,                       // key times
+                        1,  0,  0, 2, 0, 0};          // translations
   std::ofstream(dir + "/" + name + ".bin", std::ios::binary).write(reinterpret_cast<const char*>(data), sizeof data);
   char times[96];
   std::snprintf(times, sizeof times, "\"min\": [%.9g], \"max\": [%.9g]", double(t0), double(t1));
   const std::string animation = animated ? R"(, "animations": [{"name": "Slide", "channels": [{"sampler": 0,
-      "target": {"node": 0, "path": "translation"}}], "samplers": [{"input": 1, "output": 2}]}])" : "";
+      "target": {"node": 0, "path": "translation"}}], "samplers": [{"input": 1, "output": 2}]}])"
+                                         : "";
   std::ofstream(dir + "/" + name + ".gltf") << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
     "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
     "buffers": [{"uri": ")" + name + R"(.bin", "byteLength": 68}],
     "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 8},
                     {"buffer": 0, "byteOffset": 44, "byteLength": 24}],
     "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
-                  {"bufferView": 1, "componentType": 5126, "count": 2, "type": "SCALAR", )" + times + R"(},
-                  {"bufferView": 2, "componentType": 5126, "count": 2, "type": "VEC3"}])" + animation + "}";
+                  {"bufferView": 1, "componentType": 5126, "count": 2, "type": "SCALAR", )" +
+                                                   times + R"(},
+                  {"bufferView": 2, "componentType": 5126, "count": 2, "type": "VEC3"}])" +
+                                                   animation + "}";
   return " '" + dir + "/" + name + ".gltf' ";
 }
 
@@ -195,12 +198,12 @@ TEST(AnimationChoices, FramesAllFromTheCommandLine) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("pmr: warning: frame 3 lies outside the animation 'Slide' (frames 4:8 at 8 fps): it "
                           "repeats its first pose"),
-            std::string::npos) << r.output;
+            std::string::npos)
+      << r.output;
 
   // keys at 0.51 and 0.52 s lie between frames 12 (0.5 s) and 13 (0.54 s) at 24 fps: no frame inside
   const std::string narrow = slide_gltf(dir + "/in", "narrow", true, 0.51f, 0.52f);
-  expect_one_error_line(run("render" + narrow + "--frames all" + kSmall + "--out " + dir + "/narrow"),
-                        "no frame time");
+  expect_one_error_line(run("render" + narrow + "--frames all" + kSmall + "--out " + dir + "/narrow"), "no frame time");
 }
 
 // CesiumMan's first key is at 1/24 s: --frames all starts at frame 1 (frame 0 would repeat it).

@@ -24,16 +24,19 @@ std::vector<std::string> split_csv(const std::string& line) {
 
 TEST(Bench, WritesCsvWithOneRowPerPoint) {
   const std::string csv = ::testing::TempDir() + "pmr_bench_test_" + std::to_string(getpid()) + ".csv";
-  const std::string cmd = std::string(PMR_BINARY) +
-                          " bench --synthetic 2000 --views 1,3,8 --method pmr,multipass,duplicate --sampling view,subpixel --frames 1"
-                          " --view-size 64x32 --display 320x180 --csv " + csv + " > /dev/null 2>&1";
+  const std::string cmd =
+      std::string(PMR_BINARY) +
+      " bench --synthetic 2000 --views 1,3,8 --method pmr,multipass,duplicate --sampling view,subpixel --frames 1"
+      " --view-size 64x32 --display 320x180 --csv " +
+      csv + " > /dev/null 2>&1";
   const int st = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << cmd;
   std::ifstream in(csv);
   std::string header;
   std::getline(in, header);
   EXPECT_EQ(header.rfind("scene,method,views,view_w,view_h,display_w,display_h,triangles,frames,ms_median,ms_min,"
-                         "ms_setup,ms_tile,ms_fine,ms_encode,mvoxels_per_s,peak_mem_mb", 0),
+                         "ms_setup,ms_tile,ms_fine,ms_encode,mvoxels_per_s,peak_mem_mb",
+                         0),
             0u)
       << header;
   const auto cols = split_csv(header);

@@ -45,7 +45,10 @@ TEST(Brdf, KernelMatchesTheReference) {
   std::mt19937 g(7);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   std::vector<float> in;
-  struct Case { glm::dvec3 base, n, v, l; double metallic, r; };
+  struct Case {
+    glm::dvec3 base, n, v, l;
+    double metallic, r;
+  };
   std::vector<Case> cases;
   for (int i = 0; i < 4000; ++i) {
     Case c;
@@ -61,8 +64,8 @@ TEST(Brdf, KernelMatchesTheReference) {
     if (i % 50 == 0) l = glm::reflect(-v, c.n);  // the specular peak
     c.v = as_float(v), c.l = as_float(l);
     cases.push_back(c);
-    for (double x : {c.base.x, c.base.y, c.base.z, c.metallic, c.r, c.n.x, c.n.y, c.n.z, c.v.x, c.v.y, c.v.z, c.l.x,
-                     c.l.y, c.l.z})
+    for (double x :
+         {c.base.x, c.base.y, c.base.z, c.metallic, c.r, c.n.x, c.n.y, c.n.z, c.v.x, c.v.y, c.v.z, c.l.x, c.l.y, c.l.z})
       in.push_back(float(x));
   }
   const std::vector<float> out = run_probe("brdf_probe", in, 14, 3);

@@ -124,8 +124,9 @@ TEST_F(Budgets, BuffersNoAccessorUsesAreNotRead) {
   }
   doc["bufferViews"][1]["byteOffset"] = five_gib - 100;
   std::ofstream(dir_ / "overrun.gltf") << doc.dump();
-  expect_one_error_line(run("info " + (dir_ / "overrun.gltf").string()),
-                        "bufferView 1 (byteOffset 5368709020, byteLength 4096) overruns buffer 1, which has 5368709120 bytes");
+  expect_one_error_line(
+      run("info " + (dir_ / "overrun.gltf").string()),
+      "bufferView 1 (byteOffset 5368709020, byteLength 4096) overruns buffer 1, which has 5368709120 bytes");
 }
 
 // ---- vertex data ----------------------------------------------------------------------------------------
@@ -143,15 +144,15 @@ TEST_F(Budgets, MorphTargetsOnOneImplicitAccessorAreCountedEach) {
   EXPECT_LT(fs::file_size(scene), 40000u);
   const auto t0 = std::chrono::steady_clock::now();
   const CliRun r = run_capped(kGiB, "info " + scene);
-  expect_one_error_line(r, "the scene's meshes decode to 201595027452 bytes of vertex data (every instance and morph "
-                           "target counted), more than the vertex-data limit of 68719476736 (raise it with --limit "
-                           "vertex-data=N)");
+  expect_one_error_line(r,
+                        "the scene's meshes decode to 201595027452 bytes of vertex data (every instance and morph "
+                        "target counted), more than the vertex-data limit of 68719476736 (raise it with --limit "
+                        "vertex-data=N)");
   EXPECT_LT(seconds_since(t0), 10.0);
   // The budget is the key: 2 morph targets of 2^24 vertices pass the default and not 400 MB.
   g.doc["meshes"][0]["primitives"][0]["targets"] = json::array({{{"POSITION", 0}}, {{"POSITION", 0}}});
   const std::string small = write(g, "two.gltf");
-  expect_one_error_line(run("info " + small + " --limit vertex-data=400M"),
-                        "decode to 671088636 bytes of vertex data");
+  expect_one_error_line(run("info " + small + " --limit vertex-data=400M"), "decode to 671088636 bytes of vertex data");
 }
 
 // An implicit 2^24-vertex mesh instanced by 23 nodes: 600 bytes, 128 M triangles (under the
@@ -171,7 +172,8 @@ TEST_F(Budgets, ImplicitVerticesInstancedByManyNodesAreRefusedByTheMemoryBudget)
   EXPECT_LT(seconds_since(t0), 10.0);
   // the budget given by --limit memory, the same refusal on any machine
   r = run("info " + scene + " --limit memory=1G");
-  expect_one_error_line(r, "but the memory budget of 1024 MiB (set by --limit memory) (raise it with --limit memory=N)");
+  expect_one_error_line(r,
+                        "but the memory budget of 1024 MiB (set by --limit memory) (raise it with --limit memory=N)");
 }
 
 // ---- animation keys -------------------------------------------------------------------------------------
@@ -188,13 +190,15 @@ TEST_F(Budgets, SamplersSharingOneAccessorAreCountedEach) {
   g.doc["accessors"][size_t(input)]["max"] = {times.back()};
   const int output = g.accessor(-1, kFloat, "VEC3", keys);
   for (int a = 0; a < 200; ++a)
-    g.add("animations", {{"samplers", json::array({{{"input", input}, {"output", output}}})},
-                         {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}});
+    g.add("animations",
+          {{"samplers", json::array({{{"input", input}, {"output", output}}})},
+           {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}});
   const std::string scene = g.write(dir_, "samplers");
   const auto t0 = std::chrono::steady_clock::now();
   const CliRun r = run_capped(kGiB, "info " + scene);
-  expect_one_error_line(r, "the animations' samplers decode to 838860800 bytes of keys (every sampler counted), more "
-                           "than the animation-data limit of 268435456 (raise it with --limit animation-data=N)");
+  expect_one_error_line(r,
+                        "the animations' samplers decode to 838860800 bytes of keys (every sampler counted), more "
+                        "than the animation-data limit of 268435456 (raise it with --limit animation-data=N)");
   EXPECT_LT(seconds_since(t0), 10.0);
   EXPECT_EQ(run("info " + scene + " --limit animation-data=800M").status, 0);
 }
@@ -239,16 +243,19 @@ TEST_F(Budgets, FramingWorkIsBounded) {
   const int output = g.data<float>({0, 0, 0, 1, 0, 0}, kFloat, "VEC3");
   g.add("nodes", {{"mesh", 0}});
   g.scene({0});
-  g.add("animations", {{"samplers", json::array({{{"input", input}, {"output", output}}})},
-                       {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}});
+  g.add("animations",
+        {{"samplers", json::array({{{"input", input}, {"output", output}}})},
+         {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}});
   const std::string scene = g.write(dir_, "hang");
   const fs::path out = dir_ / "out";
-  const std::string render = "render --views 2 --view-size 32x16 --display 64x36 --frames 0 -q --out " + out.string() + " ";
+  const std::string render =
+      "render --views 2 --view-size 32x16 --display 64x36 --frames 0 -q --out " + out.string() + " ";
   const auto t0 = std::chrono::steady_clock::now();
-  expect_one_error_line(run(render + scene),
-                        "framing the animation poses the scene's 1048576 vertices 999987 times (every frame of its keys "
-                        "at 24.000000 fps), more than the framing-work limit of 17179869184 vertex-poses (raise it "
-                        "with --limit framing-work=N)");
+  expect_one_error_line(
+      run(render + scene),
+      "framing the animation poses the scene's 1048576 vertices 999987 times (every frame of its keys "
+      "at 24.000000 fps), more than the framing-work limit of 17179869184 vertex-poses (raise it "
+      "with --limit framing-work=N)");
   EXPECT_LT(seconds_since(t0), 20.0);
   expect_no_frames(out);
   // At the edge: a triangle moving for 1 s at 24 fps is posed 27 times (frames 0..24, and the first
@@ -258,8 +265,9 @@ TEST_F(Budgets, FramingWorkIsBounded) {
   t.doc["accessors"][size_t(in1)]["min"] = {0.0};
   t.doc["accessors"][size_t(in1)]["max"] = {1.0};
   const int out1 = t.data<float>({0, 0, 0, 1, 0, 0}, kFloat, "VEC3");
-  t.add("animations", {{"samplers", json::array({{{"input", in1}, {"output", out1}}})},
-                       {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}});
+  t.add("animations",
+        {{"samplers", json::array({{{"input", in1}, {"output", out1}}})},
+         {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}});
   const std::string moving = t.write(dir_, "moving");
   expect_one_error_line(run(render + moving + " --limit framing-work=80"),
                         "poses the scene's 3 vertices 27 times (every frame of its keys at 24.000000 fps), more than "
@@ -288,8 +296,10 @@ TEST_F(Budgets, ManyLargeTrianglesRenderUnlessTheTileQueueBudgetSaysNo) {
   g.scene({0});
   const std::string scene = g.write(dir_, "overlap");
   const fs::path out = dir_ / "out";
-  const std::string render = "render --views 8 --view-size 64x32 --display 64x36 --frames 0 -q --out " + out.string() + " ";
-  const CliRun r = run("render --views 8 --view-size 64x32 --display 64x36 --frames 0 -v --out " + out.string() + " " + scene);
+  const std::string render =
+      "render --views 8 --view-size 64x32 --display 64x36 --frames 0 -q --out " + out.string() + " ";
+  const CliRun r =
+      run("render --views 8 --view-size 64x32 --display 64x36 --frames 0 -v --out " + out.string() + " " + scene);
   ASSERT_EQ(r.status, 0) << r.output;
   // the entries the frame took, as --verbose reports them
   const size_t at = r.output.find(" tile-queue entries");
@@ -299,9 +309,10 @@ TEST_F(Budgets, ManyLargeTrianglesRenderUnlessTheTileQueueBudgetSaysNo) {
   EXPECT_GT(entries, 10000u * 4u) << "each triangle covers many tiles";
   fs::remove_all(out);
   expect_one_error_line(run(render + scene + " --limit tile-queue=" + std::to_string(entries - 1)),
-                        "the frame's tile raster produces " + std::to_string(entries) + " tile-queue entries, more "
-                        "than the tile-queue limit of " + std::to_string(entries - 1) +
-                        " (raise it with --limit tile-queue=N)");
+                        "the frame's tile raster produces " + std::to_string(entries) +
+                            " tile-queue entries, more "
+                            "than the tile-queue limit of " +
+                            std::to_string(entries - 1) + " (raise it with --limit tile-queue=N)");
   expect_no_frames(out);
 }
 
@@ -339,8 +350,9 @@ TEST_F(Budgets, ViewVolumeBeyondTheMemoryBudgetIsRefusedBeforeAllocating) {
   const fs::path out = dir_ / "out";
   const std::string scene = std::string(PMR_SOURCE_DIR) + "/data/default_scene.glb";
   CliRun r = run_capped(3 * kGiB, "render " + scene + " --views 1400 --write views --out " + out.string());
-  expect_one_error_line(r, "out of memory: 1400 views of 1024x512 (5600 MiB a view volume, on the device and in up to "
-                           "four copies being written) needs ");
+  expect_one_error_line(r,
+                        "out of memory: 1400 views of 1024x512 (5600 MiB a view volume, on the device and in up to "
+                        "four copies being written) needs ");
   EXPECT_TRUE(contains(r.output, "(RLIMIT_AS, less a margin)")) << r.output;
   expect_no_frames(out);
   r = run("render " + scene + " --views 1400 --write views --limit memory=4G --out " + out.string());
@@ -355,8 +367,10 @@ TEST_F(Budgets, DeviceBuffersAreCheckedAgainstTheMemoryBudget) {
     runtime().buffer(uint64_t(2) << 20, "test buffer");
     ADD_FAILURE() << "allocated beyond the budget";
   } catch (const Error& e) {
-    EXPECT_TRUE(contains(e.what(), "out of memory: test buffer needs 2 MiB, but the memory budget of 1 MiB (set by "
-                                   "--limit memory)")) << e.what();
+    EXPECT_TRUE(contains(e.what(),
+                         "out of memory: test buffer needs 2 MiB, but the memory budget of 1 MiB (set by "
+                         "--limit memory)"))
+        << e.what();
   }
   set_memory_budget(uint64_t(64) << 20);
   const uint64_t before = device_bytes_in_use();

@@ -100,7 +100,8 @@ TEST(Cli, BadInputsFailBeforeWritingAnything) {
   const std::string bad = temp_dir("badscene_file");
   std::system(("mkdir -p '" + bad + "'").c_str());
   std::ofstream(bad + "/broken.gltf") << "{ \"asset\": {\"version\": \"2.0\"}, \"buffers\": [ {";
-  expect_one_error_line(run("render '" + bad + "/broken.gltf' --view-size 32x16 --display 64x36 --out " + out), "broken.gltf");
+  expect_one_error_line(run("render '" + bad + "/broken.gltf' --view-size 32x16 --display 64x36 --out " + out),
+                        "broken.gltf");
   EXPECT_EQ(count_entries(out), 0u);
   // an output folder that cannot be created: a path below a regular file
   std::ofstream(bad + "/file") << "x";
@@ -111,7 +112,8 @@ TEST(Cli, BadInputsFailBeforeWritingAnything) {
 
 TEST(Cli, SmallRenderWritesReadableFiles) {
   const std::string out = temp_dir("small");
-  const CliRun r = run("render --views 8 --view-size 64x32 --display 480x270 --write encoded,views --verbose --out " + out);
+  const CliRun r =
+      run("render --views 8 --view-size 64x32 --display 480x270 --write encoded,views --verbose --out " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("fine raster"), std::string::npos) << "--verbose prints stage times";
   int w = 0, h = 0;

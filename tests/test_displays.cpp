@@ -41,11 +41,20 @@ long double shader_phase(const LookingGlassCalibration& cal, int px, int py, int
   const int x = px, y = cal.screen_h - 1 - py;
   int cell = 0;
   switch (cal.cell_pattern) {
-    case 1: cell = ((y % 2 == 0 && x % 2 == 0) || (y % 2 != 0 && x % 2 != 0)) ? 0 : 1; break;
-    case 2: cell = x % 2; break;
-    case 3: cell = (y + (x % 2) * 2) % 4; break;
-    case 4: cell = y % 2; break;
-    default: cell = 0;
+    case 1:
+      cell = ((y % 2 == 0 && x % 2 == 0) || (y % 2 != 0 && x % 2 != 0)) ? 0 : 1;
+      break;
+    case 2:
+      cell = x % 2;
+      break;
+    case 3:
+      cell = (y + (x % 2) * 2) % 4;
+      break;
+    case 4:
+      cell = y % 2;
+      break;
+    default:
+      cell = 0;
   }
   const std::array<double, 6>& off = cal.cells[size_t(cell) % cal.cells.size()];
   const long double du = off[size_t(2 * c)] / W, dv = off[size_t(2 * c + 1)] / H;
@@ -89,7 +98,8 @@ LookingGlassCalibration gen3_panel(int pattern, bool flip_x) {
   c.center = 0.16935753461833172;
   c.cells = {{-0.3100000023841858, 0.25, 0.2800000011920929, 0.25, 0.0, -0.25},
              {-0.3100000023841858, -0.25, 0.2800000011920929, -0.25, 0.0, 0.25}};
-  if (pattern == 3) c.cells.push_back({0.1, 0.2, -0.2, 0.1, 0.3, -0.1}), c.cells.push_back({0.0, 0.0, 0.1, 0.1, -0.1, 0.2});
+  if (pattern == 3)
+    c.cells.push_back({0.1, 0.2, -0.2, 0.1, 0.3, -0.1}), c.cells.push_back({0.0, 0.0, 0.1, 0.1, -0.1, 0.2});
   c.cell_pattern = pattern;
   return c;
 }
@@ -128,7 +138,8 @@ TEST(Displays, CalibrationMatchesTheLookingGlassShaderSubpixelBySubpixel) {
             ++ties;
             continue;
           }
-          ASSERT_EQ(got[(size_t(py) * d.width + px) * 3 + size_t(c)], want) << "pixel " << px << "," << py << " channel " << c;
+          ASSERT_EQ(got[(size_t(py) * d.width + px) * 3 + size_t(c)], want)
+              << "pixel " << px << "," << py << " channel " << c;
           ++checked;
         }
     EXPECT_EQ(ties, 0u);
@@ -182,7 +193,8 @@ TEST(Displays, EveryPresetShowsEveryView) {
     // and a rig can be built for it (guard band, cone)
     EXPECT_NO_THROW(make_rig(p.rig, p.display, glm::dvec3(-1), glm::dvec3(1)));
     // the default sampling docs/SAMPLING.md chose from measurements ("Which default")
-    const bool chosen_subpixel = p.name == "lg-portrait" || p.name == "lg-go" || p.name == "lg-16" || p.name == "lg-16-portrait";
+    const bool chosen_subpixel =
+        p.name == "lg-portrait" || p.name == "lg-go" || p.name == "lg-16" || p.name == "lg-16-portrait";
     EXPECT_EQ(p.subpixel_sampling, chosen_subpixel);
   }
   EXPECT_THROW(find_display_preset("lg-99"), Error);
@@ -239,7 +251,8 @@ TEST(Displays, CliRendersForALookingGlassPanel) {
   write_file(dir + "/visual.json", R"({"serial": "LKG-P0", "pitch": {"value": 52.1}, "slope": {"value": -7.1},
     "center": {"value": 0.56}, "DPI": {"value": 324}, "screenW": {"value": 1536}, "screenH": {"value": 2048},
     "viewCone": {"value": 40}, "invView": {"value": 0}})");
-  const test::CliRun r = test::run("render --display-config " + dir + "/visual.json --view-size 42x56 --write encoded,quilt --out " + dir + "/o");
+  const test::CliRun r = test::run("render --display-config " + dir +
+                                   "/visual.json --view-size 42x56 --write encoded,quilt --out " + dir + "/o");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("invView = 0 ignored"), std::string::npos) << r.output;
   // the calibration's offset reaches the encoder (not the generic -L / 2N)
@@ -280,7 +293,8 @@ TEST(Displays, Gen3CalibrationRendersFusedAndSeparateAlike) {
     write_file(cal, R"({"configVersion": "3.0", "serial": "LKG-J00332", "pitch": {"value": 44.75058319896644},
       "slope": {"value": -6.874565686767793}, "center": {"value": 0.16935753461833172}, "viewCone": {"value": 50.0},
       "DPI": {"value": 283.0}, "screenW": {"value": 384.0}, "screenH": {"value": 216.0}, "flipImageX": {"value": 0.0},
-      "CellPatternMode": {"value": )" + std::to_string(pattern) + R"(.0}, "subpixelCells": [
+      "CellPatternMode": {"value": )" +
+                        std::to_string(pattern) + R"(.0}, "subpixelCells": [
         {"ROffsetX": -0.31, "ROffsetY": 0.25, "GOffsetX": 0.28, "GOffsetY": 0.25, "BOffsetX": 0.0, "BOffsetY": -0.25},
         {"ROffsetX": -0.31, "ROffsetY": -0.25, "GOffsetX": 0.28, "GOffsetY": -0.25, "BOffsetX": 0.0, "BOffsetY": 0.25}]})");
     const std::string a = dir + "/fused" + std::to_string(pattern), b = dir + "/separate" + std::to_string(pattern);
@@ -329,37 +343,37 @@ TEST(Displays, AngularSpacingViewsMatchTheirMatrices) {
     EXPECT_DOUBLE_EQ(rig.camera_offset(rig.views - 1 - i), -rig.camera_offset(i));  // symmetric
   }
   for (Method method : {Method::Pmr, Method::Multipass}) {
-  SCOPED_TRACE(to_string(method));
-  PipelineConfig pc;
-  pc.method = method;
-  Pipeline p(test::runtime(), pc);
-  p.set_scene(s);
-  p.configure(rig, nullptr);
-  p.render(rig);
-  std::vector<uint16_t> vol;
-  p.read_volume(vol);
-  const size_t plane = size_t(rig.view_w) * rig.view_h;
-  double first_px[2] = {0, 0}, shift = 0;
-  for (int i = 0; i < rig.views; ++i)
-    for (const float x : {-0.5f, 0.5f}) {
-      const float z = x < 0 ? 0.6f : -0.6f;
-      const glm::dvec4 c = rig.projection(i) * rig.view_matrix(i) * glm::dvec4(x, 0, z, 1);
-      const double px = (c.x / c.w + 1) / 2 * rig.view_w, py = (1 - c.y / c.w) / 2 * rig.view_h;
-      // centroid of the covered pixels near the expected position
-      double sx = 0, sy = 0, n = 0;
-      for (int y = 0; y < rig.view_h; ++y)
-        for (int xx = 0; xx < rig.view_w; ++xx) {
-          if (std::abs(xx + 0.5 - px) > 16 || std::abs(y + 0.5 - py) > 16) continue;
-          if (vol[(size_t(i) * plane + size_t(y) * rig.view_w + size_t(xx)) * 4 + 3] == 0) continue;
-          sx += xx + 0.5, sy += y + 0.5, n += 1;
-        }
-      ASSERT_GT(n, 4) << "view " << i << " square " << x;
-      EXPECT_NEAR(sx / n, px, 0.5) << "view " << i << " square " << x;
-      EXPECT_NEAR(sy / n, py, 0.5) << "view " << i << " square " << x;
-      if (i == 0) first_px[x > 0] = px;
-      if (i == rig.views - 1) shift += std::abs(px - first_px[x > 0]);
-    }
-  EXPECT_GT(shift, 1.0);  // the squares off the focal plane do move between views
+    SCOPED_TRACE(to_string(method));
+    PipelineConfig pc;
+    pc.method = method;
+    Pipeline p(test::runtime(), pc);
+    p.set_scene(s);
+    p.configure(rig, nullptr);
+    p.render(rig);
+    std::vector<uint16_t> vol;
+    p.read_volume(vol);
+    const size_t plane = size_t(rig.view_w) * rig.view_h;
+    double first_px[2] = {0, 0}, shift = 0;
+    for (int i = 0; i < rig.views; ++i)
+      for (const float x : {-0.5f, 0.5f}) {
+        const float z = x < 0 ? 0.6f : -0.6f;
+        const glm::dvec4 c = rig.projection(i) * rig.view_matrix(i) * glm::dvec4(x, 0, z, 1);
+        const double px = (c.x / c.w + 1) / 2 * rig.view_w, py = (1 - c.y / c.w) / 2 * rig.view_h;
+        // centroid of the covered pixels near the expected position
+        double sx = 0, sy = 0, n = 0;
+        for (int y = 0; y < rig.view_h; ++y)
+          for (int xx = 0; xx < rig.view_w; ++xx) {
+            if (std::abs(xx + 0.5 - px) > 16 || std::abs(y + 0.5 - py) > 16) continue;
+            if (vol[(size_t(i) * plane + size_t(y) * rig.view_w + size_t(xx)) * 4 + 3] == 0) continue;
+            sx += xx + 0.5, sy += y + 0.5, n += 1;
+          }
+        ASSERT_GT(n, 4) << "view " << i << " square " << x;
+        EXPECT_NEAR(sx / n, px, 0.5) << "view " << i << " square " << x;
+        EXPECT_NEAR(sy / n, py, 0.5) << "view " << i << " square " << x;
+        if (i == 0) first_px[x > 0] = px;
+        if (i == rig.views - 1) shift += std::abs(px - first_px[x > 0]);
+      }
+    EXPECT_GT(shift, 1.0);  // the squares off the focal plane do move between views
   }
 }
 
@@ -382,7 +396,9 @@ TEST(Displays, AngularSpacingQuantizationStaysWithinTheBound) {
       const double spacing = rig.baseline() / (rig.views - 1);
       double worst = 0.0;
       for (int i = 0; i < rig.views; ++i) {
-        const double moved = std::abs(rig.camera_offset(i) - (angular ? rig.angular_offset(i) : (double(i) / (rig.views - 1) - 0.5) * rig.baseline()));
+        const double moved =
+            std::abs(rig.camera_offset(i) -
+                     (angular ? rig.angular_offset(i) : (double(i) / (rig.views - 1) - 0.5) * rig.baseline()));
         EXPECT_LE(moved, spacing / (2.0 * rig.spacing_q) * (1.0 + 1e-9)) << "view " << i;
         worst = std::max(worst, moved / spacing);
         EXPECT_LE(std::abs(rig.view_coord(i)), PMR_MAX_VIEW_COORD);
@@ -394,7 +410,8 @@ TEST(Displays, AngularSpacingQuantizationStaysWithinTheBound) {
         }
       }
       // a camera moved by m view spacings shifts a point at depth w by m Delta(w) / (N - 1) view pixels
-      const double px = worst * std::max(std::abs(rig.disparity_px(rig.near_eff)), std::abs(rig.disparity_px(rig.far))) /
+      const double px = worst *
+                        std::max(std::abs(rig.disparity_px(rig.near_eff)), std::abs(rig.disparity_px(rig.far))) /
                         (rig.views - 1);
       EXPECT_LE(px, kSpacingErrorPx);
       EXPECT_NEAR(spacing_error(rig).view_px, px, 1e-12);

@@ -64,7 +64,8 @@ TEST(Docs, LinksStayInsideTheSourceTreeAndLandOnHeadings) {
     EXPECT_EQ(text.find("DESIGN section"), std::string::npos) << name << " cites the contract by section";
     for (std::sregex_iterator it(text.begin(), text.end(), link), end; it != end; ++it) {
       const std::string target = (*it)[1];
-      if (target.rfind("http://", 0) == 0 || target.rfind("https://", 0) == 0 || target.rfind("mailto:", 0) == 0) continue;
+      if (target.rfind("http://", 0) == 0 || target.rfind("https://", 0) == 0 || target.rfind("mailto:", 0) == 0)
+        continue;
       const size_t hash = target.find('#');
       const std::string file = target.substr(0, hash);
       const fs::path resolved = file.empty() ? md : fs::weakly_canonical(md.parent_path() / file);
@@ -107,7 +108,8 @@ TEST(Docs, DesignHasEverySectionTheCodeCites) {
   std::smatch m;
   for (std::string line; std::getline(in, line);)
     if (std::regex_search(line, m, heading)) sections.insert(m[1]);
-  for (const std::string& s : cited) EXPECT_TRUE(sections.count(s)) << "the code cites DESIGN " << s << ", which docs/DESIGN.md lacks";
+  for (const std::string& s : cited)
+    EXPECT_TRUE(sections.count(s)) << "the code cites DESIGN " << s << ", which docs/DESIGN.md lacks";
 }
 
 TEST(Docs, RenderHelpPointsToTheDocs) {

@@ -35,7 +35,8 @@ std::map<std::string, std::vector<float>> read_channels(const std::string& path,
   for (auto c = in.header().channels().begin(); c != in.header().channels().end(); ++c) {
     std::vector<float>& v = out[c.name()];
     v.assign(size_t(w) * h, 0.0f);
-    fb.insert(c.name(), Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(v.data()), sizeof(float), sizeof(float) * size_t(w)));
+    fb.insert(c.name(),
+              Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(v.data()), sizeof(float), sizeof(float) * size_t(w)));
   }
   in.setFrameBuffer(fb);
   in.readPixels(dw.min.y, dw.max.y);
@@ -64,7 +65,8 @@ TEST(EncodedAlpha, EachSubpixelCarriesItsSamplesAlpha) {
     for (int y = 0; y < vh; ++y)
       for (int x = 0; x < vw; ++x) {
         const float a = alpha_of(v, x, y);
-        for (int c = 0; c < 4; ++c) vol[((v * plane) + size_t(y) * vw + x) * 4 + c] = half(c == 3 ? a : 0.5f * a).bits();
+        for (int c = 0; c < 4; ++c)
+          vol[((v * plane) + size_t(y) * vw + x) * 4 + c] = half(c == 3 ? a : 0.5f * a).bits();
       }
   p.encode_volume(vol);
   p.read_display(enc);
@@ -77,7 +79,8 @@ TEST(EncodedAlpha, EachSubpixelCarriesItsSamplesAlpha) {
       float sum = 0.0f;
       for (int k = 0; k < 3; ++k) {
         const double u = (j + (k + 0.5) / 3.0) / display.width, t = (i + 0.5) / display.height;
-        const float want = alpha_of(encode_view_index(display, views, j, i, k), int(std::floor(u * vw)), int(std::floor(t * vh)));
+        const float want =
+            alpha_of(encode_view_index(display, views, j, i, k), int(std::floor(u * vw)), int(std::floor(t * vh)));
         ASSERT_EQ(half_of(sub[px * 3 + size_t(k)]), want) << "subpixel " << j << "," << i << "," << k;
         sum += want;
       }
@@ -158,7 +161,8 @@ TEST(EncodedAlpha, CompositesLikeTheViewsOverABackground) {
 // with its AR, AG, AB; views opaque; the sidecar records it and --resume refuses another one.
 TEST(EncodedAlpha, BackgroundIsCompositedPerSubpixel) {
   const std::string out = test::temp_dir("background");
-  const std::string rig = " -q --views 6 --view-size 96x48 --display 300x160 --frames 0 --write encoded,views --out " + out;
+  const std::string rig =
+      " -q --views 6 --view-size 96x48 --display 300x160 --frames 0 --write encoded,views --out " + out;
   ASSERT_EQ(test::run("render" + rig + " --name plain").status, 0);
   ASSERT_EQ(test::run("render" + rig + " --name bg --background 0.2,0.7,0.4").status, 0);
   int w = 0, h = 0;
@@ -190,7 +194,8 @@ TEST(EncodedAlpha, BackgroundIsCompositedPerSubpixel) {
 // its transparency.
 TEST(EncodedAlpha, LookingGlassQuiltPreviewIsOpaque) {
   const std::string out = test::temp_dir("quilt_opaque");
-  const std::string small = " -q --views 4 --view-size 64x48 --frames 0 --write quilt --preview --quilt 2x2 --out " + out;
+  const std::string small =
+      " -q --views 4 --view-size 64x48 --frames 0 --write quilt --preview --quilt 2x2 --out " + out;
   ASSERT_EQ(test::run("render --preset lg-portrait --camera-spacing linear --name lg" + small).status, 0);
   ASSERT_EQ(test::run("render --name paper" + small).status, 0);
   auto alphas = [&](const std::string& prefix) {

@@ -44,7 +44,8 @@ glm::dvec3 lookup(const EnvironmentImage& m, const glm::dvec3& d) {
     const float* p = &m.rgb[(size_t(j) * size_t(m.width) + size_t(i)) * 3];
     return glm::dvec3(p[0], p[1], p[2]);
   };
-  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) + fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1));
+  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) +
+         fy * ((1 - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1));
 }
 
 double ggx(double a2, double nh) {
@@ -111,8 +112,8 @@ std::string temp_path(const std::string& name) { return ::testing::TempDir() + "
 
 // Minimal Radiance writer: run-length scanlines (dumps only) for widths 8..32767, flat otherwise.
 std::vector<unsigned char> hdr_bytes(const EnvironmentImage& m) {
-  std::string head = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(m.height) + " +X " +
-                     std::to_string(m.width) + "\n";
+  std::string head =
+      "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(m.height) + " +X " + std::to_string(m.width) + "\n";
   std::vector<unsigned char> out(head.begin(), head.end());
   auto rgbe = [&](size_t t) {
     const float* p = &m.rgb[3 * t];
@@ -180,7 +181,7 @@ TEST(EnvironmentMapping, AxesColumnsAndRows) {
   EXPECT_NEAR(uv({1, 0, 0}).y, 0.5, 1e-6);    // the horizon is the middle row
   EXPECT_NEAR(uv({0, 1, -1}).y, 0.25, 1e-6);  // 45 degrees up
   EXPECT_NEAR(uv({0, -1, -1}).y, 0.75, 1e-6);
-  EXPECT_NEAR(uv({0, 1, 0}).y, 0.5 / 32, 1e-6);   // +Y: the top row
+  EXPECT_NEAR(uv({0, 1, 0}).y, 0.5 / 32, 1e-6);    // +Y: the top row
   EXPECT_NEAR(uv({0, -1, 0}).y, 31.5 / 32, 1e-6);  // -Y: the bottom row
   EXPECT_NEAR(uv({0.3, 0.2, -1}).x, 0.5 + std::atan2(0.3, 1.0) / (2 * kPi), 1e-6);
   // Wrapping in u: across the +Z seam the lookup blends the first and last columns.
@@ -329,7 +330,8 @@ TEST(EnvironmentAccuracy, UniformMapGivesItsRadiance) {
   const Environment e = Environment::from_image(img);
   for (const glm::dvec3& d : fibonacci(50)) {
     EXPECT_LT(rel_err(e.irradiance(d), {1.5, 0.5, 0.25}), 1e-5);
-    for (double r : {0.0, 0.03, 0.2, 0.27, 0.5, 0.8, 1.0}) EXPECT_LT(rel_err(e.prefiltered(d, r), {1.5, 0.5, 0.25}), 1e-5);
+    for (double r : {0.0, 0.03, 0.2, 0.27, 0.5, 0.8, 1.0})
+      EXPECT_LT(rel_err(e.prefiltered(d, r), {1.5, 0.5, 0.25}), 1e-5);
   }
   // The brute-force reference agrees with itself on a uniform map.
   const std::vector<glm::dvec3> ref = brute_force(img, {0.2, 0.5, -1}, kTestRoughness, 100, 180);
@@ -382,7 +384,8 @@ TEST(EnvironmentAccuracy, RealHdriAgainstBruteForce) {
       for (int j = 0; j < h.width; ++j)
         for (int c = 0; c < 3; ++c) {
           auto at = [&](int x, int y) { return img.rgb[(size_t(y) * size_t(img.width) + size_t(x)) * 3 + size_t(c)]; };
-          h.rgb.push_back(0.25f * (at(2 * j, 2 * i) + at(2 * j + 1, 2 * i) + at(2 * j, 2 * i + 1) + at(2 * j + 1, 2 * i + 1)));
+          h.rgb.push_back(0.25f *
+                          (at(2 * j, 2 * i) + at(2 * j + 1, 2 * i) + at(2 * j, 2 * i + 1) + at(2 * j + 1, 2 * i + 1)));
         }
     img = std::move(h);
   }

@@ -46,13 +46,13 @@ TEST(EnvironmentCli, BadEnvironmentsFailWithOneLineAndWriteNothing) {
   test::write_exr(dir + "/nan.exr", nan);
   expect_one_error_line(run("render" + kSmall + " --environment '" + dir + "/nan.exr' --out " + out), "non-finite");
   const std::string sky = write_sky(dir, "sky.exr");
-  expect_usage_error(
-      run("render --views 4 --view-size 48x24 --display 192x108 --shading lambert --environment '" + sky + "' --out " + out),
-      "--shading pbr");
+  expect_usage_error(run("render --views 4 --view-size 48x24 --display 192x108 --shading lambert --environment '" +
+                         sky + "' --out " + out),
+                     "--shading pbr");
   expect_usage_error(run("render" + kSmall + " --environment '" + sky + "' --environment-rotation inf --out " + out),
-                        "--environment-rotation");
+                     "--environment-rotation");
   expect_usage_error(run("render" + kSmall + " --environment '" + sky + "' --environment-rotation 1e999 --out " + out),
-                        "--environment-rotation");
+                     "--environment-rotation");
   expect_one_error_line(run("bench --views 4 --method pmr --frames 1 --environment missing.exr --shading pbr"),
                         "missing.exr");
   EXPECT_EQ(count_entries(out), 0u) << "nothing written for a bad environment";

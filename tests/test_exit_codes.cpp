@@ -34,7 +34,7 @@ TEST(ExitCodes, UsageErrorsExitTwo) {
   const std::string out = temp_dir("usage") + "/out";
   expect_usage_error(run("frobnicate"), "unknown command");
   expect_usage_error(run("render --frobnicate --out " + out), "--frobnicate");
-  expect_usage_error(run("render --views --out " + out), "--views");           // "--out" is not a count
+  expect_usage_error(run("render --views --out " + out), "--views");  // "--out" is not a count
   expect_usage_error(run("render --views 0 --out " + out), "--views");
   expect_usage_error(run("render --out"), "--out needs a value");
   expect_usage_error(run("render --yfov 0 --out " + out), "--yfov");
@@ -85,7 +85,8 @@ TEST(ExitCodes, EachKindOfFailureHasItsStatus) {
   EXPECT_EQ(run_reporting_errors([]() -> int { throw 42; }), 3);
   EXPECT_EQ(run_reporting_errors([]() -> int { throw InternalError("an invariant \x1b[2J broke"); }), 3);
   // as_usage turns a parser's pmr::Error into a usage error, never a bug
-  EXPECT_EQ(run_reporting_errors([]() -> int { return as_usage([]() -> int { throw InternalError("in a parser"); }); }), 3);
+  EXPECT_EQ(run_reporting_errors([]() -> int { return as_usage([]() -> int { throw InternalError("in a parser"); }); }),
+            3);
   const std::string err = testing::internal::GetCapturedStderr();
   EXPECT_NE(err.find("pmr: internal error: vector::at"), std::string::npos) << err;
   EXPECT_NE(err.find("\npmr: internal error: an invariant"), std::string::npos) << "the prefix once: " << err;
@@ -116,8 +117,10 @@ TEST(ExitCodes, SignalNExits128PlusN) {
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
-    const std::string cmd = std::string(PMR_BINARY) + " render -q --turntable 360:50 --frames 0:49 --views 16 "
-                            "--view-size 256x128 --display 640x360 --out " + out + " > /dev/null 2>&1";
+    const std::string cmd = std::string(PMR_BINARY) +
+                            " render -q --turntable 360:50 --frames 0:49 --views 16 "
+                            "--view-size 256x128 --display 640x360 --out " +
+                            out + " > /dev/null 2>&1";
     execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), (char*)nullptr);
     _exit(127);
   }
@@ -140,11 +143,13 @@ TEST(ExitCodes, NothingIsCreatedBeforeTheInputsAreChecked) {
   expect_one_error_line(run("render '" + dir + "/broken.gltf' --out " + out + kSmall), "broken.gltf");
   EXPECT_FALSE(exists(dir + "/a")) << "the output folder was created for a scene that does not load";
   std::ofstream(dir + "/bad.hdr") << "not an image";
-  expect_one_error_line(run("render --shading pbr --environment '" + dir + "/bad.hdr' --out " + out + kSmall), "bad.hdr");
+  expect_one_error_line(run("render --shading pbr --environment '" + dir + "/bad.hdr' --out " + out + kSmall),
+                        "bad.hdr");
   EXPECT_FALSE(exists(dir + "/a"));
   // a folder below a regular file is refused at once, before the scene is read
   std::ofstream(dir + "/file") << "x";
-  expect_one_error_line(run("render '" + dir + "/broken.gltf' --out '" + dir + "/file/sub'" + kSmall), "is not a folder");
+  expect_one_error_line(run("render '" + dir + "/broken.gltf' --out '" + dir + "/file/sub'" + kSmall),
+                        "is not a folder");
 }
 
 // File names hold 255 bytes; pmr writes each file under a temporary name first (27 bytes longer at

@@ -291,8 +291,8 @@ TEST(ExrMetadata, WorldToNdcProjectsWhereTheViewDrew) {
     read_views_exr_part(f.views, i, w, h, px);
     ASSERT_EQ(w, 96);
     ASSERT_EQ(h, 48);
-    left_edge[i] = expect_projection_matches(Imf::worldToNDC(in.header(i)), px, w, h, 0, 0, w, h,
-                                             "view " + std::to_string(i));
+    left_edge[i] =
+        expect_projection_matches(Imf::worldToNDC(in.header(i)), px, w, h, 0, 0, w, h, "view " + std::to_string(i));
   }
   EXPECT_GT(std::abs(left_edge[4] - left_edge[0]), 3.0) << "the end views must differ for this test to mean anything";
 

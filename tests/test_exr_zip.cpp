@@ -85,8 +85,7 @@ void write_with_openexr(const std::string& path, int w, int h, const std::vector
   Imf::OutputFile out(path.c_str(), header);
   Imf::FrameBuffer fb;
   const char* names[4] = {"R", "G", "B", "A"};
-  for (int k = 0; k < 4; ++k)
-    fb.insert(names[k], Imf::Slice(Imf::HALF, (char*)(px.data() + k), 8, 8 * size_t(w)));
+  for (int k = 0; k < 4; ++k) fb.insert(names[k], Imf::Slice(Imf::HALF, (char*)(px.data() + k), 8, 8 * size_t(w)));
   out.setFrameBuffer(fb);
   out.writePixels(h);
 }
@@ -146,7 +145,8 @@ TEST(ExrZip, SubpixelAlphaReadsBackBitForBit) {
       std::vector<float> z(size_t(w) * size_t(h));
       for (size_t i = 0; i < z.size(); ++i) z[i] = float(i % 31) * 0.25f;
       const std::string path = dir + "/t.exr";
-      write_rgba_exr(path, w, h, px.data(), ExrCompression::Zip, 2, z.data(), 1.0f, nullptr, ExrImage::Encoded, sub.data());
+      write_rgba_exr(path, w, h, px.data(), ExrCompression::Zip, 2, z.data(), 1.0f, nullptr, ExrImage::Encoded,
+                     sub.data());
       const Decoded d = read_back(path, w, h, true);
       EXPECT_EQ(std::memcmp(d.rgba.data(), px.data(), px.size() * 2), 0);
       EXPECT_EQ(std::memcmp(d.z.data(), z.data(), z.size() * 4), 0);

@@ -99,7 +99,8 @@ TEST(Shard, ExplicitSharesAreInterleaved) {
   const std::vector<long> frames = parse_frame_list("10:19");
   EXPECT_EQ(shard_frames(frames, parse_shard("1/3", 0, 0, from({}))), (std::vector<long>{11, 14, 17}));
   EXPECT_TRUE(shard_frames({1, 2}, parse_shard("4/5", 0, 0, from({}))).empty());  // more shards than frames
-  for (const char* bad : {"3/3", "-1/2", "1", "a/b", "1/0", "2/"}) EXPECT_THROW(parse_shard(bad, 0, 0, from({})), Error) << bad;
+  for (const char* bad : {"3/3", "-1/2", "1", "a/b", "1/0", "2/"})
+    EXPECT_THROW(parse_shard(bad, 0, 0, from({})), Error) << bad;
 }
 
 TEST(Shard, EverySchedulersArrayCoversEveryFrameOnce) {
@@ -107,13 +108,19 @@ TEST(Shard, EverySchedulersArrayCoversEveryFrameOnce) {
   std::vector<Env> slurm, slurm_step, k8s, aws, sge, lsf, lsf5, pbs, torque;
   for (int t = 0; t < 4; ++t) {
     // Slurm --array=3-6 (first index other than 0 or 1), and --array=0-12:4 with a step
-    slurm.push_back({{"SLURM_ARRAY_TASK_ID", std::to_string(3 + t)}, {"SLURM_ARRAY_TASK_MIN", "3"},
-                     {"SLURM_ARRAY_TASK_MAX", "6"}, {"SLURM_ARRAY_TASK_COUNT", "4"}});
-    slurm_step.push_back({{"SLURM_ARRAY_TASK_ID", std::to_string(4 * t)}, {"SLURM_ARRAY_TASK_MIN", "0"},
-                          {"SLURM_ARRAY_TASK_MAX", "12"}, {"SLURM_ARRAY_TASK_STEP", "4"}});
+    slurm.push_back({{"SLURM_ARRAY_TASK_ID", std::to_string(3 + t)},
+                     {"SLURM_ARRAY_TASK_MIN", "3"},
+                     {"SLURM_ARRAY_TASK_MAX", "6"},
+                     {"SLURM_ARRAY_TASK_COUNT", "4"}});
+    slurm_step.push_back({{"SLURM_ARRAY_TASK_ID", std::to_string(4 * t)},
+                          {"SLURM_ARRAY_TASK_MIN", "0"},
+                          {"SLURM_ARRAY_TASK_MAX", "12"},
+                          {"SLURM_ARRAY_TASK_STEP", "4"}});
     k8s.push_back({{"JOB_COMPLETION_INDEX", std::to_string(t)}});
     aws.push_back({{"AWS_BATCH_JOB_ARRAY_INDEX", std::to_string(t)}, {"AWS_BATCH_JOB_ARRAY_SIZE", "4"}});
-    sge.push_back({{"SGE_TASK_ID", std::to_string(2 + 3 * t)}, {"SGE_TASK_FIRST", "2"}, {"SGE_TASK_LAST", "11"},
+    sge.push_back({{"SGE_TASK_ID", std::to_string(2 + 3 * t)},
+                   {"SGE_TASK_FIRST", "2"},
+                   {"SGE_TASK_LAST", "11"},
                    {"SGE_TASK_STEPSIZE", "3"}});
     lsf.push_back({{"LSB_JOBINDEX", std::to_string(1 + t)}, {"LSB_JOBINDEX_END", "4"}});
     lsf5.push_back({{"LSB_JOBINDEX", std::to_string(5 + t)}, {"LSB_JOBINDEX_END", "8"}});
@@ -148,7 +155,9 @@ TEST(Shard, BadEnvironmentsFailWithOneLine) {
   EXPECT_NE(msg({{"JOB_COMPLETION_INDEX", "5"}}, 4).find("outside"), std::string::npos);
   EXPECT_NE(msg({{"AWS_BATCH_JOB_ARRAY_INDEX", "1"}, {"AWS_BATCH_JOB_ARRAY_SIZE", "4"}}, 3).find("disagrees"),
             std::string::npos);
-  EXPECT_NE(msg({{"SLURM_ARRAY_TASK_ID", "5"}, {"SLURM_ARRAY_TASK_MIN", "0"}, {"SLURM_ARRAY_TASK_STEP", "4"},
+  EXPECT_NE(msg({{"SLURM_ARRAY_TASK_ID", "5"},
+                 {"SLURM_ARRAY_TASK_MIN", "0"},
+                 {"SLURM_ARRAY_TASK_STEP", "4"},
                  {"SLURM_ARRAY_TASK_MAX", "12"}})
                 .find("not on the array's range"),
             std::string::npos);
@@ -162,7 +171,10 @@ TEST(Shard, BadEnvironmentsFailWithOneLine) {
 TEST(Verify, SidecarRecordsEveryOutputsSizeAndChecksum) {
   const std::string out = test::temp_dir("verify_sums");
   ASSERT_EQ(test::run("render --frames 0:1 -q --views 4 --view-size 64x32 --display 240x135 --write encoded,quilt "
-                      "--preview --out " + out).status, 0);
+                      "--preview --out " +
+                      out)
+                .status,
+            0);
   const nlohmann::json j = nlohmann::json::parse(read_file(out + "/frame_0001.json"));
   ASSERT_TRUE(j.contains("output_checksums")) << j.dump(2);
   EXPECT_EQ(j["output_checksums"]["algorithm"], "XXH3-64");
@@ -214,7 +226,8 @@ TEST(Verify, QuickCheckFindsChangedAndDamagedFilesWithoutDecoding) {
   test::CliRun v = test::run("verify " + out + " --frames 0:5");
   EXPECT_EQ(v.status, 1) << v.output;
   EXPECT_NE(v.output.find("frame 1: frame_0001.exr is not the file its sidecar records (its checksum differs)"),
-            std::string::npos) << v.output;
+            std::string::npos)
+      << v.output;
   EXPECT_NE(v.output.find("frame 2: frame_0002.exr is truncated or damaged"), std::string::npos) << v.output;
   EXPECT_NE(v.output.find("frame 3: frame_0003.exr"), std::string::npos) << v.output;
   EXPECT_NE(v.output.find("frame 4: frame_0004.exr is truncated"), std::string::npos) << v.output;
@@ -273,7 +286,8 @@ TEST(Verify, ReportsMissingAndBrokenFramesAsAFramesList) {
   std::ofstream(out + "/frame_0001.json") << R"({"frame": 1, "fps": 24, "time": 0.041666666666666664})";
   v = test::run("verify " + out + " --frames 0:7");
   EXPECT_EQ(v.status, 1) << v.output;
-  EXPECT_NE(v.output.find("frame 1: frame_0001.json was rendered with another configuration"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("frame 1: frame_0001.json was rendered with another configuration"), std::string::npos)
+      << v.output;
   ASSERT_EQ(test::run("render --frames 1 -q" + args).status, 0);
   // frame 6 rendered again at another fps: another configuration (--overwrite: the other frames stay
   // in the first one)

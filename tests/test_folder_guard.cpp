@@ -138,11 +138,14 @@ TEST(FolderGuard, AnotherConfigurationThisRunWouldNotReplaceIsRefused) {
   EXPECT_EQ(without_view_matrices(moved.dump()), moved.dump()) << "another layout is compared whole";
 
   const CliRun refused = run("render --frames 0:1 --fps 30" + kSmall + at);
-  expect_one_error_line(refused, out + " holds frame_0002.json rendered with another configuration (fps differs) that "
-                                       "this run would not replace; use another --out, render those frames too, or --overwrite");
+  expect_one_error_line(refused,
+                        out +
+                            " holds frame_0002.json rendered with another configuration (fps differs) that "
+                            "this run would not replace; use another --out, render those frames too, or --overwrite");
   EXPECT_EQ(snapshot(out), before) << "a refused run wrote, removed or left something";
   // the same with --resume (which skips nothing here: every listed frame differs)
-  expect_one_error_line(run("render --resume --frames 0:1 --fps 30" + kSmall + at), "frame_0002.json rendered with another");
+  expect_one_error_line(run("render --resume --frames 0:1 --fps 30" + kSmall + at),
+                        "frame_0002.json rendered with another");
 
   // every frame of the other configuration rendered again: allowed
   CliRun r = run("render --frames 0:3 --fps 30" + kSmall + at);
@@ -153,8 +156,11 @@ TEST(FolderGuard, AnotherConfigurationThisRunWouldNotReplaceIsRefused) {
   r = run("render --frames 0:1 --overwrite" + kSmall + at);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(count(r.output, "warning: --overwrite"), 1u) << r.output;
-  EXPECT_NE(r.output.find("pmr: warning: --overwrite: " + out + " keeps 2 frame(s) of another configuration that this "
-                          "run does not replace (frame_0002.json: fps differs)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("pmr: warning: --overwrite: " + out +
+                          " keeps 2 frame(s) of another configuration that this "
+                          "run does not replace (frame_0002.json: fps differs)"),
+            std::string::npos)
+      << r.output;
   EXPECT_EQ(nlohmann::json::parse(test::read_file(out + "/frame_0000.json"))["fps"].get<double>(), 24.0);
   EXPECT_EQ(lock_files(out).size(), 0u);
 
@@ -163,8 +169,9 @@ TEST(FolderGuard, AnotherConfigurationThisRunWouldNotReplaceIsRefused) {
   r = run("render --frames 0:3 --shard 0/2" + kSmall + at);
   EXPECT_EQ(r.status, 0) << r.output;
   // shard 0/2 of 0:1 is frame 0 alone; frame 3 (30 fps) is nobody's in this job: refused
-  expect_one_error_line(run("render --frames 0:1 --shard 0/2" + kSmall + at), "frame_0003.json rendered with another "
-                                                                               "configuration (fps differs)");
+  expect_one_error_line(run("render --frames 0:1 --shard 0/2" + kSmall + at),
+                        "frame_0003.json rendered with another "
+                        "configuration (fps differs)");
   // another --name pattern does not see these frames
   r = run("render --frames 0 --fps 30 --name shot_%04d" + kSmall + at);
   EXPECT_EQ(r.status, 0) << r.output;
@@ -182,8 +189,10 @@ TEST(FolderGuard, ALiveProcessOfAnotherConfigurationRefusesTheSecond) {
     const HeldLock held(out, other);
     const auto before = snapshot(out);
     const CliRun r = run("render --frames 0:1" + kSmall + "--out " + out);
-    expect_one_error_line(r, out + " is being rendered right now by a pmr process with another configuration (fps "
-                                   "differs; it holds " + fs::path(held.path).filename().string() + ")");
+    expect_one_error_line(r, out +
+                                 " is being rendered right now by a pmr process with another configuration (fps "
+                                 "differs; it holds " +
+                                 fs::path(held.path).filename().string() + ")");
     EXPECT_EQ(snapshot(out), before) << "a refused run left something";
     // --overwrite does not override a running process
     expect_one_error_line(run("render --frames 0:1 --overwrite" + kSmall + "--out " + out), "being rendered right now");
@@ -204,8 +213,10 @@ TEST(FolderGuard, ALiveProcessOfAnotherConfigurationRefusesTheSecond) {
 // while it runs; two shards of one configuration started together both finish.
 TEST(FolderGuard, ConcurrentProcesses) {
   const std::string out = temp_dir("guard_concurrent");
-  const pid_t slow = start("render -q --turntable 360:100 --frames 0:99 --views 32 --view-size 512x256 --display 1920x1080 "
-                           "--out " + out);
+  const pid_t slow = start(
+      "render -q --turntable 360:100 --frames 0:99 --views 32 --view-size 512x256 --display 1920x1080 "
+      "--out " +
+      out);
   ASSERT_GT(slow, 0);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
   while (std::chrono::steady_clock::now() < deadline) {
@@ -214,8 +225,10 @@ TEST(FolderGuard, ConcurrentProcesses) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   ASSERT_EQ(lock_files(out).size(), 1u);
-  const CliRun second = run("render --frames 200 --fps 30 --turntable 360:100 --views 32 --view-size 512x256 "
-                            "--display 1920x1080 --out " + out);
+  const CliRun second =
+      run("render --frames 200 --fps 30 --turntable 360:100 --views 32 --view-size 512x256 "
+          "--display 1920x1080 --out " +
+          out);
   int status = 0;
   const bool slow_still_running = waitpid(slow, &status, WNOHANG) == 0;
   kill(slow, SIGINT);
@@ -228,8 +241,10 @@ TEST(FolderGuard, ConcurrentProcesses) {
 
   // two shards of one job at the same time, into one folder
   const std::string shared = temp_dir("guard_shards");
-  const std::string job = "render -q --frames 0:5 --turntable 360:6 --views 8 --view-size 128x64 --display 480x270 "
-                          "--out " + shared + " --shard ";
+  const std::string job =
+      "render -q --frames 0:5 --turntable 360:6 --views 8 --view-size 128x64 --display 480x270 "
+      "--out " +
+      shared + " --shard ";
   const pid_t a = start(job + "0/2"), b = start(job + "1/2");
   EXPECT_EQ(wait_exit(a), 0);
   EXPECT_EQ(wait_exit(b), 0);
@@ -258,7 +273,8 @@ TEST(RangeWarning, NamesTheFramesOutsideAndTheRange) {
             "turntable still turns)");
   spec.animation = kAllAnimations;
   spec.animation_label = "all";
-  EXPECT_NE(frames_outside_animation(s, spec, {60}, false).find("the animations (all) (frames 0:48"), std::string::npos);
+  EXPECT_NE(frames_outside_animation(s, spec, {60}, false).find("the animations (all) (frames 0:48"),
+            std::string::npos);
   // no animation: a still scene or a turntable alone never warns
   spec.animation = kNoAnimation;
   EXPECT_EQ(frames_outside_animation(s, spec, {0, 1000}, false), "");
@@ -295,7 +311,9 @@ TEST(RangeWarning, OncePerRunNeverForFramesAll) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(count(r.output, "outside the animation"), 1u) << r.output;
   EXPECT_NE(r.output.find("pmr: warning: frames 25:26 lie outside the animation 'Slide' (frames 0:24 at 24 fps): they "
-                          "repeat its last pose"), std::string::npos) << r.output;
+                          "repeat its last pose"),
+            std::string::npos)
+      << r.output;
   r = run("render --frames all" + scene + "--out " + dir + "/b");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(count(r.output, "outside"), 0u) << r.output;

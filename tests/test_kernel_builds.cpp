@@ -30,7 +30,8 @@ size_t count_files(const std::string& dir, const std::string& extension) {
 std::multiset<std::string> built_functions(const std::string& cache) {
   std::multiset<std::string> out;
   std::error_code ec;
-  for (auto it = fs::recursive_directory_iterator(cache, ec); it != fs::recursive_directory_iterator(); it.increment(ec)) {
+  for (auto it = fs::recursive_directory_iterator(cache, ec); it != fs::recursive_directory_iterator();
+       it.increment(ec)) {
     if (ec) break;
     const fs::path& p = it->path();
     if (p.extension() == ".so")
@@ -62,8 +63,8 @@ std::set<unsigned> mta_counts(const std::string& output) {
 
 // Renders with an empty cache; every function built must be one the render announced (one .so per
 // announced (kernel, local size) pair: the local size is the variant directory's first number).
-std::string expect_builds_before_first_frame(const std::string& name, const std::string& scene,
-                                             const std::string& args, size_t frames) {
+std::string expect_builds_before_first_frame(const std::string& name, const std::string& scene, const std::string& args,
+                                             size_t frames) {
   const std::string cache = test::temp_dir(name + "_cache"), out = test::temp_dir(name + "_out");
   fs::create_directories(cache);
   const test::CliRun r =

@@ -18,16 +18,38 @@ TEST(Layout, DeviceStructsMatchHost) {
   clReleaseEvent(e);
   uint32_t got[64] = {};
   rt.read(out, got, sizeof got);
-  const uint32_t want[] = {
-      sizeof(PmrParams), offsetof(PmrParams, ndc_scale_x), offsetof(PmrParams, light_world), offsetof(PmrParams, view_w),
-      offsetof(PmrParams, debug_outputs), sizeof(PmrVertex), offsetof(PmrVertex, x0), offsetof(PmrVertex, z),
-      sizeof(PmrMta), offsetof(PmrMta, bary), offsetof(PmrMta, key), offsetof(PmrMta, flags),
-      sizeof(PmrVertexAttr), offsetof(PmrVertexAttr, color), sizeof(PmrTriangle), offsetof(PmrTriangle, face_normal),
-      sizeof(PmrMaterial), offsetof(PmrMaterial, alpha_cutoff), sizeof(PmrTexture), offsetof(PmrTexture, wrap_t),
-      sizeof(PmrEncodeParams), offsetof(PmrEncodeParams, display_w), offsetof(PmrEncodeParams, bilinear),
-      offsetof(PmrMaterial, maps), offsetof(PmrMaterial, occlusion_strength), sizeof(PmrTextureMap),
-      offsetof(PmrParams, num_lights), sizeof(PmrLight), offsetof(PmrLight, type), offsetof(PmrLight, range),
-      offsetof(PmrLight, direction), offsetof(PmrLight, cos_outer)};
+  const uint32_t want[] = {sizeof(PmrParams),
+                           offsetof(PmrParams, ndc_scale_x),
+                           offsetof(PmrParams, light_world),
+                           offsetof(PmrParams, view_w),
+                           offsetof(PmrParams, debug_outputs),
+                           sizeof(PmrVertex),
+                           offsetof(PmrVertex, x0),
+                           offsetof(PmrVertex, z),
+                           sizeof(PmrMta),
+                           offsetof(PmrMta, bary),
+                           offsetof(PmrMta, key),
+                           offsetof(PmrMta, flags),
+                           sizeof(PmrVertexAttr),
+                           offsetof(PmrVertexAttr, color),
+                           sizeof(PmrTriangle),
+                           offsetof(PmrTriangle, face_normal),
+                           sizeof(PmrMaterial),
+                           offsetof(PmrMaterial, alpha_cutoff),
+                           sizeof(PmrTexture),
+                           offsetof(PmrTexture, wrap_t),
+                           sizeof(PmrEncodeParams),
+                           offsetof(PmrEncodeParams, display_w),
+                           offsetof(PmrEncodeParams, bilinear),
+                           offsetof(PmrMaterial, maps),
+                           offsetof(PmrMaterial, occlusion_strength),
+                           sizeof(PmrTextureMap),
+                           offsetof(PmrParams, num_lights),
+                           sizeof(PmrLight),
+                           offsetof(PmrLight, type),
+                           offsetof(PmrLight, range),
+                           offsetof(PmrLight, direction),
+                           offsetof(PmrLight, cos_outer)};
   for (size_t i = 0; i < sizeof want / sizeof want[0]; ++i) EXPECT_EQ(got[i], want[i]) << "probe " << i;
   // the environment header of --shading pbr (probes 40..43)
   EXPECT_EQ(got[40], sizeof(PmrEnvironment));

@@ -25,50 +25,50 @@ size_t covered(const test::Rendered& r) {
 
 TEST(Methods, MultipassFedPmrPositionsIsBitIdentical) {
   for (bool angular : test::kSpacings)
-  for (int views : {1, 5, 24}) {
-    SCOPED_TRACE(test::spacing_name(angular));
-    const Scene scene = test::random_scene(150, 21 + views, true);  // inside the frustum: no clipping
-    const Rig rig = test::small_rig(views, 53, 31, angular);
-    const test::Rendered pmr = render_with(Method::Pmr, scene, rig);
-    const test::Rendered mp = render_with(Method::Multipass, scene, rig, true);
-    EXPECT_TRUE(pmr.count == mp.count) << "coverage, N = " << views;
-    EXPECT_TRUE(pmr.key == mp.key) << "visibility, N = " << views;
-    EXPECT_TRUE(pmr.depth == mp.depth) << "depth, N = " << views;
-    EXPECT_TRUE(pmr.volume == mp.volume) << "colour, N = " << views;
-    EXPECT_GT(covered(pmr), pmr.key.size() / 10);
-  }
+    for (int views : {1, 5, 24}) {
+      SCOPED_TRACE(test::spacing_name(angular));
+      const Scene scene = test::random_scene(150, 21 + views, true);  // inside the frustum: no clipping
+      const Rig rig = test::small_rig(views, 53, 31, angular);
+      const test::Rendered pmr = render_with(Method::Pmr, scene, rig);
+      const test::Rendered mp = render_with(Method::Multipass, scene, rig, true);
+      EXPECT_TRUE(pmr.count == mp.count) << "coverage, N = " << views;
+      EXPECT_TRUE(pmr.key == mp.key) << "visibility, N = " << views;
+      EXPECT_TRUE(pmr.depth == mp.depth) << "depth, N = " << views;
+      EXPECT_TRUE(pmr.volume == mp.volume) << "colour, N = " << views;
+      EXPECT_GT(covered(pmr), pmr.key.size() / 10);
+    }
 }
 
 TEST(Methods, MultipassWithOwnMatricesDiffersOnlyOnEdgePixels) {
   const Scene scene = test::random_scene(150, 77, true);
   for (bool angular : test::kSpacings) {
-  SCOPED_TRACE(test::spacing_name(angular));
-  const Rig rig = test::small_rig(16, 64, 32, angular);
-  const test::Rendered pmr = render_with(Method::Pmr, scene, rig);
-  const test::Rendered mp = render_with(Method::Multipass, scene, rig);
-  size_t differ = 0;
-  for (size_t v = 0; v < pmr.count.size(); ++v) differ += pmr.count[v] != mp.count[v];
-  // positions differ by at most a few 2^-16 px: only pixel centers within that distance of an edge flip
-  EXPECT_LT(differ, pmr.count.size() / 1000 + 5) << differ << " voxels differ";
-  EXPECT_GT(covered(pmr), pmr.key.size() / 10);
+    SCOPED_TRACE(test::spacing_name(angular));
+    const Rig rig = test::small_rig(16, 64, 32, angular);
+    const test::Rendered pmr = render_with(Method::Pmr, scene, rig);
+    const test::Rendered mp = render_with(Method::Multipass, scene, rig);
+    size_t differ = 0;
+    for (size_t v = 0; v < pmr.count.size(); ++v) differ += pmr.count[v] != mp.count[v];
+    // positions differ by at most a few 2^-16 px: only pixel centers within that distance of an edge flip
+    EXPECT_LT(differ, pmr.count.size() / 1000 + 5) << differ << " voxels differ";
+    EXPECT_GT(covered(pmr), pmr.key.size() / 10);
   }
 }
 
 TEST(Methods, DuplicateMatchesPmr) {
   for (bool angular : test::kSpacings)
-  for (int views : {1, 7, 32}) {
-    SCOPED_TRACE(test::spacing_name(angular));
-    Scene scene = test::random_scene(150, 5 + views, true);
-    const float D = float(test::small_rig(views, 8, 8).focal);
-    test::add_triangle(scene, {-50, -1, D + 30}, {50, -1, D + 30}, {0, -1, -D - 40});  // clipped
-    const Rig rig = test::small_rig(views, 45, 27, angular);
-    const test::Rendered pmr = render_with(Method::Pmr, scene, rig);
-    const test::Rendered dup = render_with(Method::Duplicate, scene, rig);
-    EXPECT_TRUE(pmr.count == dup.count) << "coverage, N = " << views;
-    EXPECT_TRUE(pmr.key == dup.key) << "visibility, N = " << views;
-    EXPECT_TRUE(pmr.volume == dup.volume) << "colour, N = " << views;
-    EXPECT_GT(dup.times.mtas, pmr.times.mtas * size_t(views > 1 ? 2 : 1) / 2) << "duplicate emits one copy per view";
-  }
+    for (int views : {1, 7, 32}) {
+      SCOPED_TRACE(test::spacing_name(angular));
+      Scene scene = test::random_scene(150, 5 + views, true);
+      const float D = float(test::small_rig(views, 8, 8).focal);
+      test::add_triangle(scene, {-50, -1, D + 30}, {50, -1, D + 30}, {0, -1, -D - 40});  // clipped
+      const Rig rig = test::small_rig(views, 45, 27, angular);
+      const test::Rendered pmr = render_with(Method::Pmr, scene, rig);
+      const test::Rendered dup = render_with(Method::Duplicate, scene, rig);
+      EXPECT_TRUE(pmr.count == dup.count) << "coverage, N = " << views;
+      EXPECT_TRUE(pmr.key == dup.key) << "visibility, N = " << views;
+      EXPECT_TRUE(pmr.volume == dup.volume) << "colour, N = " << views;
+      EXPECT_GT(dup.times.mtas, pmr.times.mtas * size_t(views > 1 ? 2 : 1) / 2) << "duplicate emits one copy per view";
+    }
 }
 
 }  // namespace

@@ -71,7 +71,8 @@ TEST(MisleadingMessages, AnOptionsValueIsReportedAsThatOption) {
 
 // The pmr binary under an address-space budget (prlimit --as): exit status and output.
 CliRun run_capped(uint64_t bytes, const std::string& args) {
-  FILE* p = popen(("prlimit --as=" + std::to_string(bytes) + " " + std::string(PMR_BINARY) + " " + args + " 2>&1").c_str(), "r");
+  FILE* p = popen(
+      ("prlimit --as=" + std::to_string(bytes) + " " + std::string(PMR_BINARY) + " " + args + " 2>&1").c_str(), "r");
   std::string output;
   char buf[4096];
   for (size_t n; p && (n = fread(buf, 1, sizeof buf, p)) > 0;) output.append(buf, n);
@@ -91,7 +92,8 @@ TEST(MisleadingMessages, ExrAttributeLargerThanTheFileIsRefusedBeforeItIsAllocat
   bytes += {'\xf0', '\xff', '\xff', '\x7f'};  // 2^31 - 16 bytes
   bytes += std::string(64, 'x');
   std::ofstream(dir + "/sky.exr", std::ios::binary) << bytes;
-  const CliRun r = run_capped(1000000000, "render --shading pbr --environment '" + dir + "/sky.exr' --out " + dir + "/out");
+  const CliRun r =
+      run_capped(1000000000, "render --shading pbr --environment '" + dir + "/sky.exr' --out " + dir + "/out");
   expect_one_error_line(r, "sky.exr: not a readable OpenEXR file (");
   EXPECT_EQ(r.output.find("out of host memory"), std::string::npos) << r.output;
   EXPECT_FALSE(test::exists(dir + "/out"));
@@ -104,9 +106,11 @@ TEST(MisleadingMessages, FuzzedEnvironmentFilesAreRefusedWithinAGigabyte) {
   if (std::system("prlimit --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "prlimit not found";
   const std::string out = temp_dir("fuzzed_environments") + "/out";
   size_t files = 0;
-  for (const auto& e : std::filesystem::directory_iterator(std::string(PMR_SOURCE_DIR) + "/tests/fuzz/regressions/environment")) {
+  for (const auto& e :
+       std::filesystem::directory_iterator(std::string(PMR_SOURCE_DIR) + "/tests/fuzz/regressions/environment")) {
     ++files;
-    const CliRun r = run_capped(1000000000, "render --shading pbr --environment '" + e.path().string() + "' --out " + out);
+    const CliRun r =
+        run_capped(1000000000, "render --shading pbr --environment '" + e.path().string() + "' --out " + out);
     expect_one_error_line(r, e.path().filename().string());
     EXPECT_EQ(r.output.find("out of host memory"), std::string::npos) << r.output;
   }

@@ -48,8 +48,9 @@ std::string dolly_file(const std::string& dir) {
   const int turns = g.data<float>({0, 0, 0, 1, 0, s4, 0, c4, s3, 0, 0, c3, 0, 1, 0, 0}, kFloat, "VEC4");
   g.doc["animations"] = {{{"name", "dolly"},
                           {"samplers", {{{"input", times}, {"output", moves}}, {{"input", times}, {"output", turns}}}},
-                          {"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}},
-                                        {{"sampler", 1}, {"target", {{"node", 1}, {"path", "rotation"}}}}}}}};
+                          {"channels",
+                           {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}},
+                            {{"sampler", 1}, {"target", {{"node", 1}, {"path", "rotation"}}}}}}}};
   g.scene({0, 1});
   return g.write(dir, "dolly");
 }
@@ -153,7 +154,8 @@ TEST(MovingCamera, AFrameFacingAwayFailsAndTheOthersRender) {
   const std::string dir = temp_dir("moving_camera_cli");
   std::filesystem::create_directories(dir);
   const std::string file = dolly_file(dir);
-  const std::string common = " --camera 0 --views 8 --view-size 48x24 --display 96x54 --shading lambert --write encoded";
+  const std::string common =
+      " --camera 0 --views 8 --view-size 48x24 --display 96x54 --shading lambert --write encoded";
   const CliRun far_frame = run("render " + file + common + " --frames 24 --out " + dir + "/one");
   EXPECT_EQ(far_frame.status, 0) << far_frame.output;
   EXPECT_EQ(far_frame.output.find("nothing visible"), std::string::npos) << far_frame.output;

@@ -140,7 +140,8 @@ TEST(Output, RgbaRoundTripIsBitExact) {
     }
   }
   // Only finished files remain, no temporaries.
-  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"img_none.exr", "img_piz.exr", "img_rle.exr", "img_zip-fast.exr", "img_zip.exr"}));
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"img_none.exr", "img_piz.exr", "img_rle.exr", "img_zip-fast.exr",
+                                                     "img_zip.exr"}));
 }
 
 // Row 0 of the caller's buffer is EXR's top scanline (y = dataWindow.min.y), checked with OpenEXR
@@ -236,7 +237,8 @@ void check_views_round_trip(bool with_depth, ExrCompression c) {
     ASSERT_EQ(rw, w);
     ASSERT_EQ(rh, h);
     ASSERT_EQ(px.size(), plane * 4);
-    for (size_t k = 0; k < plane * 4; ++k) ASSERT_EQ(px[k], vol[size_t(i) * plane * 4 + k]) << "part " << i << " element " << k;
+    for (size_t k = 0; k < plane * 4; ++k)
+      ASSERT_EQ(px[k], vol[size_t(i) * plane * 4 + k]) << "part " << i << " element " << k;
     if (with_depth) {
       ASSERT_EQ(z.size(), plane);
       for (size_t k = 0; k < plane; ++k) ASSERT_EQ(z[k], depth[size_t(i) * plane + k]) << "part " << i << " Z " << k;
@@ -479,7 +481,8 @@ TEST(Output, SidecarMatricesReproduceTheRig) {
     // view_i = T(-s_i, 0, 0) * center_view, from the JSON numbers alone.
     const glm::dmat4 expect = glm::translate(glm::dmat4(1.0), glm::dvec3(-s, 0.0, 0.0)) * center;
     for (int c = 0; c < 4; ++c)
-      for (int r = 0; r < 4; ++r) EXPECT_NEAR(view[c][r], expect[c][r], 1e-12) << "view " << i << " m[" << c << "][" << r << "]";
+      for (int r = 0; r < 4; ++r)
+        EXPECT_NEAR(view[c][r], expect[c][r], 1e-12) << "view " << i << " m[" << c << "][" << r << "]";
   }
   EXPECT_NEAR(views.at(0).at("offset").get<double>(), -0.5 * rig.baseline(), 1e-12);
 

@@ -61,7 +61,8 @@ struct BoundCheck {
       got.setBits(out.volume[v * 4 + size_t(c)]);
       const double err = std::abs(double(float(got)) - want[c]), tol = 0.01 * std::abs(want[c]) + 1e-3;
       worst = std::max(worst, err / tol);
-      if (err > tol && ++bad <= 5) ADD_FAILURE() << what << " " << v << " channel " << c << ": " << float(got) << " vs " << want[c];
+      if (err > tol && ++bad <= 5)
+        ADD_FAILURE() << what << " " << v << " channel " << c << ": " << float(got) << " vs " << want[c];
     }
   }
 };
@@ -317,8 +318,8 @@ TEST(Pbr, RealModelsWithMapsMatchTheReference) {
     }
     EXPECT_EQ(check.bad, 0u);
     EXPECT_GT(compared, size_t(2000));
-    std::printf("[ pbr      ] %s: %zu voxels, largest error %.3f of the bound\n", fs::path(f).filename().c_str(), compared,
-                check.worst);
+    std::printf("[ pbr      ] %s: %zu voxels, largest error %.3f of the bound\n", fs::path(f).filename().c_str(),
+                compared, check.worst);
   }
   fs::remove_all(tmp);
 }
@@ -376,8 +377,9 @@ TEST(Pbr, SpecularHighlightMovesWithTheViews) {
         const double want = reference.colour(v, *m).y;
         if (want > best_want) best_want = want, at_want = glm::dvec2(px, py);
       }
-    EXPECT_LE(glm::length(at_got - at_want), 1.0 + 1e-9) << "view " << view << ": highlight at (" << at_got.x << ","
-                                                       << at_got.y << "), reference (" << at_want.x << "," << at_want.y << ")";
+    EXPECT_LE(glm::length(at_got - at_want), 1.0 + 1e-9)
+        << "view " << view << ": highlight at (" << at_got.x << "," << at_got.y << "), reference (" << at_want.x << ","
+        << at_want.y << ")";
     if (view == 0) first_got = at_got, first_want = at_want;
     if (view == N - 1) moved_got = at_got.x - first_got.x, moved_want = at_want.x - first_want.x;
   }
@@ -390,7 +392,8 @@ TEST(Pbr, ExposureScalesBothModels) {
   const Rig rig = test::small_rig(3, 40, 24);
   const Scene s = material_quads();
   for (Shading shading : {Shading::Lambert, Shading::Pbr}) {
-    const test::Rendered a = render_pbr(s, rig, 0.0, Method::Pmr, shading), b = render_pbr(s, rig, 1.5, Method::Pmr, shading);
+    const test::Rendered a = render_pbr(s, rig, 0.0, Method::Pmr, shading),
+                         b = render_pbr(s, rig, 1.5, Method::Pmr, shading);
     size_t lit = 0;
     for (size_t i = 0; i < a.volume.size(); ++i) {
       if (i % 4 == 3) continue;
@@ -414,13 +417,13 @@ TEST(Pbr, MethodsShadeAlike) {
   for (size_t v = 0; v < pmr.key.size(); ++v) {
     covered += pmr.key[v] != PMR_NO_KEY;
     if (pmr.key[v] == PMR_NO_KEY || pmr.key[v] != dup.key[v]) continue;
-    for (int c = 0; c < 4; ++c) ASSERT_EQ(pmr.volume[v * 4 + size_t(c)], dup.volume[v * 4 + size_t(c)]) << "voxel " << v;
+    for (int c = 0; c < 4; ++c)
+      ASSERT_EQ(pmr.volume[v * 4 + size_t(c)], dup.volume[v * 4 + size_t(c)]) << "voxel " << v;
     ++same;
   }
   EXPECT_GT(same, covered * 9 / 10);
   EXPECT_GT(covered, size_t(1000));
 }
-
 
 // ---- environment images (--environment) ------------------------------------------------------------
 
@@ -492,7 +495,7 @@ TEST(PbrEnvironment, KernelLookupsMatchTheHost) {
   std::mt19937 g(11);
   std::normal_distribution<double> N;
   std::uniform_real_distribution<double> U(0.0, 1.0);
-  std::vector<glm::dvec3> dirs = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},     {0, -1, 0},     {0, 0, 1},
+  std::vector<glm::dvec3> dirs = {{1, 0, 0},  {-1, 0, 0},   {0, 1, 0},     {0, -1, 0},        {0, 0, 1},
                                   {0, 0, -1}, {1e-3, 0, 1}, {-1e-3, 0, 1}, {0.2, 0.98, 0.01}, test::sun_direction()};
   while (dirs.size() < 4000) dirs.push_back(glm::normalize(glm::dvec3(N(g), N(g), N(g))));
   std::vector<float> in;
@@ -645,7 +648,6 @@ TEST(PbrEnvironment, PathsShadeAlike) {
   EXPECT_NEAR(sum_subpixel, sum_view, 0.05 * sum_view);
 }
 
-
 // ---- KHR_lights_punctual -----------------------------------------------------------------------------
 
 // The reference's light for a scene light, from its definition (colour, intensity, cone angles in
@@ -714,7 +716,8 @@ std::vector<SceneLight> three_lights() {
   sun.color[0] = 1.0f, sun.color[1] = 0.6f, sun.color[2] = 0.3f;
   SceneLight bulb = make_light(SceneLightType::Point, glm::dvec3(0.2, 0.3, 1.5), glm::dvec3(0, 0, -1), 3.0f, 2.2f);
   bulb.color[0] = 0.8f, bulb.color[1] = 0.9f;
-  SceneLight spot = make_light(SceneLightType::Spot, glm::dvec3(0.3, 0.2, 2.0), glm::dvec3(-0.1, 0.0, -1.0), 6.0f, 4.0f);
+  SceneLight spot =
+      make_light(SceneLightType::Spot, glm::dvec3(0.3, 0.2, 2.0), glm::dvec3(-0.1, 0.0, -1.0), 6.0f, 4.0f);
   spot.inner_cone = 0.2f, spot.outer_cone = 0.35f;
   return {sun, bulb, spot};
 }
@@ -727,7 +730,10 @@ TEST(PbrLights, EveryShadedVoxelMatchesTheReferenceUnderEachLight) {
     const char* name;
     std::vector<SceneLight> lights;
     bool leaves_dark;
-  } cases[] = {{"directional", {sun}, false}, {"point", {bulb}, true}, {"spot", {spot}, true}, {"all three", {sun, bulb, spot}, false}};
+  } cases[] = {{"directional", {sun}, false},
+               {"point", {bulb}, true},
+               {"spot", {spot}, true},
+               {"all three", {sun, bulb, spot}, false}};
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
     Scene s = material_quads();
@@ -851,12 +857,12 @@ std::string lit_quad_file(const std::string& dir, bool animated) {
   g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
   g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {
       {{"name", "Bulb"}, {"type", "point"}, {"color", {1.0, 0.9, 0.8}}, {"intensity", 2.0}, {"range", 3.0}}};
-  g.add("materials", {{"pbrMetallicRoughness", {{"baseColorFactor", {0.8, 0.8, 0.8, 1}}, {"metallicFactor", 0.0},
-                                                {"roughnessFactor", 0.5}}}});
+  g.add("materials", {{"pbrMetallicRoughness",
+                       {{"baseColorFactor", {0.8, 0.8, 0.8, 1}}, {"metallicFactor", 0.0}, {"roughnessFactor", 0.5}}}});
   g.mesh(json::array({{{"attributes", {{"POSITION", pos}, {"NORMAL", nrm}}}, {"indices", idx}, {"material", 0}}}));
   g.add("nodes", {{"mesh", 0}});
-  g.add("nodes", {{"name", "BulbNode"}, {"translation", {-1, 0, 1}},
-                  {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  g.add("nodes",
+        {{"name", "BulbNode"}, {"translation", {-1, 0, 1}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
   if (animated) {
     const int times = g.data<float>({0.0f, 1.0f}, kFloat, "SCALAR");
     const int moves = g.data<float>({-1, 0, 1, 1, 0, 1}, kFloat, "VEC3");

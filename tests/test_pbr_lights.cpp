@@ -81,7 +81,8 @@ TEST(PbrLightsSidecar, RecordsEachLightAsUsed) {
   EXPECT_FALSE(d.contains("position"));
   EXPECT_FALSE(d.contains("light"));
   EXPECT_EQ(d.at("intensity"), double(float(0.8 * glm::pi<double>())));
-  for (int c = 0; c < 3; ++c) EXPECT_EQ(d.at("direction").at(c).get<double>(), -j.at("light_dir_world").at(c).get<double>());
+  for (int c = 0; c < 3; ++c)
+    EXPECT_EQ(d.at("direction").at(c).get<double>(), -j.at("light_dir_world").at(c).get<double>());
   // lambert records no lights (its one light is light_dir_*)
   SidecarInfo lambert;
   lambert.lights = lights;
@@ -105,7 +106,8 @@ TEST(PbrLightsSidecar, ConfigDifferenceComparesTheLights) {
   EXPECT_EQ(sidecar_config_difference(here, changed([](auto& l) { l[0].outer_cone = 0.7f; })), "shading");
   EXPECT_EQ(sidecar_config_difference(here, changed([](auto& l) { l[1].range = 0.0f; })), "shading");
   EXPECT_EQ(sidecar_config_difference(here, changed([](auto& l) { l[1].position.x += 1e-9; })), "shading");
-  EXPECT_EQ(sidecar_config_difference(here, changed([](auto& l) { l[0].direction = glm::dvec3(0, 0, -1); })), "shading");
+  EXPECT_EQ(sidecar_config_difference(here, changed([](auto& l) { l[0].direction = glm::dvec3(0, 0, -1); })),
+            "shading");
   EXPECT_EQ(sidecar_config_difference(here, changed([](auto& l) { l.pop_back(); })), "shading");
   // another frame (pmr verify, the folder scan): the poses follow the frame, the rest does not
   EXPECT_EQ(sidecar_config_difference(here, changed([](auto& l) { l[1].position.x += 1.0; }, 6)), "");
@@ -123,8 +125,9 @@ TEST(PbrLightsSidecar, OlderSidecarsCompareAsBefore) {
   old["shading"].erase("lights");
   const std::string with_default = pbr_sidecar(rig, 2, {default_light(rig.light_world())});
   EXPECT_EQ(sidecar_config_difference(old.dump(), with_default), "");
-  EXPECT_EQ(sidecar_config_difference(old.dump(), pbr_sidecar(rig, 2, {file_light(SceneLightType::Point, 0, {0, 1, 0})})),
-            "shading");
+  EXPECT_EQ(
+      sidecar_config_difference(old.dump(), pbr_sidecar(rig, 2, {file_light(SceneLightType::Point, 0, {0, 1, 0})})),
+      "shading");
   EXPECT_EQ(sidecar_config_difference(old.dump(), pbr_sidecar(rig, 2, {})), "shading") << "no light at all";
   json damaged = old;
   damaged.erase("light_dir_world");
@@ -156,12 +159,16 @@ std::string lights_scene(const std::string& dir, double bulb_intensity) {
   g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
   g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {
       {{"name", "Bulb"}, {"type", "point"}, {"intensity", bulb_intensity}, {"range", 5.0}},
-      {{"name", "Spot"}, {"type", "spot"}, {"color", {1.0, 0.5, 0.25}}, {"intensity", 8.0},
+      {{"name", "Spot"},
+       {"type", "spot"},
+       {"color", {1.0, 0.5, 0.25}},
+       {"intensity", 8.0},
        {"spot", {{"innerConeAngle", 0.25}, {"outerConeAngle", 0.5}}}}};
   g.add("materials", {{"pbrMetallicRoughness", {{"metallicFactor", 0.0}, {"roughnessFactor", 0.6}}}});
   g.mesh(json::array({{{"attributes", {{"POSITION", pos}}}, {"indices", idx}, {"material", 0}}}));
   g.add("nodes", {{"mesh", 0}});
-  g.add("nodes", {{"name", "BulbNode"}, {"translation", {-1, 0, 1}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+  g.add("nodes",
+        {{"name", "BulbNode"}, {"translation", {-1, 0, 1}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
   g.add("nodes", {{"translation", {0, 0, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 1}}}}}});
   g.doc["animations"] = {{{"samplers", {{{"input", times}, {"output", moves}}}},
                           {"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}}}}}};
@@ -231,14 +238,14 @@ TEST(PbrLightsSidecar, TheDefaultLightAndLambert) {
   r = run("render --shading pbr --environment '" + sky + "'" + kSmall + "--out " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(sidecar_at(out + "/frame_0000.json").at("shading").at("lights"), json::array());
-  r = run("render '" + lights_scene(in, 2.0) + "' --shading pbr --environment '" + sky + "' --frames 1 --fps 1" + kSmall +
-          "--out " + out + "_image");
+  r = run("render '" + lights_scene(in, 2.0) + "' --shading pbr --environment '" + sky + "' --frames 1 --fps 1" +
+          kSmall + "--out " + out + "_image");
   ASSERT_EQ(r.status, 0) << r.output;
   const json file_lights = sidecar_at(out + "_image/frame_0001.json").at("shading").at("lights");
   ASSERT_EQ(file_lights.size(), 2u);
   EXPECT_EQ(file_lights[0].at("position"), json({1.0, 0.0, 1.0}));
-  r = run("render '" + lights_scene(in, 2.0) + "' --shading pbr --environment '" + sky + "' --frames 1 --fps 1 --resume" +
-          kSmall + "--out " + out + "_image");
+  r = run("render '" + lights_scene(in, 2.0) + "' --shading pbr --environment '" + sky +
+          "' --frames 1 --fps 1 --resume" + kSmall + "--out " + out + "_image");
   EXPECT_NE(r.output.find("nothing to do"), std::string::npos) << r.output;
   r = run("render --shading lambert" + kSmall + "--out " + out);
   ASSERT_EQ(r.status, 0) << r.output;

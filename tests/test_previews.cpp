@@ -58,7 +58,8 @@ std::pair<int, int> covered_box(const std::vector<uint8_t>& rgba, int w, int h) 
   int x0 = w, x1 = -1, y0 = h, y1 = -1;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
-      if (rgba[(size_t(y) * w + x) * 4 + 3] > 127) x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+      if (rgba[(size_t(y) * w + x) * 4 + 3] > 127)
+        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
   return {x1 - x0 + 1, y1 - y0 + 1};
 }
 
@@ -97,8 +98,10 @@ TEST(Previews, CenterPngHasSquarePixelsQuiltPngRecordsTheAspect) {
   const std::string scene = out + "/square.glb";
   test::save_square_glb(scene);
   // 16:9 display, 80x90 views: pixels 16/9 * 90/80 = 2 times as wide as tall
-  const CliRun r = run("render '" + scene + "' --views 4 --view-size 80x90 --display 320x180 --display-size 160x90 "
-                       "--write quilt --quilt 2x2 --preview --out " + out);
+  const CliRun r = run("render '" + scene +
+                       "' --views 4 --view-size 80x90 --display 320x180 --display-size 160x90 "
+                       "--write quilt --quilt 2x2 --preview --out " +
+                       out);
   ASSERT_EQ(r.status, 0) << r.output;
   const nlohmann::json j = sidecar(out + "/frame_0000.json");
   const double aspect = j["rig"]["aspect"].get<double>() * 90.0 / 80.0;
@@ -127,8 +130,10 @@ TEST(Previews, CenterPngHasSquarePixelsQuiltPngRecordsTheAspect) {
 // Square view pixels: the center PNG is the view itself, pixel for pixel.
 TEST(Previews, SquareViewPixelsAreKept) {
   const std::string out = temp_dir("previews_square");
-  const CliRun r = run("render --views 4 --view-size 96x48 --display 240x120 --display-size 200x100 --write views "
-                       "--preview --out " + out);
+  const CliRun r =
+      run("render --views 4 --view-size 96x48 --display 240x120 --display-size 200x100 --write views "
+          "--preview --out " +
+          out);
   ASSERT_EQ(r.status, 0) << r.output;
   int w = 0, h = 0, pw = 0, ph = 0;
   std::vector<uint16_t> view;

@@ -39,16 +39,17 @@ TEST(Quilt, LayoutsFollowTheLookingGlassConventions) {
     const QuiltLayout l = choose_quilt_layout(n, w, h);
     return std::to_string(l.columns) + "x" + std::to_string(l.rows);
   };
-  EXPECT_EQ(layout(48, 420, 560), "8x6");   // Looking Glass Portrait's standard quilt, 3360x3360
-  EXPECT_EQ(layout(45, 819, 455), "5x9");   // the 16" panels' standard quilt, 4095x4095
-  EXPECT_EQ(layout(96, 1024, 512), "8x12");  // 8192x6144
-  EXPECT_EQ(layout(8, 1024, 512), "2x4");    // square
+  EXPECT_EQ(layout(48, 420, 560), "8x6");                      // Looking Glass Portrait's standard quilt, 3360x3360
+  EXPECT_EQ(layout(45, 819, 455), "5x9");                      // the 16" panels' standard quilt, 4095x4095
+  EXPECT_EQ(layout(96, 1024, 512), "8x12");                    // 8192x6144
+  EXPECT_EQ(layout(8, 1024, 512), "2x4");                      // square
   const QuiltLayout prime = choose_quilt_layout(7, 100, 100);  // no exact near-square factorization
   EXPECT_GE(prime.columns * prime.rows, 7);
   EXPECT_LE(prime.columns * prime.rows, 9);
   EXPECT_THROW(choose_quilt_layout(96, 4096, 2048), Error);  // over 16384 px whatever the layout
   EXPECT_EQ(parse_quilt_layout("6x8", 48, 420, 560).columns, 6);
-  for (const char* bad : {"8", "8x", "x6", "0x6", "8x5", "8x6x2", "axb"}) EXPECT_THROW(parse_quilt_layout(bad, 48, 420, 560), Error) << bad;
+  for (const char* bad : {"8", "8x", "x6", "0x6", "8x5", "8x6x2", "axb"})
+    EXPECT_THROW(parse_quilt_layout(bad, 48, 420, 560), Error) << bad;
   try {
     parse_quilt_layout("96x1", 96, 1024, 512);
     ADD_FAILURE() << "a 98304-px-wide quilt was accepted";
@@ -106,8 +107,10 @@ TEST(Quilt, CliQuiltDepthAndPreviews) {
   fs::create_directories(out);
   const std::string scene = out + "/square.glb";
   test::save_square_glb(scene);
-  const CliRun r = run("render '" + scene + "' --views 6 --view-size 96x48 --display 480x270 --write encoded,views,quilt,depth --quilt 3x2 "
-                       "--preview --name f%02d --out " + out);
+  const CliRun r = run("render '" + scene +
+                       "' --views 6 --view-size 96x48 --display 480x270 --write encoded,views,quilt,depth --quilt 3x2 "
+                       "--preview --name f%02d --out " +
+                       out);
   ASSERT_EQ(r.status, 0) << r.output;
   std::ifstream sj(out + "/f00.json");
   std::stringstream text;
@@ -156,8 +159,7 @@ TEST(Quilt, CliQuiltDepthAndPreviews) {
     for (size_t i = 0; i < size_t(w) * h; ++i)
       for (int c = 0; c < 4; ++c) {
         const double lin = half_value(exr[i * 4 + c]);
-        const double expect =
-            255.0 * (c < 3 ? srgb_encode(lin) : opaque ? 1.0 : std::min(1.0, std::max(0.0, lin)));
+        const double expect = 255.0 * (c < 3 ? srgb_encode(lin) : opaque ? 1.0 : std::min(1.0, std::max(0.0, lin)));
         ASSERT_LE(std::abs(double(rgba[i * 4 + c]) - expect), 1.0) << png << " pixel " << i << " channel " << c;
       }
   };
@@ -185,7 +187,7 @@ TEST(Quilt, BadQuiltOptionsFailWithOneLine) {
   const std::string out = temp_dir("quilt_bad");
   test::expect_usage_error(run("render --write depth --out " + out), "depth");
   test::expect_usage_error(run("render --quilt 4x4 --views 8 --view-size 64x32 --display 240x135 --out " + out),
-                              "--write quilt");
+                           "--write quilt");
   test::expect_usage_error(
       run("render --write quilt --quilt 3x2 --views 8 --view-size 64x32 --display 240x135 --out " + out), "6 tiles");
   test::expect_one_error_line(run("render --write quilt --views 96 --view-size 4096x2048 --out " + out), "16384");

@@ -17,34 +17,35 @@ namespace {
 // of x_0 and d.
 TEST(Rig, SnappedPositionsMatchEachViewsMatrices) {
   for (bool angular : test::kSpacings)
-  for (int views : {1, 2, 7, 96}) {
-    SCOPED_TRACE(test::spacing_name(angular));
-    const Rig rig = test::small_rig(views, 1024, 512, angular);
-    Scene s = test::empty_scene();
-    std::mt19937 rng(3);
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-    for (int k = 0; k < 30; ++k) test::add_triangle(s, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
-    Pipeline p(test::runtime(), PipelineConfig{});
-    p.set_scene(s);
-    p.configure(rig, nullptr);
-    p.render(rig);
-    const std::vector<PmrVertex> verts = p.read_vertices();
-    for (size_t v = 0; v < verts.size(); ++v) {
-      const glm::dvec4 world(glm::dvec3(s.positions[v]), 1.0);
-      for (int i = 0; i < views; ++i) {
-        const glm::dvec4 clip = rig.projection(i) * rig.view_matrix(i) * world;
-        const double x = (clip.x / clip.w + 1.0) * 0.5 * rig.view_w;
-        const double y = (1.0 - clip.y / clip.w) * 0.5 * rig.view_h;
-        const double f = rig.view_coord(i);
-        const double xs = (double(verts[v].x0) + f * verts[v].dx) / PMR_X_ONE;
-        // rounding of x0 and of d (times F_i), plus double-precision noise
-        const double tol_x = (0.5 + 0.5 * std::abs(f)) / PMR_X_ONE + 1e-7;
-        ASSERT_NEAR(xs, x, tol_x) << "vertex " << v << " view " << i << " of " << views;
-        ASSERT_NEAR(double(verts[v].y) / PMR_Y_ONE, y, 0.5 / PMR_Y_ONE + 1e-7);
-        ASSERT_NEAR(verts[v].z, (clip.z / clip.w + 1.0) * 0.5, 1e-6);
+    for (int views : {1, 2, 7, 96}) {
+      SCOPED_TRACE(test::spacing_name(angular));
+      const Rig rig = test::small_rig(views, 1024, 512, angular);
+      Scene s = test::empty_scene();
+      std::mt19937 rng(3);
+      std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+      for (int k = 0; k < 30; ++k)
+        test::add_triangle(s, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)});
+      Pipeline p(test::runtime(), PipelineConfig{});
+      p.set_scene(s);
+      p.configure(rig, nullptr);
+      p.render(rig);
+      const std::vector<PmrVertex> verts = p.read_vertices();
+      for (size_t v = 0; v < verts.size(); ++v) {
+        const glm::dvec4 world(glm::dvec3(s.positions[v]), 1.0);
+        for (int i = 0; i < views; ++i) {
+          const glm::dvec4 clip = rig.projection(i) * rig.view_matrix(i) * world;
+          const double x = (clip.x / clip.w + 1.0) * 0.5 * rig.view_w;
+          const double y = (1.0 - clip.y / clip.w) * 0.5 * rig.view_h;
+          const double f = rig.view_coord(i);
+          const double xs = (double(verts[v].x0) + f * verts[v].dx) / PMR_X_ONE;
+          // rounding of x0 and of d (times F_i), plus double-precision noise
+          const double tol_x = (0.5 + 0.5 * std::abs(f)) / PMR_X_ONE + 1e-7;
+          ASSERT_NEAR(xs, x, tol_x) << "vertex " << v << " view " << i << " of " << views;
+          ASSERT_NEAR(double(verts[v].y) / PMR_Y_ONE, y, 0.5 / PMR_Y_ONE + 1e-7);
+          ASSERT_NEAR(verts[v].z, (clip.z / clip.w + 1.0) * 0.5, 1e-6);
+        }
       }
     }
-  }
 }
 
 // A vertex at depth z moves Delta(z) / (N - 1) pixels per view; geometry on the focal plane is
@@ -56,8 +57,10 @@ TEST(Rig, LinearDisparityAndFocalPlane) {
     Scene s = test::empty_scene();
     const double half = 0.4;  // world units; a square of about 20 x 15 px
     const float z = float(rig.focal - w);
-    test::add_triangle(s, {float(-half), float(-half), z}, {float(half), float(-half), z}, {float(half), float(half), z});
-    test::add_triangle(s, {float(-half), float(-half), z}, {float(half), float(half), z}, {float(-half), float(half), z});
+    test::add_triangle(s, {float(-half), float(-half), z}, {float(half), float(-half), z},
+                       {float(half), float(half), z});
+    test::add_triangle(s, {float(-half), float(-half), z}, {float(half), float(half), z},
+                       {float(-half), float(half), z});
     const test::Rendered out = test::render(s, rig);
     const double shift = rig.disparity_px(w) / (N - 1);
     double first = 0;
@@ -74,7 +77,8 @@ TEST(Rig, LinearDisparityAndFocalPlane) {
       // the pixelated square's centroid is within half a pixel of the exact one
       EXPECT_NEAR(cx - first, i * shift, 1.0) << "view " << i << " depth " << w;
       if (w == rig.focal) {
-        for (size_t p = 0; p < plane; ++p) ASSERT_EQ(out.count[i * plane + p], out.count[p]) << "focal plane, view " << i;
+        for (size_t p = 0; p < plane; ++p)
+          ASSERT_EQ(out.count[i * plane + p], out.count[p]) << "focal plane, view " << i;
       }
     }
     if (w != rig.focal) {
@@ -141,7 +145,8 @@ void check_encoder(const Display& display, int views, int vw, int vh, bool all_v
         ++seen;
       }
   EXPECT_EQ(seen, size_t(display.width) * display.height * 3);
-  for (int v = 0; v < views && all_views_shown; ++v) EXPECT_TRUE(views_seen[size_t(v)]) << "view " << v << " never shown";
+  for (int v = 0; v < views && all_views_shown; ++v)
+    EXPECT_TRUE(views_seen[size_t(v)]) << "view " << v << " never shown";
 }
 
 TEST(Encode, ParsesCalibrationPrecisionExactly) {
@@ -157,7 +162,7 @@ TEST(Encode, ParsesCalibrationPrecisionExactly) {
   const Rational r18 = parse_rational("0.123456789012345678", "x");  // 18 significant digits, exact
   EXPECT_EQ((__int128)r18.num * 1000000000000000000, (__int128)123456789012345678 * r18.den);
   EXPECT_THROW(parse_rational("0.000123456789012345678", "x"), Error);  // denominator 10^21
-  EXPECT_THROW(parse_rational("1.2345678901234567890", "x"), Error);  // 20 significant digits
+  EXPECT_THROW(parse_rational("1.2345678901234567890", "x"), Error);    // 20 significant digits
   EXPECT_THROW(parse_rational("1e-30", "x"), Error);
   EXPECT_THROW(parse_rational("1e", "x"), Error);
 }

@@ -27,7 +27,6 @@ using nlohmann::json;
 
 using namespace pmr::test::gltf_builder_detail;
 
-
 bool any_warning(const Scene& s, const std::string& part) {
   for (const std::string& w : s.warnings)
     if (contains(w, part)) return true;
@@ -37,9 +36,9 @@ bool any_warning(const Scene& s, const std::string& part) {
 glm::vec3 corner(const Scene& s, size_t tri, int k) { return s.positions[s.triangles[tri].v[k]]; }
 glm::vec3 vec3(const float* f) { return {f[0], f[1], f[2]}; }
 
-#define EXPECT_VEC3_NEAR(a, b, tol)                                               \
-  do {                                                                            \
-    const glm::vec3 a_ = (a), b_ = (b);                                            \
+#define EXPECT_VEC3_NEAR(a, b, tol)                                                           \
+  do {                                                                                        \
+    const glm::vec3 a_ = (a), b_ = (b);                                                       \
     EXPECT_NEAR(a_.x, b_.x, tol) << #a " = (" << a_.x << ", " << a_.y << ", " << a_.z << ")"; \
     EXPECT_NEAR(a_.y, b_.y, tol) << #a " = (" << a_.x << ", " << a_.y << ", " << a_.z << ")"; \
     EXPECT_NEAR(a_.z, b_.z, tol) << #a " = (" << a_.x << ", " << a_.y << ", " << a_.z << ")"; \
@@ -48,9 +47,8 @@ glm::vec3 vec3(const float* f) { return {f[0], f[1], f[2]}; }
 class SceneLoaderTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pmr_scene_loader_" + std::to_string(getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = fs::temp_directory_path() / ("pmr_scene_loader_" + std::to_string(getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -141,7 +139,8 @@ TEST_F(SceneLoaderTest, IndexTypesAndNonIndexedGiveTheSameTriangles) {
   const int i16 = g.data<uint16_t>({0, 1, 2, 0, 2, 3}, kUShort, "SCALAR");
   const int i32 = g.data<uint32_t>({0, 1, 2, 0, 2, 3}, kUInt, "SCALAR");
   const float pad = -99.0f;
-  const int strided_view = g.view<float>({0, 0, 0, pad, 1, 0, 0, pad, 1, 1, 0, pad, 0, 0, 0, pad, 1, 1, 0, pad, 0, 1, 0, pad}, 16);
+  const int strided_view =
+      g.view<float>({0, 0, 0, pad, 1, 0, 0, pad, 1, 1, 0, pad, 0, 0, 0, pad, 1, 1, 0, pad, 0, 1, 0, pad}, 16);
   const int strided = g.accessor(strided_view, kFloat, "VEC3", 6);
   g.mesh(json::array({{{"attributes", {{"POSITION", pos}}}, {"indices", i8}},
                       {{"attributes", {{"POSITION", pos}}}, {"indices", i16}},
@@ -200,7 +199,8 @@ TEST_F(SceneLoaderTest, SparseAccessorsAreApplied) {
                                          {"indices", {{"bufferView", sparse_idx16}, {"componentType", kUShort}}},
                                          {"values", {{"bufferView", sparse_val}}}};
   const int idx = g.data<uint16_t>({0, 1, 2, 0, 2, 3}, kUShort, "SCALAR");
-  g.mesh(json::array({{{"attributes", {{"POSITION", pos}}}, {"indices", idx}}, {{"attributes", {{"POSITION", zeros}}}}}));
+  g.mesh(
+      json::array({{{"attributes", {{"POSITION", pos}}}, {"indices", idx}}, {{"attributes", {{"POSITION", zeros}}}}}));
   g.add("nodes", {{"mesh", 0}});
   g.scene({0});
   const Scene s = load_scene(g.write(dir_, "sparse"));
@@ -268,17 +268,20 @@ TEST_F(SceneLoaderTest, MaterialsTexturesSamplersAndTextureTransform) {
   g.add("samplers", {{"wrapS", 33648}, {"wrapT", 33071}});
   for (int i = 0; i < 6; ++i) g.add("textures", {{"source", i}, {"sampler", 0}});
   json tt = {{"offset", {0, 1}}, {"rotation", 1.57079632679}, {"scale", {0.5, 0.5}}, {"texCoord", 1}};
-  g.add("materials", {{"pbrMetallicRoughness",
-                       {{"baseColorFactor", {0.5, 0.25, 1, 1}},
-                        {"baseColorTexture", {{"index", 0}, {"texCoord", 0}, {"extensions", {{"KHR_texture_transform", tt}}}}}}},
-                      {"alphaMode", "MASK"},
-                      {"alphaCutoff", 0.25},
-                      {"doubleSided", true}});
+  g.add("materials",
+        {{"pbrMetallicRoughness",
+          {{"baseColorFactor", {0.5, 0.25, 1, 1}},
+           {"baseColorTexture", {{"index", 0}, {"texCoord", 0}, {"extensions", {{"KHR_texture_transform", tt}}}}}}},
+         {"alphaMode", "MASK"},
+         {"alphaCutoff", 0.25},
+         {"doubleSided", true}});
   g.add("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 1}}}}}, {"alphaMode", "BLEND"}});
   for (int t = 2; t < 6; ++t) g.add("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", t}}}}}});
   json prims = json::array();
   for (int m = 0; m < 6; ++m)
-    prims.push_back({{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv0}, {"TEXCOORD_1", uv1}}}, {"indices", idx}, {"material", m}});
+    prims.push_back({{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv0}, {"TEXCOORD_1", uv1}}},
+                     {"indices", idx},
+                     {"material", m}});
   g.mesh(prims);
   g.add("nodes", {{"mesh", 0}});
   g.scene({0});
@@ -293,7 +296,9 @@ TEST_F(SceneLoaderTest, MaterialsTexturesSamplersAndTextureTransform) {
   EXPECT_EQ(s.materials[2].alpha_mode, PMR_ALPHA_BLEND);
   EXPECT_EQ(s.materials[3].alpha_cutoff, 0.5f);
   ASSERT_EQ(s.textures.size(), 4u);  // the missing and the undecodable image give none
-  auto texture = [&](int material) -> const SceneTexture& { return s.textures[size_t(s.materials[size_t(material)].texture)]; };
+  auto texture = [&](int material) -> const SceneTexture& {
+    return s.textures[size_t(s.materials[size_t(material)].texture)];
+  };
   ASSERT_GE(m0.texture, 0);
   EXPECT_EQ(texture(1).width, 2);
   EXPECT_EQ(texture(1).height, 1);
@@ -381,8 +386,10 @@ TEST_F(SceneLoaderTest, GlbDetectedByContentNotExtension) {
 TEST_F(SceneLoaderTest, CamerasArePlacedByTheirNodes) {
   GltfFile g = unit_triangle();
   g.add("cameras", {{"type", "perspective"}, {"name", "main"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}});
-  g.add("cameras", {{"type", "orthographic"}, {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 10}}}});
-  g.add("cameras", {{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 1}, {"zfar", 50}, {"aspectRatio", 2}}}});
+  g.add("cameras",
+        {{"type", "orthographic"}, {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 10}}}});
+  g.add("cameras",
+        {{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 1}, {"zfar", 50}, {"aspectRatio", 2}}}});
   g.add("nodes", {{"mesh", 0}, {"translation", {1, 0, 0}}, {"children", {1}}});
   g.add("nodes", {{"camera", 0}, {"translation", {0, 0, 5}}});
   g.add("nodes", {{"camera", 1}});
@@ -416,10 +423,12 @@ TEST_F(SceneLoaderTest, AnimatedCameraAndMirroringScale) {
   const int times = g.data<float>({0.0f, 1.0f}, kFloat, "SCALAR");
   const int scales = g.data<float>({1, 1, 1, -1, 1, 1}, kFloat, "VEC3");
   const int moves = g.data<float>({0, 0, 5, 2, 0, 5}, kFloat, "VEC3");
-  g.doc["animations"] = {{{"samplers", {{{"input", times}, {"output", scales}, {"interpolation", "STEP"}},
-                                        {{"input", times}, {"output", moves}}}},
-                          {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "scale"}}}},
-                                        {{"sampler", 1}, {"target", {{"node", 1}, {"path", "translation"}}}}}}}};
+  g.doc["animations"] = {
+      {{"samplers",
+        {{{"input", times}, {"output", scales}, {"interpolation", "STEP"}}, {{"input", times}, {"output", moves}}}},
+       {"channels",
+        {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "scale"}}}},
+         {{"sampler", 1}, {"target", {{"node", 1}, {"path", "translation"}}}}}}}};
   const Scene s = load_scene(g.write(dir_, "animated_camera"));
   PoseRequest r;
   r.animation = 0;
@@ -436,7 +445,8 @@ TEST_F(SceneLoaderTest, AnimatedCameraAndMirroringScale) {
   EXPECT_EQ(p.triangles[0].v[2], s.triangles[0].v[1]);
   EXPECT_EQ(glm::vec3(p.triangles[0].face_normal[0], p.triangles[0].face_normal[1], p.triangles[0].face_normal[2]),
             glm::vec3(0, 0, 1));
-  EXPECT_EQ(glm::vec3(p.attributes[0].normal[0], p.attributes[0].normal[1], p.attributes[0].normal[2]), glm::vec3(0, 0, 1));
+  EXPECT_EQ(glm::vec3(p.attributes[0].normal[0], p.attributes[0].normal[1], p.attributes[0].normal[2]),
+            glm::vec3(0, 0, 1));
 }
 
 // Without scenes, every root node is drawn (with its children).
@@ -490,7 +500,8 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
        "accessor 2 (indices of mesh 0 primitive 0) reads index 7 but POSITION has 3 vertices"},
       {"accessor overruns bufferView", [](GltfFile& g) { g.doc["accessors"][0]["count"] = 4; },
        "accessor 0 (POSITION of mesh 0 primitive 0) overruns bufferView 0"},
-      {"accessor offset overruns bufferView", [](GltfFile& g) { g.doc["accessors"][1]["byteOffset"] = 4; }, "overruns bufferView 1"},
+      {"accessor offset overruns bufferView", [](GltfFile& g) { g.doc["accessors"][1]["byteOffset"] = 4; },
+       "overruns bufferView 1"},
       {"huge count", [](GltfFile& g) { g.doc["accessors"][0]["count"] = 1000000000000ull; }, "count 1000000000000"},
       {"huge count without bufferView",
        [](GltfFile& g) {
@@ -498,16 +509,21 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
          g.doc["accessors"][0]["count"] = 1000000000000ull;
        },
        "implicit zero elements"},
-      {"count overflowing 64 bits", [](GltfFile& g) { g.doc["accessors"][0]["count"] = 0xffffffffffffffffull; }, "overruns bufferView"},
+      {"count overflowing 64 bits", [](GltfFile& g) { g.doc["accessors"][0]["count"] = 0xffffffffffffffffull; },
+       "overruns bufferView"},
       {"bufferView overruns buffer", [](GltfFile& g) { g.doc["bufferViews"][1]["byteLength"] = 1000; },
        "bufferView 1 (byteOffset 36, byteLength 1000) overruns buffer 0"},
-      {"bufferView offset overflow", [](GltfFile& g) { g.doc["bufferViews"][1]["byteOffset"] = 0xfffffffffffffff0ull; }, "overruns buffer 0"},
-      {"bufferView index out of range", [](GltfFile& g) { g.doc["accessors"][1]["bufferView"] = 9; }, "refers to bufferView 9"},
-      {"buffer index out of range", [](GltfFile& g) { g.doc["bufferViews"][0]["buffer"] = 3; }, "bufferView 0 refers to buffer 3"},
-      {"accessor index out of range", [](GltfFile& g) { g.doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 42; },
-       "refers to accessor 42"},
+      {"bufferView offset overflow", [](GltfFile& g) { g.doc["bufferViews"][1]["byteOffset"] = 0xfffffffffffffff0ull; },
+       "overruns buffer 0"},
+      {"bufferView index out of range", [](GltfFile& g) { g.doc["accessors"][1]["bufferView"] = 9; },
+       "refers to bufferView 9"},
+      {"buffer index out of range", [](GltfFile& g) { g.doc["bufferViews"][0]["buffer"] = 3; },
+       "bufferView 0 refers to buffer 3"},
+      {"accessor index out of range",
+       [](GltfFile& g) { g.doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 42; }, "refers to accessor 42"},
       {"mesh index out of range", [](GltfFile& g) { g.doc["nodes"][0]["mesh"] = 5; }, "node 0 refers to mesh 5"},
-      {"material index out of range", [](GltfFile& g) { g.doc["meshes"][0]["primitives"][0]["material"] = 2; }, "refers to material 2"},
+      {"material index out of range", [](GltfFile& g) { g.doc["meshes"][0]["primitives"][0]["material"] = 2; },
+       "refers to material 2"},
       {"texture index out of range",
        [](GltfFile& g) {
          g.add("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 4}}}}}});
@@ -527,7 +543,8 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
        },
        "texture 0 refers to sampler 2"},
       {"camera index out of range", [](GltfFile& g) { g.doc["nodes"][0]["camera"] = 0; }, "node 0 refers to camera 0"},
-      {"child index out of range", [](GltfFile& g) { g.doc["nodes"][0]["children"] = {7}; }, "node 0 children refers to node 7"},
+      {"child index out of range", [](GltfFile& g) { g.doc["nodes"][0]["children"] = {7}; },
+       "node 0 children refers to node 7"},
       {"scene node out of range", [](GltfFile& g) { g.scene({3}); }, "scene 0 refers to node 3"},
       {"default scene out of range", [](GltfFile& g) { g.doc["scene"] = 4; }, "refers to scene 4"},
       {"node cycle",
@@ -552,7 +569,8 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
          g.scene({0, 1});
        },
        "lists node 1 as a root, but it is a child of node 0"},
-      {"matrix of 15 values", [](GltfFile& g) { g.doc["nodes"][0]["matrix"] = std::vector<double>(15, 1.0); }, "16 expected"},
+      {"matrix of 15 values", [](GltfFile& g) { g.doc["nodes"][0]["matrix"] = std::vector<double>(15, 1.0); },
+       "16 expected"},
       {"matrix value beyond double range",
        [](GltfFile& g) {
          std::vector<double> m = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
@@ -560,7 +578,11 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
          g.doc["nodes"][0]["matrix"] = m;
        },
        "invalid JSON: number overflow"},
-      {"zero quaternion", [](GltfFile& g) { g.doc["nodes"][0]["rotation"] = {0, 0, 0, 0}; }, "zero-length rotation"},
+      {"zero quaternion",
+       [](GltfFile& g) {
+         g.doc["nodes"][0]["rotation"] = {0, 0, 0, 0};
+       },
+       "zero-length rotation"},
       {"overflowing world matrix",
        [](GltfFile& g) {
          g.doc["nodes"][0]["scale"] = {1e300, 1, 1};
@@ -570,16 +592,21 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
        "node 1 has a world matrix that overflows"},
       {"POSITION as UNSIGNED_INT", [](GltfFile& g) { g.doc["accessors"][0]["componentType"] = kUInt; },
        "componentType UNSIGNED_INT, which POSITION does not allow"},
-      {"POSITION as VEC2", [](GltfFile& g) { g.doc["accessors"][0]["type"] = "VEC2"; }, "type VEC2, which POSITION does not allow"},
+      {"POSITION as VEC2", [](GltfFile& g) { g.doc["accessors"][0]["type"] = "VEC2"; },
+       "type VEC2, which POSITION does not allow"},
       {"normalized float", [](GltfFile& g) { g.doc["accessors"][1]["normalized"] = true; }, "FLOAT (normalized)"},
-      {"float indices", [](GltfFile& g) { g.doc["accessors"][2]["componentType"] = kFloat; }, "which indices does not allow"},
-      {"byteStride below element size", [](GltfFile& g) { g.doc["bufferViews"][0]["byteStride"] = 4; }, "has byteStride 4"},
-      {"NORMAL count differs", [](GltfFile& g) { g.doc["accessors"][1]["count"] = 2; }, "has 2 elements but POSITION has 3"},
+      {"float indices", [](GltfFile& g) { g.doc["accessors"][2]["componentType"] = kFloat; },
+       "which indices does not allow"},
+      {"byteStride below element size", [](GltfFile& g) { g.doc["bufferViews"][0]["byteStride"] = 4; },
+       "has byteStride 4"},
+      {"NORMAL count differs", [](GltfFile& g) { g.doc["accessors"][1]["count"] = 2; },
+       "has 2 elements but POSITION has 3"},
       {"sparse index out of range",
        [](GltfFile& g) {
-         g.doc["accessors"][0]["sparse"] = {{"count", 1},
-                                            {"indices", {{"bufferView", 2}, {"componentType", kUShort}, {"byteOffset", 4}}},
-                                            {"values", {{"bufferView", 0}}}};
+         g.doc["accessors"][0]["sparse"] = {
+             {"count", 1},
+             {"indices", {{"bufferView", 2}, {"componentType", kUShort}, {"byteOffset", 4}}},
+             {"values", {{"bufferView", 0}}}};
          g.bin[g.doc["bufferViews"][2]["byteOffset"].get<size_t>() + 4] = 200;
        },
        "sparse index 200 but only 3 elements"},
@@ -611,7 +638,8 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
        "requires extension EXT_foo_bar, which this renderer does not support"},
       {"glTF 1.0", [](GltfFile& g) { g.doc["asset"]["version"] = "1.0"; }, "glTF version 1.0 is not supported"},
       {"no asset", [](GltfFile& g) { g.doc.erase("asset"); }, "asset.version is missing"},
-      {"accessor without componentType", [](GltfFile& g) { g.doc["accessors"][0].erase("componentType"); }, "not a valid glTF file"},
+      {"accessor without componentType", [](GltfFile& g) { g.doc["accessors"][0].erase("componentType"); },
+       "not a valid glTF file"},
       // the schema's minimums, which tinygltf would coerce (gltf_schema.cpp)
       {"negative bufferView byteOffset", [](GltfFile& g) { g.doc["bufferViews"][1]["byteOffset"] = -4; },
        "bufferView 1 byteOffset is -4, which the glTF schema does not allow (minimum 0)"},
@@ -625,37 +653,46 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
       {"byteStride above 252", [](GltfFile& g) { g.doc["bufferViews"][0]["byteStride"] = 256; }, "from 4 to 252"},
       {"fractional index", [](GltfFile& g) { g.doc["nodes"][0]["mesh"] = 0.5; }, "node 0 mesh is not an integer"},
       {"negative mesh index", [](GltfFile& g) { g.doc["nodes"][0]["mesh"] = -1; }, "node 0 mesh is -1"},
-      {"negative attribute accessor", [](GltfFile& g) { g.doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = -2; },
+      {"negative attribute accessor",
+       [](GltfFile& g) { g.doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = -2; },
        "mesh 0 primitive 0 attribute NORMAL is -2"},
       {"animation sampler out of range",
-       set_animations(R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":1,"target":{"node":0,"path":"translation"}}]}])"),
+       set_animations(
+           R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":1,"target":{"node":0,"path":"translation"}}]}])"),
        "animation 0 channel 0 sampler refers to sampler 1, but the file has 1"},
       {"animation target node out of range",
-       set_animations(R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":0,"target":{"node":9,"path":"translation"}}]}])"),
+       set_animations(
+           R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":0,"target":{"node":9,"path":"translation"}}]}])"),
        "animation 0 channel 0 target node refers to node 9"},
       {"animation path unknown",
-       set_animations(R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"colour"}}]}])"),
+       set_animations(
+           R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"colour"}}]}])"),
        "animation 0 channel 0 target path is 'colour'; the glTF schema allows translation, rotation, scale, weights"},
       {"animation interpolation unknown",
-       set_animations(R"([{"samplers":[{"input":3,"output":4,"interpolation":"CUBIC"}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
+       set_animations(
+           R"([{"samplers":[{"input":3,"output":4,"interpolation":"CUBIC"}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
        "animation 0 sampler 0 interpolation is 'CUBIC'"},
       {"animation input accessor out of range",
-       set_animations(R"([{"samplers":[{"input":30,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
+       set_animations(
+           R"([{"samplers":[{"input":30,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
        "animation 0 sampler 0 input refers to accessor 30"},
-      {"animation without channels",
-       set_animations(R"([{"samplers":[{"input":3,"output":4}]}])"),
+      {"animation without channels", set_animations(R"([{"samplers":[{"input":3,"output":4}]}])"),
        "animation 0 has no channels"},
       {"animation input not float scalars",
-       set_animations(R"([{"samplers":[{"input":4,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
+       set_animations(
+           R"([{"samplers":[{"input":4,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"scale"}}]}])"),
        "animation 0 sampler 0 input (accessor 4) must hold float scalars"},
       {"animation output type for the path",
-       set_animations(R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"rotation"}}]}])"),
+       set_animations(
+           R"([{"samplers":[{"input":3,"output":4}],"channels":[{"sampler":0,"target":{"node":0,"path":"rotation"}}]}])"),
        "animates rotation but its sampler's output (accessor 4) has type VEC3, VEC4 expected"},
       {"animation CUBICSPLINE key count",
-       set_animations(R"([{"samplers":[{"input":3,"output":5,"interpolation":"CUBICSPLINE"}],"channels":[{"sampler":0,"target":{"node":0,"path":"rotation"}}]}])"),
+       set_animations(
+           R"([{"samplers":[{"input":3,"output":5,"interpolation":"CUBICSPLINE"}],"channels":[{"sampler":0,"target":{"node":0,"path":"rotation"}}]}])"),
        "sampler 0 has 2 key times but 2 output elements (6 expected)"},
       {"animated weights without morph targets",
-       set_animations(R"([{"samplers":[{"input":3,"output":3}],"channels":[{"sampler":0,"target":{"node":0,"path":"weights"}}]}])"),
+       set_animations(
+           R"([{"samplers":[{"input":3,"output":3}],"channels":[{"sampler":0,"target":{"node":0,"path":"weights"}}]}])"),
        "animates weights of a node without morph targets"},
       {"animation key times not increasing",
        [](GltfFile& g) {
@@ -676,7 +713,8 @@ TEST_F(SceneLoaderTest, MalformedFilesThrowClearErrors) {
     g.scene({0});
     c.edit(g);
     std::string path = g.write(dir_, "bad");
-    if (std::string(c.name) == "matrix value beyond double range") {  // nlohmann cannot write an infinity; patch the text
+    if (std::string(c.name) ==
+        "matrix value beyond double range") {  // nlohmann cannot write an infinity; patch the text
       std::ifstream in(path);
       std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
       const size_t at = text.find("null");
@@ -745,9 +783,10 @@ TEST_F(SceneLoaderTest, BrokenFilesThrowClearErrors) {
   EXPECT_TRUE(contains(load_error(text_file("empty.gltf", "")), "file is empty"));
   EXPECT_TRUE(contains(load_error(text_file("bad.gltf", "{ \"asset\": { \"version\": \"2.0\" }, ")), "invalid JSON"));
   EXPECT_TRUE(contains(load_error(text_file("array.gltf", "[1, 2]")), "top level is not an object"));
-  EXPECT_TRUE(contains(load_error(text_file("deep.gltf", "{\"asset\":{\"version\":\"2.0\"},\"extras\":" +
-                                                              std::string(100000, '[') + std::string(100000, ']') + "}")),
-                       "nested more than"));
+  EXPECT_TRUE(contains(
+      load_error(text_file("deep.gltf", "{\"asset\":{\"version\":\"2.0\"},\"extras\":" + std::string(100000, '[') +
+                                            std::string(100000, ']') + "}")),
+      "nested more than"));
 
   // External buffer problems name the file.
   GltfFile g = unit_triangle();
@@ -808,8 +847,8 @@ std::string corpus() {
   return fs::is_directory(p) ? p.lexically_normal().string() : std::string();
 }
 
-#define REQUIRE_CORPUS()                                                           \
-  const std::string dir = corpus();                                                \
+#define REQUIRE_CORPUS()            \
+  const std::string dir = corpus(); \
   if (dir.empty()) GTEST_SKIP() << PMR_SOURCE_DIR "/../shared/gltf not found"
 
 // Triangle counts from the corpus's own README table (one per model, the same for all its variants):
@@ -860,7 +899,9 @@ TEST(SceneLoaderCorpus, EveryModelLoadsWithTheReadmeTriangleCount) {
     SCOPED_TRACE(path);
     if (contains(path, "glTF-Draco")) {
       const std::string e = load_error(path);
-      EXPECT_TRUE(contains(e, "requires KHR_draco_mesh_compression (Draco-compressed meshes), which this renderer does not support")) << e;
+      EXPECT_TRUE(contains(
+          e, "requires KHR_draco_mesh_compression (Draco-compressed meshes), which this renderer does not support"))
+          << e;
       continue;
     }
     ASSERT_TRUE(kCorpusTriangles.count(model)) << "model not in the README table: " << model;
@@ -876,7 +917,8 @@ TEST(SceneLoaderCorpus, EveryModelLoadsWithTheReadmeTriangleCount) {
     for (const PmrTriangle& t : s.triangles) {
       ASSERT_LT(t.material, s.materials.size());
       for (uint32_t v : t.v) ASSERT_LT(v, s.positions.size());
-      const float n2 = t.face_normal[0] * t.face_normal[0] + t.face_normal[1] * t.face_normal[1] + t.face_normal[2] * t.face_normal[2];
+      const float n2 = t.face_normal[0] * t.face_normal[0] + t.face_normal[1] * t.face_normal[1] +
+                       t.face_normal[2] * t.face_normal[2];
       ASSERT_NEAR(n2, 1.0f, 1e-5f);
     }
     for (const PmrMaterial& m : s.materials) ASSERT_LT(m.texture, int(s.textures.size()));
@@ -887,7 +929,8 @@ TEST(SceneLoaderCorpus, EveryModelLoadsWithTheReadmeTriangleCount) {
 
 TEST(SceneLoaderCorpus, BoxTexturedHasIts256x256TextureInEveryVariant) {
   REQUIRE_CORPUS();
-  for (const char* variant : {"glTF/BoxTextured.gltf", "glTF-Binary/BoxTextured.glb", "glTF-Embedded/BoxTextured.gltf"}) {
+  for (const char* variant :
+       {"glTF/BoxTextured.gltf", "glTF-Binary/BoxTextured.glb", "glTF-Embedded/BoxTextured.gltf"}) {
     SCOPED_TRACE(variant);
     const Scene s = load_scene(dir + "/BoxTextured/" + variant);
     ASSERT_EQ(s.textures.size(), 1u);

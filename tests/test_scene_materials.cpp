@@ -41,7 +41,8 @@ class SceneMaterialsTest : public ::testing::Test {
 };
 
 size_t warnings_with(const Scene& s, const std::string& part) {
-  return size_t(std::count_if(s.warnings.begin(), s.warnings.end(), [&](const std::string& w) { return contains(w, part); }));
+  return size_t(
+      std::count_if(s.warnings.begin(), s.warnings.end(), [&](const std::string& w) { return contains(w, part); }));
 }
 
 std::string all_warnings(const Scene& s) {
@@ -96,7 +97,8 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
           {{"baseColorTexture", {{"index", 0}}},
            {"metallicFactor", 0.3},
            {"roughnessFactor", 0.6},
-           {"metallicRoughnessTexture", {{"index", 1}, {"texCoord", 1}, {"extensions", {{"KHR_texture_transform", mr_transform}}}}}}},
+           {"metallicRoughnessTexture",
+            {{"index", 1}, {"texCoord", 1}, {"extensions", {{"KHR_texture_transform", mr_transform}}}}}}},
          {"normalTexture", {{"index", 2}, {"texCoord", 1}, {"scale", 0.5}}},
          {"occlusionTexture", {{"index", 4}, {"strength", 0.25}}},
          {"emissiveTexture", {{"index", 3}, {"extensions", {{"KHR_texture_transform", {{"texCoord", 1}}}}}}},
@@ -105,10 +107,11 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
           {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}},
            {"KHR_materials_clearcoat", {{"clearcoatFactor", 1}, {"clearcoatTexture", {{"index", 5}}}}}}}});
   g.add("materials", {{"name", "Flat"}, {"extensions", {{"KHR_materials_unlit", json::object()}}}});
-  g.mesh(json::array({{{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}, {"TEXCOORD_1", uv1}}},
-                       {"indices", q.idx},
-                       {"material", 0}},
-                      {{"attributes", {{"POSITION", q.pos}, {"TEXCOORD_0", q.uv0}}}, {"indices", q.idx}, {"material", 1}}}));
+  g.mesh(json::array(
+      {{{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}, {"TEXCOORD_1", uv1}}},
+        {"indices", q.idx},
+        {"material", 0}},
+       {{"attributes", {{"POSITION", q.pos}, {"TEXCOORD_0", q.uv0}}}, {"indices", q.idx}, {"material", 1}}}));
   g.add("nodes", {{"mesh", 0}});
   g.scene({0});
   const Scene s = load_scene(g.write(dir_, "materials"));
@@ -158,13 +161,15 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   // clear coat image is neither decoded nor read.
   ASSERT_EQ(s.textures.size(), 4u);
   EXPECT_EQ(sl[kSlotOcclusion].texture, sl[kSlotMetallicRoughness].texture);
-  EXPECT_EQ(s.textures[size_t(sl[kSlotOcclusion].texture)].slots, (1u << kSlotMetallicRoughness) | (1u << kSlotOcclusion));
+  EXPECT_EQ(s.textures[size_t(sl[kSlotOcclusion].texture)].slots,
+            (1u << kSlotMetallicRoughness) | (1u << kSlotOcclusion));
   EXPECT_EQ(s.textures[size_t(sl[kSlotOcclusion].texture)].rgba, (std::vector<uint8_t>{255, 128, 64, 255}));
   EXPECT_EQ(s.textures[size_t(sl[kSlotNormal].texture)].rgba, (std::vector<uint8_t>{128, 128, 255, 255}));
   EXPECT_EQ(s.textures[size_t(sl[kSlotEmissive].texture)].slots, 1u << kSlotEmissive);
   std::vector<std::string> read;
   for (const SceneInputFile& f : s.input_files) read.push_back(f.path);
-  EXPECT_EQ(read, (std::vector<std::string>{"materials.bin", "normal.png"})) << "the normal map is a file read, the clear coat image is not";
+  EXPECT_EQ(read, (std::vector<std::string>{"materials.bin", "normal.png"}))
+      << "the normal map is a file read, the clear coat image is not";
 
   // TEXCOORD_0 and _1 as stored, for every vertex; the second primitive has no TEXCOORD_1 (its material
   // samples none): zeros.
@@ -186,7 +191,8 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   EXPECT_EQ(s.structure.generated_tangent_primitives, 1u);
 
   EXPECT_EQ(warnings_with(s, "KHR_materials_clearcoat"), 1u) << all_warnings(s);
-  EXPECT_EQ(warnings_with(s, "KHR_materials_clearcoat (1 material): drawn without the clear coat layer"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "KHR_materials_clearcoat (1 material): drawn without the clear coat layer"), 1u)
+      << all_warnings(s);
 }
 
 TEST_F(SceneMaterialsTest, OutOfRangeFactorsAreClampedWithAWarning) {
@@ -211,13 +217,17 @@ TEST_F(SceneMaterialsTest, ATexCoordSetTheMeshLacksIsAnError) {
   g.add("images", {{"uri", png_uri(kPixel)}});
   g.add("textures", {{"source", 0}});
   g.add("materials", {{"name", "Bumpy"}, {"normalTexture", {{"index", 0}, {"texCoord", 2}}}});
-  g.add("meshes", {{"name", "Plate"},
-                   {"primitives", {{{"attributes", {{"POSITION", q.pos}, {"TEXCOORD_0", q.uv0}}}, {"indices", q.idx}, {"material", 0}}}}});
+  g.add("meshes",
+        {{"name", "Plate"},
+         {"primitives",
+          {{{"attributes", {{"POSITION", q.pos}, {"TEXCOORD_0", q.uv0}}}, {"indices", q.idx}, {"material", 0}}}}});
   g.add("nodes", {{"mesh", 0}});
   g.scene({0});
   const std::string path = g.write(dir_, "noset");
   const std::string e = load_error(path);
-  EXPECT_EQ(e, path + ": material 0 'Bumpy' normalTexture samples TEXCOORD_2, which mesh 0 'Plate' primitive 0 does not have");
+  EXPECT_EQ(
+      e,
+      path + ": material 0 'Bumpy' normalTexture samples TEXCOORD_2, which mesh 0 'Plate' primitive 0 does not have");
 }
 
 // ---- tangents ------------------------------------------------------------------------------------------------
@@ -232,10 +242,11 @@ TEST_F(SceneMaterialsTest, FileTangentsFollowNodesMorphsMirrorsAndTheTurntable) 
   g.add("images", {{"uri", png_uri(kPixel)}});
   g.add("textures", {{"source", 0}});
   g.add("materials", {{"normalTexture", {{"index", 0}}}});
-  g.add("meshes", {{"primitives", {{{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}, {"TANGENT", tan}}},
-                                    {"targets", {{{"TANGENT", dtan}}}},
-                                    {"indices", q.idx},
-                                    {"material", 0}}}},
+  g.add("meshes", {{"primitives",
+                    {{{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}, {"TANGENT", tan}}},
+                      {"targets", {{{"TANGENT", dtan}}}},
+                      {"indices", q.idx},
+                      {"material", 0}}}},
                    {"weights", {0}}});
   const double h = std::sqrt(0.5);
   g.add("nodes", {{"mesh", 0}, {"rotation", {0, 0, h, h}}});  // 90 degrees about +Z
@@ -289,8 +300,13 @@ TEST_F(SceneMaterialsTest, SkinnedTangentsFollowTheJointMatrices) {
   g.add("images", {{"uri", png_uri(kPixel)}});
   g.add("textures", {{"source", 0}});
   g.add("materials", {{"normalTexture", {{"index", 0}}}});
-  g.mesh(json::array({{{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}, {"TANGENT", tan},
-                                       {"JOINTS_0", joints}, {"WEIGHTS_0", weights}}},
+  g.mesh(json::array({{{"attributes",
+                        {{"POSITION", q.pos},
+                         {"NORMAL", q.nrm},
+                         {"TEXCOORD_0", q.uv0},
+                         {"TANGENT", tan},
+                         {"JOINTS_0", joints},
+                         {"WEIGHTS_0", weights}}},
                        {"indices", q.idx},
                        {"material", 0}}}));
   g.add("nodes", {{"mesh", 0}, {"skin", 0}, {"translation", {5, 0, 0}}});  // ignored: skinned
@@ -330,7 +346,9 @@ TEST_F(SceneMaterialsTest, GeneratedTangentsFollowTheUvDirections) {
   g.add("materials", {{"normalTexture", {{"index", 0}}}});
   json prims = json::array();
   for (int uv : {q.uv0, flip_u, flip_v})
-    prims.push_back({{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", uv}}}, {"indices", q.idx}, {"material", 0}});
+    prims.push_back({{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", uv}}},
+                     {"indices", q.idx},
+                     {"material", 0}});
   g.mesh(prims);
   g.add("nodes", {{"mesh", 0}});
   g.scene({0});
@@ -362,7 +380,7 @@ GltfFile lights_file() {
   g.mesh(json::array({{{"attributes", {{"POSITION", q.pos}}}, {"indices", q.idx}}}));
   const double h = std::sqrt(0.5);
   auto light = [](int i) { return json{{"KHR_lights_punctual", {{"light", i}}}}; };
-  g.add("nodes", {{"mesh", 0}});                                                                // 0
+  g.add("nodes", {{"mesh", 0}});                                                                 // 0
   g.add("nodes", {{"name", "Arm"}, {"translation", {0, 2, 0}}, {"children", {2}}});              // 1
   g.add("nodes", {{"name", "BulbNode"}, {"translation", {1, 0, 0}}, {"extensions", light(1)}});  // 2
   g.add("nodes", {{"rotation", {-h, 0, 0, h}}, {"extensions", light(0)}});                       // 3: -90 deg about X
@@ -408,8 +426,9 @@ TEST_F(SceneMaterialsTest, LightsMoveWithTheirNodesAnimationAndTheTurntable) {
   const double h = std::sqrt(0.5);
   const int turns = g.data<float>({0, 0, 0, 1, 0, float(h), 0, float(h)}, kFloat, "VEC4");  // 0 -> 90 deg about +Y
   g.doc["animations"] = {{{"samplers", {{{"input", times}, {"output", moves}}, {{"input", times}, {"output", turns}}}},
-                          {"channels", {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}},
-                                        {{"sampler", 1}, {"target", {{"node", 4}, {"path", "rotation"}}}}}}}};
+                          {"channels",
+                           {{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}},
+                            {{"sampler", 1}, {"target", {{"node", 4}, {"path", "rotation"}}}}}}}};
   const Scene s = load_scene(g.write(dir_, "animated_lights"));
   PoseRequest r;
   r.animation = 0;
@@ -459,21 +478,32 @@ const std::vector<LightCase>& light_cases() {
   static const std::vector<LightCase> cases = {
       {"negative intensity", [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] = -1; },
        "KHR_lights_punctual light 0 'Sun' has a negative intensity (-1)"},
-      {"non-numeric intensity", [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] = "bright"; },
+      {"non-numeric intensity",
+       [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"] = "bright"; },
        "KHR_lights_punctual light 0 'Sun' intensity is not a number"},
-      {"negative colour", [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][0]["color"] = {1, -0.5, 0}; },
+      {"negative colour",
+       [](json& d) {
+         d["extensions"]["KHR_lights_punctual"]["lights"][0]["color"] = {1, -0.5, 0};
+       },
        "KHR_lights_punctual light 0 'Sun' color has a negative value (-0.5)"},
-      {"short colour", [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][0]["color"] = {1, 1}; },
+      {"short colour",
+       [](json& d) {
+         d["extensions"]["KHR_lights_punctual"]["lights"][0]["color"] = {1, 1};
+       },
        "color is not an array of 3 numbers"},
       {"zero range", [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][1]["range"] = 0; },
        "KHR_lights_punctual light 1 'Bulb' range must be positive (is 0)"},
       {"negative range", [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][1]["range"] = -2.5; },
        "range must be positive (is -2.5)"},
-      {"inner cone = outer cone", [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][2]["spot"]["innerConeAngle"] = 0.5; },
-       "KHR_lights_punctual light 2 spot cone angles must satisfy 0 <= innerConeAngle < outerConeAngle <= pi/2 (inner 0.500000, outer 0.500000)"},
-      {"outer cone beyond pi/2", [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][2]["spot"]["outerConeAngle"] = 2; },
+      {"inner cone = outer cone",
+       [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][2]["spot"]["innerConeAngle"] = 0.5; },
+       "KHR_lights_punctual light 2 spot cone angles must satisfy 0 <= innerConeAngle < outerConeAngle <= pi/2 (inner "
+       "0.500000, outer 0.500000)"},
+      {"outer cone beyond pi/2",
+       [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][2]["spot"]["outerConeAngle"] = 2; },
        "(inner 0.200000, outer 2.000000)"},
-      {"negative inner cone", [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][2]["spot"]["innerConeAngle"] = -0.1; },
+      {"negative inner cone",
+       [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][2]["spot"]["innerConeAngle"] = -0.1; },
        "(inner -0.100000, outer 0.500000)"},
       {"unknown type", [](json& d) { d["extensions"]["KHR_lights_punctual"]["lights"][1]["type"] = "area"; },
        "KHR_lights_punctual light 1 'Bulb' has unknown type 'area' (directional, point or spot expected)"},
@@ -522,7 +552,8 @@ TEST_F(SceneMaterialsTest, OverflowingLightColourAndRangeAreErrors) {
                {"\"range\":10", "\"range\":1e999", "range is not finite"}};
   for (const auto& c : cases) {
     SCOPED_TRACE(c.to);
-    std::string text = lights_file().finished("data:application/octet-stream;base64," + base64(lights_file().bin)).dump();
+    std::string text =
+        lights_file().finished("data:application/octet-stream;base64," + base64(lights_file().bin)).dump();
     ASSERT_NE(text.find(c.from), std::string::npos) << text;
     text.replace(text.find(c.from), std::string(c.from).size(), c.to);
     std::ofstream(dir_ / "inf.gltf") << text;
@@ -537,32 +568,37 @@ TEST_F(SceneMaterialsTest, OverflowingLightColourAndRangeAreErrors) {
 TEST_F(SceneMaterialsTest, OneWarningPerUnimplementedMaterialExtension) {
   GltfFile g;
   const Quad q = quad(g);
-  g.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_sheen",
-                             "KHR_materials_pbrSpecularGlossiness", "KHR_materials_foo", "KHR_lights_punctual"};
+  g.doc["extensionsUsed"] = {"KHR_materials_transmission",          "KHR_materials_volume", "KHR_materials_sheen",
+                             "KHR_materials_pbrSpecularGlossiness", "KHR_materials_foo",    "KHR_lights_punctual"};
   g.doc["extensionsRequired"] = {"KHR_materials_transmission", "KHR_materials_pbrSpecularGlossiness"};
   const json transmission = {{"KHR_materials_transmission", {{"transmissionFactor", 1}}}};
   g.add("materials", {{"extensions", transmission}});
   g.add("materials", {{"extensions", transmission}});
-  g.add("materials", {{"extensions", {{"KHR_materials_transmission", json::object()}, {"KHR_materials_volume", json::object()}}}});
+  g.add("materials",
+        {{"extensions", {{"KHR_materials_transmission", json::object()}, {"KHR_materials_volume", json::object()}}}});
   g.add("materials", {{"extensions", {{"KHR_materials_pbrSpecularGlossiness", {{"glossinessFactor", 0.5}}}}}});
   g.add("materials", {{"extensions", {{"KHR_materials_sheen", json::object()}}}});  // no primitive uses it
   json prims = json::array();
-  for (int m = 0; m < 4; ++m) prims.push_back({{"attributes", {{"POSITION", q.pos}}}, {"indices", q.idx}, {"material", m}});
+  for (int m = 0; m < 4; ++m)
+    prims.push_back({{"attributes", {{"POSITION", q.pos}}}, {"indices", q.idx}, {"material", m}});
   g.mesh(prims);
   g.add("nodes", {{"mesh", 0}});
   g.scene({0});
   const Scene s = load_scene(g.write(dir_, "extensions"));
   EXPECT_EQ(warnings_with(s, "KHR_materials_transmission"), 1u) << all_warnings(s);
-  EXPECT_EQ(warnings_with(s, "KHR_materials_transmission (3 materials): drawn opaque, without transmission"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "KHR_materials_transmission (3 materials): drawn opaque, without transmission"), 1u)
+      << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "KHR_materials_volume (1 material): drawn as thin surfaces"), 1u) << all_warnings(s);
-  EXPECT_EQ(warnings_with(s, "KHR_materials_pbrSpecularGlossiness (1 material): drawn from their metallic-roughness"), 1u)
+  EXPECT_EQ(warnings_with(s, "KHR_materials_pbrSpecularGlossiness (1 material): drawn from their metallic-roughness"),
+            1u)
       << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "KHR_materials_sheen"), 0u) << "no drawn material uses it\n" << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "extensions used but not implemented, ignored: KHR_materials_foo"), 1u) << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "KHR_lights_punctual"), 0u) << all_warnings(s);
   // An unknown required extension is still refused.
   g.doc["extensionsRequired"] = {"KHR_materials_foo"};
-  EXPECT_TRUE(contains(load_error(g.write(dir_, "required")), "requires extension KHR_materials_foo")) << "unknown stays refused";
+  EXPECT_TRUE(contains(load_error(g.write(dir_, "required")), "requires extension KHR_materials_foo"))
+      << "unknown stays refused";
 }
 
 // ---- the command line ------------------------------------------------------------------------------------------
@@ -584,25 +620,29 @@ TEST_F(SceneMaterialsTest, CliRefusesInvalidLightsWithoutWritingFiles) {
 TEST_F(SceneMaterialsTest, InfoListsLightsAndMaterialFeatures) {
   GltfFile g = lights_file();
   const int uv1 = g.data<float>({0, 2, 2, 2, 2, 0, 0, 0}, kFloat, "VEC2");
-  g.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = g.data<float>({0, 1, 1, 1, 1, 0, 0, 0}, kFloat, "VEC2");
+  g.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] =
+      g.data<float>({0, 1, 1, 1, 1, 0, 0, 0}, kFloat, "VEC2");
   g.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = uv1;
   g.doc["meshes"][0]["primitives"][0]["material"] = 0;
   g.add("images", {{"uri", png_uri(make_png(2, 1, 6, 8, {1, 2, 3, 4, 5, 6, 7, 8}))}});
   g.add("textures", {{"source", 0}});
-  g.add("materials", {{"name", "Shiny\x1b[31m"},
-                      {"alphaMode", "MASK"},
-                      {"doubleSided", true},
-                      {"pbrMetallicRoughness", {{"metallicRoughnessTexture", {{"index", 0}, {"texCoord", 1},
-                                                  {"extensions", {{"KHR_texture_transform", {{"offset", {0.5, 0}}}}}}}}}},
-                      {"emissiveFactor", {1, 0.5, 0.25}},
-                      {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}},
-                                      {"KHR_materials_unlit", json::object()}}}});
+  g.add("materials",
+        {{"name", "Shiny\x1b[31m"},
+         {"alphaMode", "MASK"},
+         {"doubleSided", true},
+         {"pbrMetallicRoughness",
+          {{"metallicRoughnessTexture",
+            {{"index", 0}, {"texCoord", 1}, {"extensions", {{"KHR_texture_transform", {{"offset", {0.5, 0}}}}}}}}}},
+         {"emissiveFactor", {1, 0.5, 0.25}},
+         {"extensions",
+          {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}}, {"KHR_materials_unlit", json::object()}}}});
   g.doc["asset"]["generator"] = "Exporter\x1b[2J";
   const std::string path = g.write(dir_, "info");
   const test::CliRun r = test::run("info '" + path + "'");
   ASSERT_EQ(r.status, 0) << r.output;
   for (const char* part :
-       {"lights: 4", "0 'Bulb' (light 1): point, node 2 'BulbNode', color (1, 1, 1), intensity 40 cd, range 10, at (1, 2, 0)",
+       {"lights: 4",
+        "0 'Bulb' (light 1): point, node 2 'BulbNode', color (1, 1, 1), intensity 40 cd, range 10, at (1, 2, 0)",
         "1 'Sun' (light 0): directional, node 3 (unnamed), color (1, 0.5, 0.25), intensity 3 lux, toward (0, -1, 0)",
         "spot, node 4", "cones inner 11.4592 deg outer 28.6479 deg",
         "1 'Shiny\\x1b[31m': alpha MASK (cutoff 0.5), double sided, unlit",
@@ -655,7 +695,8 @@ std::string write_variant(const fs::path& model, const json& doc, const fs::path
                           const std::vector<uint8_t>& glb_bin, bool glb) {
   fs::create_directories(dir);
   for (const auto& e : fs::directory_iterator(model.parent_path()))
-    if (e.path() != model && !fs::exists(dir / e.path().filename())) fs::create_symlink(e.path(), dir / e.path().filename());
+    if (e.path() != model && !fs::exists(dir / e.path().filename()))
+      fs::create_symlink(e.path(), dir / e.path().filename());
   if (!glb) {
     const fs::path out = dir / (name + ".gltf");
     std::ofstream(out) << doc.dump();
@@ -707,7 +748,10 @@ TEST(SceneMaterialsCorpus, GeneratedTangentsMatchTheFilesTangents) {
     json doc;
     std::vector<uint8_t> bin;
     if (glb) {  // JSON chunk, then the BIN chunk
-      auto u32 = [&](size_t o) { return uint32_t(bytes[o]) | uint32_t(bytes[o + 1]) << 8 | uint32_t(bytes[o + 2]) << 16 | uint32_t(bytes[o + 3]) << 24; };
+      auto u32 = [&](size_t o) {
+        return uint32_t(bytes[o]) | uint32_t(bytes[o + 1]) << 8 | uint32_t(bytes[o + 2]) << 16 |
+               uint32_t(bytes[o + 3]) << 24;
+      };
       const uint32_t json_length = u32(12);
       doc = json::parse(bytes.begin() + 20, bytes.begin() + 20 + json_length);
       const size_t b = 20 + json_length;
@@ -719,8 +763,10 @@ TEST(SceneMaterialsCorpus, GeneratedTangentsMatchTheFilesTangents) {
     // the variants' folder links to the model's files, which lie outside it
     InputLimits linked;
     linked.allow_outside_scene_folder = true;
-    const Scene file = load_scene(write_variant(model, tangent_test_doc(doc, false, set), dir, "file", bin, glb), linked);
-    const Scene gen = load_scene(write_variant(model, tangent_test_doc(doc, true, set), dir, "generated", bin, glb), linked);
+    const Scene file =
+        load_scene(write_variant(model, tangent_test_doc(doc, false, set), dir, "file", bin, glb), linked);
+    const Scene gen =
+        load_scene(write_variant(model, tangent_test_doc(doc, true, set), dir, "generated", bin, glb), linked);
     ASSERT_EQ(file.tangents.size(), gen.tangents.size());
     ASSERT_GT(gen.structure.generated_tangent_primitives, 0u);
     // Vertices where no triangle has a UV area (all its UVs on a line) have no defined tangent, and
@@ -748,11 +794,13 @@ TEST(SceneMaterialsCorpus, GeneratedTangentsMatchTheFilesTangents) {
     ASSERT_FALSE(angles.empty());
     std::sort(angles.begin(), angles.end());
     auto pct = [&](double p) { return angles[std::min(angles.size() - 1, size_t(p * double(angles.size())))]; };
-    const double within = double(std::upper_bound(angles.begin(), angles.end(), 1.0) - angles.begin()) / double(angles.size());
-    std::printf("[ tangents ] %-62s %7zu vertices (%zu without UV area): median %.4f, p90 %.4f, p99 %.4f, max %.2f deg; "
-                "%.2f%% within 1 deg; w agrees on %.2f%%\n",
-                rel.c_str(), angles.size(), undefined, pct(0.5), pct(0.9), pct(0.99), angles.back(), 100.0 * within,
-                100.0 * double(same_w) / double(angles.size()));
+    const double within =
+        double(std::upper_bound(angles.begin(), angles.end(), 1.0) - angles.begin()) / double(angles.size());
+    std::printf(
+        "[ tangents ] %-62s %7zu vertices (%zu without UV area): median %.4f, p90 %.4f, p99 %.4f, max %.2f deg; "
+        "%.2f%% within 1 deg; w agrees on %.2f%%\n",
+        rel.c_str(), angles.size(), undefined, pct(0.5), pct(0.9), pct(0.99), angles.back(), 100.0 * within,
+        100.0 * double(same_w) / double(angles.size()));
     if (!mikk) continue;  // other exporters' tangents are reported, not required to match
     EXPECT_GE(within, 0.99) << "generated tangents within 1 degree of the file's on 99% of the vertices";
     EXPECT_GE(double(same_w) / double(angles.size()), min_w) << "handedness";

@@ -127,7 +127,8 @@ TEST(Sequence, FramesAreIndependentOfTheSequence) {
 // the missing frames; a changed configuration is refused unless --overwrite.
 TEST(Sequence, ResumeAfterInterruptRendersOnlyTheMissingFrames) {
   const std::string out = temp_dir("seq_resume");
-  const std::string args = " --turntable 360:10 --frames 0:9 --views 32 --view-size 512x256 --display 1920x1080 --out " + out;
+  const std::string args =
+      " --turntable 360:10 --frames 0:9 --views 32 --view-size 512x256 --display 1920x1080 --out " + out;
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {

@@ -84,7 +84,8 @@ TEST(Shading, TexturedVertexColouredLitMatchesReference) {
   test::add_triangle(s, {-1.2f, -0.9f, 0.4f}, {1.1f, -0.8f, -0.6f}, {1.0f, 0.9f, -0.2f});
   test::add_triangle(s, {-1.2f, -0.9f, 0.4f}, {1.0f, 0.9f, -0.2f}, {-1.1f, 1.0f, 0.5f});
   const float uv[6][2] = {{-0.3f, 1.7f}, {2.4f, 1.5f}, {2.2f, -1.1f}, {-0.3f, 1.7f}, {2.2f, -1.1f}, {-0.5f, -0.9f}};
-  const float col[6][4] = {{1, 0.2f, 0.2f, 1}, {0.2f, 1, 0.2f, 1}, {0.2f, 0.2f, 1, 1}, {1, 0.2f, 0.2f, 1}, {0.2f, 0.2f, 1, 1}, {1, 1, 1, 1}};
+  const float col[6][4] = {{1, 0.2f, 0.2f, 1}, {0.2f, 1, 0.2f, 1}, {0.2f, 0.2f, 1, 1},
+                           {1, 0.2f, 0.2f, 1}, {0.2f, 0.2f, 1, 1}, {1, 1, 1, 1}};
   for (int k = 0; k < 6; ++k) {
     PmrVertexAttr& a = s.attributes[size_t(k)];
     a.uv[0] = uv[k][0], a.uv[1] = uv[k][1];
@@ -118,7 +119,8 @@ TEST(Shading, AlphaMaskDiscardsBelowCutoff) {
   test::add_triangle(s, {-6, -3, 0.5f}, {6, -3, 0.5f}, {6, 3, 0.5f}, 1);
   test::add_triangle(s, {-6, -3, 0.5f}, {6, 3, 0.5f}, {-6, 3, 0.5f}, 1);
   const float uv[6][2] = {{0, 4}, {8, 4}, {8, 0}, {0, 4}, {8, 0}, {0, 0}};
-  for (int k = 0; k < 6; ++k) s.attributes[size_t(6 + k)].uv[0] = uv[k][0], s.attributes[size_t(6 + k)].uv[1] = uv[k][1];
+  for (int k = 0; k < 6; ++k)
+    s.attributes[size_t(6 + k)].uv[0] = uv[k][0], s.attributes[size_t(6 + k)].uv[1] = uv[k][1];
   const test::Rendered out = test::render_with(s, rig, lambert());
   std::multimap<uint32_t, PmrMta> by_key;
   for (const PmrMta& m : out.mtas) by_key.emplace(m.key, m);
@@ -172,8 +174,7 @@ TEST(Shading, BrightColoursSaturateAtTheLargestHalf) {
     int w = 0, h = 0;
     if (variant.find("--write views") != std::string::npos)
       read_views_exr_part(out + "/" + name + ".views.exr", 1, w, h, px);
-    else
-      read_rgba_exr(out + "/" + name + ".exr", w, h, px);
+    else read_rgba_exr(out + "/" + name + ".exr", w, h, px);
     ASSERT_FALSE(px.empty());
     size_t saturated = 0;
     for (size_t i = 0; i < px.size(); ++i) {

@@ -38,7 +38,7 @@ SubpixelRender render_subpixels(const Scene& scene, const Rig& rig, const Displa
   pc.tile_x = tile[0], pc.tile_y = tile[1], pc.tile_v = tile[2];
   pc.sampling = Sampling::Subpixel;
   pc.shading = Shading::Lambert;  // compared with the Lambert reference
-  pc.fuse_encode = true;  // no view volume: debug outputs per display subpixel
+  pc.fuse_encode = true;          // no view volume: debug outputs per display subpixel
   pc.debug_outputs = true;
   Pipeline p(test::runtime(), pc);
   p.set_scene(scene);
@@ -81,7 +81,8 @@ TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
                        // row class), the shader's 1 - fract phase, BGR subpixel order
       d.cell_rows = 2;
       d.cell_offsets.clear();
-      for (int k = 0; k < 12; ++k) d.cell_offsets.push_back(int64_t(std::uniform_int_distribution<int>(-300, 300)(rng)) * 10000000000000LL / 100);
+      for (int k = 0; k < 12; ++k)
+        d.cell_offsets.push_back(int64_t(std::uniform_int_distribution<int>(-300, 300)(rng)) * 10000000000000LL / 100);
       d.phase_sign = -1;
       d.subpixel_bgr = true;
     }
@@ -90,7 +91,8 @@ TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
     Scene scene = test::random_scene(150, 900u + unsigned(trial), trial % 2 == 0);
     if (trial == 7)  // huge triangles, clipped by near, far and the guard band (the paths for wide extents)
       for (int k = 0; k < 4; ++k)
-        test::add_triangle(scene, {-5000.0f + k, -3000.0f, -1.0f + 0.3f * k}, {3500.0f, -2.0f - k, 3.5f}, {-3.0f, 4500.0f, -2.0f + k});
+        test::add_triangle(scene, {-5000.0f + k, -3000.0f, -1.0f + 0.3f * k}, {3500.0f, -2.0f - k, 3.5f},
+                           {-3.0f, 4500.0f, -2.0f + k});
     const int wide_tile[3] = {64, 4, 8};
     const int* tile = trial == 10 ? wide_tile : tiles[trial % 5];
     SCOPED_TRACE("trial " + std::to_string(trial) + ": " + std::to_string(rc.views) + " views of " +
@@ -118,7 +120,8 @@ TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
       half value;
       value.setBits(got.display[(at / 3) * 4 + at % 3]);
       if (want.key[at] == PMR_NO_KEY) {
-        if (value.bits() != 0 && ++colour_bad <= 5) ADD_FAILURE() << "background subpixel " << at << " is " << float(value);
+        if (value.bits() != 0 && ++colour_bad <= 5)
+          ADD_FAILURE() << "background subpixel " << at << " is " << float(value);
         continue;
       }
       ++covered_total;
@@ -143,7 +146,8 @@ TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
                          half(want.key[3 * px + 2] != PMR_NO_KEY ? 1.0f : 0.0f)};
       const half alpha((float(a[0]) + float(a[1]) + float(a[2])) / 3.0f);
       if (got.display[px * 4 + 3] != alpha.bits() && ++alpha_bad <= 5)
-        ADD_FAILURE() << "display pixel " << px << ": alpha bits " << got.display[px * 4 + 3] << ", want " << alpha.bits();
+        ADD_FAILURE() << "display pixel " << px << ": alpha bits " << got.display[px * 4 + 3] << ", want "
+                      << alpha.bits();
       const int a0 = int(a[0]), a1 = int(a[1]), a2 = int(a[2]);
       straddles_seen += (a0 + a1 + a2) % 3 != 0;
     }
@@ -171,7 +175,9 @@ TEST(SubpixelSampling, SamplesOnEdgesFollowTheTopLeftRule) {
   const Rig rig = make_rig(rc, d, glm::dvec3(-1.0), glm::dvec3(1.0));
   Scene scene = test::empty_scene(false);
   // grid lines through sample columns s = 9c + 4 and sample rows i = 4r + 2
-  auto corner = [&](int c, int r) { return test::focal_point(rig, (2.0 * (9 * c + 4) + 1.0) / 4.0, 2.0 * (4 * r + 2) + 1.0); };
+  auto corner = [&](int c, int r) {
+    return test::focal_point(rig, (2.0 * (9 * c + 4) + 1.0) / 4.0, 2.0 * (4 * r + 2) + 1.0);
+  };
   for (int r = 0; r + 1 < 7; ++r)
     for (int c = 0; c + 1 < 20; ++c) {
       const glm::vec3 a = corner(c, r), b = corner(c + 1, r), e = corner(c + 1, r + 1), f = corner(c, r + 1);
@@ -211,8 +217,8 @@ TEST(SubpixelSampling, SamplesOnEdgesFollowTheTopLeftRule) {
     for (size_t at = 0; at < want.key.size(); ++at) {
       covered += want.key[at] != PMR_NO_KEY;
       if (got.key[at] != want.key[at] && ++bad <= 5)
-        ADD_FAILURE() << "subpixel " << at << " (sample " << want.x[at] << ", " << want.y[at] << "): key " << got.key[at]
-                      << ", reference " << want.key[at];
+        ADD_FAILURE() << "subpixel " << at << " (sample " << want.x[at] << ", " << want.y[at] << "): key "
+                      << got.key[at] << ", reference " << want.key[at];
     }
     EXPECT_EQ(bad, 0u);
     EXPECT_GT(covered, 3000u);
@@ -228,7 +234,8 @@ TEST(SubpixelSampling, CloserToAFinerReferenceThanViewSampling) {
   if (test::corpus_dir().empty())
     std::printf("[  NOTE    ] ../shared/gltf is absent: the real-model cases are skipped\n");
   else
-    for (const char* m : {"Duck/glTF-Binary/Duck.glb", "Avocado/glTF/Avocado.gltf"}) scenes.push_back(test::corpus_dir() + "/" + m);
+    for (const char* m : {"Duck/glTF-Binary/Duck.glb", "Avocado/glTF/Avocado.gltf"})
+      scenes.push_back(test::corpus_dir() + "/" + m);
   Display d;
   d.width = 480, d.height = 270;
   RigConfig rc;
@@ -288,7 +295,8 @@ TEST(SubpixelSampling, CommandLine) {
   test::expect_usage_error(test::run("bench --sampling view,subpixel --bilinear --views 2"), "--bilinear");
   // without the encoded image there is nothing to sample per subpixel: a warning, the views as usual
   const std::string views_only = test::temp_dir("subpixel_views_only");
-  const test::CliRun v = test::run("render --sampling subpixel --write views --views 4 --view-size 32x16 --display 96x54 --out " + views_only);
+  const test::CliRun v = test::run(
+      "render --sampling subpixel --write views --views 4 --view-size 32x16 --display 96x54 --out " + views_only);
   ASSERT_EQ(v.status, 0) << v.output;
   EXPECT_NE(v.output.find("warning: --sampling subpixel samples the encoded image"), std::string::npos) << v.output;
   EXPECT_TRUE(test::exists(views_only + "/frame_0000.views.exr"));
@@ -300,8 +308,10 @@ TEST(SubpixelSampling, CommandLine) {
   EXPECT_NE(test::read_file(out + "/frame_0000.json").find("\"sampling\": \"subpixel\""), std::string::npos);
   // angular camera spacing (a Looking Glass preset's) renders subpixel sampling with PMR
   const std::string lg = test::temp_dir("subpixel_angular");
-  const test::CliRun a = test::run("render --sampling subpixel --preset lg-portrait --views 6 --view-size 42x56 "
-                                   "--display 153x204 --out " + lg);
+  const test::CliRun a = test::run(
+      "render --sampling subpixel --preset lg-portrait --views 6 --view-size 42x56 "
+      "--display 153x204 --out " +
+      lg);
   ASSERT_EQ(a.status, 0) << a.output;
   const std::string sidecar = test::read_file(lg + "/frame_0000.json");
   EXPECT_NE(sidecar.find("\"sampling\": \"subpixel\""), std::string::npos);
@@ -317,14 +327,16 @@ TEST(SubpixelSampling, CommandLine) {
     const std::string dir = lg + "/fallback" + std::to_string(opt.size());
     const test::CliRun f = test::run("render " + opt + lg_small + dir);
     ASSERT_EQ(f.status, 0) << f.output;
-    EXPECT_NE(f.output.find("warning: " + opt + " samples the rendered views: --sampling view instead"), std::string::npos)
+    EXPECT_NE(f.output.find("warning: " + opt + " samples the rendered views: --sampling view instead"),
+              std::string::npos)
         << f.output;
     EXPECT_NE(test::read_file(dir + "/frame_0000.json").find("\"sampling\": \"view\""), std::string::npos) << opt;
     test::expect_usage_error(test::run("render --sampling subpixel " + opt + lg_small + dir + "x"),
                              opt == "--method multipass" ? "--method pmr" : opt);
   }
   // pmr bench --preset measures the preset as a user gets it: angular spacing, subpixel sampling
-  const test::CliRun b = test::run("bench --preset lg-portrait --views 2 --view-size 42x56 --frames 1 --no-check --method pmr");
+  const test::CliRun b =
+      test::run("bench --preset lg-portrait --views 2 --view-size 42x56 --frames 1 --no-check --method pmr");
   ASSERT_EQ(b.status, 0) << b.output;
   EXPECT_NE(b.output.find("pmr        subpixel"), std::string::npos) << b.output;
   EXPECT_EQ(b.output.find("pmr        view"), std::string::npos) << b.output;
@@ -351,7 +363,8 @@ TEST(SubpixelSampling, EqualsViewSamplingWhereSamplesArePixelCenters) {
   scene.materials.push_back(mask);
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> uv(0.0f, 3.0f);
-  for (size_t t = 0; t < scene.triangles.size(); t += 2) scene.triangles[t].material = uint32_t(scene.materials.size() - 1);
+  for (size_t t = 0; t < scene.triangles.size(); t += 2)
+    scene.triangles[t].material = uint32_t(scene.materials.size() - 1);
   for (PmrVertexAttr& a : scene.attributes) a.uv[0] = uv(rng), a.uv[1] = uv(rng);
   Display d;
   d.width = 64, d.height = 40;
@@ -386,7 +399,8 @@ TEST(SubpixelSampling, ImageDifferenceCountsColourChannelsOnly) {
   // two pixels: alpha differs everywhere (ignored), one colour channel by 0.5, one by 2^-9 (under the
   // differing threshold)
   const std::vector<uint16_t> a = {half(0.5f).bits(), 0, half(0.25f).bits(), half(1.0f).bits(), 0, 0, 0, 0};
-  const std::vector<uint16_t> b = {half(0.0f).bits(), 0, half(0.25f + 1.0f / 512).bits(), 0, 0, 0, 0, half(1.0f).bits()};
+  const std::vector<uint16_t> b = {half(0.0f).bits(), 0, half(0.25f + 1.0f / 512).bits(), 0, 0, 0, 0,
+                                   half(1.0f).bits()};
   const ImageDifference d = compare_display_images(a, b);
   EXPECT_NEAR(d.rmse, std::sqrt((0.25 + 1.0 / (512.0 * 512.0)) / 6.0), 1e-9);
   EXPECT_NEAR(d.rmse_shown, d.rmse, 1e-12) << "values within [0, 1] are shown as they are";
@@ -398,7 +412,8 @@ TEST(SubpixelSampling, ImageDifferenceCountsColourChannelsOnly) {
 TEST(SubpixelSampling, ShownDifferenceClampsToTheDisplayRange) {
   const uint16_t inf = 0x7c00u;
   const std::vector<uint16_t> a = {half(1.0e4f).bits(), inf, half(-2.0f).bits(), 0, half(0.5f).bits(), 0, 0, 0};
-  const std::vector<uint16_t> b = {half(0.0f).bits(), half(1.0f).bits(), half(0.0f).bits(), 0, half(2.0f).bits(), 0, 0, 0};
+  const std::vector<uint16_t> b = {
+      half(0.0f).bits(), half(1.0f).bits(), half(0.0f).bits(), 0, half(2.0f).bits(), 0, 0, 0};
   const ImageDifference d = compare_display_images(a, b);
   EXPECT_NEAR(d.rmse_shown, std::sqrt((1.0 + 0.25) / 6.0), 1e-12);
   EXPECT_TRUE(std::isinf(d.rmse)) << "the linear RMSE keeps the infinite value";

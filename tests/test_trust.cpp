@@ -94,14 +94,20 @@ std::string write_quad(const std::string& dir, const Quad& q) {
       {"scenes", {{{"nodes", {0}}}}},
       {"nodes", {{{"mesh", 0}}}},
       {"meshes",
-       {{{"primitives", {{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}, {"TEXCOORD_0", 2}}}, {"indices", 3}, {"material", 0}}}}}}},
+       {{{"primitives",
+          {{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}, {"TEXCOORD_0", 2}}}, {"indices", 3}, {"material", 0}}}}}}},
       {"bufferViews",
        {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 48}},
         {{"buffer", 0}, {"byteOffset", 48}, {"byteLength", 48}},
         {{"buffer", 0}, {"byteOffset", 96}, {"byteLength", 32}},
         {{"buffer", 0}, {"byteOffset", 128}, {"byteLength", 12}}}},
       {"accessors",
-       {{{"bufferView", 0}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}, {"min", {-s, -s, 0}}, {"max", {s, s, 0}}},
+       {{{"bufferView", 0},
+         {"componentType", 5126},
+         {"count", 4},
+         {"type", "VEC3"},
+         {"min", {-s, -s, 0}},
+         {"max", {s, s, 0}}},
         {{"bufferView", 1}, {"componentType", 5126}, {"count", 4}, {"type", "VEC3"}},
         {{"bufferView", 2}, {"componentType", 5126}, {"count", 4}, {"type", "VEC2"}},
         {{"bufferView", 3}, {"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}}}},
@@ -170,7 +176,8 @@ TEST(Trust, VerifyChecksEveryListedOutput) {
   v = run("verify " + out + " --frames 0:2 --write encoded");
   EXPECT_EQ(v.status, 0) << v.output;
   // --resume renders both again; then the folder verifies
-  const test::CliRun again = run("render " + scene + " --frames 0:2 --resume --write encoded,views,quilt" + kSmall + "--out " + out);
+  const test::CliRun again =
+      run("render " + scene + " --frames 0:2 --resume --write encoded,views,quilt" + kSmall + "--out " + out);
   EXPECT_EQ(again.status, 0) << again.output;
   EXPECT_EQ(run("verify " + out + " --frames 0:2").status, 0);
 }
@@ -193,9 +200,11 @@ TEST(Trust, VerifyRefusesOutputsOutsideTheFolderAndSymlinks) {
   test::CliRun v = run("verify " + out + " --frames 0:1");
   EXPECT_EQ(v.status, 1) << v.output;
   EXPECT_NE(v.output.find("frame 0: frame_0000.json lists encoded output '../x.exr', which is not a plain file name"),
-            std::string::npos) << v.output;
+            std::string::npos)
+      << v.output;
   EXPECT_NE(v.output.find("\n0\n"), std::string::npos) << v.output;
-  for (const std::string& bad : std::vector<std::string>{"..", ".", "", "a\\b.exr", std::string("a\0b", 3), dir + "/x.exr"}) {
+  for (const std::string& bad :
+       std::vector<std::string>{"..", ".", "", "a\\b.exr", std::string("a\0b", 3), dir + "/x.exr"}) {
     relist(bad);
     v = run("verify " + out + " --frames 0");
     EXPECT_EQ(v.status, 1) << "'" << bad << "': " << v.output;
@@ -213,7 +222,8 @@ TEST(Trust, VerifyRefusesOutputsOutsideTheFolderAndSymlinks) {
   fs::create_symlink(dir + "/real.exr", out + "/frame_0000.exr");
   v = run("verify " + out + " --frames 0:1");
   EXPECT_EQ(v.status, 1) << v.output;
-  EXPECT_NE(v.output.find("frame 0: frame_0000.exr is not a regular file (a symbolic link)"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("frame 0: frame_0000.exr is not a regular file (a symbolic link)"), std::string::npos)
+      << v.output;
   fs::remove(out + "/frame_0000.exr");
   fs::create_directory(out + "/frame_0000.exr");
   v = run("verify " + out + " --frames 0:1");
@@ -263,7 +273,8 @@ TEST(Trust, SidecarRecordsVersionAndChecksums) {
   write_bytes(dir + "/cal/visual.json", R"({"serial": "LKG-P0", "pitch": {"value": 52.1}, "slope": {"value": -7.1},
     "center": {"value": 0.56}, "DPI": {"value": 324}, "screenW": {"value": 1536}, "screenH": {"value": 2048},
     "viewCone": {"value": 40}})");
-  const test::CliRun r = run("render --display-config " + dir + "/cal/visual.json --view-size 42x56 -q --out " + dir + "/d");
+  const test::CliRun r =
+      run("render --display-config " + dir + "/cal/visual.json --view-size 42x56 -q --out " + dir + "/d");
   ASSERT_EQ(r.status, 0) << r.output;
   j = sidecar(dir + "/d/frame_0000.json");
   EXPECT_EQ(j["checksums"]["scene"], xxh3_of(j["scene"].get<std::string>()));
@@ -296,7 +307,8 @@ TEST(Trust, ResumeRendersFramesFromAnotherSceneAgain) {
   EXPECT_EQ(count_of(r.output, "different scene"), 1u) << r.output;
   EXPECT_NE(r.output.find("pmr: --resume: 4 frame(s) were rendered from a different scene (frame_0000.json, "
                           "frame_0001.json, frame_0002.json, ...): rendering them again\n"),
-            std::string::npos) << r.output;
+            std::string::npos)
+      << r.output;
   EXPECT_NE(r.output.find("6 frame(s) in"), std::string::npos) << r.output;
   EXPECT_NE(read_bytes(out + "/frame_0000.exr"), red);
   EXPECT_EQ(sidecar(out + "/frame_0003.json")["checksums"]["scene"], xxh3_of(scene));
@@ -307,7 +319,8 @@ TEST(Trust, ResumeRendersFramesFromAnotherSceneAgain) {
   test::CliRun v = run("verify " + out + " --frames 0:7");
   EXPECT_EQ(v.status, 1) << v.output;
   EXPECT_NE(v.output.find("frame 6: frame_0006.json was rendered from another scene than frame_0000.json"),
-            std::string::npos) << v.output;
+            std::string::npos)
+      << v.output;
   EXPECT_NE(v.output.find("6 of 8 frame(s) complete"), std::string::npos) << v.output;
   EXPECT_NE(v.output.find("6:7\n"), std::string::npos) << v.output;
   // a bigger quad: the framing bounds and the turntable pivot change with it, no refusal, all again
@@ -334,11 +347,13 @@ TEST(Trust, ResumeRendersFramesFromAnotherSceneAgain) {
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("1 frame(s) were rendered from a different scene; 1 of them record no scene checksum "
                           "(frame_0001.json): rendering them again"),
-            std::string::npos) << r.output;
+            std::string::npos)
+      << r.output;
   EXPECT_EQ(count_of(r.output, "another pmr version"), 1u) << r.output;
   EXPECT_NE(r.output.find("1 kept frame(s) were rendered by another pmr version (0.15.0+gabcdef0; this is " +
                           std::string(program_version()) + ")"),
-            std::string::npos) << r.output;
+            std::string::npos)
+      << r.output;
   EXPECT_NE(r.output.find("1 frame(s) in"), std::string::npos) << r.output;
   EXPECT_EQ(sidecar(out + "/frame_0002.json")["program_version"], "0.15.0+gabcdef0");
   EXPECT_EQ(run("verify " + out + " --frames 0:7").status, 0);

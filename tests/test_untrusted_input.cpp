@@ -149,8 +149,9 @@ TEST_F(UntrustedInput, HugeSixteenBitPngIsRefusedFromItsHeader) {
   for (const char* cmd : {"info ", "render --views 2 --view-size 32x16 --display 64x36 -q --out "}) {
     const std::string out = std::string(cmd) == "info " ? "" : (dir_ / "out").string() + " ";
     const CliRun r = run(std::string(cmd) + out + scene);
-    expect_one_error_line(r, "image 0 'huge.png': 32768x16385 16-bit is 536903680 pixels, more than the "
-                             "texture-pixels limit of 268435456 (raise it with --limit texture-pixels=N)");
+    expect_one_error_line(r,
+                          "image 0 'huge.png': 32768x16385 16-bit is 536903680 pixels, more than the "
+                          "texture-pixels limit of 268435456 (raise it with --limit texture-pixels=N)");
     EXPECT_FALSE(exists((dir_ / "out" / "frame_0000.json").string())) << "no frame written";
   }
   // Raising the budget does not reach the decoder either: 4 x 32768 x 16385 x 2 bytes does not fit the
@@ -186,7 +187,8 @@ TEST_F(UntrustedInput, JpegAndPngBombsAreRefusedByTheirHeaders) {
   EXPECT_TRUE(contains(e, "image 0 'wide.png': 18918x18918 is 357890724 pixels")) << e;
   // embedded in the file: the image is named by its index (and name, when it has one)
   std::vector<uint8_t> png = zero_png(18918, 18918, 0, 8);
-  e = load_error_with(TexturedTriangle().write(dir_, "embedded", {{"uri", png_uri(png)}, {"name", "big"}}), InputLimits());
+  e = load_error_with(TexturedTriangle().write(dir_, "embedded", {{"uri", png_uri(png)}, {"name", "big"}}),
+                      InputLimits());
   EXPECT_TRUE(contains(e, "image 0 'big': 18918x18918")) << e;
 }
 
@@ -312,7 +314,8 @@ TEST_F(UntrustedInput, OnlyRegularFilesAreRead) {
     EXPECT_TRUE(contains(ie, "image 0: file '" + uri + "' is not a regular file (" + type + ")")) << ie;
   }
   // confined (the default), /dev/zero through a symlink is outside the folder
-  EXPECT_TRUE(contains(load_error_with((dir_ / "zero.bin.gltf").string(), InputLimits()), "lies outside the scene folder"));
+  EXPECT_TRUE(
+      contains(load_error_with((dir_ / "zero.bin.gltf").string(), InputLimits()), "lies outside the scene folder"));
 }
 
 // Bytes read per file: checked on the file's size before reading. A sparse 5 GiB buffer is refused at
@@ -325,7 +328,8 @@ TEST_F(UntrustedInput, FileBytesBudgetIsCheckedBeforeReading) {
   g.scene({0});
   const uint64_t five_gib = uint64_t(5) << 30;
   {
-    std::ofstream(dir_ / "big.bin", std::ios::binary).write(reinterpret_cast<const char*>(g.bin.data()), long(g.bin.size()));
+    std::ofstream(dir_ / "big.bin", std::ios::binary)
+        .write(reinterpret_cast<const char*>(g.bin.data()), long(g.bin.size()));
     fs::resize_file(dir_ / "big.bin", five_gib);  // sparse: no disk used
   }
   json doc = g.finished("big.bin");
@@ -333,8 +337,9 @@ TEST_F(UntrustedInput, FileBytesBudgetIsCheckedBeforeReading) {
   std::ofstream(dir_ / "big.gltf") << doc.dump();
   const auto t0 = std::chrono::steady_clock::now();
   const CliRun r = run("info " + (dir_ / "big.gltf").string());
-  expect_one_error_line(r, "buffer 0: file 'big.bin' has 5368709120 bytes, more than the file-bytes limit of "
-                           "4294967296 (raise it with --limit file-bytes=N)");
+  expect_one_error_line(r,
+                        "buffer 0: file 'big.bin' has 5368709120 bytes, more than the file-bytes limit of "
+                        "4294967296 (raise it with --limit file-bytes=N)");
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 10.0);
   // a buffer of 4 kB under a lowered budget
   g.bin.resize(4096);
@@ -367,7 +372,8 @@ TEST_F(UntrustedInput, CommandLineFilesMustBeRegular) {
   expect_one_error_line(run("info /dev/zero"), "/dev/zero: is not a regular file (a character device)");
   expect_one_error_line(run("info " + fifo), "is not a regular file (a FIFO)");
   const std::string r = " --views 2 --view-size 32x16 --display 64x36 -q --out " + (dir_ / "out").string();
-  expect_one_error_line(run("render --display-config /dev/zero" + r), "/dev/zero: is not a regular file (a character device)");
+  expect_one_error_line(run("render --display-config /dev/zero" + r),
+                        "/dev/zero: is not a regular file (a character device)");
   expect_one_error_line(run("render --display-config " + fifo + r), "is not a regular file (a FIFO)");
   expect_one_error_line(run("render --display-config " + dir_.string() + r), "is not a regular file (a directory)");
   expect_one_error_line(run("render --environment " + fifo + " --shading pbr" + r), "not a regular file");
@@ -384,8 +390,9 @@ TEST_F(UntrustedInput, CommandLineFilesMustBeRegular) {
   // a sibling folder whose name starts with the scene folder's is outside it too
   fs::create_directories(dir_ / "sub2");
   write_bytes(dir_ / "sub2" / "x", {1});
-  EXPECT_EQ(read_input_file((dir_ / "sub" / ".." / "sub2" / "x").string(), real_folder((dir_ / "sub").string()), 5).status,
-            InputFile::Status::Outside);
+  EXPECT_EQ(
+      read_input_file((dir_ / "sub" / ".." / "sub2" / "x").string(), real_folder((dir_ / "sub").string()), 5).status,
+      InputFile::Status::Outside);
 }
 
 // KTX2 and WebP images in data URIs: the warning says what the data is, not "file not found".
@@ -395,7 +402,8 @@ TEST_F(UntrustedInput, UnsupportedDataUriImagesSaySo) {
         TexturedTriangle().write(dir_, type + 6, {{"uri", std::string("data:") + type + ";base64,AAAA"}});
     const Scene s = load_scene(scene, InputLimits());
     EXPECT_TRUE(s.textures.empty());
-    EXPECT_TRUE(any_warning(s, std::string("its data URI holds type ") + type + ", which is not supported (PNG and JPEG only)"))
+    EXPECT_TRUE(
+        any_warning(s, std::string("its data URI holds type ") + type + ", which is not supported (PNG and JPEG only)"))
         << (s.warnings.empty() ? "" : s.warnings[0]);
     EXPECT_FALSE(any_warning(s, "not found"));
   }
@@ -418,12 +426,14 @@ TEST_F(UntrustedInput, IndexFieldsDoNotWrapIn32Bits) {
     std::string message;
   };
   const std::vector<Case> cases = {
-      {"bufferView", [&](json& d) { d["accessors"][0]["bufferView"] = wrap; }, "accessor 0 refers to bufferView 4294967296"},
+      {"bufferView", [&](json& d) { d["accessors"][0]["bufferView"] = wrap; },
+       "accessor 0 refers to bufferView 4294967296"},
       {"buffer", [&](json& d) { d["bufferViews"][0]["buffer"] = wrap; }, "bufferView 0 refers to buffer 4294967296"},
       {"mesh", [&](json& d) { d["nodes"][0]["mesh"] = wrap; }, "node 0 refers to mesh 4294967296"},
       {"scene nodes", [&](json& d) { d["scenes"][0]["nodes"][0] = wrap; }, "scene 0 refers to node 4294967296"},
       {"scene", [&](json& d) { d["scene"] = wrap; }, "the default scene refers to scene 4294967296"},
-      {"children", [&](json& d) { d["nodes"][0]["children"] = {wrap + 1}; }, "node 0 children refers to node 4294967297"},
+      {"children", [&](json& d) { d["nodes"][0]["children"] = {wrap + 1}; },
+       "node 0 children refers to node 4294967297"},
       {"indices", [&](json& d) { d["meshes"][0]["primitives"][0]["indices"] = wrap + 1; },
        "mesh 0 primitive 0 indices refers to accessor 4294967297"},
       {"attribute", [&](json& d) { d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = wrap; },
@@ -434,10 +444,12 @@ TEST_F(UntrustedInput, IndexFieldsDoNotWrapIn32Bits) {
        "accessor 0 componentType is 4294972422, which is not a glTF component type"},
       {"2^31", [&](json& d) { d["nodes"][0]["mesh"] = uint64_t(1) << 31; }, "node 0 refers to mesh 2147483648,"},
       {"2^64-1", [&](json& d) { d["nodes"][0]["mesh"] = UINT64_MAX; }, "node 0 refers to mesh 18446744073709551615,"},
-      {"no scenes", [&](json& d) {
+      {"no scenes",
+       [&](json& d) {
          d.erase("scenes");
          d["scene"] = wrap;
-       }, "scene 4294967296 is the default but there are no scenes"},
+       },
+       "scene 4294967296 is the default but there are no scenes"},
   };
   for (const Case& c : cases) {
     json d = base.finished("valid.bin");
@@ -453,10 +465,15 @@ TEST_F(UntrustedInput, IndexFieldsDoNotWrapIn32Bits) {
 
 TEST(TerminalText, EscapesControlsIncludingC1InUtf8) {
   EXPECT_EQ(terminal_text("plain"), "plain");
-  EXPECT_EQ(terminal_text("caf\xc3\xa9 \xe6\xa8\xa1\xe5\x9e\x8b"), "caf\xc3\xa9 \xe6\xa8\xa1\xe5\x9e\x8b") << "UTF-8 kept";
+  EXPECT_EQ(terminal_text("caf\xc3\xa9 \xe6\xa8\xa1\xe5\x9e\x8b"), "caf\xc3\xa9 \xe6\xa8\xa1\xe5\x9e\x8b")
+      << "UTF-8 kept";
   EXPECT_EQ(terminal_text("a\x1b]0;title\x07z"), "a\\x1b]0;title\\x07z");
-  EXPECT_EQ(terminal_text("csi\xc2\x9b" "2J"), "csi\\xc2\\x9b2J") << "U+009B (CSI) in UTF-8";
-  EXPECT_EQ(terminal_text("c1\xc2\x80\xc2\x9f\xc2\xa0"), "c1\\xc2\\x80\\xc2\\x9f\xc2\xa0") << "U+0080..U+009F, not U+00A0";
+  EXPECT_EQ(terminal_text("csi\xc2\x9b"
+                          "2J"),
+            "csi\\xc2\\x9b2J")
+      << "U+009B (CSI) in UTF-8";
+  EXPECT_EQ(terminal_text("c1\xc2\x80\xc2\x9f\xc2\xa0"), "c1\\xc2\\x80\\xc2\\x9f\xc2\xa0")
+      << "U+0080..U+009F, not U+00A0";
   EXPECT_EQ(terminal_text("raw\x9b"), "raw\\x9b") << "a lone 8-bit CSI";
   EXPECT_EQ(terminal_text("overlong\xc0\x9b"), "overlong\\xc0\\x9b");
   EXPECT_EQ(terminal_text("cut\xe6\xa8"), "cut\\xe6\\xa8");
@@ -468,7 +485,9 @@ TEST(TerminalText, EscapesControlsIncludingC1InUtf8) {
 // UTF-8 CSI): neither pmr info nor its error messages print them raw.
 TEST_F(UntrustedInput, NamesFromFilesReachTheTerminalSanitized) {
   // (JSON text is UTF-8: a lone 0x9b byte cannot be in it, U+009B can)
-  const std::string evil = "x\x1b]0;pwned\x07\x1b[2K\rpmr: all good\xc2\x9b" "31m";
+  const std::string evil =
+      "x\x1b]0;pwned\x07\x1b[2K\rpmr: all good\xc2\x9b"
+      "31m";
   auto raw_controls = [](const std::string& out) {
     for (size_t i = 0; i < out.size(); ++i) {
       const unsigned char c = static_cast<unsigned char>(out[i]);

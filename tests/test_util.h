@@ -49,8 +49,8 @@ struct Rendered {
   std::vector<PmrMta> mtas;
   StageTimes times;
 };
-Rendered render(const Scene& scene, const Rig& rig, int tx = 4, int ty = 4, int tv = 4, const Display* display = nullptr,
-                std::vector<uint16_t>* encoded = nullptr);
+Rendered render(const Scene& scene, const Rig& rig, int tx = 4, int ty = 4, int tv = 4,
+                const Display* display = nullptr, std::vector<uint16_t>* encoded = nullptr);
 // The same with a whole configuration (debug outputs are turned on: the keys are read back).
 Rendered render_with(const Scene& scene, const Rig& rig, PipelineConfig pc, const Display* display = nullptr,
                      std::vector<uint16_t>* encoded = nullptr);
@@ -93,7 +93,7 @@ CliRun run_wrapped(const std::string& wrapper, const std::string& args);
 std::string temp_dir(const std::string& name);
 bool exists(const std::string& path);
 std::string read_file(const std::string& path);
-size_t count_entries(const std::string& dir);  // including hidden ones
+size_t count_entries(const std::string& dir);           // including hidden ones
 std::set<std::string> listing(const std::string& dir);  // the entries' names
 // A double-sided 2x2 square in the z = 0 plane, centered on the origin (facing +z), saved as a .glb.
 void save_square_glb(const std::string& path);

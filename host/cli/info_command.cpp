@@ -15,7 +15,9 @@ namespace pmr {
 namespace {
 
 // Names come from the file: control and non-ASCII bytes are escaped, long names cut.
-std::string quoted(const std::string& name) { return name.empty() ? "(unnamed)" : "'" + printable_text(name, 80) + "'"; }
+std::string quoted(const std::string& name) {
+  return name.empty() ? "(unnamed)" : "'" + printable_text(name, 80) + "'";
+}
 
 // %g, with rounding noise below 1e-12 (a direction's zero component) printed as 0.
 std::string number(double v) {
@@ -31,7 +33,8 @@ std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
                                                          "emissive"};
   std::string t = std::string(short_names[kind]) + " (texture " + std::to_string(slot.texture);
   if (slot.texture >= 0 && size_t(slot.texture) < s.textures.size())
-    t += " " + std::to_string(s.textures[size_t(slot.texture)].width) + "x" + std::to_string(s.textures[size_t(slot.texture)].height);
+    t += " " + std::to_string(s.textures[size_t(slot.texture)].width) + "x" +
+         std::to_string(s.textures[size_t(slot.texture)].height);
   t += std::string(slot.srgb ? ", sRGB" : ", linear") + ", set " + std::to_string(slot.texcoord);
   if (slot.transform)
     t += ", transform offset (" + number(slot.offset[0]) + ", " + number(slot.offset[1]) + ") rotation " +
@@ -44,13 +47,13 @@ void describe_materials(const Scene& s) {
     const PmrMaterial& m = s.materials[i];
     const SceneMaterialInputs in = i < s.material_inputs.size() ? s.material_inputs[i] : SceneMaterialInputs{};
     std::string line = "  " + std::to_string(i) + " " + (i == 0 ? std::string("(default)") : quoted(in.name)) + ": ";
-    line += m.alpha_mode == PMR_ALPHA_MASK ? "alpha MASK (cutoff " + number(m.alpha_cutoff) + ")"
+    line += m.alpha_mode == PMR_ALPHA_MASK    ? "alpha MASK (cutoff " + number(m.alpha_cutoff) + ")"
             : m.alpha_mode == PMR_ALPHA_BLEND ? std::string("alpha BLEND")
                                               : std::string("alpha OPAQUE");
     line += m.double_sided ? ", double sided" : ", single sided";
     if (in.unlit) line += ", unlit";
-    line += ", base (" + number(m.base_color[0]) + ", " + number(m.base_color[1]) + ", " + number(m.base_color[2]) + ", " +
-            number(m.base_color[3]) + ")";
+    line += ", base (" + number(m.base_color[0]) + ", " + number(m.base_color[1]) + ", " + number(m.base_color[2]) +
+            ", " + number(m.base_color[3]) + ")";
     line += ", metallic " + number(in.metallic) + ", roughness " + number(in.roughness);
     if (in.emissive[0] > 0 || in.emissive[1] > 0 || in.emissive[2] > 0 || in.slots[kSlotEmissive].texture >= 0)
       line += ", emissive (" + number(in.emissive[0]) + ", " + number(in.emissive[1]) + ", " + number(in.emissive[2]) +
@@ -69,14 +72,17 @@ void describe_materials(const Scene& s) {
 }
 
 void describe_lights(const Scene& s) {
-  std::printf("lights: %zu%s\n", s.lights.size(), s.lights.empty() ? "" : " (KHR_lights_punctual, rest pose, world space)");
+  std::printf("lights: %zu%s\n", s.lights.size(),
+              s.lights.empty() ? "" : " (KHR_lights_punctual, rest pose, world space)");
   for (size_t i = 0; i < s.lights.size(); ++i) {
     const SceneLight& l = s.lights[i];
-    const char* type = l.type == SceneLightType::Directional ? "directional" : l.type == SceneLightType::Point ? "point" : "spot";
-    std::string line = "  " + std::to_string(i) + " " + quoted(l.name) + " (light " + std::to_string(l.light) + "): " + type +
-                       ", node " + std::to_string(l.node) + " " + quoted(l.node_name) + ", color (" + number(l.color[0]) +
-                       ", " + number(l.color[1]) + ", " + number(l.color[2]) + "), intensity " + number(l.intensity) +
-                       (l.type == SceneLightType::Directional ? " lux" : " cd");
+    const char* type = l.type == SceneLightType::Directional ? "directional"
+                       : l.type == SceneLightType::Point     ? "point"
+                                                             : "spot";
+    std::string line = "  " + std::to_string(i) + " " + quoted(l.name) + " (light " + std::to_string(l.light) +
+                       "): " + type + ", node " + std::to_string(l.node) + " " + quoted(l.node_name) + ", color (" +
+                       number(l.color[0]) + ", " + number(l.color[1]) + ", " + number(l.color[2]) + "), intensity " +
+                       number(l.intensity) + (l.type == SceneLightType::Directional ? " lux" : " cd");
     if (l.type != SceneLightType::Directional) line += l.range > 0 ? ", range " + number(l.range) : ", no range";
     if (l.type == SceneLightType::Spot)
       line += ", cones inner " + number(l.inner_cone * 180.0 / 3.14159265358979323846) + " deg outer " +
@@ -94,7 +100,8 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
   set_memory_budget(limits.memory);
   const Scene s = load_scene(path, limits);
   const SceneStructure& d = s.structure;
-  std::printf("scene: %s%s\n", path.c_str(), d.generator.empty() ? "" : (" (generator: " + printable_text(d.generator, 120) + ")").c_str());
+  std::printf("scene: %s%s\n", path.c_str(),
+              d.generator.empty() ? "" : (" (generator: " + printable_text(d.generator, 120) + ")").c_str());
   std::printf("triangles: %zu, vertices: %zu (%zu mesh instance(s) of %zu mesh(es), %zu primitive(s), %zu node(s))\n",
               s.triangles.size(), s.positions.size(), d.mesh_instances, d.meshes, d.primitives, d.nodes);
   size_t textured = 0;
@@ -115,9 +122,10 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
     }
     char zfar[32] = "infinite";
     if (c.zfar > 0) std::snprintf(zfar, sizeof zfar, "%g", c.zfar);
-    std::printf("  %zu %s: perspective, yfov %.2f deg, znear %g, zfar %s%s\n", i, quoted(c.name).c_str(),
-                c.yfov * 180.0 / 3.14159265358979323846, c.znear, zfar,
-                (c.placed ? ", placed (--camera " + std::to_string(i) + ")" : ", not placed by any node of the scene").c_str());
+    std::printf(
+        "  %zu %s: perspective, yfov %.2f deg, znear %g, zfar %s%s\n", i, quoted(c.name).c_str(),
+        c.yfov * 180.0 / 3.14159265358979323846, c.znear, zfar,
+        (c.placed ? ", placed (--camera " + std::to_string(i) + ")" : ", not placed by any node of the scene").c_str());
   }
   std::printf("animations: %zu\n", s.animations.size());
   for (size_t i = 0; i < s.animations.size(); ++i) {
@@ -144,8 +152,7 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
     std::printf("bounds (rest pose): min (%g, %g, %g), max (%g, %g, %g), center (%g, %g, %g), radius %g\n", lo.x, lo.y,
                 lo.z, hi.x, hi.y, hi.z, 0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), 0.5 * (lo.z + hi.z),
                 0.5 * glm::length(hi - lo));
-  else
-    std::printf("bounds: none (no triangles)\n");
+  else std::printf("bounds: none (no triangles)\n");
   std::printf("warnings: %zu\n", s.warnings.size());
   for (const std::string& w : s.warnings) std::printf("  %s\n", w.c_str());
 }
@@ -159,11 +166,12 @@ int run_info(const std::vector<std::string>& args) {
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "-h" || a == "--help") {
-      std::printf("usage: pmr info            list OpenCL platforms and devices\n"
-                  "       pmr info SCENE [--limit KEY=VALUE[,...]] [--allow-outside-scene-folder]\n"
-                  "                           what a glTF scene holds: triangles, materials and their textures,\n"
-                  "                           lights, cameras, animations, skins, morph targets, bounds, and the\n"
-                  "                           loader's warnings; the options as for pmr render (docs/SECURITY.md)\n");
+      std::printf(
+          "usage: pmr info            list OpenCL platforms and devices\n"
+          "       pmr info SCENE [--limit KEY=VALUE[,...]] [--allow-outside-scene-folder]\n"
+          "                           what a glTF scene holds: triangles, materials and their textures,\n"
+          "                           lights, cameras, animations, skins, morph targets, bounds, and the\n"
+          "                           loader's warnings; the options as for pmr render (docs/SECURITY.md)\n");
       return 0;
     }
     if (a == "--limit") {

@@ -81,10 +81,9 @@ namespace {
 // The rig a Looking Glass panel's serial prefix recommends (the preset of that model, whose default
 // sampling `subpixel` receives), or 48 views of the panel's aspect for an unknown one.
 RigConfig rig_for_serial(const LookingGlassCalibration& c, std::string& quilt, bool& subpixel) {
-  const std::pair<const char*, const char*> models[] = {{"LKG-P", "lg-portrait"}, {"LKG-E", "lg-go"},
-                                                        {"LKG-J", "lg-16"},       {"LKG-H", "lg-16-portrait"},
-                                                        {"LKG-L", "lg-32"},       {"LKG-K", "lg-32-portrait"},
-                                                        {"LKG-A", "lg-16-gen2"},  {"LKG-B", "lg-32-gen2"}};
+  const std::pair<const char*, const char*> models[] = {
+      {"LKG-P", "lg-portrait"}, {"LKG-E", "lg-go"},          {"LKG-J", "lg-16"},      {"LKG-H", "lg-16-portrait"},
+      {"LKG-L", "lg-32"},       {"LKG-K", "lg-32-portrait"}, {"LKG-A", "lg-16-gen2"}, {"LKG-B", "lg-32-gen2"}};
   for (const auto& [prefix, preset] : models)
     if (c.serial.rfind(prefix, 0) == 0) {
       const DisplayPreset& p = find_display_preset(preset);
@@ -179,273 +178,297 @@ void set_write(RenderOptions& o, const std::string& v, const std::string&) {
     throw Error("invalid --write: depth is a channel of the views or quilt EXR: add views or quilt");
 }
 
-const Section kOutputOptions = {"output:", {
-  {"--help", "-h", nullptr, "",  // not listed: the help itself
-   [](RenderOptions& o, const std::string&, const std::string&) { o.help = true; }},
-  {"--out", "-o", "DIR", "output folder (created if missing; default: out)",
-   [](RenderOptions& o, const std::string& v, const std::string&) { o.products.out_dir = v; }},
-  {"--write", nullptr, "LIST",
-   "any of encoded, views, quilt, depth (default: encoded). DIR/frame_NNNN.exr is\n"
-   "the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view,\n"
-   "DIR/frame_NNNN_qsCxRaA.exr the views as a Looking Glass quilt (view 0 bottom\n"
-   "left), depth a float Z channel (view-space depth, +inf where empty) in the\n"
-   "views and quilt files; DIR/frame_NNNN.json (rig, display, every view's\n"
-   "matrices) is always written",
-   set_write},
-  {"--quilt", nullptr, "CxR", "quilt layout in tiles (default: the most square layout, e.g. 8x6 for 48)",
-   [](RenderOptions& o, const std::string& v, const std::string&) { o.quilt = v; }},
-  {"--preview", nullptr, nullptr,
-   "also 8-bit sRGB PNGs: the encoded image, the center view (N / 2; stretched to\n"
-   "square pixels, as a view's pixels span the display's aspect) and the quilt\n"
-   "(tiles as rendered; their pixel aspect in the PNG's pHYs chunk)",
-   [](RenderOptions& o, const std::string&, const std::string&) { o.products.preview = true; }},
-  {"--name", nullptr, "PATTERN",
-   "file stem (default frame_%04d); the frame number as %d, zero-padded %0Nd or\n"
-   "Blender's #### (N '#': N digits), %% for a percent sign; without a frame\n"
-   "number the stem of a single frame as given (--name duck: duck.exr)",
-   [](RenderOptions& o, const std::string& v, const std::string&) {
-     check_name_pattern(v);
-     o.products.name = v;
-   }},
-  {"--compression", nullptr, "C",
-   "EXR compression: none, zip, zip-fast (ZIP through ISA-L's igzip alone: a\n"
-   "third of zip's writer CPU, 10% larger files; any reader opens it), piz, rle\n"
-   "(default zip)",
-   [](RenderOptions& o, const std::string& v, const std::string&) { o.compression = v; }},
-}};
+const Section kOutputOptions = {
+    "output:",
+    {
+        {"--help", "-h", nullptr, "",  // not listed: the help itself
+         [](RenderOptions& o, const std::string&, const std::string&) { o.help = true; }},
+        {"--out", "-o", "DIR", "output folder (created if missing; default: out)",
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.products.out_dir = v; }},
+        {"--write", nullptr, "LIST",
+         "any of encoded, views, quilt, depth (default: encoded). DIR/frame_NNNN.exr is\n"
+         "the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view,\n"
+         "DIR/frame_NNNN_qsCxRaA.exr the views as a Looking Glass quilt (view 0 bottom\n"
+         "left), depth a float Z channel (view-space depth, +inf where empty) in the\n"
+         "views and quilt files; DIR/frame_NNNN.json (rig, display, every view's\n"
+         "matrices) is always written",
+         set_write},
+        {"--quilt", nullptr, "CxR", "quilt layout in tiles (default: the most square layout, e.g. 8x6 for 48)",
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.quilt = v; }},
+        {"--preview", nullptr, nullptr,
+         "also 8-bit sRGB PNGs: the encoded image, the center view (N / 2; stretched to\n"
+         "square pixels, as a view's pixels span the display's aspect) and the quilt\n"
+         "(tiles as rendered; their pixel aspect in the PNG's pHYs chunk)",
+         [](RenderOptions& o, const std::string&, const std::string&) { o.products.preview = true; }},
+        {"--name", nullptr, "PATTERN",
+         "file stem (default frame_%04d); the frame number as %d, zero-padded %0Nd or\n"
+         "Blender's #### (N '#': N digits), %% for a percent sign; without a frame\n"
+         "number the stem of a single frame as given (--name duck: duck.exr)",
+         [](RenderOptions& o, const std::string& v, const std::string&) {
+           check_name_pattern(v);
+           o.products.name = v;
+         }},
+        {"--compression", nullptr, "C",
+         "EXR compression: none, zip, zip-fast (ZIP through ISA-L's igzip alone: a\n"
+         "third of zip's writer CPU, 10% larger files; any reader opens it), piz, rle\n"
+         "(default zip)",
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.compression = v; }},
+    }};
 
 const Section kSequenceOptions = {
     "sequences (an animated glTF plays; frame f samples time f / fps; before the animation's first key\n"
-    "and after its last a frame holds the first or last pose, as glTF clamps):", {
-  {"--frames", nullptr, "LIST",
-   "frames to render: N, A:B (inclusive), A:B:STEP, a comma list of these\n"
-   "(0:99,120,130:140), or all (default 0). all = the frames whose times lie\n"
-   "inside the animation's keys, ceil(start x fps) to floor(end x fps); with\n"
-   "--turntable one turn, 0 to FRAMES-1, however long the animation; frame 0\n"
-   "for a still scene. Frames outside the keys get a warning, except all",
-   set_frames},
-  {"--frame", nullptr, "N", "", set_frames},  // not listed: --frames in the singular
-  {"--fps", nullptr, "F", "frames per second (default 24)",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     o.fps = parse_double(v, name);
-     if (!(o.fps > 0.0) || o.fps > 10000.0) throw Error("invalid --fps: must be in (0, 10000]");
-   }},
-  {"--animation", nullptr, "A",
-   "NAME, INDEX, all (every animation at once) or none (the rest pose);\n"
-   "default: the first one",
-   [](RenderOptions& o, const std::string& v, const std::string&) {
-     if (v.empty()) throw Error("invalid --animation '': expected a name, an index, all or none");
-     o.animation = v;
-   }},
-  {"--turntable", nullptr, "DEG:FRAMES",
-   "turn the scene DEG degrees every FRAMES frames about the vertical axis\n"
-   "through its framing center (360:96 loops every 96 frames)",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     const auto colon = v.find(':');
-     if (colon == std::string::npos) throw Error("invalid --turntable '" + v + "': expected DEG:FRAMES, e.g. 360:96");
-     o.turntable = true;
-     o.turntable_deg = parse_double(v.substr(0, colon), name);
-     o.turntable_frames = parse_int(v.substr(colon + 1), name, 1, 1 << 30);
-   }},
-  {"--resume", nullptr, nullptr, "skip frames whose files are all present; refuse a changed configuration",
-   [](RenderOptions& o, const std::string&, const std::string&) { o.resume = true; }},
-  {"--overwrite", nullptr, nullptr,
-   "render even though the folder keeps frames of another configuration\n"
-   "outside --frames (a warning counts them; without it the run refuses);\n"
-   "with --resume: also re-render listed frames of another configuration",
-   [](RenderOptions& o, const std::string&, const std::string&) { o.overwrite = true; }},
-  {"--quiet", "-q", nullptr, "print only errors and warnings",
-   [](RenderOptions& o, const std::string&, const std::string&) { o.quiet = true; }},
-  {"--shard", nullptr, "K/N|auto",
-   "render only task K's share of the frames (interleaved: positions K, K+N,\n"
-   "...); auto reads a Slurm, Kubernetes, AWS Batch, PBS, SGE or LSF array index\n"
-   "(--shard-count N where the environment lacks the count, --shard-first F\n"
-   "for PBS arrays not starting at 0); see docs/farm/README.md",
-   [](RenderOptions& o, const std::string& v, const std::string&) { o.shard = v; }},
-  {"--shard-count", nullptr, "N", "",  // not listed: --shard's description explains it
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     o.shard_count = parse_int(v, name, 1, 1 << 30);
-   }},
-  {"--shard-first", nullptr, "F", "",  // not listed: --shard's description explains it
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     o.shard_first = parse_int(v, name, 0, 1 << 30);
-   }},
-}};
+    "and after its last a frame holds the first or last pose, as glTF clamps):",
+    {
+        {"--frames", nullptr, "LIST",
+         "frames to render: N, A:B (inclusive), A:B:STEP, a comma list of these\n"
+         "(0:99,120,130:140), or all (default 0). all = the frames whose times lie\n"
+         "inside the animation's keys, ceil(start x fps) to floor(end x fps); with\n"
+         "--turntable one turn, 0 to FRAMES-1, however long the animation; frame 0\n"
+         "for a still scene. Frames outside the keys get a warning, except all",
+         set_frames},
+        {"--frame", nullptr, "N", "", set_frames},  // not listed: --frames in the singular
+        {"--fps", nullptr, "F", "frames per second (default 24)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.fps = parse_double(v, name);
+           if (!(o.fps > 0.0) || o.fps > 10000.0) throw Error("invalid --fps: must be in (0, 10000]");
+         }},
+        {"--animation", nullptr, "A",
+         "NAME, INDEX, all (every animation at once) or none (the rest pose);\n"
+         "default: the first one",
+         [](RenderOptions& o, const std::string& v, const std::string&) {
+           if (v.empty()) throw Error("invalid --animation '': expected a name, an index, all or none");
+           o.animation = v;
+         }},
+        {"--turntable", nullptr, "DEG:FRAMES",
+         "turn the scene DEG degrees every FRAMES frames about the vertical axis\n"
+         "through its framing center (360:96 loops every 96 frames)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           const auto colon = v.find(':');
+           if (colon == std::string::npos)
+             throw Error("invalid --turntable '" + v + "': expected DEG:FRAMES, e.g. 360:96");
+           o.turntable = true;
+           o.turntable_deg = parse_double(v.substr(0, colon), name);
+           o.turntable_frames = parse_int(v.substr(colon + 1), name, 1, 1 << 30);
+         }},
+        {"--resume", nullptr, nullptr, "skip frames whose files are all present; refuse a changed configuration",
+         [](RenderOptions& o, const std::string&, const std::string&) { o.resume = true; }},
+        {"--overwrite", nullptr, nullptr,
+         "render even though the folder keeps frames of another configuration\n"
+         "outside --frames (a warning counts them; without it the run refuses);\n"
+         "with --resume: also re-render listed frames of another configuration",
+         [](RenderOptions& o, const std::string&, const std::string&) { o.overwrite = true; }},
+        {"--quiet", "-q", nullptr, "print only errors and warnings",
+         [](RenderOptions& o, const std::string&, const std::string&) { o.quiet = true; }},
+        {"--shard", nullptr, "K/N|auto",
+         "render only task K's share of the frames (interleaved: positions K, K+N,\n"
+         "...); auto reads a Slurm, Kubernetes, AWS Batch, PBS, SGE or LSF array index\n"
+         "(--shard-count N where the environment lacks the count, --shard-first F\n"
+         "for PBS arrays not starting at 0); see docs/farm/README.md",
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.shard = v; }},
+        {"--shard-count", nullptr, "N", "",  // not listed: --shard's description explains it
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.shard_count = parse_int(v, name, 1, 1 << 30);
+         }},
+        {"--shard-first", nullptr, "F", "",  // not listed: --shard's description explains it
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.shard_first = parse_int(v, name, 0, 1 << 30);
+         }},
+    }};
 
-const Section kRigOptions = {"rig:", {
-  {"--preset", nullptr, "NAME",
-   "a display: paper-8k (default), lg-portrait, lg-go, lg-16, lg-32, ...\n"
-   "(--preset help lists them); other options override its values",
-   applied_first},
-  {"--display-config", nullptr, "F",
-   "a Looking Glass panel's own calibration file (visual.json): display,\n"
-   "encoder and the model's recommended views (docs/DISPLAYS.md)",
-   applied_first},
-  {"--views", nullptr, "N", "number of views (default 96)",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     o.rig.views = parse_int(v, name, 1, PMR_MAX_VIEWS);
-   }},
-  {"--view-size", nullptr, "WxH",
-   "view raster in pixels (default 1024x512; each side <= " + std::to_string(PMR_MAX_RASTER) + ")",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     const auto d = parse_dims(v, name, 2, PMR_MAX_RASTER);
-     o.rig.view_w = d[0], o.rig.view_h = d[1];
-   }},
-  {"--cone", nullptr, "DEG", "view cone (default 80)",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     o.rig.cone_deg = parse_double(v, name);
-     if (!(o.rig.cone_deg > 0.0 && o.rig.cone_deg < 180.0))
-       throw Error("invalid --cone '" + v + "': expected degrees in (0, 180)");
-   }},
-  {"--yfov", nullptr, "DEG", "vertical field of view (default from the display: 2 atan(46.5 / 200))",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     o.rig.yfov_deg = parse_double(v, name);
-     if (!(o.rig.yfov_deg > 0.0 && o.rig.yfov_deg < 180.0))  // 0 would silently mean "the display's default"
-       throw Error("invalid --yfov '" + v + "': expected degrees in (0, 180)");
-   }},
-  {"--camera-spacing", nullptr, "S",
-   "linear (PMR's, default for paper-8k) or angular (Looking Glass: D tan(cone\n"
-   "((i + 1/2) / N - 1/2)), default for the Looking Glass presets; each\n"
-   "angular camera moves onto a fine fixed-point grid (docs/DESIGN.md)",
-   [](RenderOptions& o, const std::string& v, const std::string&) {
-     if (v != "linear" && v != "angular") throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
-     o.rig.angular_spacing = v == "angular";
-   }},
-  {"--camera", nullptr, "K",
-   "use the scene's glTF camera K (pose and field of view) instead of framing\n"
-   "the scene's bounding sphere",
-   [](RenderOptions& o, const std::string& v, const std::string& name) { o.rig.camera = parse_int(v, name, 0, 1 << 30); }},
-  {"--background", nullptr, "R,G,B[,A]",
-   "a linear colour behind the encoded image, views, quilt and previews (default\n"
-   "transparent black; A defaults to 1). The encoded image is composited per\n"
-   "subpixel; its PNG preview is always opaque (over black). With a Looking Glass\n"
-   "preset or --display-config the quilt PNG is opaque black by default",
-   [](RenderOptions& o, const std::string& v, const std::string&) { o.background = parse_background(v); }},
-  {"--zoom", nullptr, "F",
-   "the scene appears F times larger (default 1: its bounding sphere fits the\n"
-   "view's height and width); the camera moves closer, the zero-parallax plane\n"
-   "stays through the sphere's center. Not with --camera",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     o.rig.zoom = parse_double(v, name);
-     if (!(o.rig.zoom >= 0.001 && o.rig.zoom <= 1000.0)) throw Error("invalid --zoom: expected a factor from 0.001 to 1000");
-     o.zoom_given = true;
-   }},
-}};
+const Section kRigOptions = {
+    "rig:",
+    {
+        {"--preset", nullptr, "NAME",
+         "a display: paper-8k (default), lg-portrait, lg-go, lg-16, lg-32, ...\n"
+         "(--preset help lists them); other options override its values",
+         applied_first},
+        {"--display-config", nullptr, "F",
+         "a Looking Glass panel's own calibration file (visual.json): display,\n"
+         "encoder and the model's recommended views (docs/DISPLAYS.md)",
+         applied_first},
+        {"--views", nullptr, "N", "number of views (default 96)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.rig.views = parse_int(v, name, 1, PMR_MAX_VIEWS);
+         }},
+        {"--view-size", nullptr, "WxH",
+         "view raster in pixels (default 1024x512; each side <= " + std::to_string(PMR_MAX_RASTER) + ")",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           const auto d = parse_dims(v, name, 2, PMR_MAX_RASTER);
+           o.rig.view_w = d[0], o.rig.view_h = d[1];
+         }},
+        {"--cone", nullptr, "DEG", "view cone (default 80)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.rig.cone_deg = parse_double(v, name);
+           if (!(o.rig.cone_deg > 0.0 && o.rig.cone_deg < 180.0))
+             throw Error("invalid --cone '" + v + "': expected degrees in (0, 180)");
+         }},
+        {"--yfov", nullptr, "DEG", "vertical field of view (default from the display: 2 atan(46.5 / 200))",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.rig.yfov_deg = parse_double(v, name);
+           if (!(o.rig.yfov_deg > 0.0 && o.rig.yfov_deg < 180.0))  // 0 would silently mean "the display's default"
+             throw Error("invalid --yfov '" + v + "': expected degrees in (0, 180)");
+         }},
+        {"--camera-spacing", nullptr, "S",
+         "linear (PMR's, default for paper-8k) or angular (Looking Glass: D tan(cone\n"
+         "((i + 1/2) / N - 1/2)), default for the Looking Glass presets; each\n"
+         "angular camera moves onto a fine fixed-point grid (docs/DESIGN.md)",
+         [](RenderOptions& o, const std::string& v, const std::string&) {
+           if (v != "linear" && v != "angular")
+             throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
+           o.rig.angular_spacing = v == "angular";
+         }},
+        {"--camera", nullptr, "K",
+         "use the scene's glTF camera K (pose and field of view) instead of framing\n"
+         "the scene's bounding sphere",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.rig.camera = parse_int(v, name, 0, 1 << 30);
+         }},
+        {"--background", nullptr, "R,G,B[,A]",
+         "a linear colour behind the encoded image, views, quilt and previews (default\n"
+         "transparent black; A defaults to 1). The encoded image is composited per\n"
+         "subpixel; its PNG preview is always opaque (over black). With a Looking Glass\n"
+         "preset or --display-config the quilt PNG is opaque black by default",
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.background = parse_background(v); }},
+        {"--zoom", nullptr, "F",
+         "the scene appears F times larger (default 1: its bounding sphere fits the\n"
+         "view's height and width); the camera moves closer, the zero-parallax plane\n"
+         "stays through the sphere's center. Not with --camera",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.rig.zoom = parse_double(v, name);
+           if (!(o.rig.zoom >= 0.001 && o.rig.zoom <= 1000.0))
+             throw Error("invalid --zoom: expected a factor from 0.001 to 1000");
+           o.zoom_given = true;
+         }},
+    }};
 
-const Section kDisplayOptions = {"display:", {
-  {"--display", nullptr, "WxH", "display image in pixels (default 7680x4320)",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     const auto d = parse_dims(v, name, 2, kMaxDisplaySide);
-     o.display.width = d[0], o.display.height = d[1];
-   }},
-  {"--display-size", nullptr, "WxH", "physical size in cm (default 166x93; sets the aspect A)",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     const auto x = v.find('x');
-     if (x == std::string::npos) throw Error("invalid --display-size '" + v + "': expected WxH in cm");
-     o.display.size_w_cm = parse_double(v.substr(0, x), name);
-     o.display.size_h_cm = parse_double(v.substr(x + 1), name);
-   }},
-  {"--viewing-distance", nullptr, "CM", "(default 200)",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     o.display.viewing_distance_cm = parse_double(v, name);
-   }},
-  {"--lens-pitch", nullptr, "L", "lens pitch in subpixels (default 16)",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     o.display.lens_pitch = parse_rational(v, name);
-     if (o.display.lens_pitch.num <= 0) throw Error("invalid --lens-pitch '" + v + "': must be positive");
-   }},
-  {"--tan-slant", nullptr, "T", "tangent of the lens slant (default 1/18)",
-   [](RenderOptions& o, const std::string& v, const std::string& name) { o.display.tan_slant = parse_rational(v, name); }},
-  {"--offset", nullptr, "O",
-   "subpixel offset (default -L/(2N) = -1/12)\n"
-   "(L, T, O accept decimals or fractions like 1/18; evaluated exactly)",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     o.display.offset = parse_rational(v, name);
-     o.offset_given = true;
-   }},
-  {"--reverse-views", nullptr, nullptr, "use view N-1-v instead of v",
-   [](RenderOptions& o, const std::string&, const std::string&) { o.display.reversed = true; }},
-  {"--bilinear", nullptr, nullptr, "sample views bilinearly (default nearest)",
-   [](RenderOptions& o, const std::string&, const std::string&) { o.display.bilinear = true; }},
-  {"--blend-views", nullptr, nullptr,
-   "blend the two nearest views by the lens phase, as Looking Glass's\n"
-   "webxr shader does by default (default: one view per subpixel)",
-   [](RenderOptions& o, const std::string&, const std::string&) { o.display.blend_views = true; }},
-}};
+const Section kDisplayOptions = {
+    "display:",
+    {
+        {"--display", nullptr, "WxH", "display image in pixels (default 7680x4320)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           const auto d = parse_dims(v, name, 2, kMaxDisplaySide);
+           o.display.width = d[0], o.display.height = d[1];
+         }},
+        {"--display-size", nullptr, "WxH", "physical size in cm (default 166x93; sets the aspect A)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           const auto x = v.find('x');
+           if (x == std::string::npos) throw Error("invalid --display-size '" + v + "': expected WxH in cm");
+           o.display.size_w_cm = parse_double(v.substr(0, x), name);
+           o.display.size_h_cm = parse_double(v.substr(x + 1), name);
+         }},
+        {"--viewing-distance", nullptr, "CM", "(default 200)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.display.viewing_distance_cm = parse_double(v, name);
+         }},
+        {"--lens-pitch", nullptr, "L", "lens pitch in subpixels (default 16)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.display.lens_pitch = parse_rational(v, name);
+           if (o.display.lens_pitch.num <= 0) throw Error("invalid --lens-pitch '" + v + "': must be positive");
+         }},
+        {"--tan-slant", nullptr, "T", "tangent of the lens slant (default 1/18)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.display.tan_slant = parse_rational(v, name);
+         }},
+        {"--offset", nullptr, "O",
+         "subpixel offset (default -L/(2N) = -1/12)\n"
+         "(L, T, O accept decimals or fractions like 1/18; evaluated exactly)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.display.offset = parse_rational(v, name);
+           o.offset_given = true;
+         }},
+        {"--reverse-views", nullptr, nullptr, "use view N-1-v instead of v",
+         [](RenderOptions& o, const std::string&, const std::string&) { o.display.reversed = true; }},
+        {"--bilinear", nullptr, nullptr, "sample views bilinearly (default nearest)",
+         [](RenderOptions& o, const std::string&, const std::string&) { o.display.bilinear = true; }},
+        {"--blend-views", nullptr, nullptr,
+         "blend the two nearest views by the lens phase, as Looking Glass's\n"
+         "webxr shader does by default (default: one view per subpixel)",
+         [](RenderOptions& o, const std::string&, const std::string&) { o.display.blend_views = true; }},
+    }};
 
-const Section kPipelineOptions = {"pipeline:", {
-  {"--tile", nullptr, "XxYxV", "3D tile of the tile/fine raster, voxels over x, y, view (default 16x2x16)",
-   [](RenderOptions& o, const std::string& v, const std::string& name) {
-     const auto d = parse_dims(v, name, 3, kMaxTileSide);
-     o.pipeline.tile_x = d[0], o.pipeline.tile_y = d[1], o.pipeline.tile_v = d[2];
-   }},
-  {"--method", nullptr, "M",
-   "pmr (default), multipass (one conventional pass per view) or duplicate\n"
-   "(every triangle copied per view into a 2D-tiled view atlas)",
-   [](RenderOptions& o, const std::string& v, const std::string&) {
-     o.pipeline.method = parse_method(v);
-     o.method_given = true;
-   }},
-  {"--sampling", nullptr, "S",
-   "view (default): the views rendered on their grids, each subpixel reading\n"
-   "its view's nearest pixel; subpixel: every display subpixel rasterized at\n"
-   "its own sample in its own view (docs/SAMPLING.md; the default of the\n"
-   "presets listed there, which --bilinear, --blend-views or a --method\n"
-   "other than pmr turn back to view sampling with a notice)",
-   [](RenderOptions& o, const std::string& v, const std::string&) {
-     o.pipeline.sampling = parse_sampling(v);
-     o.sampling_given = true;
-   }},
-}};
+const Section kPipelineOptions = {
+    "pipeline:",
+    {
+        {"--tile", nullptr, "XxYxV", "3D tile of the tile/fine raster, voxels over x, y, view (default 16x2x16)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           const auto d = parse_dims(v, name, 3, kMaxTileSide);
+           o.pipeline.tile_x = d[0], o.pipeline.tile_y = d[1], o.pipeline.tile_v = d[2];
+         }},
+        {"--method", nullptr, "M",
+         "pmr (default), multipass (one conventional pass per view) or duplicate\n"
+         "(every triangle copied per view into a 2D-tiled view atlas)",
+         [](RenderOptions& o, const std::string& v, const std::string&) {
+           o.pipeline.method = parse_method(v);
+           o.method_given = true;
+         }},
+        {"--sampling", nullptr, "S",
+         "view (default): the views rendered on their grids, each subpixel reading\n"
+         "its view's nearest pixel; subpixel: every display subpixel rasterized at\n"
+         "its own sample in its own view (docs/SAMPLING.md; the default of the\n"
+         "presets listed there, which --bilinear, --blend-views or a --method\n"
+         "other than pmr turn back to view sampling with a notice)",
+         [](RenderOptions& o, const std::string& v, const std::string&) {
+           o.pipeline.sampling = parse_sampling(v);
+           o.sampling_given = true;
+         }},
+    }};
 
-const Section kShadingOptions = {"shading (docs/SHADING.md):", {
-  {"--shading", nullptr, "S",
-   "pbr (default): glTF metallic-roughness with every material map, seen from\n"
-   "each view's own camera, so highlights move across the views; lit by the\n"
-   "file's KHR_lights_punctual lights (moving with their nodes; without any,\n"
-   "a default directional light) and a uniform environment or --environment;\n"
-   "lambert: base colour x (0.2 + 0.8 max(0, n.l)), the same in every view,\n"
-   "one fixed light (faster)",
-   [](RenderOptions& o, const std::string& v, const std::string&) { o.pipeline.shading = parse_shading(v); }},
-  {"--exposure", nullptr, "EV", "the colour times 2^EV, either model (default 0)",
-   [](RenderOptions& o, const std::string& v, const std::string&) { o.pipeline.exposure_ev = parse_exposure(v); }},
-  {"--environment", nullptr, "FILE",
-   "pbr: light with an equirectangular image of linear radiance (.hdr or .exr,\n"
-   "path relative to the current folder) instead of the uniform environment\n"
-   "and the default light (the file's lights stay); -Z is the image's middle\n"
-   "column, +Y its top row; prefiltered once per run (1-2.5 s for 1024x512).\n"
-   "Needs --shading pbr",
-   [](RenderOptions& o, const std::string& v, const std::string&) {
-     if (v.empty()) throw Error("invalid --environment '': expected a .hdr or .exr file");
-     o.environment_file = v;
-   }},
-  {"--environment-rotation", nullptr, "DEG",
-   "pbr: turn the image DEG degrees counter-clockwise seen from above\n"
-   "(+X moves toward -Z; default 0)",
-   [](RenderOptions& o, const std::string& v, const std::string&) {
-     o.environment_rotation_deg = parse_environment_rotation(v);
-     o.environment_rotation_given = true;
-   }},
-  {"--environment-intensity", nullptr, "X",
-   "pbr: scales the environment, the image or the uniform one of radiance\n"
-   "0.2 (0 turns it off; default 1)",
-   [](RenderOptions& o, const std::string& v, const std::string&) {
-     o.pipeline.environment_intensity = parse_environment_intensity(v);
-   }},
-  {"--verbose", "-v", nullptr, "per-stage device times and queue sizes",
-   [](RenderOptions& o, const std::string&, const std::string&) { o.verbose = true; }},
-}};
+const Section kShadingOptions = {
+    "shading (docs/SHADING.md):",
+    {
+        {"--shading", nullptr, "S",
+         "pbr (default): glTF metallic-roughness with every material map, seen from\n"
+         "each view's own camera, so highlights move across the views; lit by the\n"
+         "file's KHR_lights_punctual lights (moving with their nodes; without any,\n"
+         "a default directional light) and a uniform environment or --environment;\n"
+         "lambert: base colour x (0.2 + 0.8 max(0, n.l)), the same in every view,\n"
+         "one fixed light (faster)",
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.pipeline.shading = parse_shading(v); }},
+        {"--exposure", nullptr, "EV", "the colour times 2^EV, either model (default 0)",
+         [](RenderOptions& o, const std::string& v, const std::string&) {
+           o.pipeline.exposure_ev = parse_exposure(v);
+         }},
+        {"--environment", nullptr, "FILE",
+         "pbr: light with an equirectangular image of linear radiance (.hdr or .exr,\n"
+         "path relative to the current folder) instead of the uniform environment\n"
+         "and the default light (the file's lights stay); -Z is the image's middle\n"
+         "column, +Y its top row; prefiltered once per run (1-2.5 s for 1024x512).\n"
+         "Needs --shading pbr",
+         [](RenderOptions& o, const std::string& v, const std::string&) {
+           if (v.empty()) throw Error("invalid --environment '': expected a .hdr or .exr file");
+           o.environment_file = v;
+         }},
+        {"--environment-rotation", nullptr, "DEG",
+         "pbr: turn the image DEG degrees counter-clockwise seen from above\n"
+         "(+X moves toward -Z; default 0)",
+         [](RenderOptions& o, const std::string& v, const std::string&) {
+           o.environment_rotation_deg = parse_environment_rotation(v);
+           o.environment_rotation_given = true;
+         }},
+        {"--environment-intensity", nullptr, "X",
+         "pbr: scales the environment, the image or the uniform one of radiance\n"
+         "0.2 (0 turns it off; default 1)",
+         [](RenderOptions& o, const std::string& v, const std::string&) {
+           o.pipeline.environment_intensity = parse_environment_intensity(v);
+         }},
+        {"--verbose", "-v", nullptr, "per-stage device times and queue sizes",
+         [](RenderOptions& o, const std::string&, const std::string&) { o.verbose = true; }},
+    }};
 
-const Section kInputOptions = {"untrusted input (docs/SECURITY.md):", {
-  {"--allow-outside-scene-folder", nullptr, nullptr,
-   "read files the scene names outside its folder (by default a\n"
-   "buffer or image that resolves outside it is an error); recorded in the sidecar",
-   [](RenderOptions& o, const std::string&, const std::string&) { o.input_limits.allow_outside_scene_folder = true; }},
-  {"--limit", nullptr, "KEY=VALUE[,KEY=VALUE...]",
-   "raise or lower a budget (VALUE an integer, K/M/G/T = x1024^n):",
-   [](RenderOptions& o, const std::string& v, const std::string&) { parse_limits(v, o.input_limits); },
-   limit_help},
-}};
+const Section kInputOptions = {
+    "untrusted input (docs/SECURITY.md):",
+    {
+        {"--allow-outside-scene-folder", nullptr, nullptr,
+         "read files the scene names outside its folder (by default a\n"
+         "buffer or image that resolves outside it is an error); recorded in the sidecar",
+         [](RenderOptions& o, const std::string&, const std::string&) {
+           o.input_limits.allow_outside_scene_folder = true;
+         }},
+        {"--limit", nullptr, "KEY=VALUE[,KEY=VALUE...]",
+         "raise or lower a budget (VALUE an integer, K/M/G/T = x1024^n):",
+         [](RenderOptions& o, const std::string& v, const std::string&) { parse_limits(v, o.input_limits); },
+         limit_help},
+    }};
 
 const Section* const kSections[] = {&kOutputOptions,   &kSequenceOptions, &kRigOptions,  &kDisplayOptions,
                                     &kPipelineOptions, &kShadingOptions,  &kInputOptions};
@@ -473,8 +496,9 @@ void parse_arguments(RenderOptions& o, const std::vector<std::string>& args) {
     }
   }
   if (o.zoom_given && o.rig.camera >= 0)
-    throw Error("--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own: "
-                "give one of them");
+    throw Error(
+        "--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own: "
+        "give one of them");
 }
 
 // An option's --help entry: "--out DIR, -o DIR" padded to the description's column (or two spaces
@@ -498,7 +522,6 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
   return o;
 }
 
-
 namespace {
 
 void finalize_options(RenderOptions& o) {
@@ -506,13 +529,15 @@ void finalize_options(RenderOptions& o) {
   check_environment_options(o.environment_file, o.environment_rotation_given, o.pipeline.shading, o.option_warnings);
   if (o.pipeline.sampling == Sampling::Subpixel && !o.sampling_given) {
     // the preset's default: options that need the views rendered on their grids take precedence
-    const std::string needs_views = o.pipeline.method != Method::Pmr ? "--method " + std::string(to_string(o.pipeline.method))
-                                    : o.display.bilinear             ? "--bilinear"
-                                    : o.display.blend_views          ? "--blend-views"
-                                                                     : "";
+    const std::string needs_views = o.pipeline.method != Method::Pmr
+                                        ? "--method " + std::string(to_string(o.pipeline.method))
+                                    : o.display.bilinear    ? "--bilinear"
+                                    : o.display.blend_views ? "--blend-views"
+                                                            : "";
     if (!needs_views.empty()) {
       o.pipeline.sampling = Sampling::View;
-      o.option_warnings.push_back(needs_views + " samples the rendered views: --sampling view instead of the "
+      o.option_warnings.push_back(needs_views +
+                                  " samples the rendered views: --sampling view instead of the "
                                   "display's default, subpixel");
     } else if (!o.products.encoded) {
       o.pipeline.sampling = Sampling::View;  // no encoded image: nothing to sample by subpixel
@@ -520,10 +545,11 @@ void finalize_options(RenderOptions& o) {
   }
   if (o.pipeline.sampling == Sampling::Subpixel) {
     check_subpixel_sampling(o.pipeline.method, o.display);  // pmr unless --method says otherwise
-    if (!o.products.encoded) {  // the views are rendered on their grids in either case
+    if (!o.products.encoded) {                              // the views are rendered on their grids in either case
       o.pipeline.sampling = Sampling::View;
-      o.option_warnings.push_back("--sampling subpixel samples the encoded image, which --write does not ask for: "
-                                  "ignored");
+      o.option_warnings.push_back(
+          "--sampling subpixel samples the encoded image, which --write does not ask for: "
+          "ignored");
     }
   }
   if (!o.offset_given) {

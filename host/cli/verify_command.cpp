@@ -75,7 +75,8 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
     const SidecarProvenance p = sidecar_provenance(text);
     ++seen.try_emplace(p.scene, 0, f).first->second.first;
     const std::string v = p.version.empty() ? "unrecorded" : p.version;
-    if (std::find(folder.versions.begin(), folder.versions.end(), v) == folder.versions.end()) folder.versions.push_back(v);
+    if (std::find(folder.versions.begin(), folder.versions.end(), v) == folder.versions.end())
+      folder.versions.push_back(v);
   }
   long best = 0;
   for (const auto& [scene, count_first] : seen)
@@ -84,7 +85,8 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
       folder.scene = scene;
       folder.reference_frame = count_first.second;
     }
-  if (folder.reference_frame >= 0) folder.reference_text = read_sidecar_text(sidecar_path(dir, o, folder.reference_frame));
+  if (folder.reference_frame >= 0)
+    folder.reference_text = read_sidecar_text(sidecar_path(dir, o, folder.reference_frame));
   return folder;
 }
 
@@ -148,7 +150,10 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
     if (st.type() == fs::file_type::not_found) return printable_text(name) + " is missing";
     if (st.type() != fs::file_type::regular)
       return printable_text(name) + " is not a regular file (" +
-             (st.type() == fs::file_type::symlink ? "a symbolic link" : st.type() == fs::file_type::directory ? "a folder" : "a special file") + ")";
+             (st.type() == fs::file_type::symlink     ? "a symbolic link"
+              : st.type() == fs::file_type::directory ? "a folder"
+                                                      : "a special file") +
+             ")";
     images.push_back(path.string());
   }
   // frame_problem names the files by their (plain, but maybe not ASCII) names
@@ -206,8 +211,8 @@ int run_verify(const std::vector<std::string>& args) {
   if (folder.versions.size() > 1) {  // not a problem: versions do not change pixels (docs/SEQUENCES.md)
     std::string list;
     for (const std::string& v : folder.versions) list += (list.empty() ? "" : ", ") + printable_text(v);
-    std::fprintf(stderr, "pmr verify: note: the frames were rendered by %zu pmr versions (%s)\n", folder.versions.size(),
-                 list.c_str());
+    std::fprintf(stderr, "pmr verify: note: the frames were rendered by %zu pmr versions (%s)\n",
+                 folder.versions.size(), list.c_str());
   }
   std::fprintf(stderr, "pmr verify: %zu of %zu frame(s) complete%s\n", frames.size() - bad.size(), frames.size(),
                bad.empty() ? "" : "; resubmit the list below with --resume");

@@ -23,11 +23,13 @@ struct LimitKey {
 };
 
 const LimitKey kLimitKeys[] = {
-    {"file-bytes", &InputLimits::file_bytes, "bytes read from one file (the scene, each buffer and image it\n"
-                                             "                         names, --display-config)"},
+    {"file-bytes", &InputLimits::file_bytes,
+     "bytes read from one file (the scene, each buffer and image it\n"
+     "                         names, --display-config)"},
     {"texture-pixels", &InputLimits::texture_pixels, "pixels (width x height) of one decoded texture image"},
-    {"vertex-data", &InputLimits::vertex_data, "bytes of decoded vertex data, every instance and morph target\n"
-                                               "                         counted"},
+    {"vertex-data", &InputLimits::vertex_data,
+     "bytes of decoded vertex data, every instance and morph target\n"
+     "                         counted"},
     {"animation-data", &InputLimits::animation_data, "bytes of decoded animation keys, every sampler counted"},
     {"json-bytes", &InputLimits::json_bytes, "bytes of the scene's JSON (a .gltf file, a .glb's JSON chunk)"},
     {"framing-work", &InputLimits::framing_work, "vertices x poses the framing of an animation may pose"},
@@ -106,7 +108,8 @@ void parse_limits(const std::string& text, InputLimits& limits) {
     }
     uint64_t v = 0;
     if (!parse_amount(pair.substr(eq + 1), v))
-      throw Error("invalid --limit '" + pair + "': expected a positive integer, optionally with K, M, G or T (x1024^n)");
+      throw Error("invalid --limit '" + pair +
+                  "': expected a positive integer, optionally with K, M, G or T (x1024^n)");
     limits.*(k->field) = v;
   }
   if (!any) throw Error("invalid --limit '': expected KEY=VALUE[,KEY=VALUE...]");
@@ -117,10 +120,11 @@ std::string limit_help() {
   std::string out;
   for (const LimitKey& k : kLimitKeys) {
     const uint64_t v = defaults.*(k.field);
-    out += "                         " + std::string(k.name) + ": " + k.what +
-           (v ? " (default " + std::to_string(v) + ")\n"
-              : std::string("\n                         (default: the smallest of MemAvailable, the cgroup's memory.max "
-                            "and\n                         RLIMIT_AS, less a margin)\n"));
+    out +=
+        "                         " + std::string(k.name) + ": " + k.what +
+        (v ? " (default " + std::to_string(v) + ")\n"
+           : std::string("\n                         (default: the smallest of MemAvailable, the cgroup's memory.max "
+                         "and\n                         RLIMIT_AS, less a margin)\n"));
   }
   return out;
 }

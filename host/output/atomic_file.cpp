@@ -34,8 +34,8 @@ int create_exclusive(const std::string& path) {
 // At most kTempNameExtra bytes longer than the name (pid_t and the counter have at most 10 digits).
 constexpr size_t kTempNameExtra = 1 + 5 + 10 + 1 + 10;
 std::string temp_name(const fs::path& final_path) {
-  const std::string name = "." + final_path.filename().string() + ".tmp-" + std::to_string(::getpid()) +
-                           "-" + std::to_string(g_counter.fetch_add(1));
+  const std::string name = "." + final_path.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+                           std::to_string(g_counter.fetch_add(1));
   return (final_path.parent_path() / name).string();
 }
 
@@ -43,8 +43,7 @@ std::string temp_name(const fs::path& final_path) {
 
 AtomicFile::AtomicFile(std::string final_path) : final_path_(std::move(final_path)) {
   const fs::path p(final_path_);
-  if (final_path_.empty() || !p.has_filename())
-    throw Error("cannot write '" + final_path_ + "': not a file name");
+  if (final_path_.empty() || !p.has_filename()) throw Error("cannot write '" + final_path_ + "': not a file name");
   int err = 0;
   for (int attempt = 0; attempt < 100; ++attempt) {
     temp_path_ = temp_name(p);
@@ -104,11 +103,11 @@ void prepare_output_dir(const std::string& dir) {
   }
   // Probe: create and remove a file (access(W_OK) would not tell the truth for root or read-only mounts).
   const std::string probe =
-      (p / (".pmr-write-probe-" + std::to_string(::getpid()) + "-" + std::to_string(g_counter.fetch_add(1))))
-          .string();
+      (p / (".pmr-write-probe-" + std::to_string(::getpid()) + "-" + std::to_string(g_counter.fetch_add(1)))).string();
   const int err = create_exclusive(probe);
   if (err != 0) throw Error(what + std::strerror(err));
-  if (::unlink(probe.c_str()) != 0) throw Error(what + "cannot remove the probe file " + probe + ": " + std::strerror(errno));
+  if (::unlink(probe.c_str()) != 0)
+    throw Error(what + "cannot remove the probe file " + probe + ": " + std::strerror(errno));
 }
 
 void check_output_dir(const std::string& dir) {

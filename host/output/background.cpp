@@ -29,7 +29,8 @@ Background parse_background(const std::string& text) {
     char* end = nullptr;
     const double d = std::strtod(item.c_str(), &end);
     if (item.empty() || end != item.c_str() + item.size() || !std::isfinite(d) || d < 0.0 || d > 65504.0)
-      throw Error("invalid --background '" + text + "': expected R,G,B or R,G,B,A, linear values >= 0 (e.g. 0,0,0,1 for opaque black)");
+      throw Error("invalid --background '" + text +
+                  "': expected R,G,B or R,G,B,A, linear values >= 0 (e.g. 0,0,0,1 for opaque black)");
     v.push_back(d);
   }
   if (v.size() != 3 && v.size() != 4)

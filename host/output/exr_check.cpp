@@ -127,7 +127,9 @@ std::string exr_chunk_problem(const std::string& path) {
     for (size_t c = 0; c < tables[p].size(); ++c) {
       const uint64_t at = tables[p][c];
       const int64_t y = parts[p].min_y + int64_t(c) * parts[p].lines;
-      auto damaged = [&] { return name_of(path) + " is truncated or damaged (chunk at scanline " + std::to_string(y) + ")"; };
+      auto damaged = [&] {
+        return name_of(path) + " is truncated or damaged (chunk at scanline " + std::to_string(y) + ")";
+      };
       if (at < tables_end || at > file_bytes || file_bytes - at < leader) return damaged();
       r.seek(at);
       if (multi && r.u(4) != p) return damaged();

@@ -27,12 +27,12 @@ glm::dmat4 exr_world_to_camera(const Rig& rig, int view) {
 glm::dmat4 exr_world_to_ndc(const Rig& rig, int view) {
   // S (glm is column-major: s[c][r] is row r of column c)
   glm::dmat4 s(0.0);
-  s[0][0] = 0.5;   // x' = x_c / 2 + w_c / 2
+  s[0][0] = 0.5;  // x' = x_c / 2 + w_c / 2
   s[3][0] = 0.5;
   s[1][1] = -0.5;  // y' = -y_c / 2 + w_c / 2
   s[3][1] = 0.5;
-  s[2][2] = 1.0;   // z' = z_c
-  s[3][3] = 1.0;   // w' = w_c
+  s[2][2] = 1.0;  // z' = z_c
+  s[3][3] = 1.0;  // w' = w_c
   return s * rig.projection(view) * rig.view_matrix(view);
 }
 
@@ -71,7 +71,8 @@ void add_exr_metadata(Imf::Header& h, const ExrMetadata& meta, ExrImage image, i
   const Rig& rig = meta.rig;
   if (image != ExrImage::Views) view = meta.center_view;
   if (view < 0 || view >= rig.views)
-    throw std::invalid_argument("no view " + std::to_string(view) + " in a rig of " + std::to_string(rig.views) + " views");
+    throw std::invalid_argument("no view " + std::to_string(view) + " in a rig of " + std::to_string(rig.views) +
+                                " views");
 
   // OpenEXR 3.1 has no accessor for `software` (ImfStandardAttributes.h): a plain string attribute
   h.insert("software", Imf::StringAttribute(std::string("pmr ") + program_version()));

@@ -53,20 +53,23 @@ void guarded(const char* verb, const std::string& path, const std::string& temp,
 
 Imf::Compression to_imf(ExrCompression c, const std::string& path) {
   switch (c) {
-    case ExrCompression::None: return Imf::NO_COMPRESSION;
-    case ExrCompression::Zip: return Imf::ZIP_COMPRESSION;
-    case ExrCompression::ZipFast: return Imf::ZIP_COMPRESSION;
-    case ExrCompression::Piz: return Imf::PIZ_COMPRESSION;
-    case ExrCompression::Rle: return Imf::RLE_COMPRESSION;
+    case ExrCompression::None:
+      return Imf::NO_COMPRESSION;
+    case ExrCompression::Zip:
+      return Imf::ZIP_COMPRESSION;
+    case ExrCompression::ZipFast:
+      return Imf::ZIP_COMPRESSION;
+    case ExrCompression::Piz:
+      return Imf::PIZ_COMPRESSION;
+    case ExrCompression::Rle:
+      return Imf::RLE_COMPRESSION;
   }
   throw Error("cannot write " + path + ": invalid EXR compression value " + std::to_string(int(c)));
 }
 
 // The header's compression. zip and zip-fast are both ZIP; they differ in the encoder our writer uses
 // (zip_encoder). Readers need nothing new: neither the encoder nor its level is stored in the file.
-void set_compression(Imf::Header& h, ExrCompression c, const std::string& path) {
-  h.compression() = to_imf(c, path);
-}
+void set_compression(Imf::Header& h, ExrCompression c, const std::string& path) { h.compression() = to_imf(c, path); }
 
 // OpenEXR's per-channel alpha names for R, G, B
 const char* const kSubpixelAlpha[3] = {"AR", "AG", "AB"};
@@ -74,7 +77,9 @@ const char* const kSubpixelAlpha[3] = {"AR", "AG", "AB"};
 // zip: ISA-L and libdeflate at OpenEXR's level (exr_zip.h); zip-fast: ISA-L only, a third of zip's
 // writer CPU for files about 10% larger
 // (docs/SEQUENCES.md, "The ZIP writer").
-ZipEncoder zip_encoder(ExrCompression c) { return c == ExrCompression::ZipFast ? ZipEncoder::Fast : ZipEncoder::Default; }
+ZipEncoder zip_encoder(ExrCompression c) {
+  return c == ExrCompression::ZipFast ? ZipEncoder::Fast : ZipEncoder::Default;
+}
 
 void check_image(const std::string& path, int width, int height, int layers, const void* data) {
   if (width < 1 || height < 1 || layers < 1)
@@ -140,11 +145,16 @@ ExrCompression parse_exr_compression(const std::string& name) {
 
 const char* to_string(ExrCompression c) {
   switch (c) {
-    case ExrCompression::None: return "none";
-    case ExrCompression::Zip: return "zip";
-    case ExrCompression::ZipFast: return "zip-fast";
-    case ExrCompression::Piz: return "piz";
-    case ExrCompression::Rle: return "rle";
+    case ExrCompression::None:
+      return "none";
+    case ExrCompression::Zip:
+      return "zip";
+    case ExrCompression::ZipFast:
+      return "zip-fast";
+    case ExrCompression::Piz:
+      return "piz";
+    case ExrCompression::Rle:
+      return "rle";
   }
   return "invalid";
 }
@@ -157,9 +167,9 @@ std::string view_part_name(int i, int views) {
   return "view_" + num;
 }
 
-void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half,
-                    ExrCompression c, int threads, const float* depth, float pixel_aspect, const ExrMetadata* meta,
-                    ExrImage image, const uint16_t* subpixel_alpha) {
+void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half, ExrCompression c,
+                    int threads, const float* depth, float pixel_aspect, const ExrMetadata* meta, ExrImage image,
+                    const uint16_t* subpixel_alpha) {
   check_image(path, width, height, 1, rgba_half);
   if (!(pixel_aspect > 0.0f) || !std::isfinite(pixel_aspect))
     throw Error("cannot write " + path + ": invalid pixel aspect ratio " + std::to_string(pixel_aspect));
@@ -196,7 +206,8 @@ void write_rgba_exr(const std::string& path, int width, int height, const uint16
         char* sa = const_cast<char*>(reinterpret_cast<const char*>(subpixel_alpha));
         for (int k = 0; k < 3; ++k) {
           header.channels().insert(kSubpixelAlpha[k], Imf::Channel(Imf::HALF));
-          fb.insert(kSubpixelAlpha[k], Imf::Slice(Imf::HALF, sa + 2 * k, 3 * sizeof(uint16_t), 3 * sizeof(uint16_t) * size_t(width)));
+          fb.insert(kSubpixelAlpha[k],
+                    Imf::Slice(Imf::HALF, sa + 2 * k, 3 * sizeof(uint16_t), 3 * sizeof(uint16_t) * size_t(width)));
         }
       }
       Imf::OutputFile out(file.temp_path().c_str(), header);
@@ -213,12 +224,11 @@ void write_rgba_exr(const std::string& path, int width, int height, const uint16
 }
 
 void write_views_exr(const std::string& path, int width, int height, int views, const uint16_t* volume,
-                     const float* depth, ExrCompression c, int threads, float pixel_aspect,
-                     const ExrMetadata* meta) {
+                     const float* depth, ExrCompression c, int threads, float pixel_aspect, const ExrMetadata* meta) {
   check_image(path, width, height, views, volume);
   if (meta && meta->rig.views != views)
-    throw Error("cannot write " + path + ": the metadata's rig has " + std::to_string(meta->rig.views) + " views, the file " +
-                std::to_string(views));
+    throw Error("cannot write " + path + ": the metadata's rig has " + std::to_string(meta->rig.views) +
+                " views, the file " + std::to_string(views));
   if (!(pixel_aspect > 0.0f) || !std::isfinite(pixel_aspect))
     throw Error("cannot write " + path + ": invalid pixel aspect ratio " + std::to_string(pixel_aspect));
   AtomicFile file(path);
@@ -310,14 +320,13 @@ std::vector<std::string> read_exr_part_names(const std::string& path) {
   std::vector<std::string> names;
   guarded("cannot read", path, "", [&] {
     Imf::MultiPartInputFile in(path.c_str());
-    for (int i = 0; i < in.parts(); ++i)
-      names.push_back(in.header(i).hasName() ? in.header(i).name() : std::string());
+    for (int i = 0; i < in.parts(); ++i) names.push_back(in.header(i).hasName() ? in.header(i).name() : std::string());
   });
   return names;
 }
 
-void read_views_exr_part(const std::string& path, int part, int& width, int& height,
-                         std::vector<uint16_t>& rgba_half, std::vector<float>* depth) {
+void read_views_exr_part(const std::string& path, int part, int& width, int& height, std::vector<uint16_t>& rgba_half,
+                         std::vector<float>* depth) {
   guarded("cannot read", path, "", [&] {
     Imf::MultiPartInputFile file(path.c_str());
     if (part < 0 || part >= file.parts())

@@ -56,7 +56,7 @@ void put32(std::vector<unsigned char>& out, uint32_t v) {
 // readback's R G B A, the encoder's AR AG AB) is split in one pass over the row; any other channel
 // alone. `dest` is each component's offset within the scanline's share of the even (or odd) bytes.
 struct SplitRun {
-  const char* base;  // component 0's first value
+  const char* base;                  // component 0's first value
   size_t x_stride, y_stride, bytes;  // bytes: 2 (half) or 4 (float, always alone)
   int count = 1;                     // components: 1, or 3 or 4 interleaved halves (x_stride 2 * count)
   size_t dest[4] = {};
@@ -76,7 +76,8 @@ void split4(const unsigned char* __restrict p, int width, unsigned char* __restr
 void split3(const unsigned char* __restrict p, int width, unsigned char* __restrict e0, unsigned char* __restrict e1,
             unsigned char* __restrict e2, unsigned char* __restrict o0, unsigned char* __restrict o1,
             unsigned char* __restrict o2) {
-  for (int x = 0; x < width; ++x, p += 6) e0[x] = p[0], o0[x] = p[1], e1[x] = p[2], o1[x] = p[3], e2[x] = p[4], o2[x] = p[5];
+  for (int x = 0; x < width; ++x, p += 6)
+    e0[x] = p[0], o0[x] = p[1], e1[x] = p[2], o1[x] = p[3], e2[x] = p[4], o2[x] = p[5];
 }
 
 // The runs of a part's channels (given in the header's name order) for a scanline of `width` values.
@@ -136,7 +137,8 @@ size_t precondition_chunk(const std::vector<SplitRun>& runs, size_t line_bytes, 
       const unsigned char* row = reinterpret_cast<const unsigned char*>(r.base) + size_t(y) * r.y_stride;
       const size_t* d = r.dest;
       if (r.count == 4) {
-        split4(row, width, even + d[0], even + d[1], even + d[2], even + d[3], odd + d[0], odd + d[1], odd + d[2], odd + d[3]);
+        split4(row, width, even + d[0], even + d[1], even + d[2], even + d[3], odd + d[0], odd + d[1], odd + d[2],
+               odd + d[3]);
       } else if (r.count == 3) {
         split3(row, width, even + d[0], even + d[1], even + d[2], odd + d[0], odd + d[1], odd + d[2]);
       } else if (r.bytes == 2) {
@@ -181,7 +183,7 @@ struct Scratch {
   std::vector<unsigned char> split, pre, packed;
 };
 
-constexpr int kDefaultLevel = 4;  // libdeflate: OpenEXR's own zlib level
+constexpr int kDefaultLevel = 4;                                           // libdeflate: OpenEXR's own zlib level
 constexpr uint32_t kFastLevel = 2, kFastLevelBuf = ISAL_DEF_LVL2_DEFAULT;  // ISA-L igzip
 // zip keeps ISA-L's stream of a chunk it shrinks at least this much: on such chunks (background,
 // alpha runs) libdeflate saves few bytes for 7-8x the time. Measured over three rendered paper-8k frames:
@@ -328,7 +330,8 @@ bool prepare_scratch(Scratch& S, ZipEncoder encoder, size_t max_raw) {
     if (!S.z) return false;
   }
   if (S.isal_level_buf.size() < kFastLevelBuf) S.isal_level_buf.resize(kFastLevelBuf);
-  if (S.split.size() < max_raw) S.split.resize(max_raw), S.pre.resize(max_raw + kInputSlack), S.packed.resize(packed_bound(max_raw));
+  if (S.split.size() < max_raw)
+    S.split.resize(max_raw), S.pre.resize(max_raw + kInputSlack), S.packed.resize(packed_bound(max_raw));
   return true;
 }
 

@@ -18,7 +18,8 @@ std::atomic<int> g_signal{0};
 void on_signal(int sig) {
   int expected = 0;
   if (g_signal.compare_exchange_strong(expected, sig)) {
-    const char msg[] = "\npmr: interrupted: finishing cleanly (the frame in flight is dropped; signal again to stop at once)\n";
+    const char msg[] =
+        "\npmr: interrupted: finishing cleanly (the frame in flight is dropped; signal again to stop at once)\n";
     (void)!::write(2, msg, sizeof msg - 1);
     return;
   }

@@ -38,8 +38,8 @@ uint8_t to_byte(double v) { return uint8_t(std::lround(std::min(1.0, std::max(0.
 
 }  // namespace
 
-void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half,
-                       double pixel_aspect, bool opaque) {
+void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half, double pixel_aspect,
+                       bool opaque) {
   if (width < 1 || height < 1 || !rgba_half) throw Error("cannot write " + path + ": empty image");
   // sRGB lookup for every half value: the curve is applied once per distinct input, not per pixel
   static const std::vector<uint8_t> lut = [] {  // thread-safe initialization
@@ -63,8 +63,9 @@ void write_png_preview(const std::string& path, int width, int height, const uin
   if (ok && setjmp(png_jmpbuf(png)) == 0) {
     png_init_io(png, f);
     png_set_compression_level(png, 1);
-    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8, opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA,
-                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8,
+                 opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+                 PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
     if (pixel_aspect != 1.0) {
       // pixels per unit along x and y: a pixel is 1 / x wide and 1 / y tall, so y / x is its aspect
@@ -137,8 +138,7 @@ void read_png_rgba8(const std::string& path, int& width, int& height, std::vecto
   png_image image;
   std::memset(&image, 0, sizeof image);
   image.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&image, path.c_str()))
-    throw Error("cannot read " + path + ": " + image.message);
+  if (!png_image_begin_read_from_file(&image, path.c_str())) throw Error("cannot read " + path + ": " + image.message);
   image.format = PNG_FORMAT_RGBA;
   rgba.assign(PNG_IMAGE_SIZE(image), 0);
   if (!png_image_finish_read(&image, nullptr, rgba.data(), 0, nullptr)) {

@@ -36,7 +36,8 @@ QuiltLayout choose_quilt_layout(int views, int view_w, int view_h) {
     if (views % c) continue;
     const QuiltLayout l{c, views / c};
     const double s = squareness(l, view_w, view_h);
-    if (s < best_score - 1e-12 || (std::abs(s - best_score) <= 1e-12 && l.columns > best.columns)) best = l, best_score = s;
+    if (s < best_score - 1e-12 || (std::abs(s - best_score) <= 1e-12 && l.columns > best.columns))
+      best = l, best_score = s;
   }
   if (best_score > std::log(2.0)) {
     // e.g. a prime view count: the most square layout with the fewest empty tiles (a square costs
@@ -62,7 +63,8 @@ QuiltLayout parse_quilt_layout(const std::string& text, int views, int view_w, i
     throw Error("invalid --quilt '" + text + "': expected COLUMNSxROWS, e.g. 8x6");
   const QuiltLayout l{c, r};
   if (int64_t(c) * r < views)
-    throw Error("invalid --quilt '" + text + "': " + std::to_string(c * r) + " tiles for " + std::to_string(views) + " views");
+    throw Error("invalid --quilt '" + text + "': " + std::to_string(c * r) + " tiles for " + std::to_string(views) +
+                " views");
   if (!fits(l, view_w, view_h)) {
     std::string hint;
     try {

@@ -94,8 +94,8 @@ json shading_json(const SidecarInfo& info) {
   json s = {{"model", info.shading}, {"exposure_ev", info.exposure_ev}};
   if (info.shading != "pbr") return s;
   if (info.environment_file.empty())
-    s["environment"] = {{"kind", "uniform"}, {"radiance", 0.2 * info.environment_intensity},
-                        {"intensity", info.environment_intensity}};
+    s["environment"] = {
+        {"kind", "uniform"}, {"radiance", 0.2 * info.environment_intensity}, {"intensity", info.environment_intensity}};
   else
     s["environment"] = {{"kind", "image"},
                         {"file", info.environment_file},
@@ -132,12 +132,10 @@ json output_checksums_json(const SidecarInfo& info) {
 }
 
 json quilt_json(const Rig& rig, const SidecarInfo& info) {
-  return {{"columns", info.quilt_columns},
-          {"rows", info.quilt_rows},
-          {"aspect", rig.aspect},
-          {"tile_width", rig.view_w},
-          {"tile_height", rig.view_h},
-          {"order", "view 0 in the bottom-left tile, then left to right, then upward"}};
+  return {
+      {"columns", info.quilt_columns}, {"rows", info.quilt_rows},
+      {"aspect", rig.aspect},          {"tile_width", rig.view_w},
+      {"tile_height", rig.view_h},     {"order", "view 0 in the bottom-left tile, then left to right, then upward"}};
 }
 
 // null, not absent, when the frame has no animation or turntable: sidecar_config_difference requires
@@ -225,28 +223,35 @@ json views_json(const Rig& rig) {
 json conventions_json() {
   return {
       {"coordinates", "glTF: right-handed, +Y up, cameras look along -Z, +X right; rig distances in scene units"},
-      {"raster", "row 0 is the top row; pixel (px, py) counts px from the left and py from the top, its center is "
-                 "(px + 0.5, py + 0.5)"},
+      {"raster",
+       "row 0 is the top row; pixel (px, py) counts px from the left and py from the top, its center is "
+       "(px + 0.5, py + 0.5)"},
       {"ndc_to_raster", "x = (x_ndc + 1) / 2 * view_width, y = (1 - y_ndc) / 2 * view_height"},
-      {"views", "view 0 is the leftmost camera; camera i sits at 'offset' s_i along +X of the center camera: "
-                "view = T(-s_i, 0, 0) * center_view; views[i] is part view_NNN of the views EXR"},
-      {"matrices", "4x4, 16 numbers column-major as glTF stores them (element 4 * c + r is row r of column c); "
-                   "clip = proj * view * (x, y, z, 1); OpenGL clip space, NDC z in [-1, 1]"},
-      {"depth", "the Z channel of the views and quilt EXRs (when written) is the view-space depth w: the distance "
-                "along the view's axis, positive in front of the camera; +infinity where nothing was drawn"},
+      {"views",
+       "view 0 is the leftmost camera; camera i sits at 'offset' s_i along +X of the center camera: "
+       "view = T(-s_i, 0, 0) * center_view; views[i] is part view_NNN of the views EXR"},
+      {"matrices",
+       "4x4, 16 numbers column-major as glTF stores them (element 4 * c + r is row r of column c); "
+       "clip = proj * view * (x, y, z, 1); OpenGL clip space, NDC z in [-1, 1]"},
+      {"depth",
+       "the Z channel of the views and quilt EXRs (when written) is the view-space depth w: the distance "
+       "along the view's axis, positive in front of the camera; +infinity where nothing was drawn"},
       {"color", "linear-light RGB; alpha = coverage; background (0, 0, 0, 0)"},
-      {"light", "light_dir_*: lambert's one directional light, toward the light, fixed in the center camera's "
-                "view space; color = base * (0.2 + 0.8 * max(0, dot(n, l))). pbr is lit by shading.lights instead "
-                "(world space; a light's direction is where it travels)"},
-      {"encoding", "display pixel (j, i), row 0 at the top, subpixel k in {0,1,2} (R,G,B left to right): "
-                   "t = (3 j + k' - 3 i tan_slant - offset) / lens_pitch with k' = k (subpixel_order rgb) or 2 - k "
-                   "(bgr), v = floor(frac(phase_sign * t) * views) evaluated exactly, v -> views - 1 - v if "
-                   "reversed; with subpixel cells (display.cell_rows) k' = 0 and the offset of the pixel's cell and "
-                   "channel (display.cell_offsets_1e14 / 10^14); channel k of view v sampled at "
-                   "((j + (k + 0.5) / 3) / width, (i + 0.5) / height)"},
-      {"sampling", "view: that position read from view v's view_width x view_height raster (nearest, or bilinear "
-                   "per display.sampling); subpixel: view v rasterized at that position itself, truncated to the "
-                   "raster's 16.16 / 24.8 fixed point (docs/SAMPLING.md)"},
+      {"light",
+       "light_dir_*: lambert's one directional light, toward the light, fixed in the center camera's "
+       "view space; color = base * (0.2 + 0.8 * max(0, dot(n, l))). pbr is lit by shading.lights instead "
+       "(world space; a light's direction is where it travels)"},
+      {"encoding",
+       "display pixel (j, i), row 0 at the top, subpixel k in {0,1,2} (R,G,B left to right): "
+       "t = (3 j + k' - 3 i tan_slant - offset) / lens_pitch with k' = k (subpixel_order rgb) or 2 - k "
+       "(bgr), v = floor(frac(phase_sign * t) * views) evaluated exactly, v -> views - 1 - v if "
+       "reversed; with subpixel cells (display.cell_rows) k' = 0 and the offset of the pixel's cell and "
+       "channel (display.cell_offsets_1e14 / 10^14); channel k of view v sampled at "
+       "((j + (k + 0.5) / 3) / width, (i + 0.5) / height)"},
+      {"sampling",
+       "view: that position read from view v's view_width x view_height raster (nearest, or bilinear "
+       "per display.sampling); subpixel: view v rasterized at that position itself, truncated to the "
+       "raster's 16.16 / 24.8 fixed point (docs/SAMPLING.md)"},
   };
 }
 
@@ -264,8 +269,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["shading"] = shading_json(info);
   j["tile"] = {{"x", info.tile_x}, {"y", info.tile_y}, {"v", info.tile_v}};
   j["camera"] = info.camera;
-  if (info.has_bounds)
-    j["scene_bounds"] = {{"min", vec3_json(info.bounds_lo)}, {"max", vec3_json(info.bounds_hi)}};
+  if (info.has_bounds) j["scene_bounds"] = {{"min", vec3_json(info.bounds_lo)}, {"max", vec3_json(info.bounds_hi)}};
   if (!info.compression.empty()) j["compression"] = info.compression;
   json outputs = json::object();
   for (const auto& [kind, file] : info.outputs) outputs[kind] = file;
@@ -339,12 +343,13 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
       // written before pmr recorded the lights, when pbr used the default light, or none with an image
       const json toward = get(o, "light_dir_world");
       s["lights"] = json();
-      if (get(get(s, "environment"), "kind") == "image")
-        s["lights"] = json::array();
-      else if (toward.is_array() && toward.size() == 3 && toward[0].is_number() && toward[1].is_number() && toward[2].is_number())
-        s["lights"] = json::array({json::parse(light_json(default_light(glm::dvec3(toward[0].get<double>(), toward[1].get<double>(),
-                                                                                    toward[2].get<double>())))
-                                                   .dump())});
+      if (get(get(s, "environment"), "kind") == "image") s["lights"] = json::array();
+      else if (toward.is_array() && toward.size() == 3 && toward[0].is_number() && toward[1].is_number() &&
+               toward[2].is_number())
+        s["lights"] = json::array(
+            {json::parse(light_json(default_light(glm::dvec3(toward[0].get<double>(), toward[1].get<double>(),
+                                                             toward[2].get<double>())))
+                             .dump())});
     }
     if (ignore_scene_derived) {
       s.erase("lights");

@@ -45,7 +45,8 @@ TileOwnership EncodeStage::own_by_tiles(int tile_x) {
   straddle_slot_ = upload_table(rt_, own.straddle_slot, "straddle slots");
   straddle_columns_ = upload_table(rt_, own.straddling, "straddle columns");
   straddle_slots_ = uint32_t(own.straddling.size());
-  straddle_cov_ = rt_.buffer(std::max<size_t>(size_t(straddle_slots_) * params_.display_h * 3, 16), "straddle coverage");
+  straddle_cov_ =
+      rt_.buffer(std::max<size_t>(size_t(straddle_slots_) * params_.display_h * 3, 16), "straddle coverage");
   return own;
 }
 

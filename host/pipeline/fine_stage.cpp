@@ -15,7 +15,10 @@ constexpr size_t kFineGroup = 8;
 }  // namespace
 
 FineStage::FineStage(Launcher& launcher, const ClProgram& program, const std::string& options, const int* tile)
-    : launcher_(launcher), rt_(launcher.runtime()), options_(options), tile_{tile[0], tile[1], tile[2]},
+    : launcher_(launcher),
+      rt_(launcher.runtime()),
+      options_(options),
+      tile_{tile[0], tile[1], tile[2]},
       fine_(program, "fine_raster") {}
 
 void FineStage::configure(const FinePaths& paths, int views, int view_w, int view_h, EncodeStage* encode) {
@@ -67,9 +70,10 @@ void FineStage::configure_fused(int views, EncodeStage& encode) {
 void FineStage::configure_subpixel(int views, EncodeStage& encode) {
   const int capacity = subpixel_chunk_capacity(views);
   if (subpixel_views_ != views) {
-    subpixel_program_ = launcher_.build({"fine_subpixel.cl"}, options_ + " -DPMR_SUBPIXEL_VIEWS=" + std::to_string(views) +
-                                                                 " -DPMR_SUBPIXEL_CAP=" + std::to_string(capacity) +
-                                                                 " -DPMR_SUBPIXEL_SLOTS=" + std::to_string(kSubpixelSlots));
+    subpixel_program_ =
+        launcher_.build({"fine_subpixel.cl"}, options_ + " -DPMR_SUBPIXEL_VIEWS=" + std::to_string(views) +
+                                                  " -DPMR_SUBPIXEL_CAP=" + std::to_string(capacity) +
+                                                  " -DPMR_SUBPIXEL_SLOTS=" + std::to_string(kSubpixelSlots));
     subpixel_views_ = views;
     fine_subpixel_ = ClKernel(subpixel_program_, "fine_subpixel");
   }
@@ -116,10 +120,10 @@ void FineStage::run_subpixel(const SceneBuffers& scene, const GeometryStage& geo
                              FrameEvents& ev) {
   const cl_uint next = scene.bind_shading(fine_subpixel_, geometry.params());
   const bool debug = paths_.debug && !paths_.volume;  // per display subpixel
-  fine_subpixel_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(), encode.params_buffer(),
-                           column_a_, column_b_, encode.rows_buffer(), sample_x_, sample_y_, chunks_, num_chunks_,
-                           encode.straddle_slot(), encode.straddle_slots(), encode.straddle_cov(), encode.display(),
-                           encode.sub_alpha(), cl_uint(debug), dbg_key_, dbg_depth_);
+  fine_subpixel_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(),
+                           encode.params_buffer(), column_a_, column_b_, encode.rows_buffer(), sample_x_, sample_y_,
+                           chunks_, num_chunks_, encode.straddle_slot(), encode.straddle_slots(), encode.straddle_cov(),
+                           encode.display(), encode.sub_alpha(), cl_uint(debug), dbg_key_, dbg_depth_);
   ev.add(kFine, launcher_.launch(fine_subpixel_, num_chunks_, 1));
   encode.straddle_alpha(ev);
 }

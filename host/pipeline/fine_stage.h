@@ -18,10 +18,10 @@ namespace pmr {
 
 // The forms a configuration renders (Pipeline::configure chooses).
 struct FinePaths {
-  bool volume = true;          // the view volume (fine.cl)
-  bool fused = false;          // fused raster + encode
-  bool subpixel = false;       // --sampling subpixel
-  bool debug = false;          // debug outputs: per voxel of the volume, or per display subpixel
+  bool volume = true;     // the view volume (fine.cl)
+  bool fused = false;     // fused raster + encode
+  bool subpixel = false;  // --sampling subpixel
+  bool debug = false;     // debug outputs: per voxel of the volume, or per display subpixel
 };
 
 class FineStage {

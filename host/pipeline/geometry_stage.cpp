@@ -89,7 +89,8 @@ void GeometryStage::setup(PmrParams& P, const SceneBuffers& scene, FrameEvents& 
     if (last_mtas_ <= mta_capacity_) break;
     const uint64_t grown = uint64_t(last_mtas_) + last_mtas_ / 4 + 64;
     if (grown * sizeof(PmrMta) > rt_.max_alloc_bytes())
-      throw Error("the scene produces " + std::to_string(last_mtas_) + " multi-view triangles, more than the device can hold");
+      throw Error("the scene produces " + std::to_string(last_mtas_) +
+                  " multi-view triangles, more than the device can hold");
     mta_capacity_ = uint32_t(std::min<uint64_t>(grown, 0xffffffffu));
     mtas_ = ClBuffer();
     ++t.retries;
@@ -125,11 +126,14 @@ uint32_t GeometryStage::scan_tile_counts(StageTimes& t) {
     const uint32_t c = counts[i];
     counts[i] = uint32_t(total);
     total += c;
-    if (total >= 0xffffffffull) throw Error("the tile queues would exceed 4 G entries; use larger --tile or fewer views");
+    if (total >= 0xffffffffull)
+      throw Error("the tile queues would exceed 4 G entries; use larger --tile or fewer views");
   }
   if (t.bin_entries + total > tile_queue_limit_)  // (multipass: every pass of the frame counts)
-    throw Error("the frame's tile raster produces " + std::to_string(t.bin_entries + total) + " tile-queue entries, more than the "
-                "tile-queue limit of " + std::to_string(tile_queue_limit_) + " (raise it with --limit tile-queue=N)");
+    throw Error("the frame's tile raster produces " + std::to_string(t.bin_entries + total) +
+                " tile-queue entries, more than the "
+                "tile-queue limit of " +
+                std::to_string(tile_queue_limit_) + " (raise it with --limit tile-queue=N)");
   counts[num_tiles_] = uint32_t(total);
   rt_.write(tile_offsets_, counts.data(), counts.size() * sizeof(uint32_t));
   return uint32_t(total);
@@ -156,7 +160,8 @@ std::vector<PmrVertex> GeometryStage::read_vertices() const {
 
 size_t GeometryStage::device_bytes() const {
   size_t total = 0;
-  for (const ClBuffer* b : {&params_, &vertices_, &snapped_, &mtas_, &mta_counter_, &tile_counts_, &tile_offsets_, &tile_queue_})
+  for (const ClBuffer* b :
+       {&params_, &vertices_, &snapped_, &mtas_, &mta_counter_, &tile_counts_, &tile_offsets_, &tile_queue_})
     total += b->size();
   return total;
 }

@@ -37,12 +37,14 @@ MaterialTables make_material_tables(const Scene& scene) {
   }
   t.texels.resize(total_texels * 4);
   for (size_t i = 0; i < scene.textures.size(); ++i)
-    std::copy(scene.textures[i].rgba.begin(), scene.textures[i].rgba.end(), t.texels.begin() + size_t(t.textures[i].offset) * 4);
+    std::copy(scene.textures[i].rgba.begin(), scene.textures[i].rgba.end(),
+              t.texels.begin() + size_t(t.textures[i].offset) * 4);
 
   for (const std::vector<glm::vec2>& set : scene.texcoords)
     if (set.size() != vertices) throw InternalError("a TEXCOORD set does not have one entry per vertex");
   t.texcoords.reserve(std::max<size_t>(1, scene.texcoords.size() * vertices));
-  for (const std::vector<glm::vec2>& set : scene.texcoords) t.texcoords.insert(t.texcoords.end(), set.begin(), set.end());
+  for (const std::vector<glm::vec2>& set : scene.texcoords)
+    t.texcoords.insert(t.texcoords.end(), set.begin(), set.end());
   if (t.texcoords.empty()) t.texcoords.emplace_back(0.0f);
 
   // The device slots beyond base colour, in PMR_MAP_* order (the base colour map is PmrMaterial::texture).
@@ -66,7 +68,7 @@ MaterialTables make_material_tables(const Scene& scene) {
       if (size_t(slot.texture) >= scene.textures.size() || slot.texcoord < 0 ||
           size_t(slot.texcoord) >= scene.texcoords.size())
         throw InternalError("material " + std::to_string(i) + "'s " + texture_slot_name(kMapSlot[k]) +
-                    " names a texture or TEXCOORD set the scene does not have");
+                            " names a texture or TEXCOORD set the scene does not have");
       if (k == PMR_MAP_NORMAL && !has_tangents) continue;
       PmrTextureMap& map = m.maps[k];
       map.texture = slot.texture;

@@ -39,7 +39,8 @@ void method_tile(const PipelineConfig& config, size_t max_group, int* tile) {
     throw Error("invalid --tile: each tile side must be 1.." + std::to_string(kMaxTileSide));
   if (size_t(tx) * ty * tv > max_group)
     throw Error("invalid --tile " + std::to_string(tx) + "x" + std::to_string(ty) + "x" + std::to_string(tv) + ": " +
-                std::to_string(tx * ty * tv) + " voxels exceed the device's work-group limit of " + std::to_string(max_group));
+                std::to_string(tx * ty * tv) + " voxels exceed the device's work-group limit of " +
+                std::to_string(max_group));
 }
 
 // -w: PoCL's compiler would print "N warnings generated." on the user's terminal at every cold build.
@@ -56,7 +57,8 @@ struct Pipeline::Impl {
       : tile{tile_in[0], tile_in[1], tile_in[2]},
         launcher(rt),
         options(build_options(tile)),
-        program(launcher.build({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl", "straddle_alpha.cl"}, options)),
+        program(
+            launcher.build({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl", "straddle_alpha.cl"}, options)),
         scene(rt, config),
         geometry(launcher, program, config.tile_queue_limit),
         encode(launcher, program),
@@ -146,7 +148,9 @@ const std::vector<std::string>& Pipeline::kernel_variants() const { return impl_
 
 void Pipeline::set_mta_capacity(uint32_t capacity) { impl_->geometry.set_mta_capacity(capacity); }
 
-StageTimes Pipeline::render(const Rig& rig) { return render(describe_frame(rig, impl_->scene.scene_lights(), config_)); }
+StageTimes Pipeline::render(const Rig& rig) {
+  return render(describe_frame(rig, impl_->scene.scene_lights(), config_));
+}
 
 StageTimes Pipeline::render(const FrameDescription& frame) { return render_frame(frame, false); }
 
@@ -201,7 +205,8 @@ StageTimes Pipeline::render_frame(const FrameDescription& frame, bool empty) {
 // The multipass baseline: one conventional pass per view with view i's own view matrix and off-axis
 // projection, x_ndc = (D / a) x_view / w + s_i / a in camera i's view space. `snapped` (a test mode):
 // every pass takes PMR's snapped positions of its view, from PMR's vertex records computed once.
-void Pipeline::Impl::render_multipass(const Rig& rig, const PmrParams& P, bool snapped, FrameEvents& ev, StageTimes& t) {
+void Pipeline::Impl::render_multipass(const Rig& rig, const PmrParams& P, bool snapped, FrameEvents& ev,
+                                      StageTimes& t) {
   if (snapped) {
     geometry.transform(P, scene, ev);
     geometry.swap_snapped();
@@ -216,10 +221,8 @@ void Pipeline::Impl::render_multipass(const Rig& rig, const PmrParams& P, bool s
     Q.ndc_offset_x = rig.camera_offset(i) / a;
     Q.view_base = uint32_t(i);
     std::fill(std::begin(Q.view_coord), std::end(Q.view_coord), 0);  // the pass's one view
-    if (snapped)
-      geometry.select_view(Q, rig.view_coord(i), ev);
-    else
-      geometry.transform(Q, scene, ev);
+    if (snapped) geometry.select_view(Q, rig.view_coord(i), ev);
+    else geometry.transform(Q, scene, ev);
     geometry.setup_and_bin(Q, scene, ev, t);
     fine.run_volume(scene, geometry, num_tiles, ev);
   }
@@ -230,8 +233,8 @@ void Pipeline::Impl::render_multipass(const Rig& rig, const PmrParams& P, bool s
 // once the frame has run that long. The event's completion callback wakes the wait, so a fast frame
 // waits no longer than finish() would.
 void Pipeline::wait_reporting(const FrameEvents& ev, const StageTimes& t, std::chrono::steady_clock::time_point start) {
-  const auto step =
-      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(config_.slow_frame_seconds));
+  const auto step = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(config_.slow_frame_seconds));
   if (!ev.last()) return;
   struct Done {
     std::mutex mutex;

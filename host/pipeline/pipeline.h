@@ -61,7 +61,7 @@ struct PipelineConfig {
   // Default 16x2x16: best of the shapes measured with the fused path at N = 96 (pmr bench on
   // AnisotropyStrengthTest, TransmissionTest, --synthetic 100000; docs/PERFORMANCE.md).
   int tile_x = 16, tile_y = 2, tile_v = 16;
-  bool debug_outputs = false;      // fine raster also writes per-voxel key, depth, count
+  bool debug_outputs = false;  // fine raster also writes per-voxel key, depth, count
   // The encoded-only job: fine raster writes the display image directly (cl/fine_encode.cl) and the
   // view volume is never allocated. Applies to PMR with a display, nearest sampling and no debug
   // outputs, when one screen tile's state for all views fits a work-item's private memory;
@@ -92,11 +92,11 @@ struct PipelineConfig {
 
 struct StageTimes {  // milliseconds
   double vertex = 0, setup = 0, bin = 0, fine = 0, encode = 0;
-  double device_total = 0;  // first kernel start to last kernel end (includes host work in between)
-  double wall = 0;          // host wall-clock time of render()
-  int retries = 0;          // frames redone because a queue was full
-  uint32_t mtas = 0;        // MTAs produced by setup
-  uint64_t bin_entries = 0; // (tile, MTA) pairs produced by the tile raster
+  double device_total = 0;   // first kernel start to last kernel end (includes host work in between)
+  double wall = 0;           // host wall-clock time of render()
+  int retries = 0;           // frames redone because a queue was full
+  uint32_t mtas = 0;         // MTAs produced by setup
+  uint64_t bin_entries = 0;  // (tile, MTA) pairs produced by the tile raster
 };
 
 class Pipeline {
@@ -131,7 +131,7 @@ class Pipeline {
   int tiles_y() const { return tiles_y_; }
   int tiles_v() const { return tiles_v_; }
   size_t volume_bytes() const;
-  bool fused() const;  // the last configure() chose the fused raster + encode path
+  bool fused() const;       // the last configure() chose the fused raster + encode path
   bool has_volume() const;  // the last configure() renders the view volume (read_volume works)
   size_t display_bytes() const;
 
@@ -154,7 +154,7 @@ class Pipeline {
   // The MTA queue capacity (for tests of the grow-and-redo path).
   void set_mta_capacity(uint32_t capacity);
 
- struct Impl;
+  struct Impl;
 
  private:
   FinePaths choose_paths(const Rig& rig, const Display* display) const;

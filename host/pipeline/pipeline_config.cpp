@@ -14,9 +14,12 @@ Method parse_method(const std::string& name) {
 
 const char* to_string(Method m) {
   switch (m) {
-    case Method::Multipass: return "multipass";
-    case Method::Duplicate: return "duplicate";
-    default: return "pmr";
+    case Method::Multipass:
+      return "multipass";
+    case Method::Duplicate:
+      return "duplicate";
+    default:
+      return "pmr";
   }
 }
 
@@ -39,8 +42,9 @@ const char* to_string(Shading s) { return s == Shading::Pbr ? "pbr" : "lambert";
 void check_subpixel_sampling(Method method, const Display& display) {
   if (method != Method::Pmr) throw Error("--sampling subpixel renders with --method pmr");
   if (display.bilinear || display.blend_views)
-    throw Error("--sampling subpixel computes every subpixel at its own sample: --bilinear and --blend-views "
-                "apply to --sampling view only");
+    throw Error(
+        "--sampling subpixel computes every subpixel at its own sample: --bilinear and --blend-views "
+        "apply to --sampling view only");
 }
 
 }  // namespace pmr

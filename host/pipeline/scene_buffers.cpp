@@ -64,8 +64,10 @@ void SceneBuffers::upload_environment(const PipelineConfig& config) {
   const std::vector<float> no_data(4, 0.0f);
   const std::vector<float>& data = e ? e->tables().data : no_data;
   if (bytes_of(data) > rt_.max_alloc_bytes())
-    throw Error("the environment's tables need " + std::to_string(bytes_of(data) >> 20) + " MiB, more than the device "
-                "can allocate at once (" + std::to_string(rt_.max_alloc_bytes() >> 20) + " MiB): use a smaller image");
+    throw Error("the environment's tables need " + std::to_string(bytes_of(data) >> 20) +
+                " MiB, more than the device "
+                "can allocate at once (" +
+                std::to_string(rt_.max_alloc_bytes() >> 20) + " MiB): use a smaller image");
   env_ = upload(rt_, header, "environment header");
   env_data_ = upload(rt_, data, "environment tables");
 }
@@ -114,8 +116,9 @@ void SceneBuffers::upload_frame(const FrameDescription& frame) {
 }
 
 cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params) const {
-  const ClBuffer* inputs[] = {&params, &tris_,  &attrs_, &materials_, &textures_, &texels_, &lut_,      &positions_,
-                              &eyes_,  &split_sum_, &texcoords_, &tangents_, &env_, &env_data_, &lights_};
+  const ClBuffer* inputs[] = {&params,     &tris_,     &attrs_,     &materials_, &textures_,
+                              &texels_,    &lut_,      &positions_, &eyes_,      &split_sum_,
+                              &texcoords_, &tangents_, &env_,       &env_data_,  &lights_};
   cl_uint i = 0;
   for (const ClBuffer* b : inputs) k.arg(i++, *b);
   return i;

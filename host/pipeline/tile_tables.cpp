@@ -53,7 +53,8 @@ std::vector<PmrSampleChunk> subpixel_chunks(const TileOwnership& own, int tile_x
   const int tiles_x = (W + tile_x - 1) / tile_x, tiles_y = (H + tile_y - 1) / tile_y;
   for (int ty = 0; ty < tiles_y; ++ty)
     for (int tx = 0; tx < tiles_x; ++tx) {
-      const int s_lo = own.column_start[size_t(tx * tile_x)], s_hi = own.column_start[size_t(std::min(W, (tx + 1) * tile_x))];
+      const int s_lo = own.column_start[size_t(tx * tile_x)],
+                s_hi = own.column_start[size_t(std::min(W, (tx + 1) * tile_x))];
       const int i_lo = own.row_start[size_t(ty * tile_y)], i_hi = own.row_start[size_t(std::min(H, (ty + 1) * tile_y))];
       if (s_lo >= s_hi || i_lo >= i_hi) continue;
       for (int s0 = s_lo; s0 < s_hi;) {

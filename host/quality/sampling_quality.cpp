@@ -49,8 +49,8 @@ std::vector<uint16_t> render_display(const ClRuntime& rt, const Scene& scene, Ri
   renderer.render(0);  // warm-up
   row.render_ms = renderer.render(0).times.wall;
   row.view_w = rc.view_w, row.view_h = rc.view_h;
-  row.samples = sampling == Sampling::Subpixel ? 3.0 * display.width * display.height
-                                               : double(rc.views) * rc.view_w * rc.view_h;
+  row.samples =
+      sampling == Sampling::Subpixel ? 3.0 * display.width * display.height : double(rc.views) * rc.view_w * rc.view_h;
   std::vector<uint16_t> image;
   p.read_display(image);
   return image;
@@ -63,7 +63,8 @@ std::vector<SamplingQualityRow> sampling_quality(const ClRuntime& rt, const Scen
                                                  const std::vector<std::pair<int, int>>& extra_view_sizes) {
   if (scale < 1 || rig.view_w * scale > PMR_MAX_RASTER || rig.view_h * scale > PMR_MAX_RASTER)
     throw Error("the reference views (" + std::to_string(rig.view_w) + "x" + std::to_string(rig.view_h) + " times " +
-                std::to_string(scale) + ") exceed " + std::to_string(PMR_MAX_RASTER) + " px; use a smaller --view-size");
+                std::to_string(scale) + ") exceed " + std::to_string(PMR_MAX_RASTER) +
+                " px; use a smaller --view-size");
   std::vector<SamplingQualityRow> rows(4);
   rows[0].name = "reference";
   RigConfig fine = rig;
@@ -77,10 +78,9 @@ std::vector<SamplingQualityRow> sampling_quality(const ClRuntime& rt, const Scen
   rows[3].name = "view --bilinear";
   Display bilinear = nearest;
   bilinear.bilinear = true;
-  const std::vector<uint16_t> images[3] = {
-      render_display(rt, scene, rig, nearest, Sampling::Subpixel, rows[1]),
-      render_display(rt, scene, rig, nearest, Sampling::View, rows[2]),
-      render_display(rt, scene, rig, bilinear, Sampling::View, rows[3])};
+  const std::vector<uint16_t> images[3] = {render_display(rt, scene, rig, nearest, Sampling::Subpixel, rows[1]),
+                                           render_display(rt, scene, rig, nearest, Sampling::View, rows[2]),
+                                           render_display(rt, scene, rig, bilinear, Sampling::View, rows[3])};
   for (int k = 0; k < 3; ++k) rows[size_t(k) + 1].error = compare_display_images(images[k], reference);
   for (const auto& size : extra_view_sizes) {
     SamplingQualityRow row;

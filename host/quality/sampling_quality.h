@@ -20,17 +20,17 @@ struct ImageDifference {
   double rmse = 0.0;        // root mean square difference of the linear values
   double rmse_shown = 0.0;  // the same with every value clamped to [0, 1], as a panel shows it: one
                             // highlight of 10^4 (or an infinite half) cannot decide the comparison
-  double differing = 0.0;  // fraction of subpixels differing by more than kDifferingThreshold
+  double differing = 0.0;   // fraction of subpixels differing by more than kDifferingThreshold
 };
 constexpr double kDifferingThreshold = 1.0 / 256.0;
 ImageDifference compare_display_images(const std::vector<uint16_t>& a, const std::vector<uint16_t>& b);
 
 struct SamplingQualityRow {
-  std::string name;       // "subpixel", "view", "view --bilinear", and "reference" (first)
+  std::string name;  // "subpixel", "view", "view --bilinear", and "reference" (first)
   int view_w = 0, view_h = 0;
-  double samples = 0.0;   // samples rasterized per frame: voxels, or display subpixels
-  double render_ms = 0.0; // one frame after a warm-up (indicative; pmr bench measures speed)
-  ImageDifference error;  // against the reference
+  double samples = 0.0;    // samples rasterized per frame: voxels, or display subpixels
+  double render_ms = 0.0;  // one frame after a warm-up (indicative; pmr bench measures speed)
+  ImageDifference error;   // against the reference
 };
 // Frame 0 of `scene` with the rig and display given; throws pmr::Error when the reference views would
 // exceed the raster limit (8192 px). `extra_view_sizes` adds rows of --sampling view at other view

@@ -91,7 +91,6 @@ bool parse_decimal(const std::string& s, i128& num, i128& den) {
   return true;
 }
 
-
 }  // namespace
 
 Rational parse_rational(const std::string& text, const std::string& what) {
@@ -99,8 +98,7 @@ Rational parse_rational(const std::string& text, const std::string& what) {
   i128 n1, d1, n2 = 1, d2 = 1;
   const bool ok = slash == std::string::npos
                       ? parse_decimal(text, n1, d1)
-                      : parse_decimal(text.substr(0, slash), n1, d1) &&
-                            parse_decimal(text.substr(slash + 1), n2, d2);
+                      : parse_decimal(text.substr(0, slash), n1, d1) && parse_decimal(text.substr(slash + 1), n2, d2);
   if (!ok)
     throw Error("invalid " + what + " '" + text +
                 "': expected a number (at most 18 significant digits) or a fraction like 1/18");
@@ -130,7 +128,7 @@ namespace {
 struct Phase {
   WideInt den, p1, r0, dr;  // Den, P_1 (P_s = s P_1), R_0, R_{i+1} - R_i
   bool cells = false;
-  WideInt cell_scale;       // N b d (cells: P = cell_scale (3j G - o))
+  WideInt cell_scale;  // N b d (cells: P = cell_scale (3j G - o))
 };
 
 constexpr int64_t kCellDenominator = 100000000000000;  // 10^14

@@ -63,7 +63,8 @@ LookingGlassCalibration read_looking_glass_calibration(const std::string& path, 
   c.checksum = checksum_hex(text.data(), text.size());
   c.path = path;
   if (doc.contains("serial") && doc["serial"].is_string()) c.serial = doc["serial"].get<std::string>();
-  if (doc.contains("configVersion") && doc["configVersion"].is_string()) c.config_version = doc["configVersion"].get<std::string>();
+  if (doc.contains("configVersion") && doc["configVersion"].is_string())
+    c.config_version = doc["configVersion"].get<std::string>();
   c.pitch = number_field(doc, "pitch", path, true, 0);
   c.slope = number_field(doc, "slope", path, true, 0);
   c.center = number_field(doc, "center", path, true, 0);
@@ -75,7 +76,9 @@ LookingGlassCalibration read_looking_glass_calibration(const std::string& path, 
   c.flip_y = number_field(doc, "flipImageY", path, false, 0.0) >= 0.5;
   c.flip_subp = number_field(doc, "flipSubp", path, false, 0.0) >= 0.5;
   c.inv_view = number_field(doc, "invView", path, false, 1.0) >= 0.5;
-  auto absurd = [&](const char* field, const std::string& why) { throw Error(path + ": calibration field '" + field + "' " + why); };
+  auto absurd = [&](const char* field, const std::string& why) {
+    throw Error(path + ": calibration field '" + field + "' " + why);
+  };
   if (!(c.pitch > 0.0)) absurd("pitch", "must be positive (lenticules per inch)");
   if (c.slope == 0.0 || std::fabs(c.slope) > 1e6) absurd("slope", "must be non-zero");
   if (!(c.dpi > 0.0)) absurd("DPI", "must be positive");
@@ -94,7 +97,8 @@ LookingGlassCalibration read_looking_glass_calibration(const std::string& path, 
         if (!cell.is_object() || !cell.contains(keys[k]) || !cell[keys[k]].is_number())
           absurd("subpixelCells", std::string("needs a number ") + keys[k] + " in every cell");
         v[size_t(k)] = cell[keys[k]].get<double>();
-        if (!std::isfinite(v[size_t(k)]) || std::fabs(v[size_t(k)]) > 4.0) absurd("subpixelCells", "has an offset beyond 4 pixels");
+        if (!std::isfinite(v[size_t(k)]) || std::fabs(v[size_t(k)]) > 4.0)
+          absurd("subpixelCells", "has an offset beyond 4 pixels");
       }
       c.cells.push_back(v);
     }
@@ -105,7 +109,8 @@ LookingGlassCalibration read_looking_glass_calibration(const std::string& path, 
     c.cell_pattern = int(mode);
   }
   if (warnings) {
-    if (!c.inv_view) warnings->push_back(path + ": invView = 0 ignored, as Looking Glass's current shader (webxr 0.6) does");
+    if (!c.inv_view)
+      warnings->push_back(path + ": invView = 0 ignored, as Looking Glass's current shader (webxr 0.6) does");
     if (c.flip_y) warnings->push_back(path + ": flipImageY ignored, as Looking Glass's current shader does");
     if (c.fringe != 0.0) warnings->push_back(path + ": fringe ignored, as Looking Glass's current shader does");
   }
@@ -121,8 +126,8 @@ Display display_from_calibration(const LookingGlassCalibration& c) {
   // DESIGN section 5 (derivation in docs/DISPLAYS.md).
   const long double L = 3.0L * W / (long double)pitch_px;
   const long double T = (long double)W * tilt / H;
-  const long double O = -1.5L + (c.flip_x ? 2.0L : 0.0L) - 3.0L * W * (long double)tilt * (H - 0.5L) / H +
-                        (long double)c.center * L;
+  const long double O =
+      -1.5L + (c.flip_x ? 2.0L : 0.0L) - 3.0L * W * (long double)tilt * (H - 0.5L) / H + (long double)c.center * L;
   // Each field is checked alone when read; together they must give an encoder that exact arithmetic
   // holds (numerators and denominators below 2^62). Refused here, naming the file and its fields, not
   // later as an option (--lens-pitch, --offset) the user never gave.
@@ -165,20 +170,30 @@ Display display_from_calibration(const LookingGlassCalibration& c) {
       for (int xpar = 0; xpar < 2; ++xpar) {
         int cell = 0;  // GetCellForPixel with y mod cell_rows = row_class (y from the bottom), x mod 2 = xpar
         switch (c.cell_pattern) {
-          case 1: cell = (xpar + row_class) % 2; break;
-          case 2: cell = xpar; break;
-          case 3: cell = (row_class + 2 * xpar) % 4; break;
-          case 4: cell = row_class % 2; break;
-          default: cell = 0;
+          case 1:
+            cell = (xpar + row_class) % 2;
+            break;
+          case 2:
+            cell = xpar;
+            break;
+          case 3:
+            cell = (row_class + 2 * xpar) % 4;
+            break;
+          case 4:
+            cell = row_class % 2;
+            break;
+          default:
+            cell = 0;
         }
         const std::array<double, 6>& off = c.cells[size_t(cell) % c.cells.size()];
         for (int k = 0; k < 3; ++k) {
           const long double dx = off[size_t(2 * k)], dy = off[size_t(2 * k + 1)];
-          const long double o = -1.5L - 3.0L * dx - 3.0L * W * (long double)tilt * (H - 0.5L + dy) / H +
-                                (long double)c.center * L;
+          const long double o =
+              -1.5L - 3.0L * dx - 3.0L * W * (long double)tilt * (H - 0.5L + dy) / H + (long double)c.center * L;
           const long double scaled = std::round(o * 1e14L);
           if (!(std::fabs(scaled) < 9.0e18L))
-            throw Error(file + ": calibration fields center and subpixelCells give offsets too large for exact evaluation");
+            throw Error(file +
+                        ": calibration fields center and subpixelCells give offsets too large for exact evaluation");
           d.cell_offsets.push_back(int64_t(scaled));
         }
       }

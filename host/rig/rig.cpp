@@ -44,9 +44,7 @@ glm::dmat4 Rig::projection(int i) const {
   return glm::frustum(l, r, b, t, n, far);
 }
 
-double Rig::disparity_k() const {
-  return double(view_w) * std::tan(cone / 2.0) / (aspect * std::tan(yfov / 2.0));
-}
+double Rig::disparity_k() const { return double(view_w) * std::tan(cone / 2.0) / (aspect * std::tan(yfov / 2.0)); }
 
 double Rig::disparity_px(double w) const { return disparity_k() * (1.0 - focal / w); }
 
@@ -100,13 +98,12 @@ void choose_spacing_q(Rig& rig, std::vector<std::string>* warnings) {
 
 }  // namespace
 
-Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo,
-             const glm::dvec3& hi, const glm::dmat4* camera_pose, double camera_yfov,
-             std::vector<std::string>* warnings) {
+Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo, const glm::dvec3& hi,
+             const glm::dmat4* camera_pose, double camera_yfov, std::vector<std::string>* warnings) {
   if (config.views < 1) throw Error("invalid --views: need at least 1 view");
-  if (config.views > PMR_MAX_VIEWS) throw Error("invalid --views: at most " + std::to_string(PMR_MAX_VIEWS) + " views are supported");
-  if (config.view_w < 1 || config.view_h < 1 || config.view_w > PMR_MAX_RASTER ||
-      config.view_h > PMR_MAX_RASTER)
+  if (config.views > PMR_MAX_VIEWS)
+    throw Error("invalid --views: at most " + std::to_string(PMR_MAX_VIEWS) + " views are supported");
+  if (config.view_w < 1 || config.view_h < 1 || config.view_w > PMR_MAX_RASTER || config.view_h > PMR_MAX_RASTER)
     throw Error("invalid --view-size: each side must be 1.." + std::to_string(PMR_MAX_RASTER));
   check_positive(display.size_w_cm, "display width");
   check_positive(display.size_h_cm, "display height");
@@ -139,7 +136,8 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
     for (int k = 0; k < 3; ++k) pose[k] = glm::dvec4(glm::normalize(glm::dvec3(pose[k])), 0.0);
     rig.center_view = glm::inverse(pose);
     rig.focal = -(rig.center_view * glm::dvec4(c, 1.0)).z;
-    if (!(rig.focal > 0.0)) throw Error("the selected camera looks away from the scene (its center is behind the camera)");
+    if (!(rig.focal > 0.0))
+      throw Error("the selected camera looks away from the scene (its center is behind the camera)");
   } else {
     // The sphere's cross-section through c fits the focal-plane window (half-height D tan(phi/2),
     // half-width A D tan(phi/2)) in both directions: a portrait display frames by its width.
@@ -163,8 +161,8 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
     const double w_min = rig.focal / (1.0 + room);
     if (w_min > rig.near_eff) {
       if (warnings)
-        warnings->push_back("near plane raised from " + std::to_string(rig.near) + " to " +
-                            std::to_string(w_min) + " to keep the disparity within the fixed-point range");
+        warnings->push_back("near plane raised from " + std::to_string(rig.near) + " to " + std::to_string(w_min) +
+                            " to keep the disparity within the fixed-point range");
       rig.near_eff = w_min;
     }
   }
@@ -198,7 +196,8 @@ PmrParams make_params(const Rig& rig) {
   p.guard_ndc_y = guard_ndc(rig.view_h);
   p.view_anchor = rig.view_anchor();
   p.view_scale = rig.view_scale();
-  for (int i = 0; i < PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK; ++i) p.view_coord[i] = rig.view_coord(std::min(i, rig.views - 1));
+  for (int i = 0; i < PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK; ++i)
+    p.view_coord[i] = rig.view_coord(std::min(i, rig.views - 1));
   const glm::dvec3 l = rig.light_world();
   p.light_world[0] = float(l.x);
   p.light_world[1] = float(l.y);

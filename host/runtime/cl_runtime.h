@@ -63,8 +63,13 @@ class ClKernel {
   cl_kernel get() const { return kernel_; }
   const std::string& name() const { return name_; }
   template <typename T>
-  void arg(cl_uint index, const T& value) { set(index, sizeof(T), &value); }
-  void arg(cl_uint index, const ClBuffer& b) { cl_mem m = b.get(); set(index, sizeof(cl_mem), &m); }
+  void arg(cl_uint index, const T& value) {
+    set(index, sizeof(T), &value);
+  }
+  void arg(cl_uint index, const ClBuffer& b) {
+    cl_mem m = b.get();
+    set(index, sizeof(cl_mem), &m);
+  }
   // Sets arguments 0, 1, 2, ... in order.
   template <typename... Args>
   void args(const Args&... values) {

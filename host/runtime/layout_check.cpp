@@ -10,9 +10,11 @@ static_assert(sizeof(PmrParams) == 16 * 8 + 9 * 8 + 16 + 18 * 4 + 2 * 8 + 4 * (P
 static_assert(offsetof(PmrParams, view_anchor) == 288 && offsetof(PmrParams, view_coord) == 304, "PmrParams layout");
 static_assert(offsetof(PmrParams, light_world) == 200, "PmrParams layout");
 static_assert(offsetof(PmrParams, view_w) == 216, "PmrParams layout");
-static_assert(sizeof(PmrVertex) == 64 && offsetof(PmrVertex, x0) == 32 && offsetof(PmrVertex, z) == 48, "PmrVertex layout");
+static_assert(sizeof(PmrVertex) == 64 && offsetof(PmrVertex, x0) == 32 && offsetof(PmrVertex, z) == 48,
+              "PmrVertex layout");
 static_assert(sizeof(PmrMta) == 27 * 4, "PmrMta layout");
-static_assert(offsetof(PmrMta, bary) == 60 && offsetof(PmrMta, tri) == 84 && offsetof(PmrMta, flags) == 104, "PmrMta layout");
+static_assert(offsetof(PmrMta, bary) == 60 && offsetof(PmrMta, tri) == 84 && offsetof(PmrMta, flags) == 104,
+              "PmrMta layout");
 static_assert(sizeof(PmrVertexAttr) == 36, "PmrVertexAttr layout");
 static_assert(sizeof(PmrTriangle) == 32, "PmrTriangle layout");
 static_assert(sizeof(PmrMaterial) == 56 + 4 * 32 + 8 && offsetof(PmrMaterial, maps) == 56, "PmrMaterial layout");

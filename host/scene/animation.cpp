@@ -68,9 +68,10 @@ std::vector<float> sample(const AnimationSampler& s, double t) {
   // the interval [t_k, t_k+1) holding t
   // (compared in double: t just below the last key may round to it as a float, which would put k on
   // the last key and read past the end)
-  const size_t k = size_t(std::upper_bound(s.times.begin(), s.times.end(), t,
-                                           [](double a, float b) { return a < double(b); }) -
-                          s.times.begin()) - 1;
+  const size_t k =
+      size_t(std::upper_bound(s.times.begin(), s.times.end(), t, [](double a, float b) { return a < double(b); }) -
+             s.times.begin()) -
+      1;
   const double t0 = s.times[k], t1 = s.times[k + 1], dt = t1 - t0, u = (t - t0) / dt;
   const float *v0 = value(k), *v1 = value(k + 1);
   switch (s.interpolation) {

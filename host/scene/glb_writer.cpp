@@ -37,7 +37,8 @@ struct GlbBuilder {
               {"count", values.size() / size_t(components)},
               {"type", type}};
     if (min_max) {  // required for POSITION
-      std::vector<double> lo(size_t(components), std::numeric_limits<double>::infinity()), hi(size_t(components), -lo[0]);
+      std::vector<double> lo(size_t(components), std::numeric_limits<double>::infinity()),
+          hi(size_t(components), -lo[0]);
       for (size_t i = 0; i < values.size(); ++i) {
         const size_t c = i % size_t(components);
         lo[c] = std::min(lo[c], double(values[i])), hi[c] = std::max(hi[c], double(values[i]));
@@ -54,7 +55,8 @@ void put_u32(std::FILE* f, uint32_t v, bool& ok) { ok = ok && std::fwrite(&v, 4,
 }  // namespace
 
 void save_glb(const Scene& scene, const std::string& path) {
-  if (!scene.textures.empty()) throw Error("cannot save a scene with textures as .glb (only generated scenes are saved)");
+  if (!scene.textures.empty())
+    throw Error("cannot save a scene with textures as .glb (only generated scenes are saved)");
   if (scene.triangles.empty()) throw Error("cannot save an empty scene");
   GlbBuilder b;
   json meshes = json::array(), nodes = json::array(), materials = json::array();
@@ -116,7 +118,8 @@ void save_glb(const Scene& scene, const std::string& path) {
   std::string text = doc.dump();
   text.resize((text.size() + 3) & ~size_t(3), ' ');
   const uint64_t total = 12 + 8 + text.size() + 8 + b.bin.size();
-  if (total > std::numeric_limits<uint32_t>::max()) throw Error("cannot save " + path + ": the scene exceeds the 4 GB .glb limit");
+  if (total > std::numeric_limits<uint32_t>::max())
+    throw Error("cannot save " + path + ": the scene exceeds the 4 GB .glb limit");
 
   AtomicFile file(path);
   std::FILE* f = std::fopen(file.temp_path().c_str(), "wb");

@@ -9,12 +9,12 @@
 namespace pmr::gltf {
 namespace {
 
-constexpr int kByte = TINYGLTF_COMPONENT_TYPE_BYTE;                    // 5120
-constexpr int kUByte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;          // 5121
-constexpr int kShort = TINYGLTF_COMPONENT_TYPE_SHORT;                  // 5122
-constexpr int kUShort = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;        // 5123
-constexpr int kUInt = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;            // 5125
-constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;                  // 5126
+constexpr int kByte = TINYGLTF_COMPONENT_TYPE_BYTE;              // 5120
+constexpr int kUByte = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;    // 5121
+constexpr int kShort = TINYGLTF_COMPONENT_TYPE_SHORT;            // 5122
+constexpr int kUShort = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;  // 5123
+constexpr int kUInt = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;      // 5125
+constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;            // 5126
 
 // An accessor with no bufferView is all zeros (plus sparse values): nothing in the file bounds its
 // count, so cap it well above any real mesh instead of allocating whatever the JSON asks for.
@@ -27,81 +27,109 @@ constexpr uint32_t combo(int component_type, bool normalized) {
 
 struct Rule {
   const char* name;
-  uint32_t types;    // bit n set: n components (SCALAR = 1 .. VEC4 = 4) allowed
-  uint32_t combos;   // see combo()
+  uint32_t types;   // bit n set: n components (SCALAR = 1 .. VEC4 = 4) allowed
+  uint32_t combos;  // see combo()
 };
 
 // Core glTF 2.0 plus KHR_mesh_quantization (which only adds integer forms of the same attributes).
 const Rule kPosition{"POSITION", 1u << 3,
                      combo(kFloat, false) | combo(kByte, false) | combo(kByte, true) | combo(kUByte, false) |
-                         combo(kUByte, true) | combo(kShort, false) | combo(kShort, true) |
-                         combo(kUShort, false) | combo(kUShort, true)};
+                         combo(kUByte, true) | combo(kShort, false) | combo(kShort, true) | combo(kUShort, false) |
+                         combo(kUShort, true)};
 const Rule kNormal{"NORMAL", 1u << 3, combo(kFloat, false) | combo(kByte, true) | combo(kShort, true)};
 // TANGENT: xyz unit, w the handedness (+-1); KHR_mesh_quantization adds normalized byte and short.
 const Rule kTangent{"TANGENT", 1u << 4, combo(kFloat, false) | combo(kByte, true) | combo(kShort, true)};
 const Rule kTexcoord{"TEXCOORD", 1u << 2,
                      combo(kFloat, false) | combo(kUByte, true) | combo(kUShort, true) | combo(kByte, false) |
-                         combo(kByte, true) | combo(kUByte, false) | combo(kShort, false) |
-                         combo(kShort, true) | combo(kUShort, false)};
+                         combo(kByte, true) | combo(kUByte, false) | combo(kShort, false) | combo(kShort, true) |
+                         combo(kUShort, false)};
 const Rule kColor{"COLOR", 1u << 3 | 1u << 4, combo(kFloat, false) | combo(kUByte, true) | combo(kUShort, true)};
 const Rule kIndices{"indices", 1u << 1, combo(kUByte, false) | combo(kUShort, false) | combo(kUInt, false)};
 // Animation samplers: key times are float scalars; outputs float or normalized integers (rotations and
 // weights may be quantized), scalar (weights), VEC3 (translation, scale) or VEC4 (rotation).
 const Rule kKeyTimes{"animation input", 1u << 1, combo(kFloat, false)};
-const Rule kAnimationOutput{"animation output", 1u << 1 | 1u << 3 | 1u << 4,
-                            combo(kFloat, false) | combo(kByte, true) | combo(kUByte, true) | combo(kShort, true) |
-                                combo(kUShort, true)};
+const Rule kAnimationOutput{
+    "animation output", 1u << 1 | 1u << 3 | 1u << 4,
+    combo(kFloat, false) | combo(kByte, true) | combo(kUByte, true) | combo(kShort, true) | combo(kUShort, true)};
 // Skins: JOINTS_n are unsigned byte / short indices, WEIGHTS_n float or normalized unsigned integers,
 // inverse bind matrices float MAT4. Morph target deltas: float, or (KHR_mesh_quantization) integers.
 const Rule kJoints{"JOINTS", 1u << 4, combo(kUByte, false) | combo(kUShort, false)};
 const Rule kWeights{"WEIGHTS", 1u << 4, combo(kFloat, false) | combo(kUByte, true) | combo(kUShort, true)};
 const Rule kInverseBind{"inverseBindMatrices", 1u << 16, combo(kFloat, false)};
-const Rule kMorphDelta{"morph target", 1u << 3,
-                       combo(kFloat, false) | combo(kByte, false) | combo(kByte, true) | combo(kShort, false) |
-                           combo(kShort, true)};
+const Rule kMorphDelta{
+    "morph target", 1u << 3,
+    combo(kFloat, false) | combo(kByte, false) | combo(kByte, true) | combo(kShort, false) | combo(kShort, true)};
 
 size_t component_size(int type) {
   switch (type) {
-    case kByte: case kUByte: return 1;
-    case kShort: case kUShort: return 2;
-    case kUInt: case kFloat: return 4;
-    default: return 0;
+    case kByte:
+    case kUByte:
+      return 1;
+    case kShort:
+    case kUShort:
+      return 2;
+    case kUInt:
+    case kFloat:
+      return 4;
+    default:
+      return 0;
   }
 }
 
 int component_count(int type) {
   switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return 1;
-    case TINYGLTF_TYPE_VEC2: return 2;
-    case TINYGLTF_TYPE_VEC3: return 3;
-    case TINYGLTF_TYPE_VEC4: return 4;
-    case TINYGLTF_TYPE_MAT4: return 16;  // float MAT4 columns are 16 bytes: no padding (spec, "Data Alignment")
-    default: return 0;  // MAT2 / MAT3 are never read
+    case TINYGLTF_TYPE_SCALAR:
+      return 1;
+    case TINYGLTF_TYPE_VEC2:
+      return 2;
+    case TINYGLTF_TYPE_VEC3:
+      return 3;
+    case TINYGLTF_TYPE_VEC4:
+      return 4;
+    case TINYGLTF_TYPE_MAT4:
+      return 16;  // float MAT4 columns are 16 bytes: no padding (spec, "Data Alignment")
+    default:
+      return 0;  // MAT2 / MAT3 are never read
   }
 }
 
 std::string type_name(int type) {
   switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return "SCALAR";
-    case TINYGLTF_TYPE_VEC2: return "VEC2";
-    case TINYGLTF_TYPE_VEC3: return "VEC3";
-    case TINYGLTF_TYPE_VEC4: return "VEC4";
-    case TINYGLTF_TYPE_MAT2: return "MAT2";
-    case TINYGLTF_TYPE_MAT3: return "MAT3";
-    case TINYGLTF_TYPE_MAT4: return "MAT4";
-    default: return "type " + std::to_string(type);
+    case TINYGLTF_TYPE_SCALAR:
+      return "SCALAR";
+    case TINYGLTF_TYPE_VEC2:
+      return "VEC2";
+    case TINYGLTF_TYPE_VEC3:
+      return "VEC3";
+    case TINYGLTF_TYPE_VEC4:
+      return "VEC4";
+    case TINYGLTF_TYPE_MAT2:
+      return "MAT2";
+    case TINYGLTF_TYPE_MAT3:
+      return "MAT3";
+    case TINYGLTF_TYPE_MAT4:
+      return "MAT4";
+    default:
+      return "type " + std::to_string(type);
   }
 }
 
 std::string component_name(int type) {
   switch (type) {
-    case kByte: return "BYTE";
-    case kUByte: return "UNSIGNED_BYTE";
-    case kShort: return "SHORT";
-    case kUShort: return "UNSIGNED_SHORT";
-    case kUInt: return "UNSIGNED_INT";
-    case kFloat: return "FLOAT";
-    default: return std::to_string(type);
+    case kByte:
+      return "BYTE";
+    case kUByte:
+      return "UNSIGNED_BYTE";
+    case kShort:
+      return "SHORT";
+    case kUShort:
+      return "UNSIGNED_SHORT";
+    case kUInt:
+      return "UNSIGNED_INT";
+    case kFloat:
+      return "FLOAT";
+    default:
+      return std::to_string(type);
   }
 }
 
@@ -109,27 +137,59 @@ std::string component_name(int type) {
 // signed: max(c / max, -1), so that -128 and -32768 map to -1 like -127 and -32767).
 float read_component(const unsigned char* p, int type, bool normalized) {
   switch (type) {
-    case kByte: { int8_t v; std::memcpy(&v, p, 1); return normalized ? std::max(v / 127.0f, -1.0f) : float(v); }
-    case kUByte: { uint8_t v = *p; return normalized ? v / 255.0f : float(v); }
-    case kShort: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0f, -1.0f) : float(v); }
-    case kUShort: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0f : float(v); }
-    case kUInt: { uint32_t v; std::memcpy(&v, p, 4); return float(v); }
-    default: { float v; std::memcpy(&v, p, 4); return v; }  // kFloat (the rule admits nothing else)
+    case kByte: {
+      int8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? std::max(v / 127.0f, -1.0f) : float(v);
+    }
+    case kUByte: {
+      uint8_t v = *p;
+      return normalized ? v / 255.0f : float(v);
+    }
+    case kShort: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? std::max(v / 32767.0f, -1.0f) : float(v);
+    }
+    case kUShort: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? v / 65535.0f : float(v);
+    }
+    case kUInt: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return float(v);
+    }
+    default: {
+      float v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }  // kFloat (the rule admits nothing else)
   }
 }
 
 uint32_t read_index(const unsigned char* p, int type) {
   switch (type) {
-    case kUByte: return *p;
-    case kUShort: { uint16_t v; std::memcpy(&v, p, 2); return v; }
-    default: { uint32_t v; std::memcpy(&v, p, 4); return v; }  // kUInt
+    case kUByte:
+      return *p;
+    case kUShort: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return v;
+    }
+    default: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }  // kUInt
   }
 }
 
 // The validated layout of one accessor. data == nullptr: no bufferView, the elements are zeros.
 struct Layout {
   const tinygltf::Accessor* accessor = nullptr;
-  std::string label;       // "accessor 3 (POSITION of mesh 0 primitive 1)"
+  std::string label;  // "accessor 3 (POSITION of mesh 0 primitive 1)"
   int components = 0;
   size_t element_size = 0;
   size_t stride = 0;
@@ -163,8 +223,8 @@ Layout resolve(const tinygltf::Model& m, int index, const Rule& rule, const std:
     return l;
   }
   if (size_t(a.bufferView) >= m.bufferViews.size())
-    fail(file, l.label + " refers to bufferView " + std::to_string(a.bufferView) + ", which does not exist (the file has " +
-                   std::to_string(m.bufferViews.size()) + ")");
+    fail(file, l.label + " refers to bufferView " + std::to_string(a.bufferView) +
+                   ", which does not exist (the file has " + std::to_string(m.bufferViews.size()) + ")");
   const tinygltf::BufferView& bv = m.bufferViews[size_t(a.bufferView)];  // inside its buffer: validate_model
   l.stride = bv.byteStride != 0 ? bv.byteStride : l.element_size;
   if (l.stride < l.element_size)
@@ -177,8 +237,7 @@ Layout resolve(const tinygltf::Model& m, int index, const Rule& rule, const std:
         __builtin_add_overflow(span, uint64_t(l.element_size), &span) || !fits(a.byteOffset, span, bv.byteLength))
       fail(file, l.label + " overruns bufferView " + std::to_string(a.bufferView) + ": count " +
                      std::to_string(a.count) + " with byteStride " + std::to_string(l.stride) + " from byteOffset " +
-                     std::to_string(a.byteOffset) + " does not fit in its " + std::to_string(bv.byteLength) +
-                     " bytes");
+                     std::to_string(a.byteOffset) + " does not fit in its " + std::to_string(bv.byteLength) + " bytes");
   }
   l.data = m.buffers[size_t(bv.buffer)].data.data() + bv.byteOffset + a.byteOffset;
   return l;
@@ -223,18 +282,30 @@ void apply_sparse(const tinygltf::Model& m, const Layout& l, const std::string& 
 
 const Rule& rule_for(Semantic semantic) {
   switch (semantic) {
-    case Semantic::Position: return kPosition;
-    case Semantic::Normal: return kNormal;
-    case Semantic::Tangent: return kTangent;
-    case Semantic::Texcoord: return kTexcoord;
-    case Semantic::Color: return kColor;
-    case Semantic::KeyTimes: return kKeyTimes;
-    case Semantic::AnimationOutput: return kAnimationOutput;
-    case Semantic::Joints: return kJoints;
-    case Semantic::Weights: return kWeights;
-    case Semantic::InverseBind: return kInverseBind;
-    case Semantic::MorphDelta: return kMorphDelta;
-    default: return kIndices;
+    case Semantic::Position:
+      return kPosition;
+    case Semantic::Normal:
+      return kNormal;
+    case Semantic::Tangent:
+      return kTangent;
+    case Semantic::Texcoord:
+      return kTexcoord;
+    case Semantic::Color:
+      return kColor;
+    case Semantic::KeyTimes:
+      return kKeyTimes;
+    case Semantic::AnimationOutput:
+      return kAnimationOutput;
+    case Semantic::Joints:
+      return kJoints;
+    case Semantic::Weights:
+      return kWeights;
+    case Semantic::InverseBind:
+      return kInverseBind;
+    case Semantic::MorphDelta:
+      return kMorphDelta;
+    default:
+      return kIndices;
   }
 }
 
@@ -263,7 +334,8 @@ AttributeData read_attribute(const tinygltf::Model& m, int accessor, Semantic se
   const size_t csize = component_size(a.componentType);
   auto decode = [&](size_t element, const unsigned char* p) {
     float* dst = &out.values[element * size_t(l.components)];
-    for (int c = 0; c < l.components; ++c) dst[c] = read_component(p + size_t(c) * csize, a.componentType, a.normalized);
+    for (int c = 0; c < l.components; ++c)
+      dst[c] = read_component(p + size_t(c) * csize, a.componentType, a.normalized);
   };
   if (l.data)
     for (size_t i = 0; i < a.count; ++i) decode(i, l.data + i * l.stride);

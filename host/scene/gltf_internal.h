@@ -41,12 +41,12 @@ std::string one_line(const std::string& text, bool ascii_only = false);
 // GLB container layout, JSON syntax and nesting depth, asset.version, extensionsRequired, external
 // buffer files. Throws pmr::Error on any of them.
 struct SourceFile {
-  std::vector<unsigned char> bytes;     // the whole file (a GLB is cut to the length its header gives)
-  bool glb = false;                     // detected by the magic bytes, not by the extension
-  std::string base_dir;                 // directory relative URIs are resolved against
-  std::set<int> sampled_images;         // images some material slot samples (base colour, metallic-
-                                        // roughness, normal, occlusion, emissive): decoded and read
-  std::string checksum;                 // of `bytes` as read from disk (before a GLB is cut)
+  std::vector<unsigned char> bytes;  // the whole file (a GLB is cut to the length its header gives)
+  bool glb = false;                  // detected by the magic bytes, not by the extension
+  std::string base_dir;              // directory relative URIs are resolved against
+  std::set<int> sampled_images;      // images some material slot samples (base colour, metallic-
+                                     // roughness, normal, occlusion, emissive): decoded and read
+  std::string checksum;              // of `bytes` as read from disk (before a GLB is cut)
   // External files only unused images name (resolved like tinygltf does): never read
   std::set<std::string> unused_image_files;
   std::vector<std::string> ignored_extensions;  // in extensionsUsed, not implemented (the material
@@ -106,8 +106,7 @@ std::vector<int> validate_model(const tinygltf::Model& model, const std::map<int
 
 // Root nodes of the scene to render: the default scene (scene 0 when none is named) or, with no
 // scenes at all, every node without a parent.
-std::vector<int> scene_roots(const tinygltf::Model& model, const std::vector<int>& parent,
-                             const std::string& file);
+std::vector<int> scene_roots(const tinygltf::Model& model, const std::vector<int>& parent, const std::string& file);
 
 // The node's rest transform (matrix, or T, R, S with R normalized), checked for size and finiteness.
 // Morph weights are not filled in.
@@ -125,7 +124,18 @@ std::vector<bool> moving_nodes(const SceneMotion& motion);
 // ---- gltf_accessors.cpp ----------------------------------------------------------------------------
 
 enum class Semantic {
-  Position, Normal, Tangent, Texcoord, Color, Indices, KeyTimes, AnimationOutput, Joints, Weights, InverseBind, MorphDelta
+  Position,
+  Normal,
+  Tangent,
+  Texcoord,
+  Color,
+  Indices,
+  KeyTimes,
+  AnimationOutput,
+  Joints,
+  Weights,
+  InverseBind,
+  MorphDelta
 };
 
 // One vertex attribute, decoded to float (normalized integers mapped per the glTF spec), sparse
@@ -138,8 +148,8 @@ struct AttributeData {
 
 // `what` names the use for messages, e.g. "POSITION of mesh 0 primitive 1". Checks the type and
 // component type against what the semantic allows (core glTF plus KHR_mesh_quantization).
-AttributeData read_attribute(const tinygltf::Model& model, int accessor, Semantic semantic,
-                             const std::string& what, const std::string& file);
+AttributeData read_attribute(const tinygltf::Model& model, int accessor, Semantic semantic, const std::string& what,
+                             const std::string& file);
 
 // Runs the checks of read_attribute / read_indices (type, component type, bounds) without reading, so
 // that counts can be trusted before anything is allocated from them.

@@ -28,10 +28,10 @@ using namespace gltf;
 // ---- tinygltf callbacks ------------------------------------------------------------------------------
 
 struct FsContext {
-  std::string prefix;  // base_dir with a trailing '/'
+  std::string prefix;                                               // base_dir with a trailing '/'
   std::map<std::string, SourceFile::External>* external = nullptr;  // read_source's reads: all tinygltf gets
-  const std::set<std::string>* skip = nullptr;  // files only unused images name: not read
-  std::map<std::string, std::string> read;      // path relative to base_dir -> checksum of the bytes read
+  const std::set<std::string>* skip = nullptr;                      // files only unused images name: not read
+  std::map<std::string, std::string> read;  // path relative to base_dir -> checksum of the bytes read
 };
 
 // tinygltf looks for external files in base_dir and then in the working directory. It gets exactly the
@@ -160,9 +160,10 @@ void check_animation_budget(const tinygltf::Model& model, const InputLimits& lim
       for (const int accessor : {smp.input, smp.output})
         if (__builtin_add_overflow(bytes, decoded_bytes(model, accessor), &bytes)) bytes = UINT64_MAX;
   if (bytes > limits.animation_data)
-    fail(path, "the animations' samplers decode to " + std::to_string(bytes) + " bytes of keys (every sampler "
-               "counted), more than the animation-data limit of " + std::to_string(limits.animation_data) +
-               " (raise it with --limit animation-data=N)");
+    fail(path, "the animations' samplers decode to " + std::to_string(bytes) +
+                   " bytes of keys (every sampler "
+                   "counted), more than the animation-data limit of " +
+                   std::to_string(limits.animation_data) + " (raise it with --limit animation-data=N)");
   check_memory(bytes, "decoding the animations' keys");
 }
 
@@ -192,18 +193,18 @@ struct Loader {
   const ImageContext& images;
   Scene& scene;
   std::set<std::string> seen;
-  std::vector<MaterialUv> material_uv;   // per glTF material: its base colour texture's set and transform
+  std::vector<MaterialUv> material_uv;  // per glTF material: its base colour texture's set and transform
   std::vector<std::array<int, kTextureSlots>> slot_sets;  // per glTF material and slot: TEXCOORD set, -1 = no texture
-  int texcoord_sets = 0;                 // 1 + the highest set any slot samples
-  std::map<int, int> scene_texture_of;   // glTF texture -> Scene::textures index (-1: unusable)
+  int texcoord_sets = 0;                                  // 1 + the highest set any slot samples
+  std::map<int, int> scene_texture_of;                    // glTF texture -> Scene::textures index (-1: unusable)
   std::map<std::array<int, 3>, int> scene_texture_of_image;  // (image, wrap s, wrap t) -> Scene::textures
-  const std::vector<SceneLight>* light_defs = nullptr;  // SourceFile::lights
-  const std::vector<int>* node_light = nullptr;         // SourceFile::node_light
-  std::set<int> used_materials;          // glTF materials of emitted primitives
+  const std::vector<SceneLight>* light_defs = nullptr;       // SourceFile::lights
+  const std::vector<int>* node_light = nullptr;              // SourceFile::node_light
+  std::set<int> used_materials;                              // glTF materials of emitted primitives
   size_t point_line_primitives = 0, skipped_triangles = 0, nonfinite_attributes = 0, leftover_indices = 0;
-  size_t generated_tangents = 0;         // primitives
-  std::shared_ptr<SceneMotion> motion;   // always built; kept in the scene when a clip moves something
-  std::vector<glm::dmat4> rest_world;     // per node
+  size_t generated_tangents = 0;                     // primitives
+  std::shared_ptr<SceneMotion> motion;               // always built; kept in the scene when a clip moves something
+  std::vector<glm::dmat4> rest_world;                // per node
   std::vector<std::vector<glm::dmat4>> rest_joints;  // per skin: joint matrices at rest
   std::vector<bool> moving, weights_animated;        // per node
   std::set<int> skins_without_joints;                // meshes: skinned nodes whose mesh lacks JOINTS_0
@@ -232,8 +233,8 @@ MaterialUv material_uv(Loader& L, int texcoord, const tinygltf::ExtensionMap& ex
   auto ext = extensions.find("KHR_texture_transform");
   if (ext == extensions.end()) return uv;
   const tinygltf::Value& t = ext->second;
-  const std::string name = "material " + std::to_string(material) + (slot_name.empty() ? "" : " " + slot_name) +
-                           " KHR_texture_transform";
+  const std::string name =
+      "material " + std::to_string(material) + (slot_name.empty() ? "" : " " + slot_name) + " KHR_texture_transform";
   if (!t.IsObject()) {
     L.warn(name + " is not an object; ignored");
     return uv;
@@ -267,7 +268,8 @@ MaterialUv material_uv(Loader& L, int texcoord, const tinygltf::ExtensionMap& ex
 bool to_rgba8(const tinygltf::Image& img, SceneTexture& out, std::string& why) {
   const int bytes = img.bits == 16 ? 2 : img.bits == 8 ? 1 : 0;
   if (img.width <= 0 || img.height <= 0 || img.component < 1 || img.component > 4 || bytes == 0) {
-    why = "unsupported image layout (" + std::to_string(img.component) + " channels, " + std::to_string(img.bits) + " bits)";
+    why = "unsupported image layout (" + std::to_string(img.component) + " channels, " + std::to_string(img.bits) +
+          " bits)";
     return false;
   }
   const uint64_t pixels = uint64_t(img.width) * uint64_t(img.height);
@@ -333,16 +335,17 @@ int scene_texture(Loader& L, int texture, int slot) {
     return result;
   }
   const tinygltf::Image& img = L.model.images[size_t(t.source)];
-  const std::string image_name = "image " + std::to_string(t.source) +
-                                 (img.uri.empty() ? (img.name.empty() ? "" : " '" + img.name + "'") : " '" + img.uri + "'");
+  const std::string image_name =
+      "image " + std::to_string(t.source) +
+      (img.uri.empty() ? (img.name.empty() ? "" : " '" + img.name + "'") : " '" + img.uri + "'");
   SceneTexture st;
   std::string why;
   if (img.image.empty()) {
     auto f = L.images.failures.find(t.source);
-    why = f != L.images.failures.end()  ? f->second
-          : img.uri.empty()             ? std::string("no image data")
+    why = f != L.images.failures.end()     ? f->second
+          : img.uri.empty()                ? std::string("no image data")
           : img.uri.rfind("data:", 0) == 0 ? data_uri_problem(img.uri)
-                                        : "file not found";
+                                           : "file not found";
   } else {
     to_rgba8(img, st, why);
   }
@@ -392,13 +395,15 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
   m.metallic = material_number(L, g.pbrMetallicRoughness.metallicFactor, 1.0, 0.0, 1.0, name + " metallicFactor");
   m.roughness = material_number(L, g.pbrMetallicRoughness.roughnessFactor, 1.0, 0.0, 1.0, name + " roughnessFactor");
   m.normal_scale = material_number(L, g.normalTexture.scale, 1.0, -inf, inf, name + " normalTexture.scale");
-  m.occlusion_strength = material_number(L, g.occlusionTexture.strength, 1.0, 0.0, 1.0, name + " occlusionTexture.strength");
+  m.occlusion_strength =
+      material_number(L, g.occlusionTexture.strength, 1.0, 0.0, 1.0, name + " occlusionTexture.strength");
   if (g.emissiveFactor.size() == 3)
     for (int c = 0; c < 3; ++c)
       m.emissive[c] = material_number(L, g.emissiveFactor[size_t(c)], 0.0, 0.0, 1.0, name + " emissiveFactor");
   for (const auto& [ext, value] : g.extensions) {
     if (ext == "KHR_materials_emissive_strength") {
-      const tinygltf::Value* v = value.IsObject() && value.Has("emissiveStrength") ? &value.Get("emissiveStrength") : nullptr;
+      const tinygltf::Value* v =
+          value.IsObject() && value.Has("emissiveStrength") ? &value.Get("emissiveStrength") : nullptr;
       if (v && v->IsNumber())
         m.emissive_strength = material_number(L, v->GetNumberAsDouble(), 1.0, 0.0, inf, name + " emissiveStrength");
       else if (v || !value.IsObject())
@@ -416,7 +421,8 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
   const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
   const Info infos[kTextureSlots] = {
       {pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, &pbr.baseColorTexture.extensions},
-      {pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord, &pbr.metallicRoughnessTexture.extensions},
+      {pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+       &pbr.metallicRoughnessTexture.extensions},
       {g.normalTexture.index, g.normalTexture.texCoord, &g.normalTexture.extensions},
       {g.occlusionTexture.index, g.occlusionTexture.texCoord, &g.occlusionTexture.extensions},
       {g.emissiveTexture.index, g.emissiveTexture.texCoord, &g.emissiveTexture.extensions}};
@@ -428,8 +434,9 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
     const Info& info = infos[slot];
     if (info.index < 0) continue;
     // The base colour slot's transform was read (and warned about) by build_materials already.
-    const MaterialUv uv = slot == kSlotBaseColor ? L.material_uv[size_t(i)]
-                                                 : material_uv(L, info.texcoord, *info.extensions, i, texture_slot_name(slot));
+    const MaterialUv uv = slot == kSlotBaseColor
+                              ? L.material_uv[size_t(i)]
+                              : material_uv(L, info.texcoord, *info.extensions, i, texture_slot_name(slot));
     out.texcoord = uv.set;
     out.transform = uv.transform.active;
     if (out.transform) {
@@ -444,7 +451,6 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
   L.slot_sets.push_back(sets);
   return m;
 }
-
 
 // Scene::materials[0] is the default material; glTF material i is Scene::materials[i + 1].
 void build_materials(Loader& L) {
@@ -499,7 +505,8 @@ std::vector<Instance> walk(Loader& L, const std::vector<int>& roots) {
     const glm::dmat4& world = L.rest_world[size_t(index)];
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r)
-        if (!std::isfinite(world[c][r])) fail(L.file, "node " + std::to_string(index) + " has a world matrix that overflows");
+        if (!std::isfinite(world[c][r]))
+          fail(L.file, "node " + std::to_string(index) + " has a world matrix that overflows");
     if (node.mesh >= 0) instances.push_back({node.mesh, index});
     if (const int light = (*L.node_light)[size_t(index)]; light >= 0) {
       SceneLight l = (*L.light_defs)[size_t(light)];
@@ -509,7 +516,9 @@ std::vector<Instance> walk(Loader& L, const std::vector<int>& roots) {
       const glm::dvec3 dir = -glm::dvec3(world[2]);
       const double len = glm::length(dir);
       if (len > 0.0 && std::isfinite(len)) l.direction = dir / len;
-      else L.warn("node " + std::to_string(index) + " places a light with a degenerate matrix (zero scale?): shining along -Z");
+      else
+        L.warn("node " + std::to_string(index) +
+               " places a light with a degenerate matrix (zero scale?): shining along -Z");
       L.scene.lights.push_back(l);
       L.motion->light_node.push_back(index);
     }
@@ -558,8 +567,8 @@ struct PrimitiveAttributes {
   size_t vertices;
 
   // Empty when absent.
-  std::vector<float> read_from(const std::map<std::string, int>& attributes, const std::string& name,
-                               Semantic semantic, const std::string& label) const {
+  std::vector<float> read_from(const std::map<std::string, int>& attributes, const std::string& name, Semantic semantic,
+                               const std::string& label) const {
     const auto it = attributes.find(name);
     if (it == attributes.end()) return {};
     const int a = it->second;
@@ -582,7 +591,8 @@ struct PrimitiveAttributes {
   }
 
   std::vector<float> read_target(size_t k, const std::string& name) const {
-    return read_from(p.targets[k], name, Semantic::MorphDelta, name + " of " + where + " morph target " + std::to_string(k));
+    return read_from(p.targets[k], name, Semantic::MorphDelta,
+                     name + " of " + where + " morph target " + std::to_string(k));
   }
 };
 
@@ -600,8 +610,10 @@ void read_skin_influences(const PrimitiveAttributes& attrs, DeformSource& geo) {
     for (size_t v = 0; v < geo.vertices; ++v)
       for (int i = 0; i < k; ++i) {
         const bool old = i < geo.influences;
-        j[v * size_t(k) + size_t(i)] = old ? geo.joints[v * size_t(geo.influences) + size_t(i)] : uint16_t(joints[4 * v + size_t(i - geo.influences)]);
-        const float wv = old ? geo.weights[v * size_t(geo.influences) + size_t(i)] : weights[4 * v + size_t(i - geo.influences)];
+        j[v * size_t(k) + size_t(i)] = old ? geo.joints[v * size_t(geo.influences) + size_t(i)]
+                                           : uint16_t(joints[4 * v + size_t(i - geo.influences)]);
+        const float wv =
+            old ? geo.weights[v * size_t(geo.influences) + size_t(i)] : weights[4 * v + size_t(i - geo.influences)];
         w[v * size_t(k) + size_t(i)] = std::isfinite(wv) && wv > 0.0f ? wv : 0.0f;
       }
     geo.joints = std::move(j), geo.weights = std::move(w), geo.influences = k;
@@ -623,10 +635,11 @@ int read_texcoord_sets(const PrimitiveAttributes& attrs, int mesh, int index, De
     if (d.sets[size_t(k)].empty()) {
       const std::string& mesh_name = L.model.meshes[size_t(mesh)].name;
       const std::string& mat_name = L.model.materials[size_t(p.material)].name;
-      fail(L.file, "material " + std::to_string(p.material) + (mat_name.empty() ? "" : " '" + one_line(mat_name, true) + "'") +
-                       " " + texture_slot_name(slot) + " samples TEXCOORD_" + std::to_string(k) + ", which mesh " +
-                       std::to_string(mesh) + (mesh_name.empty() ? "" : " '" + one_line(mesh_name, true) + "'") +
-                       " primitive " + std::to_string(index) + " does not have");
+      fail(L.file, "material " + std::to_string(p.material) +
+                       (mat_name.empty() ? "" : " '" + one_line(mat_name, true) + "'") + " " + texture_slot_name(slot) +
+                       " samples TEXCOORD_" + std::to_string(k) + ", which mesh " + std::to_string(mesh) +
+                       (mesh_name.empty() ? "" : " '" + one_line(mesh_name, true) + "'") + " primitive " +
+                       std::to_string(index) + " does not have");
     }
   }
   return sets[kSlotNormal];
@@ -875,9 +888,10 @@ void check_totals(Loader& L, const std::vector<Instance>& instances) {
     add(data, it->second.data);  // per instance: each is emitted from its own decoded copy's worth
   }
   if (data > L.limits->vertex_data)
-    fail(L.file, "the scene's meshes decode to " + std::to_string(data) + " bytes of vertex data (every instance and "
-                 "morph target counted), more than the vertex-data limit of " + std::to_string(L.limits->vertex_data) +
-                 " (raise it with --limit vertex-data=N)");
+    fail(L.file, "the scene's meshes decode to " + std::to_string(data) +
+                     " bytes of vertex data (every instance and "
+                     "morph target counted), more than the vertex-data limit of " +
+                     std::to_string(L.limits->vertex_data) + " (raise it with --limit vertex-data=N)");
   // What the flattened scene holds per vertex and triangle (positions, attributes, two texture
   // coordinate sets, tangents; triangles), on top of the decoded data.
   const uint64_t per_vertex = sizeof(glm::vec3) + sizeof(PmrVertexAttr) + 2 * sizeof(glm::vec2) + sizeof(glm::vec4);
@@ -966,7 +980,8 @@ void summary_warnings(Loader& L, const SourceFile& src) {
     L.warn("mesh " + std::to_string(mesh) + " is skinned but has no JOINTS_0 / WEIGHTS_0: drawn unskinned");
   if (L.point_line_primitives)
     L.warn(std::to_string(L.point_line_primitives) + " point or line primitive(s) skipped: only triangles are drawn");
-  if (L.leftover_indices) L.warn("TRIANGLES primitive(s) with a vertex count not divisible by 3: extra vertices ignored");
+  if (L.leftover_indices)
+    L.warn("TRIANGLES primitive(s) with a vertex count not divisible by 3: extra vertices ignored");
   if (L.skipped_triangles)
     L.warn(std::to_string(L.skipped_triangles) + " triangle(s) with non-finite vertex positions skipped");
   if (L.nonfinite_attributes) L.warn("non-finite texture coordinates or colours replaced by defaults");
@@ -975,8 +990,8 @@ void summary_warnings(Loader& L, const SourceFile& src) {
   for (int m : L.used_materials)
     for (const std::string& ext : L.scene.material_inputs[size_t(m) + 1].unimplemented) ++unimplemented[ext];
   for (const auto& [ext, count] : unimplemented)
-    L.warn(ext + " (" + std::to_string(count) + (count == 1 ? " material" : " materials") + "): " +
-           material_extension_fallback(ext));
+    L.warn(ext + " (" + std::to_string(count) + (count == 1 ? " material" : " materials") +
+           "): " + material_extension_fallback(ext));
   std::vector<std::string> blend;
   for (int m : L.used_materials)
     if (L.model.materials[size_t(m)].alphaMode == "BLEND") blend.push_back(std::to_string(m));
@@ -1036,8 +1051,7 @@ Scene load_scene(const std::string& path, const InputLimits& limits) {
   if (!scene.tangents.empty()) scene.tangents.resize(scene.positions.size(), glm::vec4(0.0f));
   for (std::vector<glm::vec2>& set : scene.texcoords) set.resize(scene.positions.size(), glm::vec2(0.0f));
   summary_warnings(L, src);
-  if (scene.triangles.empty())
-    L.warn("the scene has no triangles to render: every frame will be a transparent image");
+  if (scene.triangles.empty()) L.warn("the scene has no triangles to render: every frame will be a transparent image");
   for (const MotionClip& clip : L.motion->clips)
     scene.animations.push_back({clip.name, clip.start, clip.end, clip.channels.size()});
   describe_structure(L, roots);
@@ -1046,6 +1060,5 @@ Scene load_scene(const std::string& path, const InputLimits& limits) {
   for (const auto& [file, sum] : files_read) scene.input_files.push_back({file, sum});
   return scene;
 }
-
 
 }  // namespace pmr

@@ -38,7 +38,9 @@ MotionClip read_clip(const tinygltf::Model& m, size_t a, const std::string& file
     mc.node = ch.target_node;
     mc.path = channel_path(ch.target_path);
     mc.sampler = ch.sampler;
-    const int w = mc.path == ChannelPath::Rotation ? 4 : mc.path == ChannelPath::Weights ? int(node_targets(m, mc.node)) : 3;
+    const int w = mc.path == ChannelPath::Rotation  ? 4
+                  : mc.path == ChannelPath::Weights ? int(node_targets(m, mc.node))
+                                                    : 3;
     if (width[size_t(ch.sampler)] != 0 && width[size_t(ch.sampler)] != w)
       fail(file, "animation " + std::to_string(a) + " sampler " + std::to_string(ch.sampler) +
                      " drives channels of different kinds");
@@ -81,8 +83,8 @@ MotionSkin read_skin(const tinygltf::Model& m, size_t s, const std::string& file
     const std::string what = "inverseBindMatrices of skin " + std::to_string(s);
     const AttributeData d = read_attribute(m, skin.inverseBindMatrices, Semantic::InverseBind, what, file);
     if (d.count < skin.joints.size())
-      fail(file, "accessor " + std::to_string(skin.inverseBindMatrices) + " (" + what + ") has " + std::to_string(d.count) +
-                     " matrices for " + std::to_string(skin.joints.size()) + " joints");
+      fail(file, "accessor " + std::to_string(skin.inverseBindMatrices) + " (" + what + ") has " +
+                     std::to_string(d.count) + " matrices for " + std::to_string(skin.joints.size()) + " joints");
     for (size_t j = 0; j < skin.joints.size(); ++j)
       for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r) {
@@ -96,7 +98,8 @@ MotionSkin read_skin(const tinygltf::Model& m, size_t s, const std::string& file
 
 }  // namespace
 
-std::shared_ptr<SceneMotion> read_motion(const tinygltf::Model& m, const std::vector<int>& parent, const std::string& file) {
+std::shared_ptr<SceneMotion> read_motion(const tinygltf::Model& m, const std::vector<int>& parent,
+                                         const std::string& file) {
   auto motion = std::make_shared<SceneMotion>();
   const size_t n = m.nodes.size();
   motion->nodes.resize(n);

@@ -115,9 +115,10 @@ class SchemaCheck {
     fail(path_, name + " is " + value + ", which the glTF schema does not allow (minimum " + std::to_string(lo) + ")");
   }
 
-  [[noreturn]] void out_of_range(const std::string& name, const std::string& value, int64_t hi, const char* what) const {
-    fail(path_, name + " refers to " + (what ? what : "element") + " " + value + ", but the file has " +
-                    std::to_string(hi));
+  [[noreturn]] void out_of_range(const std::string& name, const std::string& value, int64_t hi,
+                                 const char* what) const {
+    fail(path_,
+         name + " refers to " + (what ? what : "element") + " " + value + ", but the file has " + std::to_string(hi));
   }
 
   const std::string& path_;
@@ -186,7 +187,8 @@ void check_animations(const SchemaCheck& c) {
       const int64_t input = c.required_integer((*samplers)[s], "input", w, 0, accessors, "accessor");
       inputs.push_back(input);
       outputs.push_back(c.required_integer((*samplers)[s], "output", w, 0, accessors, "accessor"));
-      interpolation.push_back(c.one_of((*samplers)[s], "interpolation", w, {"LINEAR", "STEP", "CUBICSPLINE"}, "LINEAR"));
+      interpolation.push_back(
+          c.one_of((*samplers)[s], "interpolation", w, {"LINEAR", "STEP", "CUBICSPLINE"}, "LINEAR"));
       const AccessorShape in = accessor_shape(c, input);
       if (in.type != "SCALAR" || in.component != 5126)
         fail(c.path(), w + " input (accessor " + std::to_string(input) + ") must hold float scalars (key times)");
@@ -199,7 +201,8 @@ void check_animations(const SchemaCheck& c) {
       if (!target || !target->is_object()) fail(c.path(), w + " has no target");
       const int64_t node = c.integer(*target, "node", w + " target", 0, nodes, "node");
       if (!member(*target, "path")) fail(c.path(), w + " target has no path");
-      const std::string path = c.one_of(*target, "path", w + " target", {"translation", "rotation", "scale", "weights"}, "");
+      const std::string path =
+          c.one_of(*target, "path", w + " target", {"translation", "rotation", "scale", "weights"}, "");
       if (node < 0) continue;  // the animated object is defined by an extension: nothing here reads it
       // the output must fit the path: VEC3 for translation and scale, VEC4 for rotation, one scalar per
       // morph target for weights; key count x 3 for CUBICSPLINE (in-tangent, value, out-tangent)
@@ -240,7 +243,8 @@ void check_schema(const std::string& path, const json& doc) {
   const SchemaCheck c(path, doc);
   const int64_t accessors = c.count("accessors"), buffer_views = c.count("bufferViews"), nodes = c.count("nodes");
   if (c.count("scenes") > 0) {
-    if (const json* v = member(doc, "scene")) c.reference_value(*v, "the file's scene", "the default scene", "scene", c.count("scenes"));
+    if (const json* v = member(doc, "scene"))
+      c.reference_value(*v, "the file's scene", "the default scene", "scene", c.count("scenes"));
   } else if (const int64_t s = c.integer(doc, "scene", "the file's", 0); s > INT32_MAX) {
     fail(path, "scene " + member(doc, "scene")->dump() + " is the default but there are no scenes");
   }
@@ -250,7 +254,7 @@ void check_schema(const std::string& path, const json& doc) {
     c.integer(a, "count", where, 1);
     // tinygltf stores the component type as int: 2^32 + 5126 would read as FLOAT
     if (const json* t = member(a, "componentType"); t && !(t->is_number_integer() && t->get<int64_t>() >= 5120 &&
-                                                          t->get<int64_t>() <= 5126 && t->get<int64_t>() != 5124))
+                                                           t->get<int64_t>() <= 5126 && t->get<int64_t>() != 5124))
       fail(path, where + " componentType is " + t->dump() + ", which is not a glTF component type");
     if (const json* sparse = member(a, "sparse")) {
       c.integer(*sparse, "count", where + " sparse", 1);
@@ -281,14 +285,16 @@ void check_schema(const std::string& path, const json& doc) {
     for (size_t p = 0; p < prims->size(); ++p) {
       const json& prim = (*prims)[p];
       const std::string w = where + " primitive " + std::to_string(p);
-      if (const json* v = member(prim, "indices")) c.reference_value(*v, w + " indices", w + " indices", "accessor", accessors);
+      if (const json* v = member(prim, "indices"))
+        c.reference_value(*v, w + " indices", w + " indices", "accessor", accessors);
       c.reference(prim, "material", w, "material", c.count("materials"));
-      if (const json* mode = member(prim, "mode"); mode && !(mode->is_number_integer() && mode->get<int64_t>() >= 0 &&
-                                                             mode->get<int64_t>() <= 6))
+      if (const json* mode = member(prim, "mode");
+          mode && !(mode->is_number_integer() && mode->get<int64_t>() >= 0 && mode->get<int64_t>() <= 6))
         fail(path, w + " has mode " + mode->dump() + ", which is not a glTF primitive mode (0 to 6)");
       if (const json* attrs = member(prim, "attributes"))
         for (auto it = attrs->begin(); attrs->is_object() && it != attrs->end(); ++it)
-          c.reference_value(it.value(), w + " attribute " + it.key(), w + " attribute " + it.key(), "accessor", accessors);
+          c.reference_value(it.value(), w + " attribute " + it.key(), w + " attribute " + it.key(), "accessor",
+                            accessors);
       if (const json* targets = member(prim, "targets"); targets && targets->is_array())
         for (size_t t = 0; t < targets->size(); ++t)
           for (auto it = (*targets)[t].begin(); (*targets)[t].is_object() && it != (*targets)[t].end(); ++it)
@@ -305,7 +311,8 @@ void check_schema(const std::string& path, const json& doc) {
       for (const json& v : *ch) c.reference_value(v, where + " children", where + " children", "node", nodes);
     }
   });
-  c.each("scenes", "scene", [&](const json& s, const std::string& where) { c.references(s, "nodes", where, "node", nodes); });
+  c.each("scenes", "scene",
+         [&](const json& s, const std::string& where) { c.references(s, "nodes", where, "node", nodes); });
   c.each("textures", "texture", [&](const json& t, const std::string& where) {
     c.reference(t, "sampler", where, "sampler", c.count("samplers"));
     c.reference(t, "source", where, "image", c.count("images"));

@@ -152,7 +152,8 @@ void check_extensions(const std::string& path, const json& doc, SourceFile& src)
       if (!e.is_string()) fail(path, "extensionsRequired contains a non-string entry");
       const std::string name = e.get<std::string>();
       if (name == "KHR_draco_mesh_compression")
-        fail(path, "requires KHR_draco_mesh_compression (Draco-compressed meshes), which this renderer does not support");
+        fail(path,
+             "requires KHR_draco_mesh_compression (Draco-compressed meshes), which this renderer does not support");
       // A material extension only changes how a surface looks: drawn without it, with one warning
       // per extension (the loader's), even when required.
       if (!extension_supported(name) && !material_extension_fallback(name))
@@ -162,7 +163,8 @@ void check_extensions(const std::string& path, const json& doc, SourceFile& src)
   if (const json* used = member(doc, "extensionsUsed")) {
     if (!used->is_array()) return;
     for (const json& e : *used)
-      if (e.is_string() && !extension_supported(e.get<std::string>()) && !material_extension_fallback(e.get<std::string>()))
+      if (e.is_string() && !extension_supported(e.get<std::string>()) &&
+          !material_extension_fallback(e.get<std::string>()))
         src.ignored_extensions.push_back(e.get<std::string>());
   }
 }
@@ -203,13 +205,16 @@ void read_lights(const std::string& path, const json& doc, SourceFile& src) {
       else if (t == "point") out.type = SceneLightType::Point;
       else if (t == "spot") out.type = SceneLightType::Spot;
       else if (!type) fail(path, where + " has no type");
-      else fail(path, where + " has unknown type " + (type->is_string() ? "'" + one_line(t, true) + "'" : std::string("(not a string)")) +
-                          " (directional, point or spot expected)");
+      else
+        fail(path, where + " has unknown type " +
+                       (type->is_string() ? "'" + one_line(t, true) + "'" : std::string("(not a string)")) +
+                       " (directional, point or spot expected)");
       if (const json* color = member(l, "color")) {
         if (!color->is_array() || color->size() != 3) fail(path, where + " color is not an array of 3 numbers");
         for (size_t c = 0; c < 3; ++c) {
           const json& v = (*color)[c];
-          if (!v.is_number() || !std::isfinite(v.get<double>())) fail(path, where + " color has a non-finite or non-numeric value");
+          if (!v.is_number() || !std::isfinite(v.get<double>()))
+            fail(path, where + " color has a non-finite or non-numeric value");
           if (v.get<double>() < 0.0) fail(path, where + " color has a negative value (" + v.dump() + ")");
           out.color[c] = float(v.get<double>());
         }
@@ -279,7 +284,8 @@ bool read_external(const std::string& path, SourceFile& src, const std::string& 
   InputFile f = read_input_file(file, confine, limits.file_bytes);
   if (f.status != InputFile::Status::Ok) fail(path, what + " " + f.reason);
   if (byte_length >= 0 && uint64_t(byte_length) != f.bytes.size())
-    fail(path, what + " has " + std::to_string(f.bytes.size()) + " bytes but byteLength is " + std::to_string(byte_length));
+    fail(path,
+         what + " has " + std::to_string(f.bytes.size()) + " bytes but byteLength is " + std::to_string(byte_length));
   SourceFile::External& e = src.external[file];
   e.bytes = std::move(f.bytes);
   e.uses = 1;
@@ -311,8 +317,9 @@ void check_buffers(const std::string& path, const json& doc, SourceFile& src, in
     }
     if (u.rfind("data:", 0) == 0) {
       if (!tinygltf::IsDataURI(u))
-        fail(path, name + " uses an unsupported data URI (base64 application/octet-stream or "
-                          "application/gltf-buffer expected)");
+        fail(path, name +
+                       " uses an unsupported data URI (base64 application/octet-stream or "
+                       "application/gltf-buffer expected)");
       continue;  // tinygltf decodes it and checks the decoded size against byteLength
     }
     if (byte_length > uint64_t(INT64_MAX)) fail(path, name + " has an impossible byteLength");
@@ -337,8 +344,8 @@ void read_sampled_images(const std::string& path, const json& doc, SourceFile& s
     if (!uri || !uri->is_string()) continue;
     const std::string u = uri->get<std::string>();
     if (u.empty() || u.rfind("data:", 0) == 0) continue;  // tinygltf decodes data URIs
-    read_external(path, src, resolve_uri(src.base_dir, u), "image " + std::to_string(i) + ": file '" + one_line(u) + "'",
-                  confine, limits, -1, true);
+    read_external(path, src, resolve_uri(src.base_dir, u),
+                  "image " + std::to_string(i) + ": file '" + one_line(u) + "'", confine, limits, -1, true);
   }
 }
 
@@ -498,7 +505,6 @@ const json* member(const json& object, const char* key) {
   return it == object.end() ? nullptr : &*it;
 }
 
-
 std::string resolve_uri(const std::string& base_dir, const std::string& uri) {
   // Same decoding as tinygltf's dlib::urldecode ('+' is a space, %XX a byte), so that the file checked
   // here is the file tinygltf then opens.
@@ -530,8 +536,8 @@ SourceFile read_source(const std::string& path, const InputLimits& limits) {
   src.base_dir = base_dir_of(path);
   src.glb = src.bytes.size() >= 4 && std::memcmp(src.bytes.data(), "glTF", 4) == 0;
   int64_t bin_length = -1;
-  const std::string text = src.glb ? glb_json(path, src.bytes, bin_length)
-                                   : std::string(src.bytes.begin(), src.bytes.end());
+  const std::string text =
+      src.glb ? glb_json(path, src.bytes, bin_length) : std::string(src.bytes.begin(), src.bytes.end());
   if (text.size() > limits.json_bytes)
     fail(path, "the JSON " + std::string(src.glb ? "chunk" : "text") + " has " + std::to_string(text.size()) +
                    " bytes, more than the json-bytes limit of " + std::to_string(limits.json_bytes) +
@@ -601,8 +607,8 @@ void check_buffer_views(const tinygltf::Model& m, const std::map<int, uint64_t>&
     uint64_t end = 0;
     if (__builtin_add_overflow(uint64_t(bv.byteOffset), uint64_t(bv.byteLength), &end) || end > size)
       fail(file, name + " (byteOffset " + std::to_string(bv.byteOffset) + ", byteLength " +
-                     std::to_string(bv.byteLength) + ") overruns buffer " + std::to_string(bv.buffer) +
-                     ", which has " + std::to_string(size) + " bytes");
+                     std::to_string(bv.byteLength) + ") overruns buffer " + std::to_string(bv.buffer) + ", which has " +
+                     std::to_string(size) + " bytes");
   }
 }
 
@@ -629,7 +635,8 @@ void check_materials(const tinygltf::Model& m, const std::string& file) {
     const tinygltf::Material& mat = m.materials[i];
     const std::pair<int, int> infos[] = {
         {mat.pbrMetallicRoughness.baseColorTexture.index, mat.pbrMetallicRoughness.baseColorTexture.texCoord},
-        {mat.pbrMetallicRoughness.metallicRoughnessTexture.index, mat.pbrMetallicRoughness.metallicRoughnessTexture.texCoord},
+        {mat.pbrMetallicRoughness.metallicRoughnessTexture.index,
+         mat.pbrMetallicRoughness.metallicRoughnessTexture.texCoord},
         {mat.normalTexture.index, mat.normalTexture.texCoord},
         {mat.occlusionTexture.index, mat.occlusionTexture.texCoord},
         {mat.emissiveTexture.index, mat.emissiveTexture.texCoord}};
@@ -643,7 +650,8 @@ void check_materials(const tinygltf::Model& m, const std::string& file) {
   for (size_t i = 0; i < m.textures.size(); ++i) {
     const tinygltf::Texture& t = m.textures[i];
     const std::string name = "texture " + std::to_string(i);
-    if (t.source != -1 && !in_range(t.source, m.images)) fail(file, ref_error(name, "image", t.source, m.images.size()));
+    if (t.source != -1 && !in_range(t.source, m.images))
+      fail(file, ref_error(name, "image", t.source, m.images.size()));
     if (t.sampler != -1 && !in_range(t.sampler, m.samplers))
       fail(file, ref_error(name, "sampler", t.sampler, m.samplers.size()));
   }
@@ -735,7 +743,8 @@ std::vector<int> validate_model(const tinygltf::Model& model, const std::map<int
 std::vector<int> scene_roots(const tinygltf::Model& m, const std::vector<int>& parent, const std::string& file) {
   std::vector<int> roots;
   if (m.scenes.empty()) {
-    if (m.defaultScene > 0) fail(file, "scene " + std::to_string(m.defaultScene) + " is the default but there are no scenes");
+    if (m.defaultScene > 0)
+      fail(file, "scene " + std::to_string(m.defaultScene) + " is the default but there are no scenes");
     for (size_t i = 0; i < m.nodes.size(); ++i)
       if (parent[i] == -1) roots.push_back(int(i));
     return roots;
@@ -765,7 +774,8 @@ MotionNode node_transform(const tinygltf::Node& n, int index, const std::string&
   };
   MotionNode out;
   if (!n.matrix.empty()) {
-    if (n.matrix.size() != 16) fail(file, name + " has a matrix of " + std::to_string(n.matrix.size()) + " values (16 expected)");
+    if (n.matrix.size() != 16)
+      fail(file, name + " has a matrix of " + std::to_string(n.matrix.size()) + " values (16 expected)");
     if (!finite(n.matrix)) fail(file, name + " has a non-finite matrix");
     out.has_matrix = true;
     for (int c = 0; c < 4; ++c)
@@ -774,7 +784,8 @@ MotionNode node_transform(const tinygltf::Node& n, int index, const std::string&
   }
   auto check = [&](const std::vector<double>& v, size_t size, const char* what) {
     if (!v.empty() && v.size() != size)
-      fail(file, name + " has a " + what + " of " + std::to_string(v.size()) + " values (" + std::to_string(size) + " expected)");
+      fail(file, name + " has a " + what + " of " + std::to_string(v.size()) + " values (" + std::to_string(size) +
+                     " expected)");
     if (!finite(v)) fail(file, name + " has a non-finite " + what);
   };
   check(n.translation, 3, "translation");

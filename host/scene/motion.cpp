@@ -117,7 +117,8 @@ void deform_range(const DeformSource& src, const std::vector<float>& morph_weigh
     if (has_normals) n = glm::dvec3(src.nrm[3 * v], src.nrm[3 * v + 1], src.nrm[3 * v + 2]);
     for (size_t k : targets) {
       const double w = morph_weights[k];
-      if (!src.target_pos[k].empty()) p += w * glm::dvec3(src.target_pos[k][3 * v], src.target_pos[k][3 * v + 1], src.target_pos[k][3 * v + 2]);
+      if (!src.target_pos[k].empty())
+        p += w * glm::dvec3(src.target_pos[k][3 * v], src.target_pos[k][3 * v + 1], src.target_pos[k][3 * v + 2]);
       if (has_normals && !src.target_nrm[k].empty())
         n += w * glm::dvec3(src.target_nrm[k][3 * v], src.target_nrm[k][3 * v + 1], src.target_nrm[k][3 * v + 2]);
     }
@@ -126,7 +127,8 @@ void deform_range(const DeformSource& src, const std::vector<float>& morph_weigh
       t = glm::dvec3(src.tan[4 * v], src.tan[4 * v + 1], src.tan[4 * v + 2]);
       for (size_t k : targets)
         if (k < src.target_tan.size() && !src.target_tan[k].empty())
-          t += double(morph_weights[k]) * glm::dvec3(src.target_tan[k][3 * v], src.target_tan[k][3 * v + 1], src.target_tan[k][3 * v + 2]);
+          t += double(morph_weights[k]) *
+               glm::dvec3(src.target_tan[k][3 * v], src.target_tan[k][3 * v + 1], src.target_tan[k][3 * v + 2]);
     }
     glm::dvec3 wp, wn, wt;
     double tangent_sign = world_sign;
@@ -169,7 +171,8 @@ void deform_range(const DeformSource& src, const std::vector<float>& morph_weigh
     if (has_tangents) {
       const double len = glm::length(wt);
       const double w = (src.tan[4 * v + 3] < 0.0f ? -1.0 : 1.0) * tangent_sign;
-      tangents[v] = len > 0.0 && std::isfinite(len) ? glm::vec4(glm::vec3(wt / len), float(w)) : glm::vec4(0.0f, 0.0f, 0.0f, float(w));
+      tangents[v] = len > 0.0 && std::isfinite(len) ? glm::vec4(glm::vec3(wt / len), float(w))
+                                                    : glm::vec4(0.0f, 0.0f, 0.0f, float(w));
     }
   }
 }

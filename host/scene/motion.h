@@ -19,7 +19,7 @@ namespace pmr {
 
 struct MotionNode {
   int parent = -1;
-  bool has_matrix = false;   // a matrix node is never animated (the spec forbids it)
+  bool has_matrix = false;  // a matrix node is never animated (the spec forbids it)
   glm::dmat4 matrix{1.0};
   glm::dvec3 translation{0.0}, scale{1.0};
   glm::dvec4 rotation{0.0, 0.0, 0.0, 1.0};  // unit quaternion (x, y, z, w)
@@ -49,13 +49,13 @@ struct MotionSkin {
 // One mesh primitive in its mesh's space, with what deforms it. Shared by all instances of the mesh.
 struct DeformSource {
   size_t vertices = 0;
-  std::vector<float> pos, nrm;                            // 3 per vertex; nrm empty when absent
+  std::vector<float> pos, nrm;                             // 3 per vertex; nrm empty when absent
   std::vector<std::vector<float>> target_pos, target_nrm;  // per morph target, 3 per vertex or empty
-  std::vector<float> tan;                                 // 4 per vertex (xyz, w handedness) or empty
-  std::vector<std::vector<float>> target_tan;             // per morph target, 3 per vertex or empty
-  int influences = 0;                                     // joint influences per vertex: 0, 4 or 8
-  std::vector<uint16_t> joints;                           // influences per vertex (skin joint slots)
-  std::vector<float> weights;                             // influences per vertex
+  std::vector<float> tan;                                  // 4 per vertex (xyz, w handedness) or empty
+  std::vector<std::vector<float>> target_tan;              // per morph target, 3 per vertex or empty
+  int influences = 0;                                      // joint influences per vertex: 0, 4 or 8
+  std::vector<uint16_t> joints;                            // influences per vertex (skin joint slots)
+  std::vector<float> weights;                              // influences per vertex
 };
 
 // An instance whose vertices move with some animation: its ranges in the scene's arrays.
@@ -100,8 +100,8 @@ void parallel_for(size_t n, size_t grain, const std::function<void(size_t, size_
 // joint matrix's or the world matrix's upper 3x3, normalized (zero when degenerate); w = the sign of
 // src's w times the sign of that matrix's determinant (Scene::tangents).
 void deform(const DeformSource& src, const std::vector<float>& morph_weights, const glm::dmat4* joints,
-            const glm::dmat4& world, glm::vec3* positions, PmrVertexAttr* attributes,
-            uint8_t* bad_position = nullptr, uint8_t* bad_normal = nullptr, glm::vec4* tangents = nullptr);
+            const glm::dmat4& world, glm::vec3* positions, PmrVertexAttr* attributes, uint8_t* bad_position = nullptr,
+            uint8_t* bad_normal = nullptr, glm::vec4* tangents = nullptr);
 // The same for vertices [begin, end) only (the output pointers still address vertex 0).
 void deform_range(const DeformSource& src, const std::vector<float>& morph_weights, const glm::dmat4* joints,
                   const glm::dmat4& world, size_t begin, size_t end, glm::vec3* positions, PmrVertexAttr* attributes,

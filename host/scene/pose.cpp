@@ -28,15 +28,21 @@ void sample_nodes(const SceneMotion& m, const PoseRequest& r, std::vector<glm::d
       const std::vector<float> v = sample(clip.samplers[size_t(ch.sampler)], r.time);
       MotionNode& n = nodes[size_t(ch.node)];
       switch (ch.path) {
-        case ChannelPath::Translation: n.translation = glm::dvec3(v[0], v[1], v[2]); break;
-        case ChannelPath::Scale: n.scale = glm::dvec3(v[0], v[1], v[2]); break;
+        case ChannelPath::Translation:
+          n.translation = glm::dvec3(v[0], v[1], v[2]);
+          break;
+        case ChannelPath::Scale:
+          n.scale = glm::dvec3(v[0], v[1], v[2]);
+          break;
         case ChannelPath::Rotation: {
           glm::dvec4 q(v[0], v[1], v[2], v[3]);
           const double len = glm::length(q);
           n.rotation = len > 0.0 && std::isfinite(len) ? q / len : glm::dvec4(0, 0, 0, 1);
           break;
         }
-        case ChannelPath::Weights: n.weights = v; break;
+        case ChannelPath::Weights:
+          n.weights = v;
+          break;
       }
       touched[size_t(ch.node)] = true;
     }
@@ -44,7 +50,8 @@ void sample_nodes(const SceneMotion& m, const PoseRequest& r, std::vector<glm::d
   local = rest_local_matrices(m);
   weights.resize(nodes.size());
   for (size_t i = 0; i < nodes.size(); ++i) {
-    if (touched[i] && !nodes[i].has_matrix) local[i] = trs_matrix(nodes[i].translation, nodes[i].rotation, nodes[i].scale);
+    if (touched[i] && !nodes[i].has_matrix)
+      local[i] = trs_matrix(nodes[i].translation, nodes[i].rotation, nodes[i].scale);
     weights[i] = std::move(nodes[i].weights);
   }
 }
@@ -52,7 +59,8 @@ void sample_nodes(const SceneMotion& m, const PoseRequest& r, std::vector<glm::d
 // Cameras and lights placed by their nodes' world matrices.
 void place_cameras_and_lights(const SceneMotion& m, const std::vector<glm::dmat4>& world, Scene& out) {
   for (size_t c = 0; c < out.cameras.size() && c < m.camera_node.size(); ++c)
-    if (m.camera_node[c] >= 0 && out.cameras[c].placed) out.cameras[c].world_from_camera = world[size_t(m.camera_node[c])];
+    if (m.camera_node[c] >= 0 && out.cameras[c].placed)
+      out.cameras[c].world_from_camera = world[size_t(m.camera_node[c])];
   // Lights: the node's origin and -Z (a degenerate matrix keeps the rest direction).
   for (size_t l = 0; l < out.lights.size() && l < m.light_node.size(); ++l) {
     const glm::dmat4& w = world[size_t(m.light_node[l])];
@@ -64,7 +72,8 @@ void place_cameras_and_lights(const SceneMotion& m, const std::vector<glm::dmat4
 }
 
 // The world matrices of every node at the request's time, and their morph weights.
-std::vector<glm::dmat4> posed_world(const SceneMotion& m, const PoseRequest& r, std::vector<std::vector<float>>& weights) {
+std::vector<glm::dmat4> posed_world(const SceneMotion& m, const PoseRequest& r,
+                                    std::vector<std::vector<float>>& weights) {
   std::vector<glm::dmat4> local;
   sample_nodes(m, r, local, weights);
   return world_matrices(m, local);
@@ -194,7 +203,8 @@ bool pose_scene(const Scene& rest, const PoseRequest& r, Scene& out) {
       std::copy_n(&rest.positions[d.vertex_begin], n, &out.positions[d.vertex_begin]);
       std::copy_n(&rest.attributes[d.vertex_begin], n, &out.attributes[d.vertex_begin]);
       if (!rest.tangents.empty()) std::copy_n(&rest.tangents[d.vertex_begin], n, &out.tangents[d.vertex_begin]);
-      std::copy(&rest.triangles[d.triangle_begin], &rest.triangles[0] + d.triangle_end, &out.triangles[d.triangle_begin]);
+      std::copy(&rest.triangles[d.triangle_begin], &rest.triangles[0] + d.triangle_end,
+                &out.triangles[d.triangle_begin]);
     }
   }
   if (r.turntable) turn(r, out);

@@ -47,7 +47,8 @@ Scene make_synthetic_scene(size_t triangles, uint32_t seed) {
           if ((i == 0 && t == 0) || (i == stacks - 1 && t == 1)) continue;  // degenerate at the poles
           PmrTriangle pt{};
           pt.v[0] = tri[t][0], pt.v[1] = tri[t][1], pt.v[2] = tri[t][2];
-          const glm::vec3 e = glm::cross(s.positions[pt.v[1]] - s.positions[pt.v[0]], s.positions[pt.v[2]] - s.positions[pt.v[0]]);
+          const glm::vec3 e =
+              glm::cross(s.positions[pt.v[1]] - s.positions[pt.v[0]], s.positions[pt.v[2]] - s.positions[pt.v[0]]);
           const glm::vec3 fn = glm::length(e) > 0 ? glm::normalize(e) : glm::vec3(0, 0, 1);
           pt.face_normal[0] = fn.x, pt.face_normal[1] = fn.y, pt.face_normal[2] = fn.z;
           pt.has_normals = 1;
@@ -95,7 +96,8 @@ void add_grid(Scene& s, uint32_t base, int segments, int rings, bool wrap_v, uin
         const glm::vec3 p0 = s.positions[pt.v[0]], p1 = s.positions[pt.v[1]], p2 = s.positions[pt.v[2]];
         glm::vec3 e = glm::cross(p1 - p0, p2 - p0);
         glm::vec3 n(0.0f);
-        for (uint32_t v : pt.v) n += glm::vec3(s.attributes[v].normal[0], s.attributes[v].normal[1], s.attributes[v].normal[2]);
+        for (uint32_t v : pt.v)
+          n += glm::vec3(s.attributes[v].normal[0], s.attributes[v].normal[1], s.attributes[v].normal[2]);
         if (glm::dot(e, n) < 0.0f) std::swap(pt.v[1], pt.v[2]), e = -e;
         const glm::vec3 fn = glm::length(e) > 0 ? glm::normalize(e) : glm::vec3(0, 0, 1);
         pt.face_normal[0] = fn.x, pt.face_normal[1] = fn.y, pt.face_normal[2] = fn.z;
@@ -120,7 +122,8 @@ Scene make_objects_scene(size_t triangles, uint32_t seed) {
   for (size_t k = 0; k < objects; ++k) {
     PmrMaterial m = default_material();
     m.metallic = 0.0f, m.roughness = 0.5f;  // painted plastic under --shading pbr
-    m.base_color[0] = 0.15f + 0.85f * u(rng), m.base_color[1] = 0.15f + 0.85f * u(rng), m.base_color[2] = 0.15f + 0.85f * u(rng);
+    m.base_color[0] = 0.15f + 0.85f * u(rng), m.base_color[1] = 0.15f + 0.85f * u(rng),
+    m.base_color[2] = 0.15f + 0.85f * u(rng);
     m.double_sided = 1;
     const uint32_t material = uint32_t(s.materials.size());
     s.materials.push_back(m);
@@ -130,7 +133,7 @@ Scene make_objects_scene(size_t triangles, uint32_t seed) {
     const glm::mat3 rot = random_rotation(rng);
     const bool torus = u(rng) < 0.4f;
     const float e1 = 0.25f + 0.75f * u(rng), e2 = 0.25f + 0.75f * u(rng);  // superquadric: box .. ellipsoid
-    const float minor = 0.25f + 0.2f * u(rng);                                // torus tube / ring radius
+    const float minor = 0.25f + 0.2f * u(rng);                             // torus tube / ring radius
     // 2 * segments * rings triangles (torus) or 2 * segments * (rings - 2) (poles), segments ~ 2 * rings
     const int rings = std::max(3, int(std::lround(std::sqrt(per_object / 4.0) + (torus ? 0.0 : 1.5))));
     const int bands = torus ? rings : rings - 2;
@@ -149,8 +152,10 @@ Scene make_objects_scene(size_t triangles, uint32_t seed) {
           const float th = float(M_PI) * float(i) / float(rings - 1);
           // exact zeros at the poles and quarter turns: a signed power would blow sin(pi) = -8.7e-8 up
           // to a visible hole at the pole
-          const float st = snap(std::sin(th)), ct = snap(std::cos(th)), sp = snap(std::sin(ph)), cp = snap(std::cos(ph));
-          p = glm::vec3(signed_pow(st, e1) * signed_pow(cp, e2), signed_pow(ct, e1), signed_pow(st, e1) * signed_pow(sp, e2));
+          const float st = snap(std::sin(th)), ct = snap(std::cos(th)), sp = snap(std::sin(ph)),
+                      cp = snap(std::cos(ph));
+          p = glm::vec3(signed_pow(st, e1) * signed_pow(cp, e2), signed_pow(ct, e1),
+                        signed_pow(st, e1) * signed_pow(sp, e2));
           n = glm::vec3(signed_pow(st, 2 - e1) * signed_pow(cp, 2 - e2), signed_pow(ct, 2 - e1),
                         signed_pow(st, 2 - e1) * signed_pow(sp, 2 - e2));
         }

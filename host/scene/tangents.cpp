@@ -62,11 +62,14 @@ std::vector<float> generate_tangents(const std::vector<float>& pos, const std::v
                                      const std::vector<float>& uv, const std::vector<uint32_t>& tris) {
   const size_t vertices = pos.size() / 3;
   auto P = [&](uint32_t v) { return glm::dvec3(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]); };
-  auto UV = [&](uint32_t v) { return uv.size() >= 2 * (size_t(v) + 1) ? glm::dvec2(uv[2 * v], 1.0 - double(uv[2 * v + 1])) : glm::dvec2(0.0); };
+  auto UV = [&](uint32_t v) {
+    return uv.size() >= 2 * (size_t(v) + 1) ? glm::dvec2(uv[2 * v], 1.0 - double(uv[2 * v + 1])) : glm::dvec2(0.0);
+  };
   // Vertex normals: the file's, else the area-weighted sum of the face normals around the vertex.
   std::vector<glm::dvec3> normal(vertices, glm::dvec3(0.0));
   if (nrm.size() == 3 * vertices) {
-    for (size_t v = 0; v < vertices; ++v) normal[v] = unit_or_zero(glm::dvec3(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]));
+    for (size_t v = 0; v < vertices; ++v)
+      normal[v] = unit_or_zero(glm::dvec3(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]));
   } else {
     for (size_t t = 0; t + 2 < tris.size(); t += 3) {
       const glm::dvec3 f = glm::cross(P(tris[t + 1]) - P(tris[t]), P(tris[t + 2]) - P(tris[t]));

@@ -21,7 +21,9 @@ namespace pmr::gltf {
 
 namespace {
 
-uint32_t be32(const unsigned char* p) { return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3]; }
+uint32_t be32(const unsigned char* p) {
+  return uint32_t(p[0]) << 24 | uint32_t(p[1]) << 16 | uint32_t(p[2]) << 8 | p[3];
+}
 
 // A copy of the PNG without its empty IDAT chunks (up to the first chunk that runs past the end, after
 // which the bytes are kept as they are), or an empty vector when it has none. Empty IDAT chunks are
@@ -34,13 +36,11 @@ std::vector<unsigned char> without_empty_idat(const unsigned char* bytes, size_t
   std::vector<unsigned char> out(bytes, bytes + 8);
   bool removed = false;
   size_t at = 8;
-  for (; at + 12 <= size; ) {
+  for (; at + 12 <= size;) {
     const uint64_t length = be32(bytes + at);
     if (length > size - at - 12) break;  // a chunk past the end: the rest as it is
-    if (length == 0 && std::memcmp(bytes + at + 4, "IDAT", 4) == 0)
-      removed = true;
-    else
-      out.insert(out.end(), bytes + at, bytes + at + 12 + length);
+    if (length == 0 && std::memcmp(bytes + at + 4, "IDAT", 4) == 0) removed = true;
+    else out.insert(out.end(), bytes + at, bytes + at + 12 + length);
     at += 12 + size_t(length);
   }
   if (!removed) return {};

@@ -152,11 +152,12 @@ int take_own_lock(const std::string& dir, const std::string& own_name, const std
       throw Error("cannot lock output folder " + dir + ": cannot open " + own_name + ": " + std::strerror(errno));
     }
     int rc;
-    while ((rc = ::flock(fd, LOCK_SH)) != 0 && errno == EINTR) {
-    }
+    while ((rc = ::flock(fd, LOCK_SH)) != 0 && errno == EINTR) {}
     if (rc != 0) {  // e.g. ENOLCK: an NFS mount without lock support
-      std::fprintf(stderr, "pmr: warning: cannot lock output folder %s (%s): another configuration rendering into it "
-                   "at the same time would not be noticed\n", dir.c_str(), std::strerror(errno));
+      std::fprintf(stderr,
+                   "pmr: warning: cannot lock output folder %s (%s): another configuration rendering into it "
+                   "at the same time would not be noticed\n",
+                   dir.c_str(), std::strerror(errno));
       ::close(fd);
       ::unlink(lock_path.c_str());
       lock_path.clear();
@@ -241,8 +242,10 @@ void check_finished_frames(const std::string& dir, const std::vector<std::pair<l
                 " differs) that this run would not replace; use another --out, render those frames too, or "
                 "--overwrite");
   if (others > 0)
-    std::fprintf(stderr, "pmr: warning: --overwrite: %s keeps %ld frame(s) of another configuration that this run "
-                 "does not replace (%s: %s differs)\n", dir.c_str(), others, first_name.c_str(), first_diff.c_str());
+    std::fprintf(stderr,
+                 "pmr: warning: --overwrite: %s keeps %ld frame(s) of another configuration that this run "
+                 "does not replace (%s: %s differs)\n",
+                 dir.c_str(), others, first_name.c_str(), first_diff.c_str());
 }
 
 }  // namespace

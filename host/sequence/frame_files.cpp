@@ -125,7 +125,8 @@ std::string frame_problem(const std::string& sidecar, const std::vector<std::str
       const auto size = fs::file_size(p, ec);
       if (ec) return name(p) + " cannot be read";
       if (uint64_t(size) < r->second.bytes)
-        return name(p) + " is truncated (" + std::to_string(size) + " of " + std::to_string(r->second.bytes) + " bytes)";
+        return name(p) + " is truncated (" + std::to_string(size) + " of " + std::to_string(r->second.bytes) +
+               " bytes)";
       if (uint64_t(size) != r->second.bytes)
         return name(p) + " is not the file its sidecar records (" + std::to_string(size) + " bytes, recorded " +
                std::to_string(r->second.bytes) + ")";

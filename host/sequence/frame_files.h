@@ -16,8 +16,8 @@ struct FrameProducts {
   std::string out_dir = "out";
   std::string name = "frame_%04d";  // --name pattern (frame_names.h)
   bool encoded = true, views = false, quilt = false;
-  bool depth = false;               // a Z channel in the views and quilt EXRs
-  bool preview = false;             // PNG previews of the encoded image, the center view and the quilt
+  bool depth = false;    // a Z channel in the views and quilt EXRs
+  bool preview = false;  // PNG previews of the encoded image, the center view and the quilt
 };
 
 // Every file of a frame; empty = not requested.
@@ -38,7 +38,6 @@ std::string frame_problem(const std::string& sidecar, const std::vector<std::str
 // A sidecar is a few kB; a larger file is not read (read_sidecar_text returns "").
 constexpr uint64_t kMaxSidecarBytes = uint64_t(16) << 20;
 std::string read_sidecar_text(const std::string& path);
-
 
 // Throws a UsageError naming --name when a file of these frames would have a name longer than the file
 // system takes (max_output_file_name: its temporary name must fit too), so that a long --name fails

@@ -53,7 +53,8 @@ NamePattern parse_name_pattern(const std::string& p) {
     const std::string spec = p.substr(i, std::min(j + 1, p.size()) - i);
     if (j >= p.size() || p[j] != 'd')
       throw refuse("'" + spec + "' is not a frame number field (%d, %0Nd or ####; %% for a percent sign)");
-    if (!zero && digits > 0) throw refuse("'" + spec + "' pads with spaces; use %0" + spec.substr(1) + " (zero-padded)");
+    if (!zero && digits > 0)
+      throw refuse("'" + spec + "' pads with spaces; use %0" + spec.substr(1) + " (zero-padded)");
     if (digits > 2) throw refuse("'" + spec + "': at most 99 digits");
     field(digits ? std::atoi(p.substr(i + 2, digits).c_str()) : 0);
     i = j;

@@ -12,7 +12,7 @@ namespace pmr {
 struct NamePattern {
   std::string prefix, suffix;  // the text before and after the field (%% read as %); no field: prefix
   bool has_field = false;
-  int width = 0;               // zero-padded to this many digits; 0: as many as the number needs
+  int width = 0;  // zero-padded to this many digits; 0: as many as the number needs
 };
 NamePattern parse_name_pattern(const std::string& pattern);
 // Throws what parse_name_pattern throws, and when the stem would be empty or hidden.

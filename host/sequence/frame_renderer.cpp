@@ -41,9 +41,11 @@ void select_animation(const Scene& scene, const std::string& choice, SequenceSpe
     return;
   }
   std::string known;
-  for (size_t i = 0; i < a.size(); ++i) known += (known.empty() ? "" : ", ") + std::to_string(i) + " '" + printable_text(a[i].name, 80) + "'";
-  throw Error("--animation '" + choice + "': " +
-              (a.empty() ? std::string("the scene has no animations") : "no such animation (the scene has " + known + ")"));
+  for (size_t i = 0; i < a.size(); ++i)
+    known += (known.empty() ? "" : ", ") + std::to_string(i) + " '" + printable_text(a[i].name, 80) + "'";
+  throw Error(
+      "--animation '" + choice + "': " +
+      (a.empty() ? std::string("the scene has no animations") : "no such animation (the scene has " + known + ")"));
 }
 
 namespace {
@@ -93,8 +95,10 @@ void animation_frame_range(const Scene& scene, const SequenceSpec& spec, long& f
     double start = 0, end = 0;
     key_range(scene, spec.animation, start, end);
     char line[200];
-    std::snprintf(line, sizeof line, "--frames all: no frame time f / %g lies inside the animation's keys (%g to %g s): "
-                  "give --frames or a higher --fps", spec.fps, start, end);
+    std::snprintf(line, sizeof line,
+                  "--frames all: no frame time f / %g lies inside the animation's keys (%g to %g s): "
+                  "give --frames or a higher --fps",
+                  spec.fps, start, end);
     throw Error(line);
   }
   first = last = 0;

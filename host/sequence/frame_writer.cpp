@@ -153,8 +153,8 @@ void FrameWriter::write(FrameFiles& f) {
   };
   // Every final path of the frame is registered before its file is written: a second signal between a
   // rename and its registration would otherwise leave that file behind.
-  for (const std::string* p : {&f.sidecar_path, &f.encoded_path, &f.views_path, &f.quilt_path, &f.encoded_png,
-                               &f.center_png, &f.quilt_png})
+  for (const std::string* p :
+       {&f.sidecar_path, &f.encoded_path, &f.views_path, &f.quilt_path, &f.encoded_png, &f.center_png, &f.quilt_png})
     if (!p->empty()) slots.push_back(register_temp_file(*p));
   auto done = [&](const std::string& path) { committed.push_back(path); };
   const ExrMetadata* meta = f.has_meta ? &f.meta : nullptr;
@@ -183,7 +183,8 @@ void FrameWriter::write(FrameFiles& f) {
     std::vector<uint16_t> quilt;
     std::vector<float> quilt_depth;
     if (!f.quilt_path.empty() || !f.quilt_png.empty())
-      assemble_quilt(f.quilt, f.views, f.view_w, f.view_h, f.volume.data(), depth, quilt, depth ? &quilt_depth : nullptr);
+      assemble_quilt(f.quilt, f.views, f.view_w, f.view_h, f.volume.data(), depth, quilt,
+                     depth ? &quilt_depth : nullptr);
     const int qw = f.quilt.columns * f.view_w, qh = f.quilt.rows * f.view_h;
     if (!f.quilt_path.empty()) {
       check();

@@ -31,13 +31,13 @@ struct FrameFiles {
   Rig sidecar_rig;
   Display sidecar_display;
   std::string encoded_path, encoded_png;
-  std::vector<uint16_t> display;           // half RGBA, display_w x display_h
-  std::vector<uint16_t> sub_alpha;         // each display subpixel's alpha: [y][x][3] halves (AR, AG, AB)
+  std::vector<uint16_t> display;    // half RGBA, display_w x display_h
+  std::vector<uint16_t> sub_alpha;  // each display subpixel's alpha: [y][x][3] halves (AR, AG, AB)
   int display_w = 0, display_h = 0;
   std::string views_path, quilt_path, quilt_png, center_png;
-  std::vector<uint16_t> volume;            // half RGBA, views x view_h x view_w
+  std::vector<uint16_t> volume;  // half RGBA, views x view_h x view_w
   int view_w = 0, view_h = 0, views = 0;
-  float pixel_aspect = 1.0f;               // of a view's pixels (A h / w)
+  float pixel_aspect = 1.0f;  // of a view's pixels (A h / w)
   QuiltLayout quilt;
   int center_view = 0;
   // Window depth per voxel from the pipeline (INFINITY where empty), or empty: no depth requested.

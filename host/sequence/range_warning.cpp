@@ -32,10 +32,13 @@ std::string frames_outside_animation(const Scene& scene, const SequenceSpec& spe
   char range[96];
   if (inside) std::snprintf(range, sizeof range, "frames %ld:%ld at %g fps", first, last, spec.fps);
   else std::snprintf(range, sizeof range, "no frame at %g fps lies inside its keys", spec.fps);
-  const std::string what = spec.animation == kAllAnimations ? "the animations (all)" : "the animation '" + printable_text(spec.animation_label, 80) + "'";
+  const std::string what = spec.animation == kAllAnimations
+                               ? "the animations (all)"
+                               : "the animation '" + printable_text(spec.animation_label, 80) + "'";
   const char* pose = before && after ? "its first or last pose" : before ? "its first pose" : "its last pose";
-  return list + (outside.size() == 1 ? " lies" : " lie") + " outside " + what + " (" + range + "): " +
-         (outside.size() == 1 ? "it repeats " : "they repeat ") + pose + (spec.turntable ? " (the turntable still turns)" : "");
+  return list + (outside.size() == 1 ? " lies" : " lie") + " outside " + what + " (" + range +
+         "): " + (outside.size() == 1 ? "it repeats " : "they repeat ") + pose +
+         (spec.turntable ? " (the turntable still turns)" : "");
 }
 
 }  // namespace pmr

@@ -91,7 +91,7 @@ class SequenceRun {
   QuiltLayout quilt_;
   int center_view_ = 0;
   bool need_volume_ = false;
-  SidecarInfo info_;              // what every frame's sidecar shares
+  SidecarInfo info_;  // what every frame's sidecar shares
   ResumePlan plan_;
   // the summary's sums
   double render_s_ = 0.0, pose_s_ = 0.0, upload_s_ = 0.0, loop_s_ = 0.0, loop_cpu_s_ = 0.0;
@@ -127,8 +127,8 @@ void SequenceRun::load_inputs() {
                            " tile-queue entries)");
     };
   if (!job_.environment_file.empty()) {
-    auto environment = std::make_shared<const Environment>(Environment::make(
-        {job_.environment_file, job_.environment_rotation_deg, job_.pipeline.environment_intensity}));
+    auto environment = std::make_shared<const Environment>(
+        Environment::make({job_.environment_file, job_.environment_rotation_deg, job_.pipeline.environment_intensity}));
     environment_checksum_ = checksum_file(job_.environment_file);
     if (job_.verbose) {
       const PmrEnvironment& h = environment->tables().header;
@@ -153,7 +153,8 @@ void SequenceRun::choose_frames() {
   if (job_.frames == "all") {
     long first = 0, last = 0;
     animation_frame_range(scene_, spec_, first, last);
-    if (last - first >= kMaxFramesPerRun) throw Error("--frames all would be " + std::to_string(last - first + 1) + " frames; give a range");
+    if (last - first >= kMaxFramesPerRun)
+      throw Error("--frames all would be " + std::to_string(last - first + 1) + " frames; give a range");
     if (last > kMaxFrame)
       throw Error("--frames all would reach frame " + std::to_string(last) + ", beyond " + std::to_string(kMaxFrame));
     for (long f = first; f <= last; ++f) frames_.push_back(f);
@@ -175,10 +176,9 @@ void SequenceRun::choose_frames() {
   const Rig& rig = renderer_->rig();
   need_volume_ = products_.views || products_.quilt || products_.preview;
   if (products_.quilt)
-    quilt_ = job_.quilt_layout.empty() ? choose_quilt_layout(rig.views, rig.view_w, rig.view_h)
-                                       : as_usage([&] {
-                                           return parse_quilt_layout(job_.quilt_layout, rig.views, rig.view_w, rig.view_h);
-                                         });
+    quilt_ = job_.quilt_layout.empty()
+                 ? choose_quilt_layout(rig.views, rig.view_w, rig.view_h)
+                 : as_usage([&] { return parse_quilt_layout(job_.quilt_layout, rig.views, rig.view_w, rig.view_h); });
   center_view_ = rig.views / 2;
   check_frame_file_names(products_, frames_, quilt_, rig.aspect);  // not after the first frame was rendered
   check_frame_memory();
@@ -196,8 +196,9 @@ void SequenceRun::check_frame_memory() const {
   const uint64_t volume = need_volume_ ? voxels * 8 : 0;
   const uint64_t depth = need_volume_ && products_.depth ? voxels * (12 + 3 * 4) : 0;
   check_memory(5 * volume + 5 * display + depth,
-               std::to_string(rig.views) + " views of " + std::to_string(rig.view_w) + "x" + std::to_string(rig.view_h) +
-                   " (" + std::to_string(volume >> 20) + " MiB a view volume, on the device and in up to four copies being written)");
+               std::to_string(rig.views) + " views of " + std::to_string(rig.view_w) + "x" +
+                   std::to_string(rig.view_h) + " (" + std::to_string(volume >> 20) +
+                   " MiB a view volume, on the device and in up to four copies being written)");
 }
 
 // What every frame's sidecar shares.
@@ -239,23 +240,36 @@ void SequenceRun::prepare_frames() {
     const LookingGlassCalibration& c = *job_.calibration;
     info.display_config_checksum = c.checksum;
     info.calibration_serial = c.serial;
-    info.calibration = {{"pitch", c.pitch},         {"slope", c.slope},       {"center", c.center},
-                        {"DPI", c.dpi},             {"screenW", c.screen_w},  {"screenH", c.screen_h},
-                        {"viewCone", c.view_cone},  {"fringe", c.fringe},     {"flipImageX", c.flip_x},
-                        {"flipImageY", c.flip_y},   {"flipSubp", c.flip_subp}, {"invView", c.inv_view},
-                        {"CellPatternMode", c.cell_pattern}, {"subpixelCells", double(c.cells.size())}};
+    info.calibration = {{"pitch", c.pitch},
+                        {"slope", c.slope},
+                        {"center", c.center},
+                        {"DPI", c.dpi},
+                        {"screenW", c.screen_w},
+                        {"screenH", c.screen_h},
+                        {"viewCone", c.view_cone},
+                        {"fringe", c.fringe},
+                        {"flipImageX", c.flip_x},
+                        {"flipImageY", c.flip_y},
+                        {"flipSubp", c.flip_subp},
+                        {"invView", c.inv_view},
+                        {"CellPatternMode", c.cell_pattern},
+                        {"subpixelCells", double(c.cells.size())}};
   }
 }
 
-SidecarInfo SequenceRun::frame_info(long frame, const FramePaths& p, double angle, std::vector<SceneLight> lights) const {
+SidecarInfo SequenceRun::frame_info(long frame, const FramePaths& p, double angle,
+                                    std::vector<SceneLight> lights) const {
   SidecarInfo i = info_;
   i.frame = int(frame);
   i.time = double(frame) / spec_.fps;
   i.turntable_angle = angle;
   i.lights = std::move(lights);
-  const std::pair<const char*, const std::string*> kinds[] = {
-      {"encoded", &p.encoded}, {"views", &p.views}, {"quilt", &p.quilt}, {"preview_encoded", &p.encoded_png},
-      {"preview_center", &p.center_png}, {"preview_quilt", &p.quilt_png}};
+  const std::pair<const char*, const std::string*> kinds[] = {{"encoded", &p.encoded},
+                                                              {"views", &p.views},
+                                                              {"quilt", &p.quilt},
+                                                              {"preview_encoded", &p.encoded_png},
+                                                              {"preview_center", &p.center_png},
+                                                              {"preview_quilt", &p.quilt_png}};
   for (const auto& [kind, path] : kinds)
     if (!path->empty()) i.outputs.push_back({kind, base_name(*path)});
   if (products_.quilt) i.quilt_columns = quilt_.columns, i.quilt_rows = quilt_.rows;
@@ -283,8 +297,9 @@ int SequenceRun::run() {
   // this run's frames (folder_guard.h). Held until the end of the run.
   const FolderGuard folder_guard(products_.out_dir, products_.name, job_frames_.empty() ? frames_ : job_frames_,
                                  expected_sidecar(0, paths(0)), job_.overwrite, job_.quiet);
-  plan_ = plan_resume(frames_, job_.resume, job_.overwrite, [&](long f) { return paths(f); },
-                      [&](long f, const FramePaths& p) { return expected_sidecar(f, p); });
+  plan_ = plan_resume(
+      frames_, job_.resume, job_.overwrite, [&](long f) { return paths(f); },
+      [&](long f, const FramePaths& p) { return expected_sidecar(f, p); });
   if (!job_.quiet)  // --quiet: errors and warnings only
     for (const std::string& note : plan_.notes) std::fprintf(stderr, "pmr: %s\n", note.c_str());
   print_header();
@@ -356,12 +371,13 @@ void SequenceRun::print_frame_stages(long f, const FrameRenderer::Frame& fr, con
   const bool subpixel = pc_.sampling == Sampling::Subpixel, tiled_encode = pipeline.fused() || subpixel;
   const char* encode_label = subpixel ? " + subpixel samples" : " + encode (fused)";
   char line[320];
-  std::snprintf(line, sizeof line,
-                "pmr: frame %ld: pose %.2f ms, upload %.2f ms; stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, "
-                "fine raster%s %.2f, %s %.2f; %u MTAs, %llu tile-queue entries, %d queue regrowth(s)",
-                f, fr.pose_ms, fr.upload_ms, fr.times.vertex, fr.times.setup, fr.times.bin, tiled_encode ? encode_label : "",
-                fr.times.fine, tiled_encode ? "straddling alpha" : "encode", fr.times.encode, fr.times.mtas,
-                (unsigned long long)fr.times.bin_entries, fr.times.retries);
+  std::snprintf(
+      line, sizeof line,
+      "pmr: frame %ld: pose %.2f ms, upload %.2f ms; stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, "
+      "fine raster%s %.2f, %s %.2f; %u MTAs, %llu tile-queue entries, %d queue regrowth(s)",
+      f, fr.pose_ms, fr.upload_ms, fr.times.vertex, fr.times.setup, fr.times.bin, tiled_encode ? encode_label : "",
+      fr.times.fine, tiled_encode ? "straddling alpha" : "encode", fr.times.encode, fr.times.mtas,
+      (unsigned long long)fr.times.bin_entries, fr.times.retries);
   progress.message(line);
 }
 
@@ -380,7 +396,7 @@ void SequenceRun::finish_writing(FrameWriter& writer, Progress& progress) {
 
 int SequenceRun::render_frames() {
   ClRuntime runtime;
-  pc_.fuse_encode = !need_volume_;   // the volume is only kept when a product needs it
+  pc_.fuse_encode = !need_volume_;      // the volume is only kept when a product needs it
   pc_.debug_outputs = products_.depth;  // per-voxel depth
   Pipeline pipeline(runtime, pc_);
   renderer_->attach(pipeline, products_.encoded ? &job_.display : nullptr);  // builds every kernel the frames use
@@ -413,7 +429,9 @@ int SequenceRun::render_frames() {
     render_s_ += fr.times.wall / 1000.0;
     pose_s_ += fr.pose_ms / 1000.0;
     upload_s_ += fr.upload_ms / 1000.0;
-    if (!fr.visible) progress.message("pmr: warning: frame " + std::to_string(f) + ": nothing visible, written as a transparent image");
+    if (!fr.visible)
+      progress.message("pmr: warning: frame " + std::to_string(f) +
+                       ": nothing visible, written as a transparent image");
     if (job_.verbose) print_frame_stages(f, fr, pipeline, progress);
     writer.submit(frame_files(f, fr, pipeline, writer));
     ++rendered_;
@@ -424,7 +442,8 @@ int SequenceRun::render_frames() {
   loop_cpu_s_ = process_cpu_seconds() - cpu0;
   const long written = writer.frames_written();
   if (const int sig = interrupt_signal(); sig && written < total) {
-    std::fprintf(stderr, "pmr: interrupted by %s: %ld of %ld frame(s) written (%ld already complete); nothing partial "
+    std::fprintf(stderr,
+                 "pmr: interrupted by %s: %ld of %ld frame(s) written (%ld already complete); nothing partial "
                  "was left: rerun with --resume to finish\n",
                  sig == SIGTERM ? "SIGTERM" : "SIGINT", written, total, plan_.kept);
     return 128 + sig;
@@ -442,7 +461,8 @@ void SequenceRun::print_summary(const FrameWriter& writer) const {
   const double writer_cpu = writer.cpu_seconds();
   const bool ours = job_.compression == ExrCompression::Zip || job_.compression == ExrCompression::ZipFast;
   std::fprintf(stderr,
-               "pmr: %ld frame(s) in %.2f s (%.2f s/frame; %ld skipped): render %.0f ms/frame (+ pose %.1f, upload %.1f), write %.0f "
+               "pmr: %ld frame(s) in %.2f s (%.2f s/frame; %ld skipped): render %.0f ms/frame (+ pose %.1f, upload "
+               "%.1f), write %.0f "
                "ms/frame on the writer thread (%s, %.1f MB/frame); CPU per frame: renderer%s %.0f ms, writer %.0f ms; "
                "total %.2f s\n",
                rendered_, loop_s_, loop_s_ / n, plan_.kept, 1000.0 * render_s_ / n, 1000.0 * pose_s_ / n,

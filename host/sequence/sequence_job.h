@@ -18,14 +18,14 @@ namespace pmr {
 
 struct SequenceJob {
   // inputs
-  std::string scene;                  // the glTF or GLB file
-  InputLimits input_limits;           // budgets and folder confinement (docs/SECURITY.md)
-  std::string environment_file;       // pbr: equirectangular radiance image; "" = uniform
+  std::string scene;             // the glTF or GLB file
+  InputLimits input_limits;      // budgets and folder confinement (docs/SECURITY.md)
+  std::string environment_file;  // pbr: equirectangular radiance image; "" = uniform
   double environment_rotation_deg = 0.0;
   // cameras, display, pipeline
   RigConfig rig;
   Display display;
-  std::string display_source;         // what the display came from (sidecar)
+  std::string display_source;                          // what the display came from (sidecar)
   std::optional<LookingGlassCalibration> calibration;  // a calibration file's values (sidecar)
   PipelineConfig pipeline;
   // products: which files per frame (FrameProducts), the quilt layout ("" = chosen), compression
@@ -35,11 +35,11 @@ struct SequenceJob {
   // frames: a --frames list or "all" (the animation's key range, or one turn of a turntable)
   std::string frames = "0";
   double fps = 24.0;
-  std::string animation;              // name, index, "all" or "none"; "" = the first animation
+  std::string animation;  // name, index, "all" or "none"; "" = the first animation
   bool turntable = false;
   double turntable_deg = 0.0;
   long turntable_frames = 0;
-  std::string shard;                  // "K/N" or "auto"; "" = every frame
+  std::string shard;  // "K/N" or "auto"; "" = every frame
   long shard_count = 0, shard_first = 0;
   bool resume = false, overwrite = false;
   bool quiet = false, verbose = false;

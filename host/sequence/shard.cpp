@@ -23,14 +23,16 @@ long env_long(const ProcessEnvironment& env, const char* name, bool& present) {
   long v = 0;
   const char* text = env(name);
   present = read_long(text, v);
-  if (text && *text && !present) throw Error(std::string("--shard auto: ") + name + "='" + text + "' is not a whole number");
+  if (text && *text && !present)
+    throw Error(std::string("--shard auto: ") + name + "='" + text + "' is not a whole number");
   return v;
 }
 
 Shard checked(long index, long count, const std::string& source) {
   if (count < 1) throw Error(source + ": the array has no tasks");
   if (index < 0 || index >= count)
-    throw Error(source + ": task " + std::to_string(index) + " is outside the array's " + std::to_string(count) + " task(s)");
+    throw Error(source + ": task " + std::to_string(index) + " is outside the array's " + std::to_string(count) +
+                " task(s)");
   return Shard{index, count, source};
 }
 
@@ -38,8 +40,8 @@ Shard checked(long index, long count, const std::string& source) {
 long position(long id, long first, long step, const std::string& source) {
   if (step < 1) throw Error(source + ": array step " + std::to_string(step) + " is not positive");
   if (id < first || (id - first) % step != 0)
-    throw Error(source + ": task id " + std::to_string(id) + " is not on the array's range (first " + std::to_string(first) +
-                ", step " + std::to_string(step) + ")");
+    throw Error(source + ": task id " + std::to_string(id) + " is not on the array's range (first " +
+                std::to_string(first) + ", step " + std::to_string(step) + ")");
   return (id - first) / step;
 }
 
@@ -120,8 +122,9 @@ Shard parse_shard(const std::string& text, long shard_count, long shard_first, c
                         false, src);
     }
   }
-  throw Error("--shard auto: no array job in the environment (none of SLURM_ARRAY_TASK_ID, JOB_COMPLETION_INDEX, "
-              "AWS_BATCH_JOB_ARRAY_INDEX, SGE_TASK_ID, LSB_JOBINDEX, PBS_ARRAY_INDEX, PBS_ARRAYID is set)");
+  throw Error(
+      "--shard auto: no array job in the environment (none of SLURM_ARRAY_TASK_ID, JOB_COMPLETION_INDEX, "
+      "AWS_BATCH_JOB_ARRAY_INDEX, SGE_TASK_ID, LSB_JOBINDEX, PBS_ARRAY_INDEX, PBS_ARRAYID is set)");
 }
 
 std::vector<long> shard_frames(const std::vector<long>& frames, const Shard& shard) {

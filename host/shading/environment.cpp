@@ -341,7 +341,7 @@ const std::vector<float>& split_sum_table() {
     hammersley();
     parallel_for_index(N, [&](int j) {
       for (int i = 0; i < N; ++i) {
-            const double s = double(i) / (N - 1);
+        const double s = double(i) / (N - 1);
         const glm::dvec2 ab = split_sum_integral(s * s, double(j) / (N - 1));
         t[size_t(2 * (j * N + i))] = float(ab.x);
         t[size_t(2 * (j * N + i) + 1)] = float(ab.y);
@@ -360,7 +360,8 @@ glm::dvec2 split_sum(double n_dot_v, double r) {
   const int i0 = std::min(int(x), N - 2), j0 = std::min(int(y), N - 2);
   const double fx = x - i0, fy = y - j0;
   auto at = [&](int i, int j) { return glm::dvec2(t[size_t(2 * (j * N + i))], t[size_t(2 * (j * N + i) + 1)]); };
-  return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i0 + 1, j0)) + fy * ((1 - fx) * at(i0, j0 + 1) + fx * at(i0 + 1, j0 + 1));
+  return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i0 + 1, j0)) +
+         fy * ((1 - fx) * at(i0, j0 + 1) + fx * at(i0 + 1, j0 + 1));
 }
 
 const std::vector<double>& environment_level_roughness() {
@@ -414,7 +415,8 @@ EnvironmentTables assemble(const std::vector<std::pair<glm::ivec2, std::vector<f
 }  // namespace
 
 Environment Environment::uniform(double radiance) {
-  if (!std::isfinite(radiance) || radiance < 0.0) throw Error("environment: the uniform radiance must be finite and >= 0");
+  if (!std::isfinite(radiance) || radiance < 0.0)
+    throw Error("environment: the uniform radiance must be finite and >= 0");
   std::vector<std::pair<glm::ivec2, std::vector<float>>> levels;
   const float v = float(radiance);
   for (int k = 0; k <= kPrefilteredLevels; ++k) levels.push_back({glm::ivec2(1, 1), {v, v, v, 0.0f}});

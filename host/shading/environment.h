@@ -104,9 +104,9 @@ constexpr double kEnvNegativeTolerance = 1e-2;
 void check_environment_image(EnvironmentImage& image, const std::string& name);
 
 struct EnvironmentOptions {
-  std::string file;           // empty: the uniform environment
-  double rotation_deg = 0.0;  // counter-clockwise seen from above
-  double intensity = 1.0;     // >= 0; 0 turns the environment off
+  std::string file;               // empty: the uniform environment
+  double rotation_deg = 0.0;      // counter-clockwise seen from above
+  double intensity = 1.0;         // >= 0; 0 turns the environment off
   double uniform_radiance = 0.2;  // the radiance of the uniform environment (DESIGN 4b: 0.2)
 };
 
@@ -125,10 +125,10 @@ class Environment {
 
   // Host-side evaluation from exactly the tables (as cl/environment.h samples them on the device),
   // intensity and rotation applied; directions need not be unit length (zero vectors read +Y).
-  glm::dvec3 radiance(const glm::dvec3& d) const;                // the map: P(d, 0)
-  glm::dvec3 irradiance(const glm::dvec3& n) const;              // I(n) = P(n, 1)
-  glm::dvec3 prefiltered(const glm::dvec3& d, double r) const;   // P(d, r), r clamped to [0, 1]
-  glm::dvec3 level_sample(int level, const glm::dvec3& d) const; // one level, bilinear
+  glm::dvec3 radiance(const glm::dvec3& d) const;                 // the map: P(d, 0)
+  glm::dvec3 irradiance(const glm::dvec3& n) const;               // I(n) = P(n, 1)
+  glm::dvec3 prefiltered(const glm::dvec3& d, double r) const;    // P(d, r), r clamped to [0, 1]
+  glm::dvec3 level_sample(int level, const glm::dvec3& d) const;  // one level, bilinear
 
   const EnvironmentTables& tables() const { return tables_; }
   double prefilter_seconds() const { return prefilter_seconds_; }  // wall time of from_image

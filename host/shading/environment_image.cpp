@@ -94,8 +94,8 @@ std::string check_hdr_data(const std::vector<unsigned char>& b, int& width, int&
     return "unsupported resolution line '" + t.substr(0, 40) + "' (only -Y H +X W, rows top to bottom)";
   if (w <= 0 || h <= 0) return "the image is empty (" + std::to_string(w) + "x" + std::to_string(h) + ")";
   if (uint64_t(w) * uint64_t(h) > kEnvMaxTexels || w > (1 << 24) || h > (1 << 24))
-    return "the image is too large (" + std::to_string(w) + "x" + std::to_string(h) + "); environments may have at most " +
-           std::to_string(kEnvMaxTexels) + " texels (8192x4096)";
+    return "the image is too large (" + std::to_string(w) + "x" + std::to_string(h) +
+           "); environments may have at most " + std::to_string(kEnvMaxTexels) + " texels (8192x4096)";
   width = int(w), height = int(h);
   const uint64_t flat_bytes = uint64_t(w) * uint64_t(h) * 4;
   auto truncated = [&](long row) {
@@ -189,7 +189,8 @@ struct ExrLayout {
 std::string check_exr_allocations(const std::string& path, uint64_t file_size, ExrLayout& layout) {
   std::ifstream in(path, std::ios::binary);
   unsigned char head[8];
-  if (!in.read(reinterpret_cast<char*>(head), 8) || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 || head[3] != 0x01)
+  if (!in.read(reinterpret_cast<char*>(head), 8) || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 ||
+      head[3] != 0x01)
     return "";
   const bool multipart = head[5] & 0x10;  // version flags, bit 12
   uint64_t pos = 8;
@@ -215,11 +216,14 @@ std::string check_exr_allocations(const std::string& path, uint64_t file_size, E
     in.seekg(std::streamoff(n), std::ios::cur);
     pos += n;
   };
-  static const std::pair<const char*, uint64_t> kFixed[] = {
-      {"box2i", 16}, {"box2f", 16}, {"chromaticities", 32}, {"compression", 1}, {"double", 8}, {"envmap", 1},
-      {"float", 4}, {"int", 4}, {"keycode", 28}, {"lineOrder", 1}, {"m33f", 36}, {"m33d", 72}, {"m44f", 64},
-      {"m44d", 128}, {"rational", 8}, {"tiledesc", 9}, {"timecode", 8}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16},
-      {"v3i", 12}, {"v3f", 12}, {"v3d", 24}, {"deepImageState", 1}};
+  static const std::pair<const char*, uint64_t> kFixed[] = {{"box2i", 16},      {"box2f", 16},   {"chromaticities", 32},
+                                                            {"compression", 1}, {"double", 8},   {"envmap", 1},
+                                                            {"float", 4},       {"int", 4},      {"keycode", 28},
+                                                            {"lineOrder", 1},   {"m33f", 36},    {"m33d", 72},
+                                                            {"m44f", 64},       {"m44d", 128},   {"rational", 8},
+                                                            {"tiledesc", 9},    {"timecode", 8}, {"v2i", 8},
+                                                            {"v2f", 8},         {"v2d", 16},     {"v3i", 12},
+                                                            {"v3f", 12},        {"v3d", 24},     {"deepImageState", 1}};
   for (;;) {  // attributes until an empty name; a multi-part file's headers end with an empty one
     std::string name, type;
     uint32_t size = 0;
@@ -243,7 +247,8 @@ std::string check_exr_allocations(const std::string& path, uint64_t file_size, E
       for (uint32_t& x : v)
         if (!read_u32(x)) return "";
       layout.has_window = true;
-      layout.min_x = int32_t(v[0]), layout.min_y = int32_t(v[1]), layout.max_x = int32_t(v[2]), layout.max_y = int32_t(v[3]);
+      layout.min_x = int32_t(v[0]), layout.min_y = int32_t(v[1]), layout.max_x = int32_t(v[2]),
+      layout.max_y = int32_t(v[3]);
       continue;
     }
     if (type == "compression" && name == "compression") {
@@ -320,8 +325,7 @@ EnvironmentImage read_exr(const std::string& path) {
     const size_t xs = 3 * sizeof(float), ys = size_t(w) * xs;
     const char* names[3] = {"R", "G", "B"};
     for (int c = 0; c < (rgb ? 3 : 1); ++c)
-      fb.insert(rgb ? names[c] : "Y",
-                Imf::Slice::Make(Imf::FLOAT, img.rgb.data() + c, dw, xs, ys));
+      fb.insert(rgb ? names[c] : "Y", Imf::Slice::Make(Imf::FLOAT, img.rgb.data() + c, dw, xs, ys));
     file.setFrameBuffer(fb);
     file.readPixels(dw.min.y, dw.max.y);
     if (gray)
@@ -353,9 +357,9 @@ void check_image(EnvironmentImage& img, const std::string& lead) {
     const size_t px = t / 3;
     char value[64];
     std::snprintf(value, sizeof value, "%g", double(img.rgb[t]));
-    throw Error(lead + "pixel (" + std::to_string(px % size_t(img.width)) + ", " + std::to_string(px / size_t(img.width)) +
-                ") (column, row from the top-left) has " + what + channel[t % 3] + " = " + value +
-                "; radiance must be finite and >= 0");
+    throw Error(lead + "pixel (" + std::to_string(px % size_t(img.width)) + ", " +
+                std::to_string(px / size_t(img.width)) + ") (column, row from the top-left) has " + what +
+                channel[t % 3] + " = " + value + "; radiance must be finite and >= 0");
   };
   double sum = 0.0;
   for (size_t t = 0; t < img.rgb.size(); ++t) {
@@ -382,12 +386,9 @@ EnvironmentImage load_environment_image(const std::string& path) {
   if (path.empty()) throw Error("cannot read environment: no file name given");
   const std::string ext = lower_extension(path);
   EnvironmentImage img;
-  if (ext == ".hdr")
-    img = read_hdr(path);
-  else if (ext == ".exr")
-    img = read_exr(path);
-  else
-    fail(path, "unknown extension '" + printable(ext.substr(0, 16)) + "' (an environment is a .hdr or .exr file)");
+  if (ext == ".hdr") img = read_hdr(path);
+  else if (ext == ".exr") img = read_exr(path);
+  else fail(path, "unknown extension '" + printable(ext.substr(0, 16)) + "' (an environment is a .hdr or .exr file)");
   check_image(img, "cannot read environment " + printable(path) + ": ");
   return img;
 }

@@ -29,7 +29,7 @@ std::vector<SceneLight> resolve_lights(const std::vector<SceneLight>& scene_ligh
 
 PmrLight device_light(const SceneLight& light) {
   PmrLight d{};
-  d.type = light.type == SceneLightType::Point ? PMR_LIGHT_POINT
+  d.type = light.type == SceneLightType::Point  ? PMR_LIGHT_POINT
            : light.type == SceneLightType::Spot ? PMR_LIGHT_SPOT
                                                 : PMR_LIGHT_DIRECTIONAL;
   for (int c = 0; c < 3; ++c) {

@@ -45,8 +45,8 @@ Display display_from_calibration(const LookingGlassCalibration& c);
 struct DisplayPreset {
   std::string name, description;
   Display display;
-  RigConfig rig;       // views, view raster, cone, yfov as the maker recommends
-  std::string quilt;   // the maker's quilt layout "CxR"
+  RigConfig rig;      // views, view raster, cone, yfov as the maker recommends
+  std::string quilt;  // the maker's quilt layout "CxR"
   // The default --sampling: subpixel where it measured at least twice as accurate for at most 1.5x the
   // time of view sampling (docs/SAMPLING.md).
   bool subpixel_sampling = false;

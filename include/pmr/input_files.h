@@ -16,12 +16,12 @@ struct InputLimits {
   bool allow_outside_scene_folder = false;      // --allow-outside-scene-folder
   // The budgets of docs/SECURITY.md beyond the files: each is checked before the allocation or the
   // work it bounds, against counts that every reference (instance, morph target, sampler) adds to.
-  uint64_t vertex_data = uint64_t(64) << 30;        // "vertex-data": bytes of decoded vertex data
-  uint64_t animation_data = uint64_t(256) << 20;    // "animation-data": bytes of decoded animation keys
-  uint64_t json_bytes = uint64_t(32) << 20;         // "json-bytes": bytes of a scene's JSON text
-  uint64_t framing_work = uint64_t(1) << 34;        // "framing-work": vertex-poses the framing may pose
-  uint64_t tile_queue = uint64_t(1) << 30;          // "tile-queue": tile-queue entries of one frame
-  uint64_t memory = 0;                              // "memory": bytes; 0 = automatic (memory_budget.h)
+  uint64_t vertex_data = uint64_t(64) << 30;      // "vertex-data": bytes of decoded vertex data
+  uint64_t animation_data = uint64_t(256) << 20;  // "animation-data": bytes of decoded animation keys
+  uint64_t json_bytes = uint64_t(32) << 20;       // "json-bytes": bytes of a scene's JSON text
+  uint64_t framing_work = uint64_t(1) << 34;      // "framing-work": vertex-poses the framing may pose
+  uint64_t tile_queue = uint64_t(1) << 30;        // "tile-queue": tile-queue entries of one frame
+  uint64_t memory = 0;                            // "memory": bytes; 0 = automatic (memory_budget.h)
 };
 
 // Parses --limit's value into `limits`: KEY=VALUE pairs separated by commas, VALUE a positive integer

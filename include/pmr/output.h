@@ -64,12 +64,12 @@ void write_text_atomic(const std::string& path, const std::string& text);
 enum class ExrImage { Encoded, Views, Quilt };
 struct ExrMetadata {
   long frame = 0;
-  double time = 0.0;        // seconds: frame / fps, as the sidecar records it
+  double time = 0.0;  // seconds: frame / fps, as the sidecar records it
   double fps = 24.0;
-  std::string sidecar;      // the sidecar's file name (in the same folder)
-  Rig rig;                  // this frame's rig (an animated camera moves it)
-  int center_view = 0;      // the view whose matrices the encoded image and the quilt carry
-  QuiltLayout quilt;        // the quilt's layout (its worldToNDC lands in the center view's tile)
+  std::string sidecar;  // the sidecar's file name (in the same folder)
+  Rig rig;              // this frame's rig (an animated camera moves it)
+  int center_view = 0;  // the view whose matrices the encoded image and the quilt carry
+  QuiltLayout quilt;    // the quilt's layout (its worldToNDC lands in the center view's tile)
 };
 
 // Half RGBA EXR (scanline, one part), row 0 at the top (data window (0,0)-(width-1,height-1)).
@@ -80,11 +80,10 @@ struct ExrMetadata {
 // an image of kind `image` (Encoded or Quilt). subpixel_alpha (optional, [y][x][3] halves) adds the
 // half channels AR, AG, AB: OpenEXR's per-channel alpha, each colour channel's own coverage (the
 // encoded image: each subpixel's; docs/OUTPUTS.md).
-void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half,
-                    ExrCompression c, int threads = 0, const float* depth = nullptr, float pixel_aspect = 1.0f,
+void write_rgba_exr(const std::string& path, int width, int height, const uint16_t* rgba_half, ExrCompression c,
+                    int threads = 0, const float* depth = nullptr, float pixel_aspect = 1.0f,
                     const ExrMetadata* meta = nullptr, ExrImage image = ExrImage::Encoded,
                     const uint16_t* subpixel_alpha = nullptr);
-
 
 // The name of part i of a views file with `views` parts: view_000, view_001, ... with 3 digits, or as
 // many as views - 1 needs (view_0000 .. view_1000 for 1001 views) so names sort in view order.
@@ -118,8 +117,8 @@ void read_rgba_exr(const std::string& path, int& width, int& height, std::vector
 std::vector<std::string> read_exr_part_names(const std::string& path);
 // Pixels of part `part` (0-based). If depth != nullptr it receives the part's "Z" channel as floats
 // ([y][x]), or is cleared if the part has no "Z" channel.
-void read_views_exr_part(const std::string& path, int part, int& width, int& height,
-                         std::vector<uint16_t>& rgba_half, std::vector<float>* depth = nullptr);
+void read_views_exr_part(const std::string& path, int part, int& width, int& height, std::vector<uint16_t>& rgba_half,
+                         std::vector<float>* depth = nullptr);
 
 // An 8-bit sRGB PNG for a person to look at: the linear half RGBA values (row 0 at the top) encoded with
 // the sRGB transfer curve, clamped to [0, 1] and rounded; alpha linear. Written atomically, fast deflate
@@ -149,37 +148,37 @@ struct OutputChecksum {
 
 // What the sidecar records besides the rig and the display.
 struct SidecarInfo {
-  std::string scene;            // the scene file as given (empty = the bundled default scene)
+  std::string scene;  // the scene file as given (empty = the bundled default scene)
   int frame = 0;
-  std::string method = "pmr";   // "pmr" or the baseline's name
-  std::string sampling = "view";  // "view" or "subpixel" (docs/SAMPLING.md)
+  std::string method = "pmr";       // "pmr" or the baseline's name
+  std::string sampling = "view";    // "view" or "subpixel" (docs/SAMPLING.md)
   std::string shading = "lambert";  // "lambert" or "pbr" (docs/SHADING.md)
   double exposure_ev = 0.0;
   double environment_intensity = 1.0;  // pbr: scales the uniform environment
   std::vector<SceneLight> lights;      // pbr: the frame's lights as used (FrameRenderer::Frame::lights)
   int tile_x = 16, tile_y = 2, tile_v = 16;
-  int camera = -1;              // glTF camera index, -1 = the default framing of the bounding sphere
-  bool has_bounds = false;      // world bounds of the scene the default framing used
+  int camera = -1;          // glTF camera index, -1 = the default framing of the bounding sphere
+  bool has_bounds = false;  // world bounds of the scene the default framing used
   glm::dvec3 bounds_lo{0.0}, bounds_hi{0.0};
-  std::string compression;      // EXR compression of the images ("" = not recorded)
+  std::string compression;  // EXR compression of the images ("" = not recorded)
   // Files written for this frame, as (kind, file name) pairs, e.g. {"encoded", "frame_0000.exr"}.
   std::vector<std::pair<std::string, std::string>> outputs;
   std::vector<OutputChecksum> output_checksums;  // of the written outputs (the sidecar is written last)
-  std::vector<std::string> warnings;   // e.g. "near plane raised ..."
+  std::vector<std::string> warnings;             // e.g. "near plane raised ..."
   // The frame's place in a sequence (DESIGN section 7), so any frame can be reproduced alone.
-  double time = 0.0;                   // seconds: frame / fps
+  double time = 0.0;  // seconds: frame / fps
   double fps = 24.0;
-  int animation = -1;                  // glTF animation index, -1 none, -2 all
-  std::string animation_name;          // its name ("all" for every animation)
+  int animation = -1;          // glTF animation index, -1 none, -2 all
+  std::string animation_name;  // its name ("all" for every animation)
   bool turntable = false;
-  double turntable_deg = 0.0;          // DEG:FRAMES as requested
+  double turntable_deg = 0.0;  // DEG:FRAMES as requested
   long turntable_frames = 0;
-  double turntable_angle = 0.0;        // this frame's angle, degrees
-  glm::dvec3 pivot{0.0};               // the turntable axis passes through it (along +Y)
-  int quilt_columns = 0, quilt_rows = 0;  // of the quilt output (0: none)
-  int center_view = -1;                // the view of the center preview (-1: none)
-  bool depth = false;                  // Z channels in the views / quilt files
-  std::string display_source;          // "preset NAME" or "calibration FILE"
+  double turntable_angle = 0.0;                             // this frame's angle, degrees
+  glm::dvec3 pivot{0.0};                                    // the turntable axis passes through it (along +Y)
+  int quilt_columns = 0, quilt_rows = 0;                    // of the quilt output (0: none)
+  int center_view = -1;                                     // the view of the center preview (-1: none)
+  bool depth = false;                                       // Z channels in the views / quilt files
+  std::string display_source;                               // "preset NAME" or "calibration FILE"
   std::vector<std::pair<std::string, double>> calibration;  // the calibration file's values, as read
   std::string calibration_serial;
   // Checksums of what the render read (output/checksum.h; "" = not recorded): the scene file, every
@@ -193,7 +192,7 @@ struct SidecarInfo {
   std::string environment_file, environment_checksum;
   double environment_rotation_deg = 0.0;
   bool allow_outside_scene_folder = false;  // --allow-outside-scene-folder: recorded only when given
-  std::vector<double> background;     // --background as linear R, G, B, A; empty: transparent (not recorded)
+  std::vector<double> background;           // --background as linear R, G, B, A; empty: transparent (not recorded)
 };
 
 // The sidecar's JSON text (pretty printed, doubles with round-trip precision).

@@ -23,12 +23,12 @@ std::string to_string(const Rational& r);
 Rational default_offset(const Rational& lens_pitch, int views);
 
 struct Display {
-  int width = 7680, height = 4320;   // pixels
+  int width = 7680, height = 4320;  // pixels
   double size_w_cm = 166.0, size_h_cm = 93.0, viewing_distance_cm = 200.0;
-  Rational lens_pitch{16, 1};        // L, in subpixels
-  Rational tan_slant{1, 18};         // tan(alpha)
-  Rational offset{-1, 12};           // subpixels
-  bool reversed = false;             // v -> N - 1 - v
+  Rational lens_pitch{16, 1};  // L, in subpixels
+  Rational tan_slant{1, 18};   // tan(alpha)
+  Rational offset{-1, 12};     // subpixels
+  bool reversed = false;       // v -> N - 1 - v
   // Extensions for real panels (docs/DISPLAYS.md): the Looking Glass shader takes its view from
   // 1 - frac(t), i.e. from frac(-t) (phase_sign -1), and on BGR panels (or a flipped image) subpixel k
   // of pixel j sits at phase position 3j + 2 - k instead of 3j + k (subpixel_bgr). The position each
@@ -44,7 +44,7 @@ struct Display {
   // (exact numerators over a common denominator, so the encoder stays exact).
   int cell_rows = 1;
   std::vector<int64_t> cell_offsets;
-  bool bilinear = false;             // sample views bilinearly instead of nearest
+  bool bilinear = false;  // sample views bilinearly instead of nearest
   double aspect() const { return size_w_cm / size_h_cm; }
 };
 
@@ -52,8 +52,8 @@ struct RigConfig {
   int views = 96;
   int view_w = 1024, view_h = 512;
   double cone_deg = 80.0;
-  double yfov_deg = 0.0;   // 0 = from the display: 2 atan(size_h / 2 / viewing_distance)
-  int camera = -1;         // glTF camera index, -1 = frame the scene's bounding sphere
+  double yfov_deg = 0.0;  // 0 = from the display: 2 atan(size_h / 2 / viewing_distance)
+  int camera = -1;        // glTF camera index, -1 = frame the scene's bounding sphere
   // Camera spacing along the baseline: linear (DESIGN section 2, PMR's evenly spaced views) or
   // angular as Looking Glass software places them, D tan(cone ((i + 1/2) / N - 1/2)), each camera
   // moved onto a fixed-point view coordinate (make_rig).
@@ -66,34 +66,34 @@ struct RigConfig {
 // The resolved rig of one frame.
 struct Rig {
   int views = 0, view_w = 0, view_h = 0;
-  double yfov = 0, cone = 0;      // radians
-  double aspect = 0;              // display physical aspect A
-  double focal = 0;               // D
-  double near = 0, far = 0;       // the planes as requested (default or camera)
-  double near_eff = 0;            // near raised (if needed) to keep disparity inside the guard band
-  bool angular = false;           // camera spacing (RigConfig::angular_spacing)
-  glm::dmat4 center_view{1.0};    // world -> center view space
-  double zoom = 1.0;              // RigConfig::zoom (1 with a glTF camera)
+  double yfov = 0, cone = 0;    // radians
+  double aspect = 0;            // display physical aspect A
+  double focal = 0;             // D
+  double near = 0, far = 0;     // the planes as requested (default or camera)
+  double near_eff = 0;          // near raised (if needed) to keep disparity inside the guard band
+  bool angular = false;         // camera spacing (RigConfig::angular_spacing)
+  glm::dmat4 center_view{1.0};  // world -> center view space
+  double zoom = 1.0;            // RigConfig::zoom (1 with a glTF camera)
 
   // Angular spacing's view-coordinate resolution Q (1 with linear spacing): camera i sits at
   // view_coord(i) / Q view spacings B / (N - 1) from the center camera (make_rig chooses Q).
   int spacing_q = 1;
 
-  double baseline() const;                    // B = 2 D tan(theta / 2)
-  double camera_offset(int i) const;          // s_i (linear, or angular as quantized: the cameras rendered)
+  double baseline() const;            // B = 2 D tan(theta / 2)
+  double camera_offset(int i) const;  // s_i (linear, or angular as quantized: the cameras rendered)
   // Angular spacing's exact Looking Glass offset D tan(theta ((i + 1/2) / N - 1/2)), before quantization.
   double angular_offset(int i) const;
   // The integer view coordinate F_i of view i (pmr/shared.h): i with linear spacing, round(Q g_i) with
   // angular spacing, g_i = angular_offset(i) / B * (N - 1). x_i = x_0 + F_i d in every kernel.
   int view_coord(int i) const;
-  double view_anchor() const;                 // camera offset at view coordinate 0 over B: -1/2 or 0
-  double view_scale() const;                  // view coordinate units per baseline: (N - 1) Q
-  glm::dmat4 view_matrix(int i) const;        // V_i = T(-s_i, 0, 0) V
-  glm::dmat4 projection(int i) const;         // glFrustum(l_i, r_i, b, t, near_eff, far)
-  double disparity_k() const;                 // W tan(theta/2) / (A tan(phi/2))
-  double disparity_px(double w) const;        // Delta(w) = disparity_k * (1 - D / w)
-  glm::dvec3 light_view() const;              // normalize(0.3, 0.5, 1.0)
-  glm::dvec3 light_world() const;             // the same direction in world space
+  double view_anchor() const;           // camera offset at view coordinate 0 over B: -1/2 or 0
+  double view_scale() const;            // view coordinate units per baseline: (N - 1) Q
+  glm::dmat4 view_matrix(int i) const;  // V_i = T(-s_i, 0, 0) V
+  glm::dmat4 projection(int i) const;   // glFrustum(l_i, r_i, b, t, near_eff, far)
+  double disparity_k() const;           // W tan(theta/2) / (A tan(phi/2))
+  double disparity_px(double w) const;  // Delta(w) = disparity_k * (1 - D / w)
+  glm::dvec3 light_view() const;        // normalize(0.3, 0.5, 1.0)
+  glm::dvec3 light_world() const;       // the same direction in world space
 };
 
 // Angular spacing: the largest distance between a camera and its exact Looking Glass position, in view
@@ -109,9 +109,9 @@ constexpr double kSpacingErrorPx = 0.01;
 
 // Builds the rig for a scene whose world bounds are [lo, hi]. `camera_pose` (world_from_camera) and
 // `camera_yfov` are used when config.camera >= 0. Throws pmr::Error on an impossible configuration.
-Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo,
-             const glm::dvec3& hi, const glm::dmat4* camera_pose = nullptr,
-             double camera_yfov = 0.0, std::vector<std::string>* warnings = nullptr);
+Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo, const glm::dvec3& hi,
+             const glm::dmat4* camera_pose = nullptr, double camera_yfov = 0.0,
+             std::vector<std::string>* warnings = nullptr);
 
 // Frame parameters for the kernels (tile grid and capacities are filled in by the pipeline).
 PmrParams make_params(const Rig& rig);

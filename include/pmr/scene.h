@@ -21,7 +21,7 @@ struct SceneTexture {
   int width = 0, height = 0;
   std::vector<uint8_t> rgba;  // width * height * 4 bytes as stored in the image, row 0 = top of image
   int wrap_s = PMR_WRAP_REPEAT, wrap_t = PMR_WRAP_REPEAT;
-  uint32_t slots = 0;         // bit (1 << SceneTextureSlotKind) for each kind of slot that samples it
+  uint32_t slots = 0;  // bit (1 << SceneTextureSlotKind) for each kind of slot that samples it
 };
 
 // The texture slots of a glTF metallic-roughness material (DESIGN section 4b), in this order.
@@ -44,20 +44,20 @@ struct SceneTextureSlot {
   bool srgb = false;       // true for base colour and emissive
   bool transform = false;  // KHR_texture_transform present (else the identity)
   float offset[2] = {0.0f, 0.0f};
-  float rotation = 0.0f;   // radians
+  float rotation = 0.0f;  // radians
   float scale[2] = {1.0f, 1.0f};
 };
 
 // Everything of a glTF material the physically based model reads (DESIGN 4b), beside the PmrMaterial
 // the Lambert model reads (base colour factor, alpha mode and cutoff, sidedness stay there).
 struct SceneMaterialInputs {
-  std::string name;                      // as in the file ("" when unnamed or the default material)
-  float metallic = 1.0f, roughness = 1.0f;  // metallicFactor, roughnessFactor (validated to [0, 1])
-  float normal_scale = 1.0f;             // normalTexture.scale
-  float occlusion_strength = 1.0f;       // occlusionTexture.strength (validated to [0, 1])
-  float emissive[3] = {0.0f, 0.0f, 0.0f};  // emissiveFactor (linear)
-  float emissive_strength = 1.0f;        // KHR_materials_emissive_strength (1 without it)
-  bool unlit = false;                    // KHR_materials_unlit
+  std::string name;                                   // as in the file ("" when unnamed or the default material)
+  float metallic = 1.0f, roughness = 1.0f;            // metallicFactor, roughnessFactor (validated to [0, 1])
+  float normal_scale = 1.0f;                          // normalTexture.scale
+  float occlusion_strength = 1.0f;                    // occlusionTexture.strength (validated to [0, 1])
+  float emissive[3] = {0.0f, 0.0f, 0.0f};             // emissiveFactor (linear)
+  float emissive_strength = 1.0f;                     // KHR_materials_emissive_strength (1 without it)
+  bool unlit = false;                                 // KHR_materials_unlit
   std::array<SceneTextureSlot, kTextureSlots> slots;  // indexed by SceneTextureSlotKind
   std::vector<std::string> unimplemented;  // material extensions present but not drawn (warned once per scene)
 };
@@ -67,17 +67,17 @@ struct SceneMaterialInputs {
 // animation and the turntable.
 enum class SceneLightType { Directional, Point, Spot };
 struct SceneLight {
-  std::string name;            // the light's name in the file
-  int light = 0;               // index into the file's KHR_lights_punctual lights
-  int node = 0;                // the node that places it
-  std::string node_name;       // that node's name in the file
+  std::string name;       // the light's name in the file
+  int light = 0;          // index into the file's KHR_lights_punctual lights
+  int node = 0;           // the node that places it
+  std::string node_name;  // that node's name in the file
   SceneLightType type = SceneLightType::Directional;
-  float color[3] = {1.0f, 1.0f, 1.0f};  // linear
-  float intensity = 1.0f;      // directional: lux; point and spot: candela
-  float range = 0.0f;          // 0 = not given (no window); point and spot only
+  float color[3] = {1.0f, 1.0f, 1.0f};                  // linear
+  float intensity = 1.0f;                               // directional: lux; point and spot: candela
+  float range = 0.0f;                                   // 0 = not given (no window); point and spot only
   float inner_cone = 0.0f, outer_cone = 0.7853981634f;  // spot: radians, 0 <= inner < outer <= pi / 2
-  glm::dvec3 position{0.0};    // the node's origin
-  glm::dvec3 direction{0.0, 0.0, -1.0};  // unit, the node's -Z: where the light shines
+  glm::dvec3 position{0.0};                             // the node's origin
+  glm::dvec3 direction{0.0, 0.0, -1.0};                 // unit, the node's -Z: where the light shines
 };
 
 // A glTF camera, placed by the first node (in scene traversal order) that uses it. Cameras that no
@@ -87,10 +87,10 @@ struct SceneCamera {
   glm::dmat4 world_from_camera{1.0};  // the node's world matrix (camera looks along its -Z)
   double yfov = 0.0;                  // radians
   double znear = 0.0;
-  double zfar = 0.0;                  // 0 = infinite
-  double aspect = 0.0;                // 0 = not given
-  bool perspective = true;            // orthographic cameras are listed but cannot drive the rig
-  bool placed = false;                // true: a node of the scene places it (world_from_camera valid)
+  double zfar = 0.0;        // 0 = infinite
+  double aspect = 0.0;      // 0 = not given
+  bool perspective = true;  // orthographic cameras are listed but cannot drive the rig
+  bool placed = false;      // true: a node of the scene places it (world_from_camera valid)
 };
 
 struct SceneMotion;  // node hierarchy, clips, skins, moving instances (host/scene/motion.h)
@@ -105,10 +105,10 @@ struct SceneAnimation {
 // What the file holds beyond the flattened arrays, for `pmr info SCENE`.
 struct SceneStructure {
   size_t nodes = 0, meshes = 0, mesh_instances = 0, primitives = 0;
-  std::vector<size_t> skin_joints;                    // per skin: its joint count
-  std::vector<std::pair<int, size_t>> morph_meshes;   // (mesh index, morph target count) per mesh with targets
-  std::string generator;                              // asset.generator
-  size_t generated_tangent_primitives = 0;            // primitives with a normal texture and no TANGENT
+  std::vector<size_t> skin_joints;                   // per skin: its joint count
+  std::vector<std::pair<int, size_t>> morph_meshes;  // (mesh index, morph target count) per mesh with targets
+  std::string generator;                             // asset.generator
+  size_t generated_tangent_primitives = 0;           // primitives with a normal texture and no TANGENT
 };
 
 // A file the loader read besides the scene file itself (an external buffer or a decoded image), with
@@ -138,9 +138,9 @@ struct Scene {
   std::vector<SceneMaterialInputs> material_inputs;
   std::vector<std::vector<glm::vec2>> texcoords;
   std::vector<glm::vec4> tangents;
-  std::vector<SceneLight> lights;         // KHR_lights_punctual, in scene traversal order
-  std::vector<SceneCamera> cameras;       // one per glTF camera, same order (see SceneCamera::placed)
-  std::vector<std::string> warnings;      // non-fatal problems, one line each
+  std::vector<SceneLight> lights;     // KHR_lights_punctual, in scene traversal order
+  std::vector<SceneCamera> cameras;   // one per glTF camera, same order (see SceneCamera::placed)
+  std::vector<std::string> warnings;  // non-fatal problems, one line each
   // The arrays above hold the rest pose: no animation applied, default morph weights, skins bound to
   // their skeleton's rest transforms. pose_scene() places a frame.
   std::vector<SceneAnimation> animations;
@@ -158,10 +158,10 @@ constexpr int kNoAnimation = -1, kAllAnimations = -2;
 
 // One frame's pose (DESIGN section 7).
 struct PoseRequest {
-  double time = 0.0;                // seconds
-  int animation = kNoAnimation;     // index into Scene::animations, kNoAnimation or kAllAnimations
-  bool turntable = false;           // turn the geometry by turntable_deg about +Y through pivot
-  double turntable_deg = 0.0;       // counter-clockwise seen from above (right-hand rule about +Y)
+  double time = 0.0;             // seconds
+  int animation = kNoAnimation;  // index into Scene::animations, kNoAnimation or kAllAnimations
+  bool turntable = false;        // turn the geometry by turntable_deg about +Y through pivot
+  double turntable_deg = 0.0;    // counter-clockwise seen from above (right-hand rule about +Y)
   glm::dvec3 pivot{0.0};
 };
 

@@ -69,15 +69,15 @@ typedef uint32_t pmr_u32;
 #define PMR_NO_KEY 0xffffffffu
 
 /* Outcode bits of a vertex, computed once per vertex in clip space of the center camera. */
-#define PMR_CLIP_NEAR   (1u << 0)   /* w < near_eff              */
-#define PMR_CLIP_FAR    (1u << 1)   /* w > far                   */
-#define PMR_CLIP_GUARD  (0x3fu << 2) /* outside one of 6 guard-band planes (x in views 0 and N-1, y) */
-#define PMR_CULL_LEFT   (1u << 8)   /* left of every view's frustum  */
-#define PMR_CULL_RIGHT  (1u << 9)
+#define PMR_CLIP_NEAR (1u << 0)     /* w < near_eff              */
+#define PMR_CLIP_FAR (1u << 1)      /* w > far                   */
+#define PMR_CLIP_GUARD (0x3fu << 2) /* outside one of 6 guard-band planes (x in views 0 and N-1, y) */
+#define PMR_CULL_LEFT (1u << 8)     /* left of every view's frustum  */
+#define PMR_CULL_RIGHT (1u << 9)
 #define PMR_CULL_BOTTOM (1u << 10)
-#define PMR_CULL_TOP    (1u << 11)
-#define PMR_CULL_NEAR   (1u << 12)  /* same as PMR_CLIP_NEAR, kept in the cull set */
-#define PMR_CULL_FAR    (1u << 13)
+#define PMR_CULL_TOP (1u << 11)
+#define PMR_CULL_NEAR (1u << 12) /* same as PMR_CLIP_NEAR, kept in the cull set */
+#define PMR_CULL_FAR (1u << 13)
 
 /* Display pixels one encoder work-item handles (amortizes the device's per-work-item cost). */
 #define PMR_ENCODE_RUN 16
@@ -93,8 +93,8 @@ typedef uint32_t pmr_u32;
 #define PMR_WRAP_MIRROR 33648
 
 /* Mta.flags */
-#define PMR_MTA_BACK 1u   /* back-facing in its view range (double-sided): shading flips the normal */
-#define PMR_MTA_MASK 2u   /* material uses alphaMode MASK: visibility must evaluate alpha */
+#define PMR_MTA_BACK 1u /* back-facing in its view range (double-sided): shading flips the normal */
+#define PMR_MTA_MASK 2u /* material uses alphaMode MASK: visibility must evaluate alpha */
 
 /* PmrParams.setup_mode: one MTA per orientation range (PMR), or one single-view MTA per view
  * (the geometry-duplication baseline). */
@@ -122,78 +122,78 @@ typedef uint32_t pmr_u32;
 
 /* Frame parameters, one copy per frame, read by every stage. Producer: host/pipeline. */
 typedef struct {
-  double view[16];        /* center camera view matrix, column-major (world -> center view space) */
-  double ndc_scale_x;     /* x_ndc(center) = ndc_scale_x * x_view / w, = D / a              */
-  double ndc_scale_y;     /* y_ndc = ndc_scale_y * y_view / w, = 1 / tan(phi / 2)           */
-  double disparity_k;     /* Delta(w) = disparity_k * (1 - D / w), px; = W tan(theta/2) / (A tan(phi/2)) */
-  double focal;           /* D, focal (zero-parallax) distance                              */
-  double near_eff;        /* near plane actually used (>= user near, see rig.cpp)           */
-  double far;             /* far plane                                                      */
-  double guard_ndc_x;     /* guard band half-width in NDC x: PMR_GUARD_PX / (W / 2)         */
-  double guard_ndc_y;     /* guard band half-height in NDC y                                */
-  double ndc_offset_x;    /* added to x_ndc: s_i / a for a multipass view, 0 for PMR        */
-  float light_world[4];   /* unit vector toward the light, world space (xyz, w unused)      */
-  pmr_i32 view_w, view_h; /* view raster size (px)                                          */
-  pmr_i32 views;          /* N                                                              */
+  double view[16];                   /* center camera view matrix, column-major (world -> center view space) */
+  double ndc_scale_x;                /* x_ndc(center) = ndc_scale_x * x_view / w, = D / a              */
+  double ndc_scale_y;                /* y_ndc = ndc_scale_y * y_view / w, = 1 / tan(phi / 2)           */
+  double disparity_k;                /* Delta(w) = disparity_k * (1 - D / w), px; = W tan(theta/2) / (A tan(phi/2)) */
+  double focal;                      /* D, focal (zero-parallax) distance                              */
+  double near_eff;                   /* near plane actually used (>= user near, see rig.cpp)           */
+  double far;                        /* far plane                                                      */
+  double guard_ndc_x;                /* guard band half-width in NDC x: PMR_GUARD_PX / (W / 2)         */
+  double guard_ndc_y;                /* guard band half-height in NDC y                                */
+  double ndc_offset_x;               /* added to x_ndc: s_i / a for a multipass view, 0 for PMR        */
+  float light_world[4];              /* unit vector toward the light, world space (xyz, w unused)      */
+  pmr_i32 view_w, view_h;            /* view raster size (px)                                          */
+  pmr_i32 views;                     /* N                                                              */
   pmr_i32 tiles_x, tiles_y, tiles_v; /* tile grid size                                      */
   pmr_u32 num_vertices, num_triangles;
-  pmr_u32 mta_capacity;   /* size of the MTA queue; setup counts past it and stops writing   */
-  pmr_u32 debug_outputs;  /* 1: fine raster writes per-voxel key, depth and coverage count   */
-  pmr_u32 view_base;      /* volume slice of local view 0 (multipass renders one view a pass) */
-  pmr_u32 setup_mode;     /* PMR_SETUP_MTA or PMR_SETUP_DUPLICATE                            */
-  pmr_u32 sample_area;    /* PMR_SAMPLES_CENTER or PMR_SAMPLES_PIXEL                          */
-  pmr_u32 shading;        /* PMR_SHADING_LAMBERT or PMR_SHADING_PBR                           */
-  float exposure;         /* 2^EV: scales the colour of either model                          */
-  float env_radiance;     /* pbr: radiance of the uniform default environment (0.2 x intensity) */
-  pmr_u32 num_lights;     /* pbr: entries of the light table (PmrLight), the kernels' last argument */
+  pmr_u32 mta_capacity;  /* size of the MTA queue; setup counts past it and stops writing   */
+  pmr_u32 debug_outputs; /* 1: fine raster writes per-voxel key, depth and coverage count   */
+  pmr_u32 view_base;     /* volume slice of local view 0 (multipass renders one view a pass) */
+  pmr_u32 setup_mode;    /* PMR_SETUP_MTA or PMR_SETUP_DUPLICATE                            */
+  pmr_u32 sample_area;   /* PMR_SAMPLES_CENTER or PMR_SAMPLES_PIXEL                          */
+  pmr_u32 shading;       /* PMR_SHADING_LAMBERT or PMR_SHADING_PBR                           */
+  float exposure;        /* 2^EV: scales the colour of either model                          */
+  float env_radiance;    /* pbr: radiance of the uniform default environment (0.2 x intensity) */
+  pmr_u32 num_lights;    /* pbr: entries of the light table (PmrLight), the kernels' last argument */
   pmr_u32 pad_params;
-  double view_anchor;     /* camera offset at view coordinate 0 over the baseline: -1/2 linear, 0 angular */
-  double view_scale;      /* view coordinate units per baseline: N - 1 linear, Q (N - 1) angular */
+  double view_anchor; /* camera offset at view coordinate 0 over the baseline: -1/2 linear, 0 angular */
+  double view_scale;  /* view coordinate units per baseline: N - 1 linear, Q (N - 1) angular */
   pmr_i32 view_coord[PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK]; /* F_i, strictly increasing in i (a
                              multipass pass: its one view at 0) */
 } PmrParams;
 
 /* Vertex-stage output, one per scene vertex. Producer: cl/vertex.cl. */
 typedef struct {
-  double pos_view[3];     /* position in center-camera view space (used by the clipper)      */
+  double pos_view[3]; /* position in center-camera view space (used by the clipper)      */
   double pad;
-  pmr_i32 x0;             /* snapped raster x at view coordinate 0, 16.16 (view 0 if linear)  */
-  pmr_i32 dx;             /* snapped disparity per view coordinate, 16.16: x_i = x0 + F_i dx  */
-  pmr_i32 y;              /* snapped raster y, 24.8                                          */
-  pmr_u32 outcode;        /* PMR_CLIP_* | PMR_CULL_* bits                                    */
-  float z;                /* window depth in [0, 1] (glFrustum depth mapped from NDC)         */
-  float inv_w;            /* 1 / w_clip                                                      */
+  pmr_i32 x0;      /* snapped raster x at view coordinate 0, 16.16 (view 0 if linear)  */
+  pmr_i32 dx;      /* snapped disparity per view coordinate, 16.16: x_i = x0 + F_i dx  */
+  pmr_i32 y;       /* snapped raster y, 24.8                                          */
+  pmr_u32 outcode; /* PMR_CLIP_* | PMR_CULL_* bits                                    */
+  float z;         /* window depth in [0, 1] (glFrustum depth mapped from NDC)         */
+  float inv_w;     /* 1 / w_clip                                                      */
   float pad1, pad2;
 } PmrVertex;
 
 /* Multi-view triangle: one (possibly clipped) triangle over a contiguous view range with constant
  * orientation. Producer: cl/setup.cl. Consumers: cl/bin.cl, cl/fine.cl. */
 typedef struct {
-  pmr_i32 x0[3];          /* vertex raster x at view coordinate 0, 16.16                     */
-  pmr_i32 dx[3];          /* disparity per view coordinate, 16.16                            */
-  pmr_i32 y[3];           /* raster y, 24.8                                                  */
-  float z[3];             /* window depth                                                    */
-  float inv_w[3];         /* 1 / w                                                           */
-  float bary[3][2];       /* each vertex's barycentrics (b1, b2) in the source triangle        */
-  pmr_u32 tri;            /* source triangle index                                           */
-  pmr_u32 key;            /* visibility tie-break key (see PMR_KEY_SUB_BITS)                  */
+  pmr_i32 x0[3];            /* vertex raster x at view coordinate 0, 16.16                     */
+  pmr_i32 dx[3];            /* disparity per view coordinate, 16.16                            */
+  pmr_i32 y[3];             /* raster y, 24.8                                                  */
+  float z[3];               /* window depth                                                    */
+  float inv_w[3];           /* 1 / w                                                           */
+  float bary[3][2];         /* each vertex's barycentrics (b1, b2) in the source triangle        */
+  pmr_u32 tri;              /* source triangle index                                           */
+  pmr_u32 key;              /* visibility tie-break key (see PMR_KEY_SUB_BITS)                  */
   pmr_i32 view_lo, view_hi; /* inclusive view range in which the MTA is rasterized          */
-  pmr_i32 sign;           /* +1 or -1: multiplies the edge functions so that inside is >= 0   */
-  pmr_u32 flags;          /* PMR_MTA_*                                                       */
+  pmr_i32 sign;             /* +1 or -1: multiplies the edge functions so that inside is >= 0   */
+  pmr_u32 flags;            /* PMR_MTA_*                                                       */
 } PmrMta;
 
 /* Per-vertex shading attributes. Producer: host (scene flattening). */
 typedef struct {
-  float normal[3];        /* world-space unit normal (unused when the triangle has none)     */
-  float uv[2];            /* TEXCOORD_0, (0,0) = top-left of the image                       */
-  float color[4];         /* COLOR_0 (linear), (1,1,1,1) when absent                         */
+  float normal[3]; /* world-space unit normal (unused when the triangle has none)     */
+  float uv[2];     /* TEXCOORD_0, (0,0) = top-left of the image                       */
+  float color[4];  /* COLOR_0 (linear), (1,1,1,1) when absent                         */
 } PmrVertexAttr;
 
 /* Per-triangle data. Producer: host. */
 typedef struct {
-  pmr_u32 v[3];           /* vertex indices, counter-clockwise = front                        */
+  pmr_u32 v[3]; /* vertex indices, counter-clockwise = front                        */
   pmr_u32 material;
-  float face_normal[3];   /* world-space unit face normal (used when has_normals == 0)        */
+  float face_normal[3]; /* world-space unit face normal (used when has_normals == 0)        */
   pmr_u32 has_normals;
 } PmrTriangle;
 
@@ -208,28 +208,28 @@ typedef struct {
  * KHR_texture_transform (the identity without one). Producer: host/pipeline (from the scene's material
  * inputs). */
 typedef struct {
-  pmr_i32 texture;        /* index into the texture table, -1 = none                         */
-  pmr_u32 texcoord;       /* TEXCOORD set: entries [texcoord * num_vertices, ...) of the texcoord buffer */
-  float uv_transform[6];  /* u' = t0 u + t1 v + t2, v' = t3 u + t4 v + t5                     */
+  pmr_i32 texture;       /* index into the texture table, -1 = none                         */
+  pmr_u32 texcoord;      /* TEXCOORD set: entries [texcoord * num_vertices, ...) of the texcoord buffer */
+  float uv_transform[6]; /* u' = t0 u + t1 v + t2, v' = t3 u + t4 v + t5                     */
 } PmrTextureMap;
 
 typedef struct {
-  float base_color[4];    /* baseColorFactor (linear)                                        */
-  pmr_i32 texture;        /* index into the texture table, -1 = none                         */
-  pmr_i32 alpha_mode;     /* PMR_ALPHA_*                                                     */
+  float base_color[4]; /* baseColorFactor (linear)                                        */
+  pmr_i32 texture;     /* index into the texture table, -1 = none                         */
+  pmr_i32 alpha_mode;  /* PMR_ALPHA_*                                                     */
   float alpha_cutoff;
   pmr_u32 double_sided;
-  float metallic;         /* metallicFactor (pbr)                                             */
-  float roughness;        /* roughnessFactor (pbr; clamped to [0.03, 1] when shading)          */
-  float emissive[3];      /* emissiveFactor x KHR_materials_emissive_strength (pbr, linear)    */
-  pmr_u32 unlit;          /* KHR_materials_unlit (pbr): the colour is exposure x base          */
+  float metallic;               /* metallicFactor (pbr)                                             */
+  float roughness;              /* roughnessFactor (pbr; clamped to [0.03, 1] when shading)          */
+  float emissive[3];            /* emissiveFactor x KHR_materials_emissive_strength (pbr, linear)    */
+  pmr_u32 unlit;                /* KHR_materials_unlit (pbr): the colour is exposure x base          */
   PmrTextureMap maps[PMR_MAPS]; /* pbr: indexed by PMR_MAP_*; the base colour map is `texture` */
-  float normal_scale;     /* normalTexture.scale                                             */
-  float occlusion_strength; /* occlusionTexture.strength                                     */
+  float normal_scale;           /* normalTexture.scale                                             */
+  float occlusion_strength;     /* occlusionTexture.strength                                     */
 } PmrMaterial;
 
 typedef struct {
-  pmr_u32 offset;         /* first texel in the texel buffer (RGBA8, sRGB-encoded colour)     */
+  pmr_u32 offset; /* first texel in the texel buffer (RGBA8, sRGB-encoded colour)     */
   pmr_i32 width, height;
   pmr_i32 wrap_s, wrap_t; /* PMR_WRAP_*                                                      */
   pmr_u32 pad0, pad1, pad2;
@@ -239,14 +239,14 @@ typedef struct {
  * KHR_lights_punctual lights, posed, or the default light; host/shading/lights.h). Producer: host, every
  * frame. cl/brdf.h light_irradiance() evaluates it. */
 typedef struct {
-  float color[3];         /* colour x intensity, linear: lux (directional) or candela (point, spot) */
-  pmr_u32 type;           /* PMR_LIGHT_*                                                      */
-  float position[3];      /* the light's origin (point, spot)                                  */
-  float range;            /* point, spot: the distance window's range; 0 = none                */
-  float direction[3];     /* unit: the direction the light travels (its node's -Z); the direction
+  float color[3];     /* colour x intensity, linear: lux (directional) or candela (point, spot) */
+  pmr_u32 type;       /* PMR_LIGHT_*                                                      */
+  float position[3];  /* the light's origin (point, spot)                                  */
+  float range;        /* point, spot: the distance window's range; 0 = none                */
+  float direction[3]; /* unit: the direction the light travels (its node's -Z); the direction
                              toward a directional light is -direction (directional, spot)      */
-  float cos_inner;        /* spot: cos(innerConeAngle)                                         */
-  float cos_outer;        /* spot: cos(outerConeAngle)                                         */
+  float cos_inner;    /* spot: cos(innerConeAngle)                                         */
+  float cos_outer;    /* spot: cos(outerConeAngle)                                         */
   pmr_u32 pad0, pad1, pad2;
 } PmrLight;
 
@@ -256,11 +256,11 @@ typedef struct {
   pmr_i32 display_w, display_h;
   pmr_i32 views;
   pmr_i32 view_w, view_h;
-  pmr_i32 reversed;       /* 1: v -> N - 1 - v                                                 */
-  pmr_i32 bilinear;       /* 1: bilinear sampling of the view, 0: nearest                     */
-  pmr_i32 blend;          /* 1: blend views v and v + 1 by the phase's fraction (Looking Glass's
+  pmr_i32 reversed;  /* 1: v -> N - 1 - v                                                 */
+  pmr_i32 bilinear;  /* 1: bilinear sampling of the view, 0: nearest                     */
+  pmr_i32 blend;     /* 1: blend views v and v + 1 by the phase's fraction (Looking Glass's
                              webxr filter mode 1), 0: one view per subpixel                     */
-  pmr_i32 cell_rows;      /* subpixel cells: the column table has one block of 3 W_d entries per
+  pmr_i32 cell_rows; /* subpixel cells: the column table has one block of 3 W_d entries per
                              row class (H_d - 1 - i) mod cell_rows; 1 without cells            */
   pmr_i32 pad0, pad1, pad2;
 } PmrEncodeParams;
@@ -271,17 +271,17 @@ typedef struct {
  * v = (A_s mod N) - (Q_i mod N) - (B_s < S_i), plus N if negative, where B_s and S_i are the ranks of
  * the wide remainders rP_s and rR_i among all of them (same order, ties kept). */
 typedef struct {
-  pmr_i32 a_mod_n;        /* A_s mod N                                                      */
-  pmr_i32 b;              /* B_s: rank of the column's remainder                             */
-  pmr_i32 px;             /* nearest view column: floor((2s + 1) W / (6 W_d))                 */
-  float phase_frac;       /* rP_s / Den as a float: the phase's fraction, for view blending    */
+  pmr_i32 a_mod_n;  /* A_s mod N                                                      */
+  pmr_i32 b;        /* B_s: rank of the column's remainder                             */
+  pmr_i32 px;       /* nearest view column: floor((2s + 1) W / (6 W_d))                 */
+  float phase_frac; /* rP_s / Den as a float: the phase's fraction, for view blending    */
 } PmrEncodeColumn;
 
 typedef struct {
-  pmr_i32 q_mod_n;        /* Q_i mod N                                                      */
-  pmr_i32 s;              /* S_i: rank of the row's remainder                                */
-  pmr_i32 py;             /* nearest view row: floor((2i + 1) H / (2 H_d))                    */
-  float phase_frac;       /* rR_i / Den as a float                                           */
+  pmr_i32 q_mod_n;  /* Q_i mod N                                                      */
+  pmr_i32 s;        /* S_i: rank of the row's remainder                                */
+  pmr_i32 py;       /* nearest view row: floor((2i + 1) H / (2 H_d))                    */
+  float phase_frac; /* rR_i / Den as a float                                           */
 } PmrEncodeRow;
 
 /* --sampling subpixel: a block of display subpixels whose samples all lie in one screen tile (the
@@ -289,9 +289,9 @@ typedef struct {
  * rows [i0, i1). Blocks split a tile's subpixels at display-pixel boundaries, so a display pixel is cut
  * only where its subpixels' samples fall in different tiles. Producer: host/pipeline. */
 typedef struct {
-  pmr_i32 tile;           /* screen tile index ty * tiles_x + tx                              */
-  pmr_i32 s0, s1;         /* subpixel columns                                                */
-  pmr_i32 i0, i1;         /* display rows                                                    */
+  pmr_i32 tile;   /* screen tile index ty * tiles_x + tx                              */
+  pmr_i32 s0, s1; /* subpixel columns                                                */
+  pmr_i32 i0, i1; /* display rows                                                    */
   pmr_i32 pad0, pad1, pad2;
 } PmrSampleChunk;
 
@@ -302,19 +302,19 @@ typedef struct {
  * level_count == 0 (no image) selects the uniform default environment, which reads no table. */
 #define PMR_ENV_MAX_LEVELS 16
 typedef struct {
-  pmr_u32 width, height;  /* texels                                                          */
-  pmr_u32 offset;         /* float offset of texel (0, 0) in the data, a multiple of 4 (RGB0 texels) */
-  float roughness;        /* r of this level (level 0: 0, the image)                          */
+  pmr_u32 width, height; /* texels                                                          */
+  pmr_u32 offset;        /* float offset of texel (0, 0) in the data, a multiple of 4 (RGB0 texels) */
+  float roughness;       /* r of this level (level 0: 0, the image)                          */
 } PmrEnvLevel;
 
 typedef struct {
-  pmr_u32 level_count;       /* levels in use (level 0 = the image, the last r = 1); 0 = no image */
-  pmr_u32 roughness_nodes;   /* nodes of c(r), the fractional level coordinate, at r = i / (nodes - 1) */
-  pmr_u32 roughness_offset;  /* float offset of c(r)                                        */
-  pmr_u32 split_sum_size;    /* the split-sum table (PMR_SPLIT_SUM_N)                        */
-  pmr_u32 split_sum_offset;  /* float offset of its (A, B) pairs                             */
-  float intensity;           /* multiplies every radiance read (0 = off)                     */
-  float rotation_cos, rotation_sin;  /* of the map's rotation (counter-clockwise seen from above) */
+  pmr_u32 level_count;              /* levels in use (level 0 = the image, the last r = 1); 0 = no image */
+  pmr_u32 roughness_nodes;          /* nodes of c(r), the fractional level coordinate, at r = i / (nodes - 1) */
+  pmr_u32 roughness_offset;         /* float offset of c(r)                                        */
+  pmr_u32 split_sum_size;           /* the split-sum table (PMR_SPLIT_SUM_N)                        */
+  pmr_u32 split_sum_offset;         /* float offset of its (A, B) pairs                             */
+  float intensity;                  /* multiplies every radiance read (0 = off)                     */
+  float rotation_cos, rotation_sin; /* of the map's rotation (counter-clockwise seen from above) */
   PmrEnvLevel levels[PMR_ENV_MAX_LEVELS];
 } PmrEnvironment;
 

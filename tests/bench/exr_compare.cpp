@@ -55,7 +55,8 @@ int main(int argc, char** argv) {
       for (auto c = a.header(p).channels().begin(); c != a.header(p).channels().end(); ++c) {
         int wa = 0, ha = 0, wb = 0, hb = 0;
         const std::vector<uint32_t> va = read_channel(a, p, c.name(), wa, ha);
-        if (!b.header(q).channels().findChannel(c.name())) throw std::runtime_error(std::string("channel ") + c.name() + " is not in B");
+        if (!b.header(q).channels().findChannel(c.name()))
+          throw std::runtime_error(std::string("channel ") + c.name() + " is not in B");
         const std::vector<uint32_t> vb = read_channel(b, q, c.name(), wb, hb);
         if (wa != wb || ha != hb) throw std::runtime_error(std::string("channel ") + c.name() + ": sizes differ");
         size_t n = 0;

@@ -60,7 +60,8 @@ std::vector<std::vector<unsigned char>> preconditioned_chunks(const Frame& f, co
     std::vector<unsigned char> raw;
     for (int y = y0; y < std::min(f.height, y0 + 16); ++y)
       for (int c : channels) {
-        const auto* p = reinterpret_cast<const unsigned char*>(f.planes[size_t(c)].data() + size_t(y) * size_t(f.width));
+        const auto* p =
+            reinterpret_cast<const unsigned char*>(f.planes[size_t(c)].data() + size_t(y) * size_t(f.width));
         raw.insert(raw.end(), p, p + 2 * size_t(f.width));
       }
     const size_t n = raw.size();
@@ -81,7 +82,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const int repeats = argc > 2 ? std::max(1, std::atoi(argv[2])) : 3;
-  const std::string out_dir = std::filesystem::temp_directory_path() / ("pmr_exr_writer_bench_" + std::to_string(getpid()));
+  const std::string out_dir =
+      std::filesystem::temp_directory_path() / ("pmr_exr_writer_bench_" + std::to_string(getpid()));
   std::filesystem::create_directories(out_dir);
   Imf::setGlobalThreadCount(0);  // one thread everywhere
   Frame f;
@@ -93,8 +95,10 @@ int main(int argc, char** argv) {
     for (auto c = in.header().channels().begin(); c != in.header().channels().end(); ++c) f.names.push_back(c.name());
     for (const std::string& n : f.names) {
       f.planes.emplace_back(size_t(f.width) * size_t(f.height));
-      fb.insert(n, Imf::Slice(Imf::HALF, reinterpret_cast<char*>(f.planes.back().data()) - 2 * (dw.min.x + size_t(dw.min.y) * f.width),
-                              2, 2 * size_t(f.width)));
+      fb.insert(
+          n, Imf::Slice(Imf::HALF,
+                        reinterpret_cast<char*>(f.planes.back().data()) - 2 * (dw.min.x + size_t(dw.min.y) * f.width),
+                        2, 2 * size_t(f.width)));
     }
     in.setFrameBuffer(fb);
     in.readPixels(dw.min.y, dw.max.y);
@@ -117,13 +121,14 @@ int main(int argc, char** argv) {
     if (has_sub)
       for (int k = 0; k < 3; ++k) sub[3 * i + size_t(k)] = f.planes[size_t(c3[k])][i];
   }
-  std::printf("# %s: %dx%d; one thread, CPU seconds (best of %d), file or stream size in MB\n", argv[1], f.width, f.height,
-              repeats);
+  std::printf("# %s: %dx%d; one thread, CPU seconds (best of %d), file or stream size in MB\n", argv[1], f.width,
+              f.height, repeats);
   for (const bool with_sub : {false, true}) {
     if (with_sub && !has_sub) continue;
     std::vector<int> order;  // name order
     for (size_t c = 0; c < f.names.size(); ++c)
-      if (with_sub || (f.names[c].size() == 1 && std::string("RGBA").find(f.names[c]) != std::string::npos)) order.push_back(int(c));
+      if (with_sub || (f.names[c].size() == 1 && std::string("RGBA").find(f.names[c]) != std::string::npos))
+        order.push_back(int(c));
     std::printf("%s\n", with_sub ? "R G B A AR AG AB" : "R G B A");
     const std::string imf_path = out_dir + "/openexr.exr", ours_path = out_dir + "/ours.exr";
     const double imf = best_cpu(repeats, [&] {
@@ -132,7 +137,8 @@ int main(int argc, char** argv) {
       Imf::FrameBuffer fb;
       for (int c : order) {
         h.channels().insert(f.names[size_t(c)], Imf::Channel(Imf::HALF));
-        fb.insert(f.names[size_t(c)], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(f.planes[size_t(c)].data()), 2, 2 * size_t(f.width)));
+        fb.insert(f.names[size_t(c)],
+                  Imf::Slice(Imf::HALF, reinterpret_cast<char*>(f.planes[size_t(c)].data()), 2, 2 * size_t(f.width)));
       }
       Imf::OutputFile out(imf_path.c_str(), h);
       out.setFrameBuffer(fb);
@@ -142,8 +148,8 @@ int main(int argc, char** argv) {
     std::printf("  %-36s %7.3f s %8.2f MB\n", "OpenEXR ZIP (zlib 4)", imf, imf_mb);
     for (const pmr::ExrCompression c : {pmr::ExrCompression::Zip, pmr::ExrCompression::ZipFast}) {
       const double t = best_cpu(repeats, [&] {
-        pmr::write_rgba_exr(ours_path, f.width, f.height, rgba.data(), c, 1, nullptr, 1.0f, nullptr, pmr::ExrImage::Encoded,
-                            with_sub ? sub.data() : nullptr);
+        pmr::write_rgba_exr(ours_path, f.width, f.height, rgba.data(), c, 1, nullptr, 1.0f, nullptr,
+                            pmr::ExrImage::Encoded, with_sub ? sub.data() : nullptr);
       });
       const double mb = double(std::filesystem::file_size(ours_path)) / 1e6;
       std::printf("  %-36s %7.3f s %8.2f MB  (%.2fx CPU, %.3fx size)\n",
@@ -158,11 +164,13 @@ int main(int argc, char** argv) {
       size_t total = 0;
       const double t = best_cpu(repeats, [&] {
         total = 0;
-        for (const auto& ch : chunks) total += libdeflate_zlib_compress(z, ch.data(), ch.size(), dst.data(), dst.size());
+        for (const auto& ch : chunks)
+          total += libdeflate_zlib_compress(z, ch.data(), ch.size(), dst.data(), dst.size());
       });
       libdeflate_free_compressor(z);
       std::printf("  %-36s %7.3f s %8.2f MB  (%.0f MB/s of chunk data)\n",
-                  ("deflate alone: libdeflate " + std::to_string(level)).c_str(), t, double(total) / 1e6, double(raw) / 1e6 / t);
+                  ("deflate alone: libdeflate " + std::to_string(level)).c_str(), t, double(total) / 1e6,
+                  double(raw) / 1e6 / t);
     }
     const uint32_t buf_size[4] = {0, ISAL_DEF_LVL1_DEFAULT, ISAL_DEF_LVL2_DEFAULT, ISAL_DEF_LVL3_DEFAULT};
     for (uint32_t level = 1; level <= 3; ++level) {
@@ -181,7 +189,8 @@ int main(int argc, char** argv) {
         }
       });
       std::printf("  %-36s %7.3f s %8.2f MB  (%.0f MB/s of chunk data)\n",
-                  ("deflate alone: ISA-L igzip " + std::to_string(level)).c_str(), t, double(total) / 1e6, double(raw) / 1e6 / t);
+                  ("deflate alone: ISA-L igzip " + std::to_string(level)).c_str(), t, double(total) / 1e6,
+                  double(raw) / 1e6 / t);
     }
   }
   std::filesystem::remove_all(out_dir);

@@ -27,7 +27,8 @@ void save(const fs::path& path, const std::string& text) { save(path, std::vecto
 std::vector<uint8_t> png_header(uint32_t w, uint32_t h, int color_type, int depth) {
   std::vector<uint8_t> png = make_png(1, 1, color_type, depth, std::vector<uint8_t>(8, 0));
   const size_t ihdr = 16;  // signature, length, "IHDR"
-  for (int s = 0; s < 4; ++s) png[ihdr + size_t(s)] = uint8_t(w >> (24 - 8 * s)), png[ihdr + 4 + size_t(s)] = uint8_t(h >> (24 - 8 * s));
+  for (int s = 0; s < 4; ++s)
+    png[ihdr + size_t(s)] = uint8_t(w >> (24 - 8 * s)), png[ihdr + 4 + size_t(s)] = uint8_t(h >> (24 - 8 * s));
   const uint32_t crc = crc32(png.data() + 12, 17);
   for (int s = 0; s < 4; ++s) png[29 + size_t(s)] = uint8_t(crc >> (24 - 8 * s));
   return png;
@@ -48,7 +49,8 @@ GltfFile textured_triangle(const nlohmann::json& image) {
   const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
   const int uv = g.data<float>({0, 0, 1, 0, 0, 1}, kFloat, "VEC2");
   const int idx = g.data<uint16_t>({0, 1, 2}, kUShort, "SCALAR");
-  g.mesh(nlohmann::json::array({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"indices", idx}, {"material", 0}}}));
+  g.mesh(nlohmann::json::array(
+      {{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"indices", idx}, {"material", 0}}}));
   g.add("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
   g.add("textures", {{"source", 0}});
   g.add("images", image);
@@ -90,7 +92,8 @@ void gltf_seeds(const fs::path& out) {
   }
   for (const char* mime : {"image/ktx2", "image/webp"}) {
     GltfFile g = textured_triangle({{"uri", std::string("data:") + mime + ";base64,AAAA"}});
-    save(out / (std::string("data_uri_") + (mime + 6) + ".gltf"), text(g, "data:application/octet-stream;base64," + base64(g.bin)));
+    save(out / (std::string("data_uri_") + (mime + 6) + ".gltf"),
+         text(g, "data:application/octet-stream;base64," + base64(g.bin)));
   }
   {  // morph targets all pointing at one implicit (bufferView-less, all zero) POSITION accessor
     GltfFile g;
@@ -133,7 +136,10 @@ void gltf_seeds(const fs::path& out) {
     GltfFile g;
     const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
     g.mesh(nlohmann::json::array({{{"attributes", {{"POSITION", pos}}}}}));
-    g.add("nodes", {{"mesh", 0}, {"name", "\x1b]0;title\x07\xc2\x9b" "2J"}});
+    g.add("nodes", {{"mesh", 0},
+                    {"name",
+                     "\x1b]0;title\x07\xc2\x9b"
+                     "2J"}});
     g.scene({0});
     nlohmann::json d = g.finished("data:application/octet-stream;base64," + base64(g.bin));
     d["asset"]["generator"] = "\x1b[2Kpmr: all good";
@@ -148,11 +154,12 @@ void gltf_seeds(const fs::path& out) {
     const int joints = g.data<uint16_t>({0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}, kUShort, "VEC4");
     const int weights = g.data<float>({1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}, kFloat, "VEC4");
     const int ibm = g.data<float>({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}, kFloat, "MAT4");
-    g.mesh(nlohmann::json::array({{{"attributes", {{"POSITION", pos}, {"JOINTS_0", joints}, {"WEIGHTS_0", weights}}}}}));
+    g.mesh(
+        nlohmann::json::array({{{"attributes", {{"POSITION", pos}, {"JOINTS_0", joints}, {"WEIGHTS_0", weights}}}}}));
     g.add("nodes", {{"mesh", 0}, {"skin", 0}});
     g.add("nodes", {{"name", "joint"}, {"rotation", {0, 0, 0, 1}}});
-    g.add("nodes", {{"camera", 0}, {"translation", {0, 0, 3}},
-                    {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    g.add("nodes",
+          {{"camera", 0}, {"translation", {0, 0, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
     g.add("skins", {{"joints", {1}}, {"inverseBindMatrices", ibm}});
     g.add("cameras", {{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}});
     g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
@@ -168,7 +175,8 @@ void gltf_seeds(const fs::path& out) {
 
 // A Radiance .hdr of w x h, flat RGBE (rle = false) or new-style run-length encoded scanlines.
 std::vector<uint8_t> hdr(int w, int h, bool rle) {
-  std::string head = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " + std::to_string(w) + "\n";
+  std::string head =
+      "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " + std::to_string(h) + " +X " + std::to_string(w) + "\n";
   std::vector<uint8_t> out(head.begin(), head.end());
   for (int y = 0; y < h; ++y) {
     if (rle) {
@@ -198,9 +206,12 @@ void environment_seeds(const fs::path& out) {
   std::vector<Imf::Rgba> px(size_t(w * h));
   for (int i = 0; i < w * h; ++i) px[size_t(i)] = Imf::Rgba(half(0.1f * float(i)), half(0.5f), half(1.0f), half(1.0f));
   for (const auto& [name, channels, compression] :
-       {std::tuple{"rgb_zip.exr", Imf::WRITE_RGB, Imf::ZIP_COMPRESSION}, std::tuple{"y_none.exr", Imf::WRITE_Y, Imf::NO_COMPRESSION},
-        std::tuple{"rgb_piz.exr", Imf::WRITE_RGB, Imf::PIZ_COMPRESSION}, std::tuple{"rgba_rle.exr", Imf::WRITE_RGBA, Imf::RLE_COMPRESSION}}) {
-    Imf::RgbaOutputFile file((out / name).c_str(), w, h, channels, 1, Imath::V2f(0, 0), 1, Imf::INCREASING_Y, compression);
+       {std::tuple{"rgb_zip.exr", Imf::WRITE_RGB, Imf::ZIP_COMPRESSION},
+        std::tuple{"y_none.exr", Imf::WRITE_Y, Imf::NO_COMPRESSION},
+        std::tuple{"rgb_piz.exr", Imf::WRITE_RGB, Imf::PIZ_COMPRESSION},
+        std::tuple{"rgba_rle.exr", Imf::WRITE_RGBA, Imf::RLE_COMPRESSION}}) {
+    Imf::RgbaOutputFile file((out / name).c_str(), w, h, channels, 1, Imath::V2f(0, 0), 1, Imf::INCREASING_Y,
+                             compression);
     file.setFrameBuffer(px.data(), 1, size_t(w));
     file.writePixels(h);
   }
@@ -220,8 +231,10 @@ void calibration_seeds(const fs::path& out) {
   save(out / "dpi_1e-300.json", with(R"("DPI": {"value": 324})", R"("DPI": {"value": 1e-300})"));
   save(out / "slope_tiny.json", with(R"("slope": {"value": -7.1})", R"("slope": {"value": 1e-300})"));
   save(out / "center_huge.json", with(R"("center": {"value": 0.56})", R"("center": {"value": 1e300})"));
-  save(out / "unknown_serial_flipped.json", with(R"("serial": "LKG-P01234")", R"("serial": "XYZ", "flipImageX": 1, "flipSubp": 1)"));
-  save(out / "gen3_cells.json", with(R"("serial": "LKG-P01234",)", R"("serial": "LKG-L01234", "CellPatternMode": {"value": 3},
+  save(out / "unknown_serial_flipped.json",
+       with(R"("serial": "LKG-P01234")", R"("serial": "XYZ", "flipImageX": 1, "flipSubp": 1)"));
+  save(out / "gen3_cells.json",
+       with(R"("serial": "LKG-P01234",)", R"("serial": "LKG-L01234", "CellPatternMode": {"value": 3},
     "subpixelCells": [{"ROffsetX": 0.1, "ROffsetY": 0, "GOffsetX": 0.4, "GOffsetY": 0, "BOffsetX": 0.7, "BOffsetY": 0},
                       {"ROffsetX": 0.7, "ROffsetY": 0.5, "GOffsetX": 0.4, "GOffsetY": 0.5, "BOffsetX": 0.1, "BOffsetY": 0.5}],)"));
 }

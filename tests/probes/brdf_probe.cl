@@ -31,8 +31,8 @@ kernel void light_probe(global const float* in, global float* out, uint n) {
   if (i >= n) return;
   global const float* c = in + 18 * i;
   sfloat3 l;
-  const sfloat3 e = light_irradiance((int)c[0], vload3(0, c + 1), vload3(0, c + 4), vload3(0, c + 7), c[10], c[11], c[12],
-                                     s3_splat(vload3(0, c + 13)), &l);
+  const sfloat3 e = light_irradiance((int)c[0], vload3(0, c + 1), vload3(0, c + 4), vload3(0, c + 7), c[10], c[11],
+                                     c[12], s3_splat(vload3(0, c + 13)), &l);
   vstore3((float3)(e.x.s0, e.y.s0, e.z.s0), 0, out + 6 * i);
   vstore3((float3)(l.x.s0, l.y.s0, l.z.s0), 0, out + 6 * i + 3);
 }

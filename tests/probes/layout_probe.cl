@@ -2,7 +2,7 @@
  * tests/test_layout.cpp compares with the host's. Not part of the rendering program. */
 #include "common.h"
 
-#define PROBE(i, type, field) out[i] = (uint)__builtin_offsetof(type, field)
+#define PROBE(i, type, field) out[i] = (uint) __builtin_offsetof(type, field)
 
 kernel void layout_probe(global uint* out) {
   out[0] = sizeof(PmrParams);

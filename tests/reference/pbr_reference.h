@@ -17,10 +17,10 @@ enum class LightType { Directional = 0, Point = 1, Spot = 2 };
 
 struct PunctualLight {
   LightType type = LightType::Directional;
-  glm::dvec3 color_intensity{1.0};  // colour x intensity
-  glm::dvec3 position{0.0};         // world space (point, spot)
+  glm::dvec3 color_intensity{1.0};       // colour x intensity
+  glm::dvec3 position{0.0};              // world space (point, spot)
   glm::dvec3 direction{0.0, 0.0, -1.0};  // unit, the direction the light travels (the node's -Z)
-  double range = 0.0;               // 0: none
+  double range = 0.0;                    // 0: none
   double cos_inner = 1.0, cos_outer = 0.0;
 };
 
@@ -29,11 +29,11 @@ glm::dvec3 light_irradiance(const PunctualLight& light, const glm::dvec3& p, glm
 
 // The material inputs at a surface point and how it is seen.
 struct SurfacePoint {
-  glm::dvec3 base{1.0};     // base colour (rgb)
+  glm::dvec3 base{1.0};                    // base colour (rgb)
   double metallic = 0.0, roughness = 1.0;  // roughness before clamping
-  glm::dvec3 n{0.0, 0.0, 1.0};  // unit shading normal (back faces already flipped)
-  glm::dvec3 p{0.0};        // world position
-  glm::dvec3 eye{0.0, 0.0, 1.0};  // the view's camera position (world)
+  glm::dvec3 n{0.0, 0.0, 1.0};             // unit shading normal (back faces already flipped)
+  glm::dvec3 p{0.0};                       // world position
+  glm::dvec3 eye{0.0, 0.0, 1.0};           // the view's camera position (world)
   double ao = 1.0;
   glm::dvec3 emissive{0.0};
   bool unlit = false;

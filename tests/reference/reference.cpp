@@ -8,7 +8,8 @@ namespace pmr::ref {
 
 namespace {
 
-constexpr uint32_t kCullBits = PMR_CULL_LEFT | PMR_CULL_RIGHT | PMR_CULL_BOTTOM | PMR_CULL_TOP | PMR_CULL_NEAR | PMR_CULL_FAR;
+constexpr uint32_t kCullBits =
+    PMR_CULL_LEFT | PMR_CULL_RIGHT | PMR_CULL_BOTTOM | PMR_CULL_TOP | PMR_CULL_NEAR | PMR_CULL_FAR;
 
 PmrVertex project(const PmrParams& P, double xv, double yv, double zv) {
   PmrVertex out{};
@@ -42,7 +43,7 @@ PmrVertex project(const PmrParams& P, double xv, double yv, double zv) {
   if (P.views > 1) {
     const double delta = P.disparity_k * (1.0 - P.focal / w);
     x_first = x_center + P.view_anchor * delta;  // at view coordinate 0
-    d = delta / P.view_scale;                      // per view coordinate unit
+    d = delta / P.view_scale;                    // per view coordinate unit
   }
   const double y = (1.0 - yc / w) * half_h;
   auto snap = [](double v) { return int32_t(std::min(std::max(std::floor(v + 0.5), -2.0e9), 2.0e9)); };
@@ -59,14 +60,22 @@ double plane_value(const PmrParams& P, int k, const double* p) {
   const double kk = P.disparity_k / double(P.view_w);
   const double xc = P.ndc_scale_x * p[0] + P.ndc_offset_x * w;
   switch (k) {
-    case 0: return w - P.near_eff;
-    case 1: return P.far - w;
-    case 2: return P.guard_ndc_x * w - (xc - kk * (w - P.focal));
-    case 3: return P.guard_ndc_x * w + (xc - kk * (w - P.focal));
-    case 4: return P.guard_ndc_x * w - (xc + kk * (w - P.focal));
-    case 5: return P.guard_ndc_x * w + (xc + kk * (w - P.focal));
-    case 6: return P.guard_ndc_y * w - P.ndc_scale_y * p[1];
-    default: return P.guard_ndc_y * w + P.ndc_scale_y * p[1];
+    case 0:
+      return w - P.near_eff;
+    case 1:
+      return P.far - w;
+    case 2:
+      return P.guard_ndc_x * w - (xc - kk * (w - P.focal));
+    case 3:
+      return P.guard_ndc_x * w + (xc - kk * (w - P.focal));
+    case 4:
+      return P.guard_ndc_x * w - (xc + kk * (w - P.focal));
+    case 5:
+      return P.guard_ndc_x * w + (xc + kk * (w - P.focal));
+    case 6:
+      return P.guard_ndc_y * w - P.ndc_scale_y * p[1];
+    default:
+      return P.guard_ndc_y * w + P.ndc_scale_y * p[1];
   }
 }
 
@@ -101,7 +110,8 @@ PmrVertex transform_vertex(const PmrParams& P, const float* pos) {
                  V[2] * px + V[6] * py + V[10] * pz + V[14]);
 }
 
-std::vector<ClippedTriangle> clip_triangles(const PmrParams& P, const Scene& scene, const std::vector<PmrVertex>& verts) {
+std::vector<ClippedTriangle> clip_triangles(const PmrParams& P, const Scene& scene,
+                                            const std::vector<PmrVertex>& verts) {
   std::vector<ClippedTriangle> out;
   const double ident[3][2] = {{0, 0}, {1, 0}, {0, 1}};
   for (uint32_t t = 0; t < scene.triangles.size(); ++t) {

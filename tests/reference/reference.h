@@ -23,7 +23,8 @@ struct ClippedTriangle {
   bool double_sided = false, mask = false;
 };
 // Setup without the orientation split: culling, clipping, fan triangulation.
-std::vector<ClippedTriangle> clip_triangles(const PmrParams& P, const Scene& scene, const std::vector<PmrVertex>& verts);
+std::vector<ClippedTriangle> clip_triangles(const PmrParams& P, const Scene& scene,
+                                            const std::vector<PmrVertex>& verts);
 // The MTA records setup must produce, sorted by (key, view_lo).
 std::vector<PmrMta> make_mtas(const PmrParams& P, const std::vector<ClippedTriangle>& tris);
 void sort_mtas(std::vector<PmrMta>& mtas);
@@ -41,9 +42,9 @@ RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& t
 // view_of[i * 3 W_d + 3j + k]; the same top-left rule and (depth, key) visibility, the depth being the
 // triangle's plane in that view evaluated at the sample in double (anchored at vertex 0).
 struct SubpixelResult {
-  std::vector<uint32_t> key;   // [row][3 * column + k], PMR_NO_KEY when empty
-  std::vector<float> depth;    // INFINITY when empty
-  std::vector<int64_t> x, y;   // the samples, fixed point
+  std::vector<uint32_t> key;  // [row][3 * column + k], PMR_NO_KEY when empty
+  std::vector<float> depth;   // INFINITY when empty
+  std::vector<int64_t> x, y;  // the samples, fixed point
 };
 SubpixelResult rasterize_subpixels(const PmrParams& P, const std::vector<ClippedTriangle>& tris,
                                    const std::vector<int>& view_of, int display_w, int display_h);

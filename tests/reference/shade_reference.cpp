@@ -37,7 +37,8 @@ glm::dvec4 sample_texture(const SceneTexture& tex, const glm::dvec2& uv, bool sr
 }
 
 glm::dvec3 source_barycentrics(const PmrMta& m, int px, int py, int view) {
-  return source_barycentrics_at(m, int64_t(px) * PMR_X_ONE + PMR_X_ONE / 2, int64_t(py) * PMR_Y_ONE + PMR_Y_ONE / 2, view);
+  return source_barycentrics_at(m, int64_t(px) * PMR_X_ONE + PMR_X_ONE / 2, int64_t(py) * PMR_Y_ONE + PMR_Y_ONE / 2,
+                                view);
 }
 
 glm::dvec3 source_barycentrics_at(const PmrMta& m, int64_t sample_x, int64_t sample_y, int view) {

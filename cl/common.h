@@ -120,14 +120,16 @@ inline long mta_edge_bias(const PmrMta* m, int a, int b, long f_lo) {
   return (dy > 0 || (dy == 0 && dx < 0)) ? 0 : 1;
 }
 
-/* Depth plane of an MTA in view i (given by its view coordinate). Depth is linear in screen space (DESIGN section 3); it is
- * evaluated per voxel as a plane anchored at vertex 0's pixel (pr, qr), so that a row of voxels costs
- * one float multiply-add per voxel and the value depends on the MTA, the view and the voxel alone
- * (never on the tile that computes it):
- *   depth(px, py) = (float)(zr + gy * (double)(py - qr)) + gx * (float)(px - pr)
- * The gradients come from the exact integer vertex positions of view i (twice the signed area A is
- * non-zero in every view of an MTA). The C++ reference (tests/reference) evaluates the same
- * expression in the same order. */
+/* Depth plane of an MTA in view i (given by its view coordinate). Depth is linear in screen space (DESIGN
+ * section 3). One formula serves every sample, pixel center or not: the plane is anchored at the center
+ * (Xr, Yr) of vertex 0's pixel (pr, qr), and at raster point (X, Y) (16.16 / 24.8)
+ *   depth(X, Y) = (float)(zr + gy * (double)(Y - Yr) / Y_ONE) + gx * ((float)(X - Xr) / X_ONE)
+ * At pixel centers (Y - Yr) / Y_ONE and (X - Xr) / X_ONE are the integers py - qr and
+ * px - pr, so a row of voxels costs one float multiply-add per voxel after one double evaluation per row
+ * (the fine raster's form, bit for bit the same value). The value depends on the MTA, the view and the
+ * sample alone (never on the tile or chunk that computes it). The gradients come from the exact
+ * integer vertex positions of view i (twice the signed area A is non-zero in every view of an MTA). The
+ * C++ reference (tests/reference) evaluates the same expression in the same order. */
 typedef struct {
   double zr;  /* depth at the center of pixel (pr, qr) */
   double gy;  /* depth per pixel row */

@@ -17,10 +17,9 @@
  * +-2^48 (beyond which the comparison cannot change), converts exactly. So the outcome is the integer
  * one, bit for bit, in vectors of SP_LANES doubles.
  *
- * Depth at a sample: the plane through the MTA's three vertices in view v, in double and anchored at
- * vertex 0, z = (float)(z_0 + (g_x (X - x_0) + g_y (Y - y_0))): a function of the MTA, the view and the
- * sample alone, so the result does not depend on chunks, tiles or threads. Visibility is the (depth,
- * key) order as everywhere. */
+ * Depth at a sample: the one depth formula of every path (DepthPlane in cl/common.h), a function of the
+ * MTA, the view and the sample alone, so the result does not depend on chunks, tiles or threads.
+ * Visibility is the (depth, key) order as everywhere. */
 #include "fine_core.h"
 
 #define SP_LANES PMR_SUBPIXEL_LANES
@@ -141,25 +140,14 @@ PMR_HOT void sp_edges(global const PmrParams* P, const PmrMta* m, int i_lo, cons
   S->my1 = max(m->y[0], max(m->y[1], m->y[2])) - C->Yc;
 }
 
-/* The depth plane of an MTA in a view (see the head of this file) at offset (x, y) from the chunk's
- * first sample: z = (float)(z0 + (gx (bx + x) + gy (by + y))), (bx, by) = (Xc, Yc) - vertex 0. xv: the
- * vertices' x in the view. */
-typedef struct {
-  double z0, gx, gy, bx, by;
-} SpPlane;
-
-PMR_HOT SpPlane sp_plane(const PmrMta* m, const long* xv, const SpChunk* C) {
-  const long y0 = m->y[0], y1 = m->y[1], y2 = m->y[2];
-  const long area = (y1 - y0) * (xv[2] - xv[0]) - (xv[1] - xv[0]) * (y2 - y0);
-  const double inv = 1.0 / (double)area;
-  const double dz1 = (double)m->z[1] - (double)m->z[0], dz2 = (double)m->z[2] - (double)m->z[0];
-  SpPlane p;
-  p.gx = (dz1 * (double)(y0 - y2) + dz2 * (double)(y1 - y0)) * inv;
-  p.gy = (dz1 * (double)(xv[2] - xv[0]) - dz2 * (double)(xv[1] - xv[0])) * inv;
-  p.z0 = (double)m->z[0];
-  p.bx = (double)(C->Xc - xv[0]);
-  p.by = (double)(C->Yc - y0);
-  return p;
+/* The depth plane of an MTA in view fv (depth_plane, cl/common.h) at samples (Xc + x, Yc + y): the one
+ * depth formula, in vectors. The offsets from the plane's anchor are integers below 2^53, exact in
+ * double, and their scaling by a power of two is exact, so each lane's value is the formula's. */
+PMR_HOT float8 sp_depth(const DepthPlane* d, const SpChunk* C, double8 x, double8 y) {
+  const double8 rows = ((double8)((double)(C->Yc - ((long)d->qr * PMR_Y_ONE + PMR_HALF_Y))) + y) / (double)PMR_Y_ONE;
+  const float8 columns =
+      convert_float8((double8)((double)(C->Xc - ((long)d->pr * PMR_X_ONE + PMR_HALF_X))) + x) / (float)PMR_X_ONE;
+  return convert_float8((double8)(d->zr) + (double8)(d->gy) * rows) + (float8)(d->gx) * columns;
 }
 
 /* MTA m (queue entry id) in view v against the view's run of samples, SP_LANES at a time, into the
@@ -180,7 +168,7 @@ PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, con
   }
   const double8 lane_d = convert_double8(vload8(0, lane_index));
   bool have_plane = false;
-  SpPlane p;
+  DepthPlane p;
   for (int k = k0; k < k1; k += SP_LANES) {
     const int4 b = C->box[k / SP_LANES];
     if (b.x > mx1) break; /* a run's vectors go left to right (sorted by column) */
@@ -195,9 +183,8 @@ PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, con
     const long4 h4 = hit.lo | hit.hi;
     const long2 h2 = h4.lo | h4.hi;
     if ((h2.x | h2.y) == 0) continue;
-    if (!have_plane) p = sp_plane(m, xv, C), have_plane = true; /* tiny MTAs often cover no sample */
-    const float8 z = convert_float8(
-        (double8)(p.z0) + ((double8)(p.gx) * ((double8)(p.bx) + x) + (double8)(p.gy) * ((double8)(p.by) + y)));
+    if (!have_plane) p = depth_plane(m, fv), have_plane = true; /* tiny MTAs often cover no sample */
+    const float8 z = sp_depth(&p, C, x, y);
     const float8 bd = vload8(0, C->best_depth + k);
     const uint8 bk = vload8(0, C->best_key + k);
     int8 win = convert_int8(hit) & ((z < bd) | ((z == bd) & ((uint8)(m->key) < bk)));

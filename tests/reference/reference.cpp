@@ -79,21 +79,22 @@ double plane_value(const PmrParams& P, int k, const double* p) {
   }
 }
 
-// Depth of a triangle at pixel (px, py) of a view, given the view's snapped vertex positions: the
-// plane anchored at vertex 0's pixel, evaluated exactly as cl/common.h's depth_plane and the fine
-// raster do (same operations, same order, no contraction).
-float depth_at(const int64_t* x, const int64_t* y, const ClippedTriangle& c, int64_t px, int64_t py) {
+// Depth of a triangle at raster point (X, Y) (16.16 / 24.8) of a view, given the view's snapped vertex
+// positions: the plane anchored at the center (Xr, Yr) of vertex 0's pixel, evaluated exactly as
+// cl/common.h's DepthPlane states it (same operations, same order, no contraction) for every sample,
+// pixel center or not.
+float depth_at(const int64_t* x, const int64_t* y, const ClippedTriangle& c, int64_t X, int64_t Y) {
   const int64_t area = (y[1] - y[0]) * (x[2] - x[0]) - (x[1] - x[0]) * (y[2] - y[0]);
   const double inv = 1.0 / double(area);
   const double dz1 = double(c.v[1].z) - double(c.v[0].z), dz2 = double(c.v[2].z) - double(c.v[0].z);
   const double gx = (dz1 * double(y[0] - y[2]) + dz2 * double(y[1] - y[0])) * double(PMR_X_ONE) * inv;
   const double gy = (dz1 * double(x[2] - x[0]) - dz2 * double(x[1] - x[0])) * double(PMR_Y_ONE) * inv;
   const int64_t pr = x[0] >> PMR_X_FRAC_BITS, qr = y[0] >> PMR_Y_FRAC_BITS;
-  const double ox = double(pr * PMR_X_ONE + PMR_X_ONE / 2 - x[0]) / double(PMR_X_ONE);
-  const double oy = double(qr * PMR_Y_ONE + PMR_Y_ONE / 2 - y[0]) / double(PMR_Y_ONE);
-  const double zr = double(c.v[0].z) + gx * ox + gy * oy;
-  const float zrow = float(zr + gy * double(int32_t(py - qr)));
-  return zrow + float(gx) * float(int32_t(px - pr));
+  const int64_t Xr = pr * PMR_X_ONE + PMR_X_ONE / 2, Yr = qr * PMR_Y_ONE + PMR_Y_ONE / 2;
+  const double zr =
+      double(c.v[0].z) + gx * (double(Xr - x[0]) / double(PMR_X_ONE)) + gy * (double(Yr - y[0]) / double(PMR_Y_ONE));
+  const float zrow = float(zr + gy * (double(Y - Yr) / double(PMR_Y_ONE)));
+  return zrow + float(gx) * (float(X - Xr) / float(PMR_X_ONE));
 }
 
 struct CV {
@@ -257,7 +258,7 @@ RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& t
           if (!inside) continue;
           const size_t vox = (i * H + py) * W + px;
           ++r.count[vox];
-          const float depth = depth_at(x, y, c, int64_t(px), int64_t(py));
+          const float depth = depth_at(x, y, c, X, Y);
           if (depth < r.depth[vox] || (depth == r.depth[vox] && c.key < r.key[vox])) {
             r.depth[vox] = depth;
             r.key[vox] = c.key;
@@ -303,11 +304,7 @@ SubpixelResult rasterize_subpixels(const PmrParams& P, const std::vector<Clipped
           inside = sg * ((y[b] - y[a]) * (X - x[a]) - (x[b] - x[a]) * (Y - y[a])) >= bias;
         }
         if (!inside) continue;
-        const double inv = 1.0 / double(area);
-        const double dz1 = double(c.v[1].z) - double(c.v[0].z), dz2 = double(c.v[2].z) - double(c.v[0].z);
-        const double gx = (dz1 * double(y[0] - y[2]) + dz2 * double(y[1] - y[0])) * inv;
-        const double gy = (dz1 * double(x[2] - x[0]) - dz2 * double(x[1] - x[0])) * inv;
-        const float depth = float(double(c.v[0].z) + (gx * double(X - x[0]) + gy * double(Y - y[0])));
+        const float depth = depth_at(x, y, c, X, Y);
         if (depth < r.depth[at] || (depth == r.depth[at] && c.key < r.key[at])) {
           r.depth[at] = depth;
           r.key[at] = c.key;

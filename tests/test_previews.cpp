@@ -65,6 +65,27 @@ std::pair<int, int> covered_box(const std::vector<uint8_t>& rgba, int w, int h) 
 
 }  // namespace
 
+// PNG's alpha is straight: a half-covered red edge (premultiplied 0.5, alpha 0.5) is full red at alpha
+// 128, a half-covered linear grey 0.25 is straight 0.5 (sRGB 188), and the opaque form keeps what the
+// pixel shows over black.
+TEST(Previews, PngColourIsStraightAlpha) {
+  const std::string dir = temp_dir("png_straight");
+  fs::create_directories(dir);
+  const std::vector<uint16_t> px = {bits(0.5f),  0,          0,           bits(0.5f), bits(0.25f), bits(0.25f),
+                                    bits(0.25f), bits(0.5f), bits(0.25f), 0,          0,           bits(1.0f)};
+  int w = 0, h = 0;
+  std::vector<uint8_t> rgba;
+  write_png_preview(dir + "/a.png", 3, 1, px.data());
+  read_png_rgba8(dir + "/a.png", w, h, rgba);
+  ASSERT_EQ(w, 3);
+  const std::vector<uint8_t> want = {255, 0, 0, 128, 188, 188, 188, 128, 137, 0, 0, 255};
+  EXPECT_EQ(rgba, want);
+  write_png_preview(dir + "/b.png", 3, 1, px.data(), 1.0, true);
+  read_png_rgba8(dir + "/b.png", w, h, rgba);
+  EXPECT_EQ(rgba[0], 188) << "opaque: premultiplied 0.5 red shown over black";
+  EXPECT_EQ(rgba[3], 255);
+}
+
 TEST(Previews, SquarePixelsStretchOneAxis) {
   // 2x1 pixels, each twice as wide as tall: 4x1; the ends keep their values, the middle is between
   const std::vector<uint16_t> two = {bits(0), bits(0), bits(0), bits(0), bits(1), bits(0.5f), bits(0.25f), bits(1)};

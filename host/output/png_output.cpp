@@ -36,6 +36,25 @@ void on_warning(png_structp, png_const_charp) {}
 
 uint8_t to_byte(double v) { return uint8_t(std::lround(std::min(1.0, std::max(0.0, v)) * 255.0)); }
 
+// One RGBA pixel of premultiplied halves as straight 8-bit sRGB: PNG's alpha is straight, so a partly
+// covered pixel's colour is divided by its coverage before the curve (else every edge darkens into a
+// fringe). Whole coverage (the common case) goes through the table of every half value.
+void straight_pixel(const uint16_t* src, const std::vector<uint8_t>& lut, uint8_t* out) {
+  half a;
+  a.setBits(src[3]);
+  const double alpha = double(float(a));
+  out[3] = to_byte(alpha);
+  for (int c = 0; c < 3; ++c) {
+    if (alpha > 0.0 && alpha < 1.0) {
+      half v;
+      v.setBits(src[c]);
+      out[c] = to_byte(srgb_encode(double(float(v)) / alpha));
+    } else {
+      out[c] = lut[src[c]];
+    }
+  }
+}
+
 }  // namespace
 
 void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half, double pixel_aspect,
@@ -77,11 +96,11 @@ void write_png_preview(const std::string& path, int width, int height, const uin
     for (int y = 0; y < height; ++y) {
       const uint16_t* src = rgba_half + size_t(y) * size_t(width) * 4;
       for (size_t x = 0; x < size_t(width); ++x) {
-        for (int c = 0; c < 3; ++c) row[channels * x + size_t(c)] = lut[src[4 * x + size_t(c)]];
-        if (opaque) continue;
-        half a;
-        a.setBits(src[4 * x + 3]);
-        row[4 * x + 3] = to_byte(double(float(a)));
+        if (opaque) {  // what a panel shows over black: the premultiplied colour as it is
+          for (int c = 0; c < 3; ++c) row[3 * x + size_t(c)] = lut[src[4 * x + size_t(c)]];
+        } else {
+          straight_pixel(src + 4 * x, lut, &row[4 * x]);
+        }
       }
       png_write_row(png, row.data());
     }

@@ -120,8 +120,9 @@ std::vector<std::string> read_exr_part_names(const std::string& path);
 void read_views_exr_part(const std::string& path, int part, int& width, int& height, std::vector<uint16_t>& rgba_half,
                          std::vector<float>* depth = nullptr);
 
-// An 8-bit sRGB PNG for a person to look at: the linear half RGBA values (row 0 at the top) encoded with
-// the sRGB transfer curve, clamped to [0, 1] and rounded; alpha linear. Written atomically, fast deflate
+// An 8-bit sRGB PNG for a person to look at: the linear half RGBA values (row 0 at the top, colour
+// premultiplied by alpha) as PNG's straight alpha: colour divided by alpha where 0 < alpha < 1, encoded
+// with the sRGB transfer curve, clamped to [0, 1] and rounded; alpha linear. Written atomically, fast deflate
 // (a preview, not an archive). A pixel_aspect (pixel width / height) other than 1 is recorded in a pHYs
 // chunk. `opaque`: RGB only, what the pixels show over black. The encoded image is previewed so: its
 // three subpixels come from three views, so no one alpha per pixel composites it right (a viewer would

@@ -82,7 +82,7 @@ typedef struct {
   global const float* positions;    /* world space, 3 floats per vertex: the surface point (pbr)  */
   global const float4* eyes;        /* each view's camera position, world space (pbr)            */
   global const float2* split_sum;   /* PMR_SPLIT_SUM_N^2 (A, B) (see PMR_SPLIT_SUM_N)             */
-  global const float2* texcoords;   /* TEXCOORD set k of vertex v at k * num_vertices + v (pbr maps) */
+  global const float2* texcoords;   /* TEXCOORD set k of vertex v at k * num_vertices + v (the maps) */
   global const float4* tangents;    /* world tangent per vertex (w: bitangent sign), pbr normal maps */
   global const PmrEnvironment* env; /* pbr: the environment image's tables, level_count 0 = none */
   global const float4* env_data;    /* ... their data (cl/environment.h)                        */
@@ -90,7 +90,8 @@ typedef struct {
 } ShadeInputs;
 
 /* Material map `map` of triangle t at source barycentrics b (one lane): its TEXCOORD set interpolated,
- * then its KHR_texture_transform. */
+ * then its KHR_texture_transform. Every map, base colour included, is read here alone, so that a set and
+ * a transform mean the same for the colour, the alpha test and the pbr maps. */
 inline float4 sample_map(const ShadeInputs* in, global const PmrTextureMap* map, const PmrTriangle* t, float3 b,
                          bool srgb) {
   const uint set = map->texcoord * in->P->num_vertices;
@@ -120,7 +121,7 @@ typedef struct {
   sfloat3 p[3];       /* pbr: vertex positions, world space                              */
   sfloat metallic, roughness;
   sfloat3 emissive;
-  uint textured; /* bit l: lane l's material has a texture                          */
+  uint textured; /* bit l: lane l's material has a map the model reads (lambert: base colour) */
   uint tri[SW];  /* lane l's triangle, where textured                               */
 } LaneWinners;
 
@@ -164,7 +165,8 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
     if (pbr) L->p[k] = blend3(L->p[k], vload3(t.v[k], in->positions), take);
   }
   L->factor = blend3(L->factor, vload3(0, mat->base_color), take);
-  bool textured = mat->texture >= 0;
+  /* lambert reads the base colour map alone, pbr every map */
+  bool textured = mat->maps[PMR_MAP_BASE_COLOR].texture >= 0;
   if (pbr) {
     L->metallic = blend(L->metallic, mat->metallic, take);
     L->roughness = blend(L->roughness, mat->roughness, take);
@@ -256,14 +258,8 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
     const PmrTriangle t = in->tris[L->tri[l]];
     global const PmrMaterial* mat = &in->materials[t.material];
     const float3 bl = (float3)(bs[0][l], bs[1][l], bs[2][l]);
-    if (mat->texture >= 0) {
-      const PmrTexture tex = in->textures[mat->texture];
-      global const PmrVertexAttr* a0 = &in->attrs[t.v[0]];
-      global const PmrVertexAttr* a1 = &in->attrs[t.v[1]];
-      global const PmrVertexAttr* a2 = &in->attrs[t.v[2]];
-      const float u = bl.x * a0->uv[0] + bl.y * a1->uv[0] + bl.z * a2->uv[0];
-      const float v = bl.x * a0->uv[1] + bl.y * a1->uv[1] + bl.z * a2->uv[1];
-      const float4 c = sample_texture(in->texels, in->srgb_lut, &tex, u, v, true);
+    if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
+      const float4 c = sample_map(in, &mat->maps[PMR_MAP_BASE_COLOR], &t, bl, true);
       T->base[0][l] = c.x, T->base[1][l] = c.y, T->base[2][l] = c.z;
     }
     if (!pbr) continue;
@@ -446,7 +442,7 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
 
 /* alphaMode MASK: the base colour alpha of MTA m at raster point (X, Y) of view `view` passes the cutoff:
  * one voxel, scalar (the raster asks this of a few candidate voxels; its inputs are the same as the
- * lanes' base colour). */
+ * lanes' base colour: the factor, COLOR_0 and the base colour map through sample_map). */
 inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, long Y, int view, float cutoff) {
   const long f = view_coord(in->P, view);
   const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, f), m->sign * mta_edge(m, 2, 0, X, Y, f),
@@ -461,15 +457,8 @@ inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, lon
   global const PmrMaterial* mat = &in->materials[t.material];
   float alpha = mat->base_color[3] * (b.x * in->attrs[t.v[0]].color[3] + b.y * in->attrs[t.v[1]].color[3] +
                                       b.z * in->attrs[t.v[2]].color[3]);
-  if (mat->texture >= 0) {
-    const PmrTexture tex = in->textures[mat->texture];
-    global const PmrVertexAttr* a0 = &in->attrs[t.v[0]];
-    global const PmrVertexAttr* a1 = &in->attrs[t.v[1]];
-    global const PmrVertexAttr* a2 = &in->attrs[t.v[2]];
-    const float u = b.x * a0->uv[0] + b.y * a1->uv[0] + b.z * a2->uv[0];
-    const float v = b.x * a0->uv[1] + b.y * a1->uv[1] + b.z * a2->uv[1];
-    alpha *= sample_texture(in->texels, in->srgb_lut, &tex, u, v, true).w;
-  }
+  if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0)
+    alpha *= sample_map(in, &mat->maps[PMR_MAP_BASE_COLOR], &t, b, true).w;
   return alpha >= cutoff;
 }
 

@@ -267,6 +267,103 @@ TEST(Pbr, MaterialMapsMatchTheReference) {
               check.worst);
 }
 
+// An opaque quad and an alphaMode MASK quad (over a background) whose base colour texture is sampled on
+// TEXCOORD_1 through a KHR_texture_transform (offset, rotation, scale); TEXCOORD_0 holds other values.
+Scene transformed_base_colour() {
+  Scene s = test::empty_scene(false);
+  SceneTexture t;  // RGB gradients, alpha in 2x2-texel blocks of 0 and 1
+  t.width = t.height = 8;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x)
+      for (int c : {20 + 33 * x, 20 + 33 * y, 40 + 25 * ((3 * x + 5 * y) % 8), (x / 2 + y / 2) % 2 ? 0 : 255})
+        t.rgba.push_back(uint8_t(c));
+  s.textures.push_back(t);
+  for (uint32_t k = 1; k <= 2; ++k) {
+    PmrMaterial m = s.materials[0];
+    m.base_color[0] = 0.9f, m.base_color[1] = 0.8f, m.base_color[2] = 0.7f;
+    m.metallic = 0.0f, m.roughness = 0.6f;
+    if (k == 2) m.alpha_mode = PMR_ALPHA_MASK, m.alpha_cutoff = 0.5f;
+    s.materials.push_back(m);
+    SceneTextureSlot& slot = test::base_colour_texture(s, k, 0, 1);
+    slot.transform = true;
+    slot.offset[0] = 0.2f, slot.offset[1] = -0.1f, slot.rotation = 0.5f, slot.scale[0] = 2.0f, slot.scale[1] = 1.5f;
+  }
+  auto quad = [&](float x0, float x1, float z, uint32_t material) {
+    test::add_triangle(s, {x0, -0.9f, z}, {x1, -0.8f, z - 0.1f}, {x1, 0.9f, z}, material);
+    test::add_triangle(s, {x0, -0.9f, z}, {x1, 0.9f, z}, {x0, 1.0f, z + 0.1f}, material);
+  };
+  quad(-1.2f, -0.05f, 0.1f, 1);  // opaque
+  quad(0.05f, 1.2f, -0.4f, 0);   // untextured, seen through the mask's holes
+  quad(0.05f, 1.2f, 0.3f, 2);    // masked
+  for (size_t v = 0; v < s.positions.size(); ++v) {
+    const glm::vec3 p = s.positions[v];
+    test::texcoord(s, 0, v) = glm::vec2(0.3f * p.y + 0.1f, 0.7f * p.x);
+    test::texcoord(s, 1, v) = glm::vec2(0.5f * p.x + 0.6f, 0.5f - 0.5f * p.y);
+  }
+  return s;
+}
+
+// The transformed base colour in both models, and the mask's alpha test at the transformed alpha,
+// against the reference; the reference must tell the transform from none and from one applied twice
+// (a set baked on the host and transformed again), so a kernel doing either would fail.
+TEST(Pbr, BaseColourTextureTransformMatchesTheReferenceInBothModels) {
+  const Rig rig = test::small_rig(5, 72, 40);
+  const Scene s = transformed_base_colour();
+  Scene ignored = s, twice = s;
+  for (uint32_t k : {1u, 2u}) ignored.material_inputs[k].slots[kSlotBaseColor].transform = false;
+  for (glm::vec2& uv : twice.texcoords[1])
+    uv = glm::vec2(ref::transformed_uv(s.material_inputs[1].slots[kSlotBaseColor], glm::dvec2(uv)));
+  auto material = [&](uint32_t key) { return s.triangles[key >> PMR_KEY_SUB_BITS].material; };
+  const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
+  for (const Shading shading : {Shading::Lambert, Shading::Pbr}) {
+    SCOPED_TRACE(shading == Shading::Pbr ? "pbr" : "lambert");
+    const test::Rendered out = render_pbr(s, rig, 0.0, Method::Pmr, shading);
+    const VoxelReference reference(s, rig, out);
+    BoundCheck check;
+    size_t textured = 0, distinct = 0, masked = 0, moved_without = 0, moved_twice = 0;
+    for (size_t v = 0; v < out.key.size(); ++v) {
+      if (out.key[v] == PMR_NO_KEY) continue;
+      const int px = int(v % W), py = int((v / W) % H), view = int(v / (W * H));
+      const PmrMta* m = reference.mta(v);
+      ASSERT_NE(m, nullptr);
+      const glm::dvec3 b = ref::source_barycentrics(*m, px, py, view);
+      check.voxel(out, v,
+                  shading == Shading::Pbr
+                      ? reference.colour(v, *m)
+                      : glm::dvec3(ref::shade(s, m->tri, b, (m->flags & PMR_MTA_BACK) != 0, rig.light_world())));
+      if (material(out.key[v]) == 1) {
+        const glm::dvec3 want(ref::base_color(s, m->tri, b));
+        ++textured;
+        distinct += glm::length(want - glm::dvec3(ref::base_color(ignored, m->tri, b))) > 0.05 &&
+                    glm::length(want - glm::dvec3(ref::base_color(twice, m->tri, b))) > 0.05;
+        continue;
+      }
+      for (const auto& [key, mask] : reference.by_key) {  // the masked quad's alpha at this voxel
+        if (material(key) != 2 || view < mask.view_lo || view > mask.view_hi) continue;
+        const glm::dvec3 bm = ref::source_barycentrics(mask, px, py, view);
+        if (bm.x < 0 || bm.y < 0 || bm.z < 0) continue;  // not this half of the quad
+        const double alpha = ref::base_color(s, mask.tri, bm).w;
+        if (std::abs(alpha - 0.5) < 1e-3) break;  // on the cutoff: float and double may disagree
+        ++masked;
+        EXPECT_EQ(material(out.key[v]) == 2, alpha >= 0.5) << "voxel (" << px << "," << py << "," << view << ")";
+        moved_without += (ref::base_color(ignored, mask.tri, bm).w >= 0.5) != (alpha >= 0.5);
+        moved_twice += (ref::base_color(twice, mask.tri, bm).w >= 0.5) != (alpha >= 0.5);
+        break;
+      }
+    }
+    EXPECT_EQ(check.bad, 0u);
+    EXPECT_GT(textured, size_t(1000));
+    EXPECT_GT(masked, size_t(800));
+    EXPECT_GT(distinct, textured * 3 / 4) << "the transform should change most base colours";
+    EXPECT_GT(moved_without, masked / 4) << "the transform should move the mask's holes";
+    EXPECT_GT(moved_twice, masked / 4) << "applied twice, it should move them again";
+    std::printf(
+        "[ base map ] %zu textured voxels (%zu changed without the transform or with it twice), %zu masked "
+        "(the holes move on %zu without it, %zu with it twice), largest error %.3f of the bound\n",
+        textured, distinct, masked, moved_without, moved_twice, check.worst);
+  }
+}
+
 // Real models with maps (../shared/gltf): Avocado (metallic-roughness and normal maps, TANGENT), the same
 // file with TANGENT removed (generated tangents), MultiUVTest (an emissive map on TEXCOORD_1). Every
 // shaded voxel whose roughness is at least 0.2 matches the reference.

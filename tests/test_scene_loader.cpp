@@ -18,6 +18,7 @@
 #include "pmr/error.h"
 #include "pmr/scene.h"
 #include "gltf_builder.h"
+#include "reference/shade_reference.h"
 
 namespace pmr {
 namespace {
@@ -87,16 +88,17 @@ TEST_F(SceneLoaderTest, TrsChildUnderMatrixParentGivesExactWorldPositionsAndNorm
   for (int k = 0; k < 3; ++k) EXPECT_VEC3_NEAR(vec3(s.attributes[s.triangles[0].v[k]].normal), expected_normal, 1e-6);
   EXPECT_EQ(s.triangles[0].has_normals, 1u);
   EXPECT_VEC3_NEAR(vec3(s.triangles[0].face_normal), glm::vec3(0, 0, 1), 1e-6);
-  // No material: the default one (white, opaque, single-sided); no UVs or colours: defaults.
+  // No material: the default one (white, untextured, opaque, single-sided); no UVs (no set is read) or
+  // colours: defaults.
   EXPECT_EQ(s.triangles[0].material, 0u);
   ASSERT_GE(s.materials.size(), 1u);
   EXPECT_EQ(s.materials[0].base_color[0], 1.0f);
-  EXPECT_EQ(s.materials[0].texture, -1);
+  ASSERT_GE(s.material_inputs.size(), 1u);
+  EXPECT_EQ(s.material_inputs[0].slots[kSlotBaseColor].texture, -1);
   EXPECT_EQ(s.materials[0].alpha_mode, PMR_ALPHA_OPAQUE);
   EXPECT_EQ(s.materials[0].double_sided, 0u);
+  EXPECT_TRUE(s.texcoords.empty());
   const PmrVertexAttr& a = s.attributes[s.triangles[0].v[0]];
-  EXPECT_EQ(a.uv[0], 0.0f);
-  EXPECT_EQ(a.uv[1], 0.0f);
   for (float c : a.color) EXPECT_EQ(c, 1.0f);
   glm::dvec3 lo, hi;
   scene_bounds(s, lo, hi);
@@ -222,7 +224,12 @@ TEST_F(SceneLoaderTest, NormalizedColoursTexcoordsAndNormals) {
   const int uv16 = g.data<uint16_t>({65535, 32768, 0, 0, 13107, 65535}, kUShort, "VEC2", true);
   const int nrm8 = g.data<int8_t>({0, 0, 127, 0, 0, -128, -127, 0, 0, 0, 0, 0}, kByte, "VEC3", true);  // padded to 4
   g.doc["accessors"][nrm8]["count"] = 3;
-  g.mesh(json::array({{{"attributes", {{"POSITION", pos}, {"COLOR_0", col8}, {"TEXCOORD_0", uv16}, {"NORMAL", nrm8}}}},
+  // a base colour texture, so that TEXCOORD_0 is read
+  g.add("images", {{"uri", png_uri(make_png(1, 1, 6, 8, {255, 255, 255, 255}))}});
+  g.add("textures", {{"source", 0}});
+  g.add("materials", {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+  g.mesh(json::array({{{"attributes", {{"POSITION", pos}, {"COLOR_0", col8}, {"TEXCOORD_0", uv16}, {"NORMAL", nrm8}}},
+                       {"material", 0}},
                       {{"attributes", {{"POSITION", pos}, {"COLOR_0", col16}}}}}));
   g.add("nodes", {{"mesh", 0}});
   g.scene({0});
@@ -234,10 +241,11 @@ TEST_F(SceneLoaderTest, NormalizedColoursTexcoordsAndNormals) {
   EXPECT_FLOAT_EQ(a[0].color[2], 0.0f);
   EXPECT_FLOAT_EQ(a[0].color[3], 0.2f);
   EXPECT_FLOAT_EQ(a[2].color[3], 1.0f);
-  EXPECT_FLOAT_EQ(a[0].uv[0], 1.0f);
-  EXPECT_FLOAT_EQ(a[0].uv[1], 32768.0f / 65535.0f);
-  EXPECT_FLOAT_EQ(a[2].uv[0], 0.2f);
-  EXPECT_FLOAT_EQ(a[2].uv[1], 1.0f);
+  ASSERT_EQ(s.texcoords.size(), 1u);
+  EXPECT_FLOAT_EQ(s.texcoords[0][0].x, 1.0f);
+  EXPECT_FLOAT_EQ(s.texcoords[0][0].y, 32768.0f / 65535.0f);
+  EXPECT_FLOAT_EQ(s.texcoords[0][2].x, 0.2f);
+  EXPECT_FLOAT_EQ(s.texcoords[0][2].y, 1.0f);
   EXPECT_VEC3_NEAR(vec3(a[0].normal), glm::vec3(0, 0, 1), 0);
   EXPECT_VEC3_NEAR(vec3(a[1].normal), glm::vec3(0, 0, -1), 0);  // -128 clamps to -1
   EXPECT_VEC3_NEAR(vec3(a[2].normal), glm::vec3(-1, 0, 0), 0);
@@ -297,9 +305,9 @@ TEST_F(SceneLoaderTest, MaterialsTexturesSamplersAndTextureTransform) {
   EXPECT_EQ(s.materials[3].alpha_cutoff, 0.5f);
   ASSERT_EQ(s.textures.size(), 4u);  // the missing and the undecodable image give none
   auto texture = [&](int material) -> const SceneTexture& {
-    return s.textures[size_t(s.materials[size_t(material)].texture)];
+    return s.textures[size_t(s.material_inputs[size_t(material)].slots[kSlotBaseColor].texture)];
   };
-  ASSERT_GE(m0.texture, 0);
+  ASSERT_GE(s.material_inputs[1].slots[kSlotBaseColor].texture, 0);
   EXPECT_EQ(texture(1).width, 2);
   EXPECT_EQ(texture(1).height, 1);
   EXPECT_EQ(texture(1).rgba, (std::vector<uint8_t>{255, 0, 0, 255, 0, 0, 255, 128}));
@@ -308,8 +316,8 @@ TEST_F(SceneLoaderTest, MaterialsTexturesSamplersAndTextureTransform) {
   EXPECT_EQ(texture(2).rgba, (std::vector<uint8_t>{255, 255, 255, 255, 128, 128, 128, 255}));  // 16-bit grey
   EXPECT_EQ(texture(3).rgba, (std::vector<uint8_t>{10, 10, 10, 20, 30, 30, 30, 40}));          // grey + alpha
   EXPECT_EQ(texture(4).rgba, (std::vector<uint8_t>{1, 2, 3, 255}));                            // RGB
-  EXPECT_EQ(s.materials[5].texture, -1);
-  EXPECT_EQ(s.materials[6].texture, -1);
+  EXPECT_EQ(s.material_inputs[5].slots[kSlotBaseColor].texture, -1);
+  EXPECT_EQ(s.material_inputs[6].slots[kSlotBaseColor].texture, -1);
   EXPECT_TRUE(any_warning(s, "nope.png")) << "a missing image is a warning naming it";
   EXPECT_TRUE(any_warning(s, "cannot decode"));
   EXPECT_TRUE(any_warning(s, "alphaMode BLEND drawn as opaque"));
@@ -317,14 +325,30 @@ TEST_F(SceneLoaderTest, MaterialsTexturesSamplersAndTextureTransform) {
   EXPECT_FALSE(any_warning(s, "KHR_texture_transform"));
   // The extension's own example: offset (0,1), rotation pi/2, scale 0.5 maps the unit square onto the
   // lower-left quadrant of the image, (0,0) -> (0,1), (1,0) -> (0,0.5), (1,1) -> (0.5,0.5),
-  // (0,1) -> (0.5,1); its texCoord (1) overrides the textureInfo's (0).
-  const float expected_uv[4][2] = {{0, 1}, {0, 0.5f}, {0.5f, 0.5f}, {0.5f, 1}};
+  // (0,1) -> (0.5,1); its texCoord (1) overrides the textureInfo's (0). The slot keeps the extension's
+  // values and the sets stay as stored: the kernels apply the transform.
+  const SceneTextureSlot& slot = s.material_inputs[1].slots[kSlotBaseColor];
+  EXPECT_EQ(slot.texcoord, 1);
+  EXPECT_TRUE(slot.transform);
+  EXPECT_EQ(slot.offset[0], 0.0f);
+  EXPECT_EQ(slot.offset[1], 1.0f);
+  EXPECT_FLOAT_EQ(slot.rotation, 1.57079632679f);
+  EXPECT_EQ(slot.scale[0], 0.5f);
+  EXPECT_EQ(slot.scale[1], 0.5f);
+  const float stored_uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}},
+              expected_uv[4][2] = {{0, 1}, {0, 0.5f}, {0.5f, 0.5f}, {0.5f, 1}};
   ASSERT_EQ(s.triangles[0].material, 1u);
+  ASSERT_EQ(s.texcoords.size(), 2u);
   for (int v = 0; v < 4; ++v) {
-    EXPECT_NEAR(s.attributes[size_t(v)].uv[0], expected_uv[v][0], 1e-6) << "vertex " << v;
-    EXPECT_NEAR(s.attributes[size_t(v)].uv[1], expected_uv[v][1], 1e-6) << "vertex " << v;
+    EXPECT_EQ(s.texcoords[1][size_t(v)], glm::vec2(stored_uv[v][0], stored_uv[v][1])) << "vertex " << v;
+    const glm::dvec2 uv = ref::transformed_uv(slot, glm::dvec2(s.texcoords[1][size_t(v)]));
+    EXPECT_NEAR(uv.x, expected_uv[v][0], 1e-6) << "vertex " << v;
+    EXPECT_NEAR(uv.y, expected_uv[v][1], 1e-6) << "vertex " << v;
   }
-  EXPECT_EQ(s.attributes[4].uv[0], 9.0f);  // material 1 reads TEXCOORD_0 untransformed
+  // material 2 reads TEXCOORD_0 untransformed
+  EXPECT_EQ(s.material_inputs[2].slots[kSlotBaseColor].texcoord, 0);
+  EXPECT_FALSE(s.material_inputs[2].slots[kSlotBaseColor].transform);
+  EXPECT_EQ(s.texcoords[0][4], glm::vec2(9.0f));
 }
 
 // The container is recognised by its magic bytes: a GLB named .gltf and JSON named .glb both load.
@@ -921,7 +945,8 @@ TEST(SceneLoaderCorpus, EveryModelLoadsWithTheReadmeTriangleCount) {
                        t.face_normal[2] * t.face_normal[2];
       ASSERT_NEAR(n2, 1.0f, 1e-5f);
     }
-    for (const PmrMaterial& m : s.materials) ASSERT_LT(m.texture, int(s.textures.size()));
+    for (const SceneMaterialInputs& in : s.material_inputs)
+      for (const SceneTextureSlot& slot : in.slots) ASSERT_LT(slot.texture, int(s.textures.size()));
     for (const SceneTexture& t : s.textures) ASSERT_EQ(t.rgba.size(), size_t(t.width) * size_t(t.height) * 4);
   }
   EXPECT_GE(files, kCorpusTriangles.size()) << "every model in the README has at least one file";
@@ -936,7 +961,7 @@ TEST(SceneLoaderCorpus, BoxTexturedHasIts256x256TextureInEveryVariant) {
     ASSERT_EQ(s.textures.size(), 1u);
     EXPECT_EQ(s.textures[0].width, 256);
     EXPECT_EQ(s.textures[0].height, 256);
-    EXPECT_EQ(s.materials[s.triangles[0].material].texture, 0);
+    EXPECT_EQ(s.material_inputs[s.triangles[0].material].slots[kSlotBaseColor].texture, 0);
     EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
   }
 }
@@ -970,15 +995,17 @@ TEST(SceneLoaderCorpus, QuantizedDuckMatchesTheFloatDuck) {
     EXPECT_NEAR(lo1[c], lo0[c], step) << "axis " << c;
     EXPECT_NEAR(hi1[c], hi0[c], step) << "axis " << c;
   }
-  auto uv_bounds = [](const Scene& s) {
-    glm::vec4 b(1e9f, 1e9f, -1e9f, -1e9f);
-    for (const PmrVertexAttr& a : s.attributes) {
-      b.x = std::min(b.x, a.uv[0]), b.y = std::min(b.y, a.uv[1]);
-      b.z = std::max(b.z, a.uv[0]), b.w = std::max(b.w, a.uv[1]);
+  auto uv_bounds = [](const Scene& s) {  // the base colour texture's, after its transform
+    const SceneTextureSlot& slot = s.material_inputs.at(s.triangles[0].material).slots[kSlotBaseColor];
+    glm::dvec4 b(1e9, 1e9, -1e9, -1e9);
+    for (const glm::vec2& stored : s.texcoords.at(size_t(slot.texcoord))) {
+      const glm::dvec2 uv = ref::transformed_uv(slot, glm::dvec2(stored));
+      b.x = std::min(b.x, uv.x), b.y = std::min(b.y, uv.y);
+      b.z = std::max(b.z, uv.x), b.w = std::max(b.w, uv.y);
     }
     return b;
   };
-  const glm::vec4 uv0 = uv_bounds(plain), uv1 = uv_bounds(quant);
+  const glm::dvec4 uv0 = uv_bounds(plain), uv1 = uv_bounds(quant);
   for (int c = 0; c < 4; ++c) EXPECT_NEAR(uv1[c], uv0[c], 2.35e-4) << "uv bound " << c;
   // Normals are unit length after the i8 dequantization and the node transform.
   for (const PmrTriangle& t : quant.triangles) {

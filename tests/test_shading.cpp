@@ -78,7 +78,7 @@ TEST(Shading, TexturedVertexColouredLitMatchesReference) {
   const Rig rig = test::small_rig(6, 64, 40);
   Scene s = test::empty_scene(true);
   s.textures.push_back(checker(4, 3, PMR_WRAP_REPEAT, PMR_WRAP_MIRROR, false));
-  s.materials[0].texture = 0;
+  test::base_colour_texture(s, 0, 0);
   s.materials[0].base_color[0] = 0.9f, s.materials[0].base_color[2] = 0.7f;
   // a tilted quad with distinct vertex colours, curved normals, UVs spanning several repeats
   test::add_triangle(s, {-1.2f, -0.9f, 0.4f}, {1.1f, -0.8f, -0.6f}, {1.0f, 0.9f, -0.2f});
@@ -86,16 +86,16 @@ TEST(Shading, TexturedVertexColouredLitMatchesReference) {
   const float uv[6][2] = {{-0.3f, 1.7f}, {2.4f, 1.5f}, {2.2f, -1.1f}, {-0.3f, 1.7f}, {2.2f, -1.1f}, {-0.5f, -0.9f}};
   const float col[6][4] = {{1, 0.2f, 0.2f, 1}, {0.2f, 1, 0.2f, 1}, {0.2f, 0.2f, 1, 1},
                            {1, 0.2f, 0.2f, 1}, {0.2f, 0.2f, 1, 1}, {1, 1, 1, 1}};
+  // a back-facing triangle (clockwise from the camera) behind, double-sided, without normals, at uv (0, 0)
+  test::add_triangle(s, {-1.0f, -1.0f, -0.9f}, {-0.2f, 0.6f, -0.9f}, {0.8f, -0.9f, -0.8f});
+  s.triangles.back().has_normals = 0;
   for (int k = 0; k < 6; ++k) {
     PmrVertexAttr& a = s.attributes[size_t(k)];
-    a.uv[0] = uv[k][0], a.uv[1] = uv[k][1];
+    test::texcoord(s, 0, size_t(k)) = glm::vec2(uv[k][0], uv[k][1]);
     for (int c = 0; c < 4; ++c) a.color[c] = col[k][c];
     const glm::vec3 n = glm::normalize(glm::vec3(0.4f * (k % 3) - 0.4f, 0.3f * (k % 2), 1.0f));
     a.normal[0] = n.x, a.normal[1] = n.y, a.normal[2] = n.z;
   }
-  // a back-facing triangle (clockwise from the camera) behind, double-sided, without normals
-  test::add_triangle(s, {-1.0f, -1.0f, -0.9f}, {-0.2f, 0.6f, -0.9f}, {0.8f, -0.9f, -0.8f});
-  s.triangles.back().has_normals = 0;
   const test::Rendered out = test::render_with(s, rig, lambert());
   EXPECT_GT(compare_shading(s, rig, out), size_t(2000));
   size_t back = 0;
@@ -108,19 +108,18 @@ TEST(Shading, AlphaMaskDiscardsBelowCutoff) {
   const Rig rig = test::small_rig(3, 48, 32);
   Scene s = test::empty_scene(false);
   PmrMaterial mask = s.materials[0];
-  mask.texture = 0;
   mask.alpha_mode = PMR_ALPHA_MASK;
   mask.alpha_cutoff = 0.5f;
   s.materials.push_back(mask);
   s.textures.push_back(checker(2, 2, PMR_WRAP_REPEAT, PMR_WRAP_REPEAT, true));
+  test::base_colour_texture(s, 1, 0);
   // background quad (material 0) and a masked quad in front (material 1), UVs 0..3
   test::add_triangle(s, {-6, -3, -0.5f}, {6, -3, -0.5f}, {6, 3, -0.5f});
   test::add_triangle(s, {-6, -3, -0.5f}, {6, 3, -0.5f}, {-6, 3, -0.5f});
   test::add_triangle(s, {-6, -3, 0.5f}, {6, -3, 0.5f}, {6, 3, 0.5f}, 1);
   test::add_triangle(s, {-6, -3, 0.5f}, {6, 3, 0.5f}, {-6, 3, 0.5f}, 1);
   const float uv[6][2] = {{0, 4}, {8, 4}, {8, 0}, {0, 4}, {8, 0}, {0, 0}};
-  for (int k = 0; k < 6; ++k)
-    s.attributes[size_t(6 + k)].uv[0] = uv[k][0], s.attributes[size_t(6 + k)].uv[1] = uv[k][1];
+  for (int k = 0; k < 6; ++k) test::texcoord(s, 0, size_t(6 + k)) = glm::vec2(uv[k][0], uv[k][1]);
   const test::Rendered out = test::render_with(s, rig, lambert());
   std::multimap<uint32_t, PmrMta> by_key;
   for (const PmrMta& m : out.mtas) by_key.emplace(m.key, m);

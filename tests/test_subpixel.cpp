@@ -357,10 +357,10 @@ TEST(SubpixelSampling, EqualsViewSamplingWhereSamplesArePixelCenters) {
   holes.rgba = {200, 60, 30, 255, 10, 10, 10, 0, 10, 10, 10, 0, 30, 90, 220, 255};
   scene.textures.push_back(holes);
   PmrMaterial mask = scene.materials[0];
-  mask.texture = 0;
   mask.alpha_mode = PMR_ALPHA_MASK;
   mask.alpha_cutoff = 0.5f;
   scene.materials.push_back(mask);
+  test::base_colour_texture(scene, uint32_t(scene.materials.size() - 1), 0);
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> uv(0.0f, 3.0f);
   for (size_t t = 0; t < scene.triangles.size(); t += 2)
@@ -374,7 +374,10 @@ TEST(SubpixelSampling, EqualsViewSamplingWhereSamplesArePixelCenters) {
     copy.material = (copy.material + 1) % uint32_t(scene.materials.size());
     scene.triangles.push_back(copy);
   }
-  for (PmrVertexAttr& a : scene.attributes) a.uv[0] = uv(rng), a.uv[1] = uv(rng);
+  for (size_t v = 0; v < scene.positions.size(); ++v) {
+    const float u = uv(rng);
+    test::texcoord(scene, 0, v) = glm::vec2(u, uv(rng));
+  }
   Display d;
   d.width = 64, d.height = 40;
   d.lens_pitch = parse_rational("7.3125", "L");

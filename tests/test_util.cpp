@@ -50,6 +50,26 @@ void add_triangle(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t mate
   s.triangles.push_back(t);
 }
 
+SceneTextureSlot& base_colour_texture(Scene& s, uint32_t material, int texture, int set) {
+  while (s.material_inputs.size() < s.materials.size()) {
+    const PmrMaterial& m = s.materials[s.material_inputs.size()];
+    SceneMaterialInputs in;
+    in.metallic = m.metallic, in.roughness = m.roughness, in.unlit = m.unlit != 0;
+    for (int c = 0; c < 3; ++c) in.emissive[c] = m.emissive[c];
+    in.slots[kSlotBaseColor].srgb = in.slots[kSlotEmissive].srgb = true;
+    s.material_inputs.push_back(in);
+  }
+  SceneTextureSlot& slot = s.material_inputs[material].slots[kSlotBaseColor];
+  slot.texture = texture, slot.texcoord = set;
+  return slot;
+}
+
+glm::vec2& texcoord(Scene& s, int set, size_t v) {
+  if (s.texcoords.size() <= size_t(set)) s.texcoords.resize(size_t(set) + 1);
+  for (std::vector<glm::vec2>& t : s.texcoords) t.resize(s.positions.size(), glm::vec2(0.0f));
+  return s.texcoords[size_t(set)][v];
+}
+
 Scene random_scene(int n, uint32_t seed, bool double_sided) {
   Scene s = empty_scene(double_sided);
   std::mt19937 rng(seed);

@@ -29,6 +29,13 @@ Scene empty_scene(bool double_sided = false);
 // Adds a triangle with world-space corners (counter-clockwise seen from +Z = front for the default
 // rig, which looks down -Z).
 void add_triangle(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t material = 0);
+// Gives `material` the base colour texture `texture` (sRGB) sampled on TEXCOORD set `set`, and returns
+// the slot (for a transform). Material inputs are added for the materials that have none, with their
+// PmrMaterial's pbr factors.
+SceneTextureSlot& base_colour_texture(Scene& s, uint32_t material, int texture, int set = 0);
+// TEXCOORD set `set` of vertex v; every set (up to `set`) is sized to the scene's vertices first, (0, 0)
+// where not given. Call after the last vertex is added.
+glm::vec2& texcoord(Scene& s, int set, size_t v);
 // `n` random triangles inside the box [-1,1]^3, sizes from sub-pixel to a good part of the screen.
 Scene random_scene(int n, uint32_t seed, bool double_sided);
 

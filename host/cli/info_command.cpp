@@ -104,8 +104,8 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
               d.generator.empty() ? "" : (" (generator: " + printable_text(d.generator, 120) + ")").c_str());
   std::printf("triangles: %zu, vertices: %zu (%zu mesh instance(s) of %zu mesh(es), %zu primitive(s), %zu node(s))\n",
               s.triangles.size(), s.positions.size(), d.mesh_instances, d.meshes, d.primitives, d.nodes);
-  size_t textured = 0;
-  for (const PmrMaterial& m : s.materials) textured += m.texture >= 0;
+  size_t textured = 0;  // with a base colour texture
+  for (const SceneMaterialInputs& in : s.material_inputs) textured += in.slots[kSlotBaseColor].texture >= 0;
   std::printf("materials: %zu (with the default one; %zu textured), textures: %zu\n", s.materials.size(), textured,
               s.textures.size());
   describe_materials(s);

@@ -7,6 +7,12 @@
 
 namespace pmr {
 
+// A material's map k is its texture slot k (make_material_tables copies them by index).
+static_assert(PMR_MAP_BASE_COLOR == kSlotBaseColor && PMR_MAP_METALLIC_ROUGHNESS == kSlotMetallicRoughness &&
+                  PMR_MAP_NORMAL == kSlotNormal && PMR_MAP_OCCLUSION == kSlotOcclusion &&
+                  PMR_MAP_EMISSIVE == kSlotEmissive && PMR_MAPS == kTextureSlots,
+              "PMR_MAP_* follow SceneTextureSlotKind");
+
 void texture_transform_matrix(const SceneTextureSlot& slot, float out[6]) {
   if (!slot.transform) {
     const float identity[6] = {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f};
@@ -47,8 +53,6 @@ MaterialTables make_material_tables(const Scene& scene) {
     t.texcoords.insert(t.texcoords.end(), set.begin(), set.end());
   if (t.texcoords.empty()) t.texcoords.emplace_back(0.0f);
 
-  // The device slots beyond base colour, in PMR_MAP_* order (the base colour map is PmrMaterial::texture).
-  static const int kMapSlot[PMR_MAPS] = {kSlotMetallicRoughness, kSlotNormal, kSlotOcclusion, kSlotEmissive};
   const bool has_tangents = scene.tangents.size() == vertices && vertices > 0;
   t.materials = scene.materials;
   for (size_t i = 0; i < t.materials.size(); ++i) {
@@ -63,11 +67,11 @@ MaterialTables make_material_tables(const Scene& scene) {
     for (int c = 0; c < 3; ++c) m.emissive[c] = in.emissive[c] * in.emissive_strength;
     m.normal_scale = in.normal_scale, m.occlusion_strength = in.occlusion_strength;
     for (int k = 0; k < PMR_MAPS; ++k) {
-      const SceneTextureSlot& slot = in.slots[size_t(kMapSlot[k])];
+      const SceneTextureSlot& slot = in.slots[size_t(k)];  // PMR_MAP_* is the slot's kind
       if (slot.texture < 0) continue;
       if (size_t(slot.texture) >= scene.textures.size() || slot.texcoord < 0 ||
           size_t(slot.texcoord) >= scene.texcoords.size())
-        throw InternalError("material " + std::to_string(i) + "'s " + texture_slot_name(kMapSlot[k]) +
+        throw InternalError("material " + std::to_string(i) + "'s " + texture_slot_name(k) +
                             " names a texture or TEXCOORD set the scene does not have");
       if (k == PMR_MAP_NORMAL && !has_tangents) continue;
       PmrTextureMap& map = m.maps[k];

@@ -12,7 +12,7 @@
 namespace pmr {
 
 struct MaterialTables {
-  std::vector<PmrMaterial> materials;  // Scene::materials, the pbr fields from Scene::material_inputs
+  std::vector<PmrMaterial> materials;  // Scene::materials, the maps and pbr fields from Scene::material_inputs
   std::vector<PmrTexture> textures;    // one per Scene::textures
   std::vector<uint8_t> texels;         // RGBA8 as stored, textures back to back (PmrTexture::offset)
   std::vector<glm::vec2> texcoords;    // TEXCOORD set k of vertex v at k * vertices + v (at least one entry)

@@ -15,9 +15,9 @@ static_assert(sizeof(PmrVertex) == 64 && offsetof(PmrVertex, x0) == 32 && offset
 static_assert(sizeof(PmrMta) == 27 * 4, "PmrMta layout");
 static_assert(offsetof(PmrMta, bary) == 60 && offsetof(PmrMta, tri) == 84 && offsetof(PmrMta, flags) == 104,
               "PmrMta layout");
-static_assert(sizeof(PmrVertexAttr) == 36, "PmrVertexAttr layout");
+static_assert(sizeof(PmrVertexAttr) == 28 && offsetof(PmrVertexAttr, color) == 12, "PmrVertexAttr layout");
 static_assert(sizeof(PmrTriangle) == 32, "PmrTriangle layout");
-static_assert(sizeof(PmrMaterial) == 56 + 4 * 32 + 8 && offsetof(PmrMaterial, maps) == 56, "PmrMaterial layout");
+static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 8 && offsetof(PmrMaterial, maps) == 52, "PmrMaterial layout");
 static_assert(sizeof(PmrTextureMap) == 32, "PmrTextureMap layout");
 static_assert(sizeof(PmrTexture) == 32, "PmrTexture layout");
 static_assert(sizeof(PmrEncodeParams) == 48 && offsetof(PmrEncodeParams, display_w) == 0, "PmrEncodeParams layout");

@@ -169,19 +169,16 @@ void check_animation_budget(const tinygltf::Model& model, const InputLimits& lim
 
 // ---- materials and textures ---------------------------------------------------------------------------
 
-// uv' = T * R * S * uv (KHR_texture_transform). The extension's GLSL reads as
+// A textureInfo's TEXCOORD set and KHR_texture_transform, uv' = T * R * S * uv, kept as the extension's
+// values: the kernels apply it to the stored set (the matrix: texture_transform_matrix,
+// host/pipeline/material_tables.cpp). The extension's GLSL reads as
 // u' = cos*sx*u + sin*sy*v + ox, v' = -sin*sx*u + cos*sy*v + oy: this is what the Khronos sample viewer
 // does and what the extension's own example needs (offset (0,1), rotation pi/2, scale 0.5 selects the
 // lower-left quadrant of the image).
-struct UvTransform {
-  bool active = false;
-  double a = 1, b = 0, c = 0, d = 1, tx = 0, ty = 0;
-};
-
 struct MaterialUv {
-  int set = 0;  // TEXCOORD_n of the texture
-  UvTransform transform;
-  float offset[2] = {0, 0}, rotation = 0, scale[2] = {1, 1};  // the extension's values (when active)
+  int set = 0;                                                // TEXCOORD_n of the texture
+  bool transform = false;                                     // the extension is present and valid
+  float offset[2] = {0, 0}, rotation = 0, scale[2] = {1, 1};  // the extension's values (when present)
 };
 
 struct Loader {
@@ -193,7 +190,6 @@ struct Loader {
   const ImageContext& images;
   Scene& scene;
   std::set<std::string> seen;
-  std::vector<MaterialUv> material_uv;  // per glTF material: its base colour texture's set and transform
   std::vector<std::array<int, kTextureSlots>> slot_sets;  // per glTF material and slot: TEXCOORD set, -1 = no texture
   int texcoord_sets = 0;                                  // 1 + the highest set any slot samples
   std::map<int, int> scene_texture_of;                    // glTF texture -> Scene::textures index (-1: unusable)
@@ -256,8 +252,7 @@ MaterialUv material_uv(Loader& L, int texcoord, const tinygltf::ExtensionMap& ex
     if (tc.IsInt() && tc.GetNumberAsInt() >= 0) uv.set = tc.GetNumberAsInt();
     else L.warn(name + " has an invalid texCoord; ignored");
   }
-  const double c = std::cos(rotation), s = std::sin(rotation);
-  uv.transform = {true, c * scale[0], s * scale[1], -s * scale[0], c * scale[1], offset[0], offset[1]};
+  uv.transform = true;
   uv.offset[0] = float(offset[0]), uv.offset[1] = float(offset[1]);
   uv.rotation = float(rotation);
   uv.scale[0] = float(scale[0]), uv.scale[1] = float(scale[1]);
@@ -433,18 +428,17 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
     sets[size_t(slot)] = -1;
     const Info& info = infos[slot];
     if (info.index < 0) continue;
-    // The base colour slot's transform was read (and warned about) by build_materials already.
-    const MaterialUv uv = slot == kSlotBaseColor
-                              ? L.material_uv[size_t(i)]
-                              : material_uv(L, info.texcoord, *info.extensions, i, texture_slot_name(slot));
+    // the base colour slot's messages name no slot (they predate the other slots)
+    const MaterialUv uv =
+        material_uv(L, info.texcoord, *info.extensions, i, slot == kSlotBaseColor ? "" : texture_slot_name(slot));
     out.texcoord = uv.set;
-    out.transform = uv.transform.active;
+    out.transform = uv.transform;
     if (out.transform) {
       out.offset[0] = uv.offset[0], out.offset[1] = uv.offset[1];
       out.rotation = uv.rotation;
       out.scale[0] = uv.scale[0], out.scale[1] = uv.scale[1];
     }
-    out.texture = slot == kSlotBaseColor ? L.scene.materials.back().texture : scene_texture(L, info.index, slot);
+    out.texture = scene_texture(L, info.index, slot);
     sets[size_t(slot)] = uv.set;
     L.texcoord_sets = std::max(L.texcoord_sets, uv.set + 1);
   }
@@ -473,9 +467,6 @@ void build_materials(Loader& L) {
     if (std::isfinite(g.alphaCutoff) && g.alphaCutoff >= 0.0) m.alpha_cutoff = float(g.alphaCutoff);
     else L.warn(name + " has an invalid alphaCutoff; using 0.5");
     m.double_sided = g.doubleSided ? 1u : 0u;
-    const tinygltf::TextureInfo& info = g.pbrMetallicRoughness.baseColorTexture;
-    L.material_uv.push_back(material_uv(L, info.texCoord, info.extensions, int(i)));
-    if (info.index >= 0) m.texture = scene_texture(L, info.index, kSlotBaseColor);
     L.scene.materials.push_back(m);
     L.scene.material_inputs.push_back(material_inputs(L, g, int(i)));
     // the factors the kernels read, as material_inputs checked them
@@ -547,7 +538,7 @@ size_t walk_count(const Loader& L, const std::vector<int>& roots) {
 // One primitive decoded in its mesh's space, shared by all instances of the mesh.
 struct Decoded {
   std::shared_ptr<DeformSource> geo;     // positions, normals, morph targets, joints and weights
-  std::vector<float> uv, col;            // empty when the attribute is absent
+  std::vector<float> col;                // COLOR_0, empty when absent
   std::vector<std::vector<float>> sets;  // TEXCOORD_k as stored, for the sets its material samples (else empty)
   std::vector<uint32_t> tris;            // 3 local vertex indices per triangle, as authored (CCW front)
   uint32_t material = 0;                 // Scene::materials index
@@ -645,22 +636,6 @@ int read_texcoord_sets(const PrimitiveAttributes& attrs, int mesh, int index, De
   return sets[kSlotNormal];
 }
 
-// The base colour texture's UVs (PmrVertexAttr::uv), with its KHR_texture_transform applied.
-std::vector<float> read_base_colour_uv(const PrimitiveAttributes& attrs) {
-  const int material = attrs.p.material;
-  const MaterialUv uv = material >= 0 ? attrs.L.material_uv[size_t(material)] : MaterialUv{};
-  std::vector<float> values = attrs.read("TEXCOORD_" + std::to_string(uv.set), Semantic::Texcoord);
-  if (uv.transform.active) {
-    const UvTransform& t = uv.transform;
-    for (size_t v = 0; v < values.size(); v += 2) {
-      const double u0 = values[v], v0 = values[v + 1];
-      values[v] = float(t.a * u0 + t.b * v0 + t.tx);
-      values[v + 1] = float(t.c * u0 + t.d * v0 + t.ty);
-    }
-  }
-  return values;
-}
-
 // 3 vertex indices per triangle, strips and fans unrolled, each index checked against POSITION.
 std::vector<uint32_t> triangle_list(Loader& L, const tinygltf::Primitive& p, int mode, const std::string& where,
                                     size_t vertices) {
@@ -735,7 +710,6 @@ Decoded decode_primitive(Loader& L, int mesh, int index) {
   }
   read_skin_influences(attrs, geo);
   const int normal_set = read_texcoord_sets(attrs, mesh, index, d);
-  d.uv = read_base_colour_uv(attrs);
   d.col = attrs.read("COLOR_0", Semantic::Color);
   d.tris = triangle_list(L, p, mode, where, geo.vertices);
   if (normal_set >= 0) read_tangents(attrs, d, normal_set);
@@ -787,10 +761,6 @@ void emit(Loader& L, const Decoded& d, const Instance& inst) {
   }
   for (size_t v = 0; v < geo.vertices; ++v) {
     PmrVertexAttr& a = s.attributes[base + v];
-    for (int c = 0; c < 2; ++c) {
-      a.uv[c] = d.uv.empty() ? 0.0f : d.uv[2 * v + size_t(c)];
-      if (!std::isfinite(a.uv[c])) a.uv[c] = 0.0f, ++L.nonfinite_attributes;
-    }
     for (int c = 0; c < 4; ++c) {
       a.color[c] = d.col.empty() ? 1.0f : d.col[4 * v + size_t(c)];
       if (!std::isfinite(a.color[c])) a.color[c] = 1.0f, ++L.nonfinite_attributes;

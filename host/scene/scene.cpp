@@ -9,7 +9,6 @@ namespace pmr {
 PmrMaterial default_material() {
   PmrMaterial m{};
   for (float& c : m.base_color) c = 1.0f;
-  m.texture = -1;
   m.alpha_mode = PMR_ALPHA_OPAQUE;
   m.alpha_cutoff = 0.5f;
   m.double_sided = 0;

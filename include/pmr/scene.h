@@ -48,8 +48,9 @@ struct SceneTextureSlot {
   float scale[2] = {1.0f, 1.0f};
 };
 
-// Everything of a glTF material the physically based model reads (DESIGN 4b), beside the PmrMaterial
-// the Lambert model reads (base colour factor, alpha mode and cutoff, sidedness stay there).
+// A glTF material's texture slots (both models read the base colour slot) and everything else of it the
+// physically based model reads (DESIGN 4b), beside the PmrMaterial factors the Lambert model reads (base
+// colour factor, alpha mode and cutoff, sidedness stay there).
 struct SceneMaterialInputs {
   std::string name;                                   // as in the file ("" when unnamed or the default material)
   float metallic = 1.0f, roughness = 1.0f;            // metallicFactor, roughnessFactor (validated to [0, 1])
@@ -124,9 +125,9 @@ struct Scene {
   std::vector<PmrTriangle> triangles;     // CCW front (winding already fixed for mirrored nodes)
   std::vector<PmrMaterial> materials;     // at least one: index 0 may be the glTF default material
                                           // (load_scene: 0 is the default, glTF material i is i + 1)
-  std::vector<SceneTexture> textures;     // referenced by PmrMaterial::texture and SceneTextureSlot::texture
-  // Physically based inputs (DESIGN 4b). material_inputs is parallel to materials (same index), or
-  // empty (generated scenes: every material has the defaults). texcoords[k] is TEXCOORD_k for every
+  std::vector<SceneTexture> textures;     // referenced by SceneTextureSlot::texture
+  // Texture slots and physically based inputs (DESIGN 4b). material_inputs is parallel to materials
+  // (same index), or empty (generated scenes: every material has the defaults, no textures). texcoords[k] is TEXCOORD_k for every
   // vertex, as stored in the file (no KHR_texture_transform applied: each slot has its own), for each
   // set k some material slot samples ((0, 0) for vertices of meshes without it, whose materials do not
   // sample it). tangents is empty or one per vertex: world-space unit xyz, and w = the file's

@@ -185,7 +185,6 @@ typedef struct {
 /* Per-vertex shading attributes. Producer: host (scene flattening). */
 typedef struct {
   float normal[3]; /* world-space unit normal (unused when the triangle has none)     */
-  float uv[2];     /* TEXCOORD_0, (0,0) = top-left of the image                       */
   float color[4];  /* COLOR_0 (linear), (1,1,1,1) when absent                         */
 } PmrVertexAttr;
 
@@ -197,12 +196,15 @@ typedef struct {
   pmr_u32 has_normals;
 } PmrTriangle;
 
-/* The texture maps of a material beyond base colour, read by --shading pbr (PmrMaterial.maps). */
-#define PMR_MAP_METALLIC_ROUGHNESS 0 /* B metallic, G roughness (linear)                       */
-#define PMR_MAP_NORMAL 1             /* tangent-space normal (linear)                          */
-#define PMR_MAP_OCCLUSION 2          /* R occlusion (linear)                                   */
-#define PMR_MAP_EMISSIVE 3           /* RGB (sRGB-encoded)                                     */
-#define PMR_MAPS 4
+/* The texture maps of a material (PmrMaterial.maps), in the order of the scene's texture slots
+ * (SceneTextureSlotKind). Both shading models read the base colour map; only --shading pbr reads the
+ * others. */
+#define PMR_MAP_BASE_COLOR 0         /* RGBA (RGB sRGB-encoded, alpha linear)                  */
+#define PMR_MAP_METALLIC_ROUGHNESS 1 /* B metallic, G roughness (linear)                       */
+#define PMR_MAP_NORMAL 2             /* tangent-space normal (linear)                          */
+#define PMR_MAP_OCCLUSION 3          /* R occlusion (linear)                                   */
+#define PMR_MAP_EMISSIVE 4           /* RGB (sRGB-encoded)                                     */
+#define PMR_MAPS 5
 
 /* One texture map of a material: which texture, sampled at which TEXCOORD set, through which
  * KHR_texture_transform (the identity without one). Producer: host/pipeline (from the scene's material
@@ -215,7 +217,6 @@ typedef struct {
 
 typedef struct {
   float base_color[4]; /* baseColorFactor (linear)                                        */
-  pmr_i32 texture;     /* index into the texture table, -1 = none                         */
   pmr_i32 alpha_mode;  /* PMR_ALPHA_*                                                     */
   float alpha_cutoff;
   pmr_u32 double_sided;
@@ -223,7 +224,7 @@ typedef struct {
   float roughness;              /* roughnessFactor (pbr; clamped to [0.03, 1] when shading)          */
   float emissive[3];            /* emissiveFactor x KHR_materials_emissive_strength (pbr, linear)    */
   pmr_u32 unlit;                /* KHR_materials_unlit (pbr): the colour is exposure x base          */
-  PmrTextureMap maps[PMR_MAPS]; /* pbr: indexed by PMR_MAP_*; the base colour map is `texture` */
+  PmrTextureMap maps[PMR_MAPS]; /* indexed by PMR_MAP_*                                           */
   float normal_scale;           /* normalTexture.scale                                             */
   float occlusion_strength;     /* occlusionTexture.strength                                     */
 } PmrMaterial;

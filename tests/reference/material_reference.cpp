@@ -6,27 +6,6 @@
 
 namespace pmr::ref {
 
-glm::dvec2 transformed_uv(const SceneTextureSlot& slot, const glm::dvec2& uv) {
-  if (!slot.transform) return uv;
-  const double c = std::cos(double(slot.rotation)), s = std::sin(double(slot.rotation));
-  const double sx = slot.scale[0], sy = slot.scale[1];
-  return {sx * c * uv.x + sy * s * uv.y + slot.offset[0], -sx * s * uv.x + sy * c * uv.y + slot.offset[1]};
-}
-
-namespace {
-
-// The slot's texture at b, or nothing (false) when the slot has none.
-bool sample_slot(const Scene& scene, const PmrTriangle& t, const glm::dvec3& b, const SceneTextureSlot& slot,
-                 glm::dvec4& out) {
-  if (slot.texture < 0) return false;
-  glm::dvec2 uv(0.0);
-  for (int k = 0; k < 3; ++k) uv += b[k] * glm::dvec2(scene.texcoords[size_t(slot.texcoord)][t.v[k]]);
-  out = sample_texture(scene.textures[size_t(slot.texture)], transformed_uv(slot, uv), slot.srgb);
-  return true;
-}
-
-}  // namespace
-
 void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool back, SurfacePoint& sp) {
   const PmrTriangle& t = scene.triangles[tri];
   const PmrMaterial& mat = scene.materials[t.material];

@@ -17,7 +17,4 @@ namespace pmr::ref {
 // to the caller.
 void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool back, SurfacePoint& sp);
 
-// KHR_texture_transform of a slot applied to uv.
-glm::dvec2 transformed_uv(const SceneTextureSlot& slot, const glm::dvec2& uv);
-
 }  // namespace pmr::ref

@@ -36,6 +36,22 @@ glm::dvec4 sample_texture(const SceneTexture& tex, const glm::dvec2& uv, bool sr
   return glm::mix(top, bottom, ay);
 }
 
+glm::dvec2 transformed_uv(const SceneTextureSlot& slot, const glm::dvec2& uv) {
+  if (!slot.transform) return uv;
+  const double c = std::cos(double(slot.rotation)), s = std::sin(double(slot.rotation));
+  const double sx = slot.scale[0], sy = slot.scale[1];
+  return {sx * c * uv.x + sy * s * uv.y + slot.offset[0], -sx * s * uv.x + sy * c * uv.y + slot.offset[1]};
+}
+
+bool sample_slot(const Scene& scene, const PmrTriangle& t, const glm::dvec3& b, const SceneTextureSlot& slot,
+                 glm::dvec4& out) {
+  if (slot.texture < 0) return false;
+  glm::dvec2 uv(0.0);
+  for (int k = 0; k < 3; ++k) uv += b[k] * glm::dvec2(scene.texcoords[size_t(slot.texcoord)][t.v[k]]);
+  out = sample_texture(scene.textures[size_t(slot.texture)], transformed_uv(slot, uv), slot.srgb);
+  return true;
+}
+
 glm::dvec3 source_barycentrics(const PmrMta& m, int px, int py, int view) {
   return source_barycentrics_at(m, int64_t(px) * PMR_X_ONE + PMR_X_ONE / 2, int64_t(py) * PMR_Y_ONE + PMR_Y_ONE / 2,
                                 view);
@@ -72,14 +88,15 @@ glm::dvec4 base_color(const Scene& scene, uint32_t tri, const glm::dvec3& b) {
   const PmrMaterial& mat = scene.materials[t.material];
   glm::dvec4 c(mat.base_color[0], mat.base_color[1], mat.base_color[2], mat.base_color[3]);
   glm::dvec4 vc(0.0);
-  glm::dvec2 uv(0.0);
   for (int k = 0; k < 3; ++k) {
     const PmrVertexAttr& a = scene.attributes[t.v[k]];
     vc += b[k] * glm::dvec4(a.color[0], a.color[1], a.color[2], a.color[3]);
-    uv += b[k] * glm::dvec2(a.uv[0], a.uv[1]);
   }
   c *= vc;
-  if (mat.texture >= 0) c *= sample_texture(scene.textures[size_t(mat.texture)], uv, true);
+  glm::dvec4 texture;
+  if (t.material < scene.material_inputs.size() &&
+      sample_slot(scene, t, b, scene.material_inputs[t.material].slots[kSlotBaseColor], texture))
+    c *= texture;
   return c;
 }
 

@@ -17,6 +17,12 @@ glm::dvec3 source_barycentrics_at(const PmrMta& m, int64_t sample_x, int64_t sam
 // Bilinear sample at uv ((0, 0) = the image's top-left corner) with the texture's wrap modes; colour
 // textures decode sRGB, data textures are linear.
 glm::dvec4 sample_texture(const SceneTexture& tex, const glm::dvec2& uv, bool srgb);
+// KHR_texture_transform of a slot applied to uv.
+glm::dvec2 transformed_uv(const SceneTextureSlot& slot, const glm::dvec2& uv);
+// The slot's texture at source barycentrics b of triangle t (its TEXCOORD set interpolated, then its
+// transform), or nothing (false, out untouched) when the slot has none.
+bool sample_slot(const Scene& scene, const PmrTriangle& t, const glm::dvec3& b, const SceneTextureSlot& slot,
+                 glm::dvec4& out);
 // Unlit base colour (factor * texture * COLOR_0) at source barycentrics b of triangle `tri`.
 glm::dvec4 base_color(const Scene& scene, uint32_t tri, const glm::dvec3& b);
 // Lit colour (alpha = 1) with the light direction `light` (world space, unit).

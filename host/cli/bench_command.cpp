@@ -82,7 +82,7 @@ BenchOptions parse(const std::vector<std::string>& args) {
       o.views.clear();
       for (const auto& v : split(value())) {
         const RenderOptions r = parse_render_options({"--views", v});
-        o.views.push_back(r.rig.views);
+        o.views.push_back(r.job.rig.views);
       }
     } else if (a == "--method") {
       o.methods.clear();
@@ -140,16 +140,16 @@ BenchOptions parse(const std::vector<std::string>& args) {
     else throw Error("more than one scene given");
   }
   RenderOptions r = parse_render_options(rest);
-  o.view_w = r.rig.view_w, o.view_h = r.rig.view_h;
-  o.rig = r.rig;  // a Looking Glass preset's angular camera spacing included
-  if (!o.views_given && std::find(rest.begin(), rest.end(), "--preset") != rest.end()) o.views = {r.rig.views};
-  if (!o.samplings_given) o.samplings = {r.pipeline.sampling};  // the preset's default
-  o.display = r.display;
+  o.view_w = r.job.rig.view_w, o.view_h = r.job.rig.view_h;
+  o.rig = r.job.rig;  // a Looking Glass preset's angular camera spacing included
+  if (!o.views_given && std::find(rest.begin(), rest.end(), "--preset") != rest.end()) o.views = {r.job.rig.views};
+  if (!o.samplings_given) o.samplings = {r.job.pipeline.sampling};  // the preset's default
+  o.display = r.job.display;
   o.offset_given = r.offset_given;
-  o.tile[0] = r.pipeline.tile_x, o.tile[1] = r.pipeline.tile_y, o.tile[2] = r.pipeline.tile_v;
-  o.animation = r.animation, o.fps = r.fps;
-  o.turntable = r.turntable, o.turntable_deg = r.turntable_deg,
-  o.turntable_frames = r.turntable ? r.turntable_frames : 1;
+  o.tile[0] = r.job.pipeline.tile_x, o.tile[1] = r.job.pipeline.tile_y, o.tile[2] = r.job.pipeline.tile_v;
+  o.animation = r.job.animation, o.fps = r.job.fps;
+  o.turntable = r.job.turntable, o.turntable_deg = r.job.turntable_deg,
+  o.turntable_frames = r.job.turntable ? r.job.turntable_frames : 1;
   if (o.methods.empty() || o.views.empty() || o.samplings.empty()) throw Error("nothing to measure");
   std::vector<std::string> warnings;
   check_environment_options(o.environment_file, o.environment_rotation_given, o.shading, warnings);

@@ -2,12 +2,11 @@
 // which rig, display and pipeline, into which files. The command line fills it in (cli/); the frame
 // loop knows nothing of the command line.
 #pragma once
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "output/background.h"
-#include "pipeline/pipeline.h"
+#include "pipeline/pipeline_config.h"
 #include "pmr/display_presets.h"
 #include "pmr/input_files.h"
 #include "pmr/output.h"
@@ -25,8 +24,7 @@ struct SequenceJob {
   // cameras, display, pipeline
   RigConfig rig;
   Display display;
-  std::string display_source;                          // what the display came from (sidecar)
-  std::optional<LookingGlassCalibration> calibration;  // a calibration file's values (sidecar)
+  DisplaySource display_source;  // what the display came from: a preset or a calibration file (sidecar)
   PipelineConfig pipeline;
   // products: which files per frame (FrameProducts), the quilt layout ("" = chosen), compression
   FrameProducts products;

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "cli/option_table.h"
 #include "pmr/error.h"
 #include "pmr/limits.h"
 #include "pmr/shared.h"
@@ -138,23 +139,8 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
   if (sources > 1) throw UsageError("give one of --preset and --display-config, once");
 }
 
-// One option of `pmr render`. The parser and --help are both made from the tables below, so an option
-// cannot be parsed without being listed, or listed under another spelling.
-struct Option {
-  const char* name;   // "--out"
-  const char* alias;  // "-o", or nullptr
-  const char* arg;    // the value's placeholder in --help ("DIR"); nullptr for a flag
-  std::string help;   // the description, '\n' between its lines; empty: not listed (see the entry)
-  // applies the option: `value` is empty for a flag, `name` the option's name for messages
-  void (*set)(RenderOptions& o, const std::string& value, const std::string& name);
-  std::string (*more_help)() = nullptr;  // lines --help prints verbatim after the description
-};
-
-// A heading of --help and the options listed under it, in that order.
-struct Section {
-  const char* heading;
-  std::vector<Option> options;
-};
+// The options of `pmr render`, in the order --help lists them (cli/option_table.h).
+using RenderSection = OptionSection<RenderOptions>;
 
 void set_frames(RenderOptions& o, const std::string& v, const std::string&) { o.job.frames = v; }
 
@@ -178,7 +164,7 @@ void set_write(RenderOptions& o, const std::string& v, const std::string&) {
     throw Error("invalid --write: depth is a channel of the views or quilt EXR: add views or quilt");
 }
 
-const Section kOutputOptions = {
+const RenderSection kOutputOptions = {
     "output:",
     {
         {"--help", "-h", nullptr, "",  // not listed: the help itself
@@ -215,7 +201,7 @@ const Section kOutputOptions = {
          [](RenderOptions& o, const std::string& v, const std::string&) { o.compression = v; }},
     }};
 
-const Section kSequenceOptions = {
+const RenderSection kSequenceOptions = {
     "sequences (an animated glTF plays; frame f samples time f / fps; before the animation's first key\n"
     "and after its last a frame holds the first or last pose, as glTF clamps):",
     {
@@ -275,7 +261,7 @@ const Section kSequenceOptions = {
          }},
     }};
 
-const Section kRigOptions = {
+const RenderSection kRigOptions = {
     "rig:",
     {
         {"--preset", nullptr, "NAME",
@@ -342,7 +328,7 @@ const Section kRigOptions = {
          }},
     }};
 
-const Section kDisplayOptions = {
+const RenderSection kDisplayOptions = {
     "display:",
     {
         {"--display", nullptr, "WxH", "display image in pixels (default 7680x4320)",
@@ -387,7 +373,7 @@ const Section kDisplayOptions = {
          [](RenderOptions& o, const std::string&, const std::string&) { o.job.display.blend_views = true; }},
     }};
 
-const Section kPipelineOptions = {
+const RenderSection kPipelineOptions = {
     "pipeline:",
     {
         {"--tile", nullptr, "XxYxV", "3D tile of the tile/fine raster, voxels over x, y, view (default 16x2x16)",
@@ -414,7 +400,7 @@ const Section kPipelineOptions = {
          }},
     }};
 
-const Section kShadingOptions = {
+const RenderSection kShadingOptions = {
     "shading (docs/SHADING.md):",
     {
         {"--shading", nullptr, "S",
@@ -456,7 +442,7 @@ const Section kShadingOptions = {
          [](RenderOptions& o, const std::string&, const std::string&) { o.job.verbose = true; }},
     }};
 
-const Section kInputOptions = {
+const RenderSection kInputOptions = {
     "untrusted input (docs/SECURITY.md):",
     {
         {"--allow-outside-scene-folder", nullptr, nullptr,
@@ -471,47 +457,25 @@ const Section kInputOptions = {
          limit_help},
     }};
 
-const Section* const kSections[] = {&kOutputOptions,   &kSequenceOptions, &kRigOptions,  &kDisplayOptions,
-                                    &kPipelineOptions, &kShadingOptions,  &kInputOptions};
-
-const Option* find_option(const std::string& arg) {
-  for (const Section* s : kSections)
-    for (const Option& opt : s->options)
-      if (arg == opt.name || (opt.alias && arg == opt.alias)) return &opt;
-  return nullptr;
+// A bare argument is the scene.
+void set_scene(RenderOptions& o, const std::string& arg) {
+  if (!o.job.scene.empty()) throw Error("more than one scene given ('" + o.job.scene + "' and '" + arg + "')");
+  o.job.scene = arg;
 }
+
+const OptionTable<RenderOptions> kRenderTable = {"render",
+                                                 25,
+                                                 {&kOutputOptions, &kSequenceOptions, &kRigOptions, &kDisplayOptions,
+                                                  &kPipelineOptions, &kShadingOptions, &kInputOptions},
+                                                 set_scene};
 
 // The options after apply_display_source: anything they throw is a usage error (they read no file).
 void parse_arguments(RenderOptions& o, const std::vector<std::string>& args) {
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (const Option* opt = find_option(a)) {
-      if (opt->arg && i + 1 >= args.size()) throw Error("option " + a + " needs a value (see pmr render --help)");
-      opt->set(o, opt->arg ? args[++i] : std::string(), opt->name);
-    } else if (!a.empty() && a[0] == '-') {
-      throw Error("unknown option " + a + " (see pmr render --help)");
-    } else if (o.job.scene.empty()) {
-      o.job.scene = a;
-    } else {
-      throw Error("more than one scene given ('" + o.job.scene + "' and '" + a + "')");
-    }
-  }
+  parse_by_table(kRenderTable, o, args);
   if (o.zoom_given && o.job.rig.camera >= 0)
     throw Error(
         "--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own: "
         "give one of them");
-}
-
-// An option's --help entry: "--out DIR, -o DIR" padded to the description's column (or two spaces
-// after a longer one), the description's further lines indented to that column.
-std::string option_help(const Option& opt) {
-  constexpr size_t kColumn = 25;
-  const std::string arg = opt.arg ? std::string(" ") + opt.arg : "";
-  std::string line = std::string("  ") + opt.name + arg + (opt.alias ? std::string(", ") + opt.alias + arg : "");
-  line += line.size() < kColumn ? std::string(kColumn - line.size(), ' ') : "  ";
-  for (char c : opt.help) line += c == '\n' ? "\n" + std::string(kColumn, ' ') : std::string(1, c);
-  line += "\n";
-  return opt.more_help ? line + opt.more_help() : line;
 }
 
 }  // namespace
@@ -584,18 +548,12 @@ std::string main_help() {
 }
 
 std::string render_help() {
-  std::string out =
-      "usage: pmr render [SCENE] [options]\n"
-      "Renders SCENE (glTF 2.0, .gltf or .glb; default: the bundled data/default_scene.glb) as N views\n"
-      "and interlaces them into the display's subpixel image. Defaults are the preset paper-8k:\n"
-      "96 views of 1024x512, a 7680x4320 display of 166x93 cm seen from 200 cm, 80 degree view cone.\n"
-      "\n";
-  for (const Section* section : kSections) {
-    out += std::string(section->heading) + "\n";
-    for (const Option& opt : section->options)
-      if (!opt.help.empty()) out += option_help(opt);
-  }
-  return out +
+  return "usage: pmr render [SCENE] [options]\n"
+         "Renders SCENE (glTF 2.0, .gltf or .glb; default: the bundled data/default_scene.glb) as N views\n"
+         "and interlaces them into the display's subpixel image. Defaults are the preset paper-8k:\n"
+         "96 views of 1024x512, a 7680x4320 display of 166x93 cm seen from 200 cm, 80 degree view cone.\n"
+         "\n" +
+         options_help(kRenderTable) +
          "Environment: PMR_DEVICE=substring selects the OpenCL device by name (default: first CPU device).\n"
          "Docs in the source tree: README.md, docs/DESIGN.md (rig, framing, encoder, files), docs/SHADING.md.\n";
 }

@@ -71,11 +71,7 @@ PipelineConfig bench_config(const BenchOptions& o, Method method, Sampling sampl
 
 void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Scene& scene,
                  const std::string& scene_name, std::ofstream* csv) {
-  SequenceSpec spec;
-  spec.framing_work = o.limits.framing_work;
-  select_animation(scene, o.animation, spec);
-  spec.fps = o.fps;
-  spec.turntable = o.turntable, spec.turntable_deg = o.turntable_deg, spec.turntable_frames = o.turntable_frames;
+  const SequenceSpec spec = resolve_sequence(scene, o.sequence, o.limits.framing_work);
   std::printf("# %s: %zu triangles; device %s; copy bandwidth %.1f GB/s\n", scene_name.c_str(), scene.triangles.size(),
               rt.device_name().c_str(), bw * 1e-9);
   std::printf("%-10s %-8s %5s %9s %9s %9s %9s %8s %8s %8s %8s %9s %8s %7s %8s\n", "method", "sampling", "views", "view",

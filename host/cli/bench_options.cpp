@@ -193,9 +193,7 @@ BenchOptions parse_bench_options(const std::vector<std::string>& args) {
   o.display = r.job.display;
   o.offset_given = r.offset_given;
   o.tile[0] = r.job.pipeline.tile_x, o.tile[1] = r.job.pipeline.tile_y, o.tile[2] = r.job.pipeline.tile_v;
-  o.animation = r.job.animation, o.fps = r.job.fps;
-  o.turntable = r.job.turntable, o.turntable_deg = r.job.turntable_deg,
-  o.turntable_frames = r.job.turntable ? r.job.turntable_frames : 1;
+  o.sequence = r.job.sequence;
   if (o.methods.empty() || o.views.empty() || o.samplings.empty()) throw Error("nothing to measure");
   std::vector<std::string> warnings;
   check_environment_options(o.environment_file, o.environment_rotation_given, o.shading, warnings);

@@ -8,6 +8,7 @@
 #include "pipeline/pipeline_config.h"
 #include "pmr/input_files.h"
 #include "pmr/rig.h"
+#include "sequence/sequence_spec.h"
 
 namespace pmr {
 
@@ -34,11 +35,7 @@ struct BenchOptions {
   bool check = true;
   bool help = false;
   // Timed frames are frames 0..K-1 of this sequence (animation and turntable as for pmr render).
-  std::string animation;
-  double fps = 24.0;
-  bool turntable = false;
-  double turntable_deg = 0.0;
-  long turntable_frames = 1;
+  SequenceChoice sequence;
   // --environment FILE and --environment-rotation DEG (pbr), prefiltered once for every point
   std::string environment_file;
   double environment_rotation_deg = 0.0;

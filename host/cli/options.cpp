@@ -215,15 +215,16 @@ const RenderSection kSequenceOptions = {
         {"--frame", nullptr, "N", "", set_frames},  // not listed: --frames in the singular
         {"--fps", nullptr, "F", "frames per second (default 24)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.job.fps = parse_double(v, name);
-           if (!(o.job.fps > 0.0) || o.job.fps > 10000.0) throw Error("invalid --fps: must be in (0, 10000]");
+           o.job.sequence.fps = parse_double(v, name);
+           if (!(o.job.sequence.fps > 0.0) || o.job.sequence.fps > 10000.0)
+             throw Error("invalid --fps: must be in (0, 10000]");
          }},
         {"--animation", nullptr, "A",
          "NAME, INDEX, all (every animation at once) or none (the rest pose);\n"
          "default: the first one",
          [](RenderOptions& o, const std::string& v, const std::string&) {
            if (v.empty()) throw Error("invalid --animation '': expected a name, an index, all or none");
-           o.job.animation = v;
+           o.job.sequence.animation = v;
          }},
         {"--turntable", nullptr, "DEG:FRAMES",
          "turn the scene DEG degrees every FRAMES frames about the vertical axis\n"
@@ -232,9 +233,9 @@ const RenderSection kSequenceOptions = {
            const auto colon = v.find(':');
            if (colon == std::string::npos)
              throw Error("invalid --turntable '" + v + "': expected DEG:FRAMES, e.g. 360:96");
-           o.job.turntable = true;
-           o.job.turntable_deg = parse_double(v.substr(0, colon), name);
-           o.job.turntable_frames = parse_int(v.substr(colon + 1), name, 1, 1 << 30);
+           o.job.sequence.turntable = true;
+           o.job.sequence.turntable_deg = parse_double(v.substr(0, colon), name);
+           o.job.sequence.turntable_frames = parse_int(v.substr(colon + 1), name, 1, 1 << 30);
          }},
         {"--resume", nullptr, nullptr, "skip frames whose files are all present; refuse a changed configuration",
          [](RenderOptions& o, const std::string&, const std::string&) { o.job.resume = true; }},

@@ -20,6 +20,9 @@ namespace pmr {
 // is one) against the scene's clips. Throws pmr::Error naming the known animations when nothing
 // matches.
 void select_animation(const Scene& scene, const std::string& choice, SequenceSpec& spec);
+// The sequence `choice` makes of `scene`: its animation selected (select_animation), one turntable frame
+// without a turntable, `framing_work` the framing's budget.
+SequenceSpec resolve_sequence(const Scene& scene, const SequenceChoice& choice, uint64_t framing_work);
 
 // The frames whose times f / fps lie inside the chosen animation's key range: ceil(start * fps) to
 // floor(end * fps) (within 1e-6 of a frame: float key times). Outside it a frame repeats the first or

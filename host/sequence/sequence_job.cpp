@@ -144,12 +144,7 @@ void SequenceRun::load_inputs() {
 
 // The animation, --frames all, this shard's part; then the framing (FrameRenderer) and the layout.
 void SequenceRun::choose_frames() {
-  spec_.framing_work = job_.input_limits.framing_work;
-  select_animation(scene_, job_.animation, spec_);
-  spec_.fps = job_.fps;
-  spec_.turntable = job_.turntable;
-  spec_.turntable_deg = job_.turntable_deg;
-  spec_.turntable_frames = job_.turntable ? job_.turntable_frames : 1;
+  spec_ = resolve_sequence(scene_, job_.sequence, job_.input_limits.framing_work);
   if (job_.frames == "all") {
     long first = 0, last = 0;
     animation_frame_range(scene_, spec_, first, last);

@@ -12,6 +12,7 @@
 #include "pmr/output.h"
 #include "pmr/rig.h"
 #include "sequence/frame_files.h"
+#include "sequence/sequence_spec.h"
 
 namespace pmr {
 
@@ -32,12 +33,8 @@ struct SequenceJob {
   ExrCompression compression = ExrCompression::Zip;
   // frames: a --frames list or "all" (the animation's key range, or one turn of a turntable)
   std::string frames = "0";
-  double fps = 24.0;
-  std::string animation;  // name, index, "all" or "none"; "" = the first animation
-  bool turntable = false;
-  double turntable_deg = 0.0;
-  long turntable_frames = 0;
-  std::string shard;  // "K/N" or "auto"; "" = every frame
+  SequenceChoice sequence;  // --animation, --fps, --turntable
+  std::string shard;        // "K/N" or "auto"; "" = every frame
   long shard_count = 0, shard_first = 0;
   bool resume = false, overwrite = false;
   bool quiet = false, verbose = false;

@@ -1,5 +1,5 @@
-// A sequence's frames as resolved from the job (SequenceRun::choose_frames): the animation chosen, the
-// frame rate and the turntable. The framing, the poses and the sidecar follow from it.
+// A sequence's frames as chosen (SequenceChoice) and as resolved against the scene (SequenceSpec): the
+// animation, the frame rate and the turntable. The framing, the poses and the sidecar follow from it.
 #pragma once
 #include <cstdint>
 #include <string>
@@ -8,6 +8,16 @@
 #include "pmr/scene.h"
 
 namespace pmr {
+
+// The sequence as the command line chooses it, before the scene resolves the animation
+// (resolve_sequence, sequence/frame_renderer.h).
+struct SequenceChoice {
+  std::string animation;  // name, index, "all" or "none"; "" = the first animation
+  double fps = 24.0;
+  bool turntable = false;
+  double turntable_deg = 0.0;  // DEG of --turntable DEG:FRAMES
+  long turntable_frames = 0;   // FRAMES of --turntable DEG:FRAMES
+};
 
 struct SequenceSpec {
   int animation = kNoAnimation;  // Scene::animations index, kAllAnimations or kNoAnimation

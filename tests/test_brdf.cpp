@@ -20,8 +20,7 @@ std::vector<float> run_probe(const char* kernel, const std::vector<float>& in, s
   std::vector<float> out(n * out_per_case);
   {
     ClKernel k(program, kernel);
-    ClBuffer a = rt.buffer(in.size() * 4, "probe in"), b = rt.buffer(out.size() * 4, "probe out");
-    rt.write(a, in.data(), in.size() * 4);
+    ClBuffer a = rt.upload(in, "probe in"), b = rt.buffer(out.size() * 4, "probe out");
     k.args(a, b, cl_uint(n));
     clReleaseEvent(rt.launch(k, n, 64));
     rt.read(b, out.data(), out.size() * 4);

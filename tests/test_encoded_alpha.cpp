@@ -114,7 +114,7 @@ TEST(EncodedAlpha, CompositesLikeTheViewsOverABackground) {
   // the display as `render` made it from these options (the lens offset follows the view count)
   RenderOptions o = parse_render_options({"--views", "6", "--view-size", "96x48", "--display", "300x160"});
   finalize_render_options(o);
-  const Display& display = o.display;
+  const Display& display = o.job.display;
   ASSERT_EQ(display.width, w);
   const float bg[3] = {0.2f, 0.7f, 0.4f};  // an opaque background, the same in every view
   const char* colour[3] = {"R", "G", "B"};

@@ -487,6 +487,40 @@ TEST(EnvironmentFiles, HdrAndExrRoundTrip) {
             1e-6);
 }
 
+// An EXR header whose one attribute (name, type, declared size, then `body`) claims more than the file
+// holds: refused before OpenEXR allocates what it declares.
+std::vector<unsigned char> exr_with_attribute(const std::string& name, const std::string& type, uint32_t size,
+                                              const std::vector<unsigned char>& body) {
+  std::vector<unsigned char> b = {0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0};
+  for (const std::string& text : {name, type}) {
+    b.insert(b.end(), text.begin(), text.end());
+    b.push_back(0);
+  }
+  for (int i = 0; i < 4; ++i) b.push_back(static_cast<unsigned char>(size >> (8 * i)));
+  b.insert(b.end(), body.begin(), body.end());
+  b.resize(b.size() + 16, 0);
+  return b;
+}
+
+TEST(EnvironmentFiles, ExrAttributesLargerThanTheFileAreRefused) {
+  const struct {
+    std::vector<unsigned char> bytes;
+    const char* says;
+  } cases[] = {
+      {exr_with_attribute("comments", "string", 0x7fffffff, {}),
+       "header attribute 'comments' declares 2147483647 bytes, more than the file holds"},
+      {exr_with_attribute("thumb", "preview", 8, {0, 1, 0, 0, 0, 1, 0, 0}),
+       "preview attribute 'thumb' of 256x256 pixels is larger than the file"},
+      {exr_with_attribute("names", "stringvector", 8, {0, 0, 0, 1}),
+       "header attribute 'names' holds a string of 16777216 bytes, more than the file holds"},
+  };
+  for (const auto& c : cases) {
+    write_bytes(temp_path("attribute.exr"), c.bytes);
+    const std::string e = error_of(temp_path("attribute.exr"));
+    EXPECT_NE(e.find(c.says), std::string::npos) << e;
+  }
+}
+
 TEST(EnvironmentFiles, BadFilesGiveOneClearError) {
   const EnvironmentImage img = make_map(64, 32, sun_sky);
   // Truncated .hdr (run-length data cut in the middle: stb_image alone would spin or decode black).

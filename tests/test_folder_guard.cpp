@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "sequence/folder_guard.h"
 #include "sequence/range_warning.h"

@@ -12,6 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "pmr/error.h"
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "pmr/rig.h"
 #include "test_util.h"
@@ -143,7 +144,7 @@ TEST(Framing, SidecarsCompareTheZoom) {
   ASSERT_NE(before["rig"]["focal_distance"].get<double>(), now.focal);
   EXPECT_EQ(sidecar_config_difference(before.dump(), sidecar_json(now, portrait, info)), "rig.focal_distance");
   // with a glTF camera the distance is not compared: an animated camera moves it from frame to frame
-  info.camera = 0;
+  info.rig_config.camera = 0;
   before = nlohmann::json::parse(sidecar_json(now, portrait, info));
   before["rig"]["focal_distance"] = 2.0 * now.focal;
   EXPECT_EQ(sidecar_config_difference(before.dump(), sidecar_json(now, portrait, info)), "");

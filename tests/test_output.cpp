@@ -21,6 +21,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pmr/error.h"
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "pmr/rig.h"
 #include "test_util.h"
@@ -425,7 +426,7 @@ TEST(Output, SidecarMatricesReproduceTheRig) {
   SidecarInfo info;
   info.scene = "scene.glb";
   info.frame = 7;
-  info.tile_x = 8;
+  info.pipeline.tile_x = 8;
   info.outputs = {{"encoded", "frame_0007.exr"}, {"views", "frame_0007.views.exr"}};
   info.warnings = {"near plane raised"};
   const std::string path = dir / "frame_0007.json";

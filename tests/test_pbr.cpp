@@ -608,11 +608,9 @@ TEST(PbrEnvironment, KernelLookupsMatchTheHost) {
   {
     ClKernel k(program, "environment_probe");
     const EnvironmentTables& t = e.tables();
-    ClBuffer h = rt.buffer(sizeof t.header, "probe header"), data = rt.buffer(t.data.size() * 4, "probe data"),
-             a = rt.buffer(in.size() * 4, "probe in"), b = rt.buffer(out.size() * 4, "probe out");
+    ClBuffer h = rt.buffer(sizeof t.header, "probe header"), data = rt.upload(t.data, "probe data"),
+             a = rt.upload(in, "probe in"), b = rt.buffer(out.size() * 4, "probe out");
     rt.write(h, &t.header, sizeof t.header);
-    rt.write(data, t.data.data(), t.data.size() * 4);
-    rt.write(a, in.data(), in.size() * 4);
     k.args(h, data, a, b, cl_uint(dirs.size()));
     clReleaseEvent(rt.launch(k, dirs.size(), 64));
     rt.read(b, out.data(), out.size() * 4);

@@ -12,6 +12,7 @@
 
 #include "environment_maps.h"
 #include "gltf_builder.h"
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "shading/lights.h"
 #include "test_util.h"
@@ -42,7 +43,7 @@ SceneLight file_light(SceneLightType type, int index, const glm::dvec3& position
 std::string pbr_sidecar(const Rig& rig, int frame, const std::vector<SceneLight>& lights) {
   SidecarInfo info;
   info.scene = "scene.gltf";
-  info.shading = "pbr";
+  info.pipeline.shading = Shading::Pbr;
   info.frame = frame;
   info.has_bounds = true;
   info.lights = lights;
@@ -85,6 +86,7 @@ TEST(PbrLightsSidecar, RecordsEachLightAsUsed) {
     EXPECT_EQ(d.at("direction").at(c).get<double>(), -j.at("light_dir_world").at(c).get<double>());
   // lambert records no lights (its one light is light_dir_*)
   SidecarInfo lambert;
+  lambert.pipeline.shading = Shading::Lambert;
   lambert.lights = lights;
   EXPECT_FALSE(json::parse(sidecar_json(rig, Display{}, lambert)).at("shading").contains("lights"));
 }
@@ -141,6 +143,7 @@ TEST(PbrLightsSidecar, OlderSidecarsCompareAsBefore) {
   EXPECT_EQ(sidecar_config_difference(old_image.dump(), lit.dump()), "shading");
   // before --shading: lambert at exposure 0
   SidecarInfo lambert;
+  lambert.pipeline.shading = Shading::Lambert;
   lambert.has_bounds = true;
   json older = json::parse(sidecar_json(rig, Display{}, lambert));
   older.erase("shading");

@@ -6,9 +6,8 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
-#include <sstream>
 
-#include "cli/options.h"
+#include "cli/bench_options.h"
 #include "cli/render_command.h"
 #include "pipeline/pipeline.h"
 #include "pmr/error.h"
@@ -22,150 +21,6 @@
 namespace pmr {
 
 namespace {
-
-struct BenchOptions {
-  std::string scene;
-  std::string generator;                // "synthetic" or "objects": procedural scenes instead of SCENE
-  std::vector<size_t> triangle_counts;  // one generated scene per count (the triangle sweep)
-  std::string save_scene;               // write the generated scene as .glb and exit
-  std::vector<int> views = {1, 2, 4, 8, 16, 32, 48, 64, 96};
-  std::vector<Method> methods = {Method::Pmr, Method::Multipass, Method::Duplicate};
-  std::vector<Sampling> samplings = {Sampling::View};  // subpixel applies to pmr only
-  bool samplings_given = false;  // else the preset's default sampling (view for methods other than pmr)
-  Shading shading = Shading::Pbr;
-  double exposure_ev = 0.0, environment_intensity = 1.0;
-  bool views_given = false;
-  int frames = 5;
-  std::string csv;
-  std::string keep = "view";
-  int view_w = 1024, view_h = 512;  // per-view raster at N = 96 (keep total) or always (keep view)
-  RigConfig rig;                    // cone, field of view (views and sizes come from the options above)
-  bool offset_given = false;        // --offset, or a Looking Glass preset's calibrated offset
-  Display display;
-  int tile[3] = {16, 2, 16};
-  bool check = true;
-  bool help = false;
-  // Timed frames are frames 0..K-1 of this sequence (animation and turntable as for pmr render).
-  std::string animation;
-  double fps = 24.0;
-  bool turntable = false;
-  double turntable_deg = 0.0;
-  long turntable_frames = 1;
-  // --environment FILE and --environment-rotation DEG (pbr), prefiltered once for every point
-  std::string environment_file;
-  double environment_rotation_deg = 0.0;
-  bool environment_rotation_given = false;
-  std::shared_ptr<const Environment> environment;
-  InputLimits limits;  // --limit, --allow-outside-scene-folder (docs/SECURITY.md)
-};
-
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string w;
-  while (std::getline(ss, w, ',')) out.push_back(w);
-  return out;
-}
-
-BenchOptions parse(const std::vector<std::string>& args) {
-  BenchOptions o;
-  std::vector<std::string> rest;  // options shared with render go through its parser
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= args.size()) throw Error("option " + a + " needs a value (see pmr bench --help)");
-      return args[++i];
-    };
-    if (a == "-h" || a == "--help") o.help = true;
-    else if (a == "--views") {
-      o.views_given = true;
-      o.views.clear();
-      for (const auto& v : split(value())) {
-        const RenderOptions r = parse_render_options({"--views", v});
-        o.views.push_back(r.rig.views);
-      }
-    } else if (a == "--method") {
-      o.methods.clear();
-      for (const auto& m : split(value())) o.methods.push_back(parse_method(m));
-    } else if (a == "--sampling") {
-      o.samplings.clear();
-      o.samplings_given = true;
-      for (const auto& m : split(value())) o.samplings.push_back(parse_sampling(m));
-    } else if (a == "--shading") {
-      o.shading = parse_shading(value());
-    } else if (a == "--exposure") {
-      o.exposure_ev = parse_exposure(value());
-    } else if (a == "--environment-intensity") {
-      o.environment_intensity = parse_environment_intensity(value());
-    } else if (a == "--environment") {
-      o.environment_file = value();
-      if (o.environment_file.empty()) throw Error("invalid --environment '': expected a .hdr or .exr file");
-    } else if (a == "--environment-rotation") {
-      o.environment_rotation_deg = parse_environment_rotation(value());
-      o.environment_rotation_given = true;
-    } else if (a == "--frames") {
-      const std::string v = value();
-      o.frames = std::atoi(v.c_str());
-      if (o.frames < 1 || o.frames > 1000) throw Error("invalid --frames '" + v + "': expected 1..1000");
-    } else if (a == "--csv") o.csv = value();
-    else if (a == "--keep") {
-      o.keep = value();
-      if (o.keep != "view" && o.keep != "total") throw Error("invalid --keep '" + o.keep + "': expected view or total");
-    } else if (a == "--synthetic" || a == "--objects") {
-      if (!o.generator.empty()) throw Error("give one of --synthetic and --objects, once");
-      o.generator = a.substr(2);
-      for (const auto& v : split(value())) {
-        char* end = nullptr;
-        const double n = std::strtod(v.c_str(), &end);
-        if (v.empty() || *end != '\0' || !(n >= 1 && n <= 5e7))
-          throw Error("invalid " + a + " '" + v + "': expected triangle counts (1 to 5e7), comma-separated");
-        o.triangle_counts.push_back(size_t(n));
-      }
-      if (o.triangle_counts.empty()) throw Error("invalid " + a + ": expected triangle counts");
-    } else if (a == "--save-scene") o.save_scene = value();
-    else if (a == "--no-check") o.check = false;
-    else if (a == "--view-size" || a == "--display" || a == "--tile" || a == "--lens-pitch" || a == "--tan-slant" ||
-             a == "--offset" || a == "--cone" || a == "--yfov" || a == "--display-size" || a == "--animation" ||
-             a == "--fps" || a == "--turntable" || a == "--preset" || a == "--camera-spacing") {
-      rest.push_back(a);
-      rest.push_back(value());
-    } else if (a == "--bilinear" || a == "--reverse-views") {
-      rest.push_back(a);
-    } else if (a == "--limit") {
-      parse_limits(value(), o.limits);
-    } else if (a == "--allow-outside-scene-folder") {
-      o.limits.allow_outside_scene_folder = true;
-    } else if (!a.empty() && a[0] == '-') throw Error("unknown option " + a + " (see pmr bench --help)");
-    else if (o.scene.empty()) o.scene = a;
-    else throw Error("more than one scene given");
-  }
-  RenderOptions r = parse_render_options(rest);
-  o.view_w = r.rig.view_w, o.view_h = r.rig.view_h;
-  o.rig = r.rig;  // a Looking Glass preset's angular camera spacing included
-  if (!o.views_given && std::find(rest.begin(), rest.end(), "--preset") != rest.end()) o.views = {r.rig.views};
-  if (!o.samplings_given) o.samplings = {r.pipeline.sampling};  // the preset's default
-  o.display = r.display;
-  o.offset_given = r.offset_given;
-  o.tile[0] = r.pipeline.tile_x, o.tile[1] = r.pipeline.tile_y, o.tile[2] = r.pipeline.tile_v;
-  o.animation = r.animation, o.fps = r.fps;
-  o.turntable = r.turntable, o.turntable_deg = r.turntable_deg,
-  o.turntable_frames = r.turntable ? r.turntable_frames : 1;
-  if (o.methods.empty() || o.views.empty() || o.samplings.empty()) throw Error("nothing to measure");
-  std::vector<std::string> warnings;
-  check_environment_options(o.environment_file, o.environment_rotation_given, o.shading, warnings);
-  for (const std::string& w : warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
-  const bool subpixel = std::find(o.samplings.begin(), o.samplings.end(), Sampling::Subpixel) != o.samplings.end();
-  // subpixel rows are measured for pmr alone (the other methods' rows are skipped)
-  if (subpixel) {
-    const bool pmr = std::find(o.methods.begin(), o.methods.end(), Method::Pmr) != o.methods.end();
-    check_subpixel_sampling(pmr ? Method::Pmr : o.methods[0], o.display);
-  }
-  if (!o.generator.empty() && !o.scene.empty())
-    throw Error("give a SCENE or a generator (--synthetic, --objects), not both");
-  if (!o.save_scene.empty() && o.triangle_counts.size() != 1)
-    throw Error("--save-scene needs exactly one generated scene (--synthetic TRIS or --objects TRIS)");
-  return o;
-}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -216,11 +71,7 @@ PipelineConfig bench_config(const BenchOptions& o, Method method, Sampling sampl
 
 void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Scene& scene,
                  const std::string& scene_name, std::ofstream* csv) {
-  SequenceSpec spec;
-  spec.framing_work = o.limits.framing_work;
-  select_animation(scene, o.animation, spec);
-  spec.fps = o.fps;
-  spec.turntable = o.turntable, spec.turntable_deg = o.turntable_deg, spec.turntable_frames = o.turntable_frames;
+  const SequenceSpec spec = resolve_sequence(scene, o.sequence, o.limits.framing_work);
   std::printf("# %s: %zu triangles; device %s; copy bandwidth %.1f GB/s\n", scene_name.c_str(), scene.triangles.size(),
               rt.device_name().c_str(), bw * 1e-9);
   std::printf("%-10s %-8s %5s %9s %9s %9s %9s %8s %8s %8s %8s %9s %8s %7s %8s\n", "method", "sampling", "views", "view",
@@ -314,39 +165,8 @@ Scene generate(const std::string& generator, size_t triangles) {
 
 }  // namespace
 
-std::string bench_help() {
-  return "usage: pmr bench [SCENE] [options]\n"
-         "Times whole frames (render + encode, no file I/O) per view count and method.\n"
-         "  --views LIST        view counts (default 1,2,4,8,16,32,48,64,96)\n"
-         "  --method LIST       pmr, multipass, duplicate (default all three)\n"
-         "  --shading S, --exposure EV, --environment FILE, --environment-rotation DEG,\n"
-         "  --environment-intensity X   as for pmr render (default pbr)\n"
-         "  --sampling LIST     view, subpixel (subpixel with pmr only; default view, or a --preset's\n"
-         "                      default): samples per frame are the voxels, or each display subpixel once\n"
-         "  --frames K          timed frames per point after one warm-up frame (default 5)\n"
-         "  --csv FILE          write one row per point\n"
-         "  --keep view|total   view: every view is --view-size (default 1024x512); total: the total voxel\n"
-         "                      count of 96 views of --view-size is held fixed (the paper's Fig. 15; views\n"
-         "                      are capped at 4096x2048)\n"
-         "  --synthetic LIST    procedural scenes of about these triangle counts instead of SCENE (a sweep:\n"
-         "                      1000,10000,100000): UV spheres of ~200 triangles in a 4 x 2 x 3 box\n"
-         "  --objects LIST      the same with a CAD-like scene: 100 closed double-sided tori and rounded\n"
-         "                      boxes at different depths, tiny triangles at 1M (1e6 is accepted)\n"
-         "  --save-scene FILE   write the one generated scene to FILE (.glb) and exit: `pmr bench FILE` on\n"
-         "                      any build then renders the very same triangles\n"
-         "  --no-check          skip comparing the methods' images\n"
-         "  --limit KEY=VALUE[,...], --allow-outside-scene-folder  budgets and confinement for SCENE's\n"
-         "                      files, as for pmr render (docs/SECURITY.md)\n"
-         "  --preset, --camera-spacing, --view-size, --display, --tile and the display options are as for\n"
-         "  pmr render (a preset as a user gets it: its view count, camera spacing and default sampling\n"
-         "  unless --views, --camera-spacing, --sampling), and so are\n"
-         "  --animation, --fps and --turntable: the timed frames are then frames 0..K-1 of that sequence.\n"
-         "Per point it prints the frame time, the per-stage device times, and the floor: the bytes a frame\n"
-         "must move (each voxel written once, the display image written once) at the measured copy bandwidth.\n";
-}
-
 int run_bench(const std::vector<std::string>& args) {
-  BenchOptions o = as_usage([&] { return parse(args); });
+  BenchOptions o = as_usage([&] { return parse_bench_options(args); });
   if (o.help) {
     std::fputs(bench_help().c_str(), stdout);
     return 0;

@@ -6,6 +6,5 @@
 namespace pmr {
 
 int run_bench(const std::vector<std::string>& args);
-std::string bench_help();
 
 }  // namespace pmr

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "cli/option_table.h"
 #include "pmr/error.h"
 #include "pmr/limits.h"
 #include "pmr/shared.h"
@@ -104,7 +105,7 @@ RigConfig rig_for_serial(const LookingGlassCalibration& c, std::string& quilt, b
 // --preset and --display-config set the defaults that every other option then overrides.
 void apply_display_source(RenderOptions& o, const std::vector<std::string>& args) {
   for (size_t i = 0; i + 1 < args.size(); ++i)  // the calibration file is read under the file-bytes budget
-    if (args[i] == "--limit") as_usage([&] { parse_limits(args[i + 1], o.input_limits); });
+    if (args[i] == "--limit") as_usage([&] { parse_limits(args[i + 1], o.job.input_limits); });
   for (size_t i = 0; i + 1 < args.size(); ++i) {
     if (args[i] == "--preset") {
       if (args[i + 1] == "help") {
@@ -112,25 +113,25 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
         return;
       }
       const DisplayPreset& p = as_usage([&]() -> const DisplayPreset& { return find_display_preset(args[i + 1]); });
-      o.display = p.display;
+      o.job.display = p.display;
       o.offset_given = p.name != "paper-8k";  // a panel's offset comes from its calibration
-      o.rig = p.rig;
-      o.rig.angular_spacing = p.name != "paper-8k";  // Looking Glass software spaces its cameras angularly
-      o.pipeline.sampling = p.subpixel_sampling ? Sampling::Subpixel : Sampling::View;
-      o.display_source = "preset " + p.name;
-      o.quilt_preview_opaque = p.name != "paper-8k";  // Looking Glass tools show quilts opaque
+      o.job.rig = p.rig;
+      o.job.rig.angular_spacing = p.name != "paper-8k";  // Looking Glass software spaces its cameras angularly
+      o.job.pipeline.sampling = p.subpixel_sampling ? Sampling::Subpixel : Sampling::View;
+      o.job.display_source.name = "preset " + p.name;
+      o.job.quilt_preview_opaque = p.name != "paper-8k";  // Looking Glass tools show quilts opaque
     } else if (args[i] == "--display-config") {
-      o.calibration = read_looking_glass_calibration(args[i + 1], &o.option_warnings, o.input_limits.file_bytes);
-      o.has_calibration = true;
-      o.display = display_from_calibration(o.calibration);
+      const LookingGlassCalibration& c = o.job.display_source.calibration.emplace(
+          read_looking_glass_calibration(args[i + 1], &o.job.warnings, o.job.input_limits.file_bytes));
+      o.job.display = display_from_calibration(c);
       o.offset_given = true;  // the calibration's center decides it
       std::string quilt;
       bool subpixel = false;
-      o.rig = rig_for_serial(o.calibration, quilt, subpixel);
-      o.rig.angular_spacing = true;
-      o.pipeline.sampling = subpixel ? Sampling::Subpixel : Sampling::View;
-      o.display_source = "calibration " + args[i + 1];
-      o.quilt_preview_opaque = true;
+      o.job.rig = rig_for_serial(c, quilt, subpixel);
+      o.job.rig.angular_spacing = true;
+      o.job.pipeline.sampling = subpixel ? Sampling::Subpixel : Sampling::View;
+      o.job.display_source.name = "calibration " + args[i + 1];
+      o.job.quilt_preview_opaque = true;
     }
   }
   int sources = 0;
@@ -138,53 +139,38 @@ void apply_display_source(RenderOptions& o, const std::vector<std::string>& args
   if (sources > 1) throw UsageError("give one of --preset and --display-config, once");
 }
 
-// One option of `pmr render`. The parser and --help are both made from the tables below, so an option
-// cannot be parsed without being listed, or listed under another spelling.
-struct Option {
-  const char* name;   // "--out"
-  const char* alias;  // "-o", or nullptr
-  const char* arg;    // the value's placeholder in --help ("DIR"); nullptr for a flag
-  std::string help;   // the description, '\n' between its lines; empty: not listed (see the entry)
-  // applies the option: `value` is empty for a flag, `name` the option's name for messages
-  void (*set)(RenderOptions& o, const std::string& value, const std::string& name);
-  std::string (*more_help)() = nullptr;  // lines --help prints verbatim after the description
-};
+// The options of `pmr render`, in the order --help lists them (cli/option_table.h).
+using RenderSection = OptionSection<RenderOptions>;
 
-// A heading of --help and the options listed under it, in that order.
-struct Section {
-  const char* heading;
-  std::vector<Option> options;
-};
-
-void set_frames(RenderOptions& o, const std::string& v, const std::string&) { o.frames = v; }
+void set_frames(RenderOptions& o, const std::string& v, const std::string&) { o.job.frames = v; }
 
 // --preset and --display-config are applied before every other option (apply_display_source).
 void applied_first(RenderOptions&, const std::string&, const std::string&) {}
 
 void set_write(RenderOptions& o, const std::string& v, const std::string&) {
-  o.products.encoded = o.products.views = o.products.quilt = o.products.depth = false;
+  o.job.products.encoded = o.job.products.views = o.job.products.quilt = o.job.products.depth = false;
   std::stringstream ss(v);
   std::string w;
   while (std::getline(ss, w, ',')) {
-    if (w == "encoded") o.products.encoded = true;
-    else if (w == "views") o.products.views = true;
-    else if (w == "quilt") o.products.quilt = true;
-    else if (w == "depth") o.products.depth = true;
+    if (w == "encoded") o.job.products.encoded = true;
+    else if (w == "views") o.job.products.views = true;
+    else if (w == "quilt") o.job.products.quilt = true;
+    else if (w == "depth") o.job.products.depth = true;
     else throw Error("invalid --write '" + w + "': expected a list of encoded, views, quilt, depth");
   }
-  if (!o.products.encoded && !o.products.views && !o.products.quilt)
+  if (!o.job.products.encoded && !o.job.products.views && !o.job.products.quilt)
     throw Error("invalid --write: nothing to write (depth is a channel of views or quilt)");
-  if (o.products.depth && !o.products.views && !o.products.quilt)
+  if (o.job.products.depth && !o.job.products.views && !o.job.products.quilt)
     throw Error("invalid --write: depth is a channel of the views or quilt EXR: add views or quilt");
 }
 
-const Section kOutputOptions = {
+const RenderSection kOutputOptions = {
     "output:",
     {
         {"--help", "-h", nullptr, "",  // not listed: the help itself
          [](RenderOptions& o, const std::string&, const std::string&) { o.help = true; }},
         {"--out", "-o", "DIR", "output folder (created if missing; default: out)",
-         [](RenderOptions& o, const std::string& v, const std::string&) { o.products.out_dir = v; }},
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.job.products.out_dir = v; }},
         {"--write", nullptr, "LIST",
          "any of encoded, views, quilt, depth (default: encoded). DIR/frame_NNNN.exr is\n"
          "the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view,\n"
@@ -194,19 +180,19 @@ const Section kOutputOptions = {
          "matrices) is always written",
          set_write},
         {"--quilt", nullptr, "CxR", "quilt layout in tiles (default: the most square layout, e.g. 8x6 for 48)",
-         [](RenderOptions& o, const std::string& v, const std::string&) { o.quilt = v; }},
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.job.quilt_layout = v; }},
         {"--preview", nullptr, nullptr,
          "also 8-bit sRGB PNGs: the encoded image, the center view (N / 2; stretched to\n"
          "square pixels, as a view's pixels span the display's aspect) and the quilt\n"
          "(tiles as rendered; their pixel aspect in the PNG's pHYs chunk)",
-         [](RenderOptions& o, const std::string&, const std::string&) { o.products.preview = true; }},
+         [](RenderOptions& o, const std::string&, const std::string&) { o.job.products.preview = true; }},
         {"--name", nullptr, "PATTERN",
          "file stem (default frame_%04d); the frame number as %d, zero-padded %0Nd or\n"
          "Blender's #### (N '#': N digits), %% for a percent sign; without a frame\n"
          "number the stem of a single frame as given (--name duck: duck.exr)",
          [](RenderOptions& o, const std::string& v, const std::string&) {
            check_name_pattern(v);
-           o.products.name = v;
+           o.job.products.name = v;
          }},
         {"--compression", nullptr, "C",
          "EXR compression: none, zip, zip-fast (ZIP through ISA-L's igzip alone: a\n"
@@ -215,7 +201,7 @@ const Section kOutputOptions = {
          [](RenderOptions& o, const std::string& v, const std::string&) { o.compression = v; }},
     }};
 
-const Section kSequenceOptions = {
+const RenderSection kSequenceOptions = {
     "sequences (an animated glTF plays; frame f samples time f / fps; before the animation's first key\n"
     "and after its last a frame holds the first or last pose, as glTF clamps):",
     {
@@ -229,15 +215,16 @@ const Section kSequenceOptions = {
         {"--frame", nullptr, "N", "", set_frames},  // not listed: --frames in the singular
         {"--fps", nullptr, "F", "frames per second (default 24)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.fps = parse_double(v, name);
-           if (!(o.fps > 0.0) || o.fps > 10000.0) throw Error("invalid --fps: must be in (0, 10000]");
+           o.job.sequence.fps = parse_double(v, name);
+           if (!(o.job.sequence.fps > 0.0) || o.job.sequence.fps > 10000.0)
+             throw Error("invalid --fps: must be in (0, 10000]");
          }},
         {"--animation", nullptr, "A",
          "NAME, INDEX, all (every animation at once) or none (the rest pose);\n"
          "default: the first one",
          [](RenderOptions& o, const std::string& v, const std::string&) {
            if (v.empty()) throw Error("invalid --animation '': expected a name, an index, all or none");
-           o.animation = v;
+           o.job.sequence.animation = v;
          }},
         {"--turntable", nullptr, "DEG:FRAMES",
          "turn the scene DEG degrees every FRAMES frames about the vertical axis\n"
@@ -246,36 +233,36 @@ const Section kSequenceOptions = {
            const auto colon = v.find(':');
            if (colon == std::string::npos)
              throw Error("invalid --turntable '" + v + "': expected DEG:FRAMES, e.g. 360:96");
-           o.turntable = true;
-           o.turntable_deg = parse_double(v.substr(0, colon), name);
-           o.turntable_frames = parse_int(v.substr(colon + 1), name, 1, 1 << 30);
+           o.job.sequence.turntable = true;
+           o.job.sequence.turntable_deg = parse_double(v.substr(0, colon), name);
+           o.job.sequence.turntable_frames = parse_int(v.substr(colon + 1), name, 1, 1 << 30);
          }},
         {"--resume", nullptr, nullptr, "skip frames whose files are all present; refuse a changed configuration",
-         [](RenderOptions& o, const std::string&, const std::string&) { o.resume = true; }},
+         [](RenderOptions& o, const std::string&, const std::string&) { o.job.resume = true; }},
         {"--overwrite", nullptr, nullptr,
          "render even though the folder keeps frames of another configuration\n"
          "outside --frames (a warning counts them; without it the run refuses);\n"
          "with --resume: also re-render listed frames of another configuration",
-         [](RenderOptions& o, const std::string&, const std::string&) { o.overwrite = true; }},
+         [](RenderOptions& o, const std::string&, const std::string&) { o.job.overwrite = true; }},
         {"--quiet", "-q", nullptr, "print only errors and warnings",
-         [](RenderOptions& o, const std::string&, const std::string&) { o.quiet = true; }},
+         [](RenderOptions& o, const std::string&, const std::string&) { o.job.quiet = true; }},
         {"--shard", nullptr, "K/N|auto",
          "render only task K's share of the frames (interleaved: positions K, K+N,\n"
          "...); auto reads a Slurm, Kubernetes, AWS Batch, PBS, SGE or LSF array index\n"
          "(--shard-count N where the environment lacks the count, --shard-first F\n"
          "for PBS arrays not starting at 0); see docs/farm/README.md",
-         [](RenderOptions& o, const std::string& v, const std::string&) { o.shard = v; }},
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.job.shard = v; }},
         {"--shard-count", nullptr, "N", "",  // not listed: --shard's description explains it
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.shard_count = parse_int(v, name, 1, 1 << 30);
+           o.job.shard_count = parse_int(v, name, 1, 1 << 30);
          }},
         {"--shard-first", nullptr, "F", "",  // not listed: --shard's description explains it
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.shard_first = parse_int(v, name, 0, 1 << 30);
+           o.job.shard_first = parse_int(v, name, 0, 1 << 30);
          }},
     }};
 
-const Section kRigOptions = {
+const RenderSection kRigOptions = {
     "rig:",
     {
         {"--preset", nullptr, "NAME",
@@ -288,24 +275,25 @@ const Section kRigOptions = {
          applied_first},
         {"--views", nullptr, "N", "number of views (default 96)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.rig.views = parse_int(v, name, 1, PMR_MAX_VIEWS);
+           o.job.rig.views = parse_int(v, name, 1, PMR_MAX_VIEWS);
          }},
         {"--view-size", nullptr, "WxH",
          "view raster in pixels (default 1024x512; each side <= " + std::to_string(PMR_MAX_RASTER) + ")",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
            const auto d = parse_dims(v, name, 2, PMR_MAX_RASTER);
-           o.rig.view_w = d[0], o.rig.view_h = d[1];
+           o.job.rig.view_w = d[0], o.job.rig.view_h = d[1];
          }},
         {"--cone", nullptr, "DEG", "view cone (default 80)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.rig.cone_deg = parse_double(v, name);
-           if (!(o.rig.cone_deg > 0.0 && o.rig.cone_deg < 180.0))
+           o.job.rig.cone_deg = parse_double(v, name);
+           if (!(o.job.rig.cone_deg > 0.0 && o.job.rig.cone_deg < 180.0))
              throw Error("invalid --cone '" + v + "': expected degrees in (0, 180)");
          }},
         {"--yfov", nullptr, "DEG", "vertical field of view (default from the display: 2 atan(46.5 / 200))",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.rig.yfov_deg = parse_double(v, name);
-           if (!(o.rig.yfov_deg > 0.0 && o.rig.yfov_deg < 180.0))  // 0 would silently mean "the display's default"
+           o.job.rig.yfov_deg = parse_double(v, name);
+           if (!(o.job.rig.yfov_deg > 0.0 &&
+                 o.job.rig.yfov_deg < 180.0))  // 0 would silently mean "the display's default"
              throw Error("invalid --yfov '" + v + "': expected degrees in (0, 180)");
          }},
         {"--camera-spacing", nullptr, "S",
@@ -315,90 +303,90 @@ const Section kRigOptions = {
          [](RenderOptions& o, const std::string& v, const std::string&) {
            if (v != "linear" && v != "angular")
              throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
-           o.rig.angular_spacing = v == "angular";
+           o.job.rig.angular_spacing = v == "angular";
          }},
         {"--camera", nullptr, "K",
          "use the scene's glTF camera K (pose and field of view) instead of framing\n"
          "the scene's bounding sphere",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.rig.camera = parse_int(v, name, 0, 1 << 30);
+           o.job.rig.camera = parse_int(v, name, 0, 1 << 30);
          }},
         {"--background", nullptr, "R,G,B[,A]",
          "a linear colour behind the encoded image, views, quilt and previews (default\n"
          "transparent black; A defaults to 1). The encoded image is composited per\n"
          "subpixel; its PNG preview is always opaque (over black). With a Looking Glass\n"
          "preset or --display-config the quilt PNG is opaque black by default",
-         [](RenderOptions& o, const std::string& v, const std::string&) { o.background = parse_background(v); }},
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.job.background = parse_background(v); }},
         {"--zoom", nullptr, "F",
          "the scene appears F times larger (default 1: its bounding sphere fits the\n"
          "view's height and width); the camera moves closer, the zero-parallax plane\n"
          "stays through the sphere's center. Not with --camera",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.rig.zoom = parse_double(v, name);
-           if (!(o.rig.zoom >= 0.001 && o.rig.zoom <= 1000.0))
+           o.job.rig.zoom = parse_double(v, name);
+           if (!(o.job.rig.zoom >= 0.001 && o.job.rig.zoom <= 1000.0))
              throw Error("invalid --zoom: expected a factor from 0.001 to 1000");
            o.zoom_given = true;
          }},
     }};
 
-const Section kDisplayOptions = {
+const RenderSection kDisplayOptions = {
     "display:",
     {
         {"--display", nullptr, "WxH", "display image in pixels (default 7680x4320)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
            const auto d = parse_dims(v, name, 2, kMaxDisplaySide);
-           o.display.width = d[0], o.display.height = d[1];
+           o.job.display.width = d[0], o.job.display.height = d[1];
          }},
         {"--display-size", nullptr, "WxH", "physical size in cm (default 166x93; sets the aspect A)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
            const auto x = v.find('x');
            if (x == std::string::npos) throw Error("invalid --display-size '" + v + "': expected WxH in cm");
-           o.display.size_w_cm = parse_double(v.substr(0, x), name);
-           o.display.size_h_cm = parse_double(v.substr(x + 1), name);
+           o.job.display.size_w_cm = parse_double(v.substr(0, x), name);
+           o.job.display.size_h_cm = parse_double(v.substr(x + 1), name);
          }},
         {"--viewing-distance", nullptr, "CM", "(default 200)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.display.viewing_distance_cm = parse_double(v, name);
+           o.job.display.viewing_distance_cm = parse_double(v, name);
          }},
         {"--lens-pitch", nullptr, "L", "lens pitch in subpixels (default 16)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.display.lens_pitch = parse_rational(v, name);
-           if (o.display.lens_pitch.num <= 0) throw Error("invalid --lens-pitch '" + v + "': must be positive");
+           o.job.display.lens_pitch = parse_rational(v, name);
+           if (o.job.display.lens_pitch.num <= 0) throw Error("invalid --lens-pitch '" + v + "': must be positive");
          }},
         {"--tan-slant", nullptr, "T", "tangent of the lens slant (default 1/18)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.display.tan_slant = parse_rational(v, name);
+           o.job.display.tan_slant = parse_rational(v, name);
          }},
         {"--offset", nullptr, "O",
          "subpixel offset (default -L/(2N) = -1/12)\n"
          "(L, T, O accept decimals or fractions like 1/18; evaluated exactly)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.display.offset = parse_rational(v, name);
+           o.job.display.offset = parse_rational(v, name);
            o.offset_given = true;
          }},
         {"--reverse-views", nullptr, nullptr, "use view N-1-v instead of v",
-         [](RenderOptions& o, const std::string&, const std::string&) { o.display.reversed = true; }},
+         [](RenderOptions& o, const std::string&, const std::string&) { o.job.display.reversed = true; }},
         {"--bilinear", nullptr, nullptr, "sample views bilinearly (default nearest)",
-         [](RenderOptions& o, const std::string&, const std::string&) { o.display.bilinear = true; }},
+         [](RenderOptions& o, const std::string&, const std::string&) { o.job.display.bilinear = true; }},
         {"--blend-views", nullptr, nullptr,
          "blend the two nearest views by the lens phase, as Looking Glass's\n"
          "webxr shader does by default (default: one view per subpixel)",
-         [](RenderOptions& o, const std::string&, const std::string&) { o.display.blend_views = true; }},
+         [](RenderOptions& o, const std::string&, const std::string&) { o.job.display.blend_views = true; }},
     }};
 
-const Section kPipelineOptions = {
+const RenderSection kPipelineOptions = {
     "pipeline:",
     {
         {"--tile", nullptr, "XxYxV", "3D tile of the tile/fine raster, voxels over x, y, view (default 16x2x16)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
            const auto d = parse_dims(v, name, 3, kMaxTileSide);
-           o.pipeline.tile_x = d[0], o.pipeline.tile_y = d[1], o.pipeline.tile_v = d[2];
+           o.job.pipeline.tile_x = d[0], o.job.pipeline.tile_y = d[1], o.job.pipeline.tile_v = d[2];
          }},
         {"--method", nullptr, "M",
          "pmr (default), multipass (one conventional pass per view) or duplicate\n"
          "(every triangle copied per view into a 2D-tiled view atlas)",
          [](RenderOptions& o, const std::string& v, const std::string&) {
-           o.pipeline.method = parse_method(v);
+           o.job.pipeline.method = parse_method(v);
            o.method_given = true;
          }},
         {"--sampling", nullptr, "S",
@@ -408,12 +396,12 @@ const Section kPipelineOptions = {
          "presets listed there, which --bilinear, --blend-views or a --method\n"
          "other than pmr turn back to view sampling with a notice)",
          [](RenderOptions& o, const std::string& v, const std::string&) {
-           o.pipeline.sampling = parse_sampling(v);
+           o.job.pipeline.sampling = parse_sampling(v);
            o.sampling_given = true;
          }},
     }};
 
-const Section kShadingOptions = {
+const RenderSection kShadingOptions = {
     "shading (docs/SHADING.md):",
     {
         {"--shading", nullptr, "S",
@@ -423,10 +411,10 @@ const Section kShadingOptions = {
          "a default directional light) and a uniform environment or --environment;\n"
          "lambert: base colour x (0.2 + 0.8 max(0, n.l)), the same in every view,\n"
          "one fixed light (faster)",
-         [](RenderOptions& o, const std::string& v, const std::string&) { o.pipeline.shading = parse_shading(v); }},
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.job.pipeline.shading = parse_shading(v); }},
         {"--exposure", nullptr, "EV", "the colour times 2^EV, either model (default 0)",
          [](RenderOptions& o, const std::string& v, const std::string&) {
-           o.pipeline.exposure_ev = parse_exposure(v);
+           o.job.pipeline.exposure_ev = parse_exposure(v);
          }},
         {"--environment", nullptr, "FILE",
          "pbr: light with an equirectangular image of linear radiance (.hdr or .exr,\n"
@@ -436,81 +424,59 @@ const Section kShadingOptions = {
          "Needs --shading pbr",
          [](RenderOptions& o, const std::string& v, const std::string&) {
            if (v.empty()) throw Error("invalid --environment '': expected a .hdr or .exr file");
-           o.environment_file = v;
+           o.job.environment_file = v;
          }},
         {"--environment-rotation", nullptr, "DEG",
          "pbr: turn the image DEG degrees counter-clockwise seen from above\n"
          "(+X moves toward -Z; default 0)",
          [](RenderOptions& o, const std::string& v, const std::string&) {
-           o.environment_rotation_deg = parse_environment_rotation(v);
+           o.job.environment_rotation_deg = parse_environment_rotation(v);
            o.environment_rotation_given = true;
          }},
         {"--environment-intensity", nullptr, "X",
          "pbr: scales the environment, the image or the uniform one of radiance\n"
          "0.2 (0 turns it off; default 1)",
          [](RenderOptions& o, const std::string& v, const std::string&) {
-           o.pipeline.environment_intensity = parse_environment_intensity(v);
+           o.job.pipeline.environment_intensity = parse_environment_intensity(v);
          }},
         {"--verbose", "-v", nullptr, "per-stage device times and queue sizes",
-         [](RenderOptions& o, const std::string&, const std::string&) { o.verbose = true; }},
+         [](RenderOptions& o, const std::string&, const std::string&) { o.job.verbose = true; }},
     }};
 
-const Section kInputOptions = {
+const RenderSection kInputOptions = {
     "untrusted input (docs/SECURITY.md):",
     {
         {"--allow-outside-scene-folder", nullptr, nullptr,
          "read files the scene names outside its folder (by default a\n"
          "buffer or image that resolves outside it is an error); recorded in the sidecar",
          [](RenderOptions& o, const std::string&, const std::string&) {
-           o.input_limits.allow_outside_scene_folder = true;
+           o.job.input_limits.allow_outside_scene_folder = true;
          }},
         {"--limit", nullptr, "KEY=VALUE[,KEY=VALUE...]",
          "raise or lower a budget (VALUE an integer, K/M/G/T = x1024^n):",
-         [](RenderOptions& o, const std::string& v, const std::string&) { parse_limits(v, o.input_limits); },
+         [](RenderOptions& o, const std::string& v, const std::string&) { parse_limits(v, o.job.input_limits); },
          limit_help},
     }};
 
-const Section* const kSections[] = {&kOutputOptions,   &kSequenceOptions, &kRigOptions,  &kDisplayOptions,
-                                    &kPipelineOptions, &kShadingOptions,  &kInputOptions};
-
-const Option* find_option(const std::string& arg) {
-  for (const Section* s : kSections)
-    for (const Option& opt : s->options)
-      if (arg == opt.name || (opt.alias && arg == opt.alias)) return &opt;
-  return nullptr;
+// A bare argument is the scene.
+void set_scene(RenderOptions& o, const std::string& arg) {
+  if (!o.job.scene.empty()) throw Error("more than one scene given ('" + o.job.scene + "' and '" + arg + "')");
+  o.job.scene = arg;
 }
+
+const OptionTable<RenderOptions> kRenderTable = {"render",
+                                                 25,
+                                                 {&kOutputOptions, &kSequenceOptions, &kRigOptions, &kDisplayOptions,
+                                                  &kPipelineOptions, &kShadingOptions, &kInputOptions},
+                                                 set_scene};
 
 // The options after apply_display_source: anything they throw is a usage error (they read no file).
 void parse_arguments(RenderOptions& o, const std::vector<std::string>& args) {
-  for (size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (const Option* opt = find_option(a)) {
-      if (opt->arg && i + 1 >= args.size()) throw Error("option " + a + " needs a value (see pmr render --help)");
-      opt->set(o, opt->arg ? args[++i] : std::string(), opt->name);
-    } else if (!a.empty() && a[0] == '-') {
-      throw Error("unknown option " + a + " (see pmr render --help)");
-    } else if (o.scene.empty()) {
-      o.scene = a;
-    } else {
-      throw Error("more than one scene given ('" + o.scene + "' and '" + a + "')");
-    }
-  }
-  if (o.zoom_given && o.rig.camera >= 0)
+  parse_by_table(kRenderTable, o, args);
+  if (o.zoom_given && o.job.rig.camera >= 0)
     throw Error(
         "--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own: "
         "give one of them");
-}
-
-// An option's --help entry: "--out DIR, -o DIR" padded to the description's column (or two spaces
-// after a longer one), the description's further lines indented to that column.
-std::string option_help(const Option& opt) {
-  constexpr size_t kColumn = 25;
-  const std::string arg = opt.arg ? std::string(" ") + opt.arg : "";
-  std::string line = std::string("  ") + opt.name + arg + (opt.alias ? std::string(", ") + opt.alias + arg : "");
-  line += line.size() < kColumn ? std::string(kColumn - line.size(), ' ') : "  ";
-  for (char c : opt.help) line += c == '\n' ? "\n" + std::string(kColumn, ' ') : std::string(1, c);
-  line += "\n";
-  return opt.more_help ? line + opt.more_help() : line;
 }
 
 }  // namespace
@@ -525,35 +491,37 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
 namespace {
 
 void finalize_options(RenderOptions& o) {
-  if (o.display.blend_views && o.display.bilinear) throw UsageError("--blend-views and --bilinear cannot be combined");
-  check_environment_options(o.environment_file, o.environment_rotation_given, o.pipeline.shading, o.option_warnings);
-  if (o.pipeline.sampling == Sampling::Subpixel && !o.sampling_given) {
+  if (o.job.display.blend_views && o.job.display.bilinear)
+    throw UsageError("--blend-views and --bilinear cannot be combined");
+  check_environment_options(o.job.environment_file, o.environment_rotation_given, o.job.pipeline.shading,
+                            o.job.warnings);
+  if (o.job.pipeline.sampling == Sampling::Subpixel && !o.sampling_given) {
     // the preset's default: options that need the views rendered on their grids take precedence
-    const std::string needs_views = o.pipeline.method != Method::Pmr
-                                        ? "--method " + std::string(to_string(o.pipeline.method))
-                                    : o.display.bilinear    ? "--bilinear"
-                                    : o.display.blend_views ? "--blend-views"
-                                                            : "";
+    const std::string needs_views = o.job.pipeline.method != Method::Pmr
+                                        ? "--method " + std::string(to_string(o.job.pipeline.method))
+                                    : o.job.display.bilinear    ? "--bilinear"
+                                    : o.job.display.blend_views ? "--blend-views"
+                                                                : "";
     if (!needs_views.empty()) {
-      o.pipeline.sampling = Sampling::View;
-      o.option_warnings.push_back(needs_views +
-                                  " samples the rendered views: --sampling view instead of the "
-                                  "display's default, subpixel");
-    } else if (!o.products.encoded) {
-      o.pipeline.sampling = Sampling::View;  // no encoded image: nothing to sample by subpixel
+      o.job.pipeline.sampling = Sampling::View;
+      o.job.warnings.push_back(needs_views +
+                               " samples the rendered views: --sampling view instead of the "
+                               "display's default, subpixel");
+    } else if (!o.job.products.encoded) {
+      o.job.pipeline.sampling = Sampling::View;  // no encoded image: nothing to sample by subpixel
     }
   }
-  if (o.pipeline.sampling == Sampling::Subpixel) {
-    check_subpixel_sampling(o.pipeline.method, o.display);  // pmr unless --method says otherwise
-    if (!o.products.encoded) {                              // the views are rendered on their grids in either case
-      o.pipeline.sampling = Sampling::View;
-      o.option_warnings.push_back(
+  if (o.job.pipeline.sampling == Sampling::Subpixel) {
+    check_subpixel_sampling(o.job.pipeline.method, o.job.display);  // pmr unless --method says otherwise
+    if (!o.job.products.encoded) {  // the views are rendered on their grids in either case
+      o.job.pipeline.sampling = Sampling::View;
+      o.job.warnings.push_back(
           "--sampling subpixel samples the encoded image, which --write does not ask for: "
           "ignored");
     }
   }
   if (!o.offset_given) {
-    o.display.offset = default_offset(o.display.lens_pitch, o.rig.views);
+    o.job.display.offset = default_offset(o.job.display.lens_pitch, o.job.rig.views);
   }
 }
 
@@ -581,18 +549,12 @@ std::string main_help() {
 }
 
 std::string render_help() {
-  std::string out =
-      "usage: pmr render [SCENE] [options]\n"
-      "Renders SCENE (glTF 2.0, .gltf or .glb; default: the bundled data/default_scene.glb) as N views\n"
-      "and interlaces them into the display's subpixel image. Defaults are the preset paper-8k:\n"
-      "96 views of 1024x512, a 7680x4320 display of 166x93 cm seen from 200 cm, 80 degree view cone.\n"
-      "\n";
-  for (const Section* section : kSections) {
-    out += std::string(section->heading) + "\n";
-    for (const Option& opt : section->options)
-      if (!opt.help.empty()) out += option_help(opt);
-  }
-  return out +
+  return "usage: pmr render [SCENE] [options]\n"
+         "Renders SCENE (glTF 2.0, .gltf or .glb; default: the bundled data/default_scene.glb) as N views\n"
+         "and interlaces them into the display's subpixel image. Defaults are the preset paper-8k:\n"
+         "96 views of 1024x512, a 7680x4320 display of 166x93 cm seen from 200 cm, 80 degree view cone.\n"
+         "\n" +
+         options_help(kRenderTable) +
          "Environment: PMR_DEVICE=substring selects the OpenCL device by name (default: first CPU device).\n"
          "Docs in the source tree: README.md, docs/DESIGN.md (rig, framing, encoder, files), docs/SHADING.md.\n";
 }

@@ -45,19 +45,19 @@ int run_quality(const std::vector<std::string>& args) {
     if (args[i] == "--also-view-size") {  // checked as --view-size is
       if (i + 1 >= args.size()) throw UsageError("option --also-view-size needs a value (see pmr quality --help)");
       const RenderOptions r = parse_render_options({"--view-size", args[++i]});
-      extra.push_back({r.rig.view_w, r.rig.view_h});
+      extra.push_back({r.job.rig.view_w, r.job.rig.view_h});
       continue;
     }
     rest.push_back(args[i]);
   }
   RenderOptions o = parse_render_options(rest);
   finalize_render_options(o);
-  if (o.scene.empty()) o.scene = default_scene_path();
-  const Scene scene = load_scene(o.scene);
+  if (o.job.scene.empty()) o.job.scene = default_scene_path();
+  const Scene scene = load_scene(o.job.scene);
   ClRuntime rt;
-  const std::vector<SamplingQualityRow> rows = sampling_quality(rt, scene, o.rig, o.display, scale, extra);
-  std::printf("# %s: %zu triangles; %d views; display %dx%d; device %s\n", o.scene.c_str(), scene.triangles.size(),
-              o.rig.views, o.display.width, o.display.height, rt.device_name().c_str());
+  const std::vector<SamplingQualityRow> rows = sampling_quality(rt, scene, o.job.rig, o.job.display, scale, extra);
+  std::printf("# %s: %zu triangles; %d views; display %dx%d; device %s\n", o.job.scene.c_str(), scene.triangles.size(),
+              o.job.rig.views, o.job.display.width, o.job.display.height, rt.device_name().c_str());
   std::printf("%-16s %10s %10s %10s %10s %10s %10s\n", "sampling", "view", "Msamples", "render_ms", "rmse",
               "rmse_shown", "differing");
   for (const SamplingQualityRow& r : rows) {

@@ -30,35 +30,8 @@ std::string exe_dir() {
 
 // The job the options describe (the compression name checked here, before anything else).
 SequenceJob sequence_job(const RenderOptions& o) {
-  SequenceJob job;
+  SequenceJob job = o.job;
   job.compression = as_usage([&] { return parse_exr_compression(o.compression); });
-  job.scene = o.scene;
-  job.input_limits = o.input_limits;
-  job.environment_file = o.environment_file;
-  job.environment_rotation_deg = o.environment_rotation_deg;
-  job.rig = o.rig;
-  job.display = o.display;
-  job.display_source = o.display_source;
-  if (o.has_calibration) job.calibration = o.calibration;
-  job.pipeline = o.pipeline;
-  job.products = o.products;
-  job.quilt_layout = o.quilt;
-  job.frames = o.frames;
-  job.fps = o.fps;
-  job.animation = o.animation;
-  job.turntable = o.turntable;
-  job.turntable_deg = o.turntable_deg;
-  job.turntable_frames = o.turntable_frames;
-  job.shard = o.shard;
-  job.shard_count = o.shard_count;
-  job.shard_first = o.shard_first;
-  job.resume = o.resume;
-  job.overwrite = o.overwrite;
-  job.quiet = o.quiet;
-  job.verbose = o.verbose;
-  job.warnings = o.option_warnings;
-  job.background = o.background;
-  job.quilt_preview_opaque = o.quilt_preview_opaque;
   return job;
 }
 
@@ -97,7 +70,7 @@ int run_render(const std::vector<std::string>& args) {
   }
   finalize_render_options(o);
   test_hook_force_internal_error("render-options");
-  if (o.scene.empty()) o.scene = default_scene_path();
+  if (o.job.scene.empty()) o.job.scene = default_scene_path();
   return run_sequence(sequence_job(o));
 }
 

@@ -16,6 +16,7 @@
 
 #include "cli/options.h"
 #include "pmr/error.h"
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "sequence/frame_files.h"
 #include "sequence/frame_list.h"
@@ -56,7 +57,7 @@ struct FolderScene {
 };
 
 std::string sidecar_path(const std::string& dir, const RenderOptions& o, long f) {
-  return (fs::path(dir) / (frame_stem(o.products.name, f) + ".json")).string();
+  return (fs::path(dir) / (frame_stem(o.job.products.name, f) + ".json")).string();
 }
 
 FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const std::vector<long>& frames) {
@@ -94,7 +95,7 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
 // explicit_kinds: --write / --preview were given, check those kinds; else every output the sidecar lists.
 std::string check_frame(const std::string& dir, const RenderOptions& o, bool explicit_kinds, bool deep, long f,
                         const FolderScene& folder) {
-  const std::string stem = frame_stem(o.products.name, f);
+  const std::string stem = frame_stem(o.job.products.name, f);
   const std::string sidecar = sidecar_path(dir, o, f);
   std::error_code ec;
   if (!fs::is_regular_file(sidecar, ec)) return stem + ".json is missing";
@@ -111,7 +112,7 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
       !(j["fps"].get<double>() > 0.0) || std::fabs(j["time"].get<double>() - double(f) / j["fps"].get<double>()) > 1e-9)
     return stem + ".json has a time that is not frame / fps";
   const SidecarProvenance prov = sidecar_provenance(text);
-  const std::string reference_name = frame_stem(o.products.name, folder.reference_frame) + ".json";
+  const std::string reference_name = frame_stem(o.job.products.name, folder.reference_frame) + ".json";
   if (!prov.scene.empty() && prov.scene != folder.scene)
     return stem + ".json was rendered from another scene than " + reference_name +
            " and the folder's other frames (scene checksums differ)";
@@ -122,13 +123,13 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
   const nlohmann::json* outputs = j.contains("outputs") && j["outputs"].is_object() ? &j["outputs"] : nullptr;
   if (explicit_kinds) {
     std::vector<std::string> kinds;
-    if (o.products.encoded) kinds.push_back("encoded");
-    if (o.products.views) kinds.push_back("views");
-    if (o.products.quilt) kinds.push_back("quilt");
-    if (o.products.preview) {
+    if (o.job.products.encoded) kinds.push_back("encoded");
+    if (o.job.products.views) kinds.push_back("views");
+    if (o.job.products.quilt) kinds.push_back("quilt");
+    if (o.job.products.preview) {
       kinds.push_back("preview_center");
-      if (o.products.encoded) kinds.push_back("preview_encoded");
-      if (o.products.quilt) kinds.push_back("preview_quilt");
+      if (o.job.products.encoded) kinds.push_back("preview_encoded");
+      if (o.job.products.quilt) kinds.push_back("preview_quilt");
     }
     for (const std::string& kind : kinds) {
       if (!outputs || !outputs->contains(kind)) return stem + ".json lists no " + kind + " output";
@@ -193,9 +194,10 @@ int run_verify(const std::vector<std::string>& args) {
   for (const std::string& r : rest) frames_given |= r == "--frames";
   if (!frames_given) throw UsageError("pmr verify needs --frames LIST (the frames the job was asked for)");
   const RenderOptions o = parse_render_options(rest);
-  if (o.frames == "all") throw UsageError("pmr verify needs the frames as a list (--frames all depends on the scene)");
-  const std::vector<long> frames = as_usage([&] { return parse_frame_list(o.frames); });
-  as_usage([&] { check_name_covers_frames(o.products.name, frames.size()); });
+  if (o.job.frames == "all")
+    throw UsageError("pmr verify needs the frames as a list (--frames all depends on the scene)");
+  const std::vector<long> frames = as_usage([&] { return parse_frame_list(o.job.frames); });
+  as_usage([&] { check_name_covers_frames(o.job.products.name, frames.size()); });
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw Error("cannot verify " + dir + ": not a folder");
   bool explicit_kinds = false;

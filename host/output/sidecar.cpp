@@ -5,6 +5,8 @@
 #include <glm/gtc/constants.hpp>
 #include <nlohmann/json.hpp>
 
+#include "output/sidecar.h"
+
 #include "output/checksum.h"
 #include "pmr/error.h"
 #include "pmr/output.h"
@@ -91,18 +93,19 @@ json light_json(const SceneLight& l) {
 // environment image is recorded by its file (as given), the checksum of its bytes, rotation and
 // intensity, so --resume renders again when any of them changes.
 json shading_json(const SidecarInfo& info) {
-  json s = {{"model", info.shading}, {"exposure_ev", info.exposure_ev}};
-  if (info.shading != "pbr") return s;
+  const PipelineConfig& p = info.pipeline;
+  json s = {{"model", to_string(p.shading)}, {"exposure_ev", p.exposure_ev}};
+  if (p.shading != Shading::Pbr) return s;
   if (info.environment_file.empty())
     s["environment"] = {
-        {"kind", "uniform"}, {"radiance", 0.2 * info.environment_intensity}, {"intensity", info.environment_intensity}};
+        {"kind", "uniform"}, {"radiance", 0.2 * p.environment_intensity}, {"intensity", p.environment_intensity}};
   else
     s["environment"] = {{"kind", "image"},
                         {"file", info.environment_file},
                         {"checksum", info.environment_checksum},
                         {"checksum_algorithm", kChecksumAlgorithm},
                         {"rotation_deg", info.environment_rotation_deg},
-                        {"intensity", info.environment_intensity}};
+                        {"intensity", p.environment_intensity}};
   json lights = json::array();
   for (const SceneLight& l : info.lights) lights.push_back(light_json(l));
   s["lights"] = lights;
@@ -110,6 +113,11 @@ json shading_json(const SidecarInfo& info) {
 }
 
 double degrees(double rad) { return rad * (180.0 / glm::pi<double>()); }
+
+// The --display-config file's checksum; "" without one.
+std::string display_config_checksum(const SidecarInfo& info) {
+  return info.display_source.calibration ? info.display_source.calibration->checksum : "";
+}
 
 // What the render read, so that --resume and pmr verify notice a changed input.
 json checksums_json(const SidecarInfo& info) {
@@ -121,7 +129,7 @@ json checksums_json(const SidecarInfo& info) {
     for (const auto& [file, sum] : info.scene_files) files[file] = sum;
     c["scene_files"] = files;
   }
-  if (!info.display_config_checksum.empty()) c["display_config"] = info.display_config_checksum;
+  if (!display_config_checksum(info).empty()) c["display_config"] = display_config_checksum(info);
   return c;
 }
 
@@ -141,17 +149,39 @@ json quilt_json(const Rig& rig, const SidecarInfo& info) {
 // null, not absent, when the frame has no animation or turntable: sidecar_config_difference requires
 // both keys.
 json animation_json(const SidecarInfo& info) {
-  if (info.animation == -1) return nullptr;
-  return {{"index", info.animation}, {"name", info.animation_name}};
+  if (info.sequence.animation == kNoAnimation) return nullptr;
+  return {{"index", info.sequence.animation}, {"name", info.sequence.animation_label}};
 }
 
 json turntable_json(const SidecarInfo& info) {
-  if (!info.turntable) return nullptr;
-  return {{"degrees", info.turntable_deg},
-          {"frames", info.turntable_frames},
+  if (!info.sequence.turntable) return nullptr;
+  return {{"degrees", info.sequence.turntable_deg},
+          {"frames", info.sequence.turntable_frames},
           {"angle_deg", info.turntable_angle},
           {"pivot", vec3_json(info.pivot)},
           {"axis", vec3_json(glm::dvec3(0, 1, 0))}};
+}
+
+// A calibration file's values as read, by the file's names (every value a number).
+json calibration_json(const LookingGlassCalibration& c) {
+  const std::pair<const char*, double> values[] = {{"pitch", c.pitch},
+                                                   {"slope", c.slope},
+                                                   {"center", c.center},
+                                                   {"DPI", c.dpi},
+                                                   {"screenW", c.screen_w},
+                                                   {"screenH", c.screen_h},
+                                                   {"viewCone", c.view_cone},
+                                                   {"fringe", c.fringe},
+                                                   {"flipImageX", c.flip_x},
+                                                   {"flipImageY", c.flip_y},
+                                                   {"flipSubp", c.flip_subp},
+                                                   {"invView", c.inv_view},
+                                                   {"CellPatternMode", c.cell_pattern},
+                                                   {"subpixelCells", double(c.cells.size())}};
+  json cal = json::object();
+  cal["serial"] = c.serial;
+  for (const auto& [key, value] : values) cal[key] = value;
+  return cal;
 }
 
 json display_json(const Display& display, const SidecarInfo& info) {
@@ -174,13 +204,8 @@ json display_json(const Display& display, const SidecarInfo& info) {
     d["cell_rows"] = display.cell_rows;
     d["cell_offsets_1e14"] = display.cell_offsets;  // [(row class * 2 + j % 2) * 3 + k]
   }
-  if (!info.display_source.empty()) d["source"] = info.display_source;
-  if (!info.calibration.empty()) {
-    json cal = json::object();
-    cal["serial"] = info.calibration_serial;
-    for (const auto& [key, value] : info.calibration) cal[key] = value;
-    d["calibration"] = cal;
-  }
+  if (!info.display_source.name.empty()) d["source"] = info.display_source.name;
+  if (info.display_source.calibration) d["calibration"] = calibration_json(*info.display_source.calibration);
   d["sampling"] = display.bilinear ? "bilinear" : "nearest";
   d["view_blend"] = display.blend_views;
   return d;
@@ -262,28 +287,29 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["format"] = "pmr-sidecar-1";
   j["program_version"] = program_version();
   j["scene"] = info.scene;
-  if (!info.scene_checksum.empty() || !info.display_config_checksum.empty()) j["checksums"] = checksums_json(info);
+  if (!info.scene_checksum.empty() || !display_config_checksum(info).empty()) j["checksums"] = checksums_json(info);
   j["frame"] = info.frame;
-  j["method"] = info.method;
-  j["sampling"] = info.sampling;
+  j["method"] = to_string(info.pipeline.method);
+  j["sampling"] = to_string(info.pipeline.sampling);
   j["shading"] = shading_json(info);
-  j["tile"] = {{"x", info.tile_x}, {"y", info.tile_y}, {"v", info.tile_v}};
-  j["camera"] = info.camera;
+  j["tile"] = {{"x", info.pipeline.tile_x}, {"y", info.pipeline.tile_y}, {"v", info.pipeline.tile_v}};
+  j["camera"] = info.rig_config.camera;
   if (info.has_bounds) j["scene_bounds"] = {{"min", vec3_json(info.bounds_lo)}, {"max", vec3_json(info.bounds_hi)}};
-  if (!info.compression.empty()) j["compression"] = info.compression;
+  if (info.compression) j["compression"] = to_string(*info.compression);
   json outputs = json::object();
   for (const auto& [kind, file] : info.outputs) outputs[kind] = file;
   j["outputs"] = outputs;
-  if (!info.background.empty()) j["background"] = info.background;
+  const Background& bg = info.background;
+  if (!bg.transparent()) j["background"] = {bg.r, bg.g, bg.b, bg.a};
   if (!info.output_checksums.empty()) j["output_checksums"] = output_checksums_json(info);
   if (info.quilt_columns > 0) j["quilt"] = quilt_json(rig, info);
   if (info.center_view >= 0) j["preview_center_view"] = info.center_view;
   j["depth_channel"] = info.depth;
   // the scene's files were read without confinement to its folder (docs/SECURITY.md)
-  if (info.allow_outside_scene_folder) j["allow_outside_scene_folder"] = true;
+  if (info.input_limits.allow_outside_scene_folder) j["allow_outside_scene_folder"] = true;
   j["warnings"] = info.warnings;
   j["time"] = info.time;
-  j["fps"] = info.fps;
+  j["fps"] = info.sequence.fps;
   j["animation"] = animation_json(info);
   j["turntable"] = turntable_json(info);
   j["display"] = display_json(display, info);

@@ -6,12 +6,6 @@
 
 namespace pmr {
 
-ClBuffer upload_table(const ClRuntime& rt, const std::vector<int32_t>& v, const char* name) {
-  ClBuffer b = rt.buffer(std::max<size_t>(v.size() * sizeof(int32_t), 16), name, CL_MEM_READ_ONLY);
-  rt.write(b, v.data(), v.size() * sizeof(int32_t));
-  return b;
-}
-
 EncodeStage::EncodeStage(Launcher& launcher, const ClProgram& program)
     : launcher_(launcher),
       rt_(launcher.runtime()),
@@ -26,10 +20,8 @@ void EncodeStage::configure(const Display& display, int views, int w, int h) {
   params_ = make_encode_params(display, views, w, h);
   make_encode_tables(display, params_, columns_, rows_);
   rt_.write(params_buf_, &params_, sizeof params_);
-  columns_buf_ = rt_.buffer(columns_.size() * sizeof(PmrEncodeColumn), "encoder columns", CL_MEM_READ_ONLY);
-  rt_.write(columns_buf_, columns_.data(), columns_.size() * sizeof(PmrEncodeColumn));
-  rows_buf_ = rt_.buffer(rows_.size() * sizeof(PmrEncodeRow), "encoder rows", CL_MEM_READ_ONLY);
-  rt_.write(rows_buf_, rows_.data(), rows_.size() * sizeof(PmrEncodeRow));
+  columns_buf_ = rt_.upload(columns_, "encoder columns");
+  rows_buf_ = rt_.upload(rows_, "encoder rows");
   configured_ = true;
   display_ = rt_.buffer(std::max<size_t>(display_bytes(), 16), "display image");
   sub_alpha_ = rt_.buffer(std::max<size_t>(display_bytes() / 4 * 3, 16), "display subpixel alpha");
@@ -42,8 +34,8 @@ size_t EncodeStage::display_bytes() const {
 // The straddling pixels' slots and coverage bytes (fused and subpixel paths).
 TileOwnership EncodeStage::own_by_tiles(int tile_x) {
   TileOwnership own = tile_ownership(params_, columns_, rows_, tile_x);
-  straddle_slot_ = upload_table(rt_, own.straddle_slot, "straddle slots");
-  straddle_columns_ = upload_table(rt_, own.straddling, "straddle columns");
+  straddle_slot_ = rt_.upload(own.straddle_slot, "straddle slots", kMinTableBytes);
+  straddle_columns_ = rt_.upload(own.straddling, "straddle columns", kMinTableBytes);
   straddle_slots_ = uint32_t(own.straddling.size());
   straddle_cov_ =
       rt_.buffer(std::max<size_t>(size_t(straddle_slots_) * params_.display_h * 3, 16), "straddle coverage");

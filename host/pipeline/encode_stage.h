@@ -58,7 +58,8 @@ class EncodeStage {
   uint32_t straddle_slots_ = 0;
 };
 
-// A read-only buffer holding `v` (at least 16 bytes: OpenCL has no empty buffers).
-ClBuffer upload_table(const ClRuntime& rt, const std::vector<int32_t>& v, const char* name);
+// The smallest buffer of an encoder or fine-raster table: a table may be empty (no straddling
+// columns), and OpenCL has no empty buffers.
+constexpr size_t kMinTableBytes = 16;
 
 }  // namespace pmr

@@ -53,8 +53,8 @@ void FineStage::configure_fused(int views, EncodeStage& encode) {
     fine_encode_ = ClKernel(fused_program_, "fine_encode");
   }
   const TileOwnership own = encode.own_by_tiles(tile_[0]);
-  column_start_ = upload_table(rt_, own.column_start, "fused column starts");
-  row_start_ = upload_table(rt_, own.row_start, "fused row starts");
+  column_start_ = rt_.upload(own.column_start, "fused column starts", kMinTableBytes);
+  row_start_ = rt_.upload(own.row_start, "fused row starts", kMinTableBytes);
   const std::vector<PmrEncodeColumn>& columns = encode.columns();
   const size_t W = size_t(encode.params().display_w);
   std::vector<int32_t> soa(9 * W);
@@ -63,7 +63,7 @@ void FineStage::configure_fused(int views, EncodeStage& encode) {
       const PmrEncodeColumn& c = columns[3 * j + k];
       soa[(0 + k) * W + j] = c.a_mod_n, soa[(3 + k) * W + j] = c.b, soa[(6 + k) * W + j] = c.px;
     }
-  column_soa_ = upload_table(rt_, soa, "fused column planes");
+  column_soa_ = rt_.upload(soa, "fused column planes", kMinTableBytes);
 }
 
 // The subpixel program (per view count: its private per-view arrays), the samples and the chunk list.
@@ -82,20 +82,19 @@ void FineStage::configure_subpixel(int views, EncodeStage& encode) {
   // the column table's a_mod_n and b as planes, for 8-column vector loads (8 entries of slack at the end)
   std::vector<int32_t> a(columns.size() + 8), b(columns.size() + 8);
   for (size_t s = 0; s < columns.size(); ++s) a[s] = columns[s].a_mod_n, b[s] = columns[s].b;
-  column_a_ = upload_table(rt_, a, "subpixel column views");
-  column_b_ = upload_table(rt_, b, "subpixel column ranks");
+  column_a_ = rt_.upload(a, "subpixel column views", kMinTableBytes);
+  column_b_ = rt_.upload(b, "subpixel column ranks", kMinTableBytes);
   // the samples must lie in the view pixels the encoder tables name (tile ownership relies on it)
   const std::vector<int32_t> xs = subpixel_sample_columns(encode.params()), ys = subpixel_sample_rows(encode.params());
   for (size_t s = 0; s < xs.size(); ++s)
     if (xs[s] >> PMR_X_FRAC_BITS != columns[s].px) throw InternalError("subpixel sample outside its column");
   for (size_t i = 0; i < ys.size(); ++i)
     if (ys[i] >> PMR_Y_FRAC_BITS != encode.rows()[i].py) throw InternalError("subpixel sample outside its row");
-  sample_x_ = upload_table(rt_, xs, "subpixel sample columns");
-  sample_y_ = upload_table(rt_, ys, "subpixel sample rows");
+  sample_x_ = rt_.upload(xs, "subpixel sample columns", kMinTableBytes);
+  sample_y_ = rt_.upload(ys, "subpixel sample rows", kMinTableBytes);
   const std::vector<PmrSampleChunk> list = subpixel_chunks(own, tile_[0], tile_[1], capacity);
   num_chunks_ = uint32_t(list.size());
-  chunks_ = rt_.buffer(std::max<size_t>(list.size() * sizeof(PmrSampleChunk), 16), "subpixel chunks", CL_MEM_READ_ONLY);
-  rt_.write(chunks_, list.data(), list.size() * sizeof(PmrSampleChunk));
+  chunks_ = rt_.upload(list, "subpixel chunks", kMinTableBytes);
 }
 
 void FineStage::run_volume(const SceneBuffers& scene, const GeometryStage& geometry, uint64_t num_tiles,

@@ -135,7 +135,7 @@ uint32_t GeometryStage::scan_tile_counts(StageTimes& t) {
                 "tile-queue limit of " +
                 std::to_string(tile_queue_limit_) + " (raise it with --limit tile-queue=N)");
   counts[num_tiles_] = uint32_t(total);
-  rt_.write(tile_offsets_, counts.data(), counts.size() * sizeof(uint32_t));
+  rt_.write(tile_offsets_, counts);
   return uint32_t(total);
 }
 

@@ -1,5 +1,5 @@
-// The run-wide choices of a pipeline (pipeline.h): method, sampling and shading names.
-#include "pipeline/pipeline.h"
+// The run-wide choices of a pipeline (pipeline_config.h): method, sampling and shading names.
+#include "pipeline/pipeline_config.h"
 
 #include "pmr/error.h"
 

@@ -22,34 +22,14 @@ std::vector<float> srgb_lut() {
   return lut;
 }
 
-template <typename T>
-size_t bytes_of(const std::vector<T>& v) {
-  return v.size() * sizeof(T);
-}
-
-// A read-only buffer holding `v` (at least `min_bytes`: OpenCL has no empty buffers).
-template <typename T>
-ClBuffer upload(const ClRuntime& rt, const std::vector<T>& v, const char* name, size_t min_bytes = 1) {
-  ClBuffer b = rt.buffer(std::max(bytes_of(v), min_bytes), name, CL_MEM_READ_ONLY);
-  rt.write(b, v.data(), bytes_of(v));
-  return b;
-}
-
-// Rewrites `b` with `v`, reallocating only when the size changes (per-frame tables).
-template <typename T>
-void rewrite(const ClRuntime& rt, ClBuffer& b, const std::vector<T>& v, const char* name) {
-  if (b.size() != bytes_of(v)) b = rt.buffer(bytes_of(v), name, CL_MEM_READ_ONLY);
-  rt.write(b, v.data(), bytes_of(v));
-}
-
 }  // namespace
 
 SceneBuffers::SceneBuffers(const ClRuntime& rt, const PipelineConfig& config) : rt_(rt) {
-  lut_ = upload(rt, srgb_lut(), "sRGB table");
+  lut_ = rt.upload(srgb_lut(), "sRGB table");
   // the split-sum table (pbr only: computing it costs about 0.5 s of CPU once per process)
   static_assert(kEnvSplitSumSize == PMR_SPLIT_SUM_N, "the kernels' split-sum table size");
   const std::vector<float> none(2, 0.0f);
-  split_sum_ = upload(rt, config.shading == Shading::Pbr ? split_sum_table() : none, "split-sum table");
+  split_sum_ = rt.upload(config.shading == Shading::Pbr ? split_sum_table() : none, "split-sum table");
   upload_environment(config);
 }
 
@@ -68,8 +48,8 @@ void SceneBuffers::upload_environment(const PipelineConfig& config) {
                 " MiB, more than the device "
                 "can allocate at once (" +
                 std::to_string(rt_.max_alloc_bytes() >> 20) + " MiB): use a smaller image");
-  env_ = upload(rt_, header, "environment header");
-  env_data_ = upload(rt_, data, "environment tables");
+  env_ = rt_.upload(header, "environment header");
+  env_data_ = rt_.upload(data, "environment tables");
 }
 
 void SceneBuffers::set_scene(const Scene& scene) {
@@ -82,14 +62,14 @@ void SceneBuffers::set_scene(const Scene& scene) {
   has_tangents_ = scene.tangents.size() == scene.positions.size() && !scene.positions.empty();
   const std::vector<glm::vec4> no_tangents(1, glm::vec4(0.0f));
   scene_lights_ = scene.lights;
-  positions_ = upload(rt_, scene.positions, "vertex positions");
-  attrs_ = upload(rt_, scene.attributes, "vertex attributes");
-  tris_ = upload(rt_, scene.triangles, "triangles");
-  materials_ = upload(rt_, tables.materials, "materials");
-  textures_ = upload(rt_, tables.textures, "texture table", 16);
-  texels_ = upload(rt_, tables.texels, "texels", 16);
-  texcoords_ = upload(rt_, tables.texcoords, "texture coordinates");
-  tangents_ = upload(rt_, has_tangents_ ? scene.tangents : no_tangents, "tangents");
+  positions_ = rt_.upload(scene.positions, "vertex positions");
+  attrs_ = rt_.upload(scene.attributes, "vertex attributes");
+  tris_ = rt_.upload(scene.triangles, "triangles");
+  materials_ = rt_.upload(tables.materials, "materials");
+  textures_ = rt_.upload(tables.textures, "texture table", 16);
+  texels_ = rt_.upload(tables.texels, "texels", 16);
+  texcoords_ = rt_.upload(tables.texcoords, "texture coordinates");
+  tangents_ = rt_.upload(has_tangents_ ? scene.tangents : no_tangents, "tangents");
 }
 
 void SceneBuffers::update_geometry(const Scene& posed) {
@@ -97,22 +77,21 @@ void SceneBuffers::update_geometry(const Scene& posed) {
       posed.attributes.size() != posed.positions.size())
     throw InternalError("update_geometry: the posed scene does not match the scene given to set_scene");
   if (posed.triangles.empty()) return;
-  rt_.write(positions_, posed.positions.data(), bytes_of(posed.positions));
-  rt_.write(attrs_, posed.attributes.data(), bytes_of(posed.attributes));
-  rt_.write(tris_, posed.triangles.data(), bytes_of(posed.triangles));
-  if (has_tangents_ && posed.tangents.size() == posed.positions.size())
-    rt_.write(tangents_, posed.tangents.data(), bytes_of(posed.tangents));
+  rt_.write(positions_, posed.positions);
+  rt_.write(attrs_, posed.attributes);
+  rt_.write(tris_, posed.triangles);
+  if (has_tangents_ && posed.tangents.size() == posed.positions.size()) rt_.write(tangents_, posed.tangents);
 }
 
 void SceneBuffers::upload_frame(const FrameDescription& frame) {
   std::vector<PmrLight> table;
   for (const SceneLight& l : frame.lights) table.push_back(device_light(l));
   table.resize(std::max<size_t>(table.size(), 1));  // no empty buffers
-  rewrite(rt_, lights_, table, "lights");
+  rt_.rewrite(lights_, table, "lights");
   const Rig& rig = frame.rig;
   std::vector<glm::vec4> eyes(size_t(rig.views));
   for (int i = 0; i < rig.views; ++i) eyes[size_t(i)] = glm::vec4(glm::vec3(glm::inverse(rig.view_matrix(i))[3]), 1.0f);
-  rewrite(rt_, eyes_, eyes, "camera positions");
+  rt_.rewrite(eyes_, eyes, "camera positions");
 }
 
 cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params) const {

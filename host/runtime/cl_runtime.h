@@ -4,6 +4,7 @@
 #pragma once
 #include <CL/cl.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <map>
 #include <string>
@@ -17,6 +18,11 @@ void cl_check(cl_int code, const std::string& what);
 
 // One line per platform and device, for `pmr info`.
 std::vector<std::string> describe_opencl_devices();
+
+template <typename T>
+size_t bytes_of(const std::vector<T>& v) {
+  return v.size() * sizeof(T);
+}
 
 class ClBuffer {
  public:
@@ -115,6 +121,25 @@ class ClRuntime {
 
   ClBuffer buffer(size_t bytes, const std::string& name, cl_mem_flags flags = CL_MEM_READ_WRITE) const;
   void write(const ClBuffer& b, const void* data, size_t bytes, size_t offset = 0) const;
+  // Writes all of `v` at the buffer's start.
+  template <typename T>
+  void write(const ClBuffer& b, const std::vector<T>& v) const {
+    write(b, v.data(), bytes_of(v));
+  }
+  // A read-only buffer holding `v`, of at least `min_bytes` (OpenCL has no empty buffers).
+  template <typename T>
+  ClBuffer upload(const std::vector<T>& v, const std::string& name, size_t min_bytes = 1) const {
+    ClBuffer b = buffer(std::max(bytes_of(v), min_bytes), name, CL_MEM_READ_ONLY);
+    write(b, v);
+    return b;
+  }
+  // Rewrites `b` with `v`, reallocating it (read-only) only when the size changes: per-frame tables
+  // keep their buffer.
+  template <typename T>
+  void rewrite(ClBuffer& b, const std::vector<T>& v, const std::string& name) const {
+    if (b.size() != bytes_of(v)) b = buffer(bytes_of(v), name, CL_MEM_READ_ONLY);
+    write(b, v);
+  }
   void read(const ClBuffer& b, void* data, size_t bytes, size_t offset = 0) const;
   void fill_zero(const ClBuffer& b) const;
   // Every launch names its local size. PoCL compiles (and caches on disk) one work-group function

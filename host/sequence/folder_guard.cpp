@@ -17,6 +17,7 @@
 
 #include "sequence/frame_names.h"
 #include "pmr/error.h"
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "sequence/frame_files.h"
 #include "sequence/frame_list.h"

@@ -12,6 +12,7 @@
 
 #include "output/checksum.h"
 #include "pmr/error.h"
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "sequence/frame_names.h"
 

@@ -48,6 +48,17 @@ void select_animation(const Scene& scene, const std::string& choice, SequenceSpe
       (a.empty() ? std::string("the scene has no animations") : "no such animation (the scene has " + known + ")"));
 }
 
+SequenceSpec resolve_sequence(const Scene& scene, const SequenceChoice& choice, uint64_t framing_work) {
+  SequenceSpec spec;
+  spec.framing_work = framing_work;
+  select_animation(scene, choice.animation, spec);
+  spec.fps = choice.fps;
+  spec.turntable = choice.turntable;
+  spec.turntable_deg = choice.turntable_deg;
+  spec.turntable_frames = choice.turntable ? choice.turntable_frames : 1;
+  return spec;
+}
+
 namespace {
 
 // Clip key range of the selection (empty selection: false).

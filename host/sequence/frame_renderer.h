@@ -9,28 +9,20 @@
 
 #include "pipeline/pipeline.h"
 #include "sequence/frame_list.h"
+#include "sequence/sequence_spec.h"
 #include "pmr/input_files.h"
 #include "pmr/rig.h"
 #include "pmr/scene.h"
 
 namespace pmr {
 
-struct SequenceSpec {
-  int animation = kNoAnimation;  // Scene::animations index, kAllAnimations or kNoAnimation
-  std::string animation_label;   // what the sidecar records: the clip's name (or "#index"), "all" or ""
-  double fps = 24.0;
-  bool turntable = false;
-  double turntable_deg = 0.0;  // DEG of DEG:FRAMES
-  long turntable_frames = 1;   // FRAMES of DEG:FRAMES
-  // --limit framing-work: the framing poses the scene at every frame of the animation before the first
-  // frame renders; poses x the scene's vertices above this are refused (FrameRenderer).
-  uint64_t framing_work = InputLimits().framing_work;
-};
-
 // Resolves --animation (NAME, INDEX, all, or none = the rest pose; empty = the first animation if there
 // is one) against the scene's clips. Throws pmr::Error naming the known animations when nothing
 // matches.
 void select_animation(const Scene& scene, const std::string& choice, SequenceSpec& spec);
+// The sequence `choice` makes of `scene`: its animation selected (select_animation), one turntable frame
+// without a turntable, `framing_work` the framing's budget.
+SequenceSpec resolve_sequence(const Scene& scene, const SequenceChoice& choice, uint64_t framing_work);
 
 // The frames whose times f / fps lie inside the chosen animation's key range: ceil(start * fps) to
 // floor(end * fps) (within 1e-6 of a frame: float key times). Outside it a frame repeats the first or

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "output/background.h"
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "pmr/quilt.h"
 #include "pmr/rig.h"

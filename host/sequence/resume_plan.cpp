@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pmr/error.h"
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "pmr/version.h"
 

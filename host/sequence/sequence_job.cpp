@@ -144,12 +144,7 @@ void SequenceRun::load_inputs() {
 
 // The animation, --frames all, this shard's part; then the framing (FrameRenderer) and the layout.
 void SequenceRun::choose_frames() {
-  spec_.framing_work = job_.input_limits.framing_work;
-  select_animation(scene_, job_.animation, spec_);
-  spec_.fps = job_.fps;
-  spec_.turntable = job_.turntable;
-  spec_.turntable_deg = job_.turntable_deg;
-  spec_.turntable_frames = job_.turntable ? job_.turntable_frames : 1;
+  spec_ = resolve_sequence(scene_, job_.sequence, job_.input_limits.framing_work);
   if (job_.frames == "all") {
     long first = 0, last = 0;
     animation_frame_range(scene_, spec_, first, last);
@@ -201,60 +196,29 @@ void SequenceRun::check_frame_memory() const {
                    " MiB a view volume, on the device and in up to four copies being written)");
 }
 
-// What every frame's sidecar shares.
+// What every frame's sidecar shares: the job's configuration, the sequence as resolved, what the run
+// read and how it framed the scene.
 void SequenceRun::prepare_frames() {
   SidecarInfo& info = info_;
   info.scene = job_.scene;
-  info.tile_x = job_.pipeline.tile_x;
-  info.tile_y = job_.pipeline.tile_y;
-  info.tile_v = job_.pipeline.tile_v;
-  info.method = to_string(job_.pipeline.method);
-  info.sampling = to_string(job_.pipeline.sampling);
-  info.shading = to_string(job_.pipeline.shading);
-  info.exposure_ev = job_.pipeline.exposure_ev;
-  info.environment_intensity = job_.pipeline.environment_intensity;
+  info.rig_config = job_.rig;
+  info.pipeline = job_.pipeline;
+  info.display_source = job_.display_source;
+  info.sequence = spec_;
+  info.compression = job_.compression;
+  info.background = job_.background;
+  info.input_limits = job_.input_limits;
   info.environment_file = job_.environment_file;
   info.environment_checksum = environment_checksum_;
   info.environment_rotation_deg = job_.environment_rotation_deg;
-  info.camera = job_.rig.camera;
   info.has_bounds = true;
   info.bounds_lo = renderer_->bounds_lo();
   info.bounds_hi = renderer_->bounds_hi();
-  info.compression = to_string(job_.compression);
+  info.pivot = renderer_->pivot();
   info.warnings = scene_.warnings;
   info.warnings.insert(info.warnings.end(), rig_warnings_.begin(), rig_warnings_.end());
-  info.fps = spec_.fps;
-  info.animation = spec_.animation;
-  info.animation_name = spec_.animation_label;
-  info.turntable = spec_.turntable;
-  info.turntable_deg = spec_.turntable_deg;
-  info.turntable_frames = spec_.turntable ? spec_.turntable_frames : 0;
-  info.pivot = renderer_->pivot();
-  info.display_source = job_.display_source;
   info.scene_checksum = scene_.source_checksum;
   for (const SceneInputFile& f : scene_.input_files) info.scene_files.push_back({f.path, f.checksum});
-  info.allow_outside_scene_folder = job_.input_limits.allow_outside_scene_folder;
-  if (!job_.background.transparent())
-    info.background = {job_.background.r, job_.background.g, job_.background.b, job_.background.a};
-  if (job_.calibration) {
-    const LookingGlassCalibration& c = *job_.calibration;
-    info.display_config_checksum = c.checksum;
-    info.calibration_serial = c.serial;
-    info.calibration = {{"pitch", c.pitch},
-                        {"slope", c.slope},
-                        {"center", c.center},
-                        {"DPI", c.dpi},
-                        {"screenW", c.screen_w},
-                        {"screenH", c.screen_h},
-                        {"viewCone", c.view_cone},
-                        {"fringe", c.fringe},
-                        {"flipImageX", c.flip_x},
-                        {"flipImageY", c.flip_y},
-                        {"flipSubp", c.flip_subp},
-                        {"invView", c.inv_view},
-                        {"CellPatternMode", c.cell_pattern},
-                        {"subpixelCells", double(c.cells.size())}};
-  }
 }
 
 SidecarInfo SequenceRun::frame_info(long frame, const FramePaths& p, double angle,

@@ -2,17 +2,17 @@
 // which rig, display and pipeline, into which files. The command line fills it in (cli/); the frame
 // loop knows nothing of the command line.
 #pragma once
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "output/background.h"
-#include "pipeline/pipeline.h"
+#include "pipeline/pipeline_config.h"
 #include "pmr/display_presets.h"
 #include "pmr/input_files.h"
 #include "pmr/output.h"
 #include "pmr/rig.h"
 #include "sequence/frame_files.h"
+#include "sequence/sequence_spec.h"
 
 namespace pmr {
 
@@ -25,8 +25,7 @@ struct SequenceJob {
   // cameras, display, pipeline
   RigConfig rig;
   Display display;
-  std::string display_source;                          // what the display came from (sidecar)
-  std::optional<LookingGlassCalibration> calibration;  // a calibration file's values (sidecar)
+  DisplaySource display_source;  // what the display came from: a preset or a calibration file (sidecar)
   PipelineConfig pipeline;
   // products: which files per frame (FrameProducts), the quilt layout ("" = chosen), compression
   FrameProducts products;
@@ -34,12 +33,8 @@ struct SequenceJob {
   ExrCompression compression = ExrCompression::Zip;
   // frames: a --frames list or "all" (the animation's key range, or one turn of a turntable)
   std::string frames = "0";
-  double fps = 24.0;
-  std::string animation;  // name, index, "all" or "none"; "" = the first animation
-  bool turntable = false;
-  double turntable_deg = 0.0;
-  long turntable_frames = 0;
-  std::string shard;  // "K/N" or "auto"; "" = every frame
+  SequenceChoice sequence;  // --animation, --fps, --turntable
+  std::string shard;        // "K/N" or "auto"; "" = every frame
   long shard_count = 0, shard_first = 0;
   bool resume = false, overwrite = false;
   bool quiet = false, verbose = false;

@@ -16,6 +16,7 @@
 #include <cerrno>
 #include <cmath>
 #include <new>
+#include <optional>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -186,36 +187,111 @@ struct ExrLayout {
   uint64_t bytes_per_pixel = 0;
   int compression = 0;
 };
-std::string check_exr_allocations(const std::string& path, uint64_t file_size, ExrLayout& layout) {
-  std::ifstream in(path, std::ios::binary);
-  unsigned char head[8];
-  if (!in.read(reinterpret_cast<char*>(head), 8) || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 ||
-      head[3] != 0x01)
-    return "";
-  const bool multipart = head[5] & 0x10;  // version flags, bit 12
-  uint64_t pos = 8;
-  auto left = [&] { return file_size - std::min(pos, file_size); };
-  auto read_name = [&](std::string& out) {  // null-terminated, at most 255 bytes
+// The header bytes of an EXR file, read in OpenEXR's order and encoding, counting the bytes read so
+// far: what an attribute declares is checked against what the file holds after it (left()).
+class ExrHeaderReader {
+ public:
+  ExrHeaderReader(const std::string& path, uint64_t file_size) : in_(path, std::ios::binary), file_size_(file_size) {}
+  // The magic number and the version field; false when this is no EXR file (OpenEXR then says so).
+  bool read_magic(bool& multipart) {
+    unsigned char head[8];
+    if (!in_.read(reinterpret_cast<char*>(head), 8) || head[0] != 0x76 || head[1] != 0x2f || head[2] != 0x31 ||
+        head[3] != 0x01)
+      return false;
+    pos_ = 8;
+    multipart = head[5] & 0x10;  // version flags, bit 12
+    return true;
+  }
+  bool read_name(std::string& out) {  // null-terminated, at most 255 bytes
     out.clear();
-    for (char c; in.get(c);) {
-      ++pos;
+    for (char c; in_.get(c);) {
+      ++pos_;
       if (c == '\0') return true;
       if (out.size() == 255) return false;
       out += c;
     }
     return false;
-  };
-  auto read_u32 = [&](uint32_t& v) {
+  }
+  bool read_u32(uint32_t& v) {  // little-endian
     unsigned char b[4];
-    if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
-    pos += 4;
+    if (!in_.read(reinterpret_cast<char*>(b), 4)) return false;
+    pos_ += 4;
     v = uint32_t(b[0]) | uint32_t(b[1]) << 8 | uint32_t(b[2]) << 16 | uint32_t(b[3]) << 24;
     return true;
-  };
-  auto skip = [&](uint64_t n) {
-    in.seekg(std::streamoff(n), std::ios::cur);
-    pos += n;
-  };
+  }
+  int read_byte() {
+    ++pos_;
+    return in_.get();
+  }
+  void skip(uint64_t n) {
+    in_.seekg(std::streamoff(n), std::ios::cur);
+    pos_ += n;
+  }
+  // A multi-part file's list of headers ends with an empty header: one more empty name.
+  bool at_end_of_headers() { return in_.peek() == 0; }
+  uint64_t left() const { return file_size_ - std::min(pos_, file_size_); }
+
+ private:
+  std::ifstream in_;
+  uint64_t file_size_ = 0, pos_ = 0;
+};
+
+// What checking one attribute found: nothing (std::nullopt: read on), or the walk's answer: "" when
+// the header cannot be read further (OpenEXR reports what is wrong), else the problem.
+using AttributeCheck = std::optional<std::string>;
+
+std::string quoted_name(const std::string& name) { return "'" + printable(name.substr(0, 40)) + "'"; }
+
+// The channel list: channels (name, pixel type, 12 more bytes) up to an empty name, however long the
+// file declares it.
+AttributeCheck read_channels(ExrHeaderReader& in, ExrLayout& layout) {
+  std::string channel;
+  uint32_t pixel_type = 0;
+  while (in.read_name(channel) && !channel.empty() && in.read_u32(pixel_type)) {
+    layout.bytes_per_pixel += pixel_type == 1 ? 2 : 4;  // HALF, else UINT or FLOAT
+    in.skip(12);
+  }
+  return std::nullopt;
+}
+
+AttributeCheck read_data_window(ExrHeaderReader& in, ExrLayout& layout) {
+  uint32_t v[4];
+  for (uint32_t& x : v)
+    if (!in.read_u32(x)) return "";
+  layout.has_window = true;
+  layout.min_x = int32_t(v[0]), layout.min_y = int32_t(v[1]), layout.max_x = int32_t(v[2]),
+  layout.max_y = int32_t(v[3]);
+  return std::nullopt;
+}
+
+// A preview image: 4 w h bytes allocated, whatever size the attribute declares.
+AttributeCheck check_preview(ExrHeaderReader& in, const std::string& name) {
+  uint32_t w = 0, h = 0;
+  if (!in.read_u32(w) || !in.read_u32(h)) return "";
+  if (uint64_t(w) * h * 4 > in.left())
+    return "preview attribute " + quoted_name(name) + " of " + std::to_string(w) + "x" + std::to_string(h) +
+           " pixels is larger than the file";
+  in.skip(uint64_t(w) * h * 4);
+  return std::nullopt;
+}
+
+// Strings of their own length each, within the declared size: each one allocated as it declares.
+AttributeCheck check_string_vector(ExrHeaderReader& in, const std::string& name, uint32_t size) {
+  for (uint64_t read = 0; read < size;) {
+    uint32_t n = 0;
+    if (!in.read_u32(n)) return "";
+    if (n > in.left())
+      return "header attribute " + quoted_name(name) + " holds a string of " + std::to_string(n) +
+             " bytes, more than the file holds";
+    in.skip(n);
+    read += 4 + uint64_t(n);
+  }
+  return std::nullopt;
+}
+
+// The bytes OpenEXR reads for an attribute of a fixed-size type, whatever size the file declares; 0
+// for the other types.
+uint64_t fixed_size(const std::string& type) {
   static const std::pair<const char*, uint64_t> kFixed[] = {{"box2i", 16},      {"box2f", 16},   {"chromaticities", 32},
                                                             {"compression", 1}, {"double", 8},   {"envmap", 1},
                                                             {"float", 4},       {"int", 4},      {"keycode", 28},
@@ -224,67 +300,47 @@ std::string check_exr_allocations(const std::string& path, uint64_t file_size, E
                                                             {"tiledesc", 9},    {"timecode", 8}, {"v2i", 8},
                                                             {"v2f", 8},         {"v2d", 16},     {"v3i", 12},
                                                             {"v3f", 12},        {"v3d", 24},     {"deepImageState", 1}};
+  for (const auto& [t, n] : kFixed)
+    if (type == t) return n;
+  return 0;
+}
+
+// One attribute after its name, type and declared size, read as OpenEXR's Header::readFrom does.
+AttributeCheck check_attribute(ExrHeaderReader& in, const std::string& name, const std::string& type, uint32_t size,
+                               ExrLayout& layout) {
+  if (type == "chlist") return read_channels(in, layout);
+  if (type == "box2i" && name == "dataWindow") return read_data_window(in, layout);
+  if (type == "compression" && name == "compression") {
+    layout.compression = in.read_byte();
+    return std::nullopt;
+  }
+  if (type == "preview") return check_preview(in, name);
+  if (type == "stringvector") return check_string_vector(in, name, size);
+  if (const uint64_t n = fixed_size(type)) {
+    in.skip(n);
+    return std::nullopt;
+  }
+  if (size > in.left())  // string, floatvector or an unknown type: size bytes allocated
+    return "header attribute " + quoted_name(name) + " declares " + std::to_string(size) +
+           " bytes, more than the file holds";
+  in.skip(size);
+  return std::nullopt;
+}
+
+std::string check_exr_allocations(const std::string& path, uint64_t file_size, ExrLayout& layout) {
+  ExrHeaderReader in(path, file_size);
+  bool multipart = false;
+  if (!in.read_magic(multipart)) return "";
   for (;;) {  // attributes until an empty name; a multi-part file's headers end with an empty one
     std::string name, type;
     uint32_t size = 0;
-    if (!read_name(name)) return "";
+    if (!in.read_name(name)) return "";
     if (name.empty()) {
-      if (!multipart || in.peek() == 0) return "";
+      if (!multipart || in.at_end_of_headers()) return "";
       continue;
     }
-    if (!read_name(type) || !read_u32(size)) return "";
-    if (type == "chlist") {  // channels (name, pixel type, 12 more bytes) up to an empty name
-      std::string channel;
-      uint32_t pixel_type = 0;
-      while (read_name(channel) && !channel.empty() && read_u32(pixel_type)) {
-        layout.bytes_per_pixel += pixel_type == 1 ? 2 : 4;  // HALF, else UINT or FLOAT
-        skip(12);
-      }
-      continue;
-    }
-    if (type == "box2i" && name == "dataWindow") {
-      uint32_t v[4];
-      for (uint32_t& x : v)
-        if (!read_u32(x)) return "";
-      layout.has_window = true;
-      layout.min_x = int32_t(v[0]), layout.min_y = int32_t(v[1]), layout.max_x = int32_t(v[2]),
-      layout.max_y = int32_t(v[3]);
-      continue;
-    }
-    if (type == "compression" && name == "compression") {
-      layout.compression = in.get();
-      ++pos;
-      continue;
-    }
-    if (type == "preview") {
-      uint32_t w = 0, h = 0;
-      if (!read_u32(w) || !read_u32(h)) return "";
-      if (uint64_t(w) * h * 4 > left())
-        return "preview attribute '" + printable(name.substr(0, 40)) + "' of " + std::to_string(w) + "x" +
-               std::to_string(h) + " pixels is larger than the file";
-      skip(uint64_t(w) * h * 4);
-      continue;
-    }
-    if (type == "stringvector") {  // strings of their own length each, within the declared size
-      for (uint64_t read = 0; read < size;) {
-        uint32_t n = 0;
-        if (!read_u32(n)) return "";
-        if (n > left())
-          return "header attribute '" + printable(name.substr(0, 40)) + "' holds a string of " + std::to_string(n) +
-                 " bytes, more than the file holds";
-        skip(n);
-        read += 4 + uint64_t(n);
-      }
-      continue;
-    }
-    bool fixed = false;
-    for (const auto& [t, n] : kFixed)
-      if (type == t) skip(n), fixed = true;
-    if (fixed) continue;
-    if (size > left())  // string, stringvector, floatvector or an unknown type: size bytes allocated
-      return "header attribute '" + printable(name.substr(0, 40)) + "' declares " + std::to_string(size) +
-             " bytes, more than the file holds";
-    skip(size);
+    if (!in.read_name(type) || !in.read_u32(size)) return "";
+    if (const AttributeCheck found = check_attribute(in, name, type, size, layout)) return *found;
   }
 }
 

@@ -2,6 +2,7 @@
 // Looking Glass calibration file ("visual.json"), mapped onto DESIGN section 5's encoder.
 #pragma once
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,13 @@ LookingGlassCalibration read_looking_glass_calibration(const std::string& path, 
 // - 3W tilt (H - 1/2) / H + center L, phase_sign -1 (the shader's 1 - fract), subpixel_bgr = flipSubp
 // xor flipImageX (flipSubp as the HoloPlay / Unity shaders swap red and blue). Size from the DPI.
 Display display_from_calibration(const LookingGlassCalibration& c);
+
+// Where a job's display came from, as its sidecars record it: a preset (the default paper-8k unless
+// --preset names another) or a calibration file, whose values are recorded as read.
+struct DisplaySource {
+  std::string name = "preset paper-8k";  // "preset NAME" or "calibration FILE"
+  std::optional<LookingGlassCalibration> calibration;
+};
 
 struct DisplayPreset {
   std::string name, description;

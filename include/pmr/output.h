@@ -1,4 +1,5 @@
-// The data products (DESIGN section 6): EXR images, the multi-part views EXR and the JSON sidecar.
+// The data products (DESIGN section 6): EXR images, the multi-part views EXR and PNG previews (the JSON
+// sidecar: output/sidecar.h).
 // Every writer writes to a temporary file in the destination folder and renames it into place once the
 // file is complete, so a failed or interrupted run never leaves a partial file under the final name.
 // All errors are pmr::Error with one line naming the file.
@@ -138,88 +139,5 @@ std::vector<uint16_t> square_pixels(const uint16_t* rgba_half, int width, int he
 void read_png_rgba8(const std::string& path, int& width, int& height, std::vector<uint8_t>& rgba);
 // The sRGB transfer curve (IEC 61966-2-1) of a linear value, clamped to [0, 1].
 double srgb_encode(double linear);
-
-// A file the frame wrote, as its sidecar records it: name, size and checksum (output/checksum.h), so
-// that --resume and `pmr verify` can check the frame without decoding it.
-struct OutputChecksum {
-  std::string file;
-  uint64_t bytes = 0;
-  std::string checksum;
-};
-
-// What the sidecar records besides the rig and the display.
-struct SidecarInfo {
-  std::string scene;  // the scene file as given (empty = the bundled default scene)
-  int frame = 0;
-  std::string method = "pmr";       // "pmr" or the baseline's name
-  std::string sampling = "view";    // "view" or "subpixel" (docs/SAMPLING.md)
-  std::string shading = "lambert";  // "lambert" or "pbr" (docs/SHADING.md)
-  double exposure_ev = 0.0;
-  double environment_intensity = 1.0;  // pbr: scales the uniform environment
-  std::vector<SceneLight> lights;      // pbr: the frame's lights as used (FrameRenderer::Frame::lights)
-  int tile_x = 16, tile_y = 2, tile_v = 16;
-  int camera = -1;          // glTF camera index, -1 = the default framing of the bounding sphere
-  bool has_bounds = false;  // world bounds of the scene the default framing used
-  glm::dvec3 bounds_lo{0.0}, bounds_hi{0.0};
-  std::string compression;  // EXR compression of the images ("" = not recorded)
-  // Files written for this frame, as (kind, file name) pairs, e.g. {"encoded", "frame_0000.exr"}.
-  std::vector<std::pair<std::string, std::string>> outputs;
-  std::vector<OutputChecksum> output_checksums;  // of the written outputs (the sidecar is written last)
-  std::vector<std::string> warnings;             // e.g. "near plane raised ..."
-  // The frame's place in a sequence (DESIGN section 7), so any frame can be reproduced alone.
-  double time = 0.0;  // seconds: frame / fps
-  double fps = 24.0;
-  int animation = -1;          // glTF animation index, -1 none, -2 all
-  std::string animation_name;  // its name ("all" for every animation)
-  bool turntable = false;
-  double turntable_deg = 0.0;  // DEG:FRAMES as requested
-  long turntable_frames = 0;
-  double turntable_angle = 0.0;                             // this frame's angle, degrees
-  glm::dvec3 pivot{0.0};                                    // the turntable axis passes through it (along +Y)
-  int quilt_columns = 0, quilt_rows = 0;                    // of the quilt output (0: none)
-  int center_view = -1;                                     // the view of the center preview (-1: none)
-  bool depth = false;                                       // Z channels in the views / quilt files
-  std::string display_source;                               // "preset NAME" or "calibration FILE"
-  std::vector<std::pair<std::string, double>> calibration;  // the calibration file's values, as read
-  std::string calibration_serial;
-  // Checksums of what the render read (output/checksum.h; "" = not recorded): the scene file, every
-  // other file the loader read (path relative to the scene's folder, checksum), the --display-config
-  // file. The program version is always recorded (pmr::program_version()).
-  std::string scene_checksum;
-  std::vector<std::pair<std::string, std::string>> scene_files;
-  std::string display_config_checksum;
-  // pbr: the environment image (--environment as given, "" = the uniform default), its checksum and
-  // rotation (its intensity is environment_intensity)
-  std::string environment_file, environment_checksum;
-  double environment_rotation_deg = 0.0;
-  bool allow_outside_scene_folder = false;  // --allow-outside-scene-folder: recorded only when given
-  std::vector<double> background;           // --background as linear R, G, B, A; empty: transparent (not recorded)
-};
-
-// The sidecar's JSON text (pretty printed, doubles with round-trip precision).
-std::string sidecar_json(const Rig& rig, const Display& display, const SidecarInfo& info);
-// Compares the configuration that decides a frame's pixels (scene, method, tile, camera, display, rig,
-// framing, fps, animation, turntable, shading and its lights; not the frame, its time or the outputs) of
-// two sidecars' JSON texts. The lights' positions and directions follow the frame (animation, turntable):
-// they are compared only between sidecars of the same frame. Returns "" when they agree, else the first differing key (or "unreadable" when `existing` does
-// not parse).
-// With ignore_scene_derived, the keys that follow from the scene file's content (scene_bounds, the
-// turntable's pivot, the animation's name, the lights) are not compared: for a frame known to come from another
-// scene (sidecar_provenance), only the configuration the user chose matters.
-std::string sidecar_config_difference(const std::string& existing, const std::string& expected,
-                                      bool ignore_scene_derived = false);
-
-// Where a sidecar's frame came from. Never throws: a damaged or old sidecar gives empty strings.
-struct SidecarProvenance {
-  // The scene's identity: the checksum algorithm, the scene file's and every other read file's
-  // checksums as one canonical string; "" when the sidecar records none (written before pmr recorded
-  // them, or damaged). Two frames with equal non-empty identities were rendered from the same bytes.
-  std::string scene;
-  std::string version;  // program_version, "" when absent
-};
-SidecarProvenance sidecar_provenance(const std::string& sidecar_text);
-
-// Writes the JSON sidecar (DESIGN section 6) atomically. Matrices are 16 numbers, column-major.
-void write_sidecar(const std::string& path, const Rig& rig, const Display& display, const SidecarInfo& info);
 
 }  // namespace pmr

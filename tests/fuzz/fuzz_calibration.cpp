@@ -15,12 +15,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     pmr::RenderOptions o = pmr::parse_render_options({"--display-config", path});
     pmr::finalize_render_options(o);
-    const PmrEncodeParams p = pmr::make_encode_params(o.display, o.rig.views, o.rig.view_w, o.rig.view_h);
+    const PmrEncodeParams p =
+        pmr::make_encode_params(o.job.display, o.job.rig.views, o.job.rig.view_w, o.job.rig.view_h);
     std::vector<PmrEncodeColumn> columns;
     std::vector<PmrEncodeRow> rows;
-    pmr::make_encode_tables(o.display, p, columns, rows);
+    pmr::make_encode_tables(o.job.display, p, columns, rows);
     const glm::dvec3 lo(-1.0), hi(1.0);
-    pmr::make_rig(o.rig, o.display, lo, hi);
+    pmr::make_rig(o.job.rig, o.job.display, lo, hi);
   } catch (const pmr::Error&) {
     // a clear one-line refusal
   }

@@ -11,6 +11,7 @@
 #include "fuzz/fuzz_util.h"
 #include "fuzz/sidecar_reference.h"
 #include "pmr/error.h"
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "sequence/folder_guard.h"
 

@@ -3,6 +3,7 @@
 #pragma once
 #include <string>
 
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "pmr/rig.h"
 
@@ -20,15 +21,15 @@ inline std::string reference_sidecar(int frame) {
   SidecarInfo info;
   info.scene = "scene.glb";
   info.frame = frame;
-  info.time = frame / info.fps;
+  info.pipeline.shading = Shading::Lambert;
+  info.time = frame / info.sequence.fps;
   info.has_bounds = true;
   info.bounds_lo = glm::dvec3(-1.0);
   info.bounds_hi = glm::dvec3(1.0);
-  info.compression = "zip";
+  info.compression = ExrCompression::Zip;
   char stem[32];
   std::snprintf(stem, sizeof stem, "frame_%04d", frame);
   info.outputs = {{"encoded", std::string(stem) + ".exr"}};
-  info.display_source = "preset paper-8k";
   info.scene_checksum = "0123456789abcdef";
   return sidecar_json(rig, display, info);
 }

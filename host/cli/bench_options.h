@@ -1,0 +1,52 @@
+// The options of `pmr bench` (one table makes the parser and --help: cli/option_table.h); those it
+// shares with `pmr render` go through render's parser.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pipeline/pipeline_config.h"
+#include "pmr/input_files.h"
+#include "pmr/rig.h"
+#include "sequence/sequence_spec.h"
+
+namespace pmr {
+
+struct BenchOptions {
+  std::string scene;
+  std::string generator;                // "synthetic" or "objects": procedural scenes instead of SCENE
+  std::vector<size_t> triangle_counts;  // one generated scene per count (the triangle sweep)
+  std::string save_scene;               // write the generated scene as .glb and exit
+  std::vector<int> views = {1, 2, 4, 8, 16, 32, 48, 64, 96};
+  std::vector<Method> methods = {Method::Pmr, Method::Multipass, Method::Duplicate};
+  std::vector<Sampling> samplings = {Sampling::View};  // subpixel applies to pmr only
+  bool samplings_given = false;  // else the preset's default sampling (view for methods other than pmr)
+  Shading shading = Shading::Pbr;
+  double exposure_ev = 0.0, environment_intensity = 1.0;
+  bool views_given = false;
+  int frames = 5;
+  std::string csv;
+  std::string keep = "view";
+  int view_w = 1024, view_h = 512;  // per-view raster at N = 96 (keep total) or always (keep view)
+  RigConfig rig;                    // cone, field of view (views and sizes come from the options above)
+  bool offset_given = false;        // --offset, or a Looking Glass preset's calibrated offset
+  Display display;
+  int tile[3] = {16, 2, 16};
+  bool check = true;
+  bool help = false;
+  // Timed frames are frames 0..K-1 of this sequence (animation and turntable as for pmr render).
+  SequenceChoice sequence;
+  // --environment FILE and --environment-rotation DEG (pbr), prefiltered once for every point
+  std::string environment_file;
+  double environment_rotation_deg = 0.0;
+  bool environment_rotation_given = false;
+  std::shared_ptr<const Environment> environment;
+  InputLimits limits;                    // --limit, --allow-outside-scene-folder (docs/SECURITY.md)
+  std::vector<std::string> render_args;  // the options pmr render reads for bench, in the order given
+};
+
+// Parses the arguments after `bench`. Throws pmr::Error with one line on bad input.
+BenchOptions parse_bench_options(const std::vector<std::string>& args);
+std::string bench_help();
+
+}  // namespace pmr

@@ -1,0 +1,34 @@
+// A sequence's frames as chosen (SequenceChoice) and as resolved against the scene (SequenceSpec): the
+// animation, the frame rate and the turntable. The framing, the poses and the sidecar follow from it.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "pmr/input_files.h"
+#include "pmr/scene.h"
+
+namespace pmr {
+
+// The sequence as the command line chooses it, before the scene resolves the animation
+// (resolve_sequence, sequence/frame_renderer.h).
+struct SequenceChoice {
+  std::string animation;  // name, index, "all" or "none"; "" = the first animation
+  double fps = 24.0;
+  bool turntable = false;
+  double turntable_deg = 0.0;  // DEG of --turntable DEG:FRAMES
+  long turntable_frames = 0;   // FRAMES of --turntable DEG:FRAMES
+};
+
+struct SequenceSpec {
+  int animation = kNoAnimation;  // Scene::animations index, kAllAnimations or kNoAnimation
+  std::string animation_label;   // what the sidecar records: the clip's name (or "#index"), "all" or ""
+  double fps = 24.0;
+  bool turntable = false;
+  double turntable_deg = 0.0;  // DEG of DEG:FRAMES
+  long turntable_frames = 1;   // FRAMES of DEG:FRAMES
+  // --limit framing-work: the framing poses the scene at every frame of the animation before the first
+  // frame renders; poses x the scene's vertices above this are refused (FrameRenderer).
+  uint64_t framing_work = InputLimits().framing_work;
+};
+
+}  // namespace pmr

@@ -40,7 +40,7 @@ RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& t
 // --sampling subpixel (DESIGN section 5, docs/SAMPLING.md): display subpixel (j, i, k) sampled at
 // ((3j + k + 1/2) / (3 W_d) W, (i + 1/2) / H_d H) of its view's raster, truncated to 16.16 / 24.8, in view
 // view_of[i * 3 W_d + 3j + k]; the same top-left rule and (depth, key) visibility, the depth being the
-// triangle's plane in that view evaluated at the sample in double (anchored at vertex 0).
+// one depth formula (depth_at, as at pixel centers) evaluated at the sample.
 struct SubpixelResult {
   std::vector<uint32_t> key;  // [row][3 * column + k], PMR_NO_KEY when empty
   std::vector<float> depth;   // INFINITY when empty

@@ -142,11 +142,15 @@ PMR_HOT void sp_edges(global const PmrParams* P, const PmrMta* m, int i_lo, cons
 
 /* The depth plane of an MTA in view fv (depth_plane, cl/common.h) at samples (Xc + x, Yc + y): the one
  * depth formula, in vectors. The offsets from the plane's anchor are integers below 2^53, exact in
- * double, and their scaling by a power of two is exact, so each lane's value is the formula's. */
-PMR_HOT float8 sp_depth(const DepthPlane* d, const SpChunk* C, double8 x, double8 y) {
+ * double, and their scaling by a power of two is exact, so each lane's value is the formula's. The
+ * column offsets mostly fit 32 bits (x < 2^22): then they are summed as integers, which round to float
+ * as the doubles would. */
+PMR_HOT float8 sp_depth(const DepthPlane* d, const SpChunk* C, double8 x, int8 xi, double8 y) {
   const double8 rows = ((double8)((double)(C->Yc - ((long)d->qr * PMR_Y_ONE + PMR_HALF_Y))) + y) / (double)PMR_Y_ONE;
-  const float8 columns =
-      convert_float8((double8)((double)(C->Xc - ((long)d->pr * PMR_X_ONE + PMR_HALF_X))) + x) / (float)PMR_X_ONE;
+  const long bx = C->Xc - ((long)d->pr * PMR_X_ONE + PMR_HALF_X);
+  const float8 columns = (bx > -(1L << 30) && bx < (1L << 30) ? convert_float8((int8)((int)bx) + xi)
+                                                              : convert_float8((double8)((double)bx) + x)) /
+                         (float)PMR_X_ONE;
   return convert_float8((double8)(d->zr) + (double8)(d->gy) * rows) + (float8)(d->gx) * columns;
 }
 
@@ -173,7 +177,8 @@ PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, con
     const int4 b = C->box[k / SP_LANES];
     if (b.x > mx1) break; /* a run's vectors go left to right (sorted by column) */
     if (b.y < mx0 || b.w < S->my0 || b.z > S->my1) continue;
-    const double8 x = convert_double8(vload8(0, C->sx + k)), y = convert_double8(vload8(0, C->sy + k));
+    const int8 xi = vload8(0, C->sx + k);
+    const double8 x = convert_double8(xi), y = convert_double8(vload8(0, C->sy + k));
     long8 hit = ((double8)(S->dy[0]) * x + (double8)(dx[0]) * y >= (double8)(T[0])) &
                 ((double8)(S->dy[1]) * x + (double8)(dx[1]) * y >= (double8)(T[1])) &
                 ((double8)(S->dy[2]) * x + (double8)(dx[2]) * y >= (double8)(T[2]));
@@ -184,7 +189,7 @@ PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, con
     const long2 h2 = h4.lo | h4.hi;
     if ((h2.x | h2.y) == 0) continue;
     if (!have_plane) p = depth_plane(m, fv), have_plane = true; /* tiny MTAs often cover no sample */
-    const float8 z = sp_depth(&p, C, x, y);
+    const float8 z = sp_depth(&p, C, x, xi, y);
     const float8 bd = vload8(0, C->best_depth + k);
     const uint8 bk = vload8(0, C->best_key + k);
     int8 win = convert_int8(hit) & ((z < bd) | ((z == bd) & ((uint8)(m->key) < bk)));

@@ -18,13 +18,14 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
   const bool debug = P->debug_outputs != 0;
 
   ShadeInputs in = PMR_SHADE_INPUTS;
-  vfloat best_depth[FINE_ROWS];
-  vuint best_key[FINE_ROWS], best_mta[FINE_ROWS];
-  vint covered[FINE_ROWS];
-  fine_clear_state(FINE_ROWS, best_depth, best_key, best_mta);
-  for (int r = 0; r < FINE_ROWS; ++r) covered[r] = (vint)(0);
+  vfloat best_depth[FINE_ROWS * NS];
+  vuint best_key[FINE_ROWS * NS], best_mta[FINE_ROWS * NS];
+  vint covered[FINE_ROWS * NS];
+  fine_clear_state(FINE_ROWS * NS, best_depth, best_key, best_mta);
+  for (int r = 0; r < FINE_ROWS * NS; ++r) covered[r] = (vint)(0);
+  const FineState st = {best_depth, best_key, best_mta, debug ? covered : 0};
   fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], &in, tris, materials, x0, y0, v0, nx,
-                    ny, nv, v0, best_depth, best_key, best_mta, debug ? covered : 0);
+                    ny, nv, v0, &st);
 
   /* frame constants in registers: stores through the output pointers could alias P */
   const size_t W = (size_t)P->view_w, H = (size_t)P->view_h, view_base = (size_t)P->view_base;
@@ -40,16 +41,18 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
         const int r = (lv * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
         const int view = v0 + lv, py = y0 + ly;
         ushort4 colour[VW];
-        fine_shade_chunk(&in, mtas, &cache, light, best_mta[r], best_key[r] != (vuint)(PMR_NO_KEY), x0 + c * VW, py,
-                         view, colour);
+        vint won[NS];
+        for (int s = 0; s < NS; ++s) won[s] = best_key[FINE_SLOT(r, s)] != (vuint)(PMR_NO_KEY);
+        fine_shade_chunk(&in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0), won, x0 + c * VW, py, view, colour);
         for (int l = 0; l < VW && c * VW + l < nx; ++l) {
-          const int k = r * VW + l, px = x0 + c * VW + l;
+          const int px = x0 + c * VW + l;
           const size_t voxel = (((size_t)view + view_base) * H + (size_t)py) * W + (size_t)px;
           vstore4(colour[l], voxel, (global ushort*)volume);
-          if (debug) {
-            debug_key[voxel] = key_of[k];
-            debug_depth[voxel] = depth_of[k];
-            debug_count[voxel] = (uint)count_of[k];
+          for (int s = 0; s < NS && debug; ++s) { /* per sample: [voxel][sample] */
+            const int k = FINE_SLOT(r, s) * VW + l;
+            debug_key[voxel * NS + s] = key_of[k];
+            debug_depth[voxel * NS + s] = depth_of[k];
+            debug_count[voxel * NS + s] = (uint)count_of[k];
           }
         }
       }

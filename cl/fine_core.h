@@ -8,6 +8,11 @@
  * sample's outcome depends on the MTA, the view and the sample alone. */
 #include "shade.h"
 
+/* Samples per pixel (DESIGN section 3b; P->sample_x/y): the programs are built for one count. */
+#ifndef PMR_SAMPLES
+#define PMR_SAMPLES 1
+#endif
+
 /* Where a vector's lanes sample the raster (16.16 / 24.8): lane l at (X + sx[l], Y + sy[l]), or, when
  * sx is null, along the pixel-center row (X + l PMR_X_ONE, Y). */
 typedef struct {
@@ -59,6 +64,38 @@ PMR_HOT uint view_pass_mask(global const PmrParams* P, const PmrMta* m, int ib, 
   const int4 r4 = r8.lo | r8.hi;
   const int2 r2 = r4.lo | r4.hi;
   return (uint)(r2.x | r2.y) & all;
+}
+
+/* The shading point of a pixel and triangle (DESIGN section 3b), as an offset from the pixel center
+ * (16.16 / 24.8): the center where the triangle covers it, else the centroid of the samples it covers
+ * (bits of `covered`; at least one), each coordinate's sum divided by their count with truncation. */
+inline void shading_point(global const PmrParams* P, bool center, uint covered, int* ox, int* oy) {
+  *ox = *oy = 0;
+  if (center) return;
+  int n = 0;
+  long sx = 0, sy = 0;
+  for (uint b = covered; b != 0u; b &= b - 1u) {
+    const int s = 31 - (int)clz(b & (0u - b));
+    sx += P->sample_x[s], sy += P->sample_y[s], ++n;
+  }
+  *ox = (int)(sx / n), *oy = (int)(sy / n);
+}
+
+/* Whether MTA m covers the pixel center (X, Y) of the view with view coordinate f, and, where it does
+ * not, which of the NS samples around it it covers (bits): what its shading point there depends on. */
+inline uint mta_sample_cover(global const PmrParams* P, const PmrMta* m, long X, long Y, long f, bool* center) {
+  const long f_first = view_coord(P, m->view_lo);
+  const long bias[3] = {mta_edge_bias(m, 1, 2, f_first), mta_edge_bias(m, 2, 0, f_first),
+                        mta_edge_bias(m, 0, 1, f_first)};
+  long E[3];
+  mta_edges_at(m, X, Y, f, E);
+  *center = E[0] >= bias[0] && E[1] >= bias[1] && E[2] >= bias[2];
+  uint bits = 0u;
+  for (int s = 0; s < PMR_SAMPLES && !*center; ++s) {
+    mta_edges_at(m, X + P->sample_x[s], Y + P->sample_y[s], f, E);
+    if (E[0] >= bias[0] && E[1] >= bias[1] && E[2] >= bias[2]) bits |= 1u << s;
+  }
+  return bits;
 }
 
 /* alphaMode MASK: of the lanes l < n with w[l] set (candidate winners at samples S of view `view`), clears

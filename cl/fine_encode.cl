@@ -91,14 +91,15 @@ kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
   const int views = P->views;
 
   ShadeInputs in = PMR_SHADE_INPUTS;
-  vfloat best_depth[FUSED_ROWS];
-  vuint best_key[FUSED_ROWS], best_mta[FUSED_ROWS];
-  fine_clear_state(FUSED_ROWS, best_depth, best_key, best_mta);
+  vfloat best_depth[FUSED_ROWS * NS];
+  vuint best_key[FUSED_ROWS * NS], best_mta[FUSED_ROWS * NS];
+  fine_clear_state(FUSED_ROWS * NS, best_depth, best_key, best_mta);
+  const FineState st = {best_depth, best_key, best_mta, 0};
   for (int tv = 0; tv < P->tiles_v; ++tv) {
     const uint tile = ((uint)tv * tiles_y) * tiles_x + tile_xy;
     const int v0 = tv * PMR_TILE_V;
     fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], &in, tris, materials, x0, y0, v0,
-                      nx, ny, min(PMR_TILE_V, views - v0), 0, best_depth, best_key, best_mta, 0);
+                      nx, ny, min(PMR_TILE_V, views - v0), 0, &st);
   }
 
   /* the winners' colours as half bits, background zero */
@@ -110,8 +111,10 @@ kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
     for (int ly = 0; ly < ny; ++ly)
       for (int c = 0; c * VW < nx; ++c) {
         const int r = (view * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
-        fine_shade_chunk(&in, mtas, &cache, light, best_mta[r], best_key[r] != (vuint)(PMR_NO_KEY), x0 + c * VW,
-                         y0 + ly, view, colour + r * VW);
+        vint won[NS];
+        for (int s = 0; s < NS; ++s) won[s] = best_key[FINE_SLOT(r, s)] != (vuint)(PMR_NO_KEY);
+        fine_shade_chunk(&in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0), won, x0 + c * VW, y0 + ly, view,
+                         colour + r * VW);
       }
 
   /* the display pixels this tile owns, whole or in part */

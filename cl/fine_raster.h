@@ -34,9 +34,13 @@ typedef PMR_CAT(float, PMR_VW) vfloat;
 #define convert_vfloat PMR_CAT(convert_float, PMR_VW)
 #define as_vint PMR_CAT(as_int, PMR_VW)
 
-/* A tile row is FINE_CHUNKS vectors; the private visibility state is FINE_ROWS vectors per array. */
+#define NS PMR_SAMPLES
+
+/* A tile row is FINE_CHUNKS vectors; the private visibility state is FINE_ROWS vectors per array and
+ * sample. */
 #define FINE_CHUNKS ((PMR_TILE_X + VW - 1) / VW)
 #define FINE_ROWS (PMR_TILE_Y * PMR_TILE_V * FINE_CHUNKS)
+#define FINE_SLOT(r, s) ((r)*NS + (s))
 
 /* Queue entries between an MTA's prefetch and its use. */
 #define FINE_PREFETCH 4
@@ -80,18 +84,112 @@ PMR_HOT void row_edges(const PmrMta* m, long f_first, long f_lo, long X0, long Y
   }
 }
 
+/* An MTA's per-sample terms in view fi: each edge's change from the pixel center to sample s,
+ * sign (dy sample_x[s] - dx_ab(fi) sample_y[s]) (exact), so that sample s of any pixel is tested as its
+ * center plus this constant. */
+typedef struct {
+  long off[3][NS];
+} SampleEdges;
+
+PMR_HOT void sample_edges(global const PmrParams* P, const PmrMta* m, long fi, SampleEdges* O) {
+  const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
+  for (int e = 0; e < 3; ++e) {
+    const int a = ea[e], b = eb[e];
+    const long dy = (long)(m->y[b] - m->y[a]);
+    const long dx = (long)m->x0[b] + fi * m->dx[b] - (long)m->x0[a] - fi * m->dx[a];
+    for (int s = 0; s < NS; ++s) O->off[e][s] = m->sign * (dy * P->sample_x[s] - dx * P->sample_y[s]);
+  }
+}
+
+/* Lanes of a row chunk whose sample at edge offset `s` (SampleEdges, or none for the pixel centers)
+ * passes all three edges. F: the edge functions at the chunk's first pixel center. */
+inline vint chunk_hits(const RowEdges* R, const long* F, const SampleEdges* O, int s, vint in_tile, vint lane) {
+  vint hit = in_tile;
+  for (int e = 0; e < 3; ++e)
+    hit &= edge_lanes(F[e] + (O ? O->off[e][s] : 0L), R->bias[e], R->G[e], R->ramp[e], R->narrow[e], lane);
+  return hit;
+}
+
+/* alphaMode MASK for the lanes of a row chunk (first pixel center (X, Y)) that would win some sample:
+ * alpha is tested once per pixel at its shading point (shading_point), and a lane that fails leaves every
+ * sample (DESIGN section 3b). hit: the samples the MTA covers. */
+inline void mask_chunk(const ShadeInputs* in, const PmrMta* m, const RowEdges* R, const long* F, vint in_tile,
+                       vint lane, const vint* hit, long X, long Y, int view, float cutoff, vint* win) {
+  vint any_win = (vint)(0);
+  for (int s = 0; s < NS; ++s) any_win |= win[s];
+  if (!any(any_win)) return;
+  int w[VW], sx[VW], sy[VW];
+  vstore_vint(any_win, 0, w);
+  if (NS == 1) {
+    const SampleLanes S = row_samples(X, Y);
+    mask_alpha_lanes(in, m, w, VW, &S, view, cutoff);
+  } else {
+    int center[VW], bits[VW];
+    vstore_vint(chunk_hits(R, F, 0, 0, in_tile, lane), 0, center);
+    vint covered = (vint)(0);
+    for (int s = 0; s < NS; ++s) covered |= select((vint)(0), (vint)(1 << s), hit[s]);
+    vstore_vint(covered, 0, bits);
+    for (int l = 0; l < VW; ++l) {
+      shading_point(in->P, center[l] != 0, (uint)bits[l], sx + l, sy + l);
+      sx[l] += l * PMR_X_ONE;
+    }
+    const SampleLanes S = offset_samples(X, Y, sx, sy);
+    mask_alpha_lanes(in, m, w, VW, &S, view, cutoff);
+  }
+  const vint pass = vload_vint(0, w) != (vint)(0);
+  for (int s = 0; s < NS; ++s) win[s] &= pass;
+}
+
+/* The visibility state of a tile's queue walk: per (voxel, sample) the closest (depth, key), the winning
+ * MTA and, if `covered` is not null, the number of MTAs covering it. Slot FINE_SLOT(r, s) holds the VW
+ * lanes of sample s of state row r = ((view - vbase) * PMR_TILE_Y + ly) * FINE_CHUNKS + chunk. */
+typedef struct {
+  vfloat* depth;
+  vuint* key;
+  vuint* mta;
+  vint* covered;
+} FineState;
+
+/* MTA m (queue entry id) in view i over the tile's row chunk (ly, c): every sample's coverage, depth
+ * (the one formula of DepthPlane, whose row term zrow[s] the caller keeps per row) and (depth, key) test. */
+PMR_HOT void raster_chunk(const ShadeInputs* in, const PmrMta* m, uint id, const RowEdges* R, const long* F,
+                          const vint* hit, const DepthPlane* dp, const float* zrow, vint in_tile, vint lane, long X,
+                          long Y, int px0, int view, int r, float cutoff, const FineState* st) {
+  vint win[NS];
+  vfloat z[NS];
+  const vfloat column = convert_vfloat(lane + (px0 - dp->pr));
+  for (int s = 0; s < NS; ++s) {
+    const int k = FINE_SLOT(r, s);
+    z[s] = (vfloat)(zrow[s]) + (vfloat)(dp->gx) * (column + (vfloat)((float)in->P->sample_x[s] / (float)PMR_X_ONE));
+    if (st->covered) st->covered[k] -= hit[s];
+    win[s] = hit[s] & ((z[s] < st->depth[k]) | ((z[s] == st->depth[k]) & ((vuint)(m->key) < st->key[k])));
+  }
+  if (m->flags & PMR_MTA_MASK) mask_chunk(in, m, R, F, in_tile, lane, hit, X, Y, view, cutoff, win);
+  for (int s = 0; s < NS; ++s) {
+    const int k = FINE_SLOT(r, s);
+    st->depth[k] = select(st->depth[k], z[s], win[s]);
+    st->key[k] = select(st->key[k], (vuint)(m->key), win[s]);
+    st->mta[k] = select(st->mta[k], (vuint)(id), win[s]);
+  }
+}
+
 /* Rasterizes the queue entries [q0, q1) of the 3D tile at (x0, y0, v0) (nx x ny x nv voxels inside
- * the raster) into the visibility state: per voxel the closest (depth, key) and the winning MTA, and,
- * if `covered` is not null, the number of MTAs covering it. State row r = ((view - vbase) *
- * PMR_TILE_Y + ly) * FINE_CHUNKS + chunk holds VW lanes. */
+ * the raster) into the visibility state `st`, each pixel at its NS samples (P->sample_x/y). */
 inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile_queue, uint q0, uint q1,
                               const ShadeInputs* in, global const PmrTriangle* tris,
                               global const PmrMaterial* materials, int x0, int y0, int v0, int nx, int ny, int nv,
-                              int vbase, vfloat* best_depth, vuint* best_key, vuint* best_mta, vint* covered) {
+                              int vbase, const FineState* st) {
+  global const PmrParams* P = in->P;
   const long X0 = (long)x0 * PMR_X_ONE + PMR_HALF_X, Y0 = (long)y0 * PMR_Y_ONE + PMR_HALF_Y;
   const vint lane = vload_vint(0, lane_index);
   vint in_tile[FINE_CHUNKS]; /* lanes inside the raster (edge tiles are narrower) */
   for (int c = 0; c < FINE_CHUNKS; ++c) in_tile[c] = (lane + c * VW) < (vint)(nx);
+  /* the samples' extent around a pixel center */
+  int sx0 = 0, sx1 = 0, sy0 = 0, sy1 = 0;
+  for (int s = 0; s < NS; ++s) {
+    sx0 = min(sx0, P->sample_x[s]), sx1 = max(sx1, P->sample_x[s]);
+    sy0 = min(sy0, P->sample_y[s]), sy1 = max(sy1, P->sample_y[s]);
+  }
   for (uint q = q0; q < q1; ++q) {
     /* The queue visits MTAs in no memory order and a 1M-triangle frame's MTAs (150 MB) do not stay in
      * cache: ask for an MTA a few entries ahead, so its cache misses overlap this entry's work. */
@@ -103,51 +201,50 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     const uint id = tile_queue[q];
     const PmrMta m = mtas[id];
     const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
-    /* the tile rows whose centers lie within the MTA's y extent (the same in every view) */
+    /* the tile rows with a sample within the MTA's y extent (the same in every view) */
     const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));
-    const int ly0 = (int)max(0L, -floor_div_l(Y0 - ylo, PMR_Y_ONE));
-    const int ly1 = (int)min((long)ny - 1, floor_div_l(yhi - Y0, PMR_Y_ONE));
+    const int ly0 = (int)max(0L, -floor_div_l(Y0 + sy1 - ylo, PMR_Y_ONE));
+    const int ly1 = (int)min((long)ny - 1, floor_div_l(yhi - Y0 - sy0, PMR_Y_ONE));
     if (ly0 > ly1 || i_lo > i_hi) continue;
     const float cutoff = (m.flags & PMR_MTA_MASK) ? materials[tris[m.tri].material].alpha_cutoff : 0.0f;
-    const long f_lo = view_coord(in->P, i_lo);
+    const long f_lo = view_coord(P, i_lo);
     RowEdges R;
-    row_edges(&m, view_coord(in->P, m.view_lo), f_lo, X0, Y0 + (long)ly0 * PMR_Y_ONE, lane, &R);
+    row_edges(&m, view_coord(P, m.view_lo), f_lo, X0, Y0 + (long)ly0 * PMR_Y_ONE, lane, &R);
     for (int ib = i_lo; ib <= i_hi; ib += 16) {
-      uint pass = view_pass_mask(in->P, &m, ib, min(i_hi - ib + 1, 16), X0, PMR_X_FRAC_BITS, nx - 1);
+      /* views whose x extent holds a sample column of the tile: its pixel centers, or with several
+       * samples any x between the first pixel's leftmost and the last pixel's rightmost sample */
+      uint pass = NS == 1 ? view_pass_mask(P, &m, ib, min(i_hi - ib + 1, 16), X0, PMR_X_FRAC_BITS, nx - 1)
+                          : view_pass_mask(P, &m, ib, min(i_hi - ib + 1, 16), X0 + sx0, 0,
+                                           (long)(nx - 1) * PMR_X_ONE + sx1 - sx0);
       while (pass != 0) { /* the passing views, lowest first */
         const int i = ib + (31 - (int)clz(pass & (0u - pass)));
         pass &= pass - 1u;
-        const long fi = view_coord(in->P, i), di = fi - f_lo;
+        const long fi = view_coord(P, i), di = fi - f_lo;
         long row[3] = {R.row[0] + di * R.drow[0], R.row[1] + di * R.drow[1], R.row[2] + di * R.drow[2]};
         const long step_y[3] = {R.step_y[0] + di * R.dstep_y[0], R.step_y[1] + di * R.dstep_y[1],
                                 R.step_y[2] + di * R.dstep_y[2]};
+        SampleEdges O;
+        sample_edges(P, &m, fi, &O);
         DepthPlane dp;
         bool have_plane = false; /* set up on the first covered voxel: tiny MTAs often cover none */
         for (int ly = ly0; ly <= ly1; ++ly) {
-          float zrow = 0.0f;
+          float zrow[NS];
           bool have_zrow = false;
           for (int c = 0; c < FINE_CHUNKS; ++c) {
-            vint hit = in_tile[c];
-            hit &= edge_lanes(row[0] + c * R.step_c[0], R.bias[0], R.G[0], R.ramp[0], R.narrow[0], lane);
-            hit &= edge_lanes(row[1] + c * R.step_c[1], R.bias[1], R.G[1], R.ramp[1], R.narrow[1], lane);
-            hit &= edge_lanes(row[2] + c * R.step_c[2], R.bias[2], R.G[2], R.ramp[2], R.narrow[2], lane);
-            if (!any(hit)) continue;
+            const long F[3] = {row[0] + c * R.step_c[0], row[1] + c * R.step_c[1], row[2] + c * R.step_c[2]};
+            vint hit[NS], any_hit = (vint)(0);
+            for (int s = 0; s < NS; ++s) any_hit |= hit[s] = chunk_hits(&R, F, &O, s, in_tile[c], lane);
+            if (!any(any_hit)) continue;
             if (!have_plane) dp = depth_plane(&m, fi), have_plane = true;
-            if (!have_zrow) zrow = (float)(dp.zr + dp.gy * (double)(y0 + ly - dp.qr)), have_zrow = true;
-            const vfloat z = (vfloat)(zrow) + (vfloat)(dp.gx) * convert_vfloat(lane + (x0 + c * VW - dp.pr));
-            const int r = ((i - vbase) * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
-            if (covered) covered[r] -= hit;
-            vint win = hit & ((z < best_depth[r]) | ((z == best_depth[r]) & ((vuint)(m.key) < best_key[r])));
-            if ((m.flags & PMR_MTA_MASK) && any(win)) {
-              int w[VW];
-              vstore_vint(win, 0, w);
-              const SampleLanes S = row_samples(X0 + (long)c * VW * PMR_X_ONE, Y0 + (long)ly * PMR_Y_ONE);
-              mask_alpha_lanes(in, &m, w, VW, &S, i, cutoff);
-              win = vload_vint(0, w);
+            if (!have_zrow) {
+              const long rows = (long)(y0 + ly - dp.qr) * PMR_Y_ONE;
+              for (int s = 0; s < NS; ++s)
+                zrow[s] = (float)(dp.zr + dp.gy * ((double)(rows + P->sample_y[s]) / (double)PMR_Y_ONE));
+              have_zrow = true;
             }
-            best_depth[r] = select(best_depth[r], z, win);
-            best_key[r] = select(best_key[r], (vuint)(m.key), win);
-            best_mta[r] = select(best_mta[r], (vuint)(id), win);
+            const int r = ((i - vbase) * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
+            raster_chunk(in, &m, id, &R, F, hit, &dp, zrow, in_tile[c], lane, X0 + (long)c * VW * PMR_X_ONE,
+                         Y0 + (long)ly * PMR_Y_ONE, x0 + c * VW, i, r, cutoff, st);
           }
           row[0] += step_y[0];
           row[1] += step_y[1];
@@ -158,29 +255,84 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
   }
 }
 
-/* The winners of a row chunk shaded, as half RGBA bits: lane l is voxel (px0 + l, py) of view `view`,
- * won by MTA mta[l] where `won`, and out[l] gets its lit colour with alpha 1, or zero (background). SW
- * lanes at a time (lanes_gather, shade_lanes). */
-inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, vuint mta,
-                             vint won, int px0, int py, int view, ushort4* out) {
-  for (int l = 0; l < VW; ++l) out[l] = (ushort4)(0);
-  if (!any(won)) return; /* background */
-  int ids[VW + SW], w[VW + SW];
-  vstore_vint(as_vint(mta), 0, ids);
-  vstore_vint(won, 0, w);
-  for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = 0;
-  const long Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
-  for (int h = 0; h < VW; h += SW) {
-    const sint block_won = vload_s(0, w + h) != 0;
-    if (!any(block_won)) continue;
-    const SampleLanes S = row_samples((long)(px0 + h) * PMR_X_ONE + PMR_HALF_X, Y);
-    LaneWinners L;
-    lanes_gather(in, mtas, cache, block_won, vload_s(0, ids + h), &S, view, &L);
-    float c[3][SW];
-    s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
-    for (int l = 0; l < SW && h + l < VW; ++l)
-      if (w[h + l]) vstore_half4((float4)(c[0][l], c[1][l], c[2][l], 1.0f), h + l, (half*)out);
+/* SW winners of a row chunk shaded at the pixel centers (px0 + h + l, py), l < SW, where `act`, as
+ * colours c[3][SW]. */
+inline void shade_center_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
+                               sint act, sint ids, int px0, int py, int view, float c[3][SW]) {
+  const SampleLanes S = row_samples((long)px0 * PMR_X_ONE + PMR_HALF_X, (long)py * PMR_Y_ONE + PMR_HALF_Y);
+  LaneWinners L;
+  lanes_gather(in, mtas, cache, act, ids, &S, view, &L);
+  s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
+}
+
+/* The same at each lane's shading point for its winner (shading_point): the pixel center where the
+ * winner covers it (all of them: the row form above), else the centroid of its covered samples. */
+inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, sint act,
+                              sint ids, int px0, int py, int view, float c[3][SW]) {
+  const long X = (long)px0 * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
+  const long f = view_coord(in->P, view);
+  int on[SW], id_of[SW], sx[SW], sy[SW];
+  vstore_s(act, 0, on);
+  vstore_s(ids, 0, id_of);
+  bool centers = true;
+  for (int l = 0; l < SW; ++l) {
+    sx[l] = l * PMR_X_ONE, sy[l] = 0;
+    if (!on[l]) continue;
+    bool center;
+    const uint bits = mta_sample_cover(in->P, cached_mta(cache, mtas, (uint)id_of[l]), X + sx[l], Y, f, &center);
+    int ox, oy;
+    shading_point(in->P, center, bits, &ox, &oy);
+    sx[l] += ox, sy[l] += oy;
+    centers = centers && center;
   }
+  if (centers) {
+    shade_center_lanes(in, mtas, cache, light, act, ids, px0, py, view, c);
+    return;
+  }
+  const SampleLanes S = offset_samples(X, Y, sx, sy);
+  LaneWinners L;
+  lanes_gather(in, mtas, cache, act, ids, &S, view, &L);
+  s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
+}
+
+/* The winners of a row chunk shaded and resolved, as half RGBA bits: lane l is pixel (px0 + l, py) of
+ * view `view`, whose sample s was won by MTA mta[s][l] where won[s]. Each pixel shades each distinct
+ * winner once, at its shading point, weighted by the share of the samples it won; the pixel is their sum,
+ * premultiplied, so alpha is the covered fraction (DESIGN section 3b). With one sample: the winner's
+ * colour at the pixel center, alpha 1, or zero (background). */
+inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
+                             const vuint* mta, const vint* won, int px0, int py, int view, ushort4* out) {
+  float acc[4][VW];
+  for (int k = 0; k < 4; ++k)
+    for (int l = 0; l < VW; ++l) acc[k][l] = 0.0f;
+  for (int s = 0; s < NS; ++s) {
+    vint first = won[s], count = (vint)(0); /* lanes where s is the winner's first sample; its samples */
+    for (int t = 0; t < NS; ++t) {
+      const vint same = won[t] & (mta[t] == mta[s]);
+      if (t < s) first &= ~same;
+      else count -= same;
+    }
+    if (!any(first)) continue;
+    int ids[VW + SW], w[VW + SW], n[VW];
+    vstore_vint(as_vint(mta[s]), 0, ids);
+    vstore_vint(first, 0, w);
+    vstore_vint(count, 0, n);
+    for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = 0;
+    for (int h = 0; h < VW; h += SW) {
+      const sint act = vload_s(0, w + h) != 0;
+      if (!any(act)) continue;
+      float c[3][SW];
+      if (NS == 1) shade_center_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), px0 + h, py, view, c);
+      else shade_point_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), px0 + h, py, view, c);
+      for (int l = 0; l < SW && h + l < VW; ++l) {
+        if (!w[h + l]) continue;
+        const float weight = (float)n[h + l] / (float)NS; /* one sample: 1, and the colour as shaded */
+        for (int k = 0; k < 3; ++k) acc[k][h + l] = NS == 1 ? c[k][l] : acc[k][h + l] + weight * c[k][l];
+        acc[3][h + l] += weight;
+      }
+    }
+  }
+  for (int l = 0; l < VW; ++l) vstore_half4((float4)(acc[0][l], acc[1][l], acc[2][l], acc[3][l]), l, (half*)out);
 }
 
 /* Initial visibility state: nothing drawn. */

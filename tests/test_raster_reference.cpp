@@ -1,6 +1,6 @@
 // Kernels against the C++ reference: vertex records, setup records (MTAs), tile bins, and fine raster
 // coverage, depth and visibility, bit for bit, for random triangles and N in {1, 2, 7, 48, 96}, with
-// linear and angular camera spacing.
+// linear and angular camera spacing, at every sample of 1, 4, 8 and 16 samples per pixel.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,6 +16,7 @@ namespace {
 struct Case {
   int views, w, h, tris;
   bool double_sided, angular = false;
+  int samples = 1;
 };
 
 class RasterReference : public ::testing::TestWithParam<Case> {};
@@ -24,8 +25,12 @@ TEST_P(RasterReference, MatchesReferenceBitForBit) {
   const Case c = GetParam();
   const Scene scene = test::random_scene(c.tris, 1234u + c.views, c.double_sided);
   const Rig rig = test::small_rig(c.views, c.w, c.h, c.angular);
-  const test::Rendered out = test::render(scene, rig);
-  const PmrParams P = test::params_for(rig);
+  PipelineConfig pc;
+  pc.tile_x = pc.tile_y = pc.tile_v = 4;
+  pc.samples = c.samples;
+  const test::Rendered out = test::render_with(scene, rig, pc);
+  PmrParams P = test::params_for(rig);
+  set_sample_pattern(c.samples, P);
 
   // setup records
   std::vector<PmrVertex> verts;
@@ -40,11 +45,12 @@ TEST_P(RasterReference, MatchesReferenceBitForBit) {
   // coverage, depth, visibility
   const ref::RasterResult r = ref::rasterize(P, clipped);
   size_t covered = 0;
+  ASSERT_EQ(out.key.size(), r.key.size());
   for (size_t v = 0; v < r.key.size(); ++v) {
-    ASSERT_EQ(out.count[v], r.count[v]) << "voxel " << v;
-    ASSERT_EQ(out.key[v], r.key[v]) << "voxel " << v;
+    ASSERT_EQ(out.count[v], r.count[v]) << "voxel " << v / size_t(c.samples) << " sample " << v % size_t(c.samples);
+    ASSERT_EQ(out.key[v], r.key[v]) << "voxel " << v / size_t(c.samples) << " sample " << v % size_t(c.samples);
     if (r.key[v] != PMR_NO_KEY) {
-      ASSERT_EQ(out.depth[v], r.depth[v]) << "voxel " << v;
+      ASSERT_EQ(out.depth[v], r.depth[v]) << "voxel " << v / size_t(c.samples) << " sample " << v % size_t(c.samples);
       ++covered;
     }
   }
@@ -55,10 +61,13 @@ INSTANTIATE_TEST_SUITE_P(Views, RasterReference,
                          ::testing::Values(Case{1, 67, 33, 60, false}, Case{2, 64, 32, 60, true},
                                            Case{7, 53, 29, 60, false}, Case{96, 48, 24, 40, true},
                                            Case{2, 64, 32, 60, true, true}, Case{7, 53, 29, 60, false, true},
-                                           Case{48, 56, 28, 50, true, true}, Case{96, 48, 24, 40, true, true}),
+                                           Case{48, 56, 28, 50, true, true}, Case{96, 48, 24, 40, true, true},
+                                           Case{7, 53, 29, 60, false, false, 4}, Case{48, 56, 28, 50, true, true, 4},
+                                           Case{2, 64, 32, 60, true, false, 8}, Case{7, 53, 29, 60, true, true, 16}),
                          [](const ::testing::TestParamInfo<Case>& i) {
                            return "N" + std::to_string(i.param.views) + (i.param.double_sided ? "_double" : "_single") +
-                                  (i.param.angular ? "_angular" : "");
+                                  (i.param.angular ? "_angular" : "") +
+                                  (i.param.samples > 1 ? "_S" + std::to_string(i.param.samples) : "");
                          });
 
 }  // namespace

@@ -399,6 +399,15 @@ const RenderSection kPipelineOptions = {
            o.job.pipeline.sampling = parse_sampling(v);
            o.sampling_given = true;
          }},
+        {"--samples", nullptr, "S",
+         "samples per pixel: 1 (default; the pixel center), 4, 8 or 16 (Direct3D's\n"
+         "multisample patterns): coverage and depth per sample, each winner shaded\n"
+         "once per pixel, the pixel the mean of its samples (alpha is coverage)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           o.pipeline.samples = parse_int(v, name, 1, 16);
+           PmrParams P{};
+           set_sample_pattern(o.pipeline.samples, P);  // 1, 4, 8 or 16
+         }},
     }};
 
 const RenderSection kShadingOptions = {

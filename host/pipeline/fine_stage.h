@@ -21,7 +21,8 @@ struct FinePaths {
   bool volume = true;     // the view volume (fine.cl)
   bool fused = false;     // fused raster + encode
   bool subpixel = false;  // --sampling subpixel
-  bool debug = false;     // debug outputs: per voxel of the volume, or per display subpixel
+  bool debug = false;     // debug outputs: per voxel and sample of the volume, or per display subpixel
+  int samples = 1;        // samples per pixel
 };
 
 class FineStage {

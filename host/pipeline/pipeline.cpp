@@ -23,7 +23,8 @@ namespace {
 // screen tile over all views: depth, key and winning MTA, and the half RGBA colour); larger
 // configurations use the unfused path.
 constexpr size_t kFusedPrivateBudget = size_t(256) << 10;
-constexpr size_t kFusedBytesPerVoxel = 3 * sizeof(uint32_t) + 4 * sizeof(uint16_t);
+// per voxel: depth, key and winner per sample, then the shaded colour
+constexpr size_t kFusedBytesPerSample = 3 * sizeof(uint32_t), kFusedBytesPerVoxel = 4 * sizeof(uint16_t);
 
 // Fine raster vector width (PMR_VW): the smallest of 4, 8, 16 lanes that holds a tile row (wider rows
 // take several vectors).
@@ -44,10 +45,10 @@ void method_tile(const PipelineConfig& config, size_t max_group, int* tile) {
 }
 
 // -w: PoCL's compiler would print "N warnings generated." on the user's terminal at every cold build.
-std::string build_options(const int* tile) {
+std::string build_options(const int* tile, int samples) {
   return "-cl-std=CL1.2 -w -cl-fp32-correctly-rounded-divide-sqrt -DPMR_TILE_X=" + std::to_string(tile[0]) +
          " -DPMR_TILE_Y=" + std::to_string(tile[1]) + " -DPMR_TILE_V=" + std::to_string(tile[2]) +
-         " -DPMR_VW=" + std::to_string(fine_lanes(tile[0]));
+         " -DPMR_VW=" + std::to_string(fine_lanes(tile[0])) + " -DPMR_SAMPLES=" + std::to_string(samples);
 }
 
 }  // namespace
@@ -56,7 +57,7 @@ struct Pipeline::Impl {
   Impl(const ClRuntime& rt, const PipelineConfig& config, const int* tile_in)
       : tile{tile_in[0], tile_in[1], tile_in[2]},
         launcher(rt),
-        options(build_options(tile)),
+        options(build_options(tile, config.samples)),
         program(
             launcher.build({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl", "straddle_alpha.cl"}, options)),
         scene(rt, config),
@@ -115,12 +116,15 @@ FinePaths Pipeline::choose_paths(const Rig& rig, const Display* display) const {
   }
   const int* tile = impl_->tile;
   const int lanes = fine_lanes(tile[0]);
-  const size_t fused_private = size_t(tile[0] + lanes - 1) / lanes * lanes * tile[1] * rig.views * kFusedBytesPerVoxel;
+  const size_t fused_private = size_t(tile[0] + lanes - 1) / lanes * lanes * tile[1] * rig.views *
+                               (kFusedBytesPerSample * size_t(config_.samples) + kFusedBytesPerVoxel);
   p.fused = !p.subpixel && config_.fuse_encode && display && !display->bilinear && !display->blend_views &&
             display->cell_rows <= 1 && config_.method == Method::Pmr && !config_.debug_outputs &&
             fused_private <= kFusedPrivateBudget;
   p.volume = !p.fused && !(p.subpixel && config_.fuse_encode);
   p.debug = config_.debug_outputs;
+  p.samples = config_.samples;
+  if (p.subpixel && p.samples > 1) throw Error("--samples above 1 with --sampling subpixel: not implemented yet");
   return p;
 }
 
@@ -169,7 +173,8 @@ PmrParams Pipeline::frame_params(const FrameDescription& frame, bool empty) cons
   P.num_triangles = empty ? 0 : m.scene.num_triangles();
   P.debug_outputs = config_.debug_outputs ? 1u : 0u;
   P.setup_mode = config_.method == Method::Duplicate ? PMR_SETUP_DUPLICATE : PMR_SETUP_MTA;
-  P.sample_area = m.paths.subpixel ? PMR_SAMPLES_PIXEL : PMR_SAMPLES_CENTER;
+  P.sample_area = m.paths.subpixel || config_.samples > 1 ? PMR_SAMPLES_PIXEL : PMR_SAMPLES_CENTER;
+  set_sample_pattern(config_.samples, P);
   P.shading = config_.shading == Shading::Pbr ? PMR_SHADING_PBR : PMR_SHADING_LAMBERT;
   P.exposure = float(std::exp2(config_.exposure_ev));
   P.env_radiance = float(0.2 * config_.environment_intensity);

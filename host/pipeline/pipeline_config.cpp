@@ -39,6 +39,22 @@ Shading parse_shading(const std::string& name) {
 
 const char* to_string(Shading s) { return s == Shading::Pbr ? "pbr" : "lambert"; }
 
+void set_sample_pattern(int samples, PmrParams& P) {
+  static const int one[] = PMR_SAMPLE_PATTERN_1, four[] = PMR_SAMPLE_PATTERN_4, eight[] = PMR_SAMPLE_PATTERN_8,
+                   sixteen[] = PMR_SAMPLE_PATTERN_16;
+  const int* pattern = samples == 1    ? one
+                       : samples == 4  ? four
+                       : samples == 8  ? eight
+                       : samples == 16 ? sixteen
+                                       : nullptr;
+  if (!pattern) throw Error("invalid --samples " + std::to_string(samples) + ": use 1, 4, 8 or 16");
+  P.samples = uint32_t(samples);
+  for (int s = 0; s < PMR_MAX_SAMPLES; ++s) {  // 1/16 pixel to 16.16 / 24.8
+    P.sample_x[s] = s < samples ? pattern[2 * s] * (PMR_X_ONE / 16) : 0;
+    P.sample_y[s] = s < samples ? pattern[2 * s + 1] * (PMR_Y_ONE / 16) : 0;
+  }
+}
+
 void check_subpixel_sampling(Method method, const Display& display) {
   if (method != Method::Pmr) throw Error("--sampling subpixel renders with --method pmr");
   if (display.bilinear || display.blend_views)

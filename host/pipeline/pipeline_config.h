@@ -31,6 +31,9 @@ enum class Sampling {
 };
 Sampling parse_sampling(const std::string& name);  // "view", "subpixel"
 const char* to_string(Sampling s);
+// The sample positions of S samples per pixel (DESIGN section 3b) into P; throws pmr::Error unless S is
+// 1, 4, 8 or 16.
+void set_sample_pattern(int samples, PmrParams& P);
 // Throws pmr::Error when --sampling subpixel cannot render with this method and display (PMR only;
 // nearest, unblended sampling). Pipeline::configure checks it; the command line calls it before loading
 // a scene.
@@ -52,6 +55,7 @@ struct PipelineConfig {
   // AnisotropyStrengthTest, TransmissionTest, --synthetic 100000; docs/PERFORMANCE.md).
   int tile_x = 16, tile_y = 2, tile_v = 16;
   bool debug_outputs = false;  // fine raster also writes per-voxel key, depth, count
+  int samples = 1;             // samples per pixel (DESIGN section 3b): 1, 4, 8 or 16
   // The encoded-only job: fine raster writes the display image directly (cl/fine_encode.cl) and the
   // view volume is never allocated. Applies to PMR with a display, nearest sampling and no debug
   // outputs, when one screen tile's state for all views fits a work-item's private memory;

@@ -5,9 +5,12 @@
 
 #include "pmr/shared.h"
 
-static_assert(sizeof(PmrParams) == 16 * 8 + 9 * 8 + 16 + 18 * 4 + 2 * 8 + 4 * (PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK),
+static_assert(sizeof(PmrParams) == 16 * 8 + 9 * 8 + 16 + 18 * 4 + 2 * PMR_MAX_SAMPLES * 4 + 2 * 8 +
+                                        4 * (PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK),
               "PmrParams layout");
-static_assert(offsetof(PmrParams, view_anchor) == 288 && offsetof(PmrParams, view_coord) == 304, "PmrParams layout");
+static_assert(offsetof(PmrParams, sample_x) == 288 && offsetof(PmrParams, view_anchor) == 416 &&
+                  offsetof(PmrParams, view_coord) == 432,
+              "PmrParams layout");
 static_assert(offsetof(PmrParams, light_world) == 200, "PmrParams layout");
 static_assert(offsetof(PmrParams, view_w) == 216, "PmrParams layout");
 static_assert(sizeof(PmrVertex) == 64 && offsetof(PmrVertex, x0) == 32 && offsetof(PmrVertex, z) == 48,

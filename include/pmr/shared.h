@@ -115,6 +115,20 @@ typedef uint32_t pmr_u32;
 #define PMR_SAMPLES_CENTER 0u
 #define PMR_SAMPLES_PIXEL 1u
 
+/* Samples per pixel (--samples S, DESIGN section 3b): S positions inside every pixel of every view, the
+ * same in every view: the center for S = 1, else Direct3D's standard multisample patterns, as offsets
+ * (x, y) from the pixel center in 1/16 pixel, +y down. PmrParams.sample_x/y hold them in the raster's
+ * fixed point. */
+#define PMR_MAX_SAMPLES 16
+#define PMR_SAMPLE_PATTERN_1 \
+  { 0, 0 }
+#define PMR_SAMPLE_PATTERN_4 \
+  { -2, -6, 6, -2, -6, 2, 2, 6 }
+#define PMR_SAMPLE_PATTERN_8 \
+  { 1, -3, -1, 3, 5, 1, -3, -5, -5, 5, -7, -1, 3, 7, 7, -7 }
+#define PMR_SAMPLE_PATTERN_16 \
+  { 1, 1, -1, -3, -3, 2, 4, -1, -5, -2, 2, 5, 5, 3, 3, -5, -2, 6, 0, -7, -4, -6, -6, 4, -8, 0, 7, -4, 6, 7, -7, -8 }
+
 /* PmrLight.type: KHR_lights_punctual's three kinds. */
 #define PMR_LIGHT_DIRECTIONAL 0
 #define PMR_LIGHT_POINT 1
@@ -137,18 +151,20 @@ typedef struct {
   pmr_i32 views;                     /* N                                                              */
   pmr_i32 tiles_x, tiles_y, tiles_v; /* tile grid size                                      */
   pmr_u32 num_vertices, num_triangles;
-  pmr_u32 mta_capacity;  /* size of the MTA queue; setup counts past it and stops writing   */
-  pmr_u32 debug_outputs; /* 1: fine raster writes per-voxel key, depth and coverage count   */
-  pmr_u32 view_base;     /* volume slice of local view 0 (multipass renders one view a pass) */
-  pmr_u32 setup_mode;    /* PMR_SETUP_MTA or PMR_SETUP_DUPLICATE                            */
-  pmr_u32 sample_area;   /* PMR_SAMPLES_CENTER or PMR_SAMPLES_PIXEL                          */
-  pmr_u32 shading;       /* PMR_SHADING_LAMBERT or PMR_SHADING_PBR                           */
-  float exposure;        /* 2^EV: scales the colour of either model                          */
-  float env_radiance;    /* pbr: radiance of the uniform default environment (0.2 x intensity) */
-  pmr_u32 num_lights;    /* pbr: entries of the light table (PmrLight), the kernels' last argument */
-  pmr_u32 pad_params;
-  double view_anchor; /* camera offset at view coordinate 0 over the baseline: -1/2 linear, 0 angular */
-  double view_scale;  /* view coordinate units per baseline: N - 1 linear, Q (N - 1) angular */
+  pmr_u32 mta_capacity;              /* size of the MTA queue; setup counts past it and stops writing   */
+  pmr_u32 debug_outputs;             /* 1: fine raster writes per-voxel key, depth and coverage count   */
+  pmr_u32 view_base;                 /* volume slice of local view 0 (multipass renders one view a pass) */
+  pmr_u32 setup_mode;                /* PMR_SETUP_MTA or PMR_SETUP_DUPLICATE                            */
+  pmr_u32 sample_area;               /* PMR_SAMPLES_CENTER or PMR_SAMPLES_PIXEL                          */
+  pmr_u32 shading;                   /* PMR_SHADING_LAMBERT or PMR_SHADING_PBR                           */
+  float exposure;                    /* 2^EV: scales the colour of either model                          */
+  float env_radiance;                /* pbr: radiance of the uniform default environment (0.2 x intensity) */
+  pmr_u32 num_lights;                /* pbr: entries of the light table (PmrLight), the kernels' last argument */
+  pmr_u32 samples;                   /* S samples per pixel (PMR_SAMPLE_PATTERN_S); the kernels are built for it */
+  pmr_i32 sample_x[PMR_MAX_SAMPLES]; /* sample s at (X + sample_x[s], Y + sample_y[s]) from pixel center */
+  pmr_i32 sample_y[PMR_MAX_SAMPLES]; /* (X, Y), in 16.16 / 24.8 raster units                          */
+  double view_anchor;                /* camera offset at view coordinate 0 over the baseline: -1/2 linear, 0 angular */
+  double view_scale;                 /* view coordinate units per baseline: N - 1 linear, Q (N - 1) angular */
   pmr_i32 view_coord[PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK]; /* F_i, strictly increasing in i (a
                              multipass pass: its one view at 0) */
 } PmrParams;

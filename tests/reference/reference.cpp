@@ -220,11 +220,11 @@ void sort_mtas(std::vector<PmrMta>& mtas) {
 }
 
 RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& tris) {
-  const size_t W = size_t(P.view_w), H = size_t(P.view_h), N = size_t(P.views);
+  const size_t W = size_t(P.view_w), H = size_t(P.view_h), N = size_t(P.views), S = P.samples;
   RasterResult r;
-  r.key.assign(W * H * N, PMR_NO_KEY);
-  r.depth.assign(W * H * N, INFINITY);
-  r.count.assign(W * H * N, 0);
+  r.key.assign(W * H * N * S, PMR_NO_KEY);
+  r.depth.assign(W * H * N * S, INFINITY);
+  r.count.assign(W * H * N * S, 0);
   for (size_t i = 0; i < N; ++i) {
     for (const ClippedTriangle& c : tris) {
       int64_t x[3], y[3];
@@ -245,24 +245,24 @@ RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& t
         const bool top_left = dy > 0 || (dy == 0 && dx < 0);
         bias[k] = top_left ? 0 : 1;
       }
-      for (size_t py = 0; py < H; ++py) {
-        for (size_t px = 0; px < W; ++px) {
-          const int64_t X = int64_t(px) * PMR_X_ONE + PMR_X_ONE / 2, Y = int64_t(py) * PMR_Y_ONE + PMR_Y_ONE / 2;
-          int64_t e[3];
-          bool inside = true;
-          for (int k = 0; k < 3; ++k) {
-            const int a = ea[k], b = eb[k];
-            e[k] = s * ((y[b] - y[a]) * (X - x[a]) - (x[b] - x[a]) * (Y - y[a]));
-            inside = inside && e[k] >= bias[k];
-          }
-          if (!inside) continue;
-          const size_t vox = (i * H + py) * W + px;
-          ++r.count[vox];
-          const float depth = depth_at(x, y, c, X, Y);
-          if (depth < r.depth[vox] || (depth == r.depth[vox] && c.key < r.key[vox])) {
-            r.depth[vox] = depth;
-            r.key[vox] = c.key;
-          }
+      for (size_t at = 0; at < W * H * S; ++at) {
+        const size_t px = at / S % W, py = at / S / W, sample = at % S;
+        const int64_t X = int64_t(px) * PMR_X_ONE + PMR_X_ONE / 2 + P.sample_x[sample],
+                      Y = int64_t(py) * PMR_Y_ONE + PMR_Y_ONE / 2 + P.sample_y[sample];
+        int64_t e[3];
+        bool inside = true;
+        for (int k = 0; k < 3; ++k) {
+          const int a = ea[k], b = eb[k];
+          e[k] = s * ((y[b] - y[a]) * (X - x[a]) - (x[b] - x[a]) * (Y - y[a]));
+          inside = inside && e[k] >= bias[k];
+        }
+        if (!inside) continue;
+        const size_t slot = i * H * W * S + at;
+        ++r.count[slot];
+        const float depth = depth_at(x, y, c, X, Y);
+        if (depth < r.depth[slot] || (depth == r.depth[slot] && c.key < r.key[slot])) {
+          r.depth[slot] = depth;
+          r.key[slot] = c.key;
         }
       }
     }

@@ -30,11 +30,12 @@ std::vector<PmrMta> make_mtas(const PmrParams& P, const std::vector<ClippedTrian
 void sort_mtas(std::vector<PmrMta>& mtas);
 
 struct RasterResult {
-  std::vector<uint32_t> key;    // [view][y][x], PMR_NO_KEY when empty
+  std::vector<uint32_t> key;    // [view][y][x][sample], PMR_NO_KEY when empty
   std::vector<float> depth;     // INFINITY when empty
-  std::vector<uint32_t> count;  // number of triangles covering the voxel (before depth test)
+  std::vector<uint32_t> count;  // number of triangles covering the sample (before depth test)
 };
-// Conventional per-view rasterization with the top-left rule and (depth, key) visibility.
+// Conventional per-view rasterization with the top-left rule and (depth, key) visibility, at each
+// pixel's P.samples samples (P.sample_x/y from its center; DESIGN section 3b).
 RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& tris);
 
 // --sampling subpixel (DESIGN section 5, docs/SAMPLING.md): display subpixel (j, i, k) sampled at

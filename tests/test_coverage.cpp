@@ -13,8 +13,9 @@ namespace pmr {
 namespace {
 
 // Compares every voxel's key, depth and count with the reference; returns the covered voxel count.
-size_t expect_matches_reference(const Scene& scene, const Rig& rig, const test::Rendered& out) {
-  const PmrParams P = test::params_for(rig);
+size_t expect_matches_reference(const Scene& scene, const Rig& rig, const test::Rendered& out, int samples = 1) {
+  PmrParams P = test::params_for(rig);
+  set_sample_pattern(samples, P);
   const ref::RasterResult r = ref::render(P, scene);
   size_t covered = 0, mismatches = 0;
   for (size_t v = 0; v < r.key.size(); ++v) {
@@ -30,7 +31,8 @@ size_t expect_matches_reference(const Scene& scene, const Rig& rig, const test::
 }
 
 // A mesh of shared-edge triangles covering the whole screen in every view, vertices at varying depths:
-// every voxel of every view is covered exactly once.
+// every sample of every voxel of every view is covered exactly once, for 1, 4 and 16 samples per
+// pixel, and every pixel resolves to alpha 1 (no seam along shared edges).
 TEST(Coverage, WatertightMeshCoversEveryVoxelExactlyOnce) {
   for (bool angular : test::kSpacings)
     for (int views : {1, 7, 96}) {
@@ -77,11 +79,20 @@ TEST(Coverage, WatertightMeshCoversEveryVoxelExactlyOnce) {
             s.triangles.push_back(t);
           }
         }
-      const test::Rendered out = test::render(s, rig);
-      size_t bad = 0;
-      for (size_t v = 0; v < out.count.size(); ++v) bad += out.count[v] != 1;
-      EXPECT_EQ(bad, 0u) << "voxels not covered exactly once with N = " << views << ", " << test::spacing_name(angular);
-      expect_matches_reference(s, rig, out);
+      for (int samples : {1, 4, 16}) {
+        if (samples == 16 && views != 7) continue;  // (time)
+        PipelineConfig pc;
+        pc.tile_x = pc.tile_y = pc.tile_v = 4;
+        pc.samples = samples;
+        const test::Rendered out = test::render_with(s, rig, pc);
+        size_t bad = 0, seams = 0;
+        for (size_t v = 0; v < out.count.size(); ++v) bad += out.count[v] != 1;
+        for (size_t v = 0; v < out.volume.size(); v += 4) seams += out.volume[v + 3] != 0x3c00;  // alpha 1
+        EXPECT_EQ(bad, 0u) << "samples not covered exactly once with N = " << views << ", "
+                           << test::spacing_name(angular) << ", S = " << samples;
+        EXPECT_EQ(seams, 0u) << "pixels whose samples' coverage does not sum to 1, S = " << samples;
+        expect_matches_reference(s, rig, out, samples);
+      }
     }
 }
 

@@ -146,24 +146,20 @@ PMR_HOT void lanes_gather(const ShadeInputs* in, global const PmrMta* mtas, MtaC
 }
 
 /* Where the kernels that write the display image from screen tiles (fine_encode.cl, fine_subpixel.cl)
- * write it: the image (half RGBA bits), each subpixel's own alpha (store_sub_alpha), and, for display
- * pixels whose subpixels belong to different tiles ("straddling"; straddle_slot[j] is column j's slot
- * among them), a coverage byte per subpixel for encode_straddle_alpha (straddle_alpha.cl). */
+ * write it: the image (half RGBA bits) and each subpixel's own alpha (store_sub_alpha), from which
+ * encode_straddle_alpha (straddle_alpha.cl) sets the alpha of the display pixels whose subpixels belong
+ * to different tiles ("straddling"). */
 typedef struct {
   global ushort* bits;
   global ushort* sub_alpha;
-  global uchar* straddle_cov;
-  global const int* straddle_slot;
-  uint straddle_slots;
   int width; /* display pixels per row */
 } DisplayOut;
 
 /* Display pixel (j, i) from the half RGBA bits of its subpixels' samples s0, s1, s2 (channel k from
  * subpixel k, alpha its coverage), of which the calling tile owns subpixels s_lo <= 3 j + k < s_hi (the
  * others' values are not read). Wholly owned: the pixel, its alpha the mean coverage, and each
- * subpixel's alpha. Straddling: the owned channels, their own alpha (written by this tile alone), and
- * their coverage bytes, from which encode_straddle_alpha sets the pixel's alpha once all tiles are
- * done. */
+ * subpixel's alpha. Straddling: the owned channels and their own alpha (written by this tile alone),
+ * from which encode_straddle_alpha sets the pixel's alpha once all tiles are done. */
 PMR_HOT void write_display_pixel(const DisplayOut* D, int i, int j, int s_lo, int s_hi, ushort4 s0, ushort4 s1,
                                  ushort4 s2) {
   const size_t pixel = (size_t)i * (size_t)D->width + (size_t)j;
@@ -173,11 +169,9 @@ PMR_HOT void write_display_pixel(const DisplayOut* D, int i, int j, int s_lo, in
     store_sub_alpha(D->sub_alpha, pixel, s0, s1, s2);
     return;
   }
-  const size_t slot = ((size_t)i * D->straddle_slots + (size_t)D->straddle_slot[j]) * 3;
   for (int k = k_lo; k < k_hi; ++k) {
     const ushort4 s = k == 0 ? s0 : (k == 1 ? s1 : s2);
     D->bits[pixel * 4 + (size_t)k] = k == 0 ? s.x : (k == 1 ? s.y : s.z);
-    D->straddle_cov[slot + (size_t)k] = s.w != 0 ? 1 : 0;
     D->sub_alpha[pixel * 3 + (size_t)k] = s.w;
   }
 }

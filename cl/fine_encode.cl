@@ -9,9 +9,9 @@
  * tile holding its view row py(i) (both maps are monotone; column_start / row_start give each view
  * column's and row's first subpixel and display row). A display pixel whose three subpixels belong to
  * different tiles ("straddling", a column property the host lists) gets each colour channel from the
- * subpixel's owner and its alpha, the mean coverage, from encode_straddle_alpha once all tiles are
- * done: the owners leave one coverage byte per subpixel in straddle_cov (write_display_pixel in
- * fine_core.h, which fine_subpixel.cl's display pixels go through too). */
+ * subpixel's owner and its alpha, the mean of the subpixels' own alphas, from encode_straddle_alpha
+ * once all tiles are done (write_display_pixel in fine_core.h, which fine_subpixel.cl's display pixels
+ * go through too). */
 #include "fine_raster.h"
 
 #define FUSED_ROWS (PMR_TILE_Y * PMR_FUSED_VIEWS * FINE_CHUNKS)
@@ -81,7 +81,6 @@ inline void fused_display_row(const DisplayOut* D, const FusedTile* T, const Pmr
 kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
                         global const uint* tile_queue, global const PmrEncodeParams* E, global const int* column_soa,
                         global const PmrEncodeRow* rows, global const int* column_start, global const int* row_start,
-                        global const int* straddle_slot, uint straddle_slots, global uchar* straddle_cov,
                         global half* display, global ushort* sub_alpha) {
   const uint tile_xy = pmr_item_id();
   const uint tiles_x = (uint)P->tiles_x, tiles_y = (uint)P->tiles_y;
@@ -118,7 +117,7 @@ kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
       }
 
   /* the display pixels this tile owns, whole or in part */
-  const DisplayOut D = {(global ushort*)display, sub_alpha, straddle_cov, straddle_slot, straddle_slots, E->display_w};
+  const DisplayOut D = {(global ushort*)display, sub_alpha, E->display_w};
   const FusedTile T = {colour, column_soa, E->display_w, views, E->reversed, x0};
   const int s_lo = column_start[x0], s_hi = column_start[x0 + nx];
   const int i_lo = row_start[y0], i_hi = row_start[y0 + ny];

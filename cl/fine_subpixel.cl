@@ -310,7 +310,6 @@ kernel void fine_subpixel(PMR_SHADE_PARAMS, global const PmrMta* mtas, global co
                           global const uint* tile_queue, global const PmrEncodeParams* E, global const int* column_a,
                           global const int* column_b, global const PmrEncodeRow* rows, global const int* sample_x,
                           global const int* sample_y, global const PmrSampleChunk* chunks, uint num_chunks,
-                          global const int* straddle_slot, uint straddle_slots, global uchar* straddle_cov,
                           global half* display, global ushort* sub_alpha, uint debug, global uint* dbg_key,
                           global float* dbg_depth) {
   const uint chunk = pmr_item_id();
@@ -325,6 +324,6 @@ kernel void fine_subpixel(PMR_SHADE_PARAMS, global const PmrMta* mtas, global co
   ushort value[PMR_SUBPIXEL_CAP];
   uchar covered[PMR_SUBPIXEL_CAP];
   sp_shade(&in, mtas, &C, value, covered);
-  const DisplayOut D = {(global ushort*)display, sub_alpha, straddle_cov, straddle_slot, straddle_slots, E->display_w};
+  const DisplayOut D = {(global ushort*)display, sub_alpha, E->display_w};
   sp_write_display(&D, &ch, value, covered);
 }

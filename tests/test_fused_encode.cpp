@@ -2,7 +2,8 @@
 // view volume, then cl/encode.cl): the display images must be identical bit for bit, for display
 // parameter sets that exercise the whole encoder map (reversed views, slanted lenses with irrational-
 // looking pitches, offsets on exact integers, display pixels whose subpixels straddle screen tiles,
-// view rasters larger and smaller than the display), several tile shapes and view counts.
+// view rasters larger and smaller than the display), several tile shapes, view counts and samples per
+// pixel.
 #include <gtest/gtest.h>
 
 #include "pmr/rig.h"
@@ -18,12 +19,14 @@ struct FusedCase {
   bool reversed;
   int tile[3];
   bool angular = false;
+  int samples = 1;
 };
 
-std::vector<uint16_t> encode(const Scene& scene, const Rig& rig, const Display& d, const int* tile, bool fuse,
-                             bool* fused) {
+std::vector<uint16_t> encode(const Scene& scene, const Rig& rig, const Display& d, const int* tile, int samples,
+                             bool fuse, bool* fused) {
   PipelineConfig pc;
   pc.tile_x = tile[0], pc.tile_y = tile[1], pc.tile_v = tile[2];
+  pc.samples = samples;
   pc.fuse_encode = fuse;
   test::EncodedRender r = test::render_encoded(scene, rig, d, pc);
   *fused = r.fused;
@@ -46,8 +49,8 @@ TEST_P(FusedEncode, EqualsRasterThenEncodeBitForBit) {
   rc.angular_spacing = c.angular;
   const Rig rig = make_rig(rc, d, glm::dvec3(-1.0), glm::dvec3(1.0));
   bool fused = false, unfused = true;
-  const std::vector<uint16_t> want = encode(scene, rig, d, c.tile, false, &unfused);
-  const std::vector<uint16_t> got = encode(scene, rig, d, c.tile, true, &fused);
+  const std::vector<uint16_t> want = encode(scene, rig, d, c.tile, c.samples, false, &unfused);
+  const std::vector<uint16_t> got = encode(scene, rig, d, c.tile, c.samples, true, &fused);
   ASSERT_FALSE(unfused);
   ASSERT_TRUE(fused) << "the fused path should have been chosen";
   ASSERT_EQ(got.size(), want.size());
@@ -76,7 +79,10 @@ INSTANTIATE_TEST_SUITE_P(
         FusedCase{"wide_tiles", 12, 96, 40, 200, 90, "9", "1/9", "-1/24", true, {32, 4, 5}},
         // angular camera spacing (Looking Glass): the paper lens and the straddling tiles again
         FusedCase{"paper_lens_angular", 96, 64, 32, 480, 270, "16", "1/18", "-1/12", false, {16, 2, 4}, true},
-        FusedCase{"straddling_angular", 24, 50, 30, 333, 101, "4.6667", "-1/7", "0.25", true, {5, 3, 4}, true}),
+        FusedCase{"straddling_angular", 24, 50, 30, 333, 101, "4.6667", "-1/7", "0.25", true, {5, 3, 4}, true},
+        // samples per pixel: the resolved colours (fractional alpha at edges) through both paths
+        FusedCase{"paper_lens_4_samples", 96, 64, 32, 480, 270, "16", "1/18", "-1/12", false, {16, 2, 4}, false, 4},
+        FusedCase{"straddling_8_samples", 24, 50, 30, 333, 101, "4.6667", "-1/7", "0.25", true, {5, 3, 4}, true, 8}),
     [](const ::testing::TestParamInfo<FusedCase>& i) { return std::string(i.param.name); });
 
 }  // namespace

@@ -31,14 +31,11 @@ size_t EncodeStage::display_bytes() const {
   return configured_ ? size_t(params_.display_w) * params_.display_h * 4 * sizeof(uint16_t) : 0;
 }
 
-// The straddling pixels' slots and coverage bytes (fused and subpixel paths).
+// The straddling columns (fused and subpixel paths).
 TileOwnership EncodeStage::own_by_tiles(int tile_x) {
   TileOwnership own = tile_ownership(params_, columns_, rows_, tile_x);
-  straddle_slot_ = rt_.upload(own.straddle_slot, "straddle slots", kMinTableBytes);
   straddle_columns_ = rt_.upload(own.straddling, "straddle columns", kMinTableBytes);
   straddle_slots_ = uint32_t(own.straddling.size());
-  straddle_cov_ =
-      rt_.buffer(std::max<size_t>(size_t(straddle_slots_) * params_.display_h * 3, 16), "straddle coverage");
   return own;
 }
 
@@ -51,7 +48,7 @@ void EncodeStage::encode(const ClBuffer& volume, FrameEvents& ev) {
 
 void EncodeStage::straddle_alpha(FrameEvents& ev) {
   if (straddle_slots_ == 0) return;
-  straddle_.args(params_buf_, straddle_columns_, straddle_slots_, straddle_cov_, display_);
+  straddle_.args(params_buf_, straddle_columns_, straddle_slots_, sub_alpha_, display_);
   ev.add(kEncode, launcher_.launch_2d(straddle_, straddle_slots_, size_t(params_.display_h), 1, 8));
 }
 
@@ -69,8 +66,7 @@ void EncodeStage::read_sub_alpha(std::vector<uint16_t>& out) const {
 
 size_t EncodeStage::device_bytes() const {
   size_t total = 0;
-  for (const ClBuffer* b : {&params_buf_, &columns_buf_, &rows_buf_, &display_, &sub_alpha_, &straddle_slot_,
-                            &straddle_columns_, &straddle_cov_})
+  for (const ClBuffer* b : {&params_buf_, &columns_buf_, &rows_buf_, &display_, &sub_alpha_, &straddle_columns_})
     total += b->size();
   return total;
 }

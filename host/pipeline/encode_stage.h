@@ -20,7 +20,7 @@ class EncodeStage {
   void configure(const Display& display, int views, int w, int h);
   bool configured() const { return configured_; }
   // Which screen tile owns which display subpixels (tiles tile_x view pixels wide), with the straddling
-  // columns' slots uploaded for the tile paths.
+  // columns uploaded for straddle_alpha().
   TileOwnership own_by_tiles(int tile_x);
 
   // Encodes the view volume into the display image (nearest, bilinear or blended, as the display asks).
@@ -35,9 +35,6 @@ class EncodeStage {
   const ClBuffer& rows_buffer() const { return rows_buf_; }
   const ClBuffer& display() const { return display_; }
   const ClBuffer& sub_alpha() const { return sub_alpha_; }
-  const ClBuffer& straddle_slot() const { return straddle_slot_; }
-  const ClBuffer& straddle_cov() const { return straddle_cov_; }
-  uint32_t straddle_slots() const { return straddle_slots_; }
   // Bytes of the display image (half RGBA), 0 without a display.
   size_t display_bytes() const;
 
@@ -54,7 +51,7 @@ class EncodeStage {
   std::vector<PmrEncodeColumn> columns_;
   std::vector<PmrEncodeRow> rows_;
   ClBuffer params_buf_, columns_buf_, rows_buf_, display_, sub_alpha_;
-  ClBuffer straddle_slot_, straddle_columns_, straddle_cov_;
+  ClBuffer straddle_columns_;
   uint32_t straddle_slots_ = 0;
 };
 

@@ -109,8 +109,8 @@ void FineStage::run_fused(const SceneBuffers& scene, const GeometryStage& geomet
                           EncodeStage& encode, FrameEvents& ev) {
   const cl_uint next = scene.bind_shading(fine_encode_, geometry.params());
   fine_encode_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(), encode.params_buffer(),
-                         column_soa_, encode.rows_buffer(), column_start_, row_start_, encode.straddle_slot(),
-                         encode.straddle_slots(), encode.straddle_cov(), encode.display(), encode.sub_alpha());
+                         column_soa_, encode.rows_buffer(), column_start_, row_start_, encode.display(),
+                         encode.sub_alpha());
   ev.add(kFine, launcher_.launch(fine_encode_, screen_tiles, 1));
   encode.straddle_alpha(ev);
 }
@@ -121,8 +121,8 @@ void FineStage::run_subpixel(const SceneBuffers& scene, const GeometryStage& geo
   const bool debug = paths_.debug && !paths_.volume;  // per display subpixel
   fine_subpixel_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(),
                            encode.params_buffer(), column_a_, column_b_, encode.rows_buffer(), sample_x_, sample_y_,
-                           chunks_, num_chunks_, encode.straddle_slot(), encode.straddle_slots(), encode.straddle_cov(),
-                           encode.display(), encode.sub_alpha(), cl_uint(debug), dbg_key_, dbg_depth_);
+                           chunks_, num_chunks_, encode.display(), encode.sub_alpha(), cl_uint(debug), dbg_key_,
+                           dbg_depth_);
   ev.add(kFine, launcher_.launch(fine_subpixel_, num_chunks_, 1));
   encode.straddle_alpha(ev);
 }

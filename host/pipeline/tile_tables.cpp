@@ -18,12 +18,8 @@ TileOwnership tile_ownership(const PmrEncodeParams& E, const std::vector<PmrEnco
     while (i < int(rows.size()) && rows[size_t(i)].py < py) ++i;
     t.row_start[size_t(py)] = i;
   }
-  t.straddle_slot.assign(size_t(E.display_w), -1);
-  for (int j = 0; j < E.display_w; ++j) {
-    if (columns[size_t(3 * j)].px / tile_x == columns[size_t(3 * j + 2)].px / tile_x) continue;
-    t.straddle_slot[size_t(j)] = int32_t(t.straddling.size());
-    t.straddling.push_back(j);
-  }
+  for (int j = 0; j < E.display_w; ++j)
+    if (columns[size_t(3 * j)].px / tile_x != columns[size_t(3 * j + 2)].px / tile_x) t.straddling.push_back(j);
   return t;
 }
 

@@ -12,10 +12,9 @@ namespace pmr {
 // Ownership: display subpixel column s belongs to the screen tile holding its view column px(s), display
 // row i to the one holding its view row py(i) (both maps are monotone).
 struct TileOwnership {
-  std::vector<int32_t> column_start;   // per view column px (and W): its first subpixel column
-  std::vector<int32_t> row_start;      // per view row py (and H): its first display row
-  std::vector<int32_t> straddle_slot;  // per display column: its slot in `straddling`, or -1
-  std::vector<int32_t> straddling;     // display columns whose three subpixels lie in different tiles
+  std::vector<int32_t> column_start;  // per view column px (and W): its first subpixel column
+  std::vector<int32_t> row_start;     // per view row py (and H): its first display row
+  std::vector<int32_t> straddling;    // display columns whose three subpixels lie in different tiles
 };
 // `columns` may hold several blocks (subpixel cells): px is the same in every block, the first is read.
 TileOwnership tile_ownership(const PmrEncodeParams& E, const std::vector<PmrEncodeColumn>& columns,

@@ -404,9 +404,9 @@ const RenderSection kPipelineOptions = {
          "multisample patterns): coverage and depth per sample, each winner shaded\n"
          "once per pixel, the pixel the mean of its samples (alpha is coverage)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.pipeline.samples = parse_int(v, name, 1, 16);
+           o.job.pipeline.samples = parse_int(v, name, 1, 16);
            PmrParams P{};
-           set_sample_pattern(o.pipeline.samples, P);  // 1, 4, 8 or 16
+           set_sample_pattern(o.job.pipeline.samples, P);  // 1, 4, 8 or 16
          }},
     }};
 

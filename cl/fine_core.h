@@ -78,7 +78,7 @@ inline void shading_point(global const PmrParams* P, bool center, uint covered, 
     const int s = 31 - (int)clz(b & (0u - b));
     sx += P->sample_x[s], sy += P->sample_y[s], ++n;
   }
-  *ox = (int)(sx / n), *oy = (int)(sy / n);
+  if (n > 0) *ox = (int)(sx / n), *oy = (int)(sy / n); /* (n = 0 only for a lane the caller ignores) */
 }
 
 /* Whether MTA m covers the pixel center (X, Y) of the view with view coordinate f, and, where it does

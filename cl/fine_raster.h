@@ -130,7 +130,8 @@ inline void mask_chunk(const ShadeInputs* in, const PmrMta* m, const RowEdges* R
     for (int s = 0; s < NS; ++s) covered |= select((vint)(0), (vint)(1 << s), hit[s]);
     vstore_vint(covered, 0, bits);
     for (int l = 0; l < VW; ++l) {
-      shading_point(in->P, center[l] != 0, (uint)bits[l], sx + l, sy + l);
+      sx[l] = sy[l] = 0;
+      if (w[l]) shading_point(in->P, center[l] != 0, (uint)bits[l], sx + l, sy + l);
       sx[l] += l * PMR_X_ONE;
     }
     const SampleLanes S = offset_samples(X, Y, sx, sy);
@@ -266,9 +267,11 @@ inline void shade_center_lanes(const ShadeInputs* in, global const PmrMta* mtas,
 }
 
 /* The same at each lane's shading point for its winner (shading_point): the pixel center where the
- * winner covers it (all of them: the row form above), else the centroid of its covered samples. */
+ * winner covers it (all of them: the row form above), else the centroid of its covered samples. A
+ * winner of all NS samples covers the center without a test: the center lies inside the samples'
+ * convex hull, and each edge function, affine, is there a mean of its values at the samples. */
 inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, sint act,
-                              sint ids, int px0, int py, int view, float c[3][SW]) {
+                              sint ids, const int* won_samples, int px0, int py, int view, float c[3][SW]) {
   const long X = (long)px0 * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
   const long f = view_coord(in->P, view);
   int on[SW], id_of[SW], sx[SW], sy[SW];
@@ -277,7 +280,7 @@ inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, 
   bool centers = true;
   for (int l = 0; l < SW; ++l) {
     sx[l] = l * PMR_X_ONE, sy[l] = 0;
-    if (!on[l]) continue;
+    if (!on[l] || won_samples[l] == NS) continue;
     bool center;
     const uint bits = mta_sample_cover(in->P, cached_mta(cache, mtas, (uint)id_of[l]), X + sx[l], Y, f, &center);
     int ox, oy;
@@ -313,17 +316,17 @@ inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, M
       else count -= same;
     }
     if (!any(first)) continue;
-    int ids[VW + SW], w[VW + SW], n[VW];
+    int ids[VW + SW], w[VW + SW], n[VW + SW];
     vstore_vint(as_vint(mta[s]), 0, ids);
     vstore_vint(first, 0, w);
     vstore_vint(count, 0, n);
-    for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = 0;
+    for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = n[l] = 0;
     for (int h = 0; h < VW; h += SW) {
       const sint act = vload_s(0, w + h) != 0;
       if (!any(act)) continue;
       float c[3][SW];
       if (NS == 1) shade_center_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), px0 + h, py, view, c);
-      else shade_point_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), px0 + h, py, view, c);
+      else shade_point_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), n + h, px0 + h, py, view, c);
       for (int l = 0; l < SW && h + l < VW; ++l) {
         if (!w[h + l]) continue;
         const float weight = (float)n[h + l] / (float)NS; /* one sample: 1, and the colour as shaded */

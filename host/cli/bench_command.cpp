@@ -61,6 +61,7 @@ PipelineConfig bench_config(const BenchOptions& o, Method method, Sampling sampl
   PipelineConfig pc;
   pc.method = method;
   pc.sampling = sampling;
+  pc.samples = o.samples;
   pc.shading = o.shading, pc.exposure_ev = o.exposure_ev, pc.environment_intensity = o.environment_intensity;
   pc.environment = o.environment;
   pc.tile_queue_limit = o.limits.tile_queue;

@@ -77,6 +77,14 @@ std::vector<int> parse_dims(const std::string& text, const std::string& opt, siz
 
 }  // namespace
 
+int parse_samples(const std::string& text) {
+  const int samples = parse_int(text, "--samples", 1, 16);
+  PmrParams P{};
+  set_sample_pattern(samples, P);  // refuses all but 1, 4, 8 and 16
+  return samples;
+}
+
+
 namespace {
 
 // The rig a Looking Glass panel's serial prefix recommends (the preset of that model, whose default
@@ -403,11 +411,7 @@ const RenderSection kPipelineOptions = {
          "samples per pixel: 1 (default; the pixel center), 4, 8 or 16 (Direct3D's\n"
          "multisample patterns): coverage and depth per sample, each winner shaded\n"
          "once per pixel, the pixel the mean of its samples (alpha is coverage)",
-         [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.job.pipeline.samples = parse_int(v, name, 1, 16);
-           PmrParams P{};
-           set_sample_pattern(o.job.pipeline.samples, P);  // 1, 4, 8 or 16
-         }},
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.job.pipeline.samples = parse_samples(v); }},
     }};
 
 const RenderSection kShadingOptions = {

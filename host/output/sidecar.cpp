@@ -291,6 +291,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["frame"] = info.frame;
   j["method"] = to_string(info.pipeline.method);
   j["sampling"] = to_string(info.pipeline.sampling);
+  j["samples_per_pixel"] = info.pipeline.samples;
   j["shading"] = shading_json(info);
   j["tile"] = {{"x", info.pipeline.tile_x}, {"y", info.pipeline.tile_y}, {"v", info.pipeline.tile_v}};
   j["camera"] = info.rig_config.camera;
@@ -357,6 +358,11 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   // sidecars written before --sampling existed sampled the views
   auto sampling = [&](const json& o) { return get(o, "sampling").is_null() ? json("view") : get(o, "sampling"); };
   if (sampling(a) != sampling(b)) return "sampling";
+  // sidecars written before --samples existed took one sample per pixel
+  auto samples = [&](const json& o) {
+    return get(o, "samples_per_pixel").is_null() ? json(1) : get(o, "samples_per_pixel");
+  };
+  if (samples(a) != samples(b)) return "samples_per_pixel";
   if (get(a, "background") != get(b, "background")) return "background";  // absent: transparent
   // the lights: their poses follow the frame, so other frames' (pmr verify, the folder scan) are compared
   // without them; they follow from the scene file (its lights, or the default light when it has none and

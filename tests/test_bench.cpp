@@ -68,6 +68,32 @@ TEST(Bench, WritesCsvWithOneRowPerPoint) {
   EXPECT_EQ(subpixel_rows, 3);
 }
 
+// --samples LIST: a row per sample count, recorded in the CSV; the methods agree at each count.
+TEST(Bench, SweepsSamplesPerPixel) {
+  const std::string csv = ::testing::TempDir() + "pmr_bench_samples_" + std::to_string(getpid()) + ".csv";
+  const std::string cmd = std::string(PMR_BINARY) +
+                          " bench --synthetic 2000 --views 3 --method pmr,multipass --samples 1,4 --frames 1"
+                          " --view-size 64x32 --display 320x180 --csv " +
+                          csv + " > /dev/null 2>&1";
+  const int st = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(st) && WEXITSTATUS(st) == 0) << cmd;
+  std::ifstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  const auto cols = split_csv(line);
+  const size_t spp = size_t(std::find(cols.begin(), cols.end(), "samples_per_pixel") - cols.begin());
+  const size_t mismatch = size_t(std::find(cols.begin(), cols.end(), "coverage_mismatch") - cols.begin());
+  ASSERT_LT(spp, cols.size()) << line;
+  std::vector<std::string> seen;
+  while (std::getline(in, line)) {
+    const auto f = split_csv(line);
+    ASSERT_EQ(f.size(), cols.size()) << line;
+    seen.push_back(f[1] + "/" + f[spp]);
+    EXPECT_LT(std::stod(f[mismatch]), 0.001) << line;
+  }
+  EXPECT_EQ(seen, (std::vector<std::string>{"pmr/1", "pmr/4", "multipass/1", "multipass/4"}));
+}
+
 TEST(Bench, SyntheticSceneHasAboutTheRequestedTriangles) {
   for (size_t n : {1000u, 100000u}) {
     const Scene s = make_synthetic_scene(n);

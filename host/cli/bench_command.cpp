@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <memory>
 
 #include "cli/bench_options.h"
@@ -55,13 +56,12 @@ double coverage_mismatch(const std::vector<uint16_t>& a, const std::vector<uint1
   return double(diff) / double(a.size() / 4);
 }
 
-// One scene: every view count and method of the options, a table row (and CSV row) per point.
 // The pipeline of one bench row: the encoded-only job, as pmr render runs it.
-PipelineConfig bench_config(const BenchOptions& o, Method method, Sampling sampling) {
+PipelineConfig bench_config(const BenchOptions& o, Method method, Sampling sampling, int samples) {
   PipelineConfig pc;
   pc.method = method;
   pc.sampling = sampling;
-  pc.samples = o.samples;
+  pc.samples = samples;
   pc.shading = o.shading, pc.exposure_ev = o.exposure_ev, pc.environment_intensity = o.environment_intensity;
   pc.environment = o.environment;
   pc.tile_queue_limit = o.limits.tile_queue;
@@ -70,14 +70,83 @@ PipelineConfig bench_config(const BenchOptions& o, Method method, Sampling sampl
   return pc;
 }
 
+// One point of the sweep: a scene's rig and display at one view count, a method, a sampling and a
+// sample count per pixel.
+struct BenchPoint {
+  const BenchOptions& o;
+  const std::string& scene_name;
+  size_t triangles;
+  FrameRenderer& renderer;
+  const Display& display;
+  int views;
+  Method method;
+  Sampling sampling;
+  int samples;
+};
+
+// Times the point's frames and prints its table row (and CSV row). `first`: the first method's image
+// of the same sampling and samples, for the coverage check (filled by the first method).
+void bench_point(const BenchPoint& b, const ClRuntime& rt, double bw, std::vector<uint16_t>& first,
+                 std::ofstream* csv) {
+  const BenchOptions& o = b.o;
+  const Rig& rig = b.renderer.rig();
+  const double voxels = double(b.views) * rig.view_w * rig.view_h;
+  const bool subpixel = b.sampling == Sampling::Subpixel;
+  const double samples = subpixel ? 3.0 * b.display.width * b.display.height : voxels;  // per frame
+  // the least a frame must move: every sample written once, the display image written once (half RGBA)
+  const double floor_bytes = (subpixel ? 0.0 : voxels * 8.0) + double(b.display.width) * b.display.height * 8.0;
+  const double floor_ms = floor_bytes / bw * 1e3;
+  Pipeline p(rt, bench_config(o, b.method, b.sampling, b.samples));
+  b.renderer.attach(p, &b.display);
+  b.renderer.render(0);  // warm-up: first-touch of buffers, queue growth
+  std::vector<double> wall, setup, tile, fine, encode, pose, upload;
+  for (int f = 0; f < o.frames; ++f) {
+    const FrameRenderer::Frame fr = b.renderer.render(f);
+    const StageTimes& t = fr.times;
+    wall.push_back(t.wall), pose.push_back(fr.pose_ms), upload.push_back(fr.upload_ms);
+    setup.push_back(t.vertex + t.setup), tile.push_back(t.bin), fine.push_back(t.fine), encode.push_back(t.encode);
+  }
+  double mismatch = 0.0;
+  if (o.check) {
+    std::vector<uint16_t> image;
+    p.read_display(image);
+    if (first.empty()) first.swap(image);
+    else mismatch = coverage_mismatch(first, image);
+    if (mismatch > 0.001)
+      std::fprintf(stderr, "pmr: warning: %s at N = %d differs from %s on %.3f%% of display pixels\n",
+                   to_string(b.method), b.views, to_string(o.methods[0]), 100.0 * mismatch);
+  }
+  const double med = median(wall), mn = *std::min_element(wall.begin(), wall.end());
+  const double msmp = samples / (med * 1e-3) * 1e-6;
+  char view[32];
+  std::snprintf(view, sizeof view, "%dx%d", rig.view_w, rig.view_h);
+  std::printf("%-10s %-8s %3d %5d %9s %9.2f %9.1f %9.1f %8.1f %8.1f %8.1f %8.1f %9.0f %8.0f %7.1f %8.5f\n",
+              to_string(b.method), to_string(b.sampling), b.samples, b.views, view, samples * 1e-6, med, mn,
+              median(setup), median(tile), median(fine), median(encode), msmp, floor_bytes / 1e6, med / floor_ms,
+              mismatch);
+  if (median(pose) > 0.0)
+    std::printf("#   on the host per frame (not in ms_median): pose %.2f ms, upload %.2f ms\n", median(pose),
+                median(upload));
+  std::fflush(stdout);
+  if (csv)
+    *csv << b.scene_name << ',' << to_string(b.method) << ',' << b.views << ',' << rig.view_w << ',' << rig.view_h
+         << ',' << b.display.width << ',' << b.display.height << ',' << b.triangles << ',' << o.frames << ',' << med
+         << ',' << mn << ',' << median(setup) << ',' << median(tile) << ',' << median(fine) << ',' << median(encode)
+         << ',' << (subpixel ? 0.0 : voxels / (med * 1e-3) * 1e-6) << ',' << double(p.device_bytes()) / (1 << 20) << ','
+         << floor_bytes / 1e6 << ',' << floor_ms << ',' << med / floor_ms << ',' << mismatch << ','
+         << to_string(b.sampling) << ',' << samples << ',' << msmp << ',' << b.samples << '\n';
+}
+
+// One scene: every view count, method, sampling and sample count of the options, a table row (and CSV
+// row) per point.
 void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Scene& scene,
                  const std::string& scene_name, std::ofstream* csv) {
   const SequenceSpec spec = resolve_sequence(scene, o.sequence, o.limits.framing_work);
   std::printf("# %s: %zu triangles; device %s; copy bandwidth %.1f GB/s\n", scene_name.c_str(), scene.triangles.size(),
               rt.device_name().c_str(), bw * 1e-9);
-  std::printf("%-10s %-8s %5s %9s %9s %9s %9s %8s %8s %8s %8s %9s %8s %7s %8s\n", "method", "sampling", "views", "view",
-              "Msamples", "ms_median", "ms_min", "setup", "tile", "fine", "encode", "Msmp/s", "floor_MB", "xfloor",
-              "mismatch");
+  std::printf("%-10s %-8s %3s %5s %9s %9s %9s %9s %8s %8s %8s %8s %9s %8s %7s %8s\n", "method", "sampling", "spp",
+              "views", "view", "Msamples", "ms_median", "ms_min", "setup", "tile", "fine", "encode", "Msmp/s",
+              "floor_MB", "xfloor", "mismatch");
   const double total_voxels = 96.0 * o.view_w * o.view_h;
   for (int N : o.views) {
     RigConfig rc = o.rig;
@@ -95,67 +164,17 @@ void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Sc
     if (!o.offset_given)  // else the panel's own
       display.offset = as_usage([&] { return default_offset(display.lens_pitch, N); });
     FrameRenderer renderer(scene, spec, rc, display, nullptr);
-    const Rig& rig = renderer.rig();
-    const double voxels = double(N) * rig.view_w * rig.view_h;
-    const double subpixels = 3.0 * display.width * display.height;
-    std::vector<uint16_t> reference[2];  // per sampling: the first method's image
+    std::map<std::pair<Sampling, int>, std::vector<uint16_t>> first;  // per (sampling, samples): the first image
     for (Method method : o.methods)
       for (Sampling asked : o.samplings) {
         // subpixel sampling is PMR's: asked for, the other methods skip it; as a preset's default they
         // render with view sampling, as pmr render does
         if (asked == Sampling::Subpixel && method != Method::Pmr && o.samplings_given) continue;
         const Sampling sampling = method == Method::Pmr ? asked : Sampling::View;
-        // samples per frame: the voxels, or each display subpixel once
-        const double samples = sampling == Sampling::Subpixel ? subpixels : voxels;
-        // the least a frame must move: every sample written once, the display image written once (half RGBA)
-        const double floor_bytes =
-            (sampling == Sampling::Subpixel ? 0.0 : voxels * 8.0) + double(display.width) * display.height * 8.0;
-        const double floor_ms = floor_bytes / bw * 1e3;
-        Pipeline p(rt, bench_config(o, method, sampling));
-        renderer.attach(p, &display);
-        renderer.render(0);  // warm-up: first-touch of buffers, queue growth
-        std::vector<double> wall, setup, tile, fine, encode, pose, upload;
-        for (int f = 0; f < o.frames; ++f) {
-          const FrameRenderer::Frame fr = renderer.render(f);
-          const StageTimes& t = fr.times;
-          wall.push_back(t.wall);
-          pose.push_back(fr.pose_ms);
-          upload.push_back(fr.upload_ms);
-          setup.push_back(t.vertex + t.setup);
-          tile.push_back(t.bin);
-          fine.push_back(t.fine);
-          encode.push_back(t.encode);
+        for (int samples : o.samples) {
+          const BenchPoint b{o, scene_name, scene.triangles.size(), renderer, display, N, method, sampling, samples};
+          bench_point(b, rt, bw, first[{sampling, samples}], csv);
         }
-        double mismatch = 0.0;
-        if (o.check) {
-          std::vector<uint16_t> image;
-          p.read_display(image);
-          std::vector<uint16_t>& first = reference[sampling == Sampling::Subpixel];
-          if (first.empty()) first.swap(image);
-          else mismatch = coverage_mismatch(first, image);
-          if (mismatch > 0.001)
-            std::fprintf(stderr, "pmr: warning: %s at N = %d differs from %s on %.3f%% of display pixels\n",
-                         to_string(method), N, to_string(o.methods[0]), 100.0 * mismatch);
-        }
-        const double med = median(wall), mn = *std::min_element(wall.begin(), wall.end());
-        const double msmp = samples / (med * 1e-3) * 1e-6;
-        const double mem_mb = double(p.device_bytes()) / (1 << 20);
-        char view[32];
-        std::snprintf(view, sizeof view, "%dx%d", rig.view_w, rig.view_h);
-        std::printf("%-10s %-8s %5d %9s %9.2f %9.1f %9.1f %8.1f %8.1f %8.1f %8.1f %9.0f %8.0f %7.1f %8.5f\n",
-                    to_string(method), to_string(sampling), N, view, samples * 1e-6, med, mn, median(setup),
-                    median(tile), median(fine), median(encode), msmp, floor_bytes / 1e6, med / floor_ms, mismatch);
-        if (median(pose) > 0.0)
-          std::printf("#   on the host per frame (not in ms_median): pose %.2f ms, upload %.2f ms\n", median(pose),
-                      median(upload));
-        std::fflush(stdout);
-        if (csv)
-          *csv << scene_name << ',' << to_string(method) << ',' << N << ',' << rig.view_w << ',' << rig.view_h << ','
-               << display.width << ',' << display.height << ',' << scene.triangles.size() << ',' << o.frames << ','
-               << med << ',' << mn << ',' << median(setup) << ',' << median(tile) << ',' << median(fine) << ','
-               << median(encode) << ',' << (sampling == Sampling::Subpixel ? 0.0 : voxels / (med * 1e-3) * 1e-6) << ','
-               << mem_mb << ',' << floor_bytes / 1e6 << ',' << floor_ms << ',' << med / floor_ms << ',' << mismatch
-               << ',' << to_string(sampling) << ',' << samples << ',' << msmp << '\n';
       }
   }
 }
@@ -197,7 +216,7 @@ int run_bench(const std::vector<std::string>& args) {
   if (csv)
     *csv << "scene,method,views,view_w,view_h,display_w,display_h,triangles,frames,ms_median,ms_min,ms_setup,ms_tile,"
             "ms_fine,ms_encode,mvoxels_per_s,peak_mem_mb,floor_mb,floor_ms,x_floor,coverage_mismatch,sampling,samples,"
-            "msamples_per_s\n";
+            "msamples_per_s,samples_per_pixel\n";
   if (o.generator.empty()) {
     const std::string path = o.scene.empty() ? default_scene_path() : o.scene;
     bench_scene(o, rt, bw, load_scene(path, o.limits), path.substr(path.rfind('/') + 1), csv.get());

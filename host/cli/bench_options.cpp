@@ -102,8 +102,11 @@ const BenchSection kMeasureOptions = {
            o.samplings_given = true;
            for (const auto& m : split(v)) o.samplings.push_back(parse_sampling(m));
          }},
-        {"--samples", nullptr, "S", "samples per pixel, as for pmr render (default 1)",
-         [](BenchOptions& o, const std::string& v, const std::string&) { o.samples = parse_samples(v); }},
+        {"--samples", nullptr, "LIST", "samples per pixel, each as for pmr render (default 1)",
+         [](BenchOptions& o, const std::string& v, const std::string&) {
+           o.samples.clear();
+           for (const auto& s : split(v)) o.samples.push_back(parse_samples(s));
+         }},
         {"--frames", nullptr, "K", "timed frames per point after one warm-up frame (default 5)",
          [](BenchOptions& o, const std::string& v, const std::string&) {
            o.frames = std::atoi(v.c_str());

@@ -20,8 +20,8 @@ struct BenchOptions {
   std::vector<int> views = {1, 2, 4, 8, 16, 32, 48, 64, 96};
   std::vector<Method> methods = {Method::Pmr, Method::Multipass, Method::Duplicate};
   std::vector<Sampling> samplings = {Sampling::View};  // subpixel applies to pmr only
-  bool samplings_given = false;  // else the preset's default sampling (view for methods other than pmr)
-  int samples = 1;               // samples per pixel, as pmr render's --samples
+  bool samplings_given = false;    // else the preset's default sampling (view for methods other than pmr)
+  std::vector<int> samples = {1};  // samples per pixel, as pmr render's --samples
   Shading shading = Shading::Pbr;
   double exposure_ev = 0.0, environment_intensity = 1.0;
   bool views_given = false;

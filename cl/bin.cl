@@ -1,8 +1,8 @@
 /* Stage 3, tile raster: one work-item per MTA bins it into the 3D tiles (PMR_TILE_X x PMR_TILE_Y
  * pixels x PMR_TILE_V views) it may cover. Per view slab it takes the MTA's exact bounding box over
  * those views, then tests every tile of the box with the 8-corner test: the edge functions are
- * multilinear in (x, y, view), so their maximum over a box of samples (voxel centers, or with
- * --sampling subpixel every point of the tile's pixels) is at one of its 8 corners, and a tile is
+ * multilinear in (x, y, view), so their maximum over a box of samples (pixel_sample_box) is at one of
+ * its 8 corners, and a tile is
  * rejected exactly when some edge fails at all 8 (found with two evaluations,
  * see edge_may_pass).
  *
@@ -49,6 +49,20 @@ inline bool in_view(const PmrMta* m, long i, long X0, long X1) {
   return hi >= X0 && lo <= X1;
 }
 
+/* Where a pixel's samples lie: in [X + lo_x, X + hi_x] x [Y + lo_y, Y + hi_y], (X, Y) its corner. Around
+ * its center, or with --sampling subpixel around any point of the pixel (PmrParams.sample_area), the
+ * box of the S sample offsets. */
+inline void pixel_sample_box(global const PmrParams* P, long* lo_x, long* hi_x, long* lo_y, long* hi_y) {
+  const bool whole = P->sample_area == PMR_SAMPLES_PIXEL;
+  int ox0 = 0, ox1 = 0, oy0 = 0, oy1 = 0;
+  for (uint s = 0; s < P->samples; ++s) {
+    ox0 = min(ox0, P->sample_x[s]), ox1 = max(ox1, P->sample_x[s]);
+    oy0 = min(oy0, P->sample_y[s]), oy1 = max(oy1, P->sample_y[s]);
+  }
+  *lo_x = (whole ? 0 : PMR_HALF_X) + ox0, *hi_x = (whole ? PMR_X_ONE - 1 : PMR_HALF_X) + ox1;
+  *lo_y = (whole ? 0 : PMR_HALF_Y) + oy0, *hi_y = (whole ? PMR_Y_ONE - 1 : PMR_HALF_Y) + oy1;
+}
+
 /* Calls BIN_EMIT(tile) for every tile the MTA may cover. */
 #define BIN_ENUMERATE(P, m)                                                                                       \
   for (int tv = (m).view_lo / PMR_TILE_V; tv <= (m).view_hi / PMR_TILE_V; ++tv) {                                 \
@@ -63,11 +77,9 @@ inline bool in_view(const PmrMta* m, long i, long X0, long X1) {
     const long xlo = min(lo0, lo1), xhi = max(hi0, hi1);                                                          \
     const bool sheared = (xhi - xlo) - (hi0 - lo0) > (long)PMR_TILE_X * PMR_X_ONE;                                \
     const long ylo = min3l((m).y[0], (m).y[1], (m).y[2]), yhi = max3l((m).y[0], (m).y[1], (m).y[2]);              \
-    /* a pixel's samples lie in [X + slo_x, X + shi_x] x [Y + slo_y, Y + shi_y] (X, Y its corner): its \
-     * center, or the whole pixel with --sampling subpixel; the pixels whose samples meet the box */          \
-    const bool whole = (P)->sample_area == PMR_SAMPLES_PIXEL;                                                     \
-    const long slo_x = whole ? 0 : PMR_HALF_X, shi_x = whole ? PMR_X_ONE - 1 : PMR_HALF_X;                        \
-    const long slo_y = whole ? 0 : PMR_HALF_Y, shi_y = whole ? PMR_Y_ONE - 1 : PMR_HALF_Y;                        \
+    /* the pixels whose samples (pixel_sample_box) meet the box */                                                \
+    long slo_x, shi_x, slo_y, shi_y;                                                                              \
+    pixel_sample_box((P), &slo_x, &shi_x, &slo_y, &shi_y);                                                        \
     const int px0 = (int)max(0L, -floor_div_l(shi_x - xlo, PMR_X_ONE));                                           \
     const int px1 = (int)min((long)(P)->view_w - 1, floor_div_l(xhi - slo_x, PMR_X_ONE));                         \
     const int py0 = (int)max(0L, -floor_div_l(shi_y - ylo, PMR_Y_ONE));                                           \

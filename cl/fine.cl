@@ -19,11 +19,11 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
 
   ShadeInputs in = PMR_SHADE_INPUTS;
   vfloat best_depth[FINE_ROWS * NS];
-  vuint best_key[FINE_ROWS * NS], best_mta[FINE_ROWS * NS];
+  vuint best_key[FINE_ROWS * NS], best_mta[FINE_ROWS * NS], best_cover[NS > 1 ? FINE_ROWS * NS : 1];
   vint covered[FINE_ROWS * NS];
-  fine_clear_state(FINE_ROWS * NS, best_depth, best_key, best_mta);
+  const FineState st = {best_depth, best_key, best_mta, best_cover, debug ? covered : 0};
+  fine_clear_state(FINE_ROWS * NS, &st);
   for (int r = 0; r < FINE_ROWS * NS; ++r) covered[r] = (vint)(0);
-  const FineState st = {best_depth, best_key, best_mta, debug ? covered : 0};
   fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], &in, tris, materials, x0, y0, v0, nx,
                     ny, nv, v0, &st);
 
@@ -43,7 +43,8 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
         ushort4 colour[VW];
         vint won[NS];
         for (int s = 0; s < NS; ++s) won[s] = best_key[FINE_SLOT(r, s)] != (vuint)(PMR_NO_KEY);
-        fine_shade_chunk(&in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0), won, x0 + c * VW, py, view, colour);
+        fine_shade_chunk(&in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0),
+                         best_cover + (NS > 1 ? FINE_SLOT(r, 0) : 0), won, x0 + c * VW, py, view, colour);
         for (int l = 0; l < VW && c * VW + l < nx; ++l) {
           const int px = x0 + c * VW + l;
           const size_t voxel = (((size_t)view + view_base) * H + (size_t)py) * W + (size_t)px;

@@ -81,20 +81,22 @@ inline void shading_point(global const PmrParams* P, bool center, uint covered, 
   if (n > 0) *ox = (int)(sx / n), *oy = (int)(sy / n); /* (n = 0 only for a lane the caller ignores) */
 }
 
+/* Whether MTA m covers raster point (X, Y) of the view with view coordinate f. */
+inline bool mta_covers(global const PmrParams* P, const PmrMta* m, long X, long Y, long f) {
+  const long f_first = view_coord(P, m->view_lo);
+  long E[3];
+  mta_edges_at(m, X, Y, f, E);
+  return E[0] >= mta_edge_bias(m, 1, 2, f_first) && E[1] >= mta_edge_bias(m, 2, 0, f_first) &&
+         E[2] >= mta_edge_bias(m, 0, 1, f_first);
+}
+
 /* Whether MTA m covers the pixel center (X, Y) of the view with view coordinate f, and, where it does
  * not, which of the NS samples around it it covers (bits): what its shading point there depends on. */
 inline uint mta_sample_cover(global const PmrParams* P, const PmrMta* m, long X, long Y, long f, bool* center) {
-  const long f_first = view_coord(P, m->view_lo);
-  const long bias[3] = {mta_edge_bias(m, 1, 2, f_first), mta_edge_bias(m, 2, 0, f_first),
-                        mta_edge_bias(m, 0, 1, f_first)};
-  long E[3];
-  mta_edges_at(m, X, Y, f, E);
-  *center = E[0] >= bias[0] && E[1] >= bias[1] && E[2] >= bias[2];
+  *center = mta_covers(P, m, X, Y, f);
   uint bits = 0u;
-  for (int s = 0; s < PMR_SAMPLES && !*center; ++s) {
-    mta_edges_at(m, X + P->sample_x[s], Y + P->sample_y[s], f, E);
-    if (E[0] >= bias[0] && E[1] >= bias[1] && E[2] >= bias[2]) bits |= 1u << s;
-  }
+  for (int s = 0; s < PMR_SAMPLES && !*center; ++s)
+    if (mta_covers(P, m, X + P->sample_x[s], Y + P->sample_y[s], f)) bits |= 1u << s;
   return bits;
 }
 

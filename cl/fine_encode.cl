@@ -91,9 +91,9 @@ kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
 
   ShadeInputs in = PMR_SHADE_INPUTS;
   vfloat best_depth[FUSED_ROWS * NS];
-  vuint best_key[FUSED_ROWS * NS], best_mta[FUSED_ROWS * NS];
-  fine_clear_state(FUSED_ROWS * NS, best_depth, best_key, best_mta);
-  const FineState st = {best_depth, best_key, best_mta, 0};
+  vuint best_key[FUSED_ROWS * NS], best_mta[FUSED_ROWS * NS], best_cover[NS > 1 ? FUSED_ROWS * NS : 1];
+  const FineState st = {best_depth, best_key, best_mta, best_cover, 0};
+  fine_clear_state(FUSED_ROWS * NS, &st);
   for (int tv = 0; tv < P->tiles_v; ++tv) {
     const uint tile = ((uint)tv * tiles_y) * tiles_x + tile_xy;
     const int v0 = tv * PMR_TILE_V;
@@ -112,8 +112,8 @@ kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
         const int r = (view * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
         vint won[NS];
         for (int s = 0; s < NS; ++s) won[s] = best_key[FINE_SLOT(r, s)] != (vuint)(PMR_NO_KEY);
-        fine_shade_chunk(&in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0), won, x0 + c * VW, y0 + ly, view,
-                         colour + r * VW);
+        fine_shade_chunk(&in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0),
+                         best_cover + (NS > 1 ? FINE_SLOT(r, 0) : 0), won, x0 + c * VW, y0 + ly, view, colour + r * VW);
       }
 
   /* the display pixels this tile owns, whole or in part */

@@ -110,6 +110,13 @@ inline vint chunk_hits(const RowEdges* R, const long* F, const SampleEdges* O, i
   return hit;
 }
 
+/* Bit s: the lane's sample s is hit. */
+inline vuint sample_bits(const vint* hit) {
+  vuint bits = (vuint)(0u);
+  for (int s = 0; s < NS; ++s) bits |= select((vuint)(0u), (vuint)(1u << s), hit[s]);
+  return bits;
+}
+
 /* alphaMode MASK for the lanes of a row chunk (first pixel center (X, Y)) that would win some sample:
  * alpha is tested once per pixel at its shading point (shading_point), and a lane that fails leaves every
  * sample (DESIGN section 3b). hit: the samples the MTA covers. */
@@ -126,9 +133,7 @@ inline void mask_chunk(const ShadeInputs* in, const PmrMta* m, const RowEdges* R
   } else {
     int center[VW], bits[VW];
     vstore_vint(chunk_hits(R, F, 0, 0, in_tile, lane), 0, center);
-    vint covered = (vint)(0);
-    for (int s = 0; s < NS; ++s) covered |= select((vint)(0), (vint)(1 << s), hit[s]);
-    vstore_vint(covered, 0, bits);
+    vstore_vint(as_vint(sample_bits(hit)), 0, bits);
     for (int l = 0; l < VW; ++l) {
       sx[l] = sy[l] = 0;
       if (w[l]) shading_point(in->P, center[l] != 0, (uint)bits[l], sx + l, sy + l);
@@ -142,12 +147,15 @@ inline void mask_chunk(const ShadeInputs* in, const PmrMta* m, const RowEdges* R
 }
 
 /* The visibility state of a tile's queue walk: per (voxel, sample) the closest (depth, key), the winning
- * MTA and, if `covered` is not null, the number of MTAs covering it. Slot FINE_SLOT(r, s) holds the VW
- * lanes of sample s of state row r = ((view - vbase) * PMR_TILE_Y + ly) * FINE_CHUNKS + chunk. */
+ * MTA, with several samples which of the pixel's samples that MTA covers (bits: its shading point,
+ * shading_point, without testing them again), and, if `covered` is not null, the number of MTAs
+ * covering it. Slot FINE_SLOT(r, s) holds the VW lanes of sample s of state row
+ * r = ((view - vbase) * PMR_TILE_Y + ly) * FINE_CHUNKS + chunk. */
 typedef struct {
   vfloat* depth;
   vuint* key;
   vuint* mta;
+  vuint* cover; /* NS > 1 */
   vint* covered;
 } FineState;
 
@@ -166,11 +174,13 @@ PMR_HOT void raster_chunk(const ShadeInputs* in, const PmrMta* m, uint id, const
     win[s] = hit[s] & ((z[s] < st->depth[k]) | ((z[s] == st->depth[k]) & ((vuint)(m->key) < st->key[k])));
   }
   if (m->flags & PMR_MTA_MASK) mask_chunk(in, m, R, F, in_tile, lane, hit, X, Y, view, cutoff, win);
+  const vuint bits = NS > 1 ? sample_bits(hit) : (vuint)(0u);
   for (int s = 0; s < NS; ++s) {
     const int k = FINE_SLOT(r, s);
     st->depth[k] = select(st->depth[k], z[s], win[s]);
     st->key[k] = select(st->key[k], (vuint)(m->key), win[s]);
     st->mta[k] = select(st->mta[k], (vuint)(id), win[s]);
+    if (NS > 1) st->cover[k] = select(st->cover[k], bits, win[s]);
   }
 }
 
@@ -267,11 +277,12 @@ inline void shade_center_lanes(const ShadeInputs* in, global const PmrMta* mtas,
 }
 
 /* The same at each lane's shading point for its winner (shading_point): the pixel center where the
- * winner covers it (all of them: the row form above), else the centroid of its covered samples. A
- * winner of all NS samples covers the center without a test: the center lies inside the samples'
- * convex hull, and each edge function, affine, is there a mean of its values at the samples. */
+ * winner covers it (all of them: the row form above), else the centroid of its covered samples
+ * (cover[l], bits). A winner covering all NS samples covers the center without a test: the center lies
+ * inside the samples' convex hull, and each edge function, affine, is there a mean of its values at the
+ * samples. */
 inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, sint act,
-                              sint ids, const int* won_samples, int px0, int py, int view, float c[3][SW]) {
+                              sint ids, const uint* cover, int px0, int py, int view, float c[3][SW]) {
   const long X = (long)px0 * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
   const long f = view_coord(in->P, view);
   int on[SW], id_of[SW], sx[SW], sy[SW];
@@ -280,11 +291,10 @@ inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, 
   bool centers = true;
   for (int l = 0; l < SW; ++l) {
     sx[l] = l * PMR_X_ONE, sy[l] = 0;
-    if (!on[l] || won_samples[l] == NS) continue;
-    bool center;
-    const uint bits = mta_sample_cover(in->P, cached_mta(cache, mtas, (uint)id_of[l]), X + sx[l], Y, f, &center);
+    if (!on[l] || cover[l] == (1u << NS) - 1u) continue;
+    const bool center = mta_covers(in->P, cached_mta(cache, mtas, (uint)id_of[l]), X + sx[l], Y, f);
     int ox, oy;
-    shading_point(in->P, center, bits, &ox, &oy);
+    shading_point(in->P, center, cover[l], &ox, &oy);
     sx[l] += ox, sy[l] += oy;
     centers = centers && center;
   }
@@ -304,7 +314,8 @@ inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, 
  * premultiplied, so alpha is the covered fraction (DESIGN section 3b). With one sample: the winner's
  * colour at the pixel center, alpha 1, or zero (background). */
 inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                             const vuint* mta, const vint* won, int px0, int py, int view, ushort4* out) {
+                             const vuint* mta, const vuint* cover, const vint* won, int px0, int py, int view,
+                             ushort4* out) {
   float acc[4][VW];
   for (int k = 0; k < 4; ++k)
     for (int l = 0; l < VW; ++l) acc[k][l] = 0.0f;
@@ -317,16 +328,18 @@ inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, M
     }
     if (!any(first)) continue;
     int ids[VW + SW], w[VW + SW], n[VW + SW];
+    uint bits[VW + SW];
     vstore_vint(as_vint(mta[s]), 0, ids);
     vstore_vint(first, 0, w);
     vstore_vint(count, 0, n);
-    for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = n[l] = 0;
+    vstore_vint(as_vint(NS > 1 ? cover[s] : (vuint)(1u)), 0, (int*)bits);
+    for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = n[l] = 0, bits[l] = 0u;
     for (int h = 0; h < VW; h += SW) {
       const sint act = vload_s(0, w + h) != 0;
       if (!any(act)) continue;
       float c[3][SW];
       if (NS == 1) shade_center_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), px0 + h, py, view, c);
-      else shade_point_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), n + h, px0 + h, py, view, c);
+      else shade_point_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), bits + h, px0 + h, py, view, c);
       for (int l = 0; l < SW && h + l < VW; ++l) {
         if (!w[h + l]) continue;
         const float weight = (float)n[h + l] / (float)NS; /* one sample: 1, and the colour as shaded */
@@ -338,12 +351,13 @@ inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, M
   for (int l = 0; l < VW; ++l) vstore_half4((float4)(acc[0][l], acc[1][l], acc[2][l], acc[3][l]), l, (half*)out);
 }
 
-/* Initial visibility state: nothing drawn. */
-inline void fine_clear_state(int rows, vfloat* best_depth, vuint* best_key, vuint* best_mta) {
+/* Initial visibility state of `rows` slots: nothing drawn. */
+inline void fine_clear_state(int rows, const FineState* st) {
   for (int r = 0; r < rows; ++r) {
-    best_depth[r] = (vfloat)(INFINITY);
-    best_key[r] = (vuint)(PMR_NO_KEY);
-    best_mta[r] = (vuint)(0);
+    st->depth[r] = (vfloat)(INFINITY);
+    st->key[r] = (vuint)(PMR_NO_KEY);
+    st->mta[r] = (vuint)(0);
+    if (NS > 1) st->cover[r] = (vuint)(0);
   }
 }
 

@@ -8,9 +8,16 @@
  * view's run padded to whole vectors), then walks the tile's queues: per MTA and view, the run of that
  * view's samples is tested SP_LANES at a time.
  *
+ * With S samples per pixel (DESIGN section 3b) a subpixel is S samples around its own: the pattern
+ * scaled to a display pixel's footprint in the view (P->sample_x/y, set so by the host), consecutive in
+ * its view's run. Each sample has its own winner; the subpixel shades each distinct winner once, at its
+ * shading point, and takes the box mean. The tile raster binned each pixel with its samples' box
+ * (PMR_SAMPLES_PIXEL), so the tile's queues hold every MTA that can cover a sample that spills over
+ * into a neighbouring tile.
+ *
  * Why the double-precision edge test is exact. Relative to the chunk's first sample (Xc, Yc), a sample
- * is (Xc + x, Yc + y) with 0 <= x < 2^22 (a tile is at most 64 px wide, 16.16) and 0 <= y < 2^14
- * (24.8). The exact test sign * E(X, Y, v) >= bias becomes
+ * is (Xc + x, Yc + y) with |x| < 2^22 (a tile is at most 64 px wide, 16.16; samples spill at
+ * most half a display pixel) and |y| < 2^14 (24.8). The exact test sign * E(X, Y, v) >= bias becomes
  *   (sign dy) x - (sign dx_ab(v)) y >= bias - sign * E(Xc, Yc, v) = T
  * with |dy| < 2^24 and |dx_ab| < 2^32 (the guard band), so both products are integers below 2^46 and
  * their difference below 2^47: every double operation on the left is exact, and T, clamped to
@@ -23,15 +30,18 @@
 #include "fine_core.h"
 
 #define SP_LANES PMR_SUBPIXEL_LANES
-#define SP_SLOTS PMR_SUBPIXEL_SLOTS /* the host keeps area + (SP_LANES - 1) * min(views, area) within */
+#define SP_SLOTS PMR_SUBPIXEL_SLOTS /* the host keeps NS area + (SP_LANES - 1) min(views, area) within */
+#define NS PMR_SAMPLES
 
-/* A chunk's samples sorted by view: run v holds count[v] samples from first[v], padded to whole vectors
- * of SP_LANES; per sample its offset from the chunk's first sample (Xc, Yc) (fixed point), its index
- * n = (i - i0) * width + (s - s0) in the chunk and its channel k (s = 3 j + k); per vector its bounding
- * box (x0, x1, y0, y1); and the visibility state per sample (best_mta is read only where best_key says
- * drawn). */
+/* A chunk's samples sorted by view: run v holds count[v] samples from first[v] (each subpixel's NS
+ * consecutively, sample s of it at first[v] + NS j + s), padded to whole vectors of SP_LANES; per
+ * sample its offset from the chunk's first subpixel's sample (Xc, Yc) (fixed point), its subpixel's
+ * index n = (i - i0) * width + (s - s0) in the chunk and channel k (s = 3 j + k); per vector its
+ * bounding box (x0, x1, y0, y1); and the visibility state per sample (best_mta is read only where
+ * best_key says drawn). */
 typedef struct {
-  long Xc, Yc, Xl, Yl; /* the chunk's first and last sample */
+  long Xc, Yc, Xl, Yl;    /* the chunk's first and last subpixel's own sample */
+  int ox0, ox1, oy0, oy1; /* the box of the sample offsets around it */
   int first[PMR_SUBPIXEL_VIEWS + 1], count[PMR_SUBPIXEL_VIEWS];
   int sx[SP_SLOTS], sy[SP_SLOTS];
   ushort sid[SP_SLOTS];
@@ -60,15 +70,20 @@ inline void sp_sample_views(global const PmrEncodeParams* E, global const int* c
 }
 
 /* Step 1: the chunk's samples by view (a counting sort), with a clear visibility state. */
-inline void sp_sort_samples(global const PmrEncodeParams* E, global const int* column_a, global const int* column_b,
-                            global const PmrEncodeRow* rows, global const int* sample_x, global const int* sample_y,
-                            const PmrSampleChunk* ch, int views, SpChunk* C) {
-  const int width = ch->s1 - ch->s0;
+inline void sp_sort_samples(global const PmrParams* P, global const PmrEncodeParams* E, global const int* column_a,
+                            global const int* column_b, global const PmrEncodeRow* rows, global const int* sample_x,
+                            global const int* sample_y, const PmrSampleChunk* ch, SpChunk* C) {
+  const int width = ch->s1 - ch->s0, views = P->views;
   C->Xc = sample_x[ch->s0], C->Yc = sample_y[ch->i0], C->Xl = sample_x[ch->s1 - 1], C->Yl = sample_y[ch->i1 - 1];
+  C->ox0 = C->ox1 = C->oy0 = C->oy1 = 0;
+  for (int s = 0; s < NS; ++s) {
+    C->ox0 = min(C->ox0, P->sample_x[s]), C->ox1 = max(C->ox1, P->sample_x[s]);
+    C->oy0 = min(C->oy0, P->sample_y[s]), C->oy1 = max(C->oy1, P->sample_y[s]);
+  }
   ushort view_of[PMR_SUBPIXEL_CAP + 8];
   sp_sample_views(E, column_a, column_b, rows, ch, views, view_of);
   for (int v = 0; v < views; ++v) C->count[v] = 0;
-  for (int n = 0; n < width * (ch->i1 - ch->i0); ++n) ++C->count[view_of[n]];
+  for (int n = 0; n < width * (ch->i1 - ch->i0); ++n) C->count[view_of[n]] += NS;
   int run = 0;
   for (int v = 0; v < views; ++v) {
     C->first[v] = run;
@@ -88,13 +103,14 @@ inline void sp_sort_samples(global const PmrEncodeParams* E, global const int* c
   for (int s = ch->s0; s < ch->s1; ++s) {
     const int x = (int)(sample_x[s] - C->Xc);
     const uchar c = (uchar)(s % 3);
-    for (int i = ch->i0, n = s - ch->s0; i < ch->i1; ++i, n += width) {
-      const int k = fill[view_of[n]]++;
-      C->sx[k] = x;
-      C->sy[k] = (int)(sample_y[i] - C->Yc);
-      C->sid[k] = (ushort)n;
-      C->channel[k] = c;
-    }
+    for (int i = ch->i0, n = s - ch->s0; i < ch->i1; ++i, n += width)
+      for (int t = 0; t < NS; ++t) {
+        const int k = fill[view_of[n]]++;
+        C->sx[k] = x + P->sample_x[t];
+        C->sy[k] = (int)(sample_y[i] - C->Yc) + P->sample_y[t];
+        C->sid[k] = (ushort)n;
+        C->channel[k] = c;
+      }
   }
 }
 
@@ -154,6 +170,32 @@ PMR_HOT float8 sp_depth(const DepthPlane* d, const SpChunk* C, double8 x, int8 x
   return convert_float8((double8)(d->zr) + (double8)(d->gy) * rows) + (float8)(d->gx) * columns;
 }
 
+/* alphaMode MASK for the winning lanes `win` of a vector (its first sample the run's j-th, at offsets
+ * sx, sy): tested at each lane's sample, or with several samples once per subpixel at its shading point
+ * (shading_point around the subpixel's own sample), so that a failure leaves all its samples. */
+inline int8 sp_mask(const ShadeInputs* in, const PmrMta* m, int8 win, int j, int v, float cutoff, const int* sx,
+                    const int* sy, const SpChunk* C) {
+  int w[SP_LANES];
+  vstore8(win, 0, w);
+  if (NS == 1) {
+    const SampleLanes L = offset_samples(C->Xc, C->Yc, sx, sy);
+    mask_alpha_lanes(in, m, w, SP_LANES, &L, v, cutoff);
+    return vload8(0, w);
+  }
+  global const PmrParams* P = in->P;
+  for (int l = 0; l < SP_LANES; ++l) {
+    if (!w[l]) continue;
+    const int t = (j + l) % NS; /* the lane's sample of its subpixel */
+    const long X = C->Xc + sx[l] - P->sample_x[t], Y = C->Yc + sy[l] - P->sample_y[t];
+    bool center;
+    const uint bits = mta_sample_cover(P, m, X, Y, view_coord(P, v), &center);
+    int ox, oy;
+    shading_point(P, center, bits, &ox, &oy);
+    if (!mta_alpha_passes(in, m, X + ox, Y + oy, v, cutoff)) w[l] = 0;
+  }
+  return vload8(0, w);
+}
+
 /* MTA m (queue entry id) in view v against the view's run of samples, SP_LANES at a time, into the
  * visibility state. */
 PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, const SpEdges* S, int v, float cutoff,
@@ -175,7 +217,9 @@ PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, con
   DepthPlane p;
   for (int k = k0; k < k1; k += SP_LANES) {
     const int4 b = C->box[k / SP_LANES];
-    if (b.x > mx1) break; /* a run's vectors go left to right (sorted by column) */
+    /* a run's subpixels go left to right (sorted by column): no later vector has a sample left of this
+     * one's first subpixel plus the leftmost offset */
+    if (C->sx[k] - in->P->sample_x[(k - k0) % NS] + C->ox0 > mx1) break;
     if (b.y < mx0 || b.w < S->my0 || b.z > S->my1) continue;
     const int8 xi = vload8(0, C->sx + k);
     const double8 x = convert_double8(xi), y = convert_double8(vload8(0, C->sy + k));
@@ -193,13 +237,7 @@ PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, con
     const float8 bd = vload8(0, C->best_depth + k);
     const uint8 bk = vload8(0, C->best_key + k);
     int8 win = convert_int8(hit) & ((z < bd) | ((z == bd) & ((uint8)(m->key) < bk)));
-    if ((m->flags & PMR_MTA_MASK) && any(win)) {
-      int w[SP_LANES];
-      vstore8(win, 0, w);
-      const SampleLanes L = offset_samples(C->Xc, C->Yc, C->sx + k, C->sy + k);
-      mask_alpha_lanes(in, m, w, SP_LANES, &L, v, cutoff);
-      win = vload8(0, w);
-    }
+    if ((m->flags & PMR_MTA_MASK) && any(win)) win = sp_mask(in, m, win, k - k0, v, cutoff, C->sx + k, C->sy + k, C);
     vstore8(select(bd, z, win), 0, C->best_depth + k);
     vstore8(select(bk, (uint8)(m->key), as_uint8(win)), 0, C->best_key + k);
     vstore8(select(vload8(0, C->best_mta + k), (uint8)(id), as_uint8(win)), 0, C->best_mta + k);
@@ -221,13 +259,14 @@ inline void sp_visibility(const ShadeInputs* in, global const PmrMta* mtas, glob
       const uint id = tile_queue[q];
       const PmrMta m = mtas[id];
       const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));
-      if (yhi < C->Yc || ylo > C->Yl) continue;
+      if (yhi < C->Yc + C->oy0 || ylo > C->Yl + C->oy1) continue;
       const int i_lo = max(v0, m.view_lo), i_hi = min(v1, m.view_hi);
       const float cutoff = (m.flags & PMR_MTA_MASK) ? in->materials[in->tris[m.tri].material].alpha_cutoff : 0.0f;
       SpEdges S;
       sp_edges(P, &m, i_lo, C, &S);
       for (int ib = i_lo; ib <= i_hi; ib += 16) {
-        uint pass = view_pass_mask(P, &m, ib, min(i_hi - ib + 1, 16), C->Xc, 0, C->Xl - C->Xc);
+        uint pass =
+            view_pass_mask(P, &m, ib, min(i_hi - ib + 1, 16), C->Xc + C->ox0, 0, C->Xl + C->ox1 - C->Xc - C->ox0);
         while (pass != 0) { /* the passing views, lowest first */
           const int v = ib + (31 - (int)clz(pass & (0u - pass)));
           pass &= pass - 1u;
@@ -238,68 +277,114 @@ inline void sp_visibility(const ShadeInputs* in, global const PmrMta* mtas, glob
   }
 }
 
-/* Step 3, the winners shaded at their samples, SW samples of a view at a time, one per lane: channel k
- * of subpixel s = 3 j + k as half bits into value[n] and covered[n] (0: background), by sample index. */
-inline void sp_shade(const ShadeInputs* in, global const PmrMta* mtas, const SpChunk* C, ushort* value,
-                     uchar* covered) {
-  global const PmrParams* P = in->P;
-  const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
-  MtaCache cache;
-  cache.id = PMR_NO_KEY;
-  for (int v = 0; v < P->views; ++v)
-    for (int k0 = C->first[v]; k0 < C->first[v] + C->count[v]; k0 += SW) {
-      const int kn = min(SW, C->first[v] + C->count[v] - k0);
-      int todo[SW], ids[SW];
-      for (int l = 0; l < SW; ++l) {
-        const int k = k0 + l;
-        todo[l] = l < kn && C->best_key[k] != PMR_NO_KEY ? -1 : 0;
-        ids[l] = todo[l] ? (int)C->best_mta[k] : 0;
-        if (l < kn && !todo[l]) value[C->sid[k]] = 0, covered[C->sid[k]] = 0;
-      }
-      const sint act = vload_s(0, todo);
-      if (!any(act)) continue;
-      const SampleLanes S = offset_samples(C->Xc, C->Yc, C->sx + k0, C->sy + k0);
-      LaneWinners L;
-      lanes_gather(in, mtas, &cache, act, vload_s(0, ids), &S, v, &L);
-      float c[3][SW];
-      s3_store(shade_lanes(in, &L, light, v), c[0], c[1], c[2]);
-      for (int l = 0; l < kn; ++l) {
-        if (!todo[l]) continue;
-        const int k = k0 + l, n = C->sid[k];
-        ushort h;
-        vstore_half(c[C->channel[k]][l], 0, (half*)&h);
-        value[n] = h;
-        covered[n] = 1;
-      }
-    }
+/* Shading points of one view waiting for a vector of SW lanes: per lane the winning MTA, the point as
+ * an offset from (Xc, Yc), and the subpixel (sid, channel) it adds `weight` of its colour to. */
+typedef struct {
+  int n;
+  int ids[SW], sx[SW], sy[SW], sid[SW], channel[SW];
+  float weight[SW];
+} SpBatch;
+
+/* Shades a batch's points and adds them into their subpixels' premultiplied colour and coverage. With
+ * one sample each subpixel gets exactly its winner's colour (0 + 1 x c). */
+inline void sp_flush(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, int v,
+                     const SpChunk* C, SpBatch* B, float* acc, float* alpha) {
+  if (B->n == 0) return;
+  int on[SW];
+  for (int l = 0; l < SW; ++l) {
+    on[l] = l < B->n ? -1 : 0;
+    if (l >= B->n) B->ids[l] = B->sx[l] = B->sy[l] = 0;
+  }
+  const SampleLanes S = offset_samples(C->Xc, C->Yc, B->sx, B->sy);
+  LaneWinners L;
+  lanes_gather(in, mtas, cache, vload_s(0, on), vload_s(0, B->ids), &S, v, &L);
+  float c[3][SW];
+  s3_store(shade_lanes(in, &L, light, v), c[0], c[1], c[2]);
+  for (int l = 0; l < B->n; ++l) {
+    acc[B->sid[l]] += B->weight[l] * c[B->channel[l]][l];
+    alpha[B->sid[l]] += B->weight[l];
+  }
+  B->n = 0;
 }
 
-/* The debug outputs: each sample's winning key and depth, at its subpixel (display row i, column s). */
+/* The subpixel whose samples are slots k .. k + NS - 1: each distinct winner (first occurrence) into the
+ * batch at its shading point, weighted by its share of the samples. A winner of all NS samples covers the
+ * subpixel's own sample, inside the samples' convex hull (as in shade_point_lanes); others are tested. */
+inline void sp_queue_subpixel(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, int v,
+                              int k, const SpChunk* C, SpBatch* B, float* acc, float* alpha) {
+  global const PmrParams* P = in->P;
+  const int bx = C->sx[k] - P->sample_x[0], by = C->sy[k] - P->sample_y[0]; /* the subpixel's own sample */
+  for (int s = 0; s < NS; ++s) {
+    if (C->best_key[k + s] == PMR_NO_KEY) continue;
+    const uint id = C->best_mta[k + s];
+    bool first = true;
+    int count = 0;
+    for (int t = 0; t < NS; ++t) {
+      const bool same = C->best_key[k + t] != PMR_NO_KEY && C->best_mta[k + t] == id;
+      first = first && !(same && t < s);
+      count += same ? 1 : 0;
+    }
+    if (!first) continue;
+    int ox = 0, oy = 0;
+    if (count < NS) {
+      bool center;
+      const uint bits =
+          mta_sample_cover(P, cached_mta(cache, mtas, id), C->Xc + bx, C->Yc + by, view_coord(P, v), &center);
+      shading_point(P, center, bits, &ox, &oy);
+    }
+    const int l = B->n++;
+    B->ids[l] = (int)id, B->sx[l] = bx + ox, B->sy[l] = by + oy;
+    B->sid[l] = C->sid[k], B->channel[l] = C->channel[k], B->weight[l] = (float)count / (float)NS;
+    if (B->n == SW) sp_flush(in, mtas, cache, light, v, C, B, acc, alpha);
+  }
+}
+
+/* Step 3, the winners shaded and resolved (DESIGN section 3b): channel k of subpixel s = 3 j + k as the
+ * box mean of its samples' premultiplied colours into acc[n], its covered fraction into alpha[n]. */
+inline void sp_shade(const ShadeInputs* in, global const PmrMta* mtas, const SpChunk* C, int subpixels, float* acc,
+                     float* alpha) {
+  global const PmrParams* P = in->P;
+  const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
+  for (int n = 0; n < subpixels; ++n) acc[n] = alpha[n] = 0.0f;
+  MtaCache cache;
+  cache.id = PMR_NO_KEY;
+  SpBatch B;
+  B.n = 0;
+  for (int v = 0; v < P->views; ++v) {
+    for (int k = C->first[v]; k < C->first[v] + C->count[v]; k += NS)
+      sp_queue_subpixel(in, mtas, &cache, light, v, k, C, &B, acc, alpha);
+    sp_flush(in, mtas, &cache, light, v, C, &B, acc, alpha);
+  }
+}
+
+/* The debug outputs: each sample's winning key and depth, sample t of the subpixel at display row i,
+ * column s at (i 3 W_d + s) NS + t. */
 inline void sp_write_debug(const PmrSampleChunk* ch, int views, int display_w, const SpChunk* C, global uint* dbg_key,
                            global float* dbg_depth) {
   const int width = ch->s1 - ch->s0;
   for (int v = 0; v < views; ++v)
     for (int k = C->first[v]; k < C->first[v] + C->count[v]; ++k) {
-      const int n = C->sid[k];
-      const size_t at = (size_t)(ch->i0 + n / width) * (size_t)(3 * display_w) + (size_t)(ch->s0 + n % width);
-      dbg_key[at] = C->best_key[k];
-      dbg_depth[at] = C->best_depth[k];
+      const int n = C->sid[k], t = (k - C->first[v]) % NS;
+      const size_t at = ((size_t)(ch->i0 + n / width) * (size_t)(3 * display_w) + (size_t)(ch->s0 + n % width)) * NS;
+      dbg_key[at + (size_t)t] = C->best_key[k];
+      dbg_depth[at + (size_t)t] = C->best_depth[k];
     }
 }
 
-/* Step 4, the chunk's display pixels (write_display_pixel): a sample's half RGBA bits are its value in
- * every channel (the pixel takes channel k from subpixel k) and its coverage as alpha. */
-inline void sp_write_display(const DisplayOut* D, const PmrSampleChunk* ch, const ushort* value, const uchar* covered) {
-  const ushort one = 0x3c00; /* 1.0 as a half */
+/* Step 4, the chunk's display pixels (write_display_pixel): a subpixel's premultiplied colour in every
+ * channel (the pixel takes channel k from subpixel k) and its coverage as alpha, as half bits. */
+inline void sp_write_display(const DisplayOut* D, const PmrSampleChunk* ch, const float* acc, const float* alpha) {
   const int width = ch->s1 - ch->s0;
   for (int i = ch->i0; i < ch->i1; ++i) {
-    const int r = (i - ch->i0) * width - ch->s0; /* sample index of subpixel s: r + s */
+    const int r = (i - ch->i0) * width - ch->s0; /* subpixel index of subpixel s: r + s */
     for (int j = ch->s0 / 3; 3 * j < ch->s1; ++j) {
       ushort4 s[3];
       for (int k = 0; k < 3; ++k) {
         const int n = r + 3 * j + k;
         const bool own = 3 * j + k >= ch->s0 && 3 * j + k < ch->s1;
-        s[k] = own ? (ushort4)(value[n], value[n], value[n], covered[n] ? one : 0) : (ushort4)(0);
+        ushort4 h = (ushort4)(0);
+        if (own) vstore_half4((float4)(acc[n], acc[n], acc[n], alpha[n]), 0, (half*)&h);
+        s[k] = h;
       }
       write_display_pixel(D, i, j, ch->s0, ch->s1, s[0], s[1], s[2]);
     }
@@ -316,14 +401,13 @@ kernel void fine_subpixel(PMR_SHADE_PARAMS, global const PmrMta* mtas, global co
   if (chunk >= num_chunks) return;
   const PmrSampleChunk ch = chunks[chunk];
   SpChunk C;
-  sp_sort_samples(E, column_a, column_b, rows, sample_x, sample_y, &ch, P->views, &C);
+  sp_sort_samples(P, E, column_a, column_b, rows, sample_x, sample_y, &ch, &C);
   sp_boxes(P->views, &C);
   ShadeInputs in = PMR_SHADE_INPUTS;
   sp_visibility(&in, mtas, tile_offsets, tile_queue, ch.tile, &C);
   if (debug) sp_write_debug(&ch, P->views, E->display_w, &C, dbg_key, dbg_depth);
-  ushort value[PMR_SUBPIXEL_CAP];
-  uchar covered[PMR_SUBPIXEL_CAP];
-  sp_shade(&in, mtas, &C, value, covered);
+  float acc[PMR_SUBPIXEL_CAP], alpha[PMR_SUBPIXEL_CAP];
+  sp_shade(&in, mtas, &C, (ch.s1 - ch.s0) * (ch.i1 - ch.i0), acc, alpha);
   const DisplayOut D = {(global ushort*)display, sub_alpha, E->display_w};
-  sp_write_display(&D, &ch, value, covered);
+  sp_write_display(&D, &ch, acc, alpha);
 }

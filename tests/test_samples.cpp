@@ -69,6 +69,34 @@ TEST(Samples, AnEdgeThroughPixelCentersHalvesTheirCoverage) {
   }
 }
 
+// The Z channel (Pipeline::read_depth) holds each pixel's nearest covered sample's depth, not a mean:
+// where an edge halves a pixel, the rectangle's depth (constant, on the focal plane) as in the pixels it
+// covers wholly, +infinity where nothing is drawn.
+TEST(Samples, DepthIsTheNearestCoveredSampleNotAMean) {
+  const Rig rig = test::small_rig(3, 40, 12);
+  const Scene scene = rectangle_from(rig, 20.5);
+  for (int samples : {1, 4, 16}) {
+    PipelineConfig pc;
+    pc.samples = samples;
+    pc.debug_outputs = true;
+    Pipeline p(test::runtime(), pc);
+    p.set_scene(scene);
+    p.configure(rig, nullptr);
+    p.render(rig);
+    std::vector<float> z;
+    p.read_depth(z);
+    ASSERT_EQ(z.size(), size_t(rig.views) * rig.view_w * rig.view_h);
+    const float z_covered = z[size_t(rig.view_w) - 1];
+    ASSERT_TRUE(std::isfinite(z_covered) && z_covered > 0.0f && z_covered < 1.0f) << z_covered;
+    for (size_t voxel = 0; voxel < z.size(); ++voxel) {
+      const int px = int(voxel % size_t(rig.view_w));
+      if (px < 20)  // (one sample: column 20's center lies on the rectangle's left edge, which owns it)
+        EXPECT_EQ(z[voxel], INFINITY) << "S " << samples << " voxel " << voxel;
+      else EXPECT_EQ(z[voxel], z_covered) << "S " << samples << " voxel " << voxel;
+    }
+  }
+}
+
 // The sidecar records the samples per pixel (absent in older sidecars: one), and --resume refuses a
 // folder rendered with another count.
 TEST(Samples, SidecarRecordsThemAndResumeComparesThem) {

@@ -8,6 +8,7 @@
 // linear and angular camera spacing.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -33,8 +34,10 @@ struct SubpixelRender {
   std::vector<PmrMta> mtas;
 };
 
-SubpixelRender render_subpixels(const Scene& scene, const Rig& rig, const Display& d, const int* tile) {
+SubpixelRender render_subpixels(const Scene& scene, const Rig& rig, const Display& d, const int* tile,
+                                int samples = 1) {
   PipelineConfig pc;
+  pc.samples = samples;
   pc.tile_x = tile[0], pc.tile_y = tile[1], pc.tile_v = tile[2];
   pc.sampling = Sampling::Subpixel;
   pc.shading = Shading::Lambert;  // compared with the Lambert reference
@@ -160,6 +163,112 @@ TEST(SubpixelSampling, EverySubpixelEqualsDirectEvaluationAtItsSample) {
   }
   EXPECT_GT(covered_total, 10000u) << "too few covered subpixels for the test to mean much";
   EXPECT_GT(straddles_seen, 100u) << "too few partly covered display pixels";
+}
+
+// The pattern of S samples per pixel (DESIGN section 3b, Direct3D's, in 1/16 pixel) scaled to a display
+// pixel's footprint in the view, (W / W_d, H / H_d) view pixels, and rounded to the raster's fixed point.
+void scaled_pattern(int S, const Rig& rig, const Display& d, PmrParams& P) {
+  static const int four[] = PMR_SAMPLE_PATTERN_4, eight[] = PMR_SAMPLE_PATTERN_8, sixteen[] = PMR_SAMPLE_PATTERN_16;
+  const int* pattern = S == 4 ? four : S == 8 ? eight : sixteen;
+  P.samples = uint32_t(S);
+  for (int t = 0; t < S; ++t) {
+    P.sample_x[t] = int32_t(std::lround(pattern[2 * t] / 16.0 * rig.view_w / d.width * PMR_X_ONE));
+    P.sample_y[t] = int32_t(std::lround(pattern[2 * t + 1] / 16.0 * rig.view_h / d.height * PMR_Y_ONE));
+  }
+}
+
+// Subpixel `at`'s expected colour channel and coverage with S samples: each distinct winner (by key) of
+// its samples shaded once in double precision at its shading point (the subpixel's own sample where the
+// triangle covers it, else the truncated mean of the samples it covers), weighted by its share.
+std::pair<double, double> resolved_subpixel(const Scene& scene, const PmrParams& P,
+                                            const std::vector<ref::ClippedTriangle>& clipped,
+                                            const std::vector<PmrMta>& mtas, const ref::SubpixelResult& want, int view,
+                                            size_t at, const glm::dvec3& light) {
+  const size_t S = P.samples;
+  double colour = 0.0, alpha = 0.0;
+  for (size_t t = 0; t < S; ++t) {
+    const uint32_t key = want.key[at * S + t];
+    bool first = key != PMR_NO_KEY;
+    for (size_t u = 0; u < t; ++u) first = first && want.key[at * S + u] != key;
+    if (!first) continue;
+    const int won = int(std::count(want.key.begin() + long(at * S), want.key.begin() + long(at * S + S), key));
+    const ref::ClippedTriangle* c = nullptr;
+    for (const ref::ClippedTriangle& k : clipped) c = k.key == key ? &k : c;
+    const PmrMta* m = nullptr;
+    for (const PmrMta& k : mtas) m = k.key == key && view >= k.view_lo && view <= k.view_hi ? &k : m;
+    if (!c || !m) ADD_FAILURE() << "no triangle for key " << key;
+    if (!c || !m) continue;
+    const ref::ViewTriangle tri = ref::view_triangle(*c, P.view_coord[view]);
+    int64_t X = want.x[at], Y = want.y[at];
+    if (!ref::covers(tri, X, Y)) {
+      int64_t sx = 0, sy = 0, n = 0;
+      for (size_t u = 0; u < S; ++u)
+        if (ref::covers(tri, X + P.sample_x[u], Y + P.sample_y[u])) sx += P.sample_x[u], sy += P.sample_y[u], ++n;
+      X += sx / n, Y += sy / n;
+    }
+    const glm::dvec3 b = ref::source_barycentrics_at(*m, X, Y, P.view_coord[view]);
+    const double weight = double(won) / double(S);
+    colour += weight * ref::shade(scene, m->tri, b, (m->flags & PMR_MTA_BACK) != 0, light)[int(at % 3)];
+    alpha += weight;
+  }
+  return {colour, alpha};
+}
+
+// With S = 4, 8 and 16 samples per pixel: every sample of every subpixel (the pattern scaled to a display
+// pixel's footprint around the subpixel's own sample) has the reference's key and depth, bit for bit;
+// each subpixel's colour channel is the box mean of its winners shaded at their shading points (within
+// the half-float tolerance above) and its alpha the covered fraction, exactly; other tile shapes give the
+// same image.
+TEST(SubpixelSampling, SamplesPerPixelEqualDirectEvaluation) {
+  std::mt19937 rng(20261203);
+  const int counts[] = {4, 8, 16}, tiles[][3] = {{16, 2, 16}, {5, 3, 3}, {8, 4, 2}};
+  size_t partial = 0;
+  for (int trial = 0; trial < 3; ++trial) {
+    const int S = counts[trial];
+    Display d;
+    d.width = 37 + 11 * trial, d.height = 23 + 5 * trial;
+    d.lens_pitch = parse_rational(random_decimal(rng, 3.0, 12.0, 10), "L");
+    d.tan_slant = parse_rational(random_decimal(rng, -0.3, 0.3, 12), "T");
+    d.offset = parse_rational(random_decimal(rng, -10.0, 10.0, 9), "O");
+    RigConfig rc;
+    rc.views = 7 + 6 * trial, rc.view_w = 29 + 9 * trial, rc.view_h = 17 + 4 * trial;
+    rc.angular_spacing = trial == 1;
+    const Rig rig = make_rig(rc, d, glm::dvec3(-1.0), glm::dvec3(1.0));
+    const Scene scene = test::random_scene(80, 950u + unsigned(trial), trial != 1);
+    SCOPED_TRACE(std::to_string(S) + " samples");
+    const SubpixelRender got = render_subpixels(scene, rig, d, tiles[trial], S);
+    PmrParams P = test::params_for(rig);
+    scaled_pattern(S, rig, d, P);
+    std::vector<PmrVertex> verts;
+    for (const auto& p : scene.positions) verts.push_back(ref::transform_vertex(P, &p.x));
+    const auto clipped = ref::clip_triangles(P, scene, verts);
+    const std::vector<int> view_of = test::table_view_indices(d, rc.views);
+    const ref::SubpixelResult want = ref::rasterize_subpixels(P, clipped, view_of, d.width, d.height);
+    ASSERT_EQ(got.key.size(), want.key.size());
+    size_t bad = 0;
+    for (size_t k = 0; k < want.key.size(); ++k)
+      if ((got.key[k] != want.key[k] || std::memcmp(&got.depth[k], &want.depth[k], 4) != 0) && ++bad <= 5)
+        ADD_FAILURE() << "subpixel " << k / S << " sample " << k % S << ": key " << got.key[k] << " depth "
+                      << got.depth[k] << ", reference " << want.key[k] << " " << want.depth[k];
+    std::vector<half> sub_alpha(want.x.size());
+    for (size_t at = 0; at < want.x.size(); ++at) {
+      const auto [c, a] = resolved_subpixel(scene, P, clipped, got.mtas, want, view_of[at], at, rig.light_world());
+      half value;
+      value.setBits(got.display[(at / 3) * 4 + at % 3]);
+      if (std::abs(double(float(value)) - c) > std::ldexp(std::abs(c), -10) + 1e-4 && ++bad <= 5)
+        ADD_FAILURE() << "subpixel " << at << ": " << float(value) << ", reference " << c;
+      sub_alpha[at] = half(float(a));
+      partial += a > 0.0 && a < 1.0;
+    }
+    for (size_t px = 0; px < size_t(d.width) * d.height; ++px) {
+      const half alpha((float(sub_alpha[3 * px]) + float(sub_alpha[3 * px + 1]) + float(sub_alpha[3 * px + 2])) / 3.0f);
+      if (got.display[px * 4 + 3] != alpha.bits() && ++bad <= 5)
+        ADD_FAILURE() << "display pixel " << px << ": alpha " << got.display[px * 4 + 3] << ", want " << alpha.bits();
+    }
+    EXPECT_EQ(bad, 0u);
+    EXPECT_EQ(render_subpixels(scene, rig, d, tiles[(trial + 1) % 3], S).display, got.display) << "another tile shape";
+  }
+  EXPECT_GT(partial, 300u) << "too few partly covered subpixels for the test to mean much";
 }
 
 // The fill rule at samples lying exactly on edges: a grid mesh on the focal plane (the same in every

@@ -103,10 +103,7 @@ const BenchSection kMeasureOptions = {
            for (const auto& m : split(v)) o.samplings.push_back(parse_sampling(m));
          }},
         {"--samples", nullptr, "LIST", "samples per pixel, each as for pmr render (default 1)",
-         [](BenchOptions& o, const std::string& v, const std::string&) {
-           o.samples.clear();
-           for (const auto& s : split(v)) o.samples.push_back(parse_samples(s));
-         }},
+         [](BenchOptions& o, const std::string& v, const std::string&) { o.samples = parse_samples_list(v); }},
         {"--frames", nullptr, "K", "timed frames per point after one warm-up frame (default 5)",
          [](BenchOptions& o, const std::string& v, const std::string&) {
            o.frames = std::atoi(v.c_str());

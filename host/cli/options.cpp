@@ -84,6 +84,14 @@ int parse_samples(const std::string& text) {
   return samples;
 }
 
+std::vector<int> parse_samples_list(const std::string& text) {
+  std::vector<int> out;
+  std::stringstream ss(text);
+  std::string w;
+  while (std::getline(ss, w, ',')) out.push_back(parse_samples(w));
+  if (out.empty()) out.push_back(parse_samples(text));  // "" is refused there
+  return out;
+}
 
 namespace {
 

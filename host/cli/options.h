@@ -12,7 +12,8 @@ namespace pmr {
 // --exposure EV, --environment-intensity X and --environment-rotation DEG, checked (shared by render
 // and bench).
 double parse_exposure(const std::string& text);
-int parse_samples(const std::string& text);  // --samples: 1, 4, 8 or 16
+int parse_samples(const std::string& text);                    // --samples: 1, 4, 8 or 16
+std::vector<int> parse_samples_list(const std::string& text);  // a comma list of them (bench, quality)
 double parse_environment_intensity(const std::string& text);
 double parse_environment_rotation(const std::string& text);
 // Checks --environment and --environment-rotation against the shading model: an environment image

@@ -26,7 +26,7 @@ void FineStage::configure(const FinePaths& paths, int views, int view_w, int vie
   const size_t voxels = size_t(views) * view_w * view_h;
   volume_bytes_ = voxels * 4 * sizeof(uint16_t);
   const size_t display_subpixels = encode ? size_t(3) * encode->params().display_w * encode->params().display_h : 0;
-  debug_entries_ = !paths.debug ? 1 : paths.volume ? voxels * size_t(paths.samples) : display_subpixels;
+  debug_entries_ = !paths.debug ? 1 : (paths.volume ? voxels : display_subpixels) * size_t(paths.samples);
   const size_t vol = paths.volume ? volume_bytes_ : 0;
   const size_t disp = encode ? encode->display_bytes() / 4 * 7 : 0;  // RGBA and the subpixels' alpha
   const size_t dbg = paths.debug ? debug_entries_ * 12 : 0;
@@ -68,7 +68,7 @@ void FineStage::configure_fused(int views, EncodeStage& encode) {
 
 // The subpixel program (per view count: its private per-view arrays), the samples and the chunk list.
 void FineStage::configure_subpixel(int views, EncodeStage& encode) {
-  const int capacity = subpixel_chunk_capacity(views);
+  const int capacity = subpixel_chunk_capacity(views, paths_.samples);
   if (subpixel_views_ != views) {
     subpixel_program_ =
         launcher_.build({"fine_subpixel.cl"}, options_ + " -DPMR_SUBPIXEL_VIEWS=" + std::to_string(views) +

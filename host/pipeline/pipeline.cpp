@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
+#include <limits>
 #include <mutex>
 
 #include "pipeline/encode_stage.h"
@@ -23,8 +24,12 @@ namespace {
 // screen tile over all views: depth, key and winning MTA, and the half RGBA colour); larger
 // configurations use the unfused path.
 constexpr size_t kFusedPrivateBudget = size_t(256) << 10;
-// per voxel: depth, key and winner per sample, then the shaded colour
+// per voxel: depth, key and winner per sample (and the winner's sample coverage when there are several),
+// then the shaded colour
 constexpr size_t kFusedBytesPerSample = 3 * sizeof(uint32_t), kFusedBytesPerVoxel = 4 * sizeof(uint16_t);
+size_t fused_bytes_per_voxel(int samples) {
+  return (kFusedBytesPerSample + (samples > 1 ? sizeof(uint32_t) : 0)) * size_t(samples) + kFusedBytesPerVoxel;
+}
 
 // Fine raster vector width (PMR_VW): the smallest of 4, 8, 16 lanes that holds a tile row (wider rows
 // take several vectors).
@@ -116,15 +121,14 @@ FinePaths Pipeline::choose_paths(const Rig& rig, const Display* display) const {
   }
   const int* tile = impl_->tile;
   const int lanes = fine_lanes(tile[0]);
-  const size_t fused_private = size_t(tile[0] + lanes - 1) / lanes * lanes * tile[1] * rig.views *
-                               (kFusedBytesPerSample * size_t(config_.samples) + kFusedBytesPerVoxel);
+  const size_t fused_private =
+      size_t(tile[0] + lanes - 1) / lanes * lanes * tile[1] * rig.views * fused_bytes_per_voxel(config_.samples);
   p.fused = !p.subpixel && config_.fuse_encode && display && !display->bilinear && !display->blend_views &&
             display->cell_rows <= 1 && config_.method == Method::Pmr && !config_.debug_outputs &&
             fused_private <= kFusedPrivateBudget;
   p.volume = !p.fused && !(p.subpixel && config_.fuse_encode);
   p.debug = config_.debug_outputs;
   p.samples = config_.samples;
-  if (p.subpixel && p.samples > 1) throw Error("--samples above 1 with --sampling subpixel: not implemented yet");
   return p;
 }
 
@@ -173,8 +177,13 @@ PmrParams Pipeline::frame_params(const FrameDescription& frame, bool empty) cons
   P.num_triangles = empty ? 0 : m.scene.num_triangles();
   P.debug_outputs = config_.debug_outputs ? 1u : 0u;
   P.setup_mode = config_.method == Method::Duplicate ? PMR_SETUP_DUPLICATE : PMR_SETUP_MTA;
-  P.sample_area = m.paths.subpixel || config_.samples > 1 ? PMR_SAMPLES_PIXEL : PMR_SAMPLES_CENTER;
-  set_sample_pattern(config_.samples, P);
+  P.sample_area = m.paths.subpixel ? PMR_SAMPLES_PIXEL : PMR_SAMPLES_CENTER;
+  if (m.paths.subpixel) {  // the pattern spans one display pixel's footprint in the view (DESIGN section 3b)
+    const PmrEncodeParams& E = m.encode.params();
+    set_sample_pattern(config_.samples, double(rig.view_w) / E.display_w, double(rig.view_h) / E.display_h, P);
+  } else {
+    set_sample_pattern(config_.samples, P);
+  }
   P.shading = config_.shading == Shading::Pbr ? PMR_SHADING_PBR : PMR_SHADING_LAMBERT;
   P.exposure = float(std::exp2(config_.exposure_ev));
   P.env_radiance = float(0.2 * config_.environment_intensity);
@@ -284,6 +293,15 @@ void Pipeline::read_display(std::vector<uint16_t>& out) const { impl_->encode.re
 void Pipeline::read_sub_alpha(std::vector<uint16_t>& out) const { impl_->encode.read_sub_alpha(out); }
 void Pipeline::read_debug(std::vector<uint32_t>& keys, std::vector<float>& depth, std::vector<uint32_t>& count) const {
   impl_->fine.read_debug(keys, depth, count);
+}
+
+void Pipeline::read_depth(std::vector<float>& depth) const {
+  std::vector<uint32_t> keys, count;
+  std::vector<float> samples;
+  impl_->fine.read_debug(keys, samples, count);
+  const size_t S = size_t(config_.samples);
+  depth.assign(samples.size() / S, std::numeric_limits<float>::infinity());
+  for (size_t k = 0; k < samples.size(); ++k) depth[k / S] = std::min(depth[k / S], samples[k]);
 }
 
 size_t Pipeline::device_bytes() const {

@@ -75,7 +75,11 @@ class Pipeline {
   void read_sub_alpha(std::vector<uint16_t>& out) const;
   // Requires debug_outputs: per voxel the winning key (PMR_NO_KEY if empty), depth and coverage count
   // (with --sampling subpixel and no view volume: per display subpixel, and no count).
+  // With S samples per pixel, per (voxel or subpixel, sample): [voxel][sample].
   void read_debug(std::vector<uint32_t>& keys, std::vector<float>& depth, std::vector<uint32_t>& count) const;
+  // Requires debug_outputs: per voxel the window depth of its nearest covered sample, +infinity where
+  // none (the Z channel: DESIGN section 3b; not averaged).
+  void read_depth(std::vector<float>& depth) const;
   // The MTAs of the last frame, in queue order (arbitrary), and the tile queues (offsets has one entry
   // per tile plus one; queue[offsets[t] .. offsets[t+1]) are MTA indices).
   std::vector<PmrMta> read_mtas() const;

@@ -1,6 +1,8 @@
 // The run-wide choices of a pipeline (pipeline_config.h): method, sampling and shading names.
 #include "pipeline/pipeline_config.h"
 
+#include <cmath>
+
 #include "pmr/error.h"
 
 namespace pmr {
@@ -39,7 +41,7 @@ Shading parse_shading(const std::string& name) {
 
 const char* to_string(Shading s) { return s == Shading::Pbr ? "pbr" : "lambert"; }
 
-void set_sample_pattern(int samples, PmrParams& P) {
+void set_sample_pattern(int samples, double scale_x, double scale_y, PmrParams& P) {
   static const int one[] = PMR_SAMPLE_PATTERN_1, four[] = PMR_SAMPLE_PATTERN_4, eight[] = PMR_SAMPLE_PATTERN_8,
                    sixteen[] = PMR_SAMPLE_PATTERN_16;
   const int* pattern = samples == 1    ? one
@@ -49,9 +51,9 @@ void set_sample_pattern(int samples, PmrParams& P) {
                                        : nullptr;
   if (!pattern) throw Error("invalid --samples " + std::to_string(samples) + ": use 1, 4, 8 or 16");
   P.samples = uint32_t(samples);
-  for (int s = 0; s < PMR_MAX_SAMPLES; ++s) {  // 1/16 pixel to 16.16 / 24.8
-    P.sample_x[s] = s < samples ? pattern[2 * s] * (PMR_X_ONE / 16) : 0;
-    P.sample_y[s] = s < samples ? pattern[2 * s + 1] * (PMR_Y_ONE / 16) : 0;
+  for (int s = 0; s < PMR_MAX_SAMPLES; ++s) {  // 1/16 pixel to 16.16 / 24.8, rounded to the grid
+    P.sample_x[s] = s < samples ? int32_t(std::lround(pattern[2 * s] * scale_x * (PMR_X_ONE / 16))) : 0;
+    P.sample_y[s] = s < samples ? int32_t(std::lround(pattern[2 * s + 1] * scale_y * (PMR_Y_ONE / 16))) : 0;
   }
 }
 

@@ -31,9 +31,11 @@ enum class Sampling {
 };
 Sampling parse_sampling(const std::string& name);  // "view", "subpixel"
 const char* to_string(Sampling s);
-// The sample positions of S samples per pixel (DESIGN section 3b) into P; throws pmr::Error unless S is
-// 1, 4, 8 or 16.
-void set_sample_pattern(int samples, PmrParams& P);
+// The sample positions of S samples per pixel (DESIGN section 3b) into P, the pattern scaled by
+// (scale_x, scale_y) view pixels per pattern pixel (with --sampling subpixel, a display pixel's footprint
+// in the view) and rounded to the raster's fixed point; throws pmr::Error unless S is 1, 4, 8 or 16.
+void set_sample_pattern(int samples, double scale_x, double scale_y, PmrParams& P);
+inline void set_sample_pattern(int samples, PmrParams& P) { set_sample_pattern(samples, 1.0, 1.0, P); }
 // Throws pmr::Error when --sampling subpixel cannot render with this method and display (PMR only;
 // nearest, unblended sampling). Pipeline::configure checks it; the command line calls it before loading
 // a scene.

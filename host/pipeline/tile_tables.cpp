@@ -37,10 +37,10 @@ std::vector<int32_t> subpixel_sample_rows(const PmrEncodeParams& E) {
   return y;
 }
 
-int subpixel_chunk_capacity(int views) {
-  // area + (lanes - 1) * min(views, area) <= slots
-  const int area = kSubpixelSlots - (PMR_SUBPIXEL_LANES - 1) * views;
-  return area >= views ? area : kSubpixelSlots / PMR_SUBPIXEL_LANES;
+int subpixel_chunk_capacity(int views, int samples) {
+  // samples * area + (lanes - 1) * min(views, area) <= slots
+  const int area = (kSubpixelSlots - (PMR_SUBPIXEL_LANES - 1) * views) / samples;
+  return area >= views ? area : kSubpixelSlots / (samples + PMR_SUBPIXEL_LANES - 1);
 }
 
 std::vector<PmrSampleChunk> subpixel_chunks(const TileOwnership& own, int tile_x, int tile_y, int capacity) {

@@ -26,12 +26,13 @@ TileOwnership tile_ownership(const PmrEncodeParams& E, const std::vector<PmrEnco
 std::vector<int32_t> subpixel_sample_columns(const PmrEncodeParams& E);  // 3 W_d entries, 16.16
 std::vector<int32_t> subpixel_sample_rows(const PmrEncodeParams& E);     // H_d entries, 24.8
 
-// A chunk's samples sorted by view, each view's run padded to whole vectors, must fit
-// the kernel's PMR_SUBPIXEL_SLOTS private slots: the chunk capacity leaves room for the padding.
+// A chunk's samples (`samples` per subpixel) sorted by view, each view's run padded to whole vectors,
+// must fit the kernel's PMR_SUBPIXEL_SLOTS private slots: the chunk capacity (in subpixels) leaves room
+// for the padding.
 // 8192 slots make a work-item's private arrays about 230 KB: fine for PoCL's CPU devices, which run the
 // kernel with one work-item per work-group (measured best of 2048 to 16384 at paper-8k).
 constexpr int kSubpixelSlots = 8192;
-int subpixel_chunk_capacity(int views);
+int subpixel_chunk_capacity(int views, int samples);
 // Every display subpixel in exactly one chunk; a chunk lies in one screen tile, holds at most
 // `capacity` subpixels and is cut from its neighbours in the same tile at display-pixel boundaries.
 std::vector<PmrSampleChunk> subpixel_chunks(const TileOwnership& own, int tile_x, int tile_y, int capacity);

@@ -182,14 +182,14 @@ void SequenceRun::choose_frames() {
 // The images of a frame, checked against the memory budget before anything is created: the view
 // volume on the device and, when written, up to three host copies (one read back, one queued, one
 // being written) plus the encoder's output; the display image (RGBA and the subpixels' alpha)
-// likewise; depth 12 bytes a voxel on the device and 4 per host copy. The device buffers are checked
-// again as they are allocated.
+// likewise; depth 12 bytes a voxel and sample on the device and as many read back, then 4 a voxel per
+// host copy. The device buffers are checked again as they are allocated.
 void SequenceRun::check_frame_memory() const {
   const Rig& rig = renderer_->rig();
   const uint64_t voxels = uint64_t(rig.views) * uint64_t(rig.view_w) * uint64_t(rig.view_h);
   const uint64_t display = products_.encoded ? uint64_t(job_.display.width) * uint64_t(job_.display.height) * 14 : 0;
   const uint64_t volume = need_volume_ ? voxels * 8 : 0;
-  const uint64_t depth = need_volume_ && products_.depth ? voxels * (12 + 3 * 4) : 0;
+  const uint64_t depth = need_volume_ && products_.depth ? voxels * (24 * uint64_t(pc_.samples) + 3 * 4) : 0;
   check_memory(5 * volume + 5 * display + depth,
                std::to_string(rig.views) + " views of " + std::to_string(rig.view_w) + "x" +
                    std::to_string(rig.view_h) + " (" + std::to_string(volume >> 20) +
@@ -321,8 +321,7 @@ FrameFiles SequenceRun::frame_files(long f, const FrameRenderer::Frame& fr, Pipe
     else files.volume.assign(size_t(rig.views) * rig.view_w * rig.view_h * 4, 0);
     if (products_.depth) {
       files.near = fr.rig.near_eff, files.far = fr.rig.far;
-      std::vector<uint32_t> keys, count;
-      if (renderer_->has_geometry()) pipeline.read_debug(keys, files.depth, count);
+      if (renderer_->has_geometry()) pipeline.read_depth(files.depth);
       else files.depth.assign(size_t(rig.views) * rig.view_w * rig.view_h, std::numeric_limits<float>::infinity());
     }
   }

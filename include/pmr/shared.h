@@ -101,9 +101,6 @@ typedef uint32_t pmr_u32;
 #define PMR_SETUP_MTA 0u
 #define PMR_SETUP_DUPLICATE 1u
 
-/* PmrParams.sample_area: where the samples of a raster pixel lie, for the tile raster's conservative
- * tests. --sampling view samples pixel centers; --sampling subpixel samples each display subpixel at
- * its own position, anywhere in [px, px + 1) x [py, py + 1) of its view's raster. */
 /* PmrParams.shading (docs/SHADING.md): view-independent Lambert, or glTF metallic-roughness. */
 #define PMR_SHADING_LAMBERT 0u
 #define PMR_SHADING_PBR 1u
@@ -112,6 +109,10 @@ typedef uint32_t pmr_u32;
  * cos(n, v) = (i / (N - 1))^2 and roughness j / (N - 1), stored at j * N + i. */
 #define PMR_SPLIT_SUM_N 64
 
+/* PmrParams.sample_area: where the samples of a raster pixel lie, for the tile raster's conservative
+ * tests. --sampling view samples around pixel centers; --sampling subpixel samples each display
+ * subpixel around its own position, anywhere in [px, px + 1) x [py, py + 1) of its view's raster. Either
+ * way a pixel's S samples lie at the offsets PmrParams.sample_x/y from that point. */
 #define PMR_SAMPLES_CENTER 0u
 #define PMR_SAMPLES_PIXEL 1u
 

@@ -219,6 +219,35 @@ void sort_mtas(std::vector<PmrMta>& mtas) {
   });
 }
 
+ViewTriangle view_triangle(const ClippedTriangle& c, int64_t v) {
+  ViewTriangle t;
+  for (int k = 0; k < 3; ++k) {
+    t.x[k] = int64_t(c.v[k].x0) + v * c.v[k].dx;
+    t.y[k] = c.v[k].y;
+  }
+  // twice the signed area; > 0 is counter-clockwise in NDC (front) because raster y points down
+  const int64_t area = (t.y[1] - t.y[0]) * (t.x[2] - t.x[0]) - (t.x[1] - t.x[0]) * (t.y[2] - t.y[0]);
+  t.drawn = area != 0 && (area > 0 || c.double_sided);
+  t.sign = area > 0 ? 1 : -1;
+  // edge k is opposite vertex k: (1,2), (2,0), (0,1)
+  const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
+  for (int k = 0; k < 3; ++k) {
+    // oriented edge direction; top edge: horizontal going left (y down); left edge: going down
+    const int64_t dx = t.sign * (t.x[eb[k]] - t.x[ea[k]]), dy = t.sign * (t.y[eb[k]] - t.y[ea[k]]);
+    t.bias[k] = dy > 0 || (dy == 0 && dx < 0) ? 0 : 1;
+  }
+  return t;
+}
+
+bool covers(const ViewTriangle& t, int64_t X, int64_t Y) {
+  const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
+  for (int k = 0; k < 3; ++k) {
+    const int a = ea[k], b = eb[k];
+    if (t.sign * ((t.y[b] - t.y[a]) * (X - t.x[a]) - (t.x[b] - t.x[a]) * (Y - t.y[a])) < t.bias[k]) return false;
+  }
+  return t.drawn;
+}
+
 RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& tris) {
   const size_t W = size_t(P.view_w), H = size_t(P.view_h), N = size_t(P.views), S = P.samples;
   RasterResult r;
@@ -227,39 +256,16 @@ RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& t
   r.count.assign(W * H * N * S, 0);
   for (size_t i = 0; i < N; ++i) {
     for (const ClippedTriangle& c : tris) {
-      int64_t x[3], y[3];
-      for (int k = 0; k < 3; ++k) {
-        x[k] = int64_t(c.v[k].x0) + int64_t(P.view_coord[i]) * c.v[k].dx;
-        y[k] = c.v[k].y;
-      }
-      // twice the signed area; > 0 is counter-clockwise in NDC (front) because raster y points down
-      const int64_t area = (y[1] - y[0]) * (x[2] - x[0]) - (x[1] - x[0]) * (y[2] - y[0]);
-      if (area == 0 || (area < 0 && !c.double_sided)) continue;
-      const int64_t s = area > 0 ? 1 : -1;
-      // edge k is opposite vertex k: (1,2), (2,0), (0,1)
-      const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
-      int64_t bias[3];
-      for (int k = 0; k < 3; ++k) {
-        // oriented edge direction; top edge: horizontal going left (y down); left edge: going down
-        const int64_t dx = s * (x[eb[k]] - x[ea[k]]), dy = s * (y[eb[k]] - y[ea[k]]);
-        const bool top_left = dy > 0 || (dy == 0 && dx < 0);
-        bias[k] = top_left ? 0 : 1;
-      }
+      const ViewTriangle t = view_triangle(c, P.view_coord[i]);
+      if (!t.drawn) continue;
       for (size_t at = 0; at < W * H * S; ++at) {
         const size_t px = at / S % W, py = at / S / W, sample = at % S;
         const int64_t X = int64_t(px) * PMR_X_ONE + PMR_X_ONE / 2 + P.sample_x[sample],
                       Y = int64_t(py) * PMR_Y_ONE + PMR_Y_ONE / 2 + P.sample_y[sample];
-        int64_t e[3];
-        bool inside = true;
-        for (int k = 0; k < 3; ++k) {
-          const int a = ea[k], b = eb[k];
-          e[k] = s * ((y[b] - y[a]) * (X - x[a]) - (x[b] - x[a]) * (Y - y[a]));
-          inside = inside && e[k] >= bias[k];
-        }
-        if (!inside) continue;
+        if (!covers(t, X, Y)) continue;
         const size_t slot = i * H * W * S + at;
         ++r.count[slot];
-        const float depth = depth_at(x, y, c, X, Y);
+        const float depth = depth_at(t.x, t.y, c, X, Y);
         if (depth < r.depth[slot] || (depth == r.depth[slot] && c.key < r.key[slot])) {
           r.depth[slot] = depth;
           r.key[slot] = c.key;
@@ -272,42 +278,29 @@ RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& t
 
 SubpixelResult rasterize_subpixels(const PmrParams& P, const std::vector<ClippedTriangle>& tris,
                                    const std::vector<int>& view_of, int display_w, int display_h) {
-  const size_t n = size_t(3) * display_w * display_h;
+  const size_t n = size_t(3) * display_w * display_h, S = P.samples;
   SubpixelResult r;
-  r.key.assign(n, PMR_NO_KEY);
-  r.depth.assign(n, INFINITY);
+  r.key.assign(n * S, PMR_NO_KEY);
+  r.depth.assign(n * S, INFINITY);
   r.x.resize(n);
   r.y.resize(n);
   for (int i = 0; i < display_h; ++i)
     for (int s = 0; s < 3 * display_w; ++s) {
       const size_t at = size_t(i) * 3 * display_w + size_t(s);
       // floor((s + 1/2) / (3 W_d) * W * 2^16) and floor((i + 1/2) / H_d * H * 2^8), in integers
-      const int64_t X = (int64_t(2 * s + 1) * P.view_w * PMR_X_ONE) / (int64_t(6) * display_w);
-      const int64_t Y = (int64_t(2 * i + 1) * P.view_h * PMR_Y_ONE) / (int64_t(2) * display_h);
-      r.x[at] = X, r.y[at] = Y;
-      const int64_t v = P.view_coord[view_of[at]];
+      r.x[at] = (int64_t(2 * s + 1) * P.view_w * PMR_X_ONE) / (int64_t(6) * display_w);
+      r.y[at] = (int64_t(2 * i + 1) * P.view_h * PMR_Y_ONE) / (int64_t(2) * display_h);
       for (const ClippedTriangle& c : tris) {
-        int64_t x[3], y[3];
-        for (int k = 0; k < 3; ++k) {
-          x[k] = int64_t(c.v[k].x0) + v * c.v[k].dx;
-          y[k] = c.v[k].y;
-        }
-        const int64_t area = (y[1] - y[0]) * (x[2] - x[0]) - (x[1] - x[0]) * (y[2] - y[0]);
-        if (area == 0 || (area < 0 && !c.double_sided)) continue;
-        const int64_t sg = area > 0 ? 1 : -1;
-        const int ea[3] = {1, 2, 0}, eb[3] = {2, 0, 1};
-        bool inside = true;
-        for (int k = 0; k < 3 && inside; ++k) {
-          const int a = ea[k], b = eb[k];
-          const int64_t dx = sg * (x[b] - x[a]), dy = sg * (y[b] - y[a]);
-          const int64_t bias = (dy > 0 || (dy == 0 && dx < 0)) ? 0 : 1;
-          inside = sg * ((y[b] - y[a]) * (X - x[a]) - (x[b] - x[a]) * (Y - y[a])) >= bias;
-        }
-        if (!inside) continue;
-        const float depth = depth_at(x, y, c, X, Y);
-        if (depth < r.depth[at] || (depth == r.depth[at] && c.key < r.key[at])) {
-          r.depth[at] = depth;
-          r.key[at] = c.key;
+        const ViewTriangle t = view_triangle(c, P.view_coord[view_of[at]]);
+        for (size_t k = 0; k < S; ++k) {
+          const int64_t X = r.x[at] + P.sample_x[k], Y = r.y[at] + P.sample_y[k];
+          if (!covers(t, X, Y)) continue;
+          const float depth = depth_at(t.x, t.y, c, X, Y);
+          const size_t slot = at * S + k;
+          if (depth < r.depth[slot] || (depth == r.depth[slot] && c.key < r.key[slot])) {
+            r.depth[slot] = depth;
+            r.key[slot] = c.key;
+          }
         }
       }
     }

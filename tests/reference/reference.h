@@ -29,6 +29,16 @@ std::vector<ClippedTriangle> clip_triangles(const PmrParams& P, const Scene& sce
 std::vector<PmrMta> make_mtas(const PmrParams& P, const std::vector<ClippedTriangle>& tris);
 void sort_mtas(std::vector<PmrMta>& mtas);
 
+// A clipped triangle in the view with view coordinate v: its snapped vertices, orientation sign, each
+// edge's top-left bias, and whether it is drawn there (not degenerate, front-facing or double-sided).
+struct ViewTriangle {
+  int64_t x[3], y[3], sign, bias[3];
+  bool drawn;
+};
+ViewTriangle view_triangle(const ClippedTriangle& c, int64_t v);
+// Whether the triangle covers raster point (X, Y) (16.16, 24.8) under section 3's rules.
+bool covers(const ViewTriangle& t, int64_t X, int64_t Y);
+
 struct RasterResult {
   std::vector<uint32_t> key;    // [view][y][x][sample], PMR_NO_KEY when empty
   std::vector<float> depth;     // INFINITY when empty
@@ -40,12 +50,13 @@ RasterResult rasterize(const PmrParams& P, const std::vector<ClippedTriangle>& t
 
 // --sampling subpixel (DESIGN section 5, docs/SAMPLING.md): display subpixel (j, i, k) sampled at
 // ((3j + k + 1/2) / (3 W_d) W, (i + 1/2) / H_d H) of its view's raster, truncated to 16.16 / 24.8, in view
-// view_of[i * 3 W_d + 3j + k]; the same top-left rule and (depth, key) visibility, the depth being the
-// one depth formula (depth_at, as at pixel centers) evaluated at the sample.
+// view_of[i * 3 W_d + 3j + k], each of its P.samples samples at the offsets P.sample_x/y from there; the
+// same top-left rule and (depth, key) visibility, the depth being the one depth formula (depth_at, as at
+// pixel centers) evaluated at the sample.
 struct SubpixelResult {
-  std::vector<uint32_t> key;  // [row][3 * column + k], PMR_NO_KEY when empty
+  std::vector<uint32_t> key;  // [row][3 * column + k][sample], PMR_NO_KEY when empty
   std::vector<float> depth;   // INFINITY when empty
-  std::vector<int64_t> x, y;  // the samples, fixed point
+  std::vector<int64_t> x, y;  // [row][3 * column + k]: each subpixel's own sample, fixed point
 };
 SubpixelResult rasterize_subpixels(const PmrParams& P, const std::vector<ClippedTriangle>& tris,
                                    const std::vector<int>& view_of, int display_w, int display_h);

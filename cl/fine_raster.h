@@ -110,18 +110,22 @@ inline vint chunk_hits(const RowEdges* R, const long* F, const SampleEdges* O, i
   return hit;
 }
 
-/* Bit s: the lane's sample s is hit. */
-inline vuint sample_bits(const vint* hit) {
-  vuint bits = (vuint)(0u);
+/* A pixel's coverage by one MTA, with several samples: bit s its sample s, FINE_CENTER its center (what
+ * its shading point depends on: shading_point). */
+#define FINE_CENTER (1u << 31)
+#define FINE_SAMPLE_BITS ((1u << NS) - 1u)
+
+inline vuint cover_bits(const vint* hit, vint center) {
+  vuint bits = select((vuint)(0u), (vuint)(FINE_CENTER), center);
   for (int s = 0; s < NS; ++s) bits |= select((vuint)(0u), (vuint)(1u << s), hit[s]);
   return bits;
 }
 
 /* alphaMode MASK for the lanes of a row chunk (first pixel center (X, Y)) that would win some sample:
  * alpha is tested once per pixel at its shading point (shading_point), and a lane that fails leaves every
- * sample (DESIGN section 3b). hit: the samples the MTA covers. */
-inline void mask_chunk(const ShadeInputs* in, const PmrMta* m, const RowEdges* R, const long* F, vint in_tile,
-                       vint lane, const vint* hit, long X, long Y, int view, float cutoff, vint* win) {
+ * sample (DESIGN section 3b). cover: what the MTA covers of each pixel (cover_bits). */
+inline void mask_chunk(const ShadeInputs* in, const PmrMta* m, vuint cover, long X, long Y, int view, float cutoff,
+                       vint* win) {
   vint any_win = (vint)(0);
   for (int s = 0; s < NS; ++s) any_win |= win[s];
   if (!any(any_win)) return;
@@ -131,12 +135,11 @@ inline void mask_chunk(const ShadeInputs* in, const PmrMta* m, const RowEdges* R
     const SampleLanes S = row_samples(X, Y);
     mask_alpha_lanes(in, m, w, VW, &S, view, cutoff);
   } else {
-    int center[VW], bits[VW];
-    vstore_vint(chunk_hits(R, F, 0, 0, in_tile, lane), 0, center);
-    vstore_vint(as_vint(sample_bits(hit)), 0, bits);
+    uint bits[VW];
+    vstore_vint(as_vint(cover), 0, (int*)bits);
     for (int l = 0; l < VW; ++l) {
       sx[l] = sy[l] = 0;
-      if (w[l]) shading_point(in->P, center[l] != 0, (uint)bits[l], sx + l, sy + l);
+      if (w[l]) shading_point(in->P, (bits[l] & FINE_CENTER) != 0u, bits[l] & FINE_SAMPLE_BITS, sx + l, sy + l);
       sx[l] += l * PMR_X_ONE;
     }
     const SampleLanes S = offset_samples(X, Y, sx, sy);
@@ -173,8 +176,8 @@ PMR_HOT void raster_chunk(const ShadeInputs* in, const PmrMta* m, uint id, const
     if (st->covered) st->covered[k] -= hit[s];
     win[s] = hit[s] & ((z[s] < st->depth[k]) | ((z[s] == st->depth[k]) & ((vuint)(m->key) < st->key[k])));
   }
-  if (m->flags & PMR_MTA_MASK) mask_chunk(in, m, R, F, in_tile, lane, hit, X, Y, view, cutoff, win);
-  const vuint bits = NS > 1 ? sample_bits(hit) : (vuint)(0u);
+  const vuint bits = NS > 1 ? cover_bits(hit, chunk_hits(R, F, 0, 0, in_tile, lane)) : (vuint)(0u);
+  if (m->flags & PMR_MTA_MASK) mask_chunk(in, m, bits, X, Y, view, cutoff, win);
   for (int s = 0; s < NS; ++s) {
     const int k = FINE_SLOT(r, s);
     st->depth[k] = select(st->depth[k], z[s], win[s]);
@@ -278,25 +281,20 @@ inline void shade_center_lanes(const ShadeInputs* in, global const PmrMta* mtas,
 
 /* The same at each lane's shading point for its winner (shading_point): the pixel center where the
  * winner covers it (all of them: the row form above), else the centroid of its covered samples
- * (cover[l], bits). A winner covering all NS samples covers the center without a test: the center lies
- * inside the samples' convex hull, and each edge function, affine, is there a mean of its values at the
- * samples. */
+ * (cover[l], cover_bits). */
 inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, sint act,
                               sint ids, const uint* cover, int px0, int py, int view, float c[3][SW]) {
   const long X = (long)px0 * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
-  const long f = view_coord(in->P, view);
-  int on[SW], id_of[SW], sx[SW], sy[SW];
+  int on[SW], sx[SW], sy[SW];
   vstore_s(act, 0, on);
-  vstore_s(ids, 0, id_of);
   bool centers = true;
   for (int l = 0; l < SW; ++l) {
     sx[l] = l * PMR_X_ONE, sy[l] = 0;
-    if (!on[l] || cover[l] == (1u << NS) - 1u) continue;
-    const bool center = mta_covers(in->P, cached_mta(cache, mtas, (uint)id_of[l]), X + sx[l], Y, f);
+    if (!on[l] || (cover[l] & FINE_CENTER)) continue;
     int ox, oy;
-    shading_point(in->P, center, cover[l], &ox, &oy);
+    shading_point(in->P, false, cover[l] & FINE_SAMPLE_BITS, &ox, &oy);
     sx[l] += ox, sy[l] += oy;
-    centers = centers && center;
+    centers = false;
   }
   if (centers) {
     shade_center_lanes(in, mtas, cache, light, act, ids, px0, py, view, c);

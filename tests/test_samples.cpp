@@ -20,9 +20,9 @@ float value(uint16_t bits) {
 
 // A white rectangle on the focal plane (zero disparity: the same raster position in every view) from
 // raster x = x_left to beyond the right border, over the whole height.
-Scene rectangle_from(const Rig& rig, double x_left) {
+Scene rectangle_from(const Rig& rig, double x_left, double x_right = -1.0) {
   Scene s = test::empty_scene();
-  const double xs[2] = {x_left, rig.view_w + 10.0}, ys[2] = {-10.0, rig.view_h + 10.0};
+  const double xs[2] = {x_left, x_right > x_left ? x_right : rig.view_w + 10.0}, ys[2] = {-10.0, rig.view_h + 10.0};
   for (int j = 0; j < 2; ++j)
     for (int i = 0; i < 2; ++i) {
       s.positions.push_back(test::focal_point(rig, xs[i], ys[j]));
@@ -66,6 +66,39 @@ TEST(Samples, AnEdgeThroughPixelCentersHalvesTheirCoverage) {
               << "S " << samples << " voxel " << voxel << ": a wholly covered pixel is shaded at its center";
       }
     }
+  }
+}
+
+// alphaMode MASK is tested once per pixel and triangle at its shading point, not per sample: alpha falls
+// linearly from 1 on the right to 0 on the left and crosses the cutoff at x = 20.25, between column 20's
+// center and its leftmost samples, yet every pixel is wholly kept or wholly dropped, as with one sample.
+// (Pixels the rectangle's diagonal crosses are left out: there the triangle that misses the center is
+// shaded and tested at the centroid of its samples, which may lie left of the cutoff.)
+TEST(Samples, AlphaMaskKeepsOrDropsWholePixels) {
+  const Rig rig = test::small_rig(3, 40, 12);
+  Scene scene = rectangle_from(rig, -10.0, 50.5);
+  for (size_t v = 0; v < scene.attributes.size(); ++v) scene.attributes[v].color[3] = v % 2 == 0 ? 0.0f : 1.0f;
+  scene.materials[0].alpha_mode = PMR_ALPHA_MASK;
+  scene.materials[0].alpha_cutoff = 0.5f;
+  PipelineConfig one;
+  one.shading = Shading::Lambert;
+  const test::Rendered single = test::render_with(scene, rig, one);
+  for (int samples : {4, 16}) {
+    PipelineConfig pc = one;
+    pc.samples = samples;
+    const test::Rendered out = test::render_with(scene, rig, pc);
+    size_t kept = 0;
+    for (size_t voxel = 0; voxel < out.volume.size() / 4; ++voxel) {
+      const int px = int(voxel % size_t(rig.view_w)), py = int(voxel / size_t(rig.view_w) % size_t(rig.view_h));
+      const double diagonal_y = -10.0 + (rig.view_h + 20.0) * (50.5 - (px + 0.5)) / 60.5;  // from (50.5, -10)
+      if (std::abs(diagonal_y - (py + 0.5)) < 1.5) continue;
+      EXPECT_EQ(value(out.volume[voxel * 4 + 3]), px < 20 ? 0.0f : 1.0f) << "S " << samples << " voxel " << voxel;
+      for (int c = 0; c < 4; ++c)
+        EXPECT_EQ(out.volume[voxel * 4 + size_t(c)], single.volume[voxel * 4 + size_t(c)])
+            << "S " << samples << " voxel " << voxel;
+      kept += px >= 20;
+    }
+    EXPECT_GT(kept, 0u);
   }
 }
 

@@ -1,0 +1,692 @@
+// pmr_gl_bench: the conventional way to make a multi-view display image, for comparison with pmr
+// (docs/PERFORMANCE.md, "Against OpenGL (Mesa llvmpipe)"). OpenGL 3.3 core on Mesa's llvmpipe (the
+// same CPU pmr runs on), one pass per view into a (multisampled) framebuffer, each view resolved into a
+// layer of a view atlas, then the display encoding as a fragment shader and one glReadPixels.
+// The scene is loaded by pmr's own loader and the cameras and display come from a pmr sidecar, so both
+// programs draw the same triangles, materials and textures with the same matrices and view map.
+// Not a test: it times frames.
+#define GL_GLEXT_PROTOTYPES 1
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/glcorearb.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfMultiPartOutputFile.h>
+#include <ImfOutputPart.h>
+#include <ImfPartType.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <glm/gtc/type_ptr.hpp>
+#include <nlohmann/json.hpp>
+
+#include "pmr/rig.h"
+#include "pmr/scene.h"
+
+namespace {
+
+struct Options {
+  std::string scene, sidecar, out;
+  int msaa = 4, frames = 5;
+  bool mipmap = true;
+};
+
+const char* kUsage =
+    "usage: pmr_gl_bench SCENE --sidecar FRAME.json [--msaa 0|4] [--frames K] [--no-mipmap] [--out DIR]\n"
+    "  SCENE: the glTF file pmr rendered; FRAME.json: that render's sidecar (cameras, display, light)\n"
+    "  --msaa 0|4: samples per pixel of the view framebuffer (compare with pmr --samples 1|4); default 4\n"
+    "  --frames K: timed frames after one warm-up frame; default 5\n"
+    "  --no-mipmap: sample textures bilinearly without mip-maps, as pmr does (image comparisons)\n"
+    "  --out DIR: write DIR/gl_encoded.exr and DIR/gl_views.exr (parts view_000...) after timing\n";
+
+Options parse_options(int argc, char** argv) {
+  Options o;
+  for (int a = 1; a < argc; ++a) {
+    const std::string arg = argv[a];
+    auto value = [&]() -> std::string {
+      if (a + 1 >= argc) throw std::runtime_error(arg + " needs a value");
+      return argv[++a];
+    };
+    if (arg == "--sidecar") o.sidecar = value();
+    else if (arg == "--msaa") o.msaa = std::stoi(value());
+    else if (arg == "--frames") o.frames = std::stoi(value());
+    else if (arg == "--out") o.out = value();
+    else if (arg == "--no-mipmap") o.mipmap = false;
+    else if (arg == "--help" || arg == "-h") throw std::runtime_error("");
+    else if (!arg.empty() && arg[0] == '-') throw std::runtime_error("unknown option " + arg);
+    else o.scene = arg;
+  }
+  if (o.scene.empty() || o.sidecar.empty()) throw std::runtime_error("SCENE and --sidecar are required");
+  if (o.msaa != 0 && o.msaa != 4) throw std::runtime_error("--msaa takes 0 or 4");
+  if (o.frames < 1) throw std::runtime_error("--frames takes a positive count");
+  return o;
+}
+
+// What the GL renderer takes from a pmr sidecar (docs/OUTPUTS.md; host/output/sidecar.cpp).
+struct Frame {
+  int views = 0, view_w = 0, view_h = 0, samples = 1;
+  std::vector<glm::mat4> clip_from_world;  // proj * view per view, multiplied in double
+  glm::vec3 light_world{0.0f};             // toward Lambert's light
+  pmr::Display display;
+  std::string scene, sampling, shading;
+};
+
+// The display exactly as pmr encoded it: its fractions, so that make_encode_tables gives pmr's own
+// subpixel-to-view map.
+pmr::Display display_from_sidecar(const nlohmann::json& d) {
+  pmr::Display out;
+  out.width = d.at("width").get<int>();
+  out.height = d.at("height").get<int>();
+  out.lens_pitch = pmr::parse_rational(d.at("lens_pitch_fraction").get<std::string>(), "lens_pitch");
+  out.tan_slant = pmr::parse_rational(d.at("tan_slant_fraction").get<std::string>(), "tan_slant");
+  out.offset = pmr::parse_rational(d.at("offset_fraction").get<std::string>(), "offset");
+  out.reversed = d.at("reversed").get<bool>();
+  out.phase_sign = d.at("phase_sign").get<int>();
+  out.subpixel_bgr = d.at("subpixel_order").get<std::string>() == "bgr";
+  if (d.contains("cell_rows")) {
+    out.cell_rows = d.at("cell_rows").get<int>();
+    out.cell_offsets = d.at("cell_offsets_1e14").get<std::vector<int64_t>>();
+  }
+  out.bilinear = d.at("sampling").get<std::string>() == "bilinear";
+  out.blend_views = d.at("view_blend").get<bool>();
+  return out;
+}
+
+glm::dmat4 matrix_from_json(const nlohmann::json& a) {
+  const std::vector<double> m = a.get<std::vector<double>>();
+  if (m.size() != 16) throw std::runtime_error("a sidecar matrix without 16 numbers");
+  return glm::make_mat4(m.data());  // column-major, as the sidecar stores it
+}
+
+Frame read_sidecar(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  Frame f;
+  const nlohmann::json& rig = j.at("rig");
+  f.views = rig.at("views").get<int>();
+  f.view_w = rig.at("view_width").get<int>();
+  f.view_h = rig.at("view_height").get<int>();
+  f.samples = j.value("samples_per_pixel", 1);
+  f.scene = j.value("scene", "");
+  f.sampling = j.value("sampling", "view");
+  f.shading = j.contains("shading") ? j["shading"].value("model", "lambert") : "lambert";
+  for (const nlohmann::json& v : j.at("views"))
+    f.clip_from_world.push_back(glm::mat4(matrix_from_json(v.at("proj")) * matrix_from_json(v.at("view"))));
+  if (int(f.clip_from_world.size()) != f.views) throw std::runtime_error("the sidecar's views do not match rig.views");
+  const std::vector<double> l = j.at("light_dir_world").get<std::vector<double>>();
+  f.light_world = glm::vec3(float(l.at(0)), float(l.at(1)), float(l.at(2)));
+  f.display = display_from_sidecar(j.at("display"));
+  if (f.display.blend_views) throw std::runtime_error("view blending (display.view_blend) is not implemented here");
+  return f;
+}
+
+// Software rendering on every core, unless the caller chose otherwise: llvmpipe's rasterizer threads
+// are the GL side's only parallelism, as PoCL's threads are pmr's.
+void select_llvmpipe() {
+  setenv("LIBGL_ALWAYS_SOFTWARE", "1", 0);
+  setenv("GALLIUM_DRIVER", "llvmpipe", 0);
+  setenv("LP_NUM_THREADS", std::to_string(std::max(1u, std::thread::hardware_concurrency())).c_str(), 0);
+}
+
+// A surfaceless EGL display (no window system: runs on a headless machine) with a current OpenGL 3.3
+// core context. Everything renders into framebuffer objects.
+void create_context() {
+  select_llvmpipe();
+  EGLDisplay dpy = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+  EGLint major = 0, minor = 0;
+  if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, &major, &minor))
+    throw std::runtime_error("no surfaceless EGL display (Mesa's EGL_MESA_platform_surfaceless)");
+  if (!eglBindAPI(EGL_OPENGL_API)) throw std::runtime_error("EGL cannot bind desktop OpenGL");
+  // no config (EGL_KHR_no_config_context): nothing is drawn to an EGL surface
+  const EGLConfig config = EGL_NO_CONFIG_KHR;
+  const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,       3, EGL_CONTEXT_MINOR_VERSION, 3,
+                                    EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                    EGL_NONE};
+  EGLContext ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, context_attribs);
+  if (ctx == EGL_NO_CONTEXT) throw std::runtime_error("no OpenGL 3.3 core context");
+  if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) throw std::runtime_error("eglMakeCurrent failed");
+}
+
+GLuint compile(GLenum type, const char* source) {
+  const GLuint s = glCreateShader(type);
+  glShaderSource(s, 1, &source, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetShaderInfoLog(s, sizeof log, nullptr, log);
+    throw std::runtime_error(std::string("shader: ") + log);
+  }
+  return s;
+}
+
+GLuint link(const char* vertex, const char* fragment) {
+  const GLuint p = glCreateProgram();
+  glAttachShader(p, compile(GL_VERTEX_SHADER, vertex));
+  glAttachShader(p, compile(GL_FRAGMENT_SHADER, fragment));
+  glLinkProgram(p);
+  GLint ok = 0;
+  glGetProgramiv(p, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[4096];
+    glGetProgramInfoLog(p, sizeof log, nullptr, log);
+    throw std::runtime_error(std::string("program: ") + log);
+  }
+  return p;
+}
+
+// DESIGN section 4a: base = baseColorFactor x baseColorTexture x COLOR_0, colour = base (0.2 + 0.8
+// max(0, n . l)), n flipped on back faces (only double-sided materials show them), alpha = coverage.
+const char* kSceneVertex = R"(#version 330 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+layout(location = 2) in vec4 color;
+layout(location = 3) in vec2 uv0;
+layout(location = 4) in vec2 uv1;
+uniform mat4 clip_from_world;
+uniform int uv_set;
+uniform vec3 uv_u, uv_v;  // KHR_texture_transform: u' = dot(uv_u, (u, v, 1)), v' = dot(uv_v, (u, v, 1))
+out vec3 v_normal;
+out vec4 v_color;
+out vec2 v_uv;
+void main() {
+  vec3 uv = vec3(uv_set == 0 ? uv0 : uv1, 1.0);
+  v_uv = vec2(dot(uv_u, uv), dot(uv_v, uv));
+  v_normal = normal;
+  v_color = color;
+  gl_Position = clip_from_world * vec4(position, 1.0);
+}
+)";
+
+const char* kSceneFragment = R"(#version 330 core
+in vec3 v_normal;
+in vec4 v_color;
+in vec2 v_uv;
+uniform vec4 base_factor;
+uniform bool textured;
+uniform sampler2D base_texture;
+uniform bool mask;
+uniform float cutoff;
+uniform vec3 light;
+out vec4 frag;
+void main() {
+  vec4 base = base_factor * v_color;
+  if (textured) base *= texture(base_texture, v_uv);
+  if (mask && base.a < cutoff) discard;
+  vec3 n = normalize(v_normal);
+  if (!gl_FrontFacing) n = -n;
+  frag = vec4(base.rgb * (0.2 + 0.8 * max(dot(n, light), 0.0)), 1.0);
+}
+)";
+
+// A triangle covering the screen: the encoder runs once per display pixel.
+const char* kFullscreenVertex = R"(#version 330 core
+void main() {
+  vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
+  gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+
+// DESIGN section 5 through pmr's exact tables (host/rig/display.cpp): subpixel k of display pixel
+// (j, i) shows view v = a_mod_n - q_mod_n - (b < s) (+ N), sampled at its view pixel (px, py) (nearest)
+// or at ((j + (k + 1/2) / 3) / W_d, (i + 1/2) / H_d) (bilinear). GL rows count upward, pmr's downward.
+const char* kEncodeFragment = R"(#version 330 core
+uniform sampler2DArray views;
+uniform isampler2D columns;  // texel (j, 3 class + k): a_mod_n, b, px
+uniform isampler2D rows;     // texel (i, 0): q_mod_n, s, py
+uniform int view_count, reversed, cell_rows, bilinear;
+uniform ivec2 display_size, view_size;
+out vec4 frag;
+vec4 subpixel(int j, int i, int k, int cls, ivec4 row) {
+  ivec4 col = texelFetch(columns, ivec2(j, 3 * cls + k), 0);
+  int v = col.x - row.x - (col.y < row.y ? 1 : 0);
+  v = v < 0 ? v + view_count : v;
+  v = reversed != 0 ? view_count - 1 - v : v;
+  if (bilinear != 0) {
+    vec2 p = vec2((float(j) + (float(k) + 0.5) / 3.0) / float(display_size.x), (float(i) + 0.5) / float(display_size.y));
+    return texture(views, vec3(p.x, 1.0 - p.y, float(v)));
+  }
+  return texelFetch(views, ivec3(col.z, view_size.y - 1 - row.z, v), 0);
+}
+void main() {
+  int j = int(gl_FragCoord.x), i = display_size.y - 1 - int(gl_FragCoord.y);
+  int cls = cell_rows > 1 ? (display_size.y - 1 - i) % cell_rows : 0;
+  ivec4 row = texelFetch(rows, ivec2(i, 0), 0);
+  vec4 s0 = subpixel(j, i, 0, cls, row), s1 = subpixel(j, i, 1, cls, row), s2 = subpixel(j, i, 2, cls, row);
+  frag = vec4(s0.r, s1.g, s2.b, (s0.a + s1.a + s2.a) / 3.0);
+}
+)";
+
+// The scene in GL buffers: one vertex array, and per material one range of the index buffer.
+struct Vertex {
+  float position[3], normal[3], color[4], uv0[2], uv1[2];
+};
+struct Batch {
+  int material = 0;
+  GLsizei first = 0, count = 0;  // in indices
+};
+struct GlScene {
+  GLuint vao = 0;
+  std::vector<Batch> batches;
+  std::vector<GLuint> textures;  // parallel to Scene::textures
+  size_t triangles = 0;
+};
+
+Vertex make_vertex(const pmr::Scene& s, uint32_t v, const float* normal) {
+  Vertex out{};
+  for (int c = 0; c < 3; ++c) out.position[c] = s.positions[v][c], out.normal[c] = normal[c];
+  std::memcpy(out.color, s.attributes[v].color, sizeof out.color);
+  if (s.texcoords.size() > 0) out.uv0[0] = s.texcoords[0][v].x, out.uv0[1] = s.texcoords[0][v].y;
+  if (s.texcoords.size() > 1) out.uv1[0] = s.texcoords[1][v].x, out.uv1[1] = s.texcoords[1][v].y;
+  return out;
+}
+
+// Indexed triangles grouped by material. A triangle without vertex normals gets three vertices of its
+// own carrying its face normal (pmr shades it with the face normal).
+void build_geometry(const pmr::Scene& s, std::vector<Vertex>& vertices, std::vector<uint32_t>& indices,
+                    std::vector<Batch>& batches) {
+  vertices.clear();
+  for (size_t v = 0; v < s.positions.size(); ++v) vertices.push_back(make_vertex(s, uint32_t(v), s.attributes[v].normal));
+  std::vector<std::vector<uint32_t>> per_material(s.materials.size());
+  for (const PmrTriangle& t : s.triangles) {
+    std::vector<uint32_t>& out = per_material.at(t.material);
+    for (int k = 0; k < 3; ++k) {
+      if (t.has_normals) {
+        out.push_back(t.v[k]);
+      } else {
+        out.push_back(uint32_t(vertices.size()));
+        vertices.push_back(make_vertex(s, t.v[k], t.face_normal));
+      }
+    }
+  }
+  indices.clear();
+  batches.clear();
+  for (size_t m = 0; m < per_material.size(); ++m) {
+    if (per_material[m].empty()) continue;
+    batches.push_back({int(m), GLsizei(indices.size()), GLsizei(per_material[m].size())});
+    indices.insert(indices.end(), per_material[m].begin(), per_material[m].end());
+  }
+}
+
+GLuint upload_geometry(const std::vector<Vertex>& vertices, const std::vector<uint32_t>& indices) {
+  GLuint vao = 0, vbo = 0, ibo = 0;
+  glGenVertexArrays(1, &vao);
+  glBindVertexArray(vao);
+  glGenBuffers(1, &vbo);
+  glBindBuffer(GL_ARRAY_BUFFER, vbo);
+  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(Vertex)), vertices.data(), GL_STATIC_DRAW);
+  glGenBuffers(1, &ibo);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ibo);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(uint32_t)), indices.data(), GL_STATIC_DRAW);
+  const struct {
+    GLint size;
+    size_t offset;
+  } attribs[] = {{3, offsetof(Vertex, position)},
+                 {3, offsetof(Vertex, normal)},
+                 {4, offsetof(Vertex, color)},
+                 {2, offsetof(Vertex, uv0)},
+                 {2, offsetof(Vertex, uv1)}};
+  for (GLuint a = 0; a < 5; ++a) {
+    glEnableVertexAttribArray(a);
+    glVertexAttribPointer(a, attribs[a].size, GL_FLOAT, GL_FALSE, sizeof(Vertex),
+                          reinterpret_cast<const void*>(attribs[a].offset));
+  }
+  return vao;
+}
+
+// Colour maps as sRGB (decoded before filtering, as pmr decodes before its bilinear filter), data maps
+// linear; mip-mapped trilinear unless mipmap is false. Rows as stored: glTF's (0, 0) is the image's
+// top-left, which is texel row 0.
+GLuint upload_texture(const pmr::SceneTexture& t, bool mipmap) {
+  GLuint tex = 0;
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  const bool srgb = (t.slots & ((1u << pmr::kSlotBaseColor) | (1u << pmr::kSlotEmissive))) != 0;
+  glTexImage2D(GL_TEXTURE_2D, 0, srgb ? GL_SRGB8_ALPHA8 : GL_RGBA8, t.width, t.height, 0, GL_RGBA, GL_UNSIGNED_BYTE,
+               t.rgba.data());
+  if (mipmap) glGenerateMipmap(GL_TEXTURE_2D);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, mipmap ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, t.wrap_s);  // PMR_WRAP_* are the GL enums
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, t.wrap_t);
+  return tex;
+}
+
+GlScene upload_scene(const pmr::Scene& s, bool mipmap) {
+  GlScene g;
+  std::vector<Vertex> vertices;
+  std::vector<uint32_t> indices;
+  build_geometry(s, vertices, indices, g.batches);
+  g.vao = upload_geometry(vertices, indices);
+  for (const pmr::SceneTexture& t : s.textures) g.textures.push_back(upload_texture(t, mipmap));
+  g.triangles = s.triangles.size();
+  return g;
+}
+
+// The render targets: the view atlas (one RGBA16F layer per view: pmr's views are halves too), the
+// framebuffer a view is drawn into, and the display image.
+struct Targets {
+  GLuint atlas = 0, draw_fbo = 0, resolve_fbo = 0, display_tex = 0, display_fbo = 0;
+  GLuint columns = 0, rows = 0;
+};
+
+GLuint renderbuffer(GLenum format, int samples, int w, int h) {
+  GLuint rb = 0;
+  glGenRenderbuffers(1, &rb);
+  glBindRenderbuffer(GL_RENDERBUFFER, rb);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, format, w, h);
+  return rb;
+}
+
+// With MSAA a view is drawn into multisampled renderbuffers and resolved into its atlas layer; without,
+// it is drawn straight into the layer (draw_fbo gets the layer attached per view).
+void create_view_targets(const Frame& f, int msaa, Targets& t) {
+  glGenTextures(1, &t.atlas);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, t.atlas);
+  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA16F, f.view_w, f.view_h, f.views, 0, GL_RGBA, GL_HALF_FLOAT, nullptr);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);  // used by bilinear sampling only
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glGenFramebuffers(1, &t.draw_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, t.draw_fbo);
+  // float depth: pmr's depth is a float window depth
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                            renderbuffer(GL_DEPTH_COMPONENT32F, msaa, f.view_w, f.view_h));
+  if (msaa > 0) {
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                              renderbuffer(GL_RGBA16F, msaa, f.view_w, f.view_h));
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw std::runtime_error("the multisampled view framebuffer is incomplete");
+    glGenFramebuffers(1, &t.resolve_fbo);
+  } else {
+    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, t.atlas, 0, 0);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      throw std::runtime_error("the view framebuffer is incomplete");
+  }
+}
+
+// pmr's encoder tables as integer textures (columns: one row per subpixel k and row class).
+void create_encode_tables(const Frame& f, Targets& t) {
+  const PmrEncodeParams p = pmr::make_encode_params(f.display, f.views, f.view_w, f.view_h);
+  std::vector<PmrEncodeColumn> columns;
+  std::vector<PmrEncodeRow> rows;
+  pmr::make_encode_tables(f.display, p, columns, rows);
+  const int w = f.display.width, h = f.display.height, classes = std::max(1, p.cell_rows);
+  std::vector<int32_t> col_texels(size_t(w) * 3 * size_t(classes) * 4), row_texels(size_t(h) * 4);
+  for (int c = 0; c < classes; ++c)
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < w; ++j) {
+        const PmrEncodeColumn& e = columns[size_t(c) * 3 * size_t(w) + 3 * size_t(j) + size_t(k)];
+        int32_t* texel = &col_texels[((size_t(c) * 3 + size_t(k)) * size_t(w) + size_t(j)) * 4];
+        texel[0] = e.a_mod_n, texel[1] = e.b, texel[2] = e.px;
+      }
+  for (int i = 0; i < h; ++i) row_texels[size_t(i) * 4] = rows[i].q_mod_n, row_texels[size_t(i) * 4 + 1] = rows[i].s,
+                                row_texels[size_t(i) * 4 + 2] = rows[i].py;
+  glGenTextures(1, &t.columns);
+  glBindTexture(GL_TEXTURE_2D, t.columns);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32I, w, 3 * classes, 0, GL_RGBA_INTEGER, GL_INT, col_texels.data());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glGenTextures(1, &t.rows);
+  glBindTexture(GL_TEXTURE_2D, t.rows);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32I, h, 1, 0, GL_RGBA_INTEGER, GL_INT, row_texels.data());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+}
+
+void create_display_target(const Frame& f, Targets& t) {
+  glGenTextures(1, &t.display_tex);
+  glBindTexture(GL_TEXTURE_2D, t.display_tex);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, f.display.width, f.display.height, 0, GL_RGBA, GL_HALF_FLOAT, nullptr);
+  glGenFramebuffers(1, &t.display_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, t.display_fbo);
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.display_tex, 0);
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw std::runtime_error("the display framebuffer is incomplete");
+}
+
+struct Programs {
+  GLuint scene = 0, encode = 0;
+  GLuint empty_vao = 0;  // core profile: the encoder's draw needs a vertex array, without attributes
+};
+
+// One material's uniforms and state (DESIGN 4: MASK discards below the cutoff, BLEND is drawn opaque;
+// single-sided materials are culled on back faces).
+void bind_material(const pmr::Scene& s, const GlScene& g, GLuint program, int m) {
+  const PmrMaterial& mat = s.materials[size_t(m)];
+  glUniform4fv(glGetUniformLocation(program, "base_factor"), 1, mat.base_color);
+  glUniform1i(glGetUniformLocation(program, "mask"), mat.alpha_mode == PMR_ALPHA_MASK);
+  glUniform1f(glGetUniformLocation(program, "cutoff"), mat.alpha_cutoff);
+  if (mat.double_sided) glDisable(GL_CULL_FACE);
+  else glEnable(GL_CULL_FACE);
+  pmr::SceneTextureSlot slot;
+  if (size_t(m) < s.material_inputs.size()) slot = s.material_inputs[size_t(m)].slots[pmr::kSlotBaseColor];
+  const bool textured = slot.texture >= 0;
+  glUniform1i(glGetUniformLocation(program, "textured"), textured);
+  if (!textured) return;
+  glBindTexture(GL_TEXTURE_2D, g.textures.at(size_t(slot.texture)));
+  if (slot.texcoord > 1) throw std::runtime_error("base colour textures on TEXCOORD_2 and up are not implemented");
+  glUniform1i(glGetUniformLocation(program, "uv_set"), slot.texcoord);
+  const float c = std::cos(slot.rotation), sn = std::sin(slot.rotation);
+  const float sx = slot.scale[0], sy = slot.scale[1];
+  glUniform3f(glGetUniformLocation(program, "uv_u"), sx * c, sy * sn, slot.offset[0]);
+  glUniform3f(glGetUniformLocation(program, "uv_v"), -sx * sn, sy * c, slot.offset[1]);
+}
+
+// Pass 1: the N views, one pass each, each resolved into its atlas layer.
+void draw_views(const pmr::Scene& s, const GlScene& g, const Frame& f, const Programs& p, const Targets& t, int msaa) {
+  glUseProgram(p.scene);
+  glBindVertexArray(g.vao);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glViewport(0, 0, f.view_w, f.view_h);
+  glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+  glUniform3fv(glGetUniformLocation(p.scene, "light"), 1, glm::value_ptr(f.light_world));
+  const GLint clip = glGetUniformLocation(p.scene, "clip_from_world");
+  for (int v = 0; v < f.views; ++v) {
+    glBindFramebuffer(GL_FRAMEBUFFER, t.draw_fbo);
+    if (msaa == 0) glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, t.atlas, 0, v);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glUniformMatrix4fv(clip, 1, GL_FALSE, glm::value_ptr(f.clip_from_world[size_t(v)]));
+    for (const Batch& b : g.batches) {
+      bind_material(s, g, p.scene, b.material);
+      glDrawElements(GL_TRIANGLES, b.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(b.first) * 4));
+    }
+    if (msaa == 0) continue;
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, t.draw_fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, t.resolve_fbo);
+    glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, t.atlas, 0, v);
+    glBlitFramebuffer(0, 0, f.view_w, f.view_h, 0, 0, f.view_w, f.view_h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  }
+  glDisable(GL_CULL_FACE);
+  glDisable(GL_DEPTH_TEST);
+}
+
+// Pass 2: the display encoding, one fragment per display pixel.
+void encode_display(const Frame& f, const Programs& p, const Targets& t) {
+  glUseProgram(p.encode);
+  glBindVertexArray(p.empty_vao);
+  glBindFramebuffer(GL_FRAMEBUFFER, t.display_fbo);
+  glViewport(0, 0, f.display.width, f.display.height);
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D_ARRAY, t.atlas);
+  glActiveTexture(GL_TEXTURE1);
+  glBindTexture(GL_TEXTURE_2D, t.columns);
+  glActiveTexture(GL_TEXTURE2);
+  glBindTexture(GL_TEXTURE_2D, t.rows);
+  glActiveTexture(GL_TEXTURE0);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+}
+
+void set_encode_uniforms(const Frame& f, GLuint program) {
+  glUseProgram(program);
+  glUniform1i(glGetUniformLocation(program, "views"), 0);
+  glUniform1i(glGetUniformLocation(program, "columns"), 1);
+  glUniform1i(glGetUniformLocation(program, "rows"), 2);
+  glUniform1i(glGetUniformLocation(program, "view_count"), f.views);
+  glUniform1i(glGetUniformLocation(program, "reversed"), f.display.reversed);
+  glUniform1i(glGetUniformLocation(program, "cell_rows"), f.display.cell_offsets.empty() ? 1 : f.display.cell_rows);
+  glUniform1i(glGetUniformLocation(program, "bilinear"), f.display.bilinear);
+  glUniform2i(glGetUniformLocation(program, "display_size"), f.display.width, f.display.height);
+  glUniform2i(glGetUniformLocation(program, "view_size"), f.view_w, f.view_h);
+}
+
+double now_ms() {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+struct FrameTimes {
+  double views = 0, encode = 0, readback = 0, total = 0;
+};
+
+// One frame; glFinish closes each pass so its time is its own (llvmpipe runs passes asynchronously).
+FrameTimes render_frame(const pmr::Scene& s, const GlScene& g, const Frame& f, const Programs& p, const Targets& t,
+                        int msaa, std::vector<uint16_t>& display) {
+  FrameTimes ft;
+  const double t0 = now_ms();
+  draw_views(s, g, f, p, t, msaa);
+  glFinish();
+  const double t1 = now_ms();
+  encode_display(f, p, t);
+  glFinish();
+  const double t2 = now_ms();
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, t.display_fbo);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, f.display.width, f.display.height, GL_RGBA, GL_HALF_FLOAT, display.data());
+  glFinish();
+  const double t3 = now_ms();
+  ft.views = t1 - t0, ft.encode = t2 - t1, ft.readback = t3 - t2, ft.total = t3 - t0;
+  return ft;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// An EXR part of half RGBA from bottom-up GL rows (EXR rows run top-down).
+void add_part(std::vector<Imf::Header>& headers, std::vector<std::vector<uint16_t>>& pixels, const std::string& name,
+              const uint16_t* gl_rows, int w, int h) {
+  Imf::Header hd(w, h);
+  hd.setName(name);
+  hd.setType(Imf::SCANLINEIMAGE);
+  hd.compression() = Imf::ZIP_COMPRESSION;
+  for (const char* c : {"R", "G", "B", "A"}) hd.channels().insert(c, Imf::Channel(Imf::HALF));
+  headers.push_back(hd);
+  std::vector<uint16_t> top_down(size_t(w) * size_t(h) * 4);
+  for (int y = 0; y < h; ++y)
+    std::memcpy(&top_down[size_t(y) * size_t(w) * 4], gl_rows + size_t(h - 1 - y) * size_t(w) * 4, size_t(w) * 8);
+  pixels.push_back(std::move(top_down));
+}
+
+void write_parts(const std::string& path, const std::vector<Imf::Header>& headers,
+                 std::vector<std::vector<uint16_t>>& pixels) {
+  Imf::MultiPartOutputFile file(path.c_str(), headers.data(), int(headers.size()));
+  for (size_t p = 0; p < headers.size(); ++p) {
+    Imf::OutputPart part(file, int(p));
+    const int w = headers[p].dataWindow().max.x + 1, h = headers[p].dataWindow().max.y + 1;
+    Imf::FrameBuffer fb;
+    const char* names[] = {"R", "G", "B", "A"};
+    for (int c = 0; c < 4; ++c)
+      fb.insert(names[c], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(pixels[p].data() + c), 8, size_t(w) * 8));
+    part.setFrameBuffer(fb);
+    part.writePixels(h);
+  }
+}
+
+// The encoded image (pmr's frame_NNNN.exr without the per-subpixel alphas) and the views (pmr's
+// frame_NNNN.views.exr layout: one part view_NNN per view), for image comparisons with pmr's files.
+void write_outputs(const Frame& f, const Targets& t, const std::vector<uint16_t>& display, const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  std::vector<Imf::Header> headers;
+  std::vector<std::vector<uint16_t>> pixels;
+  add_part(headers, pixels, "encoded", display.data(), f.display.width, f.display.height);
+  write_parts(dir + "/gl_encoded.exr", headers, pixels);
+  std::vector<uint16_t> views(size_t(f.view_w) * size_t(f.view_h) * 4 * size_t(f.views));
+  glBindTexture(GL_TEXTURE_2D_ARRAY, t.atlas);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTexImage(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA, GL_HALF_FLOAT, views.data());
+  headers.clear(), pixels.clear();
+  char name[32];
+  for (int v = 0; v < f.views; ++v) {
+    std::snprintf(name, sizeof name, "view_%03d", v);
+    add_part(headers, pixels, name, &views[size_t(v) * size_t(f.view_w) * size_t(f.view_h) * 4], f.view_w, f.view_h);
+  }
+  write_parts(dir + "/gl_views.exr", headers, pixels);
+}
+
+void print_setup(const Options& o, const Frame& f, const GlScene& g) {
+  std::printf("renderer: %s (%s), LP_NUM_THREADS=%s\n", reinterpret_cast<const char*>(glGetString(GL_RENDERER)),
+              reinterpret_cast<const char*>(glGetString(GL_VERSION)), std::getenv("LP_NUM_THREADS"));
+  std::printf("scene: %s, %zu triangles, %zu batches, %zu textures (%s)\n", o.scene.c_str(), g.triangles,
+              g.batches.size(), g.textures.size(), o.mipmap ? "mip-mapped" : "no mip-maps");
+  std::printf("views: %d x %dx%d, MSAA %d; display %dx%d (%s); shading lambert", f.views, f.view_w, f.view_h, o.msaa,
+              f.display.width, f.display.height, f.display.bilinear ? "bilinear" : "nearest");
+  std::printf(" (sidecar: %s, %s sampling, %d spp)\n", f.shading.c_str(), f.sampling.c_str(), f.samples);
+  if (f.sampling != "view") std::printf("note: the sidecar's frame used %s sampling; this draws view sampling\n", f.sampling.c_str());
+}
+
+int run(const Options& o) {
+  const Frame f = read_sidecar(o.sidecar);
+  const pmr::Scene scene = pmr::load_scene(o.scene);
+  create_context();
+  const GlScene g = upload_scene(scene, o.mipmap);
+  Programs p{link(kSceneVertex, kSceneFragment), link(kFullscreenVertex, kEncodeFragment), 0};
+  glGenVertexArrays(1, &p.empty_vao);
+  glUseProgram(p.scene);
+  glUniform1i(glGetUniformLocation(p.scene, "base_texture"), 0);
+  set_encode_uniforms(f, p.encode);
+  Targets t;
+  create_view_targets(f, o.msaa, t);
+  create_encode_tables(f, t);
+  create_display_target(f, t);
+  print_setup(o, f, g);
+  std::vector<uint16_t> display(size_t(f.display.width) * size_t(f.display.height) * 4);
+  std::vector<double> total, views, encode, readback;
+  for (int frame = 0; frame <= o.frames; ++frame) {
+    const FrameTimes ft = render_frame(scene, g, f, p, t, o.msaa, display);
+    if (glGetError() != GL_NO_ERROR) throw std::runtime_error("OpenGL reported an error");
+    if (frame == 0) continue;  // warm-up: shader variants compiled, memory touched
+    total.push_back(ft.total), views.push_back(ft.views), encode.push_back(ft.encode), readback.push_back(ft.readback);
+  }
+  std::printf("median of %d frames: %.1f ms/frame (views %.1f, interlace %.1f, readback %.1f)\n", o.frames,
+              median(total), median(views), median(encode), median(readback));
+  std::printf("GL_MS_PER_FRAME %.3f\n", median(total));
+  if (!o.out.empty()) write_outputs(f, t, display, o.out);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  try {
+    o = parse_options(argc, argv);
+  } catch (const std::exception& e) {
+    if (*e.what()) std::fprintf(stderr, "pmr_gl_bench: %s\n", e.what());
+    std::fprintf(stderr, "%s", kUsage);
+    return 2;
+  }
+  try {
+    return run(o);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "pmr_gl_bench: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,7 +1,7 @@
 // pmr_gl_bench: the conventional way to make a multi-view display image, for comparison with pmr
 // (docs/PERFORMANCE.md, "Against OpenGL (Mesa llvmpipe)"). OpenGL 3.3 core on Mesa's llvmpipe (the
 // same CPU pmr runs on), one pass per view into a (multisampled) framebuffer, each view resolved into a
-// layer of a view atlas, then the display encoding as a fragment shader and one glReadPixels.
+// tile of a view atlas (a quilt), then the display encoding as a fragment shader and one glReadPixels.
 // The scene is loaded by pmr's own loader and the cameras and display come from a pmr sidecar, so both
 // programs draw the same triangles, materials and textures with the same matrices and view map.
 // Not a test: it times frames.
@@ -41,14 +41,18 @@ struct Options {
   std::string scene, sidecar, out;
   int msaa = 4, frames = 5;
   bool mipmap = true;
+  bool float_encoder = false;  // --encoder float
 };
 
 const char* kUsage =
-    "usage: pmr_gl_bench SCENE --sidecar FRAME.json [--msaa 0|4] [--frames K] [--no-mipmap] [--out DIR]\n"
+    "usage: pmr_gl_bench SCENE --sidecar FRAME.json [--msaa 0|4] [--frames K] [--no-mipmap]\n"
+    "                     [--encoder tables|float] [--out DIR]\n"
     "  SCENE: the glTF file pmr rendered; FRAME.json: that render's sidecar (cameras, display, light)\n"
     "  --msaa 0|4: samples per pixel of the view framebuffer (compare with pmr --samples 1|4); default 4\n"
     "  --frames K: timed frames after one warm-up frame; default 5\n"
     "  --no-mipmap: sample textures bilinearly without mip-maps, as pmr does (image comparisons)\n"
+    "  --encoder tables: pmr's exact view map from its tables (default); float: computed per subpixel in\n"
+    "    float arithmetic, as typical interlacing shaders do (no subpixel cells)\n"
     "  --out DIR: write DIR/gl_encoded.exr and DIR/gl_views.exr (parts view_000...) after timing\n";
 
 Options parse_options(int argc, char** argv) {
@@ -64,6 +68,11 @@ Options parse_options(int argc, char** argv) {
     else if (arg == "--frames") o.frames = std::stoi(value());
     else if (arg == "--out") o.out = value();
     else if (arg == "--no-mipmap") o.mipmap = false;
+    else if (arg == "--encoder") {
+      const std::string e = value();
+      if (e != "tables" && e != "float") throw std::runtime_error("--encoder takes tables or float");
+      o.float_encoder = e == "float";
+    }
     else if (arg == "--help" || arg == "-h") throw std::runtime_error("");
     else if (!arg.empty() && arg[0] == '-') throw std::runtime_error("unknown option " + arg);
     else o.scene = arg;
@@ -77,6 +86,7 @@ Options parse_options(int argc, char** argv) {
 // What the GL renderer takes from a pmr sidecar (docs/OUTPUTS.md; host/output/sidecar.cpp).
 struct Frame {
   int views = 0, view_w = 0, view_h = 0, samples = 1;
+  int quilt_columns = 1, quilt_rows = 1;   // the view atlas's tiles
   std::vector<glm::mat4> clip_from_world;  // proj * view per view, multiplied in double
   glm::vec3 light_world{0.0f};             // toward Lambert's light
   pmr::Display display;
@@ -120,6 +130,10 @@ Frame read_sidecar(const std::string& path) {
   f.view_w = rig.at("view_width").get<int>();
   f.view_h = rig.at("view_height").get<int>();
   f.samples = j.value("samples_per_pixel", 1);
+  // the squarest quilt: the likeliest to fit GL's texture size limit (checked by create_view_targets)
+  for (f.quilt_columns = 1; f.quilt_columns < f.views; ++f.quilt_columns)
+    if (f.quilt_columns * f.view_w >= (f.views + f.quilt_columns - 1) / f.quilt_columns * f.view_h) break;
+  f.quilt_rows = (f.views + f.quilt_columns - 1) / f.quilt_columns;
   f.scene = j.value("scene", "");
   f.sampling = j.value("sampling", "view");
   f.shading = j.contains("shading") ? j["shading"].value("model", "lambert") : "lambert";
@@ -241,32 +255,70 @@ void main() {
 }
 )";
 
+// Reading view v of the quilt (view 0 bottom-left, then left to right, then upward: GL's rows count
+// upward like the quilt's). A 2D texture rather than a 2D array: llvmpipe fetched from arrays about
+// 1.5x slower here. Bilinear samples are clamped to the view's own tile, as pmr clamps to the view.
+#define QUILT_GLSL \
+  "uniform sampler2D views;\n" \
+  "uniform int quilt_columns;\n" \
+  "uniform ivec2 view_size;\n" \
+  "ivec2 tile_origin(int v) { return ivec2(v % quilt_columns, v / quilt_columns) * view_size; }\n" \
+  "vec4 fetch(int v, ivec2 texel) { return texelFetch(views, tile_origin(v) + texel, 0); }\n" \
+  "vec4 bilinear(int v, vec2 p) {\n" \
+  "  vec2 q = clamp(p * vec2(view_size), vec2(0.5), vec2(view_size) - 0.5);\n" \
+  "  return texture(views, (vec2(tile_origin(v)) + q) / vec2(textureSize(views, 0)));\n" \
+  "}\n"
+
 // DESIGN section 5 through pmr's exact tables (host/rig/display.cpp): subpixel k of display pixel
 // (j, i) shows view v = a_mod_n - q_mod_n - (b < s) (+ N), sampled at its view pixel (px, py) (nearest)
 // or at ((j + (k + 1/2) / 3) / W_d, (i + 1/2) / H_d) (bilinear). GL rows count upward, pmr's downward.
-const char* kEncodeFragment = R"(#version 330 core
-uniform sampler2DArray views;
+const char* kEncodeFragment = "#version 330 core\n" QUILT_GLSL R"(
 uniform isampler2D columns;  // texel (j, 3 class + k): a_mod_n, b, px
 uniform isampler2D rows;     // texel (i, 0): q_mod_n, s, py
-uniform int view_count, reversed, cell_rows, bilinear;
-uniform ivec2 display_size, view_size;
+uniform int view_count, reversed, cell_rows, use_bilinear;
+uniform ivec2 display_size;
 out vec4 frag;
 vec4 subpixel(int j, int i, int k, int cls, ivec4 row) {
   ivec4 col = texelFetch(columns, ivec2(j, 3 * cls + k), 0);
   int v = col.x - row.x - (col.y < row.y ? 1 : 0);
   v = v < 0 ? v + view_count : v;
   v = reversed != 0 ? view_count - 1 - v : v;
-  if (bilinear != 0) {
+  if (use_bilinear != 0) {
     vec2 p = vec2((float(j) + (float(k) + 0.5) / 3.0) / float(display_size.x), (float(i) + 0.5) / float(display_size.y));
-    return texture(views, vec3(p.x, 1.0 - p.y, float(v)));
+    return bilinear(v, vec2(p.x, 1.0 - p.y));
   }
-  return texelFetch(views, ivec3(col.z, view_size.y - 1 - row.z, v), 0);
+  return fetch(v, ivec2(col.z, view_size.y - 1 - row.z));
 }
 void main() {
   int j = int(gl_FragCoord.x), i = display_size.y - 1 - int(gl_FragCoord.y);
   int cls = cell_rows > 1 ? (display_size.y - 1 - i) % cell_rows : 0;
   ivec4 row = texelFetch(rows, ivec2(i, 0), 0);
   vec4 s0 = subpixel(j, i, 0, cls, row), s1 = subpixel(j, i, 1, cls, row), s2 = subpixel(j, i, 2, cls, row);
+  frag = vec4(s0.r, s1.g, s2.b, (s0.a + s1.a + s2.a) / 3.0);
+}
+)";
+
+// The same map as a typical interlacing shader computes it, in float arithmetic, without tables (a
+// subpixel near a view boundary may pick the neighbouring view): t = (3j + k' - 3i tan_slant - offset) /
+// lens_pitch, v = floor(frac(phase_sign t) N), sampled at the subpixel's own position.
+const char* kEncodeFloatFragment = "#version 330 core\n" QUILT_GLSL R"(
+uniform int view_count, reversed, use_bilinear, phase_sign, bgr;
+uniform float tan_slant, offset, lens_pitch;
+uniform ivec2 display_size;
+out vec4 frag;
+vec4 subpixel(int j, int i, int k) {
+  float kk = float(bgr != 0 ? 2 - k : k);
+  float t = (3.0 * float(j) + kk - 3.0 * float(i) * tan_slant - offset) / lens_pitch;
+  int v = min(int(floor(fract(float(phase_sign) * t) * float(view_count))), view_count - 1);
+  v = reversed != 0 ? view_count - 1 - v : v;
+  vec2 p = vec2((float(j) + (float(k) + 0.5) / 3.0) / float(display_size.x), (float(i) + 0.5) / float(display_size.y));
+  if (use_bilinear != 0) return bilinear(v, vec2(p.x, 1.0 - p.y));
+  ivec2 texel = min(ivec2(p * vec2(view_size)), view_size - 1);
+  return fetch(v, ivec2(texel.x, view_size.y - 1 - texel.y));
+}
+void main() {
+  int j = int(gl_FragCoord.x), i = display_size.y - 1 - int(gl_FragCoord.y);
+  vec4 s0 = subpixel(j, i, 0), s1 = subpixel(j, i, 1), s2 = subpixel(j, i, 2);
   frag = vec4(s0.r, s1.g, s2.b, (s0.a + s1.a + s2.a) / 3.0);
 }
 )";
@@ -377,11 +429,12 @@ GlScene upload_scene(const pmr::Scene& s, bool mipmap) {
   return g;
 }
 
-// The render targets: the view atlas (one RGBA16F layer per view: pmr's views are halves too), the
+// The render targets: the view atlas (a quilt of RGBA16F tiles: pmr's views are halves too), the
 // framebuffer a view is drawn into, and the display image.
 struct Targets {
   GLuint atlas = 0, draw_fbo = 0, resolve_fbo = 0, display_tex = 0, display_fbo = 0;
   GLuint columns = 0, rows = 0;
+  int msaa = 0;
 };
 
 GLuint renderbuffer(GLenum format, int samples, int w, int h) {
@@ -392,32 +445,41 @@ GLuint renderbuffer(GLenum format, int samples, int w, int h) {
   return rb;
 }
 
-// With MSAA a view is drawn into multisampled renderbuffers and resolved into its atlas layer; without,
-// it is drawn straight into the layer (draw_fbo gets the layer attached per view).
+void check_framebuffer(const char* what) {
+  if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+    throw std::runtime_error(std::string("the ") + what + " framebuffer is incomplete");
+}
+
+// With MSAA a view is drawn into view-sized multisampled renderbuffers and resolved into its quilt
+// tile; without, it is drawn straight into its tile (viewport and scissor) over a quilt-sized depth
+// buffer. Depth is float: pmr's is a float window depth.
 void create_view_targets(const Frame& f, int msaa, Targets& t) {
+  GLint max_size = 0;
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+  const int qw = f.quilt_columns * f.view_w, qh = f.quilt_rows * f.view_h;
+  if (qw > max_size || qh > max_size)
+    throw std::runtime_error("the views (a " + std::to_string(qw) + "x" + std::to_string(qh) + " quilt) do not fit one texture of at most " + std::to_string(max_size));
   glGenTextures(1, &t.atlas);
-  glBindTexture(GL_TEXTURE_2D_ARRAY, t.atlas);
-  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA16F, f.view_w, f.view_h, f.views, 0, GL_RGBA, GL_HALF_FLOAT, nullptr);
-  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_LINEAR);  // used by bilinear sampling only
-  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glBindTexture(GL_TEXTURE_2D, t.atlas);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, qw, qh, 0, GL_RGBA, GL_HALF_FLOAT, nullptr);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);  // used by bilinear sampling only
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glGenFramebuffers(1, &t.draw_fbo);
   glBindFramebuffer(GL_FRAMEBUFFER, t.draw_fbo);
-  // float depth: pmr's depth is a float window depth
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
-                            renderbuffer(GL_DEPTH_COMPONENT32F, msaa, f.view_w, f.view_h));
   if (msaa > 0) {
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                              renderbuffer(GL_DEPTH_COMPONENT32F, msaa, f.view_w, f.view_h));
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
                               renderbuffer(GL_RGBA16F, msaa, f.view_w, f.view_h));
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      throw std::runtime_error("the multisampled view framebuffer is incomplete");
+    check_framebuffer("multisampled view");
     glGenFramebuffers(1, &t.resolve_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, t.resolve_fbo);
   } else {
-    glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, t.atlas, 0, 0);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      throw std::runtime_error("the view framebuffer is incomplete");
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                              renderbuffer(GL_DEPTH_COMPONENT32F, 0, qw, qh));
   }
+  glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t.atlas, 0);
+  check_framebuffer("view");
 }
 
 // pmr's encoder tables as integer textures (columns: one row per subpixel k and row class).
@@ -488,19 +550,21 @@ void bind_material(const pmr::Scene& s, const GlScene& g, GLuint program, int m)
   glUniform3f(glGetUniformLocation(program, "uv_v"), -sx * sn, sy * c, slot.offset[1]);
 }
 
-// Pass 1: the N views, one pass each, each resolved into its atlas layer.
+// Pass 1: the N views, one pass each, each drawn into or resolved into its quilt tile.
 void draw_views(const pmr::Scene& s, const GlScene& g, const Frame& f, const Programs& p, const Targets& t, int msaa) {
   glUseProgram(p.scene);
   glBindVertexArray(g.vao);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
-  glViewport(0, 0, f.view_w, f.view_h);
   glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
   glUniform3fv(glGetUniformLocation(p.scene, "light"), 1, glm::value_ptr(f.light_world));
   const GLint clip = glGetUniformLocation(p.scene, "clip_from_world");
+  if (msaa == 0) glEnable(GL_SCISSOR_TEST);  // the clear of one tile
   for (int v = 0; v < f.views; ++v) {
+    const int x = v % f.quilt_columns * f.view_w, y = v / f.quilt_columns * f.view_h;
     glBindFramebuffer(GL_FRAMEBUFFER, t.draw_fbo);
-    if (msaa == 0) glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, t.atlas, 0, v);
+    glViewport(msaa ? 0 : x, msaa ? 0 : y, f.view_w, f.view_h);
+    glScissor(x, y, f.view_w, f.view_h);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glUniformMatrix4fv(clip, 1, GL_FALSE, glm::value_ptr(f.clip_from_world[size_t(v)]));
     for (const Batch& b : g.batches) {
@@ -510,9 +574,9 @@ void draw_views(const pmr::Scene& s, const GlScene& g, const Frame& f, const Pro
     if (msaa == 0) continue;
     glBindFramebuffer(GL_READ_FRAMEBUFFER, t.draw_fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, t.resolve_fbo);
-    glFramebufferTextureLayer(GL_DRAW_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, t.atlas, 0, v);
-    glBlitFramebuffer(0, 0, f.view_w, f.view_h, 0, 0, f.view_w, f.view_h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBlitFramebuffer(0, 0, f.view_w, f.view_h, x, y, x + f.view_w, y + f.view_h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
   }
+  glDisable(GL_SCISSOR_TEST);
   glDisable(GL_CULL_FACE);
   glDisable(GL_DEPTH_TEST);
 }
@@ -524,7 +588,7 @@ void encode_display(const Frame& f, const Programs& p, const Targets& t) {
   glBindFramebuffer(GL_FRAMEBUFFER, t.display_fbo);
   glViewport(0, 0, f.display.width, f.display.height);
   glActiveTexture(GL_TEXTURE0);
-  glBindTexture(GL_TEXTURE_2D_ARRAY, t.atlas);
+  glBindTexture(GL_TEXTURE_2D, t.atlas);
   glActiveTexture(GL_TEXTURE1);
   glBindTexture(GL_TEXTURE_2D, t.columns);
   glActiveTexture(GL_TEXTURE2);
@@ -541,9 +605,16 @@ void set_encode_uniforms(const Frame& f, GLuint program) {
   glUniform1i(glGetUniformLocation(program, "view_count"), f.views);
   glUniform1i(glGetUniformLocation(program, "reversed"), f.display.reversed);
   glUniform1i(glGetUniformLocation(program, "cell_rows"), f.display.cell_offsets.empty() ? 1 : f.display.cell_rows);
-  glUniform1i(glGetUniformLocation(program, "bilinear"), f.display.bilinear);
+  glUniform1i(glGetUniformLocation(program, "use_bilinear"), f.display.bilinear);
+  glUniform1i(glGetUniformLocation(program, "quilt_columns"), f.quilt_columns);
   glUniform2i(glGetUniformLocation(program, "display_size"), f.display.width, f.display.height);
   glUniform2i(glGetUniformLocation(program, "view_size"), f.view_w, f.view_h);
+  // the float encoder's (the tables' shader has no such uniforms: these calls do nothing there)
+  glUniform1i(glGetUniformLocation(program, "phase_sign"), f.display.phase_sign);
+  glUniform1i(glGetUniformLocation(program, "bgr"), f.display.subpixel_bgr);
+  glUniform1f(glGetUniformLocation(program, "tan_slant"), float(f.display.tan_slant.value()));
+  glUniform1f(glGetUniformLocation(program, "offset"), float(f.display.offset.value()));
+  glUniform1f(glGetUniformLocation(program, "lens_pitch"), float(f.display.lens_pitch.value()));
 }
 
 double now_ms() {
@@ -618,15 +689,16 @@ void write_outputs(const Frame& f, const Targets& t, const std::vector<uint16_t>
   std::vector<std::vector<uint16_t>> pixels;
   add_part(headers, pixels, "encoded", display.data(), f.display.width, f.display.height);
   write_parts(dir + "/gl_encoded.exr", headers, pixels);
-  std::vector<uint16_t> views(size_t(f.view_w) * size_t(f.view_h) * 4 * size_t(f.views));
-  glBindTexture(GL_TEXTURE_2D_ARRAY, t.atlas);
+  std::vector<uint16_t> view(size_t(f.view_w) * size_t(f.view_h) * 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, t.msaa ? t.resolve_fbo : t.draw_fbo);  // the quilt
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glGetTexImage(GL_TEXTURE_2D_ARRAY, 0, GL_RGBA, GL_HALF_FLOAT, views.data());
   headers.clear(), pixels.clear();
   char name[32];
   for (int v = 0; v < f.views; ++v) {
+    glReadPixels(v % f.quilt_columns * f.view_w, v / f.quilt_columns * f.view_h, f.view_w, f.view_h, GL_RGBA,
+                 GL_HALF_FLOAT, view.data());
     std::snprintf(name, sizeof name, "view_%03d", v);
-    add_part(headers, pixels, name, &views[size_t(v) * size_t(f.view_w) * size_t(f.view_h) * 4], f.view_w, f.view_h);
+    add_part(headers, pixels, name, view.data(), f.view_w, f.view_h);
   }
   write_parts(dir + "/gl_views.exr", headers, pixels);
 }
@@ -644,15 +716,18 @@ void print_setup(const Options& o, const Frame& f, const GlScene& g) {
 
 int run(const Options& o) {
   const Frame f = read_sidecar(o.sidecar);
+  if (o.float_encoder && !f.display.cell_offsets.empty())
+    throw std::runtime_error("--encoder float has no subpixel cells (display.cell_rows): use tables");
   const pmr::Scene scene = pmr::load_scene(o.scene);
   create_context();
   const GlScene g = upload_scene(scene, o.mipmap);
-  Programs p{link(kSceneVertex, kSceneFragment), link(kFullscreenVertex, kEncodeFragment), 0};
+  Programs p{link(kSceneVertex, kSceneFragment), link(kFullscreenVertex, o.float_encoder ? kEncodeFloatFragment : kEncodeFragment), 0};
   glGenVertexArrays(1, &p.empty_vao);
   glUseProgram(p.scene);
   glUniform1i(glGetUniformLocation(p.scene, "base_texture"), 0);
   set_encode_uniforms(f, p.encode);
   Targets t;
+  t.msaa = o.msaa;
   create_view_targets(f, o.msaa, t);
   create_encode_tables(f, t);
   create_display_target(f, t);

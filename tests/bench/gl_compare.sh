@@ -2,15 +2,16 @@
 # pmr against OpenGL on the same CPU (docs/PERFORMANCE.md, "Against OpenGL (Mesa llvmpipe)"): for each
 # scene and sample count, pmr renders the frame once for its sidecar (the cameras and display the GL
 # program reuses), then `pmr bench` and pmr_gl_bench time it alternately, ROUNDS times each, and the
-# medians and their ratio are printed. Lambert shading on both sides; pmr --samples 1 against GL without
-# MSAA, --samples 4 against MSAA 4x.
+# medians and their ratio are printed. The same shading on both sides (SHADING: lambert, or pbr with
+# the uniform environment); pmr --samples 1 against GL without MSAA, --samples 4 against MSAA 4x.
 # Usage: tests/bench/gl_compare.sh [SCENE...]   (default: the bundled scene)
-# Environment: BUILD (build), PRESET (paper-8k), SAMPLES ("1 4"), FRAMES (3), ROUNDS (2),
+# Environment: BUILD (build), PRESET (paper-8k), SHADING (lambert), SAMPLES ("1 4"), FRAMES (3), ROUNDS (2),
 #              GL_ARGS (more pmr_gl_bench options, e.g. "--encoder float"), KEEP (a folder: keep the frames)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
 PRESET=${PRESET:-paper-8k}
+SHADING=${SHADING:-lambert}
 SAMPLES=${SAMPLES:-"1 4"}
 FRAMES=${FRAMES:-3}
 ROUNDS=${ROUNDS:-2}
@@ -24,17 +25,17 @@ WORK=${KEEP:-$(mktemp -d)}
 
 median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }'; }
 
-echo "# $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores; preset $PRESET; lambert; $FRAMES frames x $ROUNDS rounds"
+echo "# $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores (load $(cut -d' ' -f1-3 /proc/loadavg)); preset $PRESET; $SHADING; $FRAMES frames x $ROUNDS rounds"
 printf "%-28s %3s %5s %10s %10s %10s %10s %10s %7s\n" scene spp msaa pmr_ms gl_ms gl_views gl_interl gl_readbk gl/pmr
 for scene in "$@"; do
   name=$(basename "$scene")
   for s in $SAMPLES; do
     msaa=$([ "$s" = 1 ] && echo 0 || echo "$s")
     out="$WORK/${name%.*}_s$s"
-    "$BUILD/pmr" render "$scene" --preset "$PRESET" --shading lambert --samples "$s" --out "$out" >/dev/null 2>&1
+    "$BUILD/pmr" render "$scene" --preset "$PRESET" --shading "$SHADING" --samples "$s" --out "$out" >/dev/null 2>&1
     : > "$out/pmr.txt"; : > "$out/gl.txt"
     for _ in $(seq "$ROUNDS"); do
-      "$BUILD/pmr" bench "$scene" --preset "$PRESET" --method pmr --shading lambert --samples "$s" \
+      "$BUILD/pmr" bench "$scene" --preset "$PRESET" --method pmr --shading "$SHADING" --samples "$s" \
         --frames "$FRAMES" --no-check | awk '$1 == "pmr" { print $7 }' >> "$out/pmr.txt"
       # shellcheck disable=SC2086
       "$BUILD/pmr_gl_bench" "$scene" --sidecar "$out/frame_0000.json" --msaa "$msaa" --frames "$FRAMES" $GL_ARGS |

@@ -34,6 +34,7 @@
 
 #include "pmr/rig.h"
 #include "pmr/scene.h"
+#include "shading/environment.h"
 
 namespace {
 
@@ -88,10 +89,37 @@ struct Frame {
   int views = 0, view_w = 0, view_h = 0, samples = 1;
   int quilt_columns = 1, quilt_rows = 1;   // the view atlas's tiles
   std::vector<glm::mat4> clip_from_world;  // proj * view per view, multiplied in double
+  std::vector<glm::vec3> eyes;             // each view's camera position, world space (pbr)
   glm::vec3 light_world{0.0f};             // toward Lambert's light
   pmr::Display display;
   std::string scene, sampling, shading;
+  float exposure = 1.0f;  // 2^EV
+  // pbr: the lights as pmr used them (world space) and the uniform environment's radiance
+  std::vector<pmr::SceneLight> lights;
+  float env_radiance = 0.0f;
 };
+
+// pbr's lights and environment from the sidecar's "shading" (host/output/sidecar.cpp, shading_json).
+void read_pbr_inputs(const nlohmann::json& shading, Frame& f) {
+  const nlohmann::json& env = shading.at("environment");
+  if (env.at("kind").get<std::string>() != "uniform")
+    throw std::runtime_error("pbr with an environment image is not implemented here (uniform only)");
+  f.env_radiance = env.at("radiance").get<float>();
+  for (const nlohmann::json& j : shading.at("lights")) {
+    pmr::SceneLight l;
+    const std::string type = j.at("type").get<std::string>();
+    l.type = type == "point" ? pmr::SceneLightType::Point
+             : type == "spot" ? pmr::SceneLightType::Spot : pmr::SceneLightType::Directional;
+    for (int c = 0; c < 3; ++c) l.color[c] = j.at("color").at(c).get<float>();
+    l.intensity = j.at("intensity").get<float>();
+    if (j.contains("position")) l.position = glm::dvec3(j["position"][0], j["position"][1], j["position"][2]);
+    if (j.contains("direction")) l.direction = glm::dvec3(j["direction"][0], j["direction"][1], j["direction"][2]);
+    if (j.contains("range") && j["range"].is_number()) l.range = j["range"].get<float>();
+    l.inner_cone = j.value("inner_cone_angle", 0.0f), l.outer_cone = j.value("outer_cone_angle", 0.7853981634f);
+    f.lights.push_back(l);
+  }
+  if (f.lights.size() > 8) throw std::runtime_error("more than 8 lights are not implemented here");
+}
 
 // The display exactly as pmr encoded it: its fractions, so that make_encode_tables gives pmr's own
 // subpixel-to-view map.
@@ -137,8 +165,14 @@ Frame read_sidecar(const std::string& path) {
   f.scene = j.value("scene", "");
   f.sampling = j.value("sampling", "view");
   f.shading = j.contains("shading") ? j["shading"].value("model", "lambert") : "lambert";
-  for (const nlohmann::json& v : j.at("views"))
-    f.clip_from_world.push_back(glm::mat4(matrix_from_json(v.at("proj")) * matrix_from_json(v.at("view"))));
+  if (j.contains("shading")) f.exposure = float(std::exp2(j["shading"].value("exposure_ev", 0.0)));
+  if (f.shading == "pbr") read_pbr_inputs(j.at("shading"), f);
+  else if (f.shading != "lambert") throw std::runtime_error("unknown shading " + f.shading);
+  for (const nlohmann::json& v : j.at("views")) {
+    const glm::dmat4 view = matrix_from_json(v.at("view"));
+    f.clip_from_world.push_back(glm::mat4(matrix_from_json(v.at("proj")) * view));
+    f.eyes.push_back(glm::vec3(glm::inverse(view)[3]));
+  }
   if (int(f.clip_from_world.size()) != f.views) throw std::runtime_error("the sidecar's views do not match rig.views");
   const std::vector<double> l = j.at("light_dir_world").get<std::vector<double>>();
   f.light_world = glm::vec3(float(l.at(0)), float(l.at(1)), float(l.at(2)));
@@ -157,34 +191,46 @@ void select_llvmpipe() {
 
 // A surfaceless EGL display (no window system: runs on a headless machine) with a current OpenGL 3.3
 // core context. Everything renders into framebuffer objects.
+// No display or context: the test that runs this skips (tests/bench/gl_smoke.sh), it does not fail.
+struct NoContext : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+constexpr int kExitNoContext = 77;
+
 void create_context() {
   select_llvmpipe();
   EGLDisplay dpy = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
   EGLint major = 0, minor = 0;
   if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, &major, &minor))
-    throw std::runtime_error("no surfaceless EGL display (Mesa's EGL_MESA_platform_surfaceless)");
-  if (!eglBindAPI(EGL_OPENGL_API)) throw std::runtime_error("EGL cannot bind desktop OpenGL");
+    throw NoContext("no surfaceless EGL display (Mesa's EGL_MESA_platform_surfaceless)");
+  if (!eglBindAPI(EGL_OPENGL_API)) throw NoContext("EGL cannot bind desktop OpenGL");
   // no config (EGL_KHR_no_config_context): nothing is drawn to an EGL surface
   const EGLConfig config = EGL_NO_CONFIG_KHR;
   const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,       3, EGL_CONTEXT_MINOR_VERSION, 3,
                                     EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
                                     EGL_NONE};
   EGLContext ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, context_attribs);
-  if (ctx == EGL_NO_CONTEXT) throw std::runtime_error("no OpenGL 3.3 core context");
-  if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) throw std::runtime_error("eglMakeCurrent failed");
+  if (ctx == EGL_NO_CONTEXT) throw NoContext("no OpenGL 3.3 core context");
+  if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) throw NoContext("eglMakeCurrent failed");
+}
+
+// Throws the info log of a shader that did not compile or a program that did not link.
+void check_built(GLuint object, bool program) {
+  GLint ok = 0;
+  if (program) glGetProgramiv(object, GL_LINK_STATUS, &ok);
+  else glGetShaderiv(object, GL_COMPILE_STATUS, &ok);
+  if (ok) return;
+  char log[4096] = "";
+  if (program) glGetProgramInfoLog(object, sizeof log, nullptr, log);
+  else glGetShaderInfoLog(object, sizeof log, nullptr, log);
+  throw std::runtime_error(std::string(program ? "program: " : "shader: ") + log);
 }
 
 GLuint compile(GLenum type, const char* source) {
   const GLuint s = glCreateShader(type);
   glShaderSource(s, 1, &source, nullptr);
   glCompileShader(s);
-  GLint ok = 0;
-  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[4096];
-    glGetShaderInfoLog(s, sizeof log, nullptr, log);
-    throw std::runtime_error(std::string("shader: ") + log);
-  }
+  check_built(s, false);
   return s;
 }
 
@@ -193,57 +239,146 @@ GLuint link(const char* vertex, const char* fragment) {
   glAttachShader(p, compile(GL_VERTEX_SHADER, vertex));
   glAttachShader(p, compile(GL_FRAGMENT_SHADER, fragment));
   glLinkProgram(p);
-  GLint ok = 0;
-  glGetProgramiv(p, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[4096];
-    glGetProgramInfoLog(p, sizeof log, nullptr, log);
-    throw std::runtime_error(std::string("program: ") + log);
-  }
+  check_built(p, true);
   return p;
 }
 
-// DESIGN section 4a: base = baseColorFactor x baseColorTexture x COLOR_0, colour = base (0.2 + 0.8
-// max(0, n . l)), n flipped on back faces (only double-sided materials show them), alpha = coverage.
+// The vertex stage passes the world-space attributes on; every texture slot applies its own texCoord set
+// and KHR_texture_transform in the fragment stage (an affine map: the same as interpolating its result).
 const char* kSceneVertex = R"(#version 330 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec4 color;
 layout(location = 3) in vec2 uv0;
 layout(location = 4) in vec2 uv1;
+layout(location = 5) in vec4 tangent;
 uniform mat4 clip_from_world;
-uniform int uv_set;
-uniform vec3 uv_u, uv_v;  // KHR_texture_transform: u' = dot(uv_u, (u, v, 1)), v' = dot(uv_v, (u, v, 1))
-out vec3 v_normal;
-out vec4 v_color;
-out vec2 v_uv;
+out vec3 v_position, v_normal;
+out vec4 v_color, v_tangent;
+out vec2 v_uv0, v_uv1;
 void main() {
-  vec3 uv = vec3(uv_set == 0 ? uv0 : uv1, 1.0);
-  v_uv = vec2(dot(uv_u, uv), dot(uv_v, uv));
+  v_position = position;
   v_normal = normal;
   v_color = color;
+  v_tangent = tangent;
+  v_uv0 = uv0;
+  v_uv1 = uv1;
   gl_Position = clip_from_world * vec4(position, 1.0);
 }
 )";
 
+// DESIGN section 4a (lambert): base = baseColorFactor x baseColorTexture x COLOR_0, colour = base (0.2 +
+// 0.8 max(0, n . l)). Section 4b (pbr, cl/shade.h and cl/brdf.h): metallic-roughness GGX with the
+// normal, occlusion and emissive maps, the punctual lights of the sidecar and the uniform environment
+// through pmr's split-sum table. n is flipped on back faces (only double-sided materials show them),
+// alpha = coverage, colours times 2^EV and at most 65504 (half).
 const char* kSceneFragment = R"(#version 330 core
-in vec3 v_normal;
-in vec4 v_color;
-in vec2 v_uv;
+in vec3 v_position, v_normal;
+in vec4 v_color, v_tangent;
+in vec2 v_uv0, v_uv1;
+struct Slot { bool on; int set; vec3 u, v; };  // u' = dot(u, (u, v, 1)), v' = dot(v, (u, v, 1))
+uniform Slot slots[5];                         // base colour, metallic-roughness, normal, occlusion, emissive
+uniform sampler2D maps[5];
 uniform vec4 base_factor;
-uniform bool textured;
-uniform sampler2D base_texture;
-uniform bool mask;
-uniform float cutoff;
-uniform vec3 light;
+uniform bool mask, pbr, unlit;
+uniform float cutoff, exposure, metallic_factor, roughness_factor, normal_scale, occlusion_strength;
+uniform vec3 emissive_factor, light, eye;
+uniform int light_count;
+uniform int light_type[8];  // 0 directional, 1 point, 2 spot
+uniform vec3 light_color[8], light_position[8], light_direction[8];
+uniform float light_range[8], light_cos_inner[8], light_cos_outer[8];
+uniform float env_radiance;
+uniform sampler2D split_sum;  // 64 x 64 (A, B)
 out vec4 frag;
+const float PI = 3.14159265358979;
+vec4 sample_slot(sampler2D map, int k) {  // samplers: constant indices only
+  vec3 uv = vec3(slots[k].set == 0 ? v_uv0 : v_uv1, 1.0);
+  return texture(map, vec2(dot(slots[k].u, uv), dot(slots[k].v, uv)));
+}
+vec3 mapped_normal(vec3 n) {
+  vec3 t = v_tangent.xyz - n * dot(n, v_tangent.xyz);
+  float len = length(t);
+  vec3 s = sample_slot(maps[2], 2).xyz;
+  vec3 m = vec3((2.0 * s.xy - 1.0) * normal_scale, 2.0 * s.z - 1.0);
+  if (len <= 1e-12) return n;
+  t /= len;
+  vec3 mapped = t * m.x + cross(n, t) * (v_tangent.w < 0.0 ? -1.0 : 1.0) * m.y + n * m.z;
+  return length(mapped) > 0.0 ? normalize(mapped) : n;
+}
+vec3 brdf_cos(vec3 base, float metallic, float r, vec3 n, vec3 v, vec3 l) {
+  float nl = clamp(dot(n, l), 0.0, 1.0), nv = clamp(dot(n, v), 0.0, 1.0);
+  vec3 hv = l + v;
+  float hl = length(hv);
+  vec3 h = hl > 0.0 ? hv / hl : n;
+  float nh = clamp(dot(n, h), 0.0, 1.0), vh = clamp(dot(v, h), 0.0, 1.0);
+  float a2 = r * r * r * r;
+  vec3 f0 = mix(vec3(0.04), base, metallic);
+  float k = 1.0 - vh, k5 = k * k * k * k * k;
+  vec3 F = f0 + (1.0 - f0) * k5;
+  float d = nh * nh * (a2 - 1.0) + 1.0, D = a2 / (PI * d * d);
+  float sv = nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2);
+  float spec = D * (sv > 0.0 ? 0.5 / sv : 0.0);
+  vec3 f = (1.0 - F) * base * (1.0 - metallic) / PI + F * spec;
+  return nl > 0.0 ? f * nl : vec3(0.0);
+}
+vec3 irradiance_from(int i, vec3 p, out vec3 l) {
+  if (light_type[i] == 0) { l = -light_direction[i]; return light_color[i]; }
+  vec3 d = light_position[i] - p;
+  float d2 = dot(d, d), dist = sqrt(d2);
+  l = d2 > 0.0 ? d / dist : vec3(0.0);
+  float w = d2 > 0.0 ? 1.0 / d2 : 0.0;
+  if (light_range[i] > 0.0) { float q = dist / light_range[i]; w *= clamp(1.0 - q * q * q * q, 0.0, 1.0); }
+  if (light_type[i] == 2) {
+    float c = -dot(light_direction[i], l);
+    float s = clamp((c - light_cos_outer[i]) / max(0.001, light_cos_inner[i] - light_cos_outer[i]), 0.0, 1.0);
+    w *= s * s;
+  }
+  return light_color[i] * w;
+}
+vec2 split_sum_at(float nv, float r) {  // pmr's bilinear lookup (split_sum_lanes)
+  const int N = 64;
+  float x = sqrt(clamp(nv, 0.0, 1.0)) * float(N - 1), y = clamp(r, 0.0, 1.0) * float(N - 1);
+  int x0 = min(int(x), N - 2), y0 = min(int(y), N - 2);
+  float fx = x - float(x0), fy = y - float(y0);
+  vec2 a = texelFetch(split_sum, ivec2(x0, y0), 0).xy, b = texelFetch(split_sum, ivec2(x0 + 1, y0), 0).xy;
+  vec2 c = texelFetch(split_sum, ivec2(x0, y0 + 1), 0).xy, e = texelFetch(split_sum, ivec2(x0 + 1, y0 + 1), 0).xy;
+  return mix(mix(a, b, fx), mix(c, e, fx), fy);
+}
+vec3 shade_pbr(vec3 base, vec3 n) {
+  float metallic = metallic_factor, roughness = roughness_factor, ao = 1.0;
+  vec3 emissive = emissive_factor;
+  if (slots[1].on) { vec4 m = sample_slot(maps[1], 1); metallic *= m.b; roughness *= m.g; }
+  if (slots[3].on) ao = 1.0 + occlusion_strength * (sample_slot(maps[3], 3).r - 1.0);
+  if (slots[4].on) emissive *= sample_slot(maps[4], 4).rgb;
+  vec3 v = normalize(eye - v_position);
+  float r = clamp(roughness, 0.03, 1.0);
+  vec3 direct = vec3(0.0);
+  for (int i = 0; i < light_count; ++i) {
+    vec3 l;
+    vec3 E = irradiance_from(i, v_position, l);
+    direct += brdf_cos(base, metallic, r, n, v, l) * E;
+  }
+  vec2 AB = split_sum_at(dot(n, v), r);
+  vec3 f0 = mix(vec3(0.04), base, metallic);
+  vec3 ambient = ao * (base * (1.0 - metallic) * env_radiance + (f0 * AB.x + AB.y) * env_radiance);
+  return unlit ? base : direct + ambient + emissive;
+}
 void main() {
   vec4 base = base_factor * v_color;
-  if (textured) base *= texture(base_texture, v_uv);
+  if (slots[0].on) base *= sample_slot(maps[0], 0);
   if (mask && base.a < cutoff) discard;
-  vec3 n = normalize(v_normal);
-  if (!gl_FrontFacing) n = -n;
-  frag = vec4(base.rgb * (0.2 + 0.8 * max(dot(n, light), 0.0)), 1.0);
+  float len = length(v_normal);
+  vec3 n = len > 0.0 ? v_normal / len : v_normal;
+  vec3 c;
+  if (pbr) {
+    if (slots[2].on) n = mapped_normal(n);
+    if (!gl_FrontFacing) n = -n;
+    c = shade_pbr(base.rgb, n);
+  } else {
+    if (!gl_FrontFacing) n = -n;
+    c = base.rgb * (0.2 + 0.8 * max(dot(n, light), 0.0));
+  }
+  frag = vec4(min(c * exposure, vec3(65504.0)), 1.0);
 }
 )";
 
@@ -325,7 +460,7 @@ void main() {
 
 // The scene in GL buffers: one vertex array, and per material one range of the index buffer.
 struct Vertex {
-  float position[3], normal[3], color[4], uv0[2], uv1[2];
+  float position[3], normal[3], color[4], uv0[2], uv1[2], tangent[4];
 };
 struct Batch {
   int material = 0;
@@ -335,6 +470,7 @@ struct GlScene {
   GLuint vao = 0;
   std::vector<Batch> batches;
   std::vector<GLuint> textures;  // parallel to Scene::textures
+  GLuint white = 0;              // bound where a material has no texture in a slot
   size_t triangles = 0;
 };
 
@@ -344,6 +480,7 @@ Vertex make_vertex(const pmr::Scene& s, uint32_t v, const float* normal) {
   std::memcpy(out.color, s.attributes[v].color, sizeof out.color);
   if (s.texcoords.size() > 0) out.uv0[0] = s.texcoords[0][v].x, out.uv0[1] = s.texcoords[0][v].y;
   if (s.texcoords.size() > 1) out.uv1[0] = s.texcoords[1][v].x, out.uv1[1] = s.texcoords[1][v].y;
+  if (!s.tangents.empty()) std::memcpy(out.tangent, &s.tangents[v], sizeof out.tangent);
   return out;
 }
 
@@ -391,8 +528,9 @@ GLuint upload_geometry(const std::vector<Vertex>& vertices, const std::vector<ui
                  {3, offsetof(Vertex, normal)},
                  {4, offsetof(Vertex, color)},
                  {2, offsetof(Vertex, uv0)},
-                 {2, offsetof(Vertex, uv1)}};
-  for (GLuint a = 0; a < 5; ++a) {
+                 {2, offsetof(Vertex, uv1)},
+                 {4, offsetof(Vertex, tangent)}};
+  for (GLuint a = 0; a < 6; ++a) {
     glEnableVertexAttribArray(a);
     glVertexAttribPointer(a, attribs[a].size, GL_FLOAT, GL_FALSE, sizeof(Vertex),
                           reinterpret_cast<const void*>(attribs[a].offset));
@@ -425,8 +563,24 @@ GlScene upload_scene(const pmr::Scene& s, bool mipmap) {
   build_geometry(s, vertices, indices, g.batches);
   g.vao = upload_geometry(vertices, indices);
   for (const pmr::SceneTexture& t : s.textures) g.textures.push_back(upload_texture(t, mipmap));
+  pmr::SceneTexture white;
+  white.width = white.height = 1;
+  white.rgba = {255, 255, 255, 255};
+  g.white = upload_texture(white, false);
   g.triangles = s.triangles.size();
   return g;
+}
+
+// pmr's split-sum table (A, B) of the uniform environment, read texel by texel as pmr reads it.
+GLuint upload_split_sum() {
+  const std::vector<float>& table = pmr::split_sum_table();
+  GLuint tex = 0;
+  glGenTextures(1, &tex);
+  glBindTexture(GL_TEXTURE_2D, tex);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RG32F, PMR_SPLIT_SUM_N, PMR_SPLIT_SUM_N, 0, GL_RG, GL_FLOAT, table.data());
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  return tex;
 }
 
 // The render targets: the view atlas (a quilt of RGBA16F tiles: pmr's views are halves too), the
@@ -527,27 +681,73 @@ struct Programs {
   GLuint empty_vao = 0;  // core profile: the encoder's draw needs a vertex array, without attributes
 };
 
+// One texture slot: its texture on unit k (a white texel when absent: every sampler has a 2D texture),
+// its texCoord set and KHR_texture_transform (u' = sx cos(r) u + sy sin(r) v + ox, v' = -sx sin(r) u
+// + sy cos(r) v + oy).
+void bind_slot(const GlScene& g, GLuint program, int k, const pmr::SceneTextureSlot& slot) {
+  const std::string name = "slots[" + std::to_string(k) + "].";
+  glActiveTexture(GLenum(GL_TEXTURE0 + k));
+  glBindTexture(GL_TEXTURE_2D, slot.texture >= 0 ? g.textures.at(size_t(slot.texture)) : g.white);
+  glUniform1i(glGetUniformLocation(program, (name + "on").c_str()), slot.texture >= 0);
+  if (slot.texture < 0) return;
+  if (slot.texcoord > 1) throw std::runtime_error("textures on TEXCOORD_2 and up are not implemented here");
+  glUniform1i(glGetUniformLocation(program, (name + "set").c_str()), slot.texcoord);
+  const float c = std::cos(slot.rotation), sn = std::sin(slot.rotation);
+  const float sx = slot.scale[0], sy = slot.scale[1];
+  glUniform3f(glGetUniformLocation(program, (name + "u").c_str()), sx * c, sy * sn, slot.offset[0]);
+  glUniform3f(glGetUniformLocation(program, (name + "v").c_str()), -sx * sn, sy * c, slot.offset[1]);
+}
+
 // One material's uniforms and state (DESIGN 4: MASK discards below the cutoff, BLEND is drawn opaque;
-// single-sided materials are culled on back faces).
-void bind_material(const pmr::Scene& s, const GlScene& g, GLuint program, int m) {
+// single-sided materials are culled on back faces). Lambert reads the base colour slot alone.
+void bind_material(const pmr::Scene& s, const GlScene& g, GLuint program, int m, bool pbr) {
   const PmrMaterial& mat = s.materials[size_t(m)];
   glUniform4fv(glGetUniformLocation(program, "base_factor"), 1, mat.base_color);
   glUniform1i(glGetUniformLocation(program, "mask"), mat.alpha_mode == PMR_ALPHA_MASK);
   glUniform1f(glGetUniformLocation(program, "cutoff"), mat.alpha_cutoff);
   if (mat.double_sided) glDisable(GL_CULL_FACE);
   else glEnable(GL_CULL_FACE);
-  pmr::SceneTextureSlot slot;
-  if (size_t(m) < s.material_inputs.size()) slot = s.material_inputs[size_t(m)].slots[pmr::kSlotBaseColor];
-  const bool textured = slot.texture >= 0;
-  glUniform1i(glGetUniformLocation(program, "textured"), textured);
-  if (!textured) return;
-  glBindTexture(GL_TEXTURE_2D, g.textures.at(size_t(slot.texture)));
-  if (slot.texcoord > 1) throw std::runtime_error("base colour textures on TEXCOORD_2 and up are not implemented");
-  glUniform1i(glGetUniformLocation(program, "uv_set"), slot.texcoord);
-  const float c = std::cos(slot.rotation), sn = std::sin(slot.rotation);
-  const float sx = slot.scale[0], sy = slot.scale[1];
-  glUniform3f(glGetUniformLocation(program, "uv_u"), sx * c, sy * sn, slot.offset[0]);
-  glUniform3f(glGetUniformLocation(program, "uv_v"), -sx * sn, sy * c, slot.offset[1]);
+  const pmr::SceneMaterialInputs in =
+      size_t(m) < s.material_inputs.size() ? s.material_inputs[size_t(m)] : pmr::SceneMaterialInputs();
+  for (int k = 0; k < pmr::kTextureSlots; ++k)
+    bind_slot(g, program, k, k == pmr::kSlotBaseColor || pbr ? in.slots[size_t(k)] : pmr::SceneTextureSlot());
+  glActiveTexture(GL_TEXTURE0);
+  if (!pbr) return;
+  glUniform1f(glGetUniformLocation(program, "metallic_factor"), mat.metallic);
+  glUniform1f(glGetUniformLocation(program, "roughness_factor"), mat.roughness);
+  glUniform1f(glGetUniformLocation(program, "normal_scale"), mat.normal_scale);
+  glUniform1f(glGetUniformLocation(program, "occlusion_strength"), mat.occlusion_strength);
+  glUniform3fv(glGetUniformLocation(program, "emissive_factor"), 1, mat.emissive);
+  glUniform1i(glGetUniformLocation(program, "unlit"), mat.unlit != 0);
+}
+
+// The frame's shading uniforms: Lambert's light, or pbr's lights, environment and split-sum table.
+void set_shading_uniforms(const Frame& f, GLuint program, GLuint split_sum) {
+  glUseProgram(program);
+  for (int k = 0; k < pmr::kTextureSlots; ++k)
+    glUniform1i(glGetUniformLocation(program, ("maps[" + std::to_string(k) + "]").c_str()), k);
+  glUniform1i(glGetUniformLocation(program, "split_sum"), pmr::kTextureSlots);
+  glActiveTexture(GL_TEXTURE0 + pmr::kTextureSlots);
+  glBindTexture(GL_TEXTURE_2D, split_sum);
+  glActiveTexture(GL_TEXTURE0);
+  glUniform1i(glGetUniformLocation(program, "pbr"), f.shading == "pbr");
+  glUniform1f(glGetUniformLocation(program, "exposure"), f.exposure);
+  glUniform3fv(glGetUniformLocation(program, "light"), 1, glm::value_ptr(f.light_world));
+  glUniform1f(glGetUniformLocation(program, "env_radiance"), f.env_radiance);
+  glUniform1i(glGetUniformLocation(program, "light_count"), int(f.lights.size()));
+  for (size_t i = 0; i < f.lights.size(); ++i) {
+    const pmr::SceneLight& l = f.lights[i];
+    auto at = [&](const char* name) {
+      return glGetUniformLocation(program, (std::string(name) + "[" + std::to_string(i) + "]").c_str());
+    };
+    glUniform1i(at("light_type"), l.type == pmr::SceneLightType::Point ? 1 : l.type == pmr::SceneLightType::Spot ? 2 : 0);
+    glUniform3f(at("light_color"), l.color[0] * l.intensity, l.color[1] * l.intensity, l.color[2] * l.intensity);
+    glUniform3fv(at("light_position"), 1, glm::value_ptr(glm::vec3(l.position)));
+    glUniform3fv(at("light_direction"), 1, glm::value_ptr(glm::vec3(l.direction)));
+    glUniform1f(at("light_range"), l.range);
+    glUniform1f(at("light_cos_inner"), std::cos(l.inner_cone));
+    glUniform1f(at("light_cos_outer"), std::cos(l.outer_cone));
+  }
 }
 
 // Pass 1: the N views, one pass each, each drawn into or resolved into its quilt tile.
@@ -557,8 +757,8 @@ void draw_views(const pmr::Scene& s, const GlScene& g, const Frame& f, const Pro
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-  glUniform3fv(glGetUniformLocation(p.scene, "light"), 1, glm::value_ptr(f.light_world));
-  const GLint clip = glGetUniformLocation(p.scene, "clip_from_world");
+  const GLint clip = glGetUniformLocation(p.scene, "clip_from_world"), eye = glGetUniformLocation(p.scene, "eye");
+  const bool pbr = f.shading == "pbr";
   if (msaa == 0) glEnable(GL_SCISSOR_TEST);  // the clear of one tile
   for (int v = 0; v < f.views; ++v) {
     const int x = v % f.quilt_columns * f.view_w, y = v / f.quilt_columns * f.view_h;
@@ -567,8 +767,9 @@ void draw_views(const pmr::Scene& s, const GlScene& g, const Frame& f, const Pro
     glScissor(x, y, f.view_w, f.view_h);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glUniformMatrix4fv(clip, 1, GL_FALSE, glm::value_ptr(f.clip_from_world[size_t(v)]));
+    glUniform3fv(eye, 1, glm::value_ptr(f.eyes[size_t(v)]));
     for (const Batch& b : g.batches) {
-      bind_material(s, g, p.scene, b.material);
+      bind_material(s, g, p.scene, b.material, pbr);
       glDrawElements(GL_TRIANGLES, b.count, GL_UNSIGNED_INT, reinterpret_cast<const void*>(size_t(b.first) * 4));
     }
     if (msaa == 0) continue;
@@ -708,9 +909,9 @@ void print_setup(const Options& o, const Frame& f, const GlScene& g) {
               reinterpret_cast<const char*>(glGetString(GL_VERSION)), std::getenv("LP_NUM_THREADS"));
   std::printf("scene: %s, %zu triangles, %zu batches, %zu textures (%s)\n", o.scene.c_str(), g.triangles,
               g.batches.size(), g.textures.size(), o.mipmap ? "mip-mapped" : "no mip-maps");
-  std::printf("views: %d x %dx%d, MSAA %d; display %dx%d (%s); shading lambert", f.views, f.view_w, f.view_h, o.msaa,
-              f.display.width, f.display.height, f.display.bilinear ? "bilinear" : "nearest");
-  std::printf(" (sidecar: %s, %s sampling, %d spp)\n", f.shading.c_str(), f.sampling.c_str(), f.samples);
+  std::printf("views: %d x %dx%d, MSAA %d; display %dx%d (%s); shading %s", f.views, f.view_w, f.view_h, o.msaa,
+              f.display.width, f.display.height, f.display.bilinear ? "bilinear" : "nearest", f.shading.c_str());
+  std::printf(" (sidecar: %s sampling, %d spp)\n", f.sampling.c_str(), f.samples);
   if (f.sampling != "view") std::printf("note: the sidecar's frame used %s sampling; this draws view sampling\n", f.sampling.c_str());
 }
 
@@ -723,8 +924,7 @@ int run(const Options& o) {
   const GlScene g = upload_scene(scene, o.mipmap);
   Programs p{link(kSceneVertex, kSceneFragment), link(kFullscreenVertex, o.float_encoder ? kEncodeFloatFragment : kEncodeFragment), 0};
   glGenVertexArrays(1, &p.empty_vao);
-  glUseProgram(p.scene);
-  glUniform1i(glGetUniformLocation(p.scene, "base_texture"), 0);
+  set_shading_uniforms(f, p.scene, upload_split_sum());
   set_encode_uniforms(f, p.encode);
   Targets t;
   t.msaa = o.msaa;
@@ -761,6 +961,9 @@ int main(int argc, char** argv) {
   }
   try {
     return run(o);
+  } catch (const NoContext& e) {
+    std::fprintf(stderr, "pmr_gl_bench: %s\n", e.what());
+    return kExitNoContext;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pmr_gl_bench: %s\n", e.what());
     return 1;

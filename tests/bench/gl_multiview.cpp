@@ -3,8 +3,8 @@
 // same CPU pmr runs on), one pass per view into a (multisampled) framebuffer, each view resolved into a
 // tile of a view atlas (a quilt), then the display encoding as a fragment shader and one glReadPixels.
 // The scene is loaded by pmr's own loader and the cameras and display come from a pmr sidecar, so both
-// programs draw the same triangles, materials and textures with the same matrices and view map.
-// Not a test: it times frames.
+// programs draw the same triangles, materials and textures with the same matrices and view map, shaded
+// as the sidecar's frame was (lambert, or pbr with the uniform environment). Not a test: it times frames.
 #define GL_GLEXT_PROTOTYPES 1
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
@@ -48,7 +48,7 @@ struct Options {
 const char* kUsage =
     "usage: pmr_gl_bench SCENE --sidecar FRAME.json [--msaa 0|4] [--frames K] [--no-mipmap]\n"
     "                     [--encoder tables|float] [--out DIR]\n"
-    "  SCENE: the glTF file pmr rendered; FRAME.json: that render's sidecar (cameras, display, light)\n"
+    "  SCENE: the glTF file pmr rendered; FRAME.json: that render's sidecar (cameras, display, shading)\n"
     "  --msaa 0|4: samples per pixel of the view framebuffer (compare with pmr --samples 1|4); default 4\n"
     "  --frames K: timed frames after one warm-up frame; default 5\n"
     "  --no-mipmap: sample textures bilinearly without mip-maps, as pmr does (image comparisons)\n"

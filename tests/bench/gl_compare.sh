@@ -8,6 +8,8 @@
 # Environment: BUILD (build), PRESET (paper-8k), SHADING (lambert), SAMPLES ("1 4"), FRAMES (3), ROUNDS (2),
 #              GL_ARGS (more pmr_gl_bench options, e.g. "--encoder float"), KEEP (a folder: keep the frames)
 set -euo pipefail
+scenes=()
+for a in "$@"; do scenes+=("$(realpath "$a")"); done  # named from the caller's folder
 cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
 PRESET=${PRESET:-paper-8k}
@@ -16,7 +18,7 @@ SAMPLES=${SAMPLES:-"1 4"}
 FRAMES=${FRAMES:-3}
 ROUNDS=${ROUNDS:-2}
 GL_ARGS=${GL_ARGS:-}
-[ $# -gt 0 ] || set -- data/default_scene.glb
+[ ${#scenes[@]} -gt 0 ] || scenes=(data/default_scene.glb)
 for exe in pmr pmr_gl_bench; do
   [ -x "$BUILD/$exe" ] || { echo "gl_compare: $BUILD/$exe missing: cmake --build $BUILD --target $exe" >&2; exit 2; }
 done
@@ -27,7 +29,7 @@ median() { sort -g | awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] 
 
 echo "# $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores (load $(cut -d' ' -f1-3 /proc/loadavg)); preset $PRESET; $SHADING; $FRAMES frames x $ROUNDS rounds"
 printf "%-28s %3s %5s %10s %10s %10s %10s %10s %7s\n" scene spp msaa pmr_ms gl_ms gl_views gl_interl gl_readbk gl/pmr
-for scene in "$@"; do
+for scene in "${scenes[@]}"; do
   name=$(basename "$scene")
   for s in $SAMPLES; do
     msaa=$([ "$s" = 1 ] && echo 0 || echo "$s")

@@ -13,6 +13,7 @@ PACKAGES=(
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
   libopenexr-dev openexr libpng-dev libxxhash-dev libdeflate-dev libisal-dev
   libgtest-dev
+  libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri  # pmr_gl_bench (tests/bench/gl_multiview.cpp) only
   python3 python3-matplotlib
 )
 # more packages for one script's own needs (scripts/fuzz.sh: clang), installed the same way

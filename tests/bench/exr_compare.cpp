@@ -8,6 +8,8 @@
 #include <ImfInputPart.h>
 #include <ImfMultiPartInputFile.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <exception>
@@ -60,8 +62,16 @@ int main(int argc, char** argv) {
         const std::vector<uint32_t> vb = read_channel(b, q, c.name(), wb, hb);
         if (wa != wb || ha != hb) throw std::runtime_error(std::string("channel ") + c.name() + ": sizes differ");
         size_t n = 0;
-        for (size_t i = 0; i < va.size(); ++i) n += va[i] != vb[i];
-        std::printf("part %d channel %s: %zu of %zu values differ\n", p, c.name(), n, va.size());
+        double sum = 0.0, max = 0.0;  // how far apart (images of other renderers: tests/bench/gl_compare.sh)
+        for (size_t i = 0; i < va.size(); ++i) {
+          n += va[i] != vb[i];
+          float fa, fb;
+          std::memcpy(&fa, &va[i], 4), std::memcpy(&fb, &vb[i], 4);
+          const double d = std::fabs(double(fa) - double(fb));
+          if (std::isfinite(d)) sum += d, max = std::max(max, d);
+        }
+        std::printf("part %d channel %s: %zu of %zu values differ (mean |A-B| %.3g, max %.3g)\n", p, c.name(), n,
+                    va.size(), va.empty() ? 0.0 : sum / double(va.size()), max);
         differing += n;
       }
     }

@@ -107,6 +107,8 @@ const BenchSection kMeasureOptions = {
            o.samples.clear();
            for (const auto& s : split(v)) o.samples.push_back(parse_samples(s));
          }},
+        {"--texture-filter", nullptr, "F", "trilinear (default) or bilinear, as for pmr render",
+         [](BenchOptions& o, const std::string& v, const std::string&) { o.texture_filter = parse_texture_filter(v); }},
         {"--frames", nullptr, "K", "timed frames per point after one warm-up frame (default 5)",
          [](BenchOptions& o, const std::string& v, const std::string&) {
            o.frames = std::atoi(v.c_str());

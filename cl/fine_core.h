@@ -129,7 +129,7 @@ PMR_HOT void lanes_gather(const ShadeInputs* in, global const PmrMta* mtas, MtaC
     todo &= ~bits;
     const PmrMta* m = cached_mta(cache, mtas, (uint)id_of[first]);
     lanes_add(L, in, m, take, bits, pbr);
-    if (trilinear) lanes_edge_derivatives(L, in->P, m, f, bits);
+    if (trilinear && (L->textured & bits)) lanes_edge_derivatives(L, in->P, m, f, bits); /* read by maps alone */
     long E[3];
     if (!S->sx) {
       long step[3];

@@ -176,6 +176,12 @@ TEST(TextureFilter, MagnifiedTrilinearIsBilinear) {
             test::render_with(s, rig, lambert(TextureFilter::Bilinear)).volume);
 }
 
+// The sidecar records the texture filter (absent in older sidecars: bilinear), and --resume refuses a
+// folder rendered with the other one.
+TEST(TextureFilter, SidecarRecordsItAndResumeComparesIt) {
+  test::expect_resume_compares("--texture-filter bilinear", "\"texture_filter\": \"bilinear\"", "texture_filter");
+}
+
 // A texture of smooth ramps with a fine checker in green, so that every level differs.
 SceneTexture ramps(int w, int h) {
   SceneTexture t;

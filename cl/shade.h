@@ -95,8 +95,10 @@ typedef struct {
   sfloat3 emissive;
   uint textured; /* bit l: lane l's material has a map the model reads (lambert: base colour) */
   uint tri[SW];  /* lane l's triangle, where textured                               */
+#if PMR_TRILINEAR
   /* trilinear: the edge functions' derivatives per output pixel in x and y (lanes_edge_derivatives) */
   float ex[3][SW], ey[3][SW];
+#endif
 } LaneWinners;
 
 /* No lanes yet; idle lanes keep finite values so that the vector arithmetic stays cheap. */
@@ -212,6 +214,7 @@ inline void mta_edge_derivatives(global const PmrParams* P, const PmrMta* m, lon
   *ey = (float3)(dy[0], dy[1], dy[2]) * P->lod_scale_y;
 }
 
+#if PMR_TRILINEAR
 /* Trilinear filtering: lanes `bits`, won by MTA m in the view with view coordinate f, get its edge
  * functions' derivatives. */
 inline void lanes_edge_derivatives(LaneWinners* L, global const PmrParams* P, const PmrMta* m, long f, uint bits) {
@@ -223,6 +226,7 @@ inline void lanes_edge_derivatives(LaneWinners* L, global const PmrParams* P, co
     L->ey[0][l] = ey.x, L->ey[1][l] = ey.y, L->ey[2][l] = ey.z;
   }
 }
+#endif
 
 /* Barycentrics in the SOURCE triangle, perspective-correct, of every lane. */
 inline sfloat3 lane_barycentrics(const LaneWinners* L) {
@@ -247,6 +251,7 @@ typedef struct {
   float s[3][SW], tw[4][SW], normal_scale[SW];
 } LaneTextures;
 
+#if PMR_TRILINEAR
 /* A lane's inputs to bary_gradient, stored per lane (sample_lanes reads them lane by lane). */
 typedef struct {
   float e[3][SW], iw[3][SW], s1[3][SW], s2[3][SW];
@@ -269,13 +274,16 @@ inline BaryGrad lane_gradient(const LaneWinners* L, const LaneGradients* G, int 
                        (float3)(G->s1[0][l], G->s1[1][l], G->s1[2][l]),
                        (float3)(G->s2[0][l], G->s2[1][l], G->s2[2][l]));
 }
+#endif
 
 inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b, bool pbr, LaneTextures* T) {
   float bs[3][SW];
   s3_store(b, bs[0], bs[1], bs[2]);
+  const bool trilinear = PMR_USE_TRILINEAR(in->P);
+#if PMR_TRILINEAR
   LaneGradients G;
-  const bool trilinear = in->P->texture_filter == PMR_FILTER_TRILINEAR;
   if (trilinear) lane_gradient_inputs(L, &G);
+#endif
   for (int l = 0; l < SW; ++l) {
     for (int k = 0; k < 3; ++k) T->base[k][l] = 1.0f;
     for (int k = 0; k < 4; ++k) T->tw[k][l] = 0.0f;
@@ -287,7 +295,9 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
     global const PmrMaterial* mat = &in->materials[t.material];
     const float3 bl = (float3)(bs[0][l], bs[1][l], bs[2][l]);
     BaryGrad gl;
+#if PMR_TRILINEAR
     if (trilinear) gl = lane_gradient(L, &G, l);
+#endif
     const BaryGrad* g = trilinear ? &gl : 0;
     if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
       const float4 c = sample_map(in, &mat->maps[PMR_MAP_BASE_COLOR], &t, bl, g, true);
@@ -501,7 +511,7 @@ inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, lon
                                       b.z * in->attrs[t.v[2]].color[3]);
   if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
     BaryGrad g;
-    const bool trilinear = in->P->texture_filter == PMR_FILTER_TRILINEAR;
+    const bool trilinear = PMR_USE_TRILINEAR(in->P);
     if (trilinear) g = mta_bary_gradient(in->P, m, f, e);
     alpha *= sample_map(in, &mat->maps[PMR_MAP_BASE_COLOR], &t, b, trilinear ? &g : 0, true).w;
   }

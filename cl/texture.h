@@ -7,6 +7,15 @@
 
 #include "common.h"
 
+/* The kernels are built for one filter (-DPMR_TRILINEAR, the host's --texture-filter), as for one
+ * sample count: built with 0 they carry no per-lane derivatives and no level-of-detail code, so
+ * bilinear filtering costs what it did before mips. A build without the define serves both filters,
+ * chosen by PmrParams.texture_filter. */
+#ifndef PMR_TRILINEAR
+#define PMR_TRILINEAR 1
+#endif
+#define PMR_USE_TRILINEAR(P) (PMR_TRILINEAR && (P)->texture_filter == PMR_FILTER_TRILINEAR)
+
 inline int wrap_texel(int c, int size, int mode) {
   if ((uint)c < (uint)size) return c; /* inside: every mode leaves it (and skips a division) */
   if (mode == PMR_WRAP_CLAMP) return clamp(c, 0, size - 1);

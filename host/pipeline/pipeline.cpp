@@ -45,10 +45,12 @@ void method_tile(const PipelineConfig& config, size_t max_group, int* tile) {
 }
 
 // -w: PoCL's compiler would print "N warnings generated." on the user's terminal at every cold build.
-std::string build_options(const int* tile, int samples) {
+// PMR_TRILINEAR: bilinear filtering's kernels carry no level-of-detail code (cl/texture.h).
+std::string build_options(const int* tile, const PipelineConfig& config) {
   return "-cl-std=CL1.2 -w -cl-fp32-correctly-rounded-divide-sqrt -DPMR_TILE_X=" + std::to_string(tile[0]) +
          " -DPMR_TILE_Y=" + std::to_string(tile[1]) + " -DPMR_TILE_V=" + std::to_string(tile[2]) +
-         " -DPMR_VW=" + std::to_string(fine_lanes(tile[0])) + " -DPMR_SAMPLES=" + std::to_string(samples);
+         " -DPMR_VW=" + std::to_string(fine_lanes(tile[0])) + " -DPMR_SAMPLES=" + std::to_string(config.samples) +
+         " -DPMR_TRILINEAR=" + (config.texture_filter == TextureFilter::Trilinear ? "1" : "0");
 }
 
 }  // namespace
@@ -57,7 +59,7 @@ struct Pipeline::Impl {
   Impl(const ClRuntime& rt, const PipelineConfig& config, const int* tile_in)
       : tile{tile_in[0], tile_in[1], tile_in[2]},
         launcher(rt),
-        options(build_options(tile, config.samples)),
+        options(build_options(tile, config)),
         program(
             launcher.build({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl", "straddle_alpha.cl"}, options)),
         scene(rt, config),

@@ -116,6 +116,7 @@ inline void mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, int* w, int
 PMR_HOT void lanes_gather(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, sint act, sint ids,
                           const SampleLanes* S, int view, LaneWinners* L) {
   const bool pbr = in->P->shading == PMR_SHADING_PBR;
+  const bool trilinear = PMR_USE_TRILINEAR(in->P);
   const long f = view_coord(in->P, view);
   int id_of[SW];
   vstore_s(ids, 0, id_of);
@@ -130,6 +131,9 @@ PMR_HOT void lanes_gather(const ShadeInputs* in, global const PmrMta* mtas, MtaC
     todo &= ~bits;
     const PmrMta* m = cached_mta(cache, mtas, (uint)id_of[first]);
     lanes_add(L, in, m, take, bits, pbr);
+#if PMR_TRILINEAR
+    if (trilinear && (L->textured & bits)) lanes_edge_derivatives(L, in->P, m, f, bits); /* read by maps alone */
+#endif
     long E[3];
     if (!S->sx) {
       long step[3];

@@ -1,5 +1,6 @@
 /* Shading (docs/SHADING.md), the one module every path calls: base colour from baseColorFactor *
- * baseColorTexture (sRGB-decoded, bilinear, glTF wrap modes) * COLOR_0, then either view-independent
+ * baseColorTexture (sRGB-decoded; bilinear from level 0, or trilinear from mips at the analytic level of
+ * detail, docs/DESIGN.md section 3b; glTF wrap modes) * COLOR_0, then either view-independent
  * Lambert with one directional light, or glTF metallic-roughness (cl/brdf.h) with the material's
  * metallic-roughness, normal, occlusion and emissive maps, seen from each view's own camera, lit by the
  * frame's light table (the file's punctual lights or the default light) and the uniform default
@@ -18,43 +19,7 @@
 #include "lanes.h"
 #include "brdf.h"
 #include "environment.h"
-
-inline int wrap_texel(int c, int size, int mode) {
-  if ((uint)c < (uint)size) return c; /* inside: every mode leaves it (and skips a division) */
-  if (mode == PMR_WRAP_CLAMP) return clamp(c, 0, size - 1);
-  if (mode == PMR_WRAP_MIRROR) {
-    const int period = 2 * size;
-    int r = c % period;
-    if (r < 0) r += period;
-    return r < size ? r : period - 1 - r;
-  }
-  int r = c % size; /* REPEAT */
-  return r < 0 ? r + size : r;
-}
-
-/* Texel (x, y): colour maps decode sRGB, data maps (metallic-roughness, normal, occlusion) are linear. */
-inline float4 texel(global const uchar4* texels, global const float* srgb_lut, const PmrTexture* t, int x, int y,
-                    bool srgb) {
-  const uchar4 c = texels[t->offset + (uint)(y * t->width + x)];
-  if (!srgb) return convert_float4(c) * (1.0f / 255.0f);
-  return (float4)(srgb_lut[c.x], srgb_lut[c.y], srgb_lut[c.z], (float)c.w * (1.0f / 255.0f));
-}
-
-/* Bilinear sample; uv (0,0) is the top-left corner of the image (row 0). */
-inline float4 sample_texture(global const uchar4* texels, global const float* srgb_lut, const PmrTexture* t, float u,
-                             float v, bool srgb) {
-  const float fx = u * (float)t->width - 0.5f, fy = v * (float)t->height - 0.5f;
-  const float x0f = floor(fx), y0f = floor(fy);
-  const float ax = fx - x0f, ay = fy - y0f;
-  /* clamp before converting so huge UVs stay well defined */
-  const int x0 = (int)clamp(x0f, -1.0e8f, 1.0e8f), y0 = (int)clamp(y0f, -1.0e8f, 1.0e8f);
-  const int xa = wrap_texel(x0, t->width, t->wrap_s), xb = wrap_texel(x0 + 1, t->width, t->wrap_s);
-  const int ya = wrap_texel(y0, t->height, t->wrap_t), yb = wrap_texel(y0 + 1, t->height, t->wrap_t);
-  const float4 c00 = texel(texels, srgb_lut, t, xa, ya, srgb), c10 = texel(texels, srgb_lut, t, xb, ya, srgb);
-  const float4 c01 = texel(texels, srgb_lut, t, xa, yb, srgb), c11 = texel(texels, srgb_lut, t, xb, yb, srgb);
-  const float4 top = c00 + (c10 - c00) * ax, bottom = c01 + (c11 - c01) * ax;
-  return top + (bottom - top) * ay;
-}
+#include "texture.h"
 
 /* The shading inputs: the leading parameters of every kernel that shades, bound in this order by the
  * host (SceneBuffers::bind_shading, host/pipeline/scene_buffers.cpp), and gathered into one ShadeInputs
@@ -91,16 +56,23 @@ typedef struct {
 
 /* Material map `map` of triangle t at source barycentrics b (one lane): its TEXCOORD set interpolated,
  * then its KHR_texture_transform. Every map, base colour included, is read here alone, so that a set and
- * a transform mean the same for the colour, the alpha test and the pbr maps. */
+ * a transform mean the same for the colour, the alpha test and the pbr maps. g: the barycentrics'
+ * screen-space derivatives, from which the level of detail follows (trilinear); 0: level 0 (bilinear). */
 inline float4 sample_map(const ShadeInputs* in, global const PmrTextureMap* map, const PmrTriangle* t, float3 b,
-                         bool srgb) {
+                         const BaryGrad* g, bool srgb) {
   const uint set = map->texcoord * in->P->num_vertices;
-  const float2 uv =
-      b.x * in->texcoords[set + t->v[0]] + b.y * in->texcoords[set + t->v[1]] + b.z * in->texcoords[set + t->v[2]];
+  const float2 t0 = in->texcoords[set + t->v[0]], t1 = in->texcoords[set + t->v[1]],
+               t2 = in->texcoords[set + t->v[2]];
+  const float2 uv = b.x * t0 + b.y * t1 + b.z * t2;
   const float u = map->uv_transform[0] * uv.x + map->uv_transform[1] * uv.y + map->uv_transform[2];
   const float v = map->uv_transform[3] * uv.x + map->uv_transform[4] * uv.y + map->uv_transform[5];
   const PmrTexture tex = in->textures[map->texture];
-  return sample_texture(in->texels, in->srgb_lut, &tex, u, v, srgb);
+  float lambda = 0.0f;
+  if (g && tex.levels > 1u) {
+    const float2 dx = g->dx.x * t0 + g->dx.y * t1 + g->dx.z * t2, dy = g->dy.x * t0 + g->dy.y * t1 + g->dy.z * t2;
+    lambda = texture_lod(map->uv_transform, &tex, dx, dy);
+  }
+  return sample_texture(in->texels, in->srgb_lut, &tex, u, v, lambda, srgb);
 }
 
 /* SW winners to shade, one per lane (a row of 8 voxels of a real model holds a few small triangles):
@@ -123,6 +95,10 @@ typedef struct {
   sfloat3 emissive;
   uint textured; /* bit l: lane l's material has a map the model reads (lambert: base colour) */
   uint tri[SW];  /* lane l's triangle, where textured                               */
+#if PMR_TRILINEAR
+  /* trilinear: the edge functions' derivatives per output pixel in x and y (lanes_edge_derivatives) */
+  float ex[3][SW], ey[3][SW];
+#endif
 } LaneWinners;
 
 /* No lanes yet; idle lanes keep finite values so that the vector arithmetic stays cheap. */
@@ -222,6 +198,36 @@ inline void mta_edge_steps(const PmrMta* m, long* step) {
   step[2] = (long)m->sign * (long)(m->y[1] - m->y[0]) * PMR_X_ONE;
 }
 
+/* The sign-corrected edge functions' derivatives in the view with view coordinate f, per output pixel:
+ * one view pixel times PmrParams.lod_scale_x/y (the display pixel's footprint for subpixel sampling).
+ * x: (y_b - y_a) per 16.16 unit; y: -(x_b - x_a) per 24.8 unit. */
+inline void mta_edge_derivatives(global const PmrParams* P, const PmrMta* m, long f, float3* ex, float3* ey) {
+  long step[3];
+  mta_edge_steps(m, step);
+  float dy[3];
+  const int a[3] = {1, 2, 0}, b[3] = {2, 0, 1};
+  for (int k = 0; k < 3; ++k) {
+    const long xa = (long)m->x0[a[k]] + f * (long)m->dx[a[k]], xb = (long)m->x0[b[k]] + f * (long)m->dx[b[k]];
+    dy[k] = (float)(-(long)m->sign * (xb - xa) * PMR_Y_ONE);
+  }
+  *ex = (float3)((float)step[0], (float)step[1], (float)step[2]) * P->lod_scale_x;
+  *ey = (float3)(dy[0], dy[1], dy[2]) * P->lod_scale_y;
+}
+
+#if PMR_TRILINEAR
+/* Trilinear filtering: lanes `bits`, won by MTA m in the view with view coordinate f, get its edge
+ * functions' derivatives. */
+inline void lanes_edge_derivatives(LaneWinners* L, global const PmrParams* P, const PmrMta* m, long f, uint bits) {
+  float3 ex, ey;
+  mta_edge_derivatives(P, m, f, &ex, &ey);
+  for (uint b = bits; b != 0u; b &= b - 1u) {
+    const int l = 31 - (int)clz(b & (0u - b));
+    L->ex[0][l] = ex.x, L->ex[1][l] = ex.y, L->ex[2][l] = ex.z;
+    L->ey[0][l] = ey.x, L->ey[1][l] = ey.y, L->ey[2][l] = ey.z;
+  }
+}
+#endif
+
 /* Barycentrics in the SOURCE triangle, perspective-correct, of every lane. */
 inline sfloat3 lane_barycentrics(const LaneWinners* L) {
   const sfloat pa = L->e.x * L->inv_w[0], pb = L->e.y * L->inv_w[1], pc = L->e.z * L->inv_w[2];
@@ -245,9 +251,39 @@ typedef struct {
   float s[3][SW], tw[4][SW], normal_scale[SW];
 } LaneTextures;
 
+#if PMR_TRILINEAR
+/* A lane's inputs to bary_gradient, stored per lane (sample_lanes reads them lane by lane). */
+typedef struct {
+  float e[3][SW], iw[3][SW], s1[3][SW], s2[3][SW];
+} LaneGradients;
+
+inline void lane_gradient_inputs(const LaneWinners* L, LaneGradients* G) {
+  s3_store(L->e, G->e[0], G->e[1], G->e[2]);
+  for (int k = 0; k < 3; ++k) {
+    vstore_s(L->inv_w[k], 0, G->iw[k]);
+    vstore_s(L->bary[k][0], 0, G->s1[k]);
+    vstore_s(L->bary[k][1], 0, G->s2[k]);
+  }
+}
+
+inline BaryGrad lane_gradient(const LaneWinners* L, const LaneGradients* G, int l) {
+  return bary_gradient((float3)(G->e[0][l], G->e[1][l], G->e[2][l]),
+                       (float3)(L->ex[0][l], L->ex[1][l], L->ex[2][l]),
+                       (float3)(L->ey[0][l], L->ey[1][l], L->ey[2][l]),
+                       (float3)(G->iw[0][l], G->iw[1][l], G->iw[2][l]),
+                       (float3)(G->s1[0][l], G->s1[1][l], G->s1[2][l]),
+                       (float3)(G->s2[0][l], G->s2[1][l], G->s2[2][l]));
+}
+#endif
+
 inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b, bool pbr, LaneTextures* T) {
   float bs[3][SW];
   s3_store(b, bs[0], bs[1], bs[2]);
+  const bool trilinear = PMR_USE_TRILINEAR(in->P);
+#if PMR_TRILINEAR
+  LaneGradients G;
+  if (trilinear) lane_gradient_inputs(L, &G);
+#endif
   for (int l = 0; l < SW; ++l) {
     for (int k = 0; k < 3; ++k) T->base[k][l] = 1.0f;
     for (int k = 0; k < 4; ++k) T->tw[k][l] = 0.0f;
@@ -258,25 +294,30 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
     const PmrTriangle t = in->tris[L->tri[l]];
     global const PmrMaterial* mat = &in->materials[t.material];
     const float3 bl = (float3)(bs[0][l], bs[1][l], bs[2][l]);
+    BaryGrad gl;
+#if PMR_TRILINEAR
+    if (trilinear) gl = lane_gradient(L, &G, l);
+#endif
+    const BaryGrad* g = trilinear ? &gl : 0;
     if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
-      const float4 c = sample_map(in, &mat->maps[PMR_MAP_BASE_COLOR], &t, bl, true);
+      const float4 c = sample_map(in, &mat->maps[PMR_MAP_BASE_COLOR], &t, bl, g, true);
       T->base[0][l] = c.x, T->base[1][l] = c.y, T->base[2][l] = c.z;
     }
     if (!pbr) continue;
     if (mat->maps[PMR_MAP_METALLIC_ROUGHNESS].texture >= 0) {
-      const float4 m = sample_map(in, &mat->maps[PMR_MAP_METALLIC_ROUGHNESS], &t, bl, false);
+      const float4 m = sample_map(in, &mat->maps[PMR_MAP_METALLIC_ROUGHNESS], &t, bl, g, false);
       T->metallic[l] = m.z, T->roughness[l] = m.y;
     }
     if (mat->maps[PMR_MAP_OCCLUSION].texture >= 0)
       T->ao[l] =
-          1.0f + mat->occlusion_strength * (sample_map(in, &mat->maps[PMR_MAP_OCCLUSION], &t, bl, false).x - 1.0f);
+          1.0f + mat->occlusion_strength * (sample_map(in, &mat->maps[PMR_MAP_OCCLUSION], &t, bl, g, false).x - 1.0f);
     if (mat->maps[PMR_MAP_EMISSIVE].texture >= 0) {
-      const float4 e = sample_map(in, &mat->maps[PMR_MAP_EMISSIVE], &t, bl, true);
+      const float4 e = sample_map(in, &mat->maps[PMR_MAP_EMISSIVE], &t, bl, g, true);
       T->emissive[0][l] = e.x, T->emissive[1][l] = e.y, T->emissive[2][l] = e.z;
     }
     if (mat->maps[PMR_MAP_NORMAL].texture >= 0) {
       const float4 tw = bl.x * in->tangents[t.v[0]] + bl.y * in->tangents[t.v[1]] + bl.z * in->tangents[t.v[2]];
-      const float4 sn = sample_map(in, &mat->maps[PMR_MAP_NORMAL], &t, bl, false);
+      const float4 sn = sample_map(in, &mat->maps[PMR_MAP_NORMAL], &t, bl, g, false);
       T->mapped[l] = -1;
       T->normal_scale[l] = mat->normal_scale;
       T->tw[0][l] = tw.x, T->tw[1][l] = tw.y, T->tw[2][l] = tw.z, T->tw[3][l] = tw.w;
@@ -440,6 +481,17 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
   return s3_half_range(s3(base.x * lambert * exposure, base.y * lambert * exposure, base.z * lambert * exposure));
 }
 
+/* The barycentrics' derivatives of MTA m in the view with view coordinate f where its exact edge
+ * functions are e (one voxel, scalar: the MASK test). */
+inline BaryGrad mta_bary_gradient(global const PmrParams* P, const PmrMta* m, long f, const long* e) {
+  float3 ex, ey;
+  mta_edge_derivatives(P, m, f, &ex, &ey);
+  return bary_gradient((float3)((float)e[0], (float)e[1], (float)e[2]), ex, ey,
+                       (float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2]),
+                       (float3)(m->bary[0][0], m->bary[1][0], m->bary[2][0]),
+                       (float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1]));
+}
+
 /* alphaMode MASK: the base colour alpha of MTA m at raster point (X, Y) of view `view` passes the cutoff:
  * one voxel, scalar (the raster asks this of a few candidate voxels; its inputs are the same as the
  * lanes' base colour: the factor, COLOR_0 and the base colour map through sample_map). */
@@ -457,8 +509,12 @@ inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, lon
   global const PmrMaterial* mat = &in->materials[t.material];
   float alpha = mat->base_color[3] * (b.x * in->attrs[t.v[0]].color[3] + b.y * in->attrs[t.v[1]].color[3] +
                                       b.z * in->attrs[t.v[2]].color[3]);
-  if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0)
-    alpha *= sample_map(in, &mat->maps[PMR_MAP_BASE_COLOR], &t, b, true).w;
+  if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
+    BaryGrad g;
+    const bool trilinear = PMR_USE_TRILINEAR(in->P);
+    if (trilinear) g = mta_bary_gradient(in->P, m, f, e);
+    alpha *= sample_map(in, &mat->maps[PMR_MAP_BASE_COLOR], &t, b, trilinear ? &g : 0, true).w;
+  }
   return alpha >= cutoff;
 }
 

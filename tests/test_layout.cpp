@@ -59,6 +59,9 @@ TEST(Layout, DeviceStructsMatchHost) {
   // the view coordinates at the end of the frame parameters (probes 44, 45)
   EXPECT_EQ(got[44], offsetof(PmrParams, view_anchor));
   EXPECT_EQ(got[45], offsetof(PmrParams, view_coord));
+  // the texture filter's fields (probes 46, 47)
+  EXPECT_EQ(got[46], offsetof(PmrParams, lod_scale_x));
+  EXPECT_EQ(got[47], offsetof(PmrTexture, levels));
 }
 
 }  // namespace

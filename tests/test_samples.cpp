@@ -133,12 +133,7 @@ TEST(Samples, DepthIsTheNearestCoveredSampleNotAMean) {
 // The sidecar records the samples per pixel (absent in older sidecars: one), and --resume refuses a
 // folder rendered with another count.
 TEST(Samples, SidecarRecordsThemAndResumeComparesThem) {
-  const std::string out = test::temp_dir("samples_resume");
-  const std::string small = " --views 4 --view-size 48x24 --display 160x90 --out " + out;
-  ASSERT_EQ(test::run("render --samples 4" + small).status, 0);
-  EXPECT_NE(test::read_file(out + "/frame_0000.json").find("\"samples_per_pixel\": 4"), std::string::npos);
-  EXPECT_EQ(test::run("render --samples 4 --resume" + small).status, 0);
-  test::expect_one_error_line(test::run("render --resume" + small), "samples_per_pixel differs");
+  test::expect_resume_compares("--samples 4", "\"samples_per_pixel\": 4", "samples_per_pixel");
 }
 
 }  // namespace

@@ -250,6 +250,15 @@ void expect_one_error_line(const CliRun& r, const std::string& fragment, int sta
   EXPECT_NE(line.find(fragment), std::string::npos) << "expected '" << fragment << "' in: " << line;
 }
 
+void expect_resume_compares(const std::string& options, const std::string& recorded, const std::string& key) {
+  const std::string out = temp_dir("resume_" + key);
+  const std::string small = " --views 4 --view-size 48x24 --display 160x90 --out " + out;
+  ASSERT_EQ(run("render " + options + small).status, 0);
+  EXPECT_NE(read_file(out + "/frame_0000.json").find(recorded), std::string::npos);
+  EXPECT_EQ(run("render " + options + " --resume" + small).status, 0);
+  expect_one_error_line(run("render --resume" + small), key + " differs");
+}
+
 }  // namespace pmr::test
 
 namespace pmr::test {

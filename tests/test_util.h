@@ -107,6 +107,10 @@ void save_square_glb(const std::string& path);
 // The error is one line starting with "pmr: error:" (warnings may precede it), exit code `status`: 1
 // for bad input or a runtime error, 2 for a usage error (expect_usage_error).
 void expect_one_error_line(const CliRun& r, const std::string& fragment, int status = 1);
+// A run-wide choice the sidecar records and --resume compares: a small frame rendered with `options`
+// records `recorded` in its sidecar, --resume with the same options keeps it, and --resume without
+// them is refused in one error line naming `key`.
+void expect_resume_compares(const std::string& options, const std::string& recorded, const std::string& key);
 inline void expect_usage_error(const CliRun& r, const std::string& fragment) { expect_one_error_line(r, fragment, 2); }
 }  // namespace pmr::test
 

@@ -104,6 +104,8 @@ const BenchSection kMeasureOptions = {
          }},
         {"--samples", nullptr, "LIST", "samples per pixel, each as for pmr render (default 1)",
          [](BenchOptions& o, const std::string& v, const std::string&) { o.samples = parse_samples_list(v); }},
+        {"--texture-filter", nullptr, "F", "trilinear (default) or bilinear, as for pmr render",
+         [](BenchOptions& o, const std::string& v, const std::string&) { o.texture_filter = parse_texture_filter(v); }},
         {"--frames", nullptr, "K", "timed frames per point after one warm-up frame (default 5)",
          [](BenchOptions& o, const std::string& v, const std::string&) {
            o.frames = std::atoi(v.c_str());

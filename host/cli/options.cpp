@@ -420,6 +420,13 @@ const RenderSection kPipelineOptions = {
          "multisample patterns): coverage and depth per sample, each winner shaded\n"
          "once per pixel, the pixel the mean of its samples (alpha is coverage)",
          [](RenderOptions& o, const std::string& v, const std::string&) { o.job.pipeline.samples = parse_samples(v); }},
+        {"--texture-filter", nullptr, "F",
+         "trilinear (default): every texture's mip chain, the level of detail from the\n"
+         "analytic screen-space derivatives of the texture coordinates in the voxel's\n"
+         "own view; bilinear: level 0 alone, as before mips (docs/SAMPLING.md)",
+         [](RenderOptions& o, const std::string& v, const std::string&) {
+           o.job.pipeline.texture_filter = parse_texture_filter(v);
+         }},
     }};
 
 const RenderSection kShadingOptions = {
@@ -504,6 +511,7 @@ void parse_arguments(RenderOptions& o, const std::vector<std::string>& args) {
 
 RenderOptions parse_render_options(const std::vector<std::string>& args) {
   RenderOptions o;
+  o.job.pipeline.texture_filter = TextureFilter::Trilinear;  // the command line's default (DESIGN 3b)
   apply_display_source(o, args);  // a bad --display-config file is bad input (exit 1), not a usage error
   as_usage([&] { parse_arguments(o, args); });
   return o;

@@ -292,6 +292,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["method"] = to_string(info.pipeline.method);
   j["sampling"] = to_string(info.pipeline.sampling);
   j["samples_per_pixel"] = info.pipeline.samples;
+  j["texture_filter"] = to_string(info.pipeline.texture_filter);
   j["shading"] = shading_json(info);
   j["tile"] = {{"x", info.pipeline.tile_x}, {"y", info.pipeline.tile_y}, {"v", info.pipeline.tile_v}};
   j["camera"] = info.rig_config.camera;
@@ -363,6 +364,11 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
     return get(o, "samples_per_pixel").is_null() ? json(1) : get(o, "samples_per_pixel");
   };
   if (samples(a) != samples(b)) return "samples_per_pixel";
+  // sidecars written before --texture-filter existed filtered bilinearly from level 0
+  auto filter = [&](const json& o) {
+    return get(o, "texture_filter").is_null() ? json("bilinear") : get(o, "texture_filter");
+  };
+  if (filter(a) != filter(b)) return "texture_filter";
   if (get(a, "background") != get(b, "background")) return "background";  // absent: transparent
   // the lights: their poses follow the frame, so other frames' (pmr verify, the folder scan) are compared
   // without them; they follow from the scene file (its lights, or the default light when it has none and

@@ -3,7 +3,9 @@
 #include <cmath>
 #include <string>
 
+#include "pipeline/texture_mips.h"
 #include "pmr/error.h"
+#include "pmr/memory_budget.h"
 
 namespace pmr {
 
@@ -26,25 +28,73 @@ void texture_transform_matrix(const SceneTextureSlot& slot, float out[6]) {
   out[3] = float(-sx * s), out[4] = float(sy * c), out[5] = slot.offset[1];
 }
 
-MaterialTables make_material_tables(const Scene& scene) {
+namespace {
+
+// How the scene's materials sample texture i: as a colour map (sRGB) and/or as a data map (linear).
+struct TextureUses {
+  std::vector<bool> srgb, linear;
+};
+
+TextureUses texture_uses(const Scene& scene) {
+  TextureUses u{std::vector<bool>(scene.textures.size()), std::vector<bool>(scene.textures.size())};
+  for (const SceneMaterialInputs& in : scene.material_inputs)
+    for (const SceneTextureSlot& slot : in.slots)
+      if (slot.texture >= 0 && size_t(slot.texture) < scene.textures.size())
+        (slot.srgb ? u.srgb : u.linear)[size_t(slot.texture)] = true;
+  return u;
+}
+
+// Appends texture `tex` to the table: level 0 as stored, then its mips when `mips` (averaged in linear
+// light, so a colour map's chain differs from the same image's chain as a data map).
+void add_texture(MaterialTables& t, const SceneTexture& tex, bool mips, bool srgb) {
+  if (tex.rgba.size() != size_t(tex.width) * size_t(tex.height) * 4)
+    throw InternalError("a texture's texels do not match its size");
+  PmrTexture d{};
+  d.offset = uint32_t(t.texels.size() / 4);
+  d.width = tex.width, d.height = tex.height;
+  d.wrap_s = tex.wrap_s, d.wrap_t = tex.wrap_t;
+  d.levels = uint32_t(mips ? mip_levels(tex.width, tex.height) : 1);
+  t.texels.insert(t.texels.end(), tex.rgba.begin(), tex.rgba.end());
+  if (mips) {
+    const std::vector<uint8_t> chain = build_mips(tex.rgba.data(), tex.width, tex.height, srgb);
+    t.texels.insert(t.texels.end(), chain.begin(), chain.end());
+  }
+  t.textures.push_back(d);
+}
+
+// The texture table: entry i is scene texture i (with its colour chain where a colour map samples it);
+// with mips, a texture that is sampled both as a colour and as a data map gets a second entry with its
+// linear chain, whose index `linear_entry` holds (else -1). The texels are checked against the memory
+// budget before they are built.
+std::vector<int> add_textures(MaterialTables& t, const Scene& scene, bool mips) {
+  const TextureUses uses = texture_uses(scene);
+  uint64_t total = 0;
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const SceneTexture& tex = scene.textures[i];
+    const int levels = mips ? mip_levels(tex.width, tex.height) : 1;
+    const uint64_t copies = mips && uses.srgb[i] && uses.linear[i] ? 2 : 1;
+    total += copies * mip_chain_texels(tex.width, tex.height, levels);
+  }
+  if (total >= (uint64_t(1) << 32))
+    throw Error("the scene's textures are too large (over 4 G texels" + std::string(mips ? " with their mips)" : ")"));
+  check_memory(total * 4, mips ? "the textures and their mip chains" : "the textures");
+  t.texels.reserve(size_t(total) * 4);
+  std::vector<int> linear_entry(scene.textures.size(), -1);
+  for (size_t i = 0; i < scene.textures.size(); ++i) add_texture(t, scene.textures[i], mips, uses.srgb[i]);
+  for (size_t i = 0; i < scene.textures.size(); ++i)
+    if (mips && uses.srgb[i] && uses.linear[i]) {
+      linear_entry[i] = int(t.textures.size());
+      add_texture(t, scene.textures[i], mips, false);
+    }
+  return linear_entry;
+}
+
+}  // namespace
+
+MaterialTables make_material_tables(const Scene& scene, bool mips) {
   MaterialTables t;
   const size_t vertices = scene.positions.size();
-  size_t total_texels = 0;
-  for (const SceneTexture& tex : scene.textures) {
-    PmrTexture d{};
-    d.offset = uint32_t(total_texels);
-    d.width = tex.width, d.height = tex.height;
-    d.wrap_s = tex.wrap_s, d.wrap_t = tex.wrap_t;
-    if (tex.rgba.size() != size_t(tex.width) * size_t(tex.height) * 4)
-      throw InternalError("a texture's texels do not match its size");
-    total_texels += size_t(tex.width) * size_t(tex.height);
-    if (total_texels >= (size_t(1) << 32)) throw Error("the scene's textures are too large (over 4 G texels)");
-    t.textures.push_back(d);
-  }
-  t.texels.resize(total_texels * 4);
-  for (size_t i = 0; i < scene.textures.size(); ++i)
-    std::copy(scene.textures[i].rgba.begin(), scene.textures[i].rgba.end(),
-              t.texels.begin() + size_t(t.textures[i].offset) * 4);
+  const std::vector<int> linear_entry = add_textures(t, scene, mips);
 
   for (const std::vector<glm::vec2>& set : scene.texcoords)
     if (set.size() != vertices) throw InternalError("a TEXCOORD set does not have one entry per vertex");
@@ -75,7 +125,8 @@ MaterialTables make_material_tables(const Scene& scene) {
                             " names a texture or TEXCOORD set the scene does not have");
       if (k == PMR_MAP_NORMAL && !has_tangents) continue;
       PmrTextureMap& map = m.maps[k];
-      map.texture = slot.texture;
+      const int linear = linear_entry[size_t(slot.texture)];
+      map.texture = !slot.srgb && linear >= 0 ? linear : slot.texture;
       map.texcoord = uint32_t(slot.texcoord);
       texture_transform_matrix(slot, map.uv_transform);
     }

@@ -13,15 +13,19 @@ namespace pmr {
 
 struct MaterialTables {
   std::vector<PmrMaterial> materials;  // Scene::materials, the maps and pbr fields from Scene::material_inputs
-  std::vector<PmrTexture> textures;    // one per Scene::textures
-  std::vector<uint8_t> texels;         // RGBA8 as stored, textures back to back (PmrTexture::offset)
+  // Scene::textures in order, then (with mips) second entries of those sampled both as colour and as
+  // data maps, whose chains differ (cl/shade.h reads PmrMaterial's map.texture)
+  std::vector<PmrTexture> textures;
+  std::vector<uint8_t> texels;  // RGBA8 as stored, each texture's levels back to back (PmrTexture)
   std::vector<glm::vec2> texcoords;    // TEXCOORD set k of vertex v at k * vertices + v (at least one entry)
 };
 
 // Throws pmr::Error when the scene's material inputs do not fit its arrays (a map's texture or
-// TEXCOORD set missing: the loader never produces that) or the textures exceed 4 G texels.
-// A normal map is dropped (drawn with the interpolated normal) when the scene has no tangents.
-MaterialTables make_material_tables(const Scene& scene);
+// TEXCOORD set missing: the loader never produces that), or the textures with their mips exceed 4 G
+// texels or the memory budget. A normal map is dropped (drawn with the interpolated normal) when the
+// scene has no tangents. `mips`: every texture gets its mip chain (--texture-filter trilinear), else
+// level 0 alone.
+MaterialTables make_material_tables(const Scene& scene, bool mips);
 
 // KHR_texture_transform of a slot as the 2x3 matrix of PmrTextureMap::uv_transform.
 void texture_transform_matrix(const SceneTextureSlot& slot, float out[6]);

@@ -50,10 +50,12 @@ void method_tile(const PipelineConfig& config, size_t max_group, int* tile) {
 }
 
 // -w: PoCL's compiler would print "N warnings generated." on the user's terminal at every cold build.
-std::string build_options(const int* tile, int samples) {
+// PMR_TRILINEAR: bilinear filtering's kernels carry no level-of-detail code (cl/texture.h).
+std::string build_options(const int* tile, const PipelineConfig& config) {
   return "-cl-std=CL1.2 -w -cl-fp32-correctly-rounded-divide-sqrt -DPMR_TILE_X=" + std::to_string(tile[0]) +
          " -DPMR_TILE_Y=" + std::to_string(tile[1]) + " -DPMR_TILE_V=" + std::to_string(tile[2]) +
-         " -DPMR_VW=" + std::to_string(fine_lanes(tile[0])) + " -DPMR_SAMPLES=" + std::to_string(samples);
+         " -DPMR_VW=" + std::to_string(fine_lanes(tile[0])) + " -DPMR_SAMPLES=" + std::to_string(config.samples) +
+         " -DPMR_TRILINEAR=" + (config.texture_filter == TextureFilter::Trilinear ? "1" : "0");
 }
 
 }  // namespace
@@ -62,7 +64,7 @@ struct Pipeline::Impl {
   Impl(const ClRuntime& rt, const PipelineConfig& config, const int* tile_in)
       : tile{tile_in[0], tile_in[1], tile_in[2]},
         launcher(rt),
-        options(build_options(tile, config.samples)),
+        options(build_options(tile, config)),
         program(
             launcher.build({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl", "straddle_alpha.cl"}, options)),
         scene(rt, config),
@@ -80,6 +82,8 @@ struct Pipeline::Impl {
   FineStage fine;
   FinePaths paths;
   int views = 0, view_w = 0, view_h = 0;  // as configured
+  // PmrParams.lod_scale_x/y: view pixels per output pixel (subpixel sampling: a display pixel's)
+  float lod_scale[2] = {1.0f, 1.0f};
   uint64_t num_tiles = 0;
 
   void render_multipass(const Rig& rig, const PmrParams& P, bool snapped, FrameEvents& ev, StageTimes& t);
@@ -144,6 +148,10 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   if (m.num_tiles >= (uint64_t(1) << 32)) throw Error("too many tiles; use larger --tile");
   m.views = rig.views, m.view_w = rig.view_w, m.view_h = rig.view_h;
   m.paths = choose_paths(rig, display);
+  // A display pixel covers view_w / display_w view pixels across (and view_h / display_h down): the
+  // texture footprint of a subpixel's sample is the display pixel's, not its view pixel's.
+  m.lod_scale[0] = m.paths.subpixel ? float(double(rig.view_w) / display->width) : 1.0f;
+  m.lod_scale[1] = m.paths.subpixel ? float(double(rig.view_h) / display->height) : 1.0f;
   if (display) m.encode.configure(*display, rig.views, rig.view_w, rig.view_h);
   m.fine.configure(m.paths, rig.views, rig.view_w, rig.view_h, display ? &m.encode : nullptr);
   m.geometry.configure(m.num_tiles);
@@ -186,6 +194,8 @@ PmrParams Pipeline::frame_params(const FrameDescription& frame, bool empty) cons
   }
   P.shading = config_.shading == Shading::Pbr ? PMR_SHADING_PBR : PMR_SHADING_LAMBERT;
   P.exposure = float(std::exp2(config_.exposure_ev));
+  P.texture_filter = config_.texture_filter == TextureFilter::Trilinear ? PMR_FILTER_TRILINEAR : PMR_FILTER_BILINEAR;
+  P.lod_scale_x = m.lod_scale[0], P.lod_scale_y = m.lod_scale[1];
   P.env_radiance = float(0.2 * config_.environment_intensity);
   P.num_lights = uint32_t(frame.lights.size());
   return P;

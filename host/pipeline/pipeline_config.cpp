@@ -41,6 +41,14 @@ Shading parse_shading(const std::string& name) {
 
 const char* to_string(Shading s) { return s == Shading::Pbr ? "pbr" : "lambert"; }
 
+TextureFilter parse_texture_filter(const std::string& name) {
+  if (name == "bilinear") return TextureFilter::Bilinear;
+  if (name == "trilinear") return TextureFilter::Trilinear;
+  throw Error("unknown texture filter '" + name + "' (expected bilinear or trilinear)");
+}
+
+const char* to_string(TextureFilter f) { return f == TextureFilter::Trilinear ? "trilinear" : "bilinear"; }
+
 void set_sample_pattern(int samples, double scale_x, double scale_y, PmrParams& P) {
   static const int one[] = PMR_SAMPLE_PATTERN_1, four[] = PMR_SAMPLE_PATTERN_4, eight[] = PMR_SAMPLE_PATTERN_8,
                    sixteen[] = PMR_SAMPLE_PATTERN_16;

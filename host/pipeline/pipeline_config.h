@@ -49,6 +49,14 @@ enum class Shading {
 Shading parse_shading(const std::string& name);  // "lambert", "pbr"
 const char* to_string(Shading s);
 
+// How textures are filtered (DESIGN section 3b, --texture-filter).
+enum class TextureFilter {
+  Bilinear,   // level 0 alone, bilinear: the point-sampled renderer's textures, bit for bit
+  Trilinear,  // mip chains, the level of detail from the analytic screen-space derivatives
+};
+TextureFilter parse_texture_filter(const std::string& name);  // "bilinear", "trilinear"
+const char* to_string(TextureFilter f);
+
 struct PipelineConfig {
   Method method = Method::Pmr;
   // PMR: the 3D tile (voxels over x, y, view) of one fine work-group. The single-view baselines use
@@ -69,7 +77,10 @@ struct PipelineConfig {
   // them per display subpixel ([row][3 * column + k]).
   Sampling sampling = Sampling::View;
   Shading shading = Shading::Pbr;
-  double exposure_ev = 0.0;            // colour x 2^EV, either model
+  double exposure_ev = 0.0;  // colour x 2^EV, either model
+  // Bilinear here (the library's default keeps the images every existing test compares bit for bit);
+  // the command line's default is trilinear (cli/options.cpp).
+  TextureFilter texture_filter = TextureFilter::Bilinear;
   double environment_intensity = 1.0;  // pbr: scales the uniform default environment (radiance 0.2)
   // pbr: an environment image, prefiltered once (Environment::make) and shared by every pipeline of
   // a process; its rotation and intensity are its own (the intensity must equal environment_intensity).

@@ -5,6 +5,7 @@
 
 #include "pipeline/material_tables.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/texture_mips.h"
 #include "pmr/error.h"
 #include "shading/environment.h"
 #include "shading/lights.h"
@@ -15,16 +16,14 @@ namespace {
 
 std::vector<float> srgb_lut() {
   std::vector<float> lut(256);
-  for (int c = 0; c < 256; ++c) {
-    const double v = c / 255.0;
-    lut[c] = float(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
-  }
+  for (int c = 0; c < 256; ++c) lut[c] = float(srgb_to_linear(c / 255.0));
   return lut;
 }
 
 }  // namespace
 
-SceneBuffers::SceneBuffers(const ClRuntime& rt, const PipelineConfig& config) : rt_(rt) {
+SceneBuffers::SceneBuffers(const ClRuntime& rt, const PipelineConfig& config)
+    : rt_(rt), mips_(config.texture_filter == TextureFilter::Trilinear) {
   lut_ = rt.upload(srgb_lut(), "sRGB table");
   // the split-sum table (pbr only: computing it costs about 0.5 s of CPU once per process)
   static_assert(kEnvSplitSumSize == PMR_SPLIT_SUM_N, "the kernels' split-sum table size");
@@ -58,7 +57,7 @@ void SceneBuffers::set_scene(const Scene& scene) {
                 std::to_string(PMR_MAX_TRIANGLES - 1) + " are supported");
   num_vertices_ = uint32_t(scene.positions.size());
   num_triangles_ = uint32_t(scene.triangles.size());
-  const MaterialTables tables = make_material_tables(scene);
+  const MaterialTables tables = make_material_tables(scene, mips_);
   has_tangents_ = scene.tangents.size() == scene.positions.size() && !scene.positions.empty();
   const std::vector<glm::vec4> no_tangents(1, glm::vec4(0.0f));
   scene_lights_ = scene.lights;

@@ -39,6 +39,7 @@ class SceneBuffers {
   void upload_environment(const PipelineConfig& config);
 
   const ClRuntime& rt_;
+  bool mips_;  // --texture-filter trilinear: the textures' mip chains are built and uploaded
   uint32_t num_vertices_ = 0, num_triangles_ = 0;
   bool has_tangents_ = false;
   std::vector<SceneLight> scene_lights_;

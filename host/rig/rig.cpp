@@ -184,6 +184,7 @@ SpacingError spacing_error(const Rig& rig) {
 PmrParams make_params(const Rig& rig) {
   PmrParams p{};
   p.samples = 1;  // at the pixel center (offset 0) unless the pipeline sets a pattern
+  p.texture_filter = PMR_FILTER_BILINEAR, p.lod_scale_x = p.lod_scale_y = 1.0f;  // the pipeline sets them
   const double* v = &rig.center_view[0][0];
   for (int k = 0; k < 16; ++k) p.view[k] = v[k];
   const double tan_half = std::tan(rig.yfov / 2.0);

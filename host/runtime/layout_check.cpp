@@ -5,11 +5,11 @@
 
 #include "pmr/shared.h"
 
-static_assert(sizeof(PmrParams) == 16 * 8 + 9 * 8 + 16 + 18 * 4 + 2 * PMR_MAX_SAMPLES * 4 + 2 * 8 +
+static_assert(sizeof(PmrParams) == 16 * 8 + 9 * 8 + 16 + 22 * 4 + 2 * PMR_MAX_SAMPLES * 4 + 2 * 8 +
                                         4 * (PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK),
               "PmrParams layout");
-static_assert(offsetof(PmrParams, sample_x) == 288 && offsetof(PmrParams, view_anchor) == 416 &&
-                  offsetof(PmrParams, view_coord) == 432,
+static_assert(offsetof(PmrParams, sample_x) == 304 && offsetof(PmrParams, view_anchor) == 432 &&
+                  offsetof(PmrParams, view_coord) == 448 && offsetof(PmrParams, lod_scale_x) == 292,
               "PmrParams layout");
 static_assert(offsetof(PmrParams, light_world) == 200, "PmrParams layout");
 static_assert(offsetof(PmrParams, view_w) == 216, "PmrParams layout");
@@ -22,7 +22,7 @@ static_assert(sizeof(PmrVertexAttr) == 28 && offsetof(PmrVertexAttr, color) == 1
 static_assert(sizeof(PmrTriangle) == 32, "PmrTriangle layout");
 static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 8 && offsetof(PmrMaterial, maps) == 52, "PmrMaterial layout");
 static_assert(sizeof(PmrTextureMap) == 32, "PmrTextureMap layout");
-static_assert(sizeof(PmrTexture) == 32, "PmrTexture layout");
+static_assert(sizeof(PmrTexture) == 32 && offsetof(PmrTexture, levels) == 20, "PmrTexture layout");
 static_assert(sizeof(PmrEncodeParams) == 48 && offsetof(PmrEncodeParams, display_w) == 0, "PmrEncodeParams layout");
 static_assert(sizeof(PmrEncodeColumn) == 16 && sizeof(PmrEncodeRow) == 16, "encoder table layout");
 static_assert(sizeof(PmrSampleChunk) == 32, "PmrSampleChunk layout");

@@ -109,6 +109,11 @@ typedef uint32_t pmr_u32;
  * cos(n, v) = (i / (N - 1))^2 and roughness j / (N - 1), stored at j * N + i. */
 #define PMR_SPLIT_SUM_N 64
 
+/* PmrParams.texture_filter (--texture-filter): level 0 alone, bilinear (the textures have no mips);
+ * or trilinear between the mip levels around the analytic level of detail (DESIGN section 3b). */
+#define PMR_FILTER_BILINEAR 0u
+#define PMR_FILTER_TRILINEAR 1u
+
 /* PmrParams.sample_area: where the samples of a raster pixel lie, for the tile raster's conservative
  * tests. --sampling view samples around pixel centers; --sampling subpixel samples each display
  * subpixel around its own position, anywhere in [px, px + 1) x [py, py + 1) of its view's raster. Either
@@ -162,6 +167,10 @@ typedef struct {
   float env_radiance;                /* pbr: radiance of the uniform default environment (0.2 x intensity) */
   pmr_u32 num_lights;                /* pbr: entries of the light table (PmrLight), the kernels' last argument */
   pmr_u32 samples;                   /* S samples per pixel (PMR_SAMPLE_PATTERN_S); the kernels are built for it */
+  pmr_u32 texture_filter;            /* PMR_FILTER_BILINEAR or PMR_FILTER_TRILINEAR (DESIGN section 3b)   */
+  float lod_scale_x, lod_scale_y;    /* view pixels per output pixel, x and y: 1 for view sampling; the
+                                        display pixel's footprint in view pixels for subpixel sampling */
+  pmr_u32 pad_lod;
   pmr_i32 sample_x[PMR_MAX_SAMPLES]; /* sample s at (X + sample_x[s], Y + sample_y[s]) from pixel center */
   pmr_i32 sample_y[PMR_MAX_SAMPLES]; /* (X, Y), in 16.16 / 24.8 raster units                          */
   double view_anchor;                /* camera offset at view coordinate 0 over the baseline: -1/2 linear, 0 angular */
@@ -246,11 +255,15 @@ typedef struct {
   float occlusion_strength;     /* occlusionTexture.strength                                     */
 } PmrMaterial;
 
+/* A texture and its mip chain: `levels` levels back to back from `offset`, level k of
+ * max(1, width >> k) x max(1, height >> k) texels (so level k starts at offset + the sizes of levels
+ * 0..k-1). levels is 1 without mips (--texture-filter bilinear). */
 typedef struct {
-  pmr_u32 offset; /* first texel in the texel buffer (RGBA8, sRGB-encoded colour)     */
-  pmr_i32 width, height;
+  pmr_u32 offset; /* first texel of level 0 in the texel buffer (RGBA8, sRGB-encoded colour) */
+  pmr_i32 width, height; /* level 0                                                      */
   pmr_i32 wrap_s, wrap_t; /* PMR_WRAP_*                                                      */
-  pmr_u32 pad0, pad1, pad2;
+  pmr_u32 levels;         /* mip levels stored, >= 1                                         */
+  pmr_u32 pad1, pad2;
 } PmrTexture;
 
 /* One punctual light of --shading pbr, world space, as resolved for the frame (the file's

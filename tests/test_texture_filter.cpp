@@ -167,6 +167,40 @@ TEST(TextureFilter, MinifiedCheckerIsLinearGreyTrilinearAndAliasedBilinear) {
   EXPECT_GT(lo, 0.99f);
 }
 
+// With --sampling subpixel the level of detail is per display pixel (PmrParams.lod_scale): views of
+// 96 x 64 encoded into a 48 x 64 display make a display pixel 2 view pixels wide (into a 96 x 32 one, 2
+// tall), so a checker of single texels at one texel per view pixel (lambda 0 on the view grid) is read
+// at lambda 1, its level 1: uniformly grey, linear 0.5. At lambda 0 the subpixels' samples would read
+// black and white. One display stretches x only and the other y only, so each scale is tested alone.
+TEST(TextureFilter, SubpixelSamplingTakesTheDisplayPixelsFootprint) {
+  const Rig rig = test::small_rig(4, 96, 64);
+  const int px0 = 32, py0 = 16;
+  const Scene s = focal_quad(rig, px0, py0, 32.0, checker(32, 32, 1));
+  const int sizes[2][2] = {{48, 64}, {96, 32}};
+  for (const auto& size : sizes) {
+    Display d;
+    d.width = size[0], d.height = size[1];
+    PipelineConfig pc = lambert(TextureFilter::Trilinear);
+    pc.sampling = Sampling::Subpixel;
+    pc.fuse_encode = false;
+    std::vector<uint16_t> encoded;
+    test::render_with(s, rig, pc, &d, &encoded);
+    size_t checked = 0;
+    for (int i = 0; i < d.height; ++i)
+      for (int sub = 0; sub < 3 * d.width; ++sub) {
+        const double x = (2.0 * sub + 1.0) * rig.view_w / (6.0 * d.width);
+        const double y = (2.0 * i + 1.0) * rig.view_h / (2.0 * d.height);
+        if (x < px0 + 2 || x > px0 + 30 || y < py0 + 2 || y > py0 + 30) continue;  // inside, off the edges
+        half h;
+        h.setBits(encoded[(size_t(i) * size_t(d.width) + size_t(sub / 3)) * 4 + size_t(sub % 3)]);
+        ASSERT_NEAR(float(h), 0.5, 0.01) << "display " << d.width << "x" << d.height << ": subpixel " << sub
+                                         << " of row " << i;
+        ++checked;
+      }
+    EXPECT_GT(checked, 500u);
+  }
+}
+
 // Magnified textures (lambda clamped to 0) read level 0 alone: the trilinear image is the bilinear one,
 // bit for bit (the quad's 16 texels over 32 pixels).
 TEST(TextureFilter, MagnifiedTrilinearIsBilinear) {

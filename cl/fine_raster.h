@@ -101,6 +101,12 @@ PMR_HOT void sample_edges(global const PmrParams* P, const PmrMta* m, long fi, S
   }
 }
 
+/* Sample s's x offset from the pixel center in pixels. One sample is the center itself: known at compile
+ * time, so the single-sample raster neither loads nor adds the offsets. */
+inline float sample_dx(global const PmrParams* P, int s) {
+  return NS > 1 ? (float)P->sample_x[s] / (float)PMR_X_ONE : 0.0f;
+}
+
 /* Lanes of a row chunk whose sample at edge offset `s` (SampleEdges, or none for the pixel centers)
  * passes all three edges. F: the edge functions at the chunk's first pixel center. */
 inline vint chunk_hits(const RowEdges* R, const long* F, const SampleEdges* O, int s, vint in_tile, vint lane) {
@@ -172,7 +178,7 @@ PMR_HOT void raster_chunk(const ShadeInputs* in, const PmrMta* m, uint id, const
   const vfloat column = convert_vfloat(lane + (px0 - dp->pr));
   for (int s = 0; s < NS; ++s) {
     const int k = FINE_SLOT(r, s);
-    z[s] = (vfloat)(zrow[s]) + (vfloat)(dp->gx) * (column + (vfloat)((float)in->P->sample_x[s] / (float)PMR_X_ONE));
+    z[s] = (vfloat)(zrow[s]) + (vfloat)(dp->gx) * (column + (vfloat)(sample_dx(in->P, s)));
     if (st->covered) st->covered[k] -= hit[s];
     win[s] = hit[s] & ((z[s] < st->depth[k]) | ((z[s] == st->depth[k]) & ((vuint)(m->key) < st->key[k])));
   }
@@ -238,7 +244,7 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
         const long step_y[3] = {R.step_y[0] + di * R.dstep_y[0], R.step_y[1] + di * R.dstep_y[1],
                                 R.step_y[2] + di * R.dstep_y[2]};
         SampleEdges O;
-        sample_edges(P, &m, fi, &O);
+        if (NS > 1) sample_edges(P, &m, fi, &O);
         DepthPlane dp;
         bool have_plane = false; /* set up on the first covered voxel: tiny MTAs often cover none */
         for (int ly = ly0; ly <= ly1; ++ly) {
@@ -247,13 +253,13 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
           for (int c = 0; c < FINE_CHUNKS; ++c) {
             const long F[3] = {row[0] + c * R.step_c[0], row[1] + c * R.step_c[1], row[2] + c * R.step_c[2]};
             vint hit[NS], any_hit = (vint)(0);
-            for (int s = 0; s < NS; ++s) any_hit |= hit[s] = chunk_hits(&R, F, &O, s, in_tile[c], lane);
+            for (int s = 0; s < NS; ++s) any_hit |= hit[s] = chunk_hits(&R, F, NS > 1 ? &O : 0, s, in_tile[c], lane);
             if (!any(any_hit)) continue;
             if (!have_plane) dp = depth_plane(&m, fi), have_plane = true;
             if (!have_zrow) {
               const long rows = (long)(y0 + ly - dp.qr) * PMR_Y_ONE;
               for (int s = 0; s < NS; ++s)
-                zrow[s] = (float)(dp.zr + dp.gy * ((double)(rows + P->sample_y[s]) / (double)PMR_Y_ONE));
+                zrow[s] = (float)(dp.zr + dp.gy * ((double)(rows + (NS > 1 ? P->sample_y[s] : 0)) / (double)PMR_Y_ONE));
               have_zrow = true;
             }
             const int r = ((i - vbase) * PMR_TILE_Y + ly) * FINE_CHUNKS + c;

@@ -132,7 +132,8 @@ PMR_HOT void lanes_gather(const ShadeInputs* in, global const PmrMta* mtas, MtaC
     const PmrMta* m = cached_mta(cache, mtas, (uint)id_of[first]);
     lanes_add(L, in, m, take, bits, pbr);
 #if PMR_TRILINEAR
-    if (trilinear && (L->textured & bits)) lanes_edge_derivatives(L, in->P, m, f, bits); /* read by maps alone */
+    /* read by the maps and by pbr's specular antialiasing */
+    if (trilinear && (pbr || (L->textured & bits))) lanes_edge_derivatives(L, in->P, m, f, bits);
 #endif
     long E[3];
     if (!S->sx) {

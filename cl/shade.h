@@ -75,6 +75,8 @@ inline float4 sample_map(const ShadeInputs* in, global const PmrTextureMap* map,
   return sample_texture(in->texels, in->srgb_lut, &tex, u, v, lambda, srgb);
 }
 
+#define LANE3(a) s3(vload_s(0, (a)[0]), vload_s(0, (a)[1]), vload_s(0, (a)[2]))
+
 /* SW winners to shade, one per lane (a row of 8 voxels of a real model holds a few small triangles):
  * what shading reads of each lane's MTA, triangle, vertices and material, as vectors. The caller fills
  * it one MTA at a time (lanes_add): each value is loaded once per MTA and blended into the lanes the
@@ -115,6 +117,9 @@ inline void lanes_clear(LaneWinners* L) {
   L->metallic = L->roughness = zero;
   L->emissive = s3(zero, zero, zero);
   L->textured = 0u;
+#if PMR_TRILINEAR
+  for (int k = 0; k < 3; ++k) vstore_s(zero, 0, L->ex[k]), vstore_s(zero, 0, L->ey[k]);
+#endif
 }
 
 inline sfloat blend(sfloat a, float b, sint take) { return select(a, (sfloat)(b), take); }
@@ -249,56 +254,59 @@ typedef struct {
   float base[3][SW], metallic[SW], roughness[SW], ao[SW], emissive[3][SW];
   int mapped[SW];
   float s[3][SW], tw[4][SW], normal_scale[SW];
+  float toksvig[SW]; /* trilinear: the normal map's increment of alpha^2 (Toksvig), else 0 */
 } LaneTextures;
 
-#if PMR_TRILINEAR
-/* A lane's inputs to bary_gradient, stored per lane (sample_lanes reads them lane by lane). */
+/* The screen-space derivatives of SW lanes' source barycentrics, per output pixel in x and in y. */
 typedef struct {
-  float e[3][SW], iw[3][SW], s1[3][SW], s2[3][SW];
-} LaneGradients;
+  sfloat3 dx, dy;
+} LaneBaryGrad;
 
-inline void lane_gradient_inputs(const LaneWinners* L, LaneGradients* G) {
-  s3_store(L->e, G->e[0], G->e[1], G->e[2]);
-  for (int k = 0; k < 3; ++k) {
-    vstore_s(L->inv_w[k], 0, G->iw[k]);
-    vstore_s(L->bary[k][0], 0, G->s1[k]);
-    vstore_s(L->bary[k][1], 0, G->s2[k]);
-  }
+/* Perspective-correct barycentrics are l_k = p_k / S with p_k = e_k / w_k (e_k the edge functions,
+ * linear in screen x and y) and S = sum p_k, so by the quotient rule dl_k = (dp_k - l_k dS) / S; the
+ * source barycentrics (b1, b2) = sum_k l_k bary_k are linear in l. e: the edge functions at the sample;
+ * ex, ey: their derivatives; iw: 1 / w; s1, s2: the vertices' source barycentrics b1 and b2 (component
+ * k: MTA vertex k). */
+inline LaneBaryGrad bary_gradient_lanes(sfloat3 e, sfloat3 ex, sfloat3 ey, sfloat3 iw, sfloat3 s1, sfloat3 s2) {
+  const sfloat3 p = s3_mul(e, iw), px = s3_mul(ex, iw), py = s3_mul(ey, iw);
+  const sfloat S = p.x + p.y + p.z;
+  const sfloat3 l = s3(p.x / S, p.y / S, p.z / S);
+  const sfloat sx = px.x + px.y + px.z, sy = py.x + py.y + py.z;
+  const sfloat3 lx = s3((px.x - l.x * sx) / S, (px.y - l.y * sx) / S, (px.z - l.z * sx) / S);
+  const sfloat3 ly = s3((py.x - l.x * sy) / S, (py.y - l.y * sy) / S, (py.z - l.z * sy) / S);
+  const sfloat b1x = s3_dot(lx, s1), b2x = s3_dot(lx, s2), b1y = s3_dot(ly, s1), b2y = s3_dot(ly, s2);
+  LaneBaryGrad g = {s3(-b1x - b2x, b1x, b2x), s3(-b1y - b2y, b1y, b2y)};
+  return g;
 }
 
-inline BaryGrad lane_gradient(const LaneWinners* L, const LaneGradients* G, int l) {
-  return bary_gradient((float3)(G->e[0][l], G->e[1][l], G->e[2][l]),
-                       (float3)(L->ex[0][l], L->ex[1][l], L->ex[2][l]),
-                       (float3)(L->ey[0][l], L->ey[1][l], L->ey[2][l]),
-                       (float3)(G->iw[0][l], G->iw[1][l], G->iw[2][l]),
-                       (float3)(G->s1[0][l], G->s1[1][l], G->s1[2][l]),
-                       (float3)(G->s2[0][l], G->s2[1][l], G->s2[2][l]));
-}
-#endif
-
-inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b, bool pbr, LaneTextures* T) {
-  float bs[3][SW];
-  s3_store(b, bs[0], bs[1], bs[2]);
-  const bool trilinear = PMR_USE_TRILINEAR(in->P);
 #if PMR_TRILINEAR
-  LaneGradients G;
-  if (trilinear) lane_gradient_inputs(L, &G);
+/* Every lane's barycentric derivatives (idle lanes: finite values of no use). */
+inline LaneBaryGrad lane_bary_gradient(const LaneWinners* L) {
+  return bary_gradient_lanes(L->e, LANE3(L->ex), LANE3(L->ey), s3(L->inv_w[0], L->inv_w[1], L->inv_w[2]),
+                             s3(L->bary[0][0], L->bary[1][0], L->bary[2][0]),
+                             s3(L->bary[0][1], L->bary[1][1], L->bary[2][1]));
+}
 #endif
+
+/* grad: the lanes' barycentric derivatives (trilinear), or 0 (bilinear). */
+inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b, const LaneBaryGrad* grad, bool pbr,
+                         LaneTextures* T) {
+  float bs[3][SW], gx[3][SW], gy[3][SW];
+  s3_store(b, bs[0], bs[1], bs[2]);
+  if (grad) s3_store(grad->dx, gx[0], gx[1], gx[2]), s3_store(grad->dy, gy[0], gy[1], gy[2]);
   for (int l = 0; l < SW; ++l) {
     for (int k = 0; k < 3; ++k) T->base[k][l] = 1.0f;
     for (int k = 0; k < 4; ++k) T->tw[k][l] = 0.0f;
     for (int k = 0; k < 3; ++k) T->emissive[k][l] = 1.0f, T->s[k][l] = 0.0f;
     T->metallic[l] = T->roughness[l] = T->ao[l] = T->normal_scale[l] = 1.0f;
     T->mapped[l] = 0;
+    T->toksvig[l] = 0.0f;
     if (!(L->textured & (1u << l))) continue;
     const PmrTriangle t = in->tris[L->tri[l]];
     global const PmrMaterial* mat = &in->materials[t.material];
     const float3 bl = (float3)(bs[0][l], bs[1][l], bs[2][l]);
-    BaryGrad gl;
-#if PMR_TRILINEAR
-    if (trilinear) gl = lane_gradient(L, &G, l);
-#endif
-    const BaryGrad* g = trilinear ? &gl : 0;
+    const BaryGrad gl = {(float3)(gx[0][l], gx[1][l], gx[2][l]), (float3)(gy[0][l], gy[1][l], gy[2][l])};
+    const BaryGrad* g = grad ? &gl : 0;
     if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
       const float4 c = sample_map(in, &mat->maps[PMR_MAP_BASE_COLOR], &t, bl, g, true);
       T->base[0][l] = c.x, T->base[1][l] = c.y, T->base[2][l] = c.z;
@@ -322,11 +330,12 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
       T->normal_scale[l] = mat->normal_scale;
       T->tw[0][l] = tw.x, T->tw[1][l] = tw.y, T->tw[2][l] = tw.z, T->tw[3][l] = tw.w;
       T->s[0][l] = sn.x, T->s[1][l] = sn.y, T->s[2][l] = sn.z;
+      /* the chain's alpha is the square root of the increment for unit normals (MipKind::Normal); a
+       * scale shrinks the normals' spread in x and y with their slopes */
+      if (g) T->toksvig[l] = sn.w * sn.w * fmin(1.0f, mat->normal_scale * mat->normal_scale);
     }
   }
 }
-
-#define LANE3(a) s3(vload_s(0, (a)[0]), vload_s(0, (a)[1]), vload_s(0, (a)[2]))
 
 /* The normal map applied to the unit normals n (before any back-face flip), in the lanes that have
  * one: the interpolated tangent made orthogonal to n, the bitangent sign(w) * cross(n, t),
@@ -403,12 +412,33 @@ inline void split_sum_lanes(global const float2* t, sfloat nv, sfloat r, sfloat*
   }
 }
 
+/* Specular antialiasing (docs/DESIGN.md section 3b): roughness r widened so that alpha^2 = r^4 grows by
+ * `spread` (at most to 1); lanes without spread keep r bit for bit. */
+inline sfloat widened_roughness(sfloat r, sfloat spread) {
+  const sfloat a2 = (r * r) * (r * r);
+  return select(r, sqrt(sqrt(fmin(a2 + spread, 1.0f))), spread > 0.0f);
+}
+
+#if PMR_TRILINEAR
+/* The geometric term of specular antialiasing: the increment of alpha^2 from the interpolated normal's
+ * change across the pixel, min(2 sigma^2 (|dn/dx|^2 + |dn/dy|^2), 0.18) with sigma^2 = 1 / (2 pi) and
+ * n = ni / |ni| (ni = sum b_k n_k, len = |ni|), so dn = (dni - n (n . dni)) / |ni|. Flat lanes: 0. */
+inline sfloat geometric_spread(const LaneWinners* L, const LaneBaryGrad* g, sfloat3 n, sfloat len) {
+  const sfloat3 nix = s3_interp_lanes(g->dx, L->n), niy = s3_interp_lanes(g->dy, L->n);
+  const sfloat inv = 1.0f / len;
+  const sfloat3 dx = s3_scale(s3_sub(nix, s3_scale(n, s3_dot(n, nix))), inv);
+  const sfloat3 dy = s3_scale(s3_sub(niy, s3_scale(n, s3_dot(n, niy))), inv);
+  const sfloat spread = fmin((s3_dot(dx, dx) + s3_dot(dy, dy)) * (1.0f / PMR_PI_F), 0.18f);
+  return select((sfloat)(0.0f), spread, L->smooth & (len > 0.0f) & isfinite(spread));
+}
+#endif
+
 /* glTF metallic-roughness of the lanes with unit normals n (already flipped for back faces, normal map
  * applied) and base colours `base`, seen from view `view`'s camera: the sum over the light table of
  * f E n.l (the file's punctual lights, or the default light, or none), the environment times the
  * occlusion, plus the emissive term; an unlit material is its base colour. */
 inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const LaneTextures* T, bool textured, sfloat3 b,
-                         sfloat3 n, sfloat3 base, int view) {
+                         sfloat3 n, sfloat3 base, sfloat spread, int view) {
   global const PmrParams* P = in->P;
   const sfloat3 p = s3_interp_lanes(b, L->p);
   sfloat metallic = L->metallic, roughness = L->roughness, ao = 1.0f;
@@ -419,7 +449,7 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
   }
   const sfloat3 to_eye = s3_sub(s3_splat(in->eyes[view + (int)P->view_base].xyz), p);
   const sfloat3 v = s3_scale(to_eye, 1.0f / sqrt(s3_dot(to_eye, to_eye)));
-  const sfloat r = pbr_roughness(roughness);
+  const sfloat r = widened_roughness(pbr_roughness(roughness), spread);
   sfloat3 direct = s3_splat((float3)(0.0f));
   const uint num_lights = P->num_lights;
   for (uint i = 0; i < num_lights; ++i) {
@@ -465,16 +495,25 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
   const sfloat3 b = lane_barycentrics(L);
   LaneTextures T;
   const bool textured = L->textured != 0u;
-  if (textured) sample_lanes(in, L, b, pbr, &T);
+  const LaneBaryGrad* grad = 0; /* the barycentrics' derivatives: trilinear maps, specular antialiasing */
+#if PMR_TRILINEAR
+  LaneBaryGrad g;
+  if (PMR_USE_TRILINEAR(in->P) && (pbr || textured)) g = lane_bary_gradient(L), grad = &g;
+#endif
+  if (textured) sample_lanes(in, L, b, grad, pbr, &T);
   const sfloat3 base = lane_base_color(L, &T, textured, b);
   const sfloat3 ni = s3_interp_lanes(b, L->n);
   const sfloat len = sqrt(s3_dot(ni, ni));
   sfloat3 n = s3_select(L->face, s3_scale(ni, 1.0f / len), L->smooth & (len > 0.0f));
   const float exposure = in->P->exposure;
   if (pbr) {
+    sfloat spread = 0.0f;
+#if PMR_TRILINEAR
+    if (grad) spread = geometric_spread(L, grad, n, len) + (textured ? vload_s(0, T.toksvig) : 0.0f);
+#endif
     if (textured) n = mapped_normal(&T, n);
     n = s3_select(n, s3_neg(n), L->back); /* t, b and n together */
-    return s3_half_range(s3_scale(shade_pbr(in, L, &T, textured, b, n, base, view), exposure));
+    return s3_half_range(s3_scale(shade_pbr(in, L, &T, textured, b, n, base, spread, view), exposure));
   }
   n = s3_select(n, s3_neg(n), L->back);
   const sfloat lambert = 0.2f + 0.8f * max(s3_dot(n, s3_splat(light)), 0.0f);
@@ -486,10 +525,14 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
 inline BaryGrad mta_bary_gradient(global const PmrParams* P, const PmrMta* m, long f, const long* e) {
   float3 ex, ey;
   mta_edge_derivatives(P, m, f, &ex, &ey);
-  return bary_gradient((float3)((float)e[0], (float)e[1], (float)e[2]), ex, ey,
-                       (float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2]),
-                       (float3)(m->bary[0][0], m->bary[1][0], m->bary[2][0]),
-                       (float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1]));
+  /* the lanes' arithmetic on one voxel (in every lane): the MASK test asks it of a few voxels alone */
+  const LaneBaryGrad g = bary_gradient_lanes(s3_splat((float3)((float)e[0], (float)e[1], (float)e[2])),
+                                             s3_splat(ex), s3_splat(ey),
+                                             s3_splat((float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2])),
+                                             s3_splat((float3)(m->bary[0][0], m->bary[1][0], m->bary[2][0])),
+                                             s3_splat((float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1])));
+  const BaryGrad one = {(float3)(g.dx.x.s0, g.dx.y.s0, g.dx.z.s0), (float3)(g.dy.x.s0, g.dy.y.s0, g.dy.z.s0)};
+  return one;
 }
 
 /* alphaMode MASK: the base colour alpha of MTA m at raster point (X, Y) of view `view` passes the cutoff:

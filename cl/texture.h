@@ -1,6 +1,6 @@
 /* Texture filtering (docs/DESIGN.md section 3b, "Filtered textures"): texels of a mip level, the
  * bilinear sample of one level with the glTF sampler's wrap modes, the trilinear sample between two,
- * and the level of detail from the analytic screen-space derivatives of the barycentrics. cl/shade.h's
+ * and the level of detail from the analytic screen-space derivatives of the texture coordinates. cl/shade.h's
  * sample_map is the one caller: every path and every map samples through it. */
 #ifndef PMR_CL_TEXTURE_H
 #define PMR_CL_TEXTURE_H
@@ -87,24 +87,11 @@ inline float4 sample_texture(global const uchar4* texels, global const float* sr
   return ca + (sample_level(texels, srgb_lut, t, &b, u, v, srgb) - ca) * frac;
 }
 
-/* The screen-space derivatives of a lane's source barycentrics, per output pixel in x and in y. */
+/* The screen-space derivatives of one lane's source barycentrics, per output pixel in x and in y
+ * (cl/shade.h's bary_gradient_lanes computes them). */
 typedef struct {
   float3 dx, dy;
 } BaryGrad;
-
-/* Perspective-correct barycentrics are l_k = p_k / S with p_k = e_k / w_k (e_k the edge functions,
- * linear in screen x and y) and S = sum p_k, so by the quotient rule dl_k = (dp_k - l_k dS) / S; the
- * source barycentrics (b1, b2) = sum_k l_k bary_k are linear in l. e: the edge functions at the sample;
- * ex, ey: their derivatives; iw: 1 / w; s1, s2: the vertices' source barycentrics b1 and b2. */
-inline BaryGrad bary_gradient(float3 e, float3 ex, float3 ey, float3 iw, float3 s1, float3 s2) {
-  const float3 p = e * iw, px = ex * iw, py = ey * iw;
-  const float S = p.x + p.y + p.z;
-  const float3 l = p / S;
-  const float3 lx = (px - l * (px.x + px.y + px.z)) / S, ly = (py - l * (py.x + py.y + py.z)) / S;
-  const float b1x = dot(lx, s1), b2x = dot(lx, s2), b1y = dot(ly, s1), b2y = dot(ly, s2);
-  BaryGrad g = {(float3)(-b1x - b2x, b1x, b2x), (float3)(-b1y - b2y, b1y, b2y)};
-  return g;
-}
 
 /* Level of detail of texture t for texture-coordinate derivatives dx, dy (before the map's transform m,
  * whose 2x2 linear part applies to them): rho = the longer of the two footprint axes in level-0 texels,

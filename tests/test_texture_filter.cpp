@@ -32,11 +32,11 @@ SceneTexture checker(int w, int h, int cell) {
 TEST(TextureMips, ColourChecker2x2AveragesInLinearLight) {
   const SceneTexture t = checker(2, 2, 1);
   ASSERT_EQ(mip_levels(2, 2), 2);
-  const std::vector<uint8_t> srgb = build_mips(t.rgba.data(), 2, 2, true);
+  const std::vector<uint8_t> srgb = build_mips(t.rgba.data(), 2, 2, MipKind::Colour);
   // the mean of linear 0 and 1 is 0.5, stored as sRGB: 255 * (1.055 * 0.5^(1/2.4) - 0.055) = 187.5 -> 188
   EXPECT_EQ(srgb, (std::vector<uint8_t>{188, 188, 188, 255}));
   // as a data map the same texels average to 127.5 -> 128
-  EXPECT_EQ(build_mips(t.rgba.data(), 2, 2, false), (std::vector<uint8_t>{128, 128, 128, 255}));
+  EXPECT_EQ(build_mips(t.rgba.data(), 2, 2, MipKind::Data), (std::vector<uint8_t>{128, 128, 128, 255}));
 }
 
 TEST(TextureMips, OddSidesRoundDownAndAverageTheirBoxes) {
@@ -49,7 +49,7 @@ TEST(TextureMips, OddSidesRoundDownAndAverageTheirBoxes) {
   std::vector<uint8_t> rgba;
   for (int y = 0; y < 3; ++y)
     for (int x = 0; x < 5; ++x) rgba.insert(rgba.end(), {uint8_t(10 * x + 100 * y), uint8_t(4 * x), 0, 255});
-  const std::vector<uint8_t> mips = build_mips(rgba.data(), 5, 3, false);
+  const std::vector<uint8_t> mips = build_mips(rgba.data(), 5, 3, MipKind::Data);
   ASSERT_EQ(mips.size(), size_t(3 * 4));
   // red: texel (0,0): (0 + 10 + 100 + 110) / 4 = 55; (1,0): (20 + 30 + 120 + 130) / 4 = 75; level 2: 65
   // green: (0 + 4 + 0 + 4) / 4 = 2; (8 + 12 + 8 + 12) / 4 = 10; level 2: 6

@@ -423,7 +423,8 @@ const RenderSection kPipelineOptions = {
         {"--texture-filter", nullptr, "F",
          "trilinear (default): every texture's mip chain, the level of detail from the\n"
          "analytic screen-space derivatives of the texture coordinates in the voxel's\n"
-         "own view; bilinear: level 0 alone, as before mips (docs/SAMPLING.md)",
+         "own view, and pbr's specular antialiasing; bilinear: level 0 alone, no\n"
+         "specular antialiasing, as before mips (docs/SAMPLING.md)",
          [](RenderOptions& o, const std::string& v, const std::string&) {
            o.job.pipeline.texture_filter = parse_texture_filter(v);
          }},

@@ -1,5 +1,6 @@
 #include "pipeline/material_tables.h"
 
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -30,23 +31,40 @@ void texture_transform_matrix(const SceneTextureSlot& slot, float out[6]) {
 
 namespace {
 
-// How the scene's materials sample texture i: as a colour map (sRGB) and/or as a data map (linear).
-struct TextureUses {
-  std::vector<bool> srgb, linear;
-};
+// The chain a texture slot samples: colour maps (sRGB), the normal map, or the other data maps.
+MipKind slot_kind(const SceneTextureSlot& slot, int k) {
+  return slot.srgb ? MipKind::Colour : k == PMR_MAP_NORMAL ? MipKind::Normal : MipKind::Data;
+}
+constexpr int kMipKinds = 3;
+
+// Which chains the scene's materials sample texture i through: used[kind][i].
+using TextureUses = std::array<std::vector<bool>, kMipKinds>;
 
 TextureUses texture_uses(const Scene& scene) {
-  TextureUses u{std::vector<bool>(scene.textures.size()), std::vector<bool>(scene.textures.size())};
+  TextureUses u;
+  for (std::vector<bool>& kind : u) kind.assign(scene.textures.size(), false);
   for (const SceneMaterialInputs& in : scene.material_inputs)
-    for (const SceneTextureSlot& slot : in.slots)
+    for (int k = 0; k < PMR_MAPS; ++k) {
+      const SceneTextureSlot& slot = in.slots[size_t(k)];
       if (slot.texture >= 0 && size_t(slot.texture) < scene.textures.size())
-        (slot.srgb ? u.srgb : u.linear)[size_t(slot.texture)] = true;
+        u[size_t(slot_kind(slot, k))][size_t(slot.texture)] = true;
+    }
   return u;
 }
 
-// Appends texture `tex` to the table: level 0 as stored, then its mips when `mips` (averaged in linear
-// light, so a colour map's chain differs from the same image's chain as a data map).
-void add_texture(MaterialTables& t, const SceneTexture& tex, bool mips, bool srgb) {
+// The chain kinds texture i gets an entry for, first its own (the first kind used, else colour); without
+// mips one entry serves every use.
+std::vector<MipKind> entry_kinds(const TextureUses& uses, size_t i, bool mips) {
+  std::vector<MipKind> kinds;
+  for (int k = 0; k < kMipKinds; ++k)
+    if (uses[size_t(k)][i] && (mips || kinds.empty())) kinds.push_back(MipKind(k));
+  if (kinds.empty()) kinds.push_back(MipKind::Colour);
+  return kinds;
+}
+
+// Appends texture `tex` to the table: level 0 as stored (a normal chain's alpha 0: its level 0 is unit
+// normals), then its mips of `kind` when `mips`.
+void add_texture(MaterialTables& t, const SceneTexture& tex, bool mips, MipKind kind) {
   if (tex.rgba.size() != size_t(tex.width) * size_t(tex.height) * 4)
     throw InternalError("a texture's texels do not match its size");
   PmrTexture d{};
@@ -55,38 +73,44 @@ void add_texture(MaterialTables& t, const SceneTexture& tex, bool mips, bool srg
   d.wrap_s = tex.wrap_s, d.wrap_t = tex.wrap_t;
   d.levels = uint32_t(mips ? mip_levels(tex.width, tex.height) : 1);
   t.texels.insert(t.texels.end(), tex.rgba.begin(), tex.rgba.end());
+  if (mips && kind == MipKind::Normal)
+    for (size_t a = size_t(d.offset) * 4 + 3; a < t.texels.size(); a += 4) t.texels[a] = 0;
   if (mips) {
-    const std::vector<uint8_t> chain = build_mips(tex.rgba.data(), tex.width, tex.height, srgb);
+    const std::vector<uint8_t> chain = build_mips(tex.rgba.data(), tex.width, tex.height, kind);
     t.texels.insert(t.texels.end(), chain.begin(), chain.end());
   }
   t.textures.push_back(d);
 }
 
-// The texture table: entry i is scene texture i (with its colour chain where a colour map samples it);
-// with mips, a texture that is sampled both as a colour and as a data map gets a second entry with its
-// linear chain, whose index `linear_entry` holds (else -1). The texels are checked against the memory
-// budget before they are built.
-std::vector<int> add_textures(MaterialTables& t, const Scene& scene, bool mips) {
+// The texture table: entry i is scene texture i with the chain of its first use; with mips, a texture
+// sampled through more than one kind of chain gets further entries, after all the first ones.
+// entry[kind][i] is the entry of texture i's chain of that kind (-1: not sampled so). The texels are
+// checked against the memory budget before they are built.
+std::array<std::vector<int>, kMipKinds> add_textures(MaterialTables& t, const Scene& scene, bool mips) {
   const TextureUses uses = texture_uses(scene);
   uint64_t total = 0;
   for (size_t i = 0; i < scene.textures.size(); ++i) {
     const SceneTexture& tex = scene.textures[i];
     const int levels = mips ? mip_levels(tex.width, tex.height) : 1;
-    const uint64_t copies = mips && uses.srgb[i] && uses.linear[i] ? 2 : 1;
-    total += copies * mip_chain_texels(tex.width, tex.height, levels);
+    total += entry_kinds(uses, i, mips).size() * mip_chain_texels(tex.width, tex.height, levels);
   }
   if (total >= (uint64_t(1) << 32))
     throw Error("the scene's textures are too large (over 4 G texels" + std::string(mips ? " with their mips)" : ")"));
   check_memory(total * 4, mips ? "the textures and their mip chains" : "the textures");
   t.texels.reserve(size_t(total) * 4);
-  std::vector<int> linear_entry(scene.textures.size(), -1);
-  for (size_t i = 0; i < scene.textures.size(); ++i) add_texture(t, scene.textures[i], mips, uses.srgb[i]);
-  for (size_t i = 0; i < scene.textures.size(); ++i)
-    if (mips && uses.srgb[i] && uses.linear[i]) {
-      linear_entry[i] = int(t.textures.size());
-      add_texture(t, scene.textures[i], mips, false);
+  std::array<std::vector<int>, kMipKinds> entry;
+  for (std::vector<int>& kind : entry) kind.assign(scene.textures.size(), -1);
+  for (size_t pass = 0; pass < size_t(kMipKinds); ++pass)  // first entries first: entry i is texture i
+    for (size_t i = 0; i < scene.textures.size(); ++i) {
+      const std::vector<MipKind> kinds = entry_kinds(uses, i, mips);
+      if (pass >= kinds.size()) continue;
+      const int index = int(t.textures.size());
+      add_texture(t, scene.textures[i], mips, kinds[pass]);
+      if (mips) entry[size_t(kinds[pass])][i] = index;
+      else
+        for (std::vector<int>& kind : entry) kind[i] = index;
     }
-  return linear_entry;
+  return entry;
 }
 
 }  // namespace
@@ -94,7 +118,7 @@ std::vector<int> add_textures(MaterialTables& t, const Scene& scene, bool mips) 
 MaterialTables make_material_tables(const Scene& scene, bool mips) {
   MaterialTables t;
   const size_t vertices = scene.positions.size();
-  const std::vector<int> linear_entry = add_textures(t, scene, mips);
+  const std::array<std::vector<int>, kMipKinds> entry = add_textures(t, scene, mips);
 
   for (const std::vector<glm::vec2>& set : scene.texcoords)
     if (set.size() != vertices) throw InternalError("a TEXCOORD set does not have one entry per vertex");
@@ -125,8 +149,7 @@ MaterialTables make_material_tables(const Scene& scene, bool mips) {
                             " names a texture or TEXCOORD set the scene does not have");
       if (k == PMR_MAP_NORMAL && !has_tangents) continue;
       PmrTextureMap& map = m.maps[k];
-      const int linear = linear_entry[size_t(slot.texture)];
-      map.texture = !slot.srgb && linear >= 0 ? linear : slot.texture;
+      map.texture = entry[size_t(slot_kind(slot, k))][size_t(slot.texture)];
       map.texcoord = uint32_t(slot.texcoord);
       texture_transform_matrix(slot, map.uv_transform);
     }

@@ -312,17 +312,73 @@ inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, 
   s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
 }
 
+/* Shading jobs of a row chunk beyond its pixels' first winners (pixel `lane`, winner `ids`, shading point
+ * (sx, sy) from the chunk's first pixel center, its share `weight` of the samples), packed SW to a batch:
+ * edge pixels are few, and shading them lane by lane in the pixels' own positions would run a whole
+ * vector for each. */
+typedef struct {
+  int n;
+  int lane[SW], ids[SW], sx[SW], sy[SW];
+  float weight[SW];
+} ShadeBatch;
+
+/* Shades the batch's jobs and adds their weighted colours and alpha into acc; empties it. */
+inline void shade_batch(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, long X,
+                        long Y, int view, ShadeBatch* B, float acc[4][VW]) {
+  if (B->n == 0) return;
+  int on[SW];
+  for (int l = 0; l < SW; ++l) {
+    on[l] = l < B->n ? -1 : 0;
+    if (l >= B->n) B->ids[l] = B->sx[l] = B->sy[l] = 0;
+  }
+  const SampleLanes S = offset_samples(X, Y, B->sx, B->sy);
+  LaneWinners L;
+  lanes_gather(in, mtas, cache, vload_s(0, on), vload_s(0, B->ids), &S, view, &L);
+  float c[3][SW];
+  s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
+  for (int l = 0; l < B->n; ++l) {
+    const int p = B->lane[l];
+    for (int k = 0; k < 3; ++k) acc[k][p] += B->weight[l] * c[k][l];
+    acc[3][p] += B->weight[l];
+  }
+  B->n = 0;
+}
+
+/* The lanes w of a row chunk whose winners (ids, covering `bits`, of n samples) are shaded in pixel order,
+ * each lane its own pixel (the row forms of shade_center_lanes and shade_point_lanes), into acc. */
+inline void shade_pixel_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
+                              const int* ids, const int* w, const int* n, const uint* bits, int px0, int py, int view,
+                              float acc[4][VW]) {
+  for (int h = 0; h < VW; h += SW) {
+    const sint act = vload_s(0, w + h) != 0;
+    if (!any(act)) continue;
+    float c[3][SW];
+    if (NS == 1) shade_center_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), px0 + h, py, view, c);
+    else shade_point_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), bits + h, px0 + h, py, view, c);
+    for (int l = 0; l < SW && h + l < VW; ++l) {
+      if (!w[h + l]) continue;
+      const float weight = (float)n[h + l] / (float)NS; /* one sample: 1, and the colour as shaded */
+      for (int k = 0; k < 3; ++k) acc[k][h + l] = NS == 1 ? c[k][l] : acc[k][h + l] + weight * c[k][l];
+      acc[3][h + l] += weight;
+    }
+  }
+}
+
 /* The winners of a row chunk shaded and resolved, as half RGBA bits: lane l is pixel (px0 + l, py) of
  * view `view`, whose sample s was won by MTA mta[s][l] where won[s]. Each pixel shades each distinct
  * winner once, at its shading point, weighted by the share of the samples it won; the pixel is their sum,
  * premultiplied, so alpha is the covered fraction (DESIGN section 3b). With one sample: the winner's
- * colour at the pixel center, alpha 1, or zero (background). */
+ * colour at the pixel center, alpha 1, or zero (background). The winners first met at sample 0 are shaded
+ * in pixel order, the others packed into batches; each pixel adds its winners in sample order either way. */
 inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
                              const vuint* mta, const vuint* cover, const vint* won, int px0, int py, int view,
                              ushort4* out) {
   float acc[4][VW];
   for (int k = 0; k < 4; ++k)
     for (int l = 0; l < VW; ++l) acc[k][l] = 0.0f;
+  ShadeBatch B;
+  B.n = 0;
+  const long X = (long)px0 * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
   for (int s = 0; s < NS; ++s) {
     vint first = won[s], count = (vint)(0); /* lanes where s is the winner's first sample; its samples */
     for (int t = 0; t < NS; ++t) {
@@ -338,20 +394,20 @@ inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, M
     vstore_vint(count, 0, n);
     vstore_vint(as_vint(NS > 1 ? cover[s] : (vuint)(1u)), 0, (int*)bits);
     for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = n[l] = 0, bits[l] = 0u;
-    for (int h = 0; h < VW; h += SW) {
-      const sint act = vload_s(0, w + h) != 0;
-      if (!any(act)) continue;
-      float c[3][SW];
-      if (NS == 1) shade_center_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), px0 + h, py, view, c);
-      else shade_point_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), bits + h, px0 + h, py, view, c);
-      for (int l = 0; l < SW && h + l < VW; ++l) {
-        if (!w[h + l]) continue;
-        const float weight = (float)n[h + l] / (float)NS; /* one sample: 1, and the colour as shaded */
-        for (int k = 0; k < 3; ++k) acc[k][h + l] = NS == 1 ? c[k][l] : acc[k][h + l] + weight * c[k][l];
-        acc[3][h + l] += weight;
-      }
+    if (s == 0) {
+      shade_pixel_lanes(in, mtas, cache, light, ids, w, n, bits, px0, py, view, acc);
+      continue;
+    }
+    for (int l = 0; l < VW; ++l) {
+      if (!w[l]) continue;
+      int ox, oy;
+      shading_point(in->P, (bits[l] & FINE_CENTER) != 0u, bits[l] & FINE_SAMPLE_BITS, &ox, &oy);
+      B.lane[B.n] = l, B.ids[B.n] = ids[l], B.sx[B.n] = l * PMR_X_ONE + ox, B.sy[B.n] = oy;
+      B.weight[B.n] = (float)n[l] / (float)NS;
+      if (++B.n == SW) shade_batch(in, mtas, cache, light, X, Y, view, &B, acc);
     }
   }
+  shade_batch(in, mtas, cache, light, X, Y, view, &B, acc);
   for (int l = 0; l < VW; ++l) vstore_half4((float4)(acc[0][l], acc[1][l], acc[2][l], acc[3][l]), l, (half*)out);
 }
 

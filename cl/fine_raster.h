@@ -323,8 +323,8 @@ typedef struct {
 } ShadeBatch;
 
 /* Shades the batch's jobs and adds their weighted colours and alpha into acc; empties it. */
-inline void shade_batch(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, long X,
-                        long Y, int view, ShadeBatch* B, float acc[4][VW]) {
+inline void shade_batch(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, long X, long Y,
+                        int view, ShadeBatch* B, float acc[4][VW]) {
   if (B->n == 0) return;
   int on[SW];
   for (int l = 0; l < SW; ++l) {

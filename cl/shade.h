@@ -61,8 +61,7 @@ typedef struct {
 inline float4 sample_map(const ShadeInputs* in, global const PmrTextureMap* map, const PmrTriangle* t, float3 b,
                          const BaryGrad* g, bool srgb) {
   const uint set = map->texcoord * in->P->num_vertices;
-  const float2 t0 = in->texcoords[set + t->v[0]], t1 = in->texcoords[set + t->v[1]],
-               t2 = in->texcoords[set + t->v[2]];
+  const float2 t0 = in->texcoords[set + t->v[0]], t1 = in->texcoords[set + t->v[1]], t2 = in->texcoords[set + t->v[2]];
   const float2 uv = b.x * t0 + b.y * t1 + b.z * t2;
   const float u = map->uv_transform[0] * uv.x + map->uv_transform[1] * uv.y + map->uv_transform[2];
   const float v = map->uv_transform[3] * uv.x + map->uv_transform[4] * uv.y + map->uv_transform[5];
@@ -526,9 +525,8 @@ inline BaryGrad mta_bary_gradient(global const PmrParams* P, const PmrMta* m, lo
   float3 ex, ey;
   mta_edge_derivatives(P, m, f, &ex, &ey);
   /* the lanes' arithmetic on one voxel (in every lane): the MASK test asks it of a few voxels alone */
-  const LaneBaryGrad g = bary_gradient_lanes(s3_splat((float3)((float)e[0], (float)e[1], (float)e[2])),
-                                             s3_splat(ex), s3_splat(ey),
-                                             s3_splat((float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2])),
+  const LaneBaryGrad g = bary_gradient_lanes(s3_splat((float3)((float)e[0], (float)e[1], (float)e[2])), s3_splat(ex),
+                                             s3_splat(ey), s3_splat((float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2])),
                                              s3_splat((float3)(m->bary[0][0], m->bary[1][0], m->bary[2][0])),
                                              s3_splat((float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1])));
   const BaryGrad one = {(float3)(g.dx.x.s0, g.dx.y.s0, g.dx.z.s0), (float3)(g.dy.x.s0, g.dy.y.s0, g.dy.z.s0)};

@@ -95,7 +95,8 @@ TEST(EncodedAlpha, EachSubpixelCarriesItsSamplesAlpha) {
 // that background, which the single mean alpha A does not.
 TEST(EncodedAlpha, CompositesLikeTheViewsOverABackground) {
   const std::string out = test::temp_dir("encoded_alpha");
-  const std::string rig = " -q --views 6 --view-size 96x48 --display 300x160 --frames 0";
+  // one sample per pixel: a subpixel's alpha is then its one sample's coverage, 0 or 1 (checked below)
+  const std::string rig = " -q --views 6 --view-size 96x48 --display 300x160 --frames 0 --samples 1";
   ASSERT_EQ(test::run("render" + rig + " --write encoded,views --name views --out " + out).status, 0);
   ASSERT_EQ(test::run("render" + rig + " --write encoded --name fused --out " + out).status, 0);
   ASSERT_EQ(test::run("render" + rig + " --write encoded --sampling subpixel --name subpixel --out " + out).status, 0);

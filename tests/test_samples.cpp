@@ -133,7 +133,7 @@ TEST(Samples, DepthIsTheNearestCoveredSampleNotAMean) {
 // The sidecar records the samples per pixel (absent in older sidecars: one), and --resume refuses a
 // folder rendered with another count.
 TEST(Samples, SidecarRecordsThemAndResumeComparesThem) {
-  test::expect_resume_compares("--samples 4", "\"samples_per_pixel\": 4", "samples_per_pixel");
+  test::expect_resume_compares("--samples 8", "\"samples_per_pixel\": 8", "samples_per_pixel");
 }
 
 }  // namespace

@@ -102,7 +102,7 @@ const BenchSection kMeasureOptions = {
            o.samplings_given = true;
            for (const auto& m : split(v)) o.samplings.push_back(parse_sampling(m));
          }},
-        {"--samples", nullptr, "LIST", "samples per pixel, each as for pmr render (default 1)",
+        {"--samples", nullptr, "LIST", "samples per pixel, each as for pmr render (default 4)",
          [](BenchOptions& o, const std::string& v, const std::string&) { o.samples = parse_samples_list(v); }},
         {"--texture-filter", nullptr, "F", "trilinear (default) or bilinear, as for pmr render",
          [](BenchOptions& o, const std::string& v, const std::string&) { o.texture_filter = parse_texture_filter(v); }},

@@ -21,7 +21,7 @@ struct BenchOptions {
   std::vector<Method> methods = {Method::Pmr, Method::Multipass, Method::Duplicate};
   std::vector<Sampling> samplings = {Sampling::View};  // subpixel applies to pmr only
   bool samplings_given = false;    // else the preset's default sampling (view for methods other than pmr)
-  std::vector<int> samples = {1};  // samples per pixel, as pmr render's --samples
+  std::vector<int> samples = {4};  // samples per pixel, as pmr render's --samples (and its default)
   TextureFilter texture_filter = TextureFilter::Trilinear;  // --texture-filter, as pmr render's
   Shading shading = Shading::Pbr;
   double exposure_ev = 0.0, environment_intensity = 1.0;

@@ -9,7 +9,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 scene="$source/data/default_scene.glb"
 "$build/pmr" render "$scene" --views 4 --view-size 96x48 --display 240x135 --shading lambert \
-  --write encoded,views --out "$work/pmr" >/dev/null
+  --samples 1 --write encoded,views --out "$work/pmr" >/dev/null
 status=0
 "$build/pmr_gl_bench" "$scene" --sidecar "$work/pmr/frame_0000.json" --msaa 0 --frames 1 --no-mipmap \
   --out "$work/gl" || status=$?

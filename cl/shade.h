@@ -9,7 +9,8 @@
  * Shading goes SW voxels (or samples) at a time, one per lane (cl/lanes.h), each lane with its own
  * winning MTA: the caller loads each winning MTA's triangle, vertices and material once and blends them
  * into the lanes it won (LaneWinners); the barycentrics, normals, base colour, BRDF and lights then run
- * on all lanes at once, and the texture, split-sum and environment lookups are gathered lane by lane.
+ * on all lanes at once. Texture sampling runs on all the lanes of one material at once (cl/texture.h),
+ * only its texel loads lane by lane; the split-sum and environment lookups are gathered lane by lane.
  * Each lane's result is a function of its own voxel alone, so it depends neither on the other lanes,
  * nor on the tile shape, nor on the path. */
 #ifndef PMR_CL_SHADE_H
@@ -53,26 +54,6 @@ typedef struct {
   global const float4* env_data;    /* ... their data (cl/environment.h)                        */
   global const PmrLight* lights;    /* P->num_lights punctual lights, world space (pbr)           */
 } ShadeInputs;
-
-/* Material map `map` of triangle t at source barycentrics b (one lane): its TEXCOORD set interpolated,
- * then its KHR_texture_transform. Every map, base colour included, is read here alone, so that a set and
- * a transform mean the same for the colour, the alpha test and the pbr maps. g: the barycentrics'
- * screen-space derivatives, from which the level of detail follows (trilinear); 0: level 0 (bilinear). */
-inline float4 sample_map(const ShadeInputs* in, global const PmrTextureMap* map, const PmrTriangle* t, float3 b,
-                         const BaryGrad* g, bool srgb) {
-  const uint set = map->texcoord * in->P->num_vertices;
-  const float2 t0 = in->texcoords[set + t->v[0]], t1 = in->texcoords[set + t->v[1]], t2 = in->texcoords[set + t->v[2]];
-  const float2 uv = b.x * t0 + b.y * t1 + b.z * t2;
-  const float u = map->uv_transform[0] * uv.x + map->uv_transform[1] * uv.y + map->uv_transform[2];
-  const float v = map->uv_transform[3] * uv.x + map->uv_transform[4] * uv.y + map->uv_transform[5];
-  const PmrTexture tex = in->textures[map->texture];
-  float lambda = 0.0f;
-  if (g && tex.levels > 1u) {
-    const float2 dx = g->dx.x * t0 + g->dx.y * t1 + g->dx.z * t2, dy = g->dy.x * t0 + g->dy.y * t1 + g->dy.z * t2;
-    lambda = texture_lod(map->uv_transform, &tex, dx, dy);
-  }
-  return sample_texture(in->texels, in->srgb_lut, &tex, u, v, lambda, srgb);
-}
 
 #define LANE3(a) s3(vload_s(0, (a)[0]), vload_s(0, (a)[1]), vload_s(0, (a)[2]))
 
@@ -246,7 +227,7 @@ inline sfloat3 s3_interp_lanes(sfloat3 b, const sfloat3* a) {
   return s3_add(s3_add(s3_scale(a[0], b.x), s3_scale(a[1], b.y)), s3_scale(a[2], b.z));
 }
 
-/* The texture lookups of the textured lanes, lane by lane (they are gathers), as factors: base colour
+/* The texture lookups of the textured lanes as factors: base colour
  * (RGB), metallic and roughness, occlusion, emissive; and the normal map's sample with the interpolated
  * tangent, where there is one (mapped). Untextured lanes get factors of 1 and no normal map. */
 typedef struct {
@@ -287,52 +268,126 @@ inline LaneBaryGrad lane_bary_gradient(const LaneWinners* L) {
 }
 #endif
 
-/* grad: the lanes' barycentric derivatives (trilinear), or 0 (bilinear). */
+/* The three vertices' TEXCOORD set of each lane's triangle (lanes `bits`, triangles tri[l]; others 0). */
+typedef struct {
+  uint set; /* which set (PMR_NO_KEY: none loaded yet) */
+  sfloat u[3], v[3];
+} LaneTexcoords;
+
+inline void lane_texcoords(const ShadeInputs* in, const uint* tri, uint bits, uint set, LaneTexcoords* C) {
+  float u[3][SW], v[3][SW];
+  for (int l = 0; l < SW; ++l) u[0][l] = u[1][l] = u[2][l] = v[0][l] = v[1][l] = v[2][l] = 0.0f;
+  const uint first = set * in->P->num_vertices;
+  for (uint b = bits; b != 0u; b &= b - 1u) {
+    const int l = 31 - (int)clz(b & (0u - b));
+    global const uint* vi = in->tris[tri[l]].v;
+    for (int k = 0; k < 3; ++k) {
+      const float2 t = in->texcoords[first + vi[k]];
+      u[k][l] = t.x, v[k][l] = t.y;
+    }
+  }
+  C->set = set;
+  for (int k = 0; k < 3; ++k) C->u[k] = vload_s(0, u[k]), C->v[k] = vload_s(0, v[k]);
+}
+
+/* Material map `map`, the same for the lanes `act`, at their source barycentrics b: its TEXCOORD set
+ * interpolated (C, loaded here when it holds another set), then its KHR_texture_transform. Every map,
+ * base colour included, is read here alone, so that a set and a transform mean the same for the colour,
+ * the alpha test and the pbr maps. g: the barycentrics' screen-space derivatives, from which the level
+ * of detail follows (trilinear); 0: level 0 (bilinear). out: RGBA, 4 vectors. */
+inline void sample_map_lanes(const ShadeInputs* in, global const PmrTextureMap* map, const uint* tri, uint bits,
+                             sint act, sfloat3 b, const LaneBaryGrad* g, bool srgb, LaneTexcoords* C, sfloat* out) {
+  if (C->set != map->texcoord) lane_texcoords(in, tri, bits, map->texcoord, C);
+  const sfloat uu = b.x * C->u[0] + b.y * C->u[1] + b.z * C->u[2], vv = b.x * C->v[0] + b.y * C->v[1] + b.z * C->v[2];
+  global const float* m = map->uv_transform;
+  const sfloat u = m[0] * uu + m[1] * vv + m[2], v = m[3] * uu + m[4] * vv + m[5];
+  const PmrTexture tex = in->textures[map->texture];
+  sfloat lambda = 0.0f;
+  if (g && tex.levels > 1u) {
+    const sfloat dxu = g->dx.x * C->u[0] + g->dx.y * C->u[1] + g->dx.z * C->u[2],
+                 dxv = g->dx.x * C->v[0] + g->dx.y * C->v[1] + g->dx.z * C->v[2],
+                 dyu = g->dy.x * C->u[0] + g->dy.y * C->u[1] + g->dy.z * C->u[2],
+                 dyv = g->dy.x * C->v[0] + g->dy.y * C->v[1] + g->dy.z * C->v[2];
+    lambda = texture_lod_lanes(m, &tex, dxu, dxv, dyu, dyv);
+  }
+  sample_texture_lanes(in->texels, in->srgb_lut, &tex, u, v, lambda, act, srgb, out);
+}
+
+/* Where `take`, array x (SW floats) gets the lanes of value. */
+inline void lanes_put(float* x, sfloat value, sint take) { vstore_s(select(vload_s(0, x), value, take), 0, x); }
+
+/* The maps of material `mat` for its lanes `bits` (`take`). */
+inline void sample_material_lanes(const ShadeInputs* in, global const PmrMaterial* mat, const LaneWinners* L, uint bits,
+                                  sint take, sfloat3 b, const LaneBaryGrad* g, bool pbr, LaneTexcoords* C,
+                                  LaneTextures* T) {
+  sfloat c[4];
+  if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_BASE_COLOR], L->tri, bits, take, b, g, true, C, c);
+    for (int k = 0; k < 3; ++k) lanes_put(T->base[k], c[k], take);
+  }
+  if (!pbr) return;
+  if (mat->maps[PMR_MAP_METALLIC_ROUGHNESS].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_METALLIC_ROUGHNESS], L->tri, bits, take, b, g, false, C, c);
+    lanes_put(T->metallic, c[2], take), lanes_put(T->roughness, c[1], take);
+  }
+  if (mat->maps[PMR_MAP_OCCLUSION].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_OCCLUSION], L->tri, bits, take, b, g, false, C, c);
+    lanes_put(T->ao, 1.0f + mat->occlusion_strength * (c[0] - 1.0f), take);
+  }
+  if (mat->maps[PMR_MAP_EMISSIVE].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_EMISSIVE], L->tri, bits, take, b, g, true, C, c);
+    for (int k = 0; k < 3; ++k) lanes_put(T->emissive[k], c[k], take);
+  }
+  if (mat->maps[PMR_MAP_NORMAL].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_NORMAL], L->tri, bits, take, b, g, false, C, c);
+    for (int k = 0; k < 3; ++k) lanes_put(T->s[k], c[k], take);
+    lanes_put(T->normal_scale, (sfloat)(mat->normal_scale), take);
+    vstore_s(select(vload_s(0, T->mapped), (sint)(-1), take), 0, T->mapped);
+    /* the chain's alpha is the square root of the increment for unit normals (MipKind::Normal); a
+     * scale shrinks the normals' spread in x and y with their slopes */
+    if (g) lanes_put(T->toksvig, c[3] * c[3] * fmin(1.0f, mat->normal_scale * mat->normal_scale), take);
+    float bs[3][SW];
+    s3_store(b, bs[0], bs[1], bs[2]);
+    for (uint r = bits; r != 0u; r &= r - 1u) { /* the interpolated tangent, lane by lane (a gather) */
+      const int l = 31 - (int)clz(r & (0u - r));
+      global const uint* vi = in->tris[L->tri[l]].v;
+      const float4 tw =
+          bs[0][l] * in->tangents[vi[0]] + bs[1][l] * in->tangents[vi[1]] + bs[2][l] * in->tangents[vi[2]];
+      T->tw[0][l] = tw.x, T->tw[1][l] = tw.y, T->tw[2][l] = tw.z, T->tw[3][l] = tw.w;
+    }
+  }
+}
+
+/* The texture lookups of the textured lanes, material by material (a row's lanes mostly share one), as
+ * factors (LaneTextures). grad: the lanes' barycentric derivatives (trilinear), or 0 (bilinear). */
 inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b, const LaneBaryGrad* grad, bool pbr,
                          LaneTextures* T) {
-  float bs[3][SW], gx[3][SW], gy[3][SW];
-  s3_store(b, bs[0], bs[1], bs[2]);
-  if (grad) s3_store(grad->dx, gx[0], gx[1], gx[2]), s3_store(grad->dy, gy[0], gy[1], gy[2]);
   for (int l = 0; l < SW; ++l) {
-    for (int k = 0; k < 3; ++k) T->base[k][l] = 1.0f;
+    for (int k = 0; k < 3; ++k) T->base[k][l] = T->emissive[k][l] = 1.0f, T->s[k][l] = 0.0f;
     for (int k = 0; k < 4; ++k) T->tw[k][l] = 0.0f;
-    for (int k = 0; k < 3; ++k) T->emissive[k][l] = 1.0f, T->s[k][l] = 0.0f;
     T->metallic[l] = T->roughness[l] = T->ao[l] = T->normal_scale[l] = 1.0f;
     T->mapped[l] = 0;
     T->toksvig[l] = 0.0f;
-    if (!(L->textured & (1u << l))) continue;
-    const PmrTriangle t = in->tris[L->tri[l]];
-    global const PmrMaterial* mat = &in->materials[t.material];
-    const float3 bl = (float3)(bs[0][l], bs[1][l], bs[2][l]);
-    const BaryGrad gl = {(float3)(gx[0][l], gx[1][l], gx[2][l]), (float3)(gy[0][l], gy[1][l], gy[2][l])};
-    const BaryGrad* g = grad ? &gl : 0;
-    if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
-      const float4 c = sample_map(in, &mat->maps[PMR_MAP_BASE_COLOR], &t, bl, g, true);
-      T->base[0][l] = c.x, T->base[1][l] = c.y, T->base[2][l] = c.z;
+  }
+  uint material[SW];
+  for (uint r = L->textured; r != 0u; r &= r - 1u) {
+    const int l = 31 - (int)clz(r & (0u - r));
+    material[l] = in->tris[L->tri[l]].material;
+  }
+  const sint lane = vload_s(0, lane_index);
+  uint todo = L->textured;
+  while (todo != 0u) {
+    const uint mat = material[31 - (int)clz(todo & (0u - todo))];
+    uint bits = 0u;
+    for (uint r = todo; r != 0u; r &= r - 1u) {
+      const int l = 31 - (int)clz(r & (0u - r));
+      if (material[l] == mat) bits |= 1u << l;
     }
-    if (!pbr) continue;
-    if (mat->maps[PMR_MAP_METALLIC_ROUGHNESS].texture >= 0) {
-      const float4 m = sample_map(in, &mat->maps[PMR_MAP_METALLIC_ROUGHNESS], &t, bl, g, false);
-      T->metallic[l] = m.z, T->roughness[l] = m.y;
-    }
-    if (mat->maps[PMR_MAP_OCCLUSION].texture >= 0)
-      T->ao[l] =
-          1.0f + mat->occlusion_strength * (sample_map(in, &mat->maps[PMR_MAP_OCCLUSION], &t, bl, g, false).x - 1.0f);
-    if (mat->maps[PMR_MAP_EMISSIVE].texture >= 0) {
-      const float4 e = sample_map(in, &mat->maps[PMR_MAP_EMISSIVE], &t, bl, g, true);
-      T->emissive[0][l] = e.x, T->emissive[1][l] = e.y, T->emissive[2][l] = e.z;
-    }
-    if (mat->maps[PMR_MAP_NORMAL].texture >= 0) {
-      const float4 tw = bl.x * in->tangents[t.v[0]] + bl.y * in->tangents[t.v[1]] + bl.z * in->tangents[t.v[2]];
-      const float4 sn = sample_map(in, &mat->maps[PMR_MAP_NORMAL], &t, bl, g, false);
-      T->mapped[l] = -1;
-      T->normal_scale[l] = mat->normal_scale;
-      T->tw[0][l] = tw.x, T->tw[1][l] = tw.y, T->tw[2][l] = tw.z, T->tw[3][l] = tw.w;
-      T->s[0][l] = sn.x, T->s[1][l] = sn.y, T->s[2][l] = sn.z;
-      /* the chain's alpha is the square root of the increment for unit normals (MipKind::Normal); a
-       * scale shrinks the normals' spread in x and y with their slopes */
-      if (g) T->toksvig[l] = sn.w * sn.w * fmin(1.0f, mat->normal_scale * mat->normal_scale);
-    }
+    todo &= ~bits;
+    const sint take = ((sint)(bits) >> lane & 1) != 0;
+    LaneTexcoords C;
+    C.set = PMR_NO_KEY;
+    sample_material_lanes(in, &in->materials[mat], L, bits, take, b, grad, pbr, &C, T);
   }
 }
 
@@ -520,22 +575,19 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
 }
 
 /* The barycentrics' derivatives of MTA m in the view with view coordinate f where its exact edge
- * functions are e (one voxel, scalar: the MASK test). */
-inline BaryGrad mta_bary_gradient(global const PmrParams* P, const PmrMta* m, long f, const long* e) {
+ * functions are e, in every lane (one voxel: the MASK test). */
+inline LaneBaryGrad mta_bary_gradient(global const PmrParams* P, const PmrMta* m, long f, const long* e) {
   float3 ex, ey;
   mta_edge_derivatives(P, m, f, &ex, &ey);
-  /* the lanes' arithmetic on one voxel (in every lane): the MASK test asks it of a few voxels alone */
-  const LaneBaryGrad g = bary_gradient_lanes(s3_splat((float3)((float)e[0], (float)e[1], (float)e[2])), s3_splat(ex),
-                                             s3_splat(ey), s3_splat((float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2])),
-                                             s3_splat((float3)(m->bary[0][0], m->bary[1][0], m->bary[2][0])),
-                                             s3_splat((float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1])));
-  const BaryGrad one = {(float3)(g.dx.x.s0, g.dx.y.s0, g.dx.z.s0), (float3)(g.dy.x.s0, g.dy.y.s0, g.dy.z.s0)};
-  return one;
+  return bary_gradient_lanes(s3_splat((float3)((float)e[0], (float)e[1], (float)e[2])), s3_splat(ex), s3_splat(ey),
+                             s3_splat((float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2])),
+                             s3_splat((float3)(m->bary[0][0], m->bary[1][0], m->bary[2][0])),
+                             s3_splat((float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1])));
 }
 
 /* alphaMode MASK: the base colour alpha of MTA m at raster point (X, Y) of view `view` passes the cutoff:
  * one voxel, scalar (the raster asks this of a few candidate voxels; its inputs are the same as the
- * lanes' base colour: the factor, COLOR_0 and the base colour map through sample_map). */
+ * lanes' base colour: the factor, COLOR_0 and the base colour map through sample_map_lanes). */
 inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, long Y, int view, float cutoff) {
   const long f = view_coord(in->P, view);
   const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, f), m->sign * mta_edge(m, 2, 0, X, Y, f),
@@ -551,10 +603,17 @@ inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, lon
   float alpha = mat->base_color[3] * (b.x * in->attrs[t.v[0]].color[3] + b.y * in->attrs[t.v[1]].color[3] +
                                       b.z * in->attrs[t.v[2]].color[3]);
   if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
-    BaryGrad g;
+    /* the lanes' sampling with lane 0 alone: the MASK test asks it of a few voxels */
+    LaneBaryGrad g;
     const bool trilinear = PMR_USE_TRILINEAR(in->P);
     if (trilinear) g = mta_bary_gradient(in->P, m, f, e);
-    alpha *= sample_map(in, &mat->maps[PMR_MAP_BASE_COLOR], &t, b, trilinear ? &g : 0, true).w;
+    const uint tri[SW] = {m->tri, 0, 0, 0, 0, 0, 0, 0};
+    LaneTexcoords C;
+    C.set = PMR_NO_KEY;
+    sfloat c[4];
+    sample_map_lanes(in, &mat->maps[PMR_MAP_BASE_COLOR], tri, 1u, vload_s(0, lane_index) == 0, s3_splat(b),
+                     trilinear ? &g : 0, true, &C, c);
+    alpha *= c[3].s0;
   }
   return alpha >= cutoff;
 }

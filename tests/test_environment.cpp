@@ -18,6 +18,7 @@
 #include "environment_maps.h"
 #include "pmr/error.h"
 #include "shading/environment.h"
+#include "shading/split_sum_integral.h"
 
 namespace pmr {
 namespace {
@@ -457,6 +458,18 @@ TEST(EnvironmentSplitSum, AgainstBruteForce) {
   // r = 0 is exact; the white furnace at r = 1, n.v = 1 (A + B = directional albedo < 1).
   EXPECT_NEAR(split_sum(1.0 / 9, 0.0).y, std::pow(8.0 / 9, 5), 1e-6);  // a node: dot(n, v) = (21 / 63)^2
   EXPECT_NEAR(split_sum(0.4, 0.0).y, std::pow(0.6, 5), 1e-3);
+}
+
+// The table compiled in at build time is the computation's, bit for bit (it is printed as hexadecimal
+// float literals), and split_sum_table() serves it.
+TEST(EnvironmentSplitSum, BuiltInTableIsTheComputedOne) {
+  const std::vector<float> computed = compute_split_sum_table();
+  const std::vector<float>& table = split_sum_table();
+  ASSERT_EQ(computed.size(), size_t(2 * kEnvSplitSumSize * kEnvSplitSumSize));
+  ASSERT_EQ(table.size(), computed.size());
+  for (size_t i = 0; i < computed.size(); ++i) ASSERT_EQ(table[i], computed[i]) << "entry " << i;
+  const int N = kEnvSplitSumSize, i = N - 1, j = N / 2;  // dot(n, v) = 1, r = 32 / 63
+  EXPECT_EQ(table[size_t(2 * (j * N + i))], float(split_sum_integral(1.0, double(j) / (N - 1)).x));
 }
 
 // ---- files --------------------------------------------------------------------------------------------

@@ -140,8 +140,8 @@ class Environment {
 
 // (A, B) for (dot(n, v), r) from the table (bilinear; arguments clamped to [0, 1]).
 glm::dvec2 split_sum(double n_dot_v, double r);
-// The table itself: kEnvSplitSumSize^2 nodes of (A, B), node (i, j) at 2 * (j * N + i). Computed on
-// first use (thread-safe), about 30 ms.
+// The table itself: kEnvSplitSumSize^2 nodes of (A, B), node (i, j) at 2 * (j * N + i). Computed
+// at build time (shading/split_sum_integral.h), so no process pays for it.
 const std::vector<float>& split_sum_table();
 
 // The roughness of each prefiltered level after level 0, and c(r) (the fractional level coordinate).

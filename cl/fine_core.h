@@ -152,6 +152,27 @@ PMR_HOT void lanes_gather(const ShadeInputs* in, global const PmrMta* mtas, MtaC
   if (S->sx) L->e = LANE3(e);
 }
 
+/* SW winners (MTA ids where `act`) shaded at the raster points S of view `view`, as colours c[3][SW]. */
+inline void shade_sample_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
+                               sint act, sint ids, const SampleLanes* S, int view, float c[3][SW]) {
+  LaneWinners L;
+  lanes_gather(in, mtas, cache, act, ids, S, view, &L);
+  s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
+}
+
+/* A packed batch's first n lanes shaded: winner ids[l] at raster point (X + sx[l], Y + sy[l]); the lanes
+ * from n on are set idle (their entries zeroed). */
+inline void shade_packed_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, long X,
+                               long Y, int view, int n, int* ids, int* sx, int* sy, float c[3][SW]) {
+  int on[SW];
+  for (int l = 0; l < SW; ++l) {
+    on[l] = l < n ? -1 : 0;
+    if (l >= n) ids[l] = sx[l] = sy[l] = 0;
+  }
+  const SampleLanes S = offset_samples(X, Y, sx, sy);
+  shade_sample_lanes(in, mtas, cache, light, vload_s(0, on), vload_s(0, ids), &S, view, c);
+}
+
 /* Where the kernels that write the display image from screen tiles (fine_encode.cl, fine_subpixel.cl)
  * write it: the image (half RGBA bits) and each subpixel's own alpha (store_sub_alpha), from which
  * encode_straddle_alpha (straddle_alpha.cl) sets the alpha of the display pixels whose subpixels belong

@@ -280,9 +280,7 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
 inline void shade_center_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
                                sint act, sint ids, int px0, int py, int view, float c[3][SW]) {
   const SampleLanes S = row_samples((long)px0 * PMR_X_ONE + PMR_HALF_X, (long)py * PMR_Y_ONE + PMR_HALF_Y);
-  LaneWinners L;
-  lanes_gather(in, mtas, cache, act, ids, &S, view, &L);
-  s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
+  shade_sample_lanes(in, mtas, cache, light, act, ids, &S, view, c);
 }
 
 /* The same at each lane's shading point for its winner (shading_point): the pixel center where the
@@ -307,9 +305,7 @@ inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, 
     return;
   }
   const SampleLanes S = offset_samples(X, Y, sx, sy);
-  LaneWinners L;
-  lanes_gather(in, mtas, cache, act, ids, &S, view, &L);
-  s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
+  shade_sample_lanes(in, mtas, cache, light, act, ids, &S, view, c);
 }
 
 /* Shading jobs of a row chunk beyond its pixels' first winners (pixel `lane`, winner `ids`, shading point
@@ -326,16 +322,8 @@ typedef struct {
 inline void shade_batch(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, long X, long Y,
                         int view, ShadeBatch* B, float acc[4][VW]) {
   if (B->n == 0) return;
-  int on[SW];
-  for (int l = 0; l < SW; ++l) {
-    on[l] = l < B->n ? -1 : 0;
-    if (l >= B->n) B->ids[l] = B->sx[l] = B->sy[l] = 0;
-  }
-  const SampleLanes S = offset_samples(X, Y, B->sx, B->sy);
-  LaneWinners L;
-  lanes_gather(in, mtas, cache, vload_s(0, on), vload_s(0, B->ids), &S, view, &L);
   float c[3][SW];
-  s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
+  shade_packed_lanes(in, mtas, cache, light, X, Y, view, B->n, B->ids, B->sx, B->sy, c);
   for (int l = 0; l < B->n; ++l) {
     const int p = B->lane[l];
     for (int k = 0; k < 3; ++k) acc[k][p] += B->weight[l] * c[k][l];

@@ -290,16 +290,8 @@ typedef struct {
 inline void sp_flush(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, int v,
                      const SpChunk* C, SpBatch* B, float* acc, float* alpha) {
   if (B->n == 0) return;
-  int on[SW];
-  for (int l = 0; l < SW; ++l) {
-    on[l] = l < B->n ? -1 : 0;
-    if (l >= B->n) B->ids[l] = B->sx[l] = B->sy[l] = 0;
-  }
-  const SampleLanes S = offset_samples(C->Xc, C->Yc, B->sx, B->sy);
-  LaneWinners L;
-  lanes_gather(in, mtas, cache, vload_s(0, on), vload_s(0, B->ids), &S, v, &L);
   float c[3][SW];
-  s3_store(shade_lanes(in, &L, light, v), c[0], c[1], c[2]);
+  shade_packed_lanes(in, mtas, cache, light, C->Xc, C->Yc, v, B->n, B->ids, B->sx, B->sy, c);
   for (int l = 0; l < B->n; ++l) {
     acc[B->sid[l]] += B->weight[l] * c[B->channel[l]][l];
     alpha[B->sid[l]] += B->weight[l];

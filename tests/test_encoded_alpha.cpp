@@ -43,12 +43,6 @@ std::map<std::string, std::vector<float>> read_channels(const std::string& path,
   return out;
 }
 
-float half_of(uint16_t bits) {
-  half h;
-  h.setBits(bits);
-  return float(h);
-}
-
 }  // namespace
 
 // The encoder kernel: subpixel k's alpha is the alpha of the voxel it samples, A their mean.
@@ -81,11 +75,12 @@ TEST(EncodedAlpha, EachSubpixelCarriesItsSamplesAlpha) {
         const double u = (j + (k + 0.5) / 3.0) / display.width, t = (i + 0.5) / display.height;
         const float want =
             alpha_of(encode_view_index(display, views, j, i, k), int(std::floor(u * vw)), int(std::floor(t * vh)));
-        ASSERT_EQ(half_of(sub[px * 3 + size_t(k)]), want) << "subpixel " << j << "," << i << "," << k;
+        ASSERT_EQ(test::half_value(sub[px * 3 + size_t(k)]), want) << "subpixel " << j << "," << i << "," << k;
         sum += want;
       }
-      EXPECT_NEAR(half_of(enc[px * 4 + 3]), sum / 3.0f, 1e-3f) << "pixel " << j << "," << i;
-      mixed += half_of(sub[px * 3]) != half_of(sub[px * 3 + 1]) || half_of(sub[px * 3 + 1]) != half_of(sub[px * 3 + 2]);
+      EXPECT_NEAR(test::half_value(enc[px * 4 + 3]), sum / 3.0f, 1e-3f) << "pixel " << j << "," << i;
+      mixed += test::half_value(sub[px * 3]) != test::half_value(sub[px * 3 + 1]) ||
+               test::half_value(sub[px * 3 + 1]) != test::half_value(sub[px * 3 + 2]);
     }
   EXPECT_GT(mixed, size_t(display.width) * display.height / 4);  // the subpixels' alphas do differ
 }
@@ -129,7 +124,8 @@ TEST(EncodedAlpha, CompositesLikeTheViewsOverABackground) {
         const double u = (j + (k + 0.5) / 3.0) / w, t = (i + 0.5) / h;
         const int v = encode_view_index(display, 6, j, i, k);
         const size_t at = (size_t(std::floor(t * vh)) * vw + size_t(std::floor(u * vw))) * 4;
-        const float c = half_of(views[size_t(v)][at + size_t(k)]), a = half_of(views[size_t(v)][at + 3]);
+        const float c = test::half_value(views[size_t(v)][at + size_t(k)]),
+                    a = test::half_value(views[size_t(v)][at + 3]);
         const float want = c + (1.0f - a) * bg[k];  // the view over the background, premultiplied
         const float got = enc.at(colour[k])[px] + (1.0f - enc.at(alpha[k])[px]) * bg[k];
         ASSERT_NEAR(got, want, 1e-3f) << "subpixel " << j << "," << i << "," << k;
@@ -182,7 +178,7 @@ TEST(EncodedAlpha, BackgroundIsCompositedPerSubpixel) {
   std::vector<uint16_t> view;
   int vw = 0, vh = 0;
   read_views_exr_part(out + "/bg.views.exr", 0, vw, vh, view);
-  for (size_t i = 0; i < view.size(); i += 4) ASSERT_EQ(half_of(view[i + 3]), 1.0f);
+  for (size_t i = 0; i < view.size(); i += 4) ASSERT_EQ(test::half_value(view[i + 3]), 1.0f);
   test::CliRun r = test::run("render" + rig + " --name bg --background 0,0,0 --resume");
   EXPECT_NE(r.status, 0);
   EXPECT_NE(r.output.find("background"), std::string::npos) << r.output;

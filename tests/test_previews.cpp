@@ -26,11 +26,6 @@ using test::run;
 using test::temp_dir;
 
 uint16_t bits(float v) { return half(v).bits(); }
-float value(uint16_t b) {
-  half h;
-  h.setBits(b);
-  return float(h);
-}
 
 // The pHYs chunk's pixels per unit (x, y), or (0, 0) without one.
 std::pair<uint32_t, uint32_t> phys(const std::string& png) {
@@ -93,12 +88,12 @@ TEST(Previews, SquarePixelsStretchOneAxis) {
   std::vector<uint16_t> out = square_pixels(two.data(), 2, 1, 2.0, w, h);
   ASSERT_EQ(w, 4);
   ASSERT_EQ(h, 1);
-  EXPECT_EQ(value(out[0]), 0.0f);
-  EXPECT_EQ(value(out[12]), 1.0f);
-  EXPECT_EQ(value(out[13]), 0.5f);
-  EXPECT_GT(value(out[4]), 0.0f);
-  EXPECT_LT(value(out[4]), value(out[8]));
-  EXPECT_LT(value(out[8]), 1.0f);
+  EXPECT_EQ(test::half_value(out[0]), 0.0f);
+  EXPECT_EQ(test::half_value(out[12]), 1.0f);
+  EXPECT_EQ(test::half_value(out[13]), 0.5f);
+  EXPECT_GT(test::half_value(out[4]), 0.0f);
+  EXPECT_LT(test::half_value(out[4]), test::half_value(out[8]));
+  EXPECT_LT(test::half_value(out[8]), 1.0f);
   // tall pixels (aspect 0.5): the height doubles; a uniform image stays uniform
   const std::vector<uint16_t> flat(3 * 2 * 4, bits(0.3f));
   out = square_pixels(flat.data(), 3, 2, 0.5, w, h);
@@ -164,7 +159,7 @@ TEST(Previews, SquareViewPixelsAreKept) {
   ASSERT_EQ(pw, w);
   ASSERT_EQ(ph, h);
   for (size_t i = 0; i < size_t(w) * h; ++i)
-    ASSERT_NEAR(png[i * 4 + 3], 255.0 * std::min(1.0f, value(view[i * 4 + 3])), 1.0) << "pixel " << i;
+    ASSERT_NEAR(png[i * 4 + 3], 255.0 * std::min(1.0f, test::half_value(view[i * 4 + 3])), 1.0) << "pixel " << i;
 }
 
 }  // namespace pmr

@@ -12,12 +12,6 @@
 namespace pmr {
 namespace {
 
-float value(uint16_t bits) {
-  half h;
-  h.setBits(bits);
-  return float(h);
-}
-
 // A white rectangle on the focal plane (zero disparity: the same raster position in every view) from
 // raster x = x_left to beyond the right border, over the whole height.
 Scene rectangle_from(const Rig& rig, double x_left, double x_right = -1.0) {
@@ -53,12 +47,12 @@ TEST(Samples, AnEdgeThroughPixelCentersHalvesTheirCoverage) {
     ASSERT_EQ(out.volume.size(), single.volume.size());
     for (size_t voxel = 0; voxel < out.volume.size() / 4; ++voxel) {
       const int px = int(voxel % size_t(rig.view_w));
-      const float alpha = value(out.volume[voxel * 4 + 3]);
+      const float alpha = test::half_value(out.volume[voxel * 4 + 3]);
       if (px < 20) {
         EXPECT_EQ(alpha, 0.0f) << "S " << samples << " voxel " << voxel;
       } else if (px == 20) {
         EXPECT_NEAR(alpha, 0.5f, 1.0f / samples) << "S " << samples << " voxel " << voxel;
-        EXPECT_NEAR(value(out.volume[voxel * 4]), alpha * value(single.volume[voxel * 4]), 1e-3)
+        EXPECT_NEAR(test::half_value(out.volume[voxel * 4]), alpha * test::half_value(single.volume[voxel * 4]), 1e-3)
             << "premultiplied: the colour scales with coverage";
       } else {
         for (int c = 0; c < 4; ++c)
@@ -92,7 +86,8 @@ TEST(Samples, AlphaMaskKeepsOrDropsWholePixels) {
       const int px = int(voxel % size_t(rig.view_w)), py = int(voxel / size_t(rig.view_w) % size_t(rig.view_h));
       const double diagonal_y = -10.0 + (rig.view_h + 20.0) * (50.5 - (px + 0.5)) / 60.5;  // from (50.5, -10)
       if (std::abs(diagonal_y - (py + 0.5)) < 1.5) continue;
-      EXPECT_EQ(value(out.volume[voxel * 4 + 3]), px < 20 ? 0.0f : 1.0f) << "S " << samples << " voxel " << voxel;
+      EXPECT_EQ(test::half_value(out.volume[voxel * 4 + 3]), px < 20 ? 0.0f : 1.0f)
+          << "S " << samples << " voxel " << voxel;
       for (int c = 0; c < 4; ++c)
         EXPECT_EQ(out.volume[voxel * 4 + size_t(c)], single.volume[voxel * 4 + size_t(c)])
             << "S " << samples << " voxel " << voxel;

@@ -18,12 +18,6 @@
 namespace pmr {
 namespace {
 
-float value(uint16_t bits) {
-  half h;
-  h.setBits(bits);
-  return float(h);
-}
-
 // A triangle by its center-view raster corners, each corner dz (world units) behind (> 0) or in front
 // of (< 0) the focal plane, and its colour.
 struct FlatTriangle {
@@ -137,9 +131,10 @@ Errors compare(const std::vector<uint16_t>& volume, const BoxReference& ref) {
   Errors e;
   const size_t voxels = ref.interior.size();
   for (size_t v = 0; v < voxels; ++v) {
-    const double alpha = std::abs(value(volume[v * 4 + 3]) - ref.rgba[v * 4 + 3]);
+    const double alpha = std::abs(test::half_value(volume[v * 4 + 3]) - ref.rgba[v * 4 + 3]);
     double colour = 0.0;
-    for (size_t k = 0; k < 3; ++k) colour = std::max(colour, std::abs(value(volume[v * 4 + k]) - ref.rgba[v * 4 + k]));
+    for (size_t k = 0; k < 3; ++k)
+      colour = std::max(colour, std::abs(test::half_value(volume[v * 4 + k]) - ref.rgba[v * 4 + k]));
     e.max_alpha = std::max(e.max_alpha, alpha), e.mean_alpha += alpha / double(voxels);
     e.max_colour = std::max(e.max_colour, colour), e.mean_colour += colour / double(voxels);
     if (ref.interior[v]) {

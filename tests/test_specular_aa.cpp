@@ -8,6 +8,7 @@
 #include <Imath/half.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 
@@ -68,9 +69,9 @@ Scene sphere(glm::vec3 c, float r, float roughness, bool bumps, glm::vec2 repeat
   for (int i = 0; i < stacks; ++i)
     for (int j = 0; j < slices; ++j) {
       const uint32_t q[4] = {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)};
-      for (const uint32_t* v : {q, q + 1}) {  // (0, 1, 2) and (0, 2, 3)
+      for (const std::array<uint32_t, 3>& tri : {std::array<uint32_t, 3>{q[0], q[1], q[2]}, {q[0], q[2], q[3]}}) {
         PmrTriangle t{};
-        t.v[0] = q[0], t.v[1] = v == q ? q[1] : q[2], t.v[2] = v == q ? q[2] : q[3];
+        t.v[0] = tri[0], t.v[1] = tri[1], t.v[2] = tri[2];
         const glm::vec3 a = s.positions[t.v[0]], b = s.positions[t.v[1]], d = s.positions[t.v[2]];
         glm::vec3 f = glm::cross(b - a, d - a);
         if (glm::length(f) < 1e-12f) continue;  // the poles' degenerate halves
@@ -93,11 +94,7 @@ std::vector<double> radiance(const test::Rendered& r, const Rig& rig, int down) 
       for (int x = 0; x < rig.view_w; ++x) {
         const size_t voxel = (size_t(v) * size_t(rig.view_h) + size_t(y)) * size_t(rig.view_w) + size_t(x);
         double sum = 0.0;
-        for (int c = 0; c < 3; ++c) {
-          half value;
-          value.setBits(r.volume[voxel * 4 + size_t(c)]);
-          sum += double(value);
-        }
+        for (int c = 0; c < 3; ++c) sum += double(test::half_value(r.volume[voxel * 4 + size_t(c)]));
         out[(size_t(v) * size_t(h) + size_t(y / down)) * size_t(w) + size_t(x / down)] += sum / (down * down);
       }
   return out;

@@ -87,6 +87,12 @@ Scene random_scene(int n, uint32_t seed, bool double_sided) {
   return s;
 }
 
+float half_value(uint16_t bits) {
+  half h;
+  h.setBits(bits);
+  return float(h);
+}
+
 Rig sidecar_rig() {
   Rig rig;
   rig.views = 3;

@@ -45,6 +45,9 @@ Rig small_rig(int views, int w, int h, bool angular = false);
 // Both camera spacings, for the exactness tests that must hold for either.
 constexpr bool kSpacings[] = {false, true};
 inline const char* spacing_name(bool angular) { return angular ? "angular" : "linear"; }
+
+// The value of a half's bits (the volumes, EXR channels and encoded images hold halves).
+float half_value(uint16_t bits);
 // A fixed rig (3 views of 64x32, a camera at (3, 2, 4) looking at (0, 0.5, 0)) for sidecar tests.
 Rig sidecar_rig();
 

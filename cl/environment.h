@@ -80,19 +80,20 @@ inline float4 env_log2(float4 x) {
 }
 
 /* The four texels and weights of a bilinear lookup at (u, v) on a W x H level: texel centers at
- * (j + 1/2) / W, wrapping in u, clamped in v. */
+ * (j + 1/2) / W, wrapping in u; v clamped half a texel beyond the outer rows' centers, between them
+ * and the pole rows stored above and below (host/shading/environment.h). */
 typedef struct {
   uint i00, i10, i01, i11; /* texel indices, row-major */
   float fx, fy;
 } EnvTaps;
 
 inline EnvTaps env_taps(uint W, uint H, float2 uv) {
-  const float x = uv.x * (float)W - 0.5f, y = uv.y * (float)H - 0.5f;
+  const float x = uv.x * (float)W - 0.5f, y = clamp(uv.y * (float)H - 0.5f, -0.5f, (float)H - 0.5f);
   const float x0f = floor(x), y0f = floor(y);
   /* u is in [0, 1], so x0 is in [-1, W - 1]: one step of wrapping each way suffices */
   const int xi = (int)x0f, yi = (int)y0f;
   const uint x0 = xi < 0 ? W - 1u : min((uint)xi, W - 1u), x1 = x0 + 1u < W ? x0 + 1u : 0u;
-  const uint y0 = (uint)clamp(yi, 0, (int)H - 1) * W, y1 = (uint)clamp(yi + 1, 0, (int)H - 1) * W;
+  const uint y0 = (uint)(yi + 1) * W, y1 = (uint)min(yi + 2, (int)H + 1) * W; /* rows with the pole rows */
   EnvTaps k = {y0 + x0, y0 + x1, y1 + x0, y1 + x1, x - x0f, y - y0f};
   return k;
 }

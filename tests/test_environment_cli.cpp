@@ -92,15 +92,43 @@ TEST(EnvironmentCli, SidecarRecordsItAndResumeNoticesChanges) {
   EXPECT_EQ(sidecar(out)["shading"]["environment"]["checksum"], checksum_file(sky));
 }
 
-// Without an image the sidecar records the uniform default as before, and a rotation alone warns.
-TEST(EnvironmentCli, UniformDefaultAndRotationWithoutImage) {
-  const std::string out = temp_dir("env_uniform");
-  const test::CliRun r = run("render" + kSmall + " --environment-rotation 20 --out " + out);
-  ASSERT_EQ(r.status, 0) << r.output;
-  EXPECT_NE(r.output.find("without --environment it does nothing"), std::string::npos) << r.output;
-  const nlohmann::json e = sidecar(out)["shading"]["environment"];
-  EXPECT_EQ(e["kind"], "uniform");
-  EXPECT_FALSE(e.contains("rotation_deg"));
+// The studio is the default, recorded in the sidecar with its rotation, and lights the scene without the
+// default light; `uniform` is the earlier default (with the default light), where a rotation warns;
+// `./studio` names a file; --resume notices a change of environment; lambert needs none.
+TEST(EnvironmentCli, StudioByDefaultUniformByNameAndFilesByPath) {
+  const std::string dir = temp_dir("env_keywords");
+  const std::string out = dir + "/out";
+  const test::CliRun studio = run("render" + kSmall + " --environment-rotation 20 --out '" + out + "'");
+  ASSERT_EQ(studio.status, 0) << studio.output;
+  EXPECT_EQ(studio.output.find("warning"), std::string::npos) << studio.output;
+  nlohmann::json s = sidecar(out)["shading"];
+  EXPECT_EQ(s["environment"]["kind"], "studio");
+  EXPECT_EQ(s["environment"]["rotation_deg"], 20.0);
+  EXPECT_EQ(s["environment"]["intensity"], 1.0);
+  EXPECT_EQ(s["lights"], nlohmann::json::array()) << "the studio lights the default scene alone";
+  expect_one_error_line(run("render" + kSmall + " --environment uniform --resume --out '" + out + "'"),
+                        "shading differs");
+
+  const std::string flat = dir + "/flat";
+  const test::CliRun uniform =
+      run("render" + kSmall + " --environment uniform --environment-rotation 20 --out '" + flat + "'");
+  ASSERT_EQ(uniform.status, 0) << uniform.output;
+  EXPECT_NE(uniform.output.find("does nothing to the uniform environment"), std::string::npos) << uniform.output;
+  s = sidecar(flat)["shading"];
+  EXPECT_EQ(s["environment"]["kind"], "uniform");
+  EXPECT_FALSE(s["environment"].contains("rotation_deg"));
+  ASSERT_EQ(s["lights"].size(), 1u);
+  EXPECT_EQ(s["lights"][0]["name"], "default");
+
+  expect_one_error_line(run("render" + kSmall + " --environment ./studio --out '" + dir + "/file'"), "./studio");
+  expect_usage_error(run("render --views 4 --view-size 48x24 --display 192x108 --shading lambert --environment "
+                         "studio --out '" +
+                         dir + "/lambert'"),
+                     "--shading pbr");
+  const test::CliRun lambert =
+      run("render --views 4 --view-size 48x24 --display 192x108 --shading lambert --out '" + dir + "/lambert'");
+  ASSERT_EQ(lambert.status, 0) << lambert.output;
+  EXPECT_FALSE(sidecar(dir + "/lambert")["shading"].contains("environment"));
 }
 
 }  // namespace

@@ -123,7 +123,8 @@ TEST(Names, QuietPrintsOnlyErrorsAndWarnings) {
   CliRun r = run("render -q" + kSmall + "--out " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(r.output, "");
-  r = run("render --quiet --environment-rotation 30" + kSmall + "--out " + temp_dir("names_quiet_warning"));
+  r = run("render --quiet --environment uniform --environment-rotation 30" + kSmall + "--out " +
+          temp_dir("names_quiet_warning"));
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(r.output.rfind("pmr: warning: --environment-rotation", 0), 0u) << r.output;
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;

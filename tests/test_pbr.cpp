@@ -704,6 +704,128 @@ TEST(PbrEnvironment, IntensityScalesAndZeroTurnsOff) {
   EXPECT_GT(lit, size_t(1000));
 }
 
+// ---- the built-in studio (the command line's default environment) ----------------------------------
+
+// A white rough dielectric facing the camera reads 0.8 to 1.0 under the studio (DESIGN 4b), lit by the
+// studio alone: no default light comes with it.
+TEST(PbrEnvironment, TheStudioLightsAWhiteRoughDielectricFacingTheCameraAt08To1) {
+  const Rig rig = test::small_rig(5, 40, 24);
+  Scene s = test::empty_scene(true);
+  s.materials[0].metallic = 0.0f, s.materials[0].roughness = 1.0f;
+  for (float& c : s.materials[0].base_color) c = 1.0f;
+  test::add_triangle(s, {-1.0f, -1.0f, 0.0f}, {1.0f, -1.0f, 0.0f}, {1.0f, 1.0f, 0.0f});
+  test::add_triangle(s, {-1.0f, -1.0f, 0.0f}, {1.0f, 1.0f, 0.0f}, {-1.0f, 1.0f, 0.0f});
+  const auto studio = std::make_shared<const Environment>(Environment::studio());
+  const test::Rendered out = render_environment(s, rig, studio);
+  size_t covered = 0;
+  double lo = 1e9, hi = -1e9;
+  for (size_t v = 0; v < out.key.size(); ++v) {
+    if (out.key[v] == PMR_NO_KEY) continue;
+    ++covered;
+    for (int c = 0; c < 3; ++c) {
+      half x;
+      x.setBits(out.volume[v * 4 + size_t(c)]);
+      lo = std::min(lo, double(float(x))), hi = std::max(hi, double(float(x)));
+    }
+  }
+  std::printf("[ studio   ] white rough dielectric facing the camera: %.3f to %.3f\n", lo, hi);
+  EXPECT_GT(covered, size_t(500));
+  EXPECT_GE(lo, 0.8);
+  EXPECT_LE(hi, 1.0);
+}
+
+// Pixels of view `view` brighter than `threshold` in red: 1 where pmr's (or the reference's) colour is.
+std::vector<uint8_t> bright_mask(const test::Rendered& out, const Rig& rig, int view, const VoxelReference* ref,
+                                 double threshold) {
+  const size_t W = size_t(rig.view_w), H = size_t(rig.view_h), base = size_t(view) * W * H;
+  std::vector<uint8_t> mask(W * H, 0);
+  for (size_t p = 0; p < W * H; ++p) {
+    const size_t v = base + p;
+    if (out.key[v] == PMR_NO_KEY) continue;
+    double red = 0.0;
+    if (ref) {
+      const PmrMta* m = ref->mta(v);
+      red = m ? ref->colour(v, *m).x : 0.0;
+    } else {
+      half x;
+      x.setBits(out.volume[v * 4]);
+      red = float(x);
+    }
+    mask[p] = red > threshold;
+  }
+  return mask;
+}
+
+// Pixels of `a` with no pixel of `b` within one pixel (3x3).
+size_t farther_than_one_pixel(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b, int W, int H) {
+  size_t far = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      if (!a[size_t(y * W + x)]) continue;
+      bool near = false;
+      for (int dy = -1; dy <= 1 && !near; ++dy)
+        for (int dx = -1; dx <= 1 && !near; ++dx) {
+          const int xx = x + dx, yy = y + dy;
+          near = xx >= 0 && yy >= 0 && xx < W && yy < H && b[size_t(yy * W + xx)];
+        }
+      far += !near;
+    }
+  return far;
+}
+
+// 8-connected regions of a mask.
+int regions(std::vector<uint8_t> mask, int W, int H) {
+  int count = 0;
+  for (int start = 0; start < W * H; ++start) {
+    if (!mask[size_t(start)]) continue;
+    ++count;
+    std::vector<int> stack{start};
+    mask[size_t(start)] = 0;
+    while (!stack.empty()) {
+      const int p = stack.back();
+      stack.pop_back();
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int x = p % W + dx, y = p / W + dy;
+          if (x < 0 || y < 0 || x >= W || y >= H || !mask[size_t(y * W + x)]) continue;
+          mask[size_t(y * W + x)] = 0;
+          stack.push_back(y * W + x);
+        }
+    }
+  }
+  return count;
+}
+
+// A polished metal sphere under the studio mirrors its soft boxes (radiance 8 to 20; the walls at most
+// 0.3): in views 0 and N-1 every pixel pmr shows a box in lies within 1 px of one where the double-
+// precision reference (its own reflection vectors from each view's eye, the same studio lookups) does,
+// and the other way round. The boxes are at least four separate reflections, and they move between the
+// views.
+TEST(PbrEnvironment, APolishedSphereShowsTheStudioBoxesWhereTheReferenceDoes) {
+  const int N = 7, W = 96, H = 96;
+  const Rig rig = test::small_rig(N, W, H);
+  const Scene s = sphere(0.9f, glm::vec3(0.0f), 1.0f, 0.0f);  // roughness clamped to 0.03
+  const auto studio = std::make_shared<const Environment>(Environment::studio());
+  const test::Rendered out = render_environment(s, rig, studio);
+  VoxelReference reference(s, rig, out);
+  reference.lights.clear();
+  reference.env = image_environment(*studio);
+  std::vector<uint8_t> first;
+  for (int view : {0, N - 1}) {
+    const std::vector<uint8_t> got = bright_mask(out, rig, view, nullptr, 2.0),
+                               want = bright_mask(out, rig, view, &reference, 2.0);
+    const size_t lit = size_t(std::count(got.begin(), got.end(), 1));
+    const int boxes = regions(got, W, H);
+    std::printf("[ studio   ] polished sphere, view %d: %zu pixels show a box, %d regions\n", view, lit, boxes);
+    EXPECT_GT(lit, size_t(40)) << "view " << view;
+    EXPECT_GE(boxes, 4) << "view " << view;
+    EXPECT_EQ(farther_than_one_pixel(got, want, W, H), 0u) << "view " << view << ": pmr shows a box elsewhere";
+    EXPECT_EQ(farther_than_one_pixel(want, got, W, H), 0u) << "view " << view << ": the reference shows one elsewhere";
+    if (view == 0) first = got;
+    else EXPECT_NE(first, got) << "the reflections do not move between views 0 and N-1";
+  }
+}
+
 // Every rendering path shades with the environment alike: multipass fed PMR's positions and the fused
 // raster + encode give PMR's values bit for bit; --sampling subpixel (which samples elsewhere) lights
 // the same scene to the same overall brightness.

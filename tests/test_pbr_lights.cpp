@@ -222,11 +222,15 @@ TEST(PbrLightsSidecar, ResumeComparesTheLightsOfEachFrame) {
   EXPECT_EQ(sidecar_at(out + "/frame_0001.json")["shading"]["lights"][0]["intensity"], 3.0);
 }
 
-// Without lights in the file, pbr records the default light (toward light_dir_world), and none with an
-// environment image; the file's lights stay with an image; lambert records none.
+// Without lights in the file, pbr records the default light (toward light_dir_world) with the uniform
+// environment, and none with the studio (the default) or an image; the file's lights stay with an
+// image; lambert records none.
 TEST(PbrLightsSidecar, TheDefaultLightAndLambert) {
   const std::string out = test::temp_dir("pbr_lights_default");
   CliRun r = run("render --shading pbr" + kSmall + "--out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(sidecar_at(out + "/frame_0000.json").at("shading").at("lights"), json::array());
+  r = run("render --shading pbr --environment uniform --overwrite" + kSmall + "--out " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   json j = sidecar_at(out + "/frame_0000.json");
   const json lights = j.at("shading").at("lights");

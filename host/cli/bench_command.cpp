@@ -14,6 +14,7 @@
 #include "pmr/error.h"
 #include "pmr/memory_budget.h"
 #include "pmr/output.h"
+#include "pmr/printable.h"
 #include "pmr/scene.h"
 #include "runtime/cl_runtime.h"
 #include "sequence/frame_renderer.h"
@@ -203,13 +204,17 @@ int run_bench(const std::vector<std::string>& args) {
     csv.reset(new std::ofstream(o.csv));
     if (!*csv) throw Error("cannot write " + o.csv);
   }
-  if (!o.environment_file.empty()) {  // prefiltered once, before the first point
-    o.environment = std::make_shared<const Environment>(
-        Environment::make({o.environment_file, o.environment_rotation_deg, o.environment_intensity}));
-    const PmrEnvironment& h = o.environment->tables().header;
-    std::printf("# environment %s: %ux%u, prefiltered in %.2f s (%.1f MB of tables)\n", o.environment_file.c_str(),
-                h.levels[0].width, h.levels[0].height, o.environment->prefilter_seconds(),
-                double(o.environment->tables().data.size() * sizeof(float)) / 1e6);
+  if (o.shading == Shading::Pbr) {  // made once, before the first point
+    o.environment =
+        make_pipeline_environment({o.environment_source, o.environment_rotation_deg, o.environment_intensity});
+    std::printf("# environment %s", printable_text(o.environment_source.name()).c_str());
+    if (o.environment) {
+      const PmrEnvironment& h = o.environment->tables().header;
+      std::printf(": %ux%u, prefiltered in %.2f s (%.1f MB of tables)", h.levels[0].width, h.levels[0].height,
+                  o.environment->prefilter_seconds(),
+                  double(o.environment->tables().data.size() * sizeof(float)) / 1e6);
+    }
+    std::printf("\n");
   }
   set_memory_budget(o.limits.memory);
   ClRuntime rt;

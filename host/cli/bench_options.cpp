@@ -68,17 +68,17 @@ const BenchSection kSweepOptions = {
 
 // Not listed one by one: the heading names them.
 const BenchSection kShadingOptions = {
-    "  --shading S, --exposure EV, --environment FILE, --environment-rotation DEG,\n"
-    "  --environment-intensity X   as for pmr render (default pbr)",
+    "  --shading S, --exposure EV, --environment E, --environment-rotation DEG,\n"
+    "  --environment-intensity X   as for pmr render (default pbr, studio)",
     {
         {"--shading", nullptr, "S", "",
          [](BenchOptions& o, const std::string& v, const std::string&) { o.shading = parse_shading(v); }},
         {"--exposure", nullptr, "EV", "",
          [](BenchOptions& o, const std::string& v, const std::string&) { o.exposure_ev = parse_exposure(v); }},
-        {"--environment", nullptr, "FILE", "",
+        {"--environment", nullptr, "E", "",
          [](BenchOptions& o, const std::string& v, const std::string&) {
-           o.environment_file = v;
-           if (o.environment_file.empty()) throw Error("invalid --environment '': expected a .hdr or .exr file");
+           o.environment_source = parse_environment(v);
+           o.environment_given = true;
          }},
         {"--environment-rotation", nullptr, "DEG", "",
          [](BenchOptions& o, const std::string& v, const std::string&) {
@@ -200,7 +200,8 @@ BenchOptions parse_bench_options(const std::vector<std::string>& args) {
   o.sequence = r.job.sequence;
   if (o.methods.empty() || o.views.empty() || o.samplings.empty()) throw Error("nothing to measure");
   std::vector<std::string> warnings;
-  check_environment_options(o.environment_file, o.environment_rotation_given, o.shading, warnings);
+  check_environment_options(o.environment_source, o.environment_given, o.environment_rotation_given, o.shading,
+                            warnings);
   for (const std::string& w : warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
   const bool subpixel = std::find(o.samplings.begin(), o.samplings.end(), Sampling::Subpixel) != o.samplings.end();
   // subpixel rows are measured for pmr alone (the other methods' rows are skipped)

@@ -9,6 +9,7 @@
 #include "pmr/input_files.h"
 #include "pmr/rig.h"
 #include "sequence/sequence_spec.h"
+#include "shading/environment.h"
 
 namespace pmr {
 
@@ -38,8 +39,9 @@ struct BenchOptions {
   bool help = false;
   // Timed frames are frames 0..K-1 of this sequence (animation and turntable as for pmr render).
   SequenceChoice sequence;
-  // --environment FILE and --environment-rotation DEG (pbr), prefiltered once for every point
-  std::string environment_file;
+  // --environment E and --environment-rotation DEG (pbr), made once for every point
+  EnvironmentSource environment_source;
+  bool environment_given = false;
   double environment_rotation_deg = 0.0;
   bool environment_rotation_given = false;
   std::shared_ptr<const Environment> environment;

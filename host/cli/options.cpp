@@ -44,12 +44,18 @@ double parse_environment_rotation(const std::string& text) {
   return parse_double(text, "--environment-rotation");  // any finite angle
 }
 
-void check_environment_options(const std::string& file, bool rotation_given, Shading shading,
+EnvironmentSource parse_environment(const std::string& text) { return EnvironmentSource::parse(text); }
+
+void check_environment_options(const EnvironmentSource& source, bool given, bool rotation_given, Shading shading,
                                std::vector<std::string>& warnings) {
-  if (!file.empty() && shading != Shading::Pbr)
-    throw Error("--environment lights the pbr model only: add --shading pbr");
-  if (file.empty() && rotation_given)
-    warnings.push_back("--environment-rotation turns an environment image: without --environment it does nothing");
+  if (given && shading != Shading::Pbr) throw Error("--environment lights the pbr model only: add --shading pbr");
+  if (rotation_given && shading != Shading::Pbr)
+    warnings.push_back("--environment-rotation turns the pbr model's environment: with --shading " +
+                       std::string(to_string(shading)) + " it does nothing");
+  else if (rotation_given && source.kind == EnvironmentSource::Kind::Uniform)
+    warnings.push_back(
+        "--environment-rotation does nothing to the uniform environment: it is the same in every "
+        "direction");
 }
 
 namespace {
@@ -437,7 +443,8 @@ const RenderSection kShadingOptions = {
          "pbr (default): glTF metallic-roughness with every material map, seen from\n"
          "each view's own camera, so highlights move across the views; lit by the\n"
          "file's KHR_lights_punctual lights (moving with their nodes; without any,\n"
-         "a default directional light) and a uniform environment or --environment;\n"
+         "a default directional light only with --environment uniform) and the\n"
+         "environment (the built-in studio by default);\n"
          "lambert: base colour x (0.2 + 0.8 max(0, n.l)), the same in every view,\n"
          "one fixed light (faster)",
          [](RenderOptions& o, const std::string& v, const std::string&) { o.job.pipeline.shading = parse_shading(v); }},
@@ -445,26 +452,31 @@ const RenderSection kShadingOptions = {
          [](RenderOptions& o, const std::string& v, const std::string&) {
            o.job.pipeline.exposure_ev = parse_exposure(v);
          }},
-        {"--environment", nullptr, "FILE",
-         "pbr: light with an equirectangular image of linear radiance (.hdr or .exr,\n"
-         "path relative to the current folder) instead of the uniform environment\n"
-         "and the default light (the file's lights stay); -Z is the image's middle\n"
-         "column, +Y its top row; prefiltered once per run (1-2.5 s for 1024x512).\n"
-         "Needs --shading pbr",
+        {"--environment", nullptr, "E",
+         "pbr: what lights the scene besides its own lights (they stay):\n"
+         "studio (default): a built-in studio room, grey walls and soft boxes\n"
+         "above, left, right and behind the camera;\n"
+         "uniform: radiance 0.2 from everywhere, with a default directional light\n"
+         "when the file has no lights (pmr's look before 0.19);\n"
+         "FILE: an equirectangular image of linear radiance (.hdr or .exr, path\n"
+         "relative to the current folder; ./studio for a file of that name), -Z\n"
+         "its middle column, +Y its top row; prefiltered once per run (1-2.5 s\n"
+         "for 1024x512). Given explicitly, needs --shading pbr",
          [](RenderOptions& o, const std::string& v, const std::string&) {
-           if (v.empty()) throw Error("invalid --environment '': expected a .hdr or .exr file");
-           o.job.environment_file = v;
+           o.job.environment = parse_environment(v);
+           o.environment_given = true;
          }},
         {"--environment-rotation", nullptr, "DEG",
-         "pbr: turn the image DEG degrees counter-clockwise seen from above\n"
+         "pbr: turn the studio or the image DEG degrees counter-clockwise seen\n"
+         "from above\n"
          "(+X moves toward -Z; default 0)",
          [](RenderOptions& o, const std::string& v, const std::string&) {
            o.job.environment_rotation_deg = parse_environment_rotation(v);
            o.environment_rotation_given = true;
          }},
         {"--environment-intensity", nullptr, "X",
-         "pbr: scales the environment, the image or the uniform one of radiance\n"
-         "0.2 (0 turns it off; default 1)",
+         "pbr: scales the environment, whichever it is (0 turns it off;\n"
+         "default 1)",
          [](RenderOptions& o, const std::string& v, const std::string&) {
            o.job.pipeline.environment_intensity = parse_environment_intensity(v);
          }},
@@ -526,8 +538,8 @@ namespace {
 void finalize_options(RenderOptions& o) {
   if (o.job.display.blend_views && o.job.display.bilinear)
     throw UsageError("--blend-views and --bilinear cannot be combined");
-  check_environment_options(o.job.environment_file, o.environment_rotation_given, o.job.pipeline.shading,
-                            o.job.warnings);
+  check_environment_options(o.job.environment, o.environment_given, o.environment_rotation_given,
+                            o.job.pipeline.shading, o.job.warnings);
   if (o.job.pipeline.sampling == Sampling::Subpixel && !o.sampling_given) {
     // the preset's default: options that need the views rendered on their grids take precedence
     const std::string needs_views = o.job.pipeline.method != Method::Pmr

@@ -16,10 +16,12 @@ int parse_samples(const std::string& text);                    // --samples: 1, 
 std::vector<int> parse_samples_list(const std::string& text);  // a comma list of them (bench, quality)
 double parse_environment_intensity(const std::string& text);
 double parse_environment_rotation(const std::string& text);
-// Checks --environment and --environment-rotation against the shading model: an environment image
-// lights --shading pbr only (an error with lambert); a rotation without an image is a warning, added
-// to `warnings`.
-void check_environment_options(const std::string& file, bool rotation_given, Shading shading,
+// --environment studio|uniform|FILE (EnvironmentSource::parse).
+EnvironmentSource parse_environment(const std::string& text);
+// Checks --environment and --environment-rotation against the shading model: an environment given on
+// the command line lights --shading pbr only (an error with lambert); a rotation of the uniform
+// environment, or with lambert, is a warning, added to `warnings`.
+void check_environment_options(const EnvironmentSource& source, bool given, bool rotation_given, Shading shading,
                                std::vector<std::string>& warnings);
 
 // The job the command line describes, and what the command line alone needs to know about how it
@@ -29,8 +31,9 @@ struct RenderOptions {
   std::string compression = "zip";  // --compression, checked with the job (render_command.cpp)
   bool offset_given = false;        // else offset = -L / (2N), which centres every subpixel in its view
   bool help = false;
-  bool preset_help = false;   // --preset help
-  bool method_given = false;  // --method was on the command line
+  bool preset_help = false;        // --preset help
+  bool method_given = false;       // --method was on the command line
+  bool environment_given = false;  // --environment was on the command line
   bool environment_rotation_given = false;
   bool zoom_given = false;  // --zoom was on the command line (rig.zoom)
   // --sampling was on the command line; else pipeline.sampling is the preset's default, and subpixel

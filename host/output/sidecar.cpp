@@ -96,12 +96,16 @@ json shading_json(const SidecarInfo& info) {
   const PipelineConfig& p = info.pipeline;
   json s = {{"model", to_string(p.shading)}, {"exposure_ev", p.exposure_ev}};
   if (p.shading != Shading::Pbr) return s;
-  if (info.environment_file.empty())
+  const EnvironmentSource::Kind kind = info.environment.kind;
+  if (kind == EnvironmentSource::Kind::Uniform)
     s["environment"] = {
         {"kind", "uniform"}, {"radiance", 0.2 * p.environment_intensity}, {"intensity", p.environment_intensity}};
+  else if (kind == EnvironmentSource::Kind::Studio)
+    s["environment"] = {
+        {"kind", "studio"}, {"rotation_deg", info.environment_rotation_deg}, {"intensity", p.environment_intensity}};
   else
     s["environment"] = {{"kind", "image"},
-                        {"file", info.environment_file},
+                        {"file", info.environment.file},
                         {"checksum", info.environment_checksum},
                         {"checksum_algorithm", kChecksumAlgorithm},
                         {"rotation_deg", info.environment_rotation_deg},

@@ -15,6 +15,7 @@
 #include "pmr/rig.h"
 #include "pmr/scene.h"
 #include "sequence/sequence_spec.h"
+#include "shading/environment.h"
 
 namespace pmr {
 
@@ -38,9 +39,10 @@ struct SidecarInfo {
   std::optional<ExrCompression> compression;  // of the images (none: not recorded)
   Background background;                      // transparent: not recorded
   InputLimits input_limits;                   // allow_outside_scene_folder: recorded only when given
-  // pbr: the environment image (--environment as given, "" = the uniform default), its checksum and
-  // rotation (its intensity is pipeline.environment_intensity)
-  std::string environment_file, environment_checksum;
+  // pbr: the environment (--environment: the studio, the uniform one or an image file as given), an
+  // image's checksum, the rotation (its intensity is pipeline.environment_intensity)
+  EnvironmentSource environment;
+  std::string environment_checksum;
   double environment_rotation_deg = 0.0;
   // what the run read and framed
   bool has_bounds = false;  // world bounds of the scene the default framing used

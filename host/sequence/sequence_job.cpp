@@ -30,6 +30,7 @@
 #include "sequence/range_warning.h"
 #include "sequence/resume_plan.h"
 #include "sequence/shard.h"
+#include "pmr/printable.h"
 #include "shading/environment.h"
 
 namespace pmr {
@@ -126,17 +127,18 @@ void SequenceRun::load_inputs() {
                            std::to_string(long(seconds)) + " s so far (" + std::to_string(entries) +
                            " tile-queue entries)");
     };
-  if (!job_.environment_file.empty()) {
-    auto environment = std::make_shared<const Environment>(
-        Environment::make({job_.environment_file, job_.environment_rotation_deg, job_.pipeline.environment_intensity}));
-    environment_checksum_ = checksum_file(job_.environment_file);
-    if (job_.verbose) {
-      const PmrEnvironment& h = environment->tables().header;
+  if (job_.pipeline.shading == Shading::Pbr) {
+    const EnvironmentSource& source = job_.environment;
+    pc_.environment =
+        make_pipeline_environment({source, job_.environment_rotation_deg, job_.pipeline.environment_intensity});
+    if (source.kind == EnvironmentSource::Kind::File) environment_checksum_ = checksum_file(source.file);
+    if (job_.verbose && pc_.environment) {
+      const PmrEnvironment& h = pc_.environment->tables().header;
       std::fprintf(stderr, "pmr: environment %s: %ux%u, prefiltered in %.2f s (%.1f MB of tables)\n",
-                   job_.environment_file.c_str(), h.levels[0].width, h.levels[0].height,
-                   environment->prefilter_seconds(), double(environment->tables().data.size() * sizeof(float)) / 1e6);
+                   printable_text(source.name()).c_str(), h.levels[0].width, h.levels[0].height,
+                   pc_.environment->prefilter_seconds(),
+                   double(pc_.environment->tables().data.size() * sizeof(float)) / 1e6);
     }
-    pc_.environment = std::move(environment);
   }
   scene_ = load_scene(job_.scene, job_.input_limits);
   for (const auto& w : scene_.warnings) warn(w);
@@ -208,7 +210,7 @@ void SequenceRun::prepare_frames() {
   info.compression = job_.compression;
   info.background = job_.background;
   info.input_limits = job_.input_limits;
-  info.environment_file = job_.environment_file;
+  info.environment = job_.environment;
   info.environment_checksum = environment_checksum_;
   info.environment_rotation_deg = job_.environment_rotation_deg;
   info.has_bounds = true;

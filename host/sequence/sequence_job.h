@@ -13,14 +13,15 @@
 #include "pmr/rig.h"
 #include "sequence/frame_files.h"
 #include "sequence/sequence_spec.h"
+#include "shading/environment.h"
 
 namespace pmr {
 
 struct SequenceJob {
   // inputs
-  std::string scene;             // the glTF or GLB file
-  InputLimits input_limits;      // budgets and folder confinement (docs/SECURITY.md)
-  std::string environment_file;  // pbr: equirectangular radiance image; "" = uniform
+  std::string scene;              // the glTF or GLB file
+  InputLimits input_limits;       // budgets and folder confinement (docs/SECURITY.md)
+  EnvironmentSource environment;  // pbr: the studio (default), the uniform one or an image
   double environment_rotation_deg = 0.0;
   // cameras, display, pipeline
   RigConfig rig;

@@ -6,7 +6,8 @@
 //   u = 1/2 + atan2(x, -z) / (2 pi),  v = acos(y) / pi
 // (u from the image's left, v from its top): -Z is the middle column, +X is at u = 3/4, +Y is the top
 // row. Texel (j, i) has its center at u = (j + 1/2) / W, v = (i + 1/2) / H; lookups are bilinear,
-// wrapping in u and clamped in v. A rotation of DEG degrees turns the map counter-clockwise seen from
+// wrapping in u and clamped in v (the image itself; the prefiltered levels blend toward the poles,
+// below). A rotation of DEG degrees turns the map counter-clockwise seen from
 // above (right-hand rule about +Y, as the turntable): a feature at +X moves to -Z at DEG = 90. It is
 // applied at lookup time (d is turned by -DEG before the mapping); the intensity also multiplies at
 // lookup time, so neither changes the tables.
@@ -39,24 +40,32 @@
 // - The split-sum terms (A, B)(dot(n, v), r) of DESIGN 4b's F (Schlick), D (GGX) and height-
 //   correlated Smith Vis: integral of f_spec * dot(n, l) dl = F0 * A + B. A kEnvSplitSumSize^2
 //   table, nodes at dot(n, v) = (i / (N - 1))^2 (denser at grazing angles, where A changes fast) and
-//   r = j / (N - 1), bilinear in (sqrt(dot(n, v)), r), computed once per process (independent of
-//   the environment; about 0.5 s of CPU) with 8192 Hammersley GGX samples per node; r = 0 is exact
+//   r = j / (N - 1), bilinear in (sqrt(dot(n, v)), r), computed at build time (independent of the
+//   environment; split_sum_integral.h) with 8192 Hammersley GGX samples per node; r = 0 is exact
 //   (A = 1 - (1 - dot(n, v))^5, B = (1 - dot(n, v))^5).
 //
 // Flat layout for upload (EnvironmentTables::data, 32-bit floats; EnvTablesHeader says where):
-//   [levels]     level k: width_k * height_k texels of 4 floats (R, G, B, 0), rows top to bottom,
-//                starting at float offset levels[k].offset
+//   [levels]     level k: width_k * (height_k + 2) texels of 4 floats (R, G, B, 0), rows top to
+//                bottom, starting at float offset levels[k].offset: a north pole row, the level's
+//                rows, a south pole row. Lookups clamp v half a texel beyond the outer rows'
+//                centers, and interpolate there between the outer row and its pole row. Level 0's
+//                pole rows repeat its outer rows (clamped, as the map is defined); a prefiltered
+//                level's hold 2 m - t beside each outer texel t, m the outer row's mean, so that the
+//                lookup at the pole itself reads m: the mean of the ring of texels around the pole,
+//                where clamping would read the ring's texel at the direction's longitude, 1.4 degrees
+//                off the pole in a 128x64 level (2% of I at +Y under the studio).
 //   [roughness]  kEnvRoughnessNodes floats at roughness_offset: c(r) at r = i / (nodes - 1)
 //   [split sum]  kEnvSplitSumSize^2 nodes of 2 floats (A, B) at split_sum_offset, node (i, j) =
 //                (dot(n, v) = (i / (N - 1))^2, r = j / (N - 1)) at split_sum_offset + 2 * (j * N + i)
-// For a 1024x512 image: 4 x (524288 + 2 x 131072 + 3 x 32768 + 9 x 8192) floats + 101 + 8192,
-// about 3.8 M floats (15 MB). The uniform environment (no image; radiance 0.2) has 1x1 levels.
+// For a 1024x512 image: 4 x (1024 x 514 + 2 x 512 x 258 + 3 x 256 x 130 + 9 x 128 x 66) floats +
+// 101 + 8192, about 3.8 M floats (15 MB). The uniform environment (no image; radiance 0.2) has 1x1 levels.
 //
 // Cost: per level H^2 / 4 complex FFTs of length W and 3 H^2 W / 2 multiply-adds; about 1 s for a
 // 1024x512 image on 2 cores (measured: docs/SHADING.md). Accuracy against brute-force integration:
 // docs/SHADING.md and tests/test_environment.cpp.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -103,8 +112,23 @@ EnvironmentImage load_environment_image(const std::string& path);
 constexpr double kEnvNegativeTolerance = 1e-2;
 void check_environment_image(EnvironmentImage& image, const std::string& name);
 
+// What lights a pbr scene besides its own lights (--environment): the built-in studio (the default),
+// the uniform environment of radiance 0.2 (with the default light), or an image file.
+struct EnvironmentSource {
+  enum class Kind { Studio, Uniform, File };
+  Kind kind = Kind::Studio;
+  std::string file;  // Kind::File: the path as given
+
+  // "studio" and "uniform" are the keywords; anything else is a file ("./studio" for a file of that
+  // name). Throws pmr::Error for an empty text.
+  static EnvironmentSource parse(const std::string& text);
+  // The keyword or the file as given.
+  std::string name() const;
+  bool operator==(const EnvironmentSource& o) const { return kind == o.kind && file == o.file; }
+};
+
 struct EnvironmentOptions {
-  std::string file;               // empty: the uniform environment
+  EnvironmentSource source;
   double rotation_deg = 0.0;      // counter-clockwise seen from above
   double intensity = 1.0;         // >= 0; 0 turns the environment off
   double uniform_radiance = 0.2;  // the radiance of the uniform environment (DESIGN 4b: 0.2)
@@ -116,7 +140,10 @@ class Environment {
   static Environment uniform(double radiance = 0.2);
   // Prefilters an image (checked with check_environment_image).
   static Environment from_image(const EnvironmentImage& image, const std::string& name = "environment");
-  // load_environment_image + from_image, or uniform() when options.file is empty; then the rotation
+  // The built-in studio (studio_environment.h), prefiltered at build time: from_image of
+  // studio_environment_image(), bit for bit, without the wait.
+  static Environment studio();
+  // studio(), uniform() or load_environment_image + from_image as the source says; then the rotation
   // and intensity (which must be finite, intensity >= 0).
   static Environment make(const EnvironmentOptions& options);
 
@@ -137,6 +164,10 @@ class Environment {
   EnvironmentTables tables_;
   double prefilter_seconds_ = 0.0;
 };
+
+// The environment a run's pipelines share (PipelineConfig::environment), made once: null for the
+// uniform one, whose radiance the kernels take from the frame's parameters.
+std::shared_ptr<const Environment> make_pipeline_environment(const EnvironmentOptions& options);
 
 // (A, B) for (dot(n, v), r) from the table (bilinear; arguments clamped to [0, 1]).
 glm::dvec2 split_sum(double n_dot_v, double r);

@@ -334,7 +334,8 @@ typedef struct {
 #define PMR_ENV_MAX_LEVELS 16
 typedef struct {
   pmr_u32 width, height; /* texels                                                          */
-  pmr_u32 offset;        /* float offset of texel (0, 0) in the data, a multiple of 4 (RGB0 texels) */
+  pmr_u32 offset;        /* float offset of the level's first row, the north pole row: texel (j, i)
+                            is at offset + 4 ((i + 1) width + j), rows -1 and height the pole rows */
   float roughness;       /* r of this level (level 0: 0, the image)                          */
 } PmrEnvLevel;
 

@@ -18,6 +18,8 @@ SAMPLES=${SAMPLES:-"1 4"}
 FRAMES=${FRAMES:-3}
 ROUNDS=${ROUNDS:-2}
 GL_ARGS=${GL_ARGS:-}
+shading=(--shading "$SHADING")  # pbr: the uniform environment, the one pmr_gl_bench draws
+[ "$SHADING" = pbr ] && shading+=(--environment uniform)
 [ ${#scenes[@]} -gt 0 ] || scenes=(data/default_scene.glb)
 for exe in pmr pmr_gl_bench; do
   [ -x "$BUILD/$exe" ] || { echo "gl_compare: $BUILD/$exe missing: cmake --build $BUILD --target $exe" >&2; exit 2; }
@@ -34,10 +36,10 @@ for scene in "${scenes[@]}"; do
   for s in $SAMPLES; do
     msaa=$([ "$s" = 1 ] && echo 0 || echo "$s")
     out="$WORK/${name%.*}_s$s"
-    "$BUILD/pmr" render "$scene" --preset "$PRESET" --shading "$SHADING" --samples "$s" --out "$out" >/dev/null 2>&1
+    "$BUILD/pmr" render "$scene" --preset "$PRESET" "${shading[@]}" --samples "$s" --out "$out" >/dev/null 2>&1
     : > "$out/pmr.txt"; : > "$out/gl.txt"
     for _ in $(seq "$ROUNDS"); do
-      "$BUILD/pmr" bench "$scene" --preset "$PRESET" --method pmr --shading "$SHADING" --samples "$s" \
+      "$BUILD/pmr" bench "$scene" --preset "$PRESET" --method pmr "${shading[@]}" --samples "$s" \
         --frames "$FRAMES" --no-check | awk '$1 == "pmr" { print $7 }' >> "$out/pmr.txt"
       # shellcheck disable=SC2086
       "$BUILD/pmr_gl_bench" "$scene" --sidecar "$out/frame_0000.json" --msaa "$msaa" --frames "$FRAMES" $GL_ARGS |

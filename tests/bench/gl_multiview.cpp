@@ -73,8 +73,7 @@ Options parse_options(int argc, char** argv) {
       const std::string e = value();
       if (e != "tables" && e != "float") throw std::runtime_error("--encoder takes tables or float");
       o.float_encoder = e == "float";
-    }
-    else if (arg == "--help" || arg == "-h") throw std::runtime_error("");
+    } else if (arg == "--help" || arg == "-h") throw std::runtime_error("");
     else if (!arg.empty() && arg[0] == '-') throw std::runtime_error("unknown option " + arg);
     else o.scene = arg;
   }
@@ -103,13 +102,16 @@ struct Frame {
 void read_pbr_inputs(const nlohmann::json& shading, Frame& f) {
   const nlohmann::json& env = shading.at("environment");
   if (env.at("kind").get<std::string>() != "uniform")
-    throw std::runtime_error("pbr with an environment image is not implemented here (uniform only)");
+    throw std::runtime_error(
+        "pbr with the studio or an environment image is not implemented here: render the "
+        "sidecar's frame with --environment uniform");
   f.env_radiance = env.at("radiance").get<float>();
   for (const nlohmann::json& j : shading.at("lights")) {
     pmr::SceneLight l;
     const std::string type = j.at("type").get<std::string>();
-    l.type = type == "point" ? pmr::SceneLightType::Point
-             : type == "spot" ? pmr::SceneLightType::Spot : pmr::SceneLightType::Directional;
+    l.type = type == "point"  ? pmr::SceneLightType::Point
+             : type == "spot" ? pmr::SceneLightType::Spot
+                              : pmr::SceneLightType::Directional;
     for (int c = 0; c < 3; ++c) l.color[c] = j.at("color").at(c).get<float>();
     l.intensity = j.at("intensity").get<float>();
     if (j.contains("position")) l.position = glm::dvec3(j["position"][0], j["position"][1], j["position"][2]);
@@ -206,9 +208,9 @@ void create_context() {
   if (!eglBindAPI(EGL_OPENGL_API)) throw NoContext("EGL cannot bind desktop OpenGL");
   // no config (EGL_KHR_no_config_context): nothing is drawn to an EGL surface
   const EGLConfig config = EGL_NO_CONFIG_KHR;
-  const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION,       3, EGL_CONTEXT_MINOR_VERSION, 3,
-                                    EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                    EGL_NONE};
+  const EGLint context_attribs[] = {
+      EGL_CONTEXT_MAJOR_VERSION,           3,       EGL_CONTEXT_MINOR_VERSION, 3, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+      EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
   EGLContext ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, context_attribs);
   if (ctx == EGL_NO_CONTEXT) throw NoContext("no OpenGL 3.3 core context");
   if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) throw NoContext("eglMakeCurrent failed");
@@ -393,15 +395,15 @@ void main() {
 // Reading view v of the quilt (view 0 bottom-left, then left to right, then upward: GL's rows count
 // upward like the quilt's). A quilt, as multi-view display software keeps its views, lets MSAA 0 draw
 // straight into the tiles. Bilinear samples are clamped to the view's own tile, as pmr clamps to the view.
-#define QUILT_GLSL \
-  "uniform sampler2D views;\n" \
-  "uniform int quilt_columns;\n" \
-  "uniform ivec2 view_size;\n" \
+#define QUILT_GLSL                                                                                 \
+  "uniform sampler2D views;\n"                                                                     \
+  "uniform int quilt_columns;\n"                                                                   \
+  "uniform ivec2 view_size;\n"                                                                     \
   "ivec2 tile_origin(int v) { return ivec2(v % quilt_columns, v / quilt_columns) * view_size; }\n" \
-  "vec4 fetch(int v, ivec2 texel) { return texelFetch(views, tile_origin(v) + texel, 0); }\n" \
-  "vec4 bilinear(int v, vec2 p) {\n" \
-  "  vec2 q = clamp(p * vec2(view_size), vec2(0.5), vec2(view_size) - 0.5);\n" \
-  "  return texture(views, (vec2(tile_origin(v)) + q) / vec2(textureSize(views, 0)));\n" \
+  "vec4 fetch(int v, ivec2 texel) { return texelFetch(views, tile_origin(v) + texel, 0); }\n"      \
+  "vec4 bilinear(int v, vec2 p) {\n"                                                               \
+  "  vec2 q = clamp(p * vec2(view_size), vec2(0.5), vec2(view_size) - 0.5);\n"                     \
+  "  return texture(views, (vec2(tile_origin(v)) + q) / vec2(textureSize(views, 0)));\n"           \
   "}\n"
 
 // DESIGN section 5 through pmr's exact tables (host/rig/display.cpp): subpixel k of display pixel
@@ -489,7 +491,8 @@ Vertex make_vertex(const pmr::Scene& s, uint32_t v, const float* normal) {
 void build_geometry(const pmr::Scene& s, std::vector<Vertex>& vertices, std::vector<uint32_t>& indices,
                     std::vector<Batch>& batches) {
   vertices.clear();
-  for (size_t v = 0; v < s.positions.size(); ++v) vertices.push_back(make_vertex(s, uint32_t(v), s.attributes[v].normal));
+  for (size_t v = 0; v < s.positions.size(); ++v)
+    vertices.push_back(make_vertex(s, uint32_t(v), s.attributes[v].normal));
   std::vector<std::vector<uint32_t>> per_material(s.materials.size());
   for (const PmrTriangle& t : s.triangles) {
     std::vector<uint32_t>& out = per_material.at(t.material);
@@ -524,12 +527,8 @@ GLuint upload_geometry(const std::vector<Vertex>& vertices, const std::vector<ui
   const struct {
     GLint size;
     size_t offset;
-  } attribs[] = {{3, offsetof(Vertex, position)},
-                 {3, offsetof(Vertex, normal)},
-                 {4, offsetof(Vertex, color)},
-                 {2, offsetof(Vertex, uv0)},
-                 {2, offsetof(Vertex, uv1)},
-                 {4, offsetof(Vertex, tangent)}};
+  } attribs[] = {{3, offsetof(Vertex, position)}, {3, offsetof(Vertex, normal)}, {4, offsetof(Vertex, color)},
+                 {2, offsetof(Vertex, uv0)},      {2, offsetof(Vertex, uv1)},    {4, offsetof(Vertex, tangent)}};
   for (GLuint a = 0; a < 6; ++a) {
     glEnableVertexAttribArray(a);
     glVertexAttribPointer(a, attribs[a].size, GL_FLOAT, GL_FALSE, sizeof(Vertex),
@@ -612,7 +611,8 @@ void create_view_targets(const Frame& f, int msaa, Targets& t) {
   glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
   const int qw = f.quilt_columns * f.view_w, qh = f.quilt_rows * f.view_h;
   if (qw > max_size || qh > max_size)
-    throw std::runtime_error("the views (a " + std::to_string(qw) + "x" + std::to_string(qh) + " quilt) do not fit one texture of at most " + std::to_string(max_size));
+    throw std::runtime_error("the views (a " + std::to_string(qw) + "x" + std::to_string(qh) +
+                             " quilt) do not fit one texture of at most " + std::to_string(max_size));
   glGenTextures(1, &t.atlas);
   glBindTexture(GL_TEXTURE_2D, t.atlas);
   glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, qw, qh, 0, GL_RGBA, GL_HALF_FLOAT, nullptr);
@@ -651,8 +651,9 @@ void create_encode_tables(const Frame& f, Targets& t) {
         int32_t* texel = &col_texels[((size_t(c) * 3 + size_t(k)) * size_t(w) + size_t(j)) * 4];
         texel[0] = e.a_mod_n, texel[1] = e.b, texel[2] = e.px;
       }
-  for (int i = 0; i < h; ++i) row_texels[size_t(i) * 4] = rows[i].q_mod_n, row_texels[size_t(i) * 4 + 1] = rows[i].s,
-                                row_texels[size_t(i) * 4 + 2] = rows[i].py;
+  for (int i = 0; i < h; ++i)
+    row_texels[size_t(i) * 4] = rows[i].q_mod_n, row_texels[size_t(i) * 4 + 1] = rows[i].s,
+                           row_texels[size_t(i) * 4 + 2] = rows[i].py;
   glGenTextures(1, &t.columns);
   glBindTexture(GL_TEXTURE_2D, t.columns);
   glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32I, w, 3 * classes, 0, GL_RGBA_INTEGER, GL_INT, col_texels.data());
@@ -740,7 +741,9 @@ void set_shading_uniforms(const Frame& f, GLuint program, GLuint split_sum) {
     auto at = [&](const char* name) {
       return glGetUniformLocation(program, (std::string(name) + "[" + std::to_string(i) + "]").c_str());
     };
-    glUniform1i(at("light_type"), l.type == pmr::SceneLightType::Point ? 1 : l.type == pmr::SceneLightType::Spot ? 2 : 0);
+    glUniform1i(at("light_type"), l.type == pmr::SceneLightType::Point  ? 1
+                                  : l.type == pmr::SceneLightType::Spot ? 2
+                                                                        : 0);
     glUniform3f(at("light_color"), l.color[0] * l.intensity, l.color[1] * l.intensity, l.color[2] * l.intensity);
     glUniform3fv(at("light_position"), 1, glm::value_ptr(glm::vec3(l.position)));
     glUniform3fv(at("light_direction"), 1, glm::value_ptr(glm::vec3(l.direction)));
@@ -912,7 +915,8 @@ void print_setup(const Options& o, const Frame& f, const GlScene& g) {
   std::printf("views: %d x %dx%d, MSAA %d; display %dx%d (%s); shading %s", f.views, f.view_w, f.view_h, o.msaa,
               f.display.width, f.display.height, f.display.bilinear ? "bilinear" : "nearest", f.shading.c_str());
   std::printf(" (sidecar: %s sampling, %d spp)\n", f.sampling.c_str(), f.samples);
-  if (f.sampling != "view") std::printf("note: the sidecar's frame used %s sampling; this draws view sampling\n", f.sampling.c_str());
+  if (f.sampling != "view")
+    std::printf("note: the sidecar's frame used %s sampling; this draws view sampling\n", f.sampling.c_str());
 }
 
 int run(const Options& o) {
@@ -922,7 +926,8 @@ int run(const Options& o) {
   const pmr::Scene scene = pmr::load_scene(o.scene);
   create_context();
   const GlScene g = upload_scene(scene, o.mipmap);
-  Programs p{link(kSceneVertex, kSceneFragment), link(kFullscreenVertex, o.float_encoder ? kEncodeFloatFragment : kEncodeFragment), 0};
+  Programs p{link(kSceneVertex, kSceneFragment),
+             link(kFullscreenVertex, o.float_encoder ? kEncodeFloatFragment : kEncodeFragment), 0};
   glGenVertexArrays(1, &p.empty_vao);
   set_shading_uniforms(f, p.scene, upload_split_sum());
   set_encode_uniforms(f, p.encode);

@@ -23,6 +23,7 @@ WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 w=${SIZE%x*} h=${SIZE#*x}
 rig=(--views "$VIEWS" --shading "$SHADING")
+[ "$SHADING" = pbr ] && rig+=(--environment uniform)  # the environment pmr_gl_bench draws
 for scene in "${scenes[@]}"; do
   name=$(basename "$scene")
   echo "== $name: $VIEWS views of $SIZE, $SHADING"

@@ -5,12 +5,15 @@
 # converts (checked byte for byte against the renderer's center-view preview of every center view):
 #
 #   docs/shading_default_scene.png      data/default_scene.glb, center view, --shading lambert | pbr
+#                                       (under the studio, the default environment)
 #   docs/shading_suzanne.png            the Khronos sample model Suzanne, center view, lambert | pbr
 #   docs/shading_highlight_views.png    a glossy gold sphere (made here by shading_pictures.py sphere),
-#                                       views 0, N/2 and N-1 of the default 96; the brightest pixel of each
-#                                       view is ticked in the margin and printed
-#   docs/shading_environment_forest.png the Khronos sample model AnisotropyStrengthTest, center view,
-#                                       pbr with the default light | pbr under Blender's forest.exr
+#                                       views 0, N/2 and N-1 of the default 96, under the default light
+#                                       (--environment uniform); the brightest pixel of each view is
+#                                       ticked in the margin and printed
+#   docs/shading_studio.png             the Khronos sample model AnisotropyStrengthTest, center view,
+#                                       pbr with --environment uniform (the default light) | the studio
+#   docs/shading_environment_forest.png the same, --environment uniform | Blender's forest.exr
 #
 # usage: scripts/make_shading_pictures.sh [GLTF_DIR]
 #   GLTF_DIR   folder of the Khronos sample models (GLTF_DIR/Suzanne/glTF/Suzanne.gltf, ...); default
@@ -54,7 +57,8 @@ present() {  # present FILE PICTURE HINT
   return 1
 }
 
-# Views of 16:9 (display 166x93 cm: pixels square to 0.4%), 9 views so that view 4 is the center
+# Views of 166:93 (the display is 166x93 cm: square pixels, so the preview is not resampled and the
+# check against it holds byte for byte), 9 views so that view 4 is the center
 # camera itself.
 pair() {  # pair OUT SCENE VIEW_SIZE: the center view under lambert and pbr
   local out=$1 scene=$2 size=$3
@@ -64,27 +68,35 @@ pair() {  # pair OUT SCENE VIEW_SIZE: the center view under lambert and pbr
 }
 
 echo "== default scene, lambert | pbr"
-pair "$OUT/shading_default_scene.png" data/default_scene.glb 1024x576
+pair "$OUT/shading_default_scene.png" data/default_scene.glb 996x558
 
 echo "== Suzanne, lambert | pbr"
 SUZANNE=$GLTF_DIR/Suzanne/glTF/Suzanne.gltf
 if present "$SUZANNE" "$OUT/shading_suzanne.png" "$MODELS_HINT"; then
-  pair "$OUT/shading_suzanne.png" "$SUZANNE" 800x450
+  pair "$OUT/shading_suzanne.png" "$SUZANNE" 830x465
 fi
 
 echo "== a glossy sphere in views 0, 48 and 95 of 96"
 $PICTURES sphere "$WORK/sphere.glb"
-render sphere "$WORK/sphere.glb" --views 96 --view-size 512x288
+render sphere "$WORK/sphere.glb" --views 96 --view-size 498x279 --environment uniform
 $PICTURES strip "$OUT/shading_highlight_views.png" "$(views sphere 0)" "$(views sphere 48)" "$(views sphere 95)" --mark \
   --check-center - "$(center sphere)" -
 
-echo "== AnisotropyStrengthTest, default light | forest.exr"
+echo "== AnisotropyStrengthTest, uniform and the default light | the studio"
 ANISOTROPY=$GLTF_DIR/AnisotropyStrengthTest/glTF-Binary/AnisotropyStrengthTest.glb
+if present "$ANISOTROPY" "$OUT/shading_studio.png" "$MODELS_HINT"; then
+  # the model's KHR_materials_anisotropy warning is expected: it is drawn isotropic
+  render light "$ANISOTROPY" --views 9 --view-size 664x372 --environment uniform \
+    2> >(grep -v KHR_materials_anisotropy >&2)
+  render studio "$ANISOTROPY" --views 9 --view-size 664x372 2> >(grep -v KHR_materials_anisotropy >&2)
+  $PICTURES strip "$OUT/shading_studio.png" "$(views light 4)" "$(views studio 4)" \
+    --check-center "$(center light)" "$(center studio)"
+fi
+
+echo "== AnisotropyStrengthTest, uniform and the default light | forest.exr"
 if present "$ANISOTROPY" "$OUT/shading_environment_forest.png" "$MODELS_HINT" &&
    present "$FOREST" "$OUT/shading_environment_forest.png" "set FOREST, or install Debian's blender-data"; then
-  # the model's KHR_materials_anisotropy warning is expected: it is drawn isotropic
-  render light "$ANISOTROPY" --views 9 --view-size 720x405 2> >(grep -v KHR_materials_anisotropy >&2)
-  render forest "$ANISOTROPY" --views 9 --view-size 720x405 --environment "$FOREST" \
+  render forest "$ANISOTROPY" --views 9 --view-size 664x372 --environment "$FOREST" \
     2> >(grep -v KHR_materials_anisotropy >&2)
   $PICTURES strip "$OUT/shading_environment_forest.png" "$(views light 4)" "$(views forest 4)" \
     --check-center "$(center light)" "$(center forest)"

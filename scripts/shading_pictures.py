@@ -240,12 +240,26 @@ def to_srgb(x):
 
 
 def view_bytes(rows):
-    """RGBA bytes exactly as `pmr render --preview` writes the view."""
+    """RGBA bytes exactly as `pmr render --preview` writes the view: straight alpha, so a partly
+    covered pixel's premultiplied colour is divided by its coverage first."""
     out = bytearray()
     for row in rows:
         for r, g, b, a in row:
-            out += bytes((to_srgb(r), to_srgb(g), to_srgb(b), _alpha_byte(a)))
+            if 0.0 < a < 1.0:
+                out += bytes((_srgb_byte(r / a), _srgb_byte(g / a), _srgb_byte(b / a), _alpha_byte(a)))
+            else:
+                out += bytes((to_srgb(r), to_srgb(g), to_srgb(b), _alpha_byte(a)))
     return bytes(out)
+
+
+def _linear(byte):
+    v = byte / 255.0
+    return v / 12.92 if v <= 0.04045 else ((v + 0.055) / 1.055) ** 2.4
+
+
+def over_background(r, g, b, a):
+    """sRGB bytes of a premultiplied pixel composited over the background, in linear light."""
+    return bytes(_srgb_byte(c + (1.0 - a) * _linear(k)) for c, k in zip((r, g, b), BACKGROUND))
 
 
 def _alpha_byte(a):
@@ -299,9 +313,9 @@ def strip(out_path, panels, mark, checks):
         for y in range(ch):
             for x in range(cw):
                 r, g, b, a = rows[y0 + y][x0 + x]
-                if a > 0.0:  # pmr's views are opaque where covered and empty elsewhere
+                if a > 0.0:  # edges are partly covered (pmr's samples per pixel): composited
                     o = 3 * (y * total_w + left + x)
-                    canvas[o:o + 3] = bytes((to_srgb(r), to_srgb(g), to_srgb(b)))
+                    canvas[o:o + 3] = bytes((to_srgb(r), to_srgb(g), to_srgb(b))) if a >= 1.0 else over_background(r, g, b, a)
         if mark:
             (hx, hy), value = brightest(rows)
             print(f"{panel}: brightest pixel ({hx}, {hy}), G = {value:.3f}")

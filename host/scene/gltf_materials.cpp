@@ -1,0 +1,296 @@
+// The materials of a glTF file (DESIGN 4b, 4c): each material's factors, its texture slots with their
+// TEXCOORD sets and KHR_texture_transform, and the material extensions pmr reads.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "pmr/error.h"
+#include "pmr/printable.h"
+#include "scene/gltf_loader_state.h"
+
+namespace pmr::gltf {
+namespace {
+
+// ---- materials and textures ---------------------------------------------------------------------------
+
+// A textureInfo's TEXCOORD set and KHR_texture_transform, uv' = T * R * S * uv, kept as the extension's
+// values: the kernels apply it to the stored set (the matrix: texture_transform_matrix,
+// host/pipeline/material_tables.cpp). The extension's GLSL reads as
+// u' = cos*sx*u + sin*sy*v + ox, v' = -sin*sx*u + cos*sy*v + oy: this is what the Khronos sample viewer
+// does and what the extension's own example needs (offset (0,1), rotation pi/2, scale 0.5 selects the
+// lower-left quadrant of the image).
+struct MaterialUv {
+  int set = 0;                                                // TEXCOORD_n of the texture
+  bool transform = false;                                     // the extension is present and valid
+  float offset[2] = {0, 0}, rotation = 0, scale[2] = {1, 1};  // the extension's values (when present)
+};
+
+bool finite_numbers(const tinygltf::Value& v, size_t n, double* out) {
+  if (!v.IsArray() || v.ArrayLen() != n) return false;
+  for (size_t i = 0; i < n; ++i) {
+    const tinygltf::Value& e = v.Get(int(i));
+    if (!e.IsNumber() || !std::isfinite(e.GetNumberAsDouble())) return false;
+    out[i] = e.GetNumberAsDouble();
+  }
+  return true;
+}
+
+// `slot_name` is "" for the base colour texture (its messages predate the other slots).
+MaterialUv material_uv(Loader& L, int texcoord, const tinygltf::ExtensionMap& extensions, int material,
+                       const std::string& slot_name = "") {
+  MaterialUv uv;
+  uv.set = texcoord;
+  auto ext = extensions.find("KHR_texture_transform");
+  if (ext == extensions.end()) return uv;
+  const tinygltf::Value& t = ext->second;
+  const std::string name =
+      "material " + std::to_string(material) + (slot_name.empty() ? "" : " " + slot_name) + " KHR_texture_transform";
+  if (!t.IsObject()) {
+    L.warn(name + " is not an object; ignored");
+    return uv;
+  }
+  double offset[2] = {0, 0}, scale[2] = {1, 1}, rotation = 0;
+  bool ok = (!t.Has("offset") || finite_numbers(t.Get("offset"), 2, offset)) &&
+            (!t.Has("scale") || finite_numbers(t.Get("scale"), 2, scale));
+  if (t.Has("rotation")) {
+    const tinygltf::Value& r = t.Get("rotation");
+    ok = ok && r.IsNumber() && std::isfinite(r.GetNumberAsDouble());
+    if (ok) rotation = r.GetNumberAsDouble();
+  }
+  if (!ok) {
+    L.warn(name + " has an invalid offset, rotation or scale; ignored");
+    return uv;
+  }
+  if (t.Has("texCoord")) {
+    const tinygltf::Value& tc = t.Get("texCoord");
+    if (tc.IsInt() && tc.GetNumberAsInt() >= 0) uv.set = tc.GetNumberAsInt();
+    else L.warn(name + " has an invalid texCoord; ignored");
+  }
+  uv.transform = true;
+  uv.offset[0] = float(offset[0]), uv.offset[1] = float(offset[1]);
+  uv.rotation = float(rotation);
+  uv.scale[0] = float(scale[0]), uv.scale[1] = float(scale[1]);
+  return uv;
+}
+
+// Any tinygltf image (1..4 channels, 8 or 16 bits) to RGBA8, rows top first as decoded.
+bool to_rgba8(const tinygltf::Image& img, SceneTexture& out, std::string& why) {
+  const int bytes = img.bits == 16 ? 2 : img.bits == 8 ? 1 : 0;
+  if (img.width <= 0 || img.height <= 0 || img.component < 1 || img.component > 4 || bytes == 0) {
+    why = "unsupported image layout (" + std::to_string(img.component) + " channels, " + std::to_string(img.bits) +
+          " bits)";
+    return false;
+  }
+  const uint64_t pixels = uint64_t(img.width) * uint64_t(img.height);
+  if (img.image.size() != pixels * uint64_t(img.component) * uint64_t(bytes)) {
+    why = "image data size does not match its dimensions";
+    return false;
+  }
+  out.width = img.width;
+  out.height = img.height;
+  out.rgba.resize(size_t(pixels) * 4);
+  const unsigned char* src = img.image.data();
+  auto channel = [&](size_t i) -> uint8_t {
+    if (bytes == 1) return src[i];
+    uint16_t v;
+    std::memcpy(&v, src + 2 * i, 2);  // stb_image gives native-endian 16-bit samples
+    return uint8_t((uint32_t(v) * 255u + 32767u) / 65535u);
+  };
+  const size_t n = size_t(img.component);
+  for (size_t p = 0; p < size_t(pixels); ++p) {
+    uint8_t* dst = &out.rgba[4 * p];
+    const size_t i = p * n;
+    if (n <= 2) {  // grey, grey + alpha
+      dst[0] = dst[1] = dst[2] = channel(i);
+      dst[3] = n == 2 ? channel(i + 1) : 255;
+    } else {
+      dst[0] = channel(i), dst[1] = channel(i + 1), dst[2] = channel(i + 2);
+      dst[3] = n == 4 ? channel(i + 3) : 255;
+    }
+  }
+  return true;
+}
+
+int wrap_mode(Loader& L, int mode, int sampler) {
+  if (mode == PMR_WRAP_REPEAT || mode == PMR_WRAP_CLAMP || mode == PMR_WRAP_MIRROR) return mode;
+  L.warn("sampler " + std::to_string(sampler) + " has wrap mode " + std::to_string(mode) + "; using REPEAT");
+  return PMR_WRAP_REPEAT;
+}
+
+// tinygltf decodes data URIs of PNG and JPEG only and treats any other as a file name: say what the
+// data URI holds instead ("image/ktx2", "image/webp").
+std::string data_uri_problem(const std::string& uri) {
+  const size_t end = uri.find_first_of(";,");
+  const std::string type = uri.substr(5, end == std::string::npos ? 0 : end - 5);
+  if (type == "image/png" || type == "image/jpeg") return "its data URI cannot be decoded (base64 expected)";
+  return "its data URI holds " + (type.empty() ? std::string("no media type") : "type " + printable_text(type, 40)) +
+         ", which is not supported (PNG and JPEG only)";
+}
+
+// The Scene::textures index of a glTF texture, decoding its image on first use; -1 when unusable (with
+// a warning). One image sampled with the same wrap modes is stored once, whichever textures and slots
+// name it.
+int scene_texture(Loader& L, int texture, int slot) {
+  auto cached = L.scene_texture_of.find(texture);
+  if (cached != L.scene_texture_of.end()) {
+    if (cached->second >= 0) L.scene.textures[size_t(cached->second)].slots |= 1u << slot;
+    return cached->second;
+  }
+  int& result = L.scene_texture_of[texture] = -1;
+  const tinygltf::Texture& t = L.model.textures[size_t(texture)];
+  const std::string name = "texture " + std::to_string(texture);
+  if (t.source < 0) {
+    L.warn(name + " has no PNG/JPEG image (other formats are not supported); drawn untextured");
+    return result;
+  }
+  const tinygltf::Image& img = L.model.images[size_t(t.source)];
+  const std::string image_name =
+      "image " + std::to_string(t.source) +
+      (img.uri.empty() ? (img.name.empty() ? "" : " '" + img.name + "'") : " '" + img.uri + "'");
+  SceneTexture st;
+  std::string why;
+  if (img.image.empty()) {
+    auto f = L.images.failures.find(t.source);
+    why = f != L.images.failures.end()     ? f->second
+          : img.uri.empty()                ? std::string("no image data")
+          : img.uri.rfind("data:", 0) == 0 ? data_uri_problem(img.uri)
+                                           : "file not found";
+  } else {
+    to_rgba8(img, st, why);
+  }
+  if (!why.empty()) {
+    L.warn(name + " (" + image_name + "): " + why + "; drawn untextured");
+    return result;
+  }
+  if (t.sampler >= 0) {
+    const tinygltf::Sampler& s = L.model.samplers[size_t(t.sampler)];
+    st.wrap_s = wrap_mode(L, s.wrapS, t.sampler);
+    st.wrap_t = wrap_mode(L, s.wrapT, t.sampler);
+  }
+  const std::array<int, 3> key = {t.source, st.wrap_s, st.wrap_t};
+  auto same = L.scene_texture_of_image.find(key);
+  if (same != L.scene_texture_of_image.end()) {
+    L.scene.textures[size_t(same->second)].slots |= 1u << slot;
+    return result = same->second;
+  }
+  st.slots = 1u << slot;
+  L.scene.textures.push_back(std::move(st));
+  result = int(L.scene.textures.size() - 1);
+  L.scene_texture_of_image[key] = result;
+  return result;
+}
+
+// A number property of a material, checked finite and within [lo, hi] (clamped, with a warning).
+float material_number(Loader& L, double value, double fallback, double lo, double hi, const std::string& what) {
+  if (!std::isfinite(value)) {
+    L.warn(what + " is not finite; using " + one_line(std::to_string(fallback)));
+    return float(fallback);
+  }
+  if (value < lo || value > hi) {
+    const double clamped = std::min(hi, std::max(lo, value));
+    L.warn(what + " is outside [" + std::to_string(lo).substr(0, 3) + ", " +
+           (std::isfinite(hi) ? std::to_string(hi).substr(0, 3) : std::string("inf")) + "]; clamped");
+    return float(clamped);
+  }
+  return float(value);
+}
+
+// The PBR inputs of glTF material i (DESIGN 4b). Records each slot's TEXCOORD set in L.slot_sets.
+SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int i) {
+  const std::string name = "material " + std::to_string(i);
+  SceneMaterialInputs m;
+  m.name = g.name;
+  const double inf = std::numeric_limits<double>::infinity();
+  m.metallic = material_number(L, g.pbrMetallicRoughness.metallicFactor, 1.0, 0.0, 1.0, name + " metallicFactor");
+  m.roughness = material_number(L, g.pbrMetallicRoughness.roughnessFactor, 1.0, 0.0, 1.0, name + " roughnessFactor");
+  m.normal_scale = material_number(L, g.normalTexture.scale, 1.0, -inf, inf, name + " normalTexture.scale");
+  m.occlusion_strength =
+      material_number(L, g.occlusionTexture.strength, 1.0, 0.0, 1.0, name + " occlusionTexture.strength");
+  if (g.emissiveFactor.size() == 3)
+    for (int c = 0; c < 3; ++c)
+      m.emissive[c] = material_number(L, g.emissiveFactor[size_t(c)], 0.0, 0.0, 1.0, name + " emissiveFactor");
+  for (const auto& [ext, value] : g.extensions) {
+    if (ext == "KHR_materials_emissive_strength") {
+      const tinygltf::Value* v =
+          value.IsObject() && value.Has("emissiveStrength") ? &value.Get("emissiveStrength") : nullptr;
+      if (v && v->IsNumber())
+        m.emissive_strength = material_number(L, v->GetNumberAsDouble(), 1.0, 0.0, inf, name + " emissiveStrength");
+      else if (v || !value.IsObject())
+        L.warn(name + " KHR_materials_emissive_strength has no valid emissiveStrength; using 1");
+    } else if (ext == "KHR_materials_unlit") {
+      m.unlit = true;
+    } else if (material_extension_fallback(ext)) {
+      m.unimplemented.push_back(ext);
+    }
+  }
+  struct Info {
+    int index, texcoord;
+    const tinygltf::ExtensionMap* extensions;
+  };
+  const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
+  const Info infos[kTextureSlots] = {
+      {pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, &pbr.baseColorTexture.extensions},
+      {pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+       &pbr.metallicRoughnessTexture.extensions},
+      {g.normalTexture.index, g.normalTexture.texCoord, &g.normalTexture.extensions},
+      {g.occlusionTexture.index, g.occlusionTexture.texCoord, &g.occlusionTexture.extensions},
+      {g.emissiveTexture.index, g.emissiveTexture.texCoord, &g.emissiveTexture.extensions}};
+  std::array<int, kTextureSlots> sets;
+  for (int slot = 0; slot < kTextureSlots; ++slot) {
+    SceneTextureSlot& out = m.slots[size_t(slot)];
+    out.srgb = slot == kSlotBaseColor || slot == kSlotEmissive;
+    sets[size_t(slot)] = -1;
+    const Info& info = infos[slot];
+    if (info.index < 0) continue;
+    // the base colour slot's messages name no slot (they predate the other slots)
+    const MaterialUv uv =
+        material_uv(L, info.texcoord, *info.extensions, i, slot == kSlotBaseColor ? "" : texture_slot_name(slot));
+    out.texcoord = uv.set;
+    out.transform = uv.transform;
+    if (out.transform) {
+      out.offset[0] = uv.offset[0], out.offset[1] = uv.offset[1];
+      out.rotation = uv.rotation;
+      out.scale[0] = uv.scale[0], out.scale[1] = uv.scale[1];
+    }
+    out.texture = scene_texture(L, info.index, slot);
+    sets[size_t(slot)] = uv.set;
+    L.texcoord_sets = std::max(L.texcoord_sets, uv.set + 1);
+  }
+  L.slot_sets.push_back(sets);
+  return m;
+}
+
+}  // namespace
+
+// Scene::materials[0] is the default material; glTF material i is Scene::materials[i + 1].
+void build_materials(Loader& L) {
+  L.scene.materials.push_back(default_material());
+  L.scene.material_inputs.emplace_back();
+  L.scene.material_inputs[0].slots[kSlotBaseColor].srgb = L.scene.material_inputs[0].slots[kSlotEmissive].srgb = true;
+  for (size_t i = 0; i < L.model.materials.size(); ++i) {
+    const tinygltf::Material& g = L.model.materials[i];
+    const std::string name = "material " + std::to_string(i);
+    PmrMaterial m = default_material();
+    const std::vector<double>& f = g.pbrMetallicRoughness.baseColorFactor;
+    if (f.size() == 4 && std::all_of(f.begin(), f.end(), [](double x) { return std::isfinite(x); })) {
+      for (int c = 0; c < 4; ++c) m.base_color[c] = float(f[size_t(c)]);
+    } else {
+      L.warn(name + " has an invalid baseColorFactor; using white");
+    }
+    if (g.alphaMode == "MASK") m.alpha_mode = PMR_ALPHA_MASK;
+    else if (g.alphaMode == "BLEND") m.alpha_mode = PMR_ALPHA_BLEND;
+    else if (g.alphaMode != "OPAQUE") L.warn(name + " has unknown alphaMode '" + g.alphaMode + "'; drawn opaque");
+    if (std::isfinite(g.alphaCutoff) && g.alphaCutoff >= 0.0) m.alpha_cutoff = float(g.alphaCutoff);
+    else L.warn(name + " has an invalid alphaCutoff; using 0.5");
+    m.double_sided = g.doubleSided ? 1u : 0u;
+    L.scene.materials.push_back(m);
+    L.scene.material_inputs.push_back(material_inputs(L, g, int(i)));
+    // the factors the kernels read, as material_inputs checked them
+    const SceneMaterialInputs& in = L.scene.material_inputs.back();
+    PmrMaterial& dm = L.scene.materials.back();
+    dm.metallic = in.metallic, dm.roughness = in.roughness, dm.unlit = in.unlit ? 1u : 0u;
+    for (int c = 0; c < 3; ++c) dm.emissive[c] = in.emissive[c] * in.emissive_strength;
+  }
+}
+
+}  // namespace pmr::gltf

@@ -209,6 +209,63 @@ TEST_F(SceneMaterialsTest, OutOfRangeFactorsAreClampedWithAWarning) {
   EXPECT_EQ(warnings_with(s, "material 0 emissiveStrength"), 1u) << all_warnings(s);
 }
 
+// KHR_materials_transmission, _volume and _ior (DESIGN 4c): their factors read and checked (absent:
+// the extensions' defaults), invalid ones replaced with a warning; still drawn by 4b, and warned so.
+TEST_F(SceneMaterialsTest, TransmissionVolumeAndIorFactorsAreRead) {
+  GltfFile g;
+  g.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_ior"};
+  const Quad q = quad(g);
+  g.add("materials",
+        {{"name", "Glass"},
+         {"extensions",
+          {{"KHR_materials_transmission", {{"transmissionFactor", 0.75}}},
+           {"KHR_materials_volume",
+            {{"thicknessFactor", 2.5}, {"attenuationDistance", 0.4}, {"attenuationColor", {0.1, 0.5, 0.9}}}},
+           {"KHR_materials_ior", {{"ior", 1.33}}}}}});
+  g.add("materials", {{"name", "Defaults"},
+                      {"extensions",
+                       {{"KHR_materials_transmission", json::object()},
+                        {"KHR_materials_volume", json::object()},
+                        {"KHR_materials_ior", json::object()}}}});
+  g.add("materials", {{"name", "Bad"},
+                      {"extensions",
+                       {{"KHR_materials_transmission", {{"transmissionFactor", 3}}},
+                        {"KHR_materials_volume", {{"attenuationDistance", 0}, {"attenuationColor", {1, 2}}}},
+                        {"KHR_materials_ior", {{"ior", 0.5}}}}}});
+  g.add("materials", {{"name", "Compat"}, {"extensions", {{"KHR_materials_ior", {{"ior", 0}}}}}});
+  json prims = json::array();
+  for (int m = 0; m < 4; ++m)
+    prims.push_back({{"attributes", {{"POSITION", q.pos}}}, {"indices", q.idx}, {"material", m}});
+  g.mesh(prims);
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  const Scene s = load_scene(g.write(dir_, "layers"));
+  ASSERT_EQ(s.material_inputs.size(), 5u);
+  const SceneMaterialInputs &glass = s.material_inputs[1], &defaults = s.material_inputs[2],
+                            &bad = s.material_inputs[3];
+  EXPECT_EQ(glass.transmission, 0.75f);
+  EXPECT_EQ(glass.thickness, 2.5f);
+  EXPECT_EQ(glass.attenuation_distance, 0.4f);
+  EXPECT_EQ(glm::vec3(glass.attenuation_color[0], glass.attenuation_color[1], glass.attenuation_color[2]),
+            glm::vec3(0.1f, 0.5f, 0.9f));
+  EXPECT_EQ(glass.ior, 1.33f);
+  EXPECT_EQ(defaults.transmission, 0.0f);
+  EXPECT_EQ(defaults.thickness, 0.0f);
+  EXPECT_TRUE(std::isinf(defaults.attenuation_distance));
+  EXPECT_EQ(defaults.attenuation_color[1], 1.0f);
+  EXPECT_EQ(defaults.ior, 1.5f);
+  EXPECT_EQ(bad.transmission, 1.0f) << "clamped";
+  EXPECT_TRUE(std::isinf(bad.attenuation_distance));
+  EXPECT_EQ(bad.attenuation_color[0], 1.0f);
+  EXPECT_EQ(bad.ior, 1.5f);
+  EXPECT_EQ(s.material_inputs[4].ior, 0.0f) << "0 is the extension's compatibility mode";
+  EXPECT_EQ(warnings_with(s, "material 2 transmissionFactor is outside [0.0, 1.0]; clamped"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "material 2 attenuationDistance must be positive"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "material 2 KHR_materials_volume has no valid attenuationColor"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "material 2 ior 0.5 is neither 0 nor at least 1; using 1.5"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "KHR_materials_transmission (3 materials): drawn opaque"), 1u) << all_warnings(s);
+}
+
 TEST_F(SceneMaterialsTest, ATexCoordSetTheMeshLacksIsAnError) {
   GltfFile g;
   const Quad q = quad(g);

@@ -1,5 +1,6 @@
 #include "cli/info_command.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -42,6 +43,23 @@ std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
   return t + ")";
 }
 
+// KHR_materials_transmission, _volume and _ior, where the material has them (not drawn yet: the
+// "not drawn" line names them).
+std::string layer_text(const SceneMaterialInputs& in) {
+  std::string t;
+  auto has = [&](const char* ext) {
+    return std::find(in.unimplemented.begin(), in.unimplemented.end(), ext) != in.unimplemented.end();
+  };
+  if (has("KHR_materials_transmission")) t += ", transmission " + number(in.transmission);
+  if (has("KHR_materials_volume")) {
+    t += ", thickness " + number(in.thickness) + ", attenuation (" + number(in.attenuation_color[0]) + ", " +
+         number(in.attenuation_color[1]) + ", " + number(in.attenuation_color[2]) + ") over " +
+         number(in.attenuation_distance);
+  }
+  if (has("KHR_materials_ior")) t += ", ior " + number(in.ior);
+  return t;
+}
+
 void describe_materials(const Scene& s) {
   for (size_t i = 0; i < s.materials.size(); ++i) {
     const PmrMaterial& m = s.materials[i];
@@ -60,6 +78,7 @@ void describe_materials(const Scene& s) {
               ") x strength " + number(in.emissive_strength);
     if (in.slots[kSlotNormal].texture >= 0) line += ", normal scale " + number(in.normal_scale);
     if (in.slots[kSlotOcclusion].texture >= 0) line += ", occlusion strength " + number(in.occlusion_strength);
+    line += layer_text(in);
     std::printf("%s\n", line.c_str());
     for (int k = 0; k < kTextureSlots; ++k)
       if (in.slots[size_t(k)].texture >= 0) std::printf("      %s\n", slot_text(s, in.slots[size_t(k)], k).c_str());

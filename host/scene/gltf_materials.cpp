@@ -2,6 +2,7 @@
 // TEXCOORD sets and KHR_texture_transform, and the material extensions pmr reads.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "pmr/error.h"
@@ -180,6 +181,12 @@ int scene_texture(Loader& L, int texture, int slot) {
   return result;
 }
 
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 // A number property of a material, checked finite and within [lo, hi] (clamped, with a warning).
 float material_number(Loader& L, double value, double fallback, double lo, double hi, const std::string& what) {
   if (!std::isfinite(value)) {
@@ -193,6 +200,48 @@ float material_number(Loader& L, double value, double fallback, double lo, doubl
     return float(clamped);
   }
   return float(value);
+}
+
+// The number `key` of material extension `ext` (its JSON object `value`): `fallback` when absent, or,
+// with a warning, when not a number; checked as material_number does.
+float extension_number(Loader& L, const tinygltf::Value& value, const std::string& ext, const char* key,
+                       double fallback, double lo, double hi, const std::string& material) {
+  const tinygltf::Value* v = value.IsObject() && value.Has(key) ? &value.Get(key) : nullptr;
+  if (v && v->IsNumber()) return material_number(L, v->GetNumberAsDouble(), fallback, lo, hi, material + " " + key);
+  if (v || !value.IsObject())
+    L.warn(material + " " + ext + " has no valid " + key + "; using " + number_text(fallback));
+  return float(fallback);
+}
+
+// The factors of KHR_materials_transmission, KHR_materials_volume and KHR_materials_ior (DESIGN 4c),
+// read and checked for `pmr info` and the sidecar; the surfaces are still drawn by 4b alone.
+void read_layer_factors(Loader& L, const std::string& ext, const tinygltf::Value& value, const std::string& name,
+                        SceneMaterialInputs& m) {
+  const double inf = std::numeric_limits<double>::infinity();
+  if (ext == "KHR_materials_transmission") {
+    m.transmission = extension_number(L, value, ext, "transmissionFactor", 0.0, 0.0, 1.0, name);
+  } else if (ext == "KHR_materials_volume") {
+    m.thickness = extension_number(L, value, ext, "thicknessFactor", 0.0, 0.0, inf, name);
+    m.attenuation_distance = extension_number(L, value, ext, "attenuationDistance", inf, 0.0, inf, name);
+    if (!(m.attenuation_distance > 0.0f)) {
+      L.warn(name + " attenuationDistance must be positive; using infinity (no attenuation)");
+      m.attenuation_distance = float(inf);
+    }
+    double c[3];
+    if (value.IsObject() && value.Has("attenuationColor")) {
+      if (finite_numbers(value.Get("attenuationColor"), 3, c))
+        for (int k = 0; k < 3; ++k)
+          m.attenuation_color[k] = material_number(L, c[k], 1.0, 0.0, 1.0, name + " attenuationColor");
+      else L.warn(name + " KHR_materials_volume has no valid attenuationColor; using (1, 1, 1)");
+    }
+  } else if (ext == "KHR_materials_ior") {
+    // 0 or at least 1 (0: the extension's compatibility mode, a Fresnel term of 1)
+    m.ior = extension_number(L, value, ext, "ior", 1.5, 0.0, inf, name);
+    if (m.ior > 0.0f && m.ior < 1.0f) {
+      L.warn(name + " ior " + number_text(m.ior) + " is neither 0 nor at least 1; using 1.5");
+      m.ior = 1.5f;
+    }
+  }
 }
 
 // The PBR inputs of glTF material i (DESIGN 4b). Records each slot's TEXCOORD set in L.slot_sets.
@@ -211,15 +260,11 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
       m.emissive[c] = material_number(L, g.emissiveFactor[size_t(c)], 0.0, 0.0, 1.0, name + " emissiveFactor");
   for (const auto& [ext, value] : g.extensions) {
     if (ext == "KHR_materials_emissive_strength") {
-      const tinygltf::Value* v =
-          value.IsObject() && value.Has("emissiveStrength") ? &value.Get("emissiveStrength") : nullptr;
-      if (v && v->IsNumber())
-        m.emissive_strength = material_number(L, v->GetNumberAsDouble(), 1.0, 0.0, inf, name + " emissiveStrength");
-      else if (v || !value.IsObject())
-        L.warn(name + " KHR_materials_emissive_strength has no valid emissiveStrength; using 1");
+      m.emissive_strength = extension_number(L, value, ext, "emissiveStrength", 1.0, 0.0, inf, name);
     } else if (ext == "KHR_materials_unlit") {
       m.unlit = true;
     } else if (material_extension_fallback(ext)) {
+      read_layer_factors(L, ext, value, name, m);
       m.unimplemented.push_back(ext);
     }
   }

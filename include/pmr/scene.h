@@ -2,6 +2,7 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <utility>
@@ -52,14 +53,20 @@ struct SceneTextureSlot {
 // physically based model reads (DESIGN 4b), beside the PmrMaterial factors the Lambert model reads (base
 // colour factor, alpha mode and cutoff, sidedness stay there).
 struct SceneMaterialInputs {
-  std::string name;                                   // as in the file ("" when unnamed or the default material)
-  float metallic = 1.0f, roughness = 1.0f;            // metallicFactor, roughnessFactor (validated to [0, 1])
-  float normal_scale = 1.0f;                          // normalTexture.scale
-  float occlusion_strength = 1.0f;                    // occlusionTexture.strength (validated to [0, 1])
-  float emissive[3] = {0.0f, 0.0f, 0.0f};             // emissiveFactor (linear)
-  float emissive_strength = 1.0f;                     // KHR_materials_emissive_strength (1 without it)
-  bool unlit = false;                                 // KHR_materials_unlit
-  std::array<SceneTextureSlot, kTextureSlots> slots;  // indexed by SceneTextureSlotKind
+  std::string name;                         // as in the file ("" when unnamed or the default material)
+  float metallic = 1.0f, roughness = 1.0f;  // metallicFactor, roughnessFactor (validated to [0, 1])
+  float normal_scale = 1.0f;                // normalTexture.scale
+  float occlusion_strength = 1.0f;          // occlusionTexture.strength (validated to [0, 1])
+  float emissive[3] = {0.0f, 0.0f, 0.0f};   // emissiveFactor (linear)
+  float emissive_strength = 1.0f;           // KHR_materials_emissive_strength (1 without it)
+  bool unlit = false;                       // KHR_materials_unlit
+  // DESIGN 4c, read but not drawn yet (the surface is drawn by 4b, and the warning says so)
+  float transmission = 0.0f;  // KHR_materials_transmission transmissionFactor
+  float ior = 1.5f;           // KHR_materials_ior: 0 or >= 1
+  float thickness = 0.0f;     // KHR_materials_volume thicknessFactor (0: thin)
+  float attenuation_distance = std::numeric_limits<float>::infinity();  // KHR_materials_volume (none)
+  float attenuation_color[3] = {1.0f, 1.0f, 1.0f};                      // KHR_materials_volume (linear)
+  std::array<SceneTextureSlot, kTextureSlots> slots;                    // indexed by SceneTextureSlotKind
   std::vector<std::string> unimplemented;  // material extensions present but not drawn (warned once per scene)
 };
 

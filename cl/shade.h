@@ -418,24 +418,17 @@ inline void environment_lanes(const ShadeInputs* in, sfloat3 n, sfloat3 v, sfloa
     *irradiance = *prefiltered = s3_splat((float3)(in->P->env_radiance));
     return;
   }
-  float nx[SW], ny[SW], nz[SW], dx[SW], dy[SW], dz[SW], ms[SW], rs[SW], c[6][SW];
-  int acts[SW];
-  s3_store(n, nx, ny, nz);
-  s3_store(s3_sub(s3_scale(n, 2.0f * nv), v), dx, dy, dz); /* reflect(-v, n) */
-  vstore_s(metallic, 0, ms);
-  vstore_s(r, 0, rs);
-  vstore_s(act, 0, acts);
-  for (int l = 0; l < SW; ++l) {
-    float3 irr = (float3)(0.0f), pre = (float3)(0.0f);
-    if (acts[l]) {
-      const float4 uv = env_uv(in->env, (float3)(nx[l], ny[l], nz[l]), (float3)(dx[l], dy[l], dz[l]));
-      if (ms[l] < 1.0f) irr = env_irradiance(in->env, in->env_data, uv.xy);
-      pre = env_prefiltered(in->env, in->env_data, uv.zw, rs[l]);
-    }
-    c[0][l] = irr.x, c[1][l] = irr.y, c[2][l] = irr.z, c[3][l] = pre.x, c[4][l] = pre.y, c[5][l] = pre.z;
-  }
-  *irradiance = LANE3(c);
-  *prefiltered = LANE3(c + 3);
+  /* idle lanes look up +Y at roughness 1: their values are ignored, but their texel indices are read */
+  const sfloat3 up = s3((sfloat)(0.0f), (sfloat)(1.0f), (sfloat)(0.0f));
+  const sfloat3 d = s3_select(up, s3_sub(s3_scale(n, 2.0f * nv), v), act); /* reflect(-v, n) */
+  sfloat un, vn, ud, vd;
+  env_uv(in->env, s3_select(up, n, act), &un, &vn);
+  env_uv(in->env, d, &ud, &vd);
+  /* a metal has no diffuse term: its lanes skip the irradiance (0) */
+  const sint diffuse = act & (metallic < 1.0f);
+  const sfloat3 zero = s3_splat((float3)(0.0f));
+  *irradiance = any(diffuse) ? s3_select(zero, env_irradiance(in->env, in->env_data, un, vn), diffuse) : zero;
+  *prefiltered = s3_select(zero, env_prefiltered(in->env, in->env_data, ud, vd, select((sfloat)(1.0f), r, act)), act);
 }
 
 /* The split-sum table's bilinear lookup for every lane, as pmr::split_sum (host/shading/environment.cpp)

@@ -612,7 +612,8 @@ TEST(PbrEnvironment, KernelLookupsMatchTheHost) {
              a = rt.upload(in, "probe in"), b = rt.buffer(out.size() * 4, "probe out");
     rt.write(h, &t.header, sizeof t.header);
     k.args(h, data, a, b, cl_uint(dirs.size()));
-    clReleaseEvent(rt.launch(k, dirs.size(), 64));
+    ASSERT_EQ(dirs.size() % 8, 0u) << "the probe takes 8 directions per work-item (SW lanes)";
+    clReleaseEvent(rt.launch(k, dirs.size() / 8, 64));
     rt.read(b, out.data(), out.size() * 4);
   }
   double worst = 0.0;

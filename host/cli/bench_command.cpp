@@ -207,14 +207,7 @@ int run_bench(const std::vector<std::string>& args) {
   if (o.shading == Shading::Pbr) {  // made once, before the first point
     o.environment =
         make_pipeline_environment({o.environment_source, o.environment_rotation_deg, o.environment_intensity});
-    std::printf("# environment %s", printable_text(o.environment_source.name()).c_str());
-    if (o.environment) {
-      const PmrEnvironment& h = o.environment->tables().header;
-      std::printf(": %ux%u, prefiltered in %.2f s (%.1f MB of tables)", h.levels[0].width, h.levels[0].height,
-                  o.environment->prefilter_seconds(),
-                  double(o.environment->tables().data.size() * sizeof(float)) / 1e6);
-    }
-    std::printf("\n");
+    std::printf("# environment %s\n", environment_summary(o.environment_source, o.environment.get()).c_str());
   }
   set_memory_budget(o.limits.memory);
   ClRuntime rt;

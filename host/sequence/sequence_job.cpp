@@ -132,13 +132,8 @@ void SequenceRun::load_inputs() {
     pc_.environment =
         make_pipeline_environment({source, job_.environment_rotation_deg, job_.pipeline.environment_intensity});
     if (source.kind == EnvironmentSource::Kind::File) environment_checksum_ = checksum_file(source.file);
-    if (job_.verbose && pc_.environment) {
-      const PmrEnvironment& h = pc_.environment->tables().header;
-      std::fprintf(stderr, "pmr: environment %s: %ux%u, prefiltered in %.2f s (%.1f MB of tables)\n",
-                   printable_text(source.name()).c_str(), h.levels[0].width, h.levels[0].height,
-                   pc_.environment->prefilter_seconds(),
-                   double(pc_.environment->tables().data.size() * sizeof(float)) / 1e6);
-    }
+    if (job_.verbose)
+      std::fprintf(stderr, "pmr: environment %s\n", environment_summary(source, pc_.environment.get()).c_str());
   }
   scene_ = load_scene(job_.scene, job_.input_limits);
   for (const auto& w : scene_.warnings) warn(w);

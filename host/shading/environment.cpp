@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "pmr/error.h"
+#include "pmr/printable.h"
 #include "shading/environment_prefilter.h"
 
 namespace pmr {
@@ -98,6 +99,20 @@ std::shared_ptr<const Environment> make_pipeline_environment(const EnvironmentOp
     return nullptr;
   }
   return std::make_shared<const Environment>(Environment::make(options));
+}
+
+std::string environment_summary(const EnvironmentSource& source, const Environment* e) {
+  if (!e) return "uniform (radiance 0.2 x intensity)";
+  const EnvTablesHeader& h = e->tables().header;
+  char line[160];
+  const double mb = double(e->tables().data.size() * sizeof(float)) / 1e6;
+  if (source.kind == EnvironmentSource::Kind::Studio)
+    std::snprintf(line, sizeof line, ": %ux%u, prefiltered when pmr was built (%.1f MB of tables)", h.levels[0].width,
+                  h.levels[0].height, mb);
+  else
+    std::snprintf(line, sizeof line, ": %ux%u, prefiltered in %.2f s (%.1f MB of tables)", h.levels[0].width,
+                  h.levels[0].height, e->prefilter_seconds(), mb);
+  return printable_text(source.name()) + line;
 }
 
 void Environment::set_rotation(double deg) {

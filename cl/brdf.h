@@ -13,10 +13,9 @@
 /* Roughness as the material gives it (factor x texture G) clamped to [0.03, 1]; alpha = r^2. */
 inline sfloat pbr_roughness(sfloat r) { return clamp(r, 0.03f, 1.0f); }
 
-/* F0 = mix(0.04, base, metallic) per channel */
-inline sfloat3 pbr_f0(sfloat3 base, sfloat metallic) {
-  return s3(0.04f + (base.x - 0.04f) * metallic, 0.04f + (base.y - 0.04f) * metallic,
-            0.04f + (base.z - 0.04f) * metallic);
+/* F0 = mix(f0d, base, metallic) per channel, f0d the dielectric's (0.04, or from KHR_materials_ior) */
+inline sfloat3 pbr_f0(sfloat3 base, sfloat metallic, sfloat f0d) {
+  return s3(f0d + (base.x - f0d) * metallic, f0d + (base.y - f0d) * metallic, f0d + (base.z - f0d) * metallic);
 }
 
 /* GGX normal distribution D for cos(n, h) = nh and a2 = alpha^2. */
@@ -32,8 +31,9 @@ inline sfloat smith_vis(sfloat nl, sfloat nv, sfloat a2) {
 }
 
 /* f(l, v) * dot(n, l) per lane: the radiance reflected toward v per unit irradiance from the direction
- * l (unit, toward the light). n and v are unit vectors; r is the clamped roughness. */
-inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat r, sfloat3 n, sfloat3 v, sfloat3 l) {
+ * l (unit, toward the light). n and v are unit vectors; r is the clamped roughness; f0d the dielectric
+ * F0. */
+inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat f0d, sfloat r, sfloat3 n, sfloat3 v, sfloat3 l) {
   const sfloat nl = clamp(s3_dot(n, l), 0.0f, 1.0f);
   const sfloat nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
   const sfloat3 hv = s3_add(l, v);
@@ -41,7 +41,7 @@ inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat r, sfloat3 n, sflo
   const sfloat3 h = s3_select(n, s3_scale(hv, 1.0f / hl), hl > 0.0f);
   const sfloat nh = clamp(s3_dot(n, h), 0.0f, 1.0f), vh = clamp(s3_dot(v, h), 0.0f, 1.0f);
   const sfloat alpha = r * r, a2 = alpha * alpha;
-  const sfloat3 f0 = pbr_f0(base, metallic);
+  const sfloat3 f0 = pbr_f0(base, metallic, f0d);
   const sfloat k = 1.0f - vh, k2 = k * k, k5 = k2 * k2 * k;
   const sfloat3 F = s3(f0.x + (1.0f - f0.x) * k5, f0.y + (1.0f - f0.y) * k5, f0.z + (1.0f - f0.z) * k5);
   const sfloat diffuse = (1.0f - metallic) * (1.0f / PMR_PI_F), spec = ggx_d(nh, a2) * smith_vis(nl, nv, a2);

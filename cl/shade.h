@@ -74,6 +74,7 @@ typedef struct {
   sfloat3 factor;     /* baseColorFactor (RGB)                                           */
   sfloat3 p[3];       /* pbr: vertex positions, world space                              */
   sfloat metallic, roughness;
+  sfloat f0d; /* pbr: the dielectric F0 (PmrMaterial.f0_dielectric)                  */
   sfloat3 emissive;
   uint textured; /* bit l: lane l's material has a map the model reads (lambert: base colour) */
   uint tri[SW];  /* lane l's triangle, where textured                               */
@@ -94,7 +95,7 @@ inline void lanes_clear(LaneWinners* L) {
     L->n[k] = L->face, L->c[k] = s3(one, one, one), L->p[k] = s3(zero, zero, zero);
   }
   L->factor = s3(zero, zero, zero);
-  L->metallic = L->roughness = zero;
+  L->metallic = L->roughness = L->f0d = zero;
   L->emissive = s3(zero, zero, zero);
   L->textured = 0u;
 #if PMR_TRILINEAR
@@ -131,6 +132,7 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
   if (pbr) {
     L->metallic = blend(L->metallic, mat->metallic, take);
     L->roughness = blend(L->roughness, mat->roughness, take);
+    L->f0d = blend(L->f0d, mat->f0_dielectric, take);
     L->emissive = blend3(L->emissive, vload3(0, mat->emissive), take);
     if (mat->unlit) L->unlit |= take;
     for (int k = 0; k < PMR_MAPS; ++k) textured = textured || mat->maps[k].texture >= 0;
@@ -505,14 +507,14 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
     const sfloat3 E =
         light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
                          vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, p, &l);
-    direct = s3_add(direct, s3_mul(brdf_cos(base, metallic, r, n, v, l), E));
+    direct = s3_add(direct, s3_mul(brdf_cos(base, metallic, L->f0d, r, n, v, l), E));
   }
   const sfloat nv = s3_dot(n, v);
   sfloat A, B;
   split_sum_lanes(in->split_sum, nv, r, &A, &B);
   sfloat3 irradiance, prefiltered;
   environment_lanes(in, n, v, nv, metallic, r, L->act, &irradiance, &prefiltered);
-  const sfloat3 f0 = pbr_f0(base, metallic);
+  const sfloat3 f0 = pbr_f0(base, metallic, L->f0d);
   const sfloat kd = 1.0f - metallic;
   const sfloat3 ambient = s3(ao * (base.x * kd * irradiance.x + (f0.x * A + B) * prefiltered.x),
                              ao * (base.y * kd * irradiance.y + (f0.y * A + B) * prefiltered.y),

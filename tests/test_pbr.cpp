@@ -485,6 +485,57 @@ TEST(Pbr, SpecularHighlightMovesWithTheViews) {
 }
 
 // Exposure scales either model by 2^EV (half-float outputs: 2^-10 relative).
+// KHR_materials_ior: a dielectric's F0 is ((ior - 1) / (ior + 1))^2 (0 at ior 1, 0.17 at 2.4, 1 at the
+// extension's ior 0), in the lights' and the environment's terms. Four grey dielectric quads, every
+// voxel within the bound of the reference (which computes F0 from the material's ior itself); the
+// reference at glTF's default 1.5 is outside it on 20% to all of each quad's voxels, so a kernel ignoring ior fails.
+TEST(Pbr, IorSetsTheDielectricReflectance) {
+  const Rig rig = test::small_rig(5, 64, 36);
+  Scene s = test::empty_scene(true);
+  const float iors[4] = {1.0f, 1.33f, 2.4f, 0.0f};
+  for (int q = 0; q < 4; ++q) {
+    PmrMaterial m = s.materials[0];
+    m.metallic = 0.0f, m.roughness = 0.35f;
+    m.base_color[0] = m.base_color[1] = m.base_color[2] = 0.5f;
+    m.f0_dielectric = dielectric_f0(iors[q]);  // as the loader sets it (SceneMaterials tests read ior)
+    s.materials.push_back(m);
+    const float x0 = -1.2f + 0.62f * float(q), x1 = x0 + 0.56f;
+    test::add_triangle(s, {x0, -0.9f, 0.2f}, {x1, -0.9f, -0.2f}, {x1, 0.9f, 0.0f}, uint32_t(q + 1));
+    test::add_triangle(s, {x0, -0.9f, 0.2f}, {x1, 0.9f, 0.0f}, {x0, 0.9f, 0.2f}, uint32_t(q + 1));
+  }
+  for (size_t k = 0; k < s.attributes.size(); ++k) {  // curved normals
+    const glm::vec3 n = glm::normalize(glm::vec3(0.4f * float(k % 3) - 0.4f, 0.3f * float(k % 2) - 0.15f, 1.0f));
+    std::copy(&n.x, &n.x + 3, s.attributes[k].normal);
+  }
+  test::base_colour_texture(s, 1, -1, 0);  // material inputs for every material (no texture)
+  for (int q = 0; q < 4; ++q) s.material_inputs[size_t(q + 1)].ior = iors[q];
+  const test::Rendered out = render_pbr(s, rig);
+  VoxelReference reference(s, rig, out), plain(s, rig, out);
+  Scene default_ior = s;
+  for (SceneMaterialInputs& in : default_ior.material_inputs) in.ior = 1.5f;
+  const VoxelReference at_15(default_ior, rig, out);
+  BoundCheck check;
+  std::map<uint32_t, size_t> per_material, off_at_15;
+  for (size_t v = 0; v < out.key.size(); ++v) {
+    if (out.key[v] == PMR_NO_KEY) continue;
+    const PmrMta* m = reference.mta(v);
+    ASSERT_NE(m, nullptr);
+    const uint32_t material = s.triangles[m->tri].material;
+    check.voxel(out, v, reference.colour(v, *m), "ior " + std::to_string(iors[material - 1]));
+    ++per_material[material];
+    half g;
+    g.setBits(out.volume[v * 4 + 1]);
+    const double want15 = at_15.colour(v, *m).y;
+    off_at_15[material] += std::abs(double(float(g)) - want15) > 0.01 * want15 + 1e-3;
+  }
+  EXPECT_EQ(check.bad, 0u);
+  for (uint32_t material = 1; material <= 4; ++material) {
+    EXPECT_GT(per_material[material], size_t(150)) << "material " << material;
+    EXPECT_GT(off_at_15[material], per_material[material] / 8) << "ior " << iors[material - 1] << " looks like 1.5";
+  }
+  std::printf("[ pbr ior  ] largest error %.3f of the bound\n", check.worst);
+}
+
 TEST(Pbr, ExposureScalesBothModels) {
   const Rig rig = test::small_rig(3, 40, 24);
   const Scene s = material_quads();

@@ -210,7 +210,8 @@ TEST_F(SceneMaterialsTest, OutOfRangeFactorsAreClampedWithAWarning) {
 }
 
 // KHR_materials_transmission, _volume and _ior (DESIGN 4c): their factors read and checked (absent:
-// the extensions' defaults), invalid ones replaced with a warning; still drawn by 4b, and warned so.
+// the extensions' defaults), invalid ones replaced with a warning; ior sets the dielectric's F0,
+// transmission and volume are still drawn by 4b, and warned so.
 TEST_F(SceneMaterialsTest, TransmissionVolumeAndIorFactorsAreRead) {
   GltfFile g;
   g.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_ior"};
@@ -259,6 +260,11 @@ TEST_F(SceneMaterialsTest, TransmissionVolumeAndIorFactorsAreRead) {
   EXPECT_EQ(bad.attenuation_color[0], 1.0f);
   EXPECT_EQ(bad.ior, 1.5f);
   EXPECT_EQ(s.material_inputs[4].ior, 0.0f) << "0 is the extension's compatibility mode";
+  // ior is drawn (the dielectric's F0), the others not yet
+  EXPECT_NEAR(s.materials[1].f0_dielectric, (0.33 / 2.33) * (0.33 / 2.33), 1e-7);
+  EXPECT_EQ(s.materials[2].f0_dielectric, 0.04f);
+  EXPECT_EQ(s.materials[4].f0_dielectric, 1.0f);
+  EXPECT_EQ(warnings_with(s, "KHR_materials_ior ("), 0u) << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "material 2 transmissionFactor is outside [0.0, 1.0]; clamped"), 1u) << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "material 2 attenuationDistance must be positive"), 1u) << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "material 2 KHR_materials_volume has no valid attenuationColor"), 1u) << all_warnings(s);

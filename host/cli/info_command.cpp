@@ -43,8 +43,8 @@ std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
   return t + ")";
 }
 
-// KHR_materials_transmission, _volume and _ior, where the material has them (not drawn yet: the
-// "not drawn" line names them).
+// KHR_materials_transmission and _volume where the material has them (not drawn yet: the "not drawn"
+// line names them), and KHR_materials_ior's ior where it is not the default 1.5.
 std::string layer_text(const SceneMaterialInputs& in) {
   std::string t;
   auto has = [&](const char* ext) {
@@ -56,7 +56,7 @@ std::string layer_text(const SceneMaterialInputs& in) {
          number(in.attenuation_color[1]) + ", " + number(in.attenuation_color[2]) + ") over " +
          number(in.attenuation_distance);
   }
-  if (has("KHR_materials_ior")) t += ", ior " + number(in.ior);
+  if (in.ior != 1.5f) t += ", ior " + number(in.ior);
   return t;
 }
 

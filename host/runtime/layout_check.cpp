@@ -20,7 +20,7 @@ static_assert(offsetof(PmrMta, bary) == 60 && offsetof(PmrMta, tri) == 84 && off
               "PmrMta layout");
 static_assert(sizeof(PmrVertexAttr) == 28 && offsetof(PmrVertexAttr, color) == 12, "PmrVertexAttr layout");
 static_assert(sizeof(PmrTriangle) == 32, "PmrTriangle layout");
-static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 8 && offsetof(PmrMaterial, maps) == 52, "PmrMaterial layout");
+static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 12 && offsetof(PmrMaterial, maps) == 52, "PmrMaterial layout");
 static_assert(sizeof(PmrTextureMap) == 32, "PmrTextureMap layout");
 static_assert(sizeof(PmrTexture) == 32 && offsetof(PmrTexture, levels) == 20, "PmrTexture layout");
 static_assert(sizeof(PmrEncodeParams) == 48 && offsetof(PmrEncodeParams, display_w) == 0, "PmrEncodeParams layout");

@@ -213,7 +213,7 @@ float extension_number(Loader& L, const tinygltf::Value& value, const std::strin
   return float(fallback);
 }
 
-// The factors of KHR_materials_transmission, KHR_materials_volume and KHR_materials_ior (DESIGN 4c),
+// The factors of KHR_materials_transmission and KHR_materials_volume (DESIGN 4c),
 // read and checked for `pmr info` and the sidecar; the surfaces are still drawn by 4b alone.
 void read_layer_factors(Loader& L, const std::string& ext, const tinygltf::Value& value, const std::string& name,
                         SceneMaterialInputs& m) {
@@ -234,14 +234,18 @@ void read_layer_factors(Loader& L, const std::string& ext, const tinygltf::Value
           m.attenuation_color[k] = material_number(L, c[k], 1.0, 0.0, 1.0, name + " attenuationColor");
       else L.warn(name + " KHR_materials_volume has no valid attenuationColor; using (1, 1, 1)");
     }
-  } else if (ext == "KHR_materials_ior") {
-    // 0 or at least 1 (0: the extension's compatibility mode, a Fresnel term of 1)
-    m.ior = extension_number(L, value, ext, "ior", 1.5, 0.0, inf, name);
-    if (m.ior > 0.0f && m.ior < 1.0f) {
-      L.warn(name + " ior " + number_text(m.ior) + " is neither 0 nor at least 1; using 1.5");
-      m.ior = 1.5f;
-    }
   }
+}
+
+// KHR_materials_ior's ior: 0 or at least 1 (0: the extension's compatibility mode, a Fresnel term of 1).
+float read_ior(Loader& L, const tinygltf::Value& value, const std::string& name) {
+  const float ior =
+      extension_number(L, value, "KHR_materials_ior", "ior", 1.5, 0.0, std::numeric_limits<double>::infinity(), name);
+  if (ior > 0.0f && ior < 1.0f) {
+    L.warn(name + " ior " + number_text(ior) + " is neither 0 nor at least 1; using 1.5");
+    return 1.5f;
+  }
+  return ior;
 }
 
 // The PBR inputs of glTF material i (DESIGN 4b). Records each slot's TEXCOORD set in L.slot_sets.
@@ -263,6 +267,8 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
       m.emissive_strength = extension_number(L, value, ext, "emissiveStrength", 1.0, 0.0, inf, name);
     } else if (ext == "KHR_materials_unlit") {
       m.unlit = true;
+    } else if (ext == "KHR_materials_ior") {
+      m.ior = read_ior(L, value, name);
     } else if (material_extension_fallback(ext)) {
       read_layer_factors(L, ext, value, name, m);
       m.unimplemented.push_back(ext);
@@ -334,6 +340,7 @@ void build_materials(Loader& L) {
     const SceneMaterialInputs& in = L.scene.material_inputs.back();
     PmrMaterial& dm = L.scene.materials.back();
     dm.metallic = in.metallic, dm.roughness = in.roughness, dm.unlit = in.unlit ? 1u : 0u;
+    dm.f0_dielectric = dielectric_f0(in.ior);
     for (int c = 0; c < 3; ++c) dm.emissive[c] = in.emissive[c] * in.emissive_strength;
   }
 }

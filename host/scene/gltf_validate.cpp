@@ -52,7 +52,7 @@ constexpr uint64_t kJsonBytesPerValue = 200;
 // extensions are read into the scene (DESIGN 4b).
 bool extension_supported(const std::string& name) {
   return name == "KHR_mesh_quantization" || name == "KHR_texture_transform" || name == "KHR_lights_punctual" ||
-         name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit";
+         name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit" || name == "KHR_materials_ior";
 }
 
 uint32_t read_u32le(const unsigned char* p) {
@@ -488,7 +488,6 @@ const char* material_extension_fallback(const std::string& name) {
       {"KHR_materials_clearcoat", "drawn without the clear coat layer"},
       {"KHR_materials_sheen", "drawn without sheen"},
       {"KHR_materials_specular", "drawn with the default specular (F0 0.04, white)"},
-      {"KHR_materials_ior", "drawn with the default index of refraction 1.5 (F0 0.04)"},
       {"KHR_materials_iridescence", "drawn without iridescence"},
       {"KHR_materials_anisotropy", "drawn with isotropic highlights"},
       {"KHR_materials_pbrSpecularGlossiness",

@@ -17,7 +17,14 @@ PmrMaterial default_material() {
   for (PmrTextureMap& map : m.maps) map = PmrTextureMap{-1, 0, {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f}};
   m.normal_scale = 1.0f;
   m.occlusion_strength = 1.0f;
+  m.f0_dielectric = dielectric_f0(1.5);
   return m;
+}
+
+float dielectric_f0(double ior) {
+  if (ior == 1.5) return 0.04f;  // glTF's default, exactly as the core specification writes it
+  const double f = (ior - 1.0) / (ior + 1.0);
+  return float(f * f);  // ior 0 (KHR_materials_ior's compatibility mode): 1
 }
 
 const char* texture_slot_name(int slot) {

@@ -60,9 +60,9 @@ struct SceneMaterialInputs {
   float emissive[3] = {0.0f, 0.0f, 0.0f};   // emissiveFactor (linear)
   float emissive_strength = 1.0f;           // KHR_materials_emissive_strength (1 without it)
   bool unlit = false;                       // KHR_materials_unlit
+  float ior = 1.5f;                         // KHR_materials_ior: 0 or >= 1 (its F0: PmrMaterial::f0_dielectric)
   // DESIGN 4c, read but not drawn yet (the surface is drawn by 4b, and the warning says so)
   float transmission = 0.0f;  // KHR_materials_transmission transmissionFactor
-  float ior = 1.5f;           // KHR_materials_ior: 0 or >= 1
   float thickness = 0.0f;     // KHR_materials_volume thicknessFactor (0: thin)
   float attenuation_distance = std::numeric_limits<float>::infinity();  // KHR_materials_volume (none)
   float attenuation_color[3] = {1.0f, 1.0f, 1.0f};                      // KHR_materials_volume (linear)
@@ -210,6 +210,9 @@ bool scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi);
 namespace pmr {
 // The glTF default material: white, opaque, single-sided (used when a primitive has none).
 PmrMaterial default_material();
+// The reflectance at normal incidence of a dielectric of index of refraction `ior` in air,
+// ((ior - 1) / (ior + 1))^2 (KHR_materials_ior): 0.04 for glTF's default 1.5; 1 for ior 0.
+float dielectric_f0(double ior);
 
 // A procedural scene of about `triangles` triangles (1k to 1M): UV spheres of ~200 triangles with
 // random sizes and colours spread through a 4 x 2 x 3 box, so they cover the whole depth range in

@@ -253,6 +253,8 @@ typedef struct {
   PmrTextureMap maps[PMR_MAPS]; /* indexed by PMR_MAP_*                                           */
   float normal_scale;           /* normalTexture.scale                                             */
   float occlusion_strength;     /* occlusionTexture.strength                                     */
+  float f0_dielectric;          /* F0 of the dielectric part: ((ior - 1) / (ior + 1))^2 for
+                                   KHR_materials_ior (0.04 for the default 1.5; 1 for ior 0)       */
 } PmrMaterial;
 
 /* A texture and its mip chain: `levels` levels back to back from `offset`, level k of

@@ -16,7 +16,8 @@ kernel void brdf_probe(global const float* in, global float* out, uint n) {
     for (int k = 0; k < 14; ++k) c[k][l] = in[14 * probe_case(first, l, n) + k];
 #define LANES(k) vload_s(0, c[k])
 #define LANES3(k) s3(LANES(k), LANES(k + 1), LANES(k + 2))
-  const sfloat3 r = brdf_cos(LANES3(0), LANES(3), pbr_roughness(LANES(4)), LANES3(5), LANES3(8), LANES3(11));
+  const sfloat3 r =
+      brdf_cos(LANES3(0), LANES(3), (sfloat)(0.04f), pbr_roughness(LANES(4)), LANES3(5), LANES3(8), LANES3(11));
   float o[3][SW];
   vstore_s(r.x, 0, o[0]), vstore_s(r.y, 0, o[1]), vstore_s(r.z, 0, o[2]);
   for (int l = 0; l < SW && first + (uint)l < n; ++l)

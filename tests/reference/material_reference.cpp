@@ -25,7 +25,7 @@ void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool bac
   sp.ao = 1.0;
   if (t.material < scene.material_inputs.size()) {
     const SceneMaterialInputs& in = scene.material_inputs[t.material];
-    sp.metallic = in.metallic, sp.roughness = in.roughness, sp.unlit = in.unlit;
+    sp.metallic = in.metallic, sp.roughness = in.roughness, sp.unlit = in.unlit, sp.ior = in.ior;
     sp.emissive = glm::dvec3(in.emissive[0], in.emissive[1], in.emissive[2]) * double(in.emissive_strength);
     glm::dvec4 s;
     if (sample_slot(scene, t, b, in.slots[kSlotMetallicRoughness], s)) sp.metallic *= s.z, sp.roughness *= s.y;

@@ -11,12 +11,16 @@ constexpr double kPi = 3.14159265358979323846;
 
 double clamp01(double x) { return std::min(1.0, std::max(0.0, x)); }
 
-glm::dvec3 f0_of(const glm::dvec3& base, double metallic) { return glm::mix(glm::dvec3(0.04), base, metallic); }
+// F0 = mix(dielectric, base, metallic), the dielectric's ((ior - 1) / (ior + 1))^2 (0.04 at ior 1.5)
+glm::dvec3 f0_of(const glm::dvec3& base, double metallic, double ior) {
+  const double f = (ior - 1.0) / (ior + 1.0);
+  return glm::mix(glm::dvec3(f * f), base, metallic);
+}
 
 }  // namespace
 
 glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
-                    const glm::dvec3& l) {
+                    const glm::dvec3& l, double ior) {
   const double nl = clamp01(glm::dot(n, l));
   if (nl <= 0.0) return glm::dvec3(0.0);
   const double nv = clamp01(glm::dot(n, v));
@@ -24,7 +28,7 @@ glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm
   const glm::dvec3 h = glm::length(hv) > 0.0 ? glm::normalize(hv) : n;
   const double nh = clamp01(glm::dot(n, h)), vh = clamp01(glm::dot(v, h));
   const double alpha = r * r, a2 = alpha * alpha;
-  const glm::dvec3 f0 = f0_of(base, metallic);
+  const glm::dvec3 f0 = f0_of(base, metallic, ior);
   const glm::dvec3 F = f0 + (1.0 - f0) * std::pow(1.0 - vh, 5.0);
   const double dd = nh * nh * (a2 - 1.0) + 1.0;
   const double D = a2 / (kPi * dd * dd);
@@ -67,9 +71,9 @@ glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& li
   for (const PunctualLight& light : lights) {
     glm::dvec3 l;
     const glm::dvec3 E = light_irradiance(light, s.p, l);
-    sum += brdf_cos(s.base, s.metallic, r, s.n, v, l) * E;
+    sum += brdf_cos(s.base, s.metallic, r, s.n, v, l, s.ior) * E;
   }
-  const glm::dvec3 f0 = f0_of(s.base, s.metallic), c_diff = s.base * (1.0 - s.metallic);
+  const glm::dvec3 f0 = f0_of(s.base, s.metallic, s.ior), c_diff = s.base * (1.0 - s.metallic);
   const glm::dvec2 ab = env.split_sum(clamp01(glm::dot(s.n, v)), r);
   const glm::dvec3 reflected = glm::reflect(-v, s.n);
   sum += s.ao * (c_diff * env.irradiance(s.n) + (f0 * ab.x + ab.y) * env.prefiltered(reflected, r));

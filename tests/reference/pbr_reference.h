@@ -9,9 +9,10 @@
 
 namespace pmr::ref {
 
-// f(l, v) * dot(n, l) for unit n, v, l; r = the clamped roughness (alpha = r^2).
+// f(l, v) * dot(n, l) for unit n, v, l; r = the clamped roughness (alpha = r^2); the dielectric's F0
+// from its index of refraction ((ior - 1) / (ior + 1))^2 (KHR_materials_ior; 0.04 at glTF's 1.5).
 glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
-                    const glm::dvec3& l);
+                    const glm::dvec3& l, double ior = 1.5);
 
 enum class LightType { Directional = 0, Point = 1, Spot = 2 };
 
@@ -31,6 +32,7 @@ glm::dvec3 light_irradiance(const PunctualLight& light, const glm::dvec3& p, glm
 struct SurfacePoint {
   glm::dvec3 base{1.0};                    // base colour (rgb)
   double metallic = 0.0, roughness = 1.0;  // roughness before clamping
+  double ior = 1.5;                        // KHR_materials_ior
   glm::dvec3 n{0.0, 0.0, 1.0};             // unit shading normal (back faces already flipped)
   glm::dvec3 p{0.0};                       // world position
   glm::dvec3 eye{0.0, 0.0, 1.0};           // the view's camera position (world)

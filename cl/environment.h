@@ -135,8 +135,9 @@ inline sfloat3 env_fetch(global const float4* data, EnvTaps k) {
 /* I(n), the cosine-weighted mean radiance about n (irradiance / pi), for each lane's n at (u, v): the
  * last level (r = 1). */
 inline sfloat3 env_irradiance(global const PmrEnvironment* e, global const float4* data, sfloat u, sfloat v) {
-  const sint last = (sint)((int)e->level_count - 1);
-  return s3_scale(env_fetch(data, env_level_taps(e, last, u, v)), (sfloat)(e->intensity));
+  global const PmrEnvLevel* L = &e->levels[e->level_count - 1u]; /* the same level in every lane */
+  const EnvTaps k = env_taps((sint)((int)L->width), (sint)((int)L->height), (sint)((int)(L->offset / 4u)), u, v);
+  return s3_scale(env_fetch(data, k), (sfloat)(e->intensity));
 }
 
 /* c(r), the fractional level coordinate of each lane's roughness, from its table (linear between

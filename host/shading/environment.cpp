@@ -80,10 +80,18 @@ std::string EnvironmentSource::name() const {
   return kind == Kind::Studio ? "studio" : kind == Kind::Uniform ? "uniform" : file;
 }
 
-Environment Environment::make(const EnvironmentOptions& o) {
+namespace {
+
+void check_rotation_and_intensity(const EnvironmentOptions& o) {
   if (!std::isfinite(o.intensity) || o.intensity < 0.0)
     throw Error("environment intensity must be a finite number >= 0");
   if (!std::isfinite(o.rotation_deg)) throw Error("environment rotation must be a finite number of degrees");
+}
+
+}  // namespace
+
+Environment Environment::make(const EnvironmentOptions& o) {
+  check_rotation_and_intensity(o);
   const EnvironmentSource& s = o.source;
   Environment e = s.kind == EnvironmentSource::Kind::Studio    ? studio()
                   : s.kind == EnvironmentSource::Kind::Uniform ? uniform(o.uniform_radiance)
@@ -95,7 +103,7 @@ Environment Environment::make(const EnvironmentOptions& o) {
 
 std::shared_ptr<const Environment> make_pipeline_environment(const EnvironmentOptions& options) {
   if (options.source.kind == EnvironmentSource::Kind::Uniform) {
-    (void)Environment::make(options);  // the same checks of rotation and intensity
+    check_rotation_and_intensity(options);
     return nullptr;
   }
   return std::make_shared<const Environment>(Environment::make(options));

@@ -24,23 +24,28 @@
 
 namespace pmr {
 
-// Bilinear, texel centers at (j + 1/2) / W, wrapping in u, clamped in v.
-glm::dvec3 environment_bilinear(const float* tex, int W, int H, int stride, double u, double v) {
-  const double x = u * W - 0.5, y = v * H - 0.5;
-  const double x0f = std::floor(x), y0f = std::floor(y);
-  const double fx = x - x0f, fy = y - y0f;
+namespace {
+
+// The bilinear blend of rows row0 and row1 (weight fy of row1) at u: texel centers at (j + 1/2) / W,
+// wrapping in u.
+glm::dvec3 bilinear_rows(const float* tex, int W, int stride, double u, long row0, long row1, double fy) {
+  const double x = u * W - 0.5, x0f = std::floor(x), fx = x - x0f;
   long x0 = long(x0f) % W;
   if (x0 < 0) x0 += W;
   const long x1 = (x0 + 1) % W;
-  const long y0 = std::clamp(long(y0f), 0L, long(H - 1)), y1 = std::clamp(long(y0f) + 1, 0L, long(H - 1));
   auto at = [&](long xx, long yy) {
     const float* p = tex + (size_t(yy) * size_t(W) + size_t(xx)) * size_t(stride);
     return glm::dvec3(p[0], p[1], p[2]);
   };
-  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) + fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+  return (1 - fy) * ((1 - fx) * at(x0, row0) + fx * at(x1, row0)) + fy * ((1 - fx) * at(x0, row1) + fx * at(x1, row1));
 }
 
-namespace {
+// An image's bilinear lookup: texel centers at (j + 1/2) / W, wrapping in u, clamped in v.
+glm::dvec3 image_bilinear(const float* tex, int W, int H, int stride, double u, double v) {
+  const double y = v * H - 0.5, y0f = std::floor(y);
+  const long y0 = std::clamp(long(y0f), 0L, long(H - 1)), y1 = std::clamp(long(y0f) + 1, 0L, long(H - 1));
+  return bilinear_rows(tex, W, stride, u, y0, y1, y - y0f);
+}
 
 constexpr double kPi = 3.14159265358979323846;
 using cd = std::complex<double>;
@@ -132,7 +137,7 @@ std::vector<double> resample(const Image3& s, int W, int H) {
       glm::dvec3 sum(0.0);
       for (int b = 0; b < sy; ++b)
         for (int a = 0; a < sx; ++a)
-          sum += environment_bilinear(s.rgb.data(), s.w, s.h, 3, (j + (a + 0.5) / sx) / W, (i + (b + 0.5) / sy) / H);
+          sum += image_bilinear(s.rgb.data(), s.w, s.h, 3, (j + (a + 0.5) / sx) / W, (i + (b + 0.5) / sy) / H);
       sum /= double(sx * sy);
       for (int c = 0; c < 3; ++c) out[(size_t(c) * size_t(H) + size_t(i)) * size_t(W) + size_t(j)] = sum[c];
     }
@@ -353,17 +358,9 @@ double environment_level_coordinate(double r) {
 }
 
 glm::dvec3 environment_level_bilinear(const float* level, int W, int H, double u, double v) {
-  const double x = u * W - 0.5, y = std::clamp(v * H - 0.5, -0.5, H - 0.5);
-  const double x0f = std::floor(x), y0f = std::floor(y);
-  const double fx = x - x0f, fy = y - y0f;
-  long x0 = long(x0f) % W;
-  if (x0 < 0) x0 += W;
-  const long x1 = (x0 + 1) % W, y0 = long(y0f) + 1, y1 = std::min(y0 + 1, long(H + 1));  // rows with the pole rows
-  auto at = [&](long xx, long yy) {
-    const float* p = level + (size_t(yy) * size_t(W) + size_t(xx)) * 4;
-    return glm::dvec3(p[0], p[1], p[2]);
-  };
-  return (1 - fy) * ((1 - fx) * at(x0, y0) + fx * at(x1, y0)) + fy * ((1 - fx) * at(x0, y1) + fx * at(x1, y1));
+  const double y = std::clamp(v * H - 0.5, -0.5, H - 0.5), y0f = std::floor(y);
+  const long y0 = long(y0f) + 1, y1 = std::min(y0 + 1, long(H + 1));  // rows counted with the pole row
+  return bilinear_rows(level, W, 4, u, y0, y1, y - y0f);
 }
 
 EnvironmentTables prefilter_environment(const EnvironmentImage& image) {

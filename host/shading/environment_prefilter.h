@@ -16,8 +16,4 @@ EnvironmentTables uniform_environment_tables(float radiance);
 // in u, v clamped half a texel beyond the outer rows' centers.
 glm::dvec3 environment_level_bilinear(const float* level, int W, int H, double u, double v);
 
-// A bilinear lookup in an image of `stride` floats per texel: texel centers at ((j + 1/2) / W,
-// (i + 1/2) / H), wrapping in u, clamped in v.
-glm::dvec3 environment_bilinear(const float* tex, int W, int H, int stride, double u, double v);
-
 }  // namespace pmr

@@ -32,8 +32,10 @@ inline sfloat smith_vis(sfloat nl, sfloat nv, sfloat a2) {
 
 /* f(l, v) * dot(n, l) per lane: the radiance reflected toward v per unit irradiance from the direction
  * l (unit, toward the light). n and v are unit vectors; r is the clamped roughness; f0d the dielectric
- * F0. */
-inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat f0d, sfloat r, sfloat3 n, sfloat3 v, sfloat3 l) {
+ * F0; `transmission` (KHR_materials_transmission) the part of the diffuse lobe that transmits instead
+ * (the environment's transmission term takes its place: cl/transmission.h). */
+inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat f0d, sfloat r, sfloat3 n, sfloat3 v,
+                                     sfloat3 l, sfloat transmission) {
   const sfloat nl = clamp(s3_dot(n, l), 0.0f, 1.0f);
   const sfloat nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
   const sfloat3 hv = s3_add(l, v);
@@ -44,11 +46,17 @@ inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat f0d, sfloat r, sfl
   const sfloat3 f0 = pbr_f0(base, metallic, f0d);
   const sfloat k = 1.0f - vh, k2 = k * k, k5 = k2 * k2 * k;
   const sfloat3 F = s3(f0.x + (1.0f - f0.x) * k5, f0.y + (1.0f - f0.y) * k5, f0.z + (1.0f - f0.z) * k5);
-  const sfloat diffuse = (1.0f - metallic) * (1.0f / PMR_PI_F), spec = ggx_d(nh, a2) * smith_vis(nl, nv, a2);
+  const sfloat diffuse = (1.0f - metallic) * (1.0f - transmission) * (1.0f / PMR_PI_F),
+               spec = ggx_d(nh, a2) * smith_vis(nl, nv, a2);
   const sfloat3 f = s3((1.0f - F.x) * base.x * diffuse + F.x * spec, (1.0f - F.y) * base.y * diffuse + F.y * spec,
                        (1.0f - F.z) * base.z * diffuse + F.z * spec);
   /* nl = 0 (the light behind the surface) gives 0, whatever the rest computed */
   return s3_scale(f, select((sfloat)(0.0f), nl, nl > 0.0f));
+}
+
+/* The same for an opaque surface. */
+inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat f0d, sfloat r, sfloat3 n, sfloat3 v, sfloat3 l) {
+  return brdf_cos_transmissive(base, metallic, f0d, r, n, v, l, (sfloat)(0.0f));
 }
 
 /* KHR_lights_punctual at the surface points p: the unit directions toward the light (*l) and the

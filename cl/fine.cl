@@ -1,7 +1,8 @@
 /* Stage 4, fine raster: one work-item per 3D tile (PMR_TILE_X x PMR_TILE_Y pixels x PMR_TILE_V views)
  * rasterizes its queue (fine_raster.h), shades the winners and writes them to the view volume. This is
  * the path for jobs that need the views themselves (--write views, bilinear encoding, the baselines,
- * the debug outputs); the encoded-only job uses fine_encode.cl, which never writes the volume. */
+ * the debug outputs) and for every path's transmission source (the opaque pass, into the source's level
+ * 0); the encoded-only job uses fine_encode.cl, which never writes the volume. */
 #include "fine_raster.h"
 
 kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
@@ -15,9 +16,8 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
   const int v0 = (int)(tile / tiles_xy) * PMR_TILE_V;
   const int nx = min(PMR_TILE_X, P->view_w - x0), ny = min(PMR_TILE_Y, P->view_h - y0);
   const int nv = min(PMR_TILE_V, P->views - v0);
-  const bool debug = P->debug_outputs != 0;
-
   ShadeInputs in = PMR_SHADE_INPUTS;
+  const bool debug = P->debug_outputs != 0 && !source_info->opaque_only; /* the frame's outputs: its last pass */
   vfloat best_depth[FINE_ROWS * NS];
   vuint best_key[FINE_ROWS * NS], best_mta[FINE_ROWS * NS], best_cover[NS > 1 ? FINE_ROWS * NS : 1];
   vint covered[FINE_ROWS * NS];

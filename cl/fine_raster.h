@@ -194,12 +194,14 @@ PMR_HOT void raster_chunk(const ShadeInputs* in, const PmrMta* m, uint id, const
 }
 
 /* Rasterizes the queue entries [q0, q1) of the 3D tile at (x0, y0, v0) (nx x ny x nv voxels inside
- * the raster) into the visibility state `st`, each pixel at its NS samples (P->sample_x/y). */
+ * the raster) into the visibility state `st`, each pixel at its NS samples (P->sample_x/y); the
+ * transmission source's opaque pass leaves the transmissive MTAs out. */
 inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile_queue, uint q0, uint q1,
                               const ShadeInputs* in, global const PmrTriangle* tris,
                               global const PmrMaterial* materials, int x0, int y0, int v0, int nx, int ny, int nv,
                               int vbase, const FineState* st) {
   global const PmrParams* P = in->P;
+  const bool opaque_only = in->source_info->opaque_only != 0u;
   const long X0 = (long)x0 * PMR_X_ONE + PMR_HALF_X, Y0 = (long)y0 * PMR_Y_ONE + PMR_HALF_Y;
   const vint lane = vload_vint(0, lane_index);
   vint in_tile[FINE_CHUNKS]; /* lanes inside the raster (edge tiles are narrower) */
@@ -220,6 +222,7 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     }
     const uint id = tile_queue[q];
     const PmrMta m = mtas[id];
+    if ((m.flags & PMR_MTA_TRANSMISSIVE) && opaque_only) continue; /* the transmission source's pass */
     const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
     /* the tile rows with a sample within the MTA's y extent (the same in every view) */
     const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));

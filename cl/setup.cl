@@ -62,7 +62,7 @@ inline void emit_mta(global const PmrParams* P, global PmrMta* mtas, volatile gl
 inline void emit_triangle(global const PmrParams* P, global PmrMta* mtas, volatile global uint* counter,
                           const PmrVertex* a, const PmrVertex* b, const PmrVertex* c, const double* bary_a,
                           const double* bary_b, const double* bary_c, uint tri, uint sub, uint double_sided,
-                          uint mask) {
+                          uint mflag) {
   PmrMta m;
   const PmrVertex* v[3] = {a, b, c};
   const double* bary[3] = {bary_a, bary_b, bary_c};
@@ -82,7 +82,6 @@ inline void emit_triangle(global const PmrParams* P, global PmrMta* mtas, volati
   const long ya = m.y[0], yb = m.y[1], yc = m.y[2];
   const long a0 = (yb - ya) * ((long)m.x0[2] - m.x0[0]) - ((long)m.x0[1] - m.x0[0]) * (yc - ya);
   const long a1 = (yb - ya) * ((long)m.dx[2] - m.dx[0]) - ((long)m.dx[1] - m.dx[0]) * (yc - ya);
-  const uint mflag = mask ? PMR_MTA_MASK : 0u;
   int lo, hi;
   positive_views(P, a0, a1, &lo, &hi);
   emit_mta(P, mtas, counter, &m, lo, hi, 1, mflag);
@@ -141,7 +140,10 @@ kernel void setup_triangles(global const PmrParams* P, global const PmrTriangle*
   const uint oc_or = v[0].outcode | v[1].outcode | v[2].outcode;
   if (oc_and & CULL_BITS) return;
   const PmrMaterial mat = materials[tri.material];
-  const uint ds = mat.double_sided, mask = mat.alpha_mode == PMR_ALPHA_MASK;
+  /* the material's MTA flags: alphaMode MASK; pbr transmission (left out of the opaque pass) */
+  const uint ds = mat.double_sided;
+  const uint mask = (mat.alpha_mode == PMR_ALPHA_MASK ? PMR_MTA_MASK : 0u) |
+                    (P->shading == PMR_SHADING_PBR && mat.transmission > 0.0f ? PMR_MTA_TRANSMISSIVE : 0u);
   const double ident[3][2] = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
 
   if (!(oc_or & CLIP_BITS)) {

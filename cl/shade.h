@@ -30,11 +30,12 @@
       global const PmrMaterial *materials, global const PmrTexture *textures, global const uchar4 *texels, \
       global const float *srgb_lut, global const float *positions, global const float4 *eyes,              \
       global const float2 *split_sum, global const float2 *texcoords, global const float4 *tangents,       \
-      global const PmrEnvironment *env, global const float4 *env_data, global const PmrLight *lights
+      global const PmrEnvironment *env, global const float4 *env_data, global const PmrLight *lights,      \
+      global const half *source, global const PmrSource *source_info
 #define PMR_SHADE_INPUTS                                                                                         \
   {                                                                                                              \
     tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, \
-        env_data, lights                                                                                         \
+        env_data, lights, source, source_info                                                                    \
   }
 
 typedef struct {
@@ -45,14 +46,16 @@ typedef struct {
   global const uchar4* texels;
   global const float* srgb_lut;
   global const PmrParams* P;
-  global const float* positions;    /* world space, 3 floats per vertex: the surface point (pbr)  */
-  global const float4* eyes;        /* each view's camera position, world space (pbr)            */
-  global const float2* split_sum;   /* PMR_SPLIT_SUM_N^2 (A, B) (see PMR_SPLIT_SUM_N)             */
-  global const float2* texcoords;   /* TEXCOORD set k of vertex v at k * num_vertices + v (the maps) */
-  global const float4* tangents;    /* world tangent per vertex (w: bitangent sign), pbr normal maps */
-  global const PmrEnvironment* env; /* pbr: the environment image's tables, level_count 0 = none */
-  global const float4* env_data;    /* ... their data (cl/environment.h)                        */
-  global const PmrLight* lights;    /* P->num_lights punctual lights, world space (pbr)           */
+  global const float* positions;       /* world space, 3 floats per vertex: the surface point (pbr)  */
+  global const float4* eyes;           /* each view's camera position, world space (pbr)            */
+  global const float2* split_sum;      /* PMR_SPLIT_SUM_N^2 (A, B) (see PMR_SPLIT_SUM_N)             */
+  global const float2* texcoords;      /* TEXCOORD set k of vertex v at k * num_vertices + v (the maps) */
+  global const float4* tangents;       /* world tangent per vertex (w: bitangent sign), pbr normal maps */
+  global const PmrEnvironment* env;    /* pbr: the environment image's tables, level_count 0 = none */
+  global const float4* env_data;       /* ... their data (cl/environment.h)                        */
+  global const PmrLight* lights;       /* P->num_lights punctual lights, world space (pbr)           */
+  global const half* source;           /* pbr: the transmission source (cl/transmission.h)           */
+  global const PmrSource* source_info; /* ... its levels, and whether this is the opaque pass       */
 } ShadeInputs;
 
 #define LANE3(a) s3(vload_s(0, (a)[0]), vload_s(0, (a)[1]), vload_s(0, (a)[2]))
@@ -76,6 +79,10 @@ typedef struct {
   sfloat metallic, roughness;
   sfloat f0d; /* pbr: the dielectric F0 (PmrMaterial.f0_dielectric)                  */
   sfloat3 emissive;
+  /* pbr, transmissive materials (lanes `glass`; the others keep lanes_clear's opaque values) */
+  sint glass;
+  sfloat transmission, ior, thickness, att_dist; /* thickness in world units (x the node's scale) */
+  sfloat3 att_color;
   uint textured; /* bit l: lane l's material has a map the model reads (lambert: base colour) */
   uint tri[SW];  /* lane l's triangle, where textured                               */
 #if PMR_TRILINEAR
@@ -97,6 +104,9 @@ inline void lanes_clear(LaneWinners* L) {
   L->factor = s3(zero, zero, zero);
   L->metallic = L->roughness = L->f0d = zero;
   L->emissive = s3(zero, zero, zero);
+  L->glass = (sint)(0);
+  L->transmission = L->thickness = zero, L->ior = 1.5f, L->att_dist = INFINITY;
+  L->att_color = s3(one, one, one);
   L->textured = 0u;
 #if PMR_TRILINEAR
   for (int k = 0; k < 3; ++k) vstore_s(zero, 0, L->ex[k]), vstore_s(zero, 0, L->ey[k]);
@@ -105,6 +115,17 @@ inline void lanes_clear(LaneWinners* L) {
 
 inline sfloat blend(sfloat a, float b, sint take) { return select(a, (sfloat)(b), take); }
 inline sfloat3 blend3(sfloat3 a, float3 b, sint take) { return s3_select(a, s3_splat(b), take); }
+
+/* The transmission inputs of material `mat` (triangle t) into lanes `take`. */
+inline void lanes_add_transmission(LaneWinners* L, const ShadeInputs* in, global const PmrMaterial* mat,
+                                   const PmrTriangle* t, sint take) {
+  L->glass |= take;
+  L->transmission = blend(L->transmission, mat->transmission, take);
+  L->ior = blend(L->ior, mat->ior, take);
+  L->thickness = blend(L->thickness, mat->thickness * in->attrs[t->v[0]].scale, take);
+  L->att_dist = blend(L->att_dist, mat->attenuation_distance, take);
+  L->att_color = blend3(L->att_color, vload3(0, mat->attenuation_color), take);
+}
 
 /* Lanes `take` (bits: the same as bits) are won by MTA m: its values blended into them (the edge
  * functions are set apart: lanes_gather in fine_core.h). */
@@ -135,6 +156,7 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
     L->f0d = blend(L->f0d, mat->f0_dielectric, take);
     L->emissive = blend3(L->emissive, vload3(0, mat->emissive), take);
     if (mat->unlit) L->unlit |= take;
+    if (mat->transmission > 0.0f) lanes_add_transmission(L, in, mat, &t, take);
     for (int k = 0; k < PMR_MAPS; ++k) textured = textured || mat->maps[k].texture >= 0;
   }
   if (textured) {
@@ -236,7 +258,8 @@ typedef struct {
   float base[3][SW], metallic[SW], roughness[SW], ao[SW], emissive[3][SW];
   int mapped[SW];
   float s[3][SW], tw[4][SW], normal_scale[SW];
-  float toksvig[SW]; /* trilinear: the normal map's increment of alpha^2 (Toksvig), else 0 */
+  float toksvig[SW];                     /* trilinear: the normal map's increment of alpha^2 (Toksvig), else 0 */
+  float transmission[SW], thickness[SW]; /* KHR_materials_transmission R, KHR_materials_volume G */
 } LaneTextures;
 
 /* The screen-space derivatives of SW lanes' source barycentrics, per output pixel in x and in y. */
@@ -340,6 +363,14 @@ inline void sample_material_lanes(const ShadeInputs* in, global const PmrMateria
     sample_map_lanes(in, &mat->maps[PMR_MAP_EMISSIVE], L->tri, bits, take, b, g, true, C, c);
     for (int k = 0; k < 3; ++k) lanes_put(T->emissive[k], c[k], take);
   }
+  if (mat->maps[PMR_MAP_TRANSMISSION].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_TRANSMISSION], L->tri, bits, take, b, g, false, C, c);
+    lanes_put(T->transmission, c[0], take);
+  }
+  if (mat->maps[PMR_MAP_THICKNESS].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_THICKNESS], L->tri, bits, take, b, g, false, C, c);
+    lanes_put(T->thickness, c[1], take);
+  }
   if (mat->maps[PMR_MAP_NORMAL].texture >= 0) {
     sample_map_lanes(in, &mat->maps[PMR_MAP_NORMAL], L->tri, bits, take, b, g, false, C, c);
     for (int k = 0; k < 3; ++k) lanes_put(T->s[k], c[k], take);
@@ -368,6 +399,7 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
     for (int k = 0; k < 3; ++k) T->base[k][l] = T->emissive[k][l] = 1.0f, T->s[k][l] = 0.0f;
     for (int k = 0; k < 4; ++k) T->tw[k][l] = 0.0f;
     T->metallic[l] = T->roughness[l] = T->ao[l] = T->normal_scale[l] = 1.0f;
+    T->transmission[l] = T->thickness[l] = 1.0f;
     T->mapped[l] = 0;
     T->toksvig[l] = 0.0f;
   }
@@ -411,6 +443,17 @@ inline sfloat3 mapped_normal(const LaneTextures* T, sfloat3 n) {
   return s3_select(n, s3_scale(mapped, 1.0f / mlen), vload_s(0, T->mapped) & (len > 1e-12f) & (mlen > 0.0f));
 }
 
+/* The environment's P(d, r) per lane where `act` (0 elsewhere), or the uniform default's radiance. */
+inline sfloat3 environment_along(const ShadeInputs* in, sfloat3 d, sfloat r, sint act) {
+  if (in->env->level_count == 0) return s3_splat((float3)(in->P->env_radiance));
+  /* idle lanes look up +Y at roughness 1: their values are ignored, but their texel indices are read */
+  const sfloat3 up = s3((sfloat)(0.0f), (sfloat)(1.0f), (sfloat)(0.0f));
+  sfloat u, v;
+  env_uv(in->env, s3_select(up, d, act), &u, &v);
+  return s3_select(s3_splat((float3)(0.0f)),
+                   env_prefiltered(in->env, in->env_data, u, v, select((sfloat)(1.0f), r, act)), act);
+}
+
 /* The environment's I(n) and P(reflect(-v, n), r) per lane where `act` (cl/environment.h), or the
  * uniform default of radiance L, for which I(n) = P = L and no table is read. I is not needed (0) where
  * metallic is 1 (c_diff = 0). */
@@ -420,17 +463,14 @@ inline void environment_lanes(const ShadeInputs* in, sfloat3 n, sfloat3 v, sfloa
     *irradiance = *prefiltered = s3_splat((float3)(in->P->env_radiance));
     return;
   }
-  /* idle lanes look up +Y at roughness 1: their values are ignored, but their texel indices are read */
   const sfloat3 up = s3((sfloat)(0.0f), (sfloat)(1.0f), (sfloat)(0.0f));
-  const sfloat3 d = s3_select(up, s3_sub(s3_scale(n, 2.0f * nv), v), act); /* reflect(-v, n) */
-  sfloat un, vn, ud, vd;
+  sfloat un, vn;
   env_uv(in->env, s3_select(up, n, act), &un, &vn);
-  env_uv(in->env, d, &ud, &vd);
   /* a metal has no diffuse term: its lanes skip the irradiance (0) */
   const sint diffuse = act & (metallic < 1.0f);
   const sfloat3 zero = s3_splat((float3)(0.0f));
   *irradiance = any(diffuse) ? s3_select(zero, env_irradiance(in->env, in->env_data, un, vn), diffuse) : zero;
-  *prefiltered = s3_select(zero, env_prefiltered(in->env, in->env_data, ud, vd, select((sfloat)(1.0f), r, act)), act);
+  *prefiltered = environment_along(in, s3_sub(s3_scale(n, 2.0f * nv), v), r, act); /* reflect(-v, n) */
 }
 
 /* The split-sum table's bilinear lookup for every lane, as pmr::split_sum (host/shading/environment.cpp)
@@ -482,6 +522,8 @@ inline sfloat geometric_spread(const LaneWinners* L, const LaneBaryGrad* g, sflo
 }
 #endif
 
+#include "transmission.h" /* reads the inputs and lanes above */
+
 /* glTF metallic-roughness of the lanes with unit normals n (already flipped for back faces, normal map
  * applied) and base colours `base`, seen from view `view`'s camera: the sum over the light table of
  * f E n.l (the file's punctual lights, or the default light, or none), the environment times the
@@ -490,11 +532,13 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
                          sfloat3 n, sfloat3 base, sfloat spread, int view) {
   global const PmrParams* P = in->P;
   const sfloat3 p = s3_interp_lanes(b, L->p);
-  sfloat metallic = L->metallic, roughness = L->roughness, ao = 1.0f;
+  sfloat metallic = L->metallic, roughness = L->roughness, ao = 1.0f, transmission = L->transmission;
+  sfloat thickness = L->thickness;
   sfloat3 emissive = L->emissive;
   if (textured) {
     metallic *= vload_s(0, T->metallic), roughness *= vload_s(0, T->roughness), ao = vload_s(0, T->ao);
     emissive = s3_mul(emissive, LANE3(T->emissive));
+    transmission *= vload_s(0, T->transmission), thickness *= vload_s(0, T->thickness);
   }
   const sfloat3 to_eye = s3_sub(s3_splat(in->eyes[view + (int)P->view_base].xyz), p);
   const sfloat3 v = s3_scale(to_eye, 1.0f / sqrt(s3_dot(to_eye, to_eye)));
@@ -507,7 +551,7 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
     const sfloat3 E =
         light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
                          vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, p, &l);
-    direct = s3_add(direct, s3_mul(brdf_cos(base, metallic, L->f0d, r, n, v, l), E));
+    direct = s3_add(direct, s3_mul(brdf_cos_transmissive(base, metallic, L->f0d, r, n, v, l, transmission), E));
   }
   const sfloat nv = s3_dot(n, v);
   sfloat A, B;
@@ -515,10 +559,17 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
   sfloat3 irradiance, prefiltered;
   environment_lanes(in, n, v, nv, metallic, r, L->act, &irradiance, &prefiltered);
   const sfloat3 f0 = pbr_f0(base, metallic, L->f0d);
-  const sfloat kd = 1.0f - metallic;
-  const sfloat3 ambient = s3(ao * (base.x * kd * irradiance.x + (f0.x * A + B) * prefiltered.x),
-                             ao * (base.y * kd * irradiance.y + (f0.y * A + B) * prefiltered.y),
-                             ao * (base.z * kd * irradiance.z + (f0.z * A + B) * prefiltered.z));
+  const sfloat kd = (1.0f - metallic) * (1.0f - transmission); /* transmission replaces diffuse */
+  sfloat3 ambient = s3(ao * (base.x * kd * irradiance.x + (f0.x * A + B) * prefiltered.x),
+                       ao * (base.y * kd * irradiance.y + (f0.y * A + B) * prefiltered.y),
+                       ao * (base.z * kd * irradiance.z + (f0.z * A + B) * prefiltered.z));
+  if (any(L->glass)) { /* KHR_materials_transmission's BTDF: (1 - (F0 A + B)) c_diff x the light through */
+    const sfloat3 through = transmitted_lanes(in, L, p, n, v, r, thickness, view);
+    const sfloat w = select((sfloat)(0.0f), ao * transmission * (1.0f - metallic), L->glass);
+    ambient = s3_add(
+        ambient, s3(w * (1.0f - (f0.x * A + B)) * base.x * through.x, w * (1.0f - (f0.y * A + B)) * base.y * through.y,
+                    w * (1.0f - (f0.z * A + B)) * base.z * through.z));
+  }
   const sfloat3 lit = s3_add(s3_add(direct, ambient), emissive);
   return s3_select(lit, base, L->unlit);
 }

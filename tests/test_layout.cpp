@@ -62,6 +62,10 @@ TEST(Layout, DeviceStructsMatchHost) {
   // the texture filter's fields (probes 46, 47)
   EXPECT_EQ(got[46], offsetof(PmrParams, lod_scale_x));
   EXPECT_EQ(got[47], offsetof(PmrTexture, levels));
+  // the transmission fields of --shading pbr (probes 48..50)
+  EXPECT_EQ(got[48], offsetof(PmrMaterial, attenuation_color));
+  EXPECT_EQ(got[49], sizeof(PmrSource));
+  EXPECT_EQ(got[50], offsetof(PmrSource, opaque_only));
 }
 
 }  // namespace

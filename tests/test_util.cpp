@@ -40,6 +40,7 @@ void add_triangle(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, uint32_t mate
     PmrVertexAttr at{};
     at.normal[0] = n.x, at.normal[1] = n.y, at.normal[2] = n.z;
     for (int k = 0; k < 4; ++k) at.color[k] = 1.0f;
+    at.scale = 1.0f;
     s.attributes.push_back(at);
   }
   PmrTriangle t{};

@@ -43,15 +43,12 @@ std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
   return t + ")";
 }
 
-// KHR_materials_transmission and _volume where the material has them (not drawn yet: the "not drawn"
-// line names them), and KHR_materials_ior's ior where it is not the default 1.5.
+// KHR_materials_transmission and _volume where the material has them, and KHR_materials_ior's ior
+// where it is not the default 1.5.
 std::string layer_text(const SceneMaterialInputs& in) {
   std::string t;
-  auto has = [&](const char* ext) {
-    return std::find(in.unimplemented.begin(), in.unimplemented.end(), ext) != in.unimplemented.end();
-  };
-  if (has("KHR_materials_transmission")) t += ", transmission " + number(in.transmission);
-  if (has("KHR_materials_volume")) {
+  if (in.has_transmission) t += ", transmission " + number(in.transmission);
+  if (in.has_volume) {
     t += ", thickness " + number(in.thickness) + ", attenuation (" + number(in.attenuation_color[0]) + ", " +
          number(in.attenuation_color[1]) + ", " + number(in.attenuation_color[2]) + ") over " +
          number(in.attenuation_distance);

@@ -98,16 +98,16 @@ void FineStage::configure_subpixel(int views, EncodeStage& encode) {
 }
 
 void FineStage::run_volume(const SceneBuffers& scene, const GeometryStage& geometry, uint64_t num_tiles,
-                           FrameEvents& ev) {
-  const cl_uint next = scene.bind_shading(fine_, geometry.params());
-  fine_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(), volume_, dbg_key_, dbg_depth_,
-                  dbg_count_);
+                           const SourceBinding& source, FrameEvents& ev, const ClBuffer* out) {
+  const cl_uint next = scene.bind_shading(fine_, geometry.params(), source);
+  fine_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(), out ? *out : volume_, dbg_key_,
+                  dbg_depth_, dbg_count_);
   ev.add(kFine, launcher_.launch(fine_, size_t(num_tiles), kFineGroup));
 }
 
 void FineStage::run_fused(const SceneBuffers& scene, const GeometryStage& geometry, size_t screen_tiles,
-                          EncodeStage& encode, FrameEvents& ev) {
-  const cl_uint next = scene.bind_shading(fine_encode_, geometry.params());
+                          EncodeStage& encode, const SourceBinding& source, FrameEvents& ev) {
+  const cl_uint next = scene.bind_shading(fine_encode_, geometry.params(), source);
   fine_encode_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(), encode.params_buffer(),
                          column_soa_, encode.rows_buffer(), column_start_, row_start_, encode.display(),
                          encode.sub_alpha());
@@ -116,8 +116,8 @@ void FineStage::run_fused(const SceneBuffers& scene, const GeometryStage& geomet
 }
 
 void FineStage::run_subpixel(const SceneBuffers& scene, const GeometryStage& geometry, EncodeStage& encode,
-                             FrameEvents& ev) {
-  const cl_uint next = scene.bind_shading(fine_subpixel_, geometry.params());
+                             const SourceBinding& source, FrameEvents& ev) {
+  const cl_uint next = scene.bind_shading(fine_subpixel_, geometry.params(), source);
   const bool debug = paths_.debug && !paths_.volume;  // per display subpixel
   fine_subpixel_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(),
                            encode.params_buffer(), column_a_, column_b_, encode.rows_buffer(), sample_x_, sample_y_,

@@ -136,10 +136,7 @@ MaterialTables make_material_tables(const Scene& scene, bool mips) {
     m.normal_scale = 1.0f, m.occlusion_strength = 1.0f;
     if (i >= scene.material_inputs.size()) continue;  // generated scenes: no maps
     const SceneMaterialInputs& in = scene.material_inputs[i];
-    // the factors as the loader checked them (a scene's PmrMaterial copies may be stale)
-    m.metallic = in.metallic, m.roughness = in.roughness, m.unlit = in.unlit ? 1u : 0u;
-    for (int c = 0; c < 3; ++c) m.emissive[c] = in.emissive[c] * in.emissive_strength;
-    m.normal_scale = in.normal_scale, m.occlusion_strength = in.occlusion_strength;
+    apply_material_inputs(in, m);  // the factors as the loader checked them (a scene's copies may be stale)
     for (int k = 0; k < PMR_MAPS; ++k) {
       const SceneTextureSlot& slot = in.slots[size_t(k)];  // PMR_MAP_* is the slot's kind
       if (slot.texture < 0) continue;

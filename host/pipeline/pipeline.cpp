@@ -65,12 +65,14 @@ struct Pipeline::Impl {
       : tile{tile_in[0], tile_in[1], tile_in[2]},
         launcher(rt),
         options(build_options(tile, config)),
-        program(
-            launcher.build({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl", "straddle_alpha.cl"}, options)),
+        program(launcher.build(
+            {"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl", "straddle_alpha.cl", "source_mips.cl"},
+            options)),
         scene(rt, config),
         geometry(launcher, program, config.tile_queue_limit),
         encode(launcher, program),
-        fine(launcher, program, options, tile) {}
+        fine(launcher, program, options, tile),
+        transmission(launcher, program) {}
 
   int tile[3];
   Launcher launcher;
@@ -80,6 +82,7 @@ struct Pipeline::Impl {
   GeometryStage geometry;
   EncodeStage encode;
   FineStage fine;
+  TransmissionStage transmission;
   FinePaths paths;
   int views = 0, view_w = 0, view_h = 0;  // as configured
   // PmrParams.lod_scale_x/y: view pixels per output pixel (subpixel sampling: a display pixel's)
@@ -87,6 +90,8 @@ struct Pipeline::Impl {
   uint64_t num_tiles = 0;
 
   void render_multipass(const Rig& rig, const PmrParams& P, bool snapped, FrameEvents& ev, StageTimes& t);
+  void render_fine(FrameEvents& ev, int screen_tiles);
+  void configure_transmission() { transmission.configure(scene.transmissive(), views, view_w, view_h); }
 };
 
 Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config) : config_(config) {
@@ -99,6 +104,7 @@ Pipeline::~Pipeline() = default;
 
 void Pipeline::set_scene(const Scene& scene) {
   impl_->scene.set_scene(scene);
+  if (impl_->views > 0) impl_->configure_transmission();
   impl_->geometry.set_scene(impl_->scene, config_.method == Method::Multipass && config_.multipass_snapped);
 }
 
@@ -155,6 +161,7 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   if (display) m.encode.configure(*display, rig.views, rig.view_w, rig.view_h);
   m.fine.configure(m.paths, rig.views, rig.view_w, rig.view_h, display ? &m.encode : nullptr);
   m.geometry.configure(m.num_tiles);
+  m.configure_transmission();
   m.launcher.runtime().finish();
   m.launcher.warm_up([&] { render_frame(describe_frame(rig, {}, config_), true); });
 }
@@ -214,9 +221,7 @@ StageTimes Pipeline::render_frame(const FrameDescription& frame, bool empty) {
   } else {
     m.geometry.transform(P, m.scene, ev);
     m.geometry.setup_and_bin(P, m.scene, ev, times);
-    if (m.paths.fused) m.fine.run_fused(m.scene, m.geometry, size_t(tiles_x_) * tiles_y_, m.encode, ev);
-    if (m.paths.volume) m.fine.run_volume(m.scene, m.geometry, m.num_tiles, ev);
-    if (m.paths.subpixel) m.fine.run_subpixel(m.scene, m.geometry, m.encode, ev);
+    m.render_fine(ev, tiles_x_ * tiles_y_);
   }
   if (m.encode.configured() && m.paths.volume && !m.paths.subpixel) m.encode.encode(m.fine.volume(), ev);
   if (config_.slow_frame && !empty) wait_reporting(ev, times, t_start);
@@ -224,6 +229,20 @@ StageTimes Pipeline::render_frame(const FrameDescription& frame, bool empty) {
   ev.collect(times);
   times.wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
   return times;
+}
+
+// Stage 4 of a frame whose geometry is binned: with transmissive surfaces, first the transmission
+// source (the opaque pass into its level 0 and the mip chain: DESIGN section 4c step 2), then the
+// configuration's paths, which read it.
+void Pipeline::Impl::render_fine(FrameEvents& ev, int screen_tiles) {
+  if (transmission.active()) {
+    fine.run_volume(scene, geometry, num_tiles, transmission.opaque_pass(), ev, &transmission.source());
+    transmission.mip(0, views, ev);
+  }
+  const SourceBinding source = transmission.full_pass();
+  if (paths.fused) fine.run_fused(scene, geometry, size_t(screen_tiles), encode, source, ev);
+  if (paths.volume) fine.run_volume(scene, geometry, num_tiles, source, ev);
+  if (paths.subpixel) fine.run_subpixel(scene, geometry, encode, source, ev);
 }
 
 // The multipass baseline: one conventional pass per view with view i's own view matrix and off-axis
@@ -248,7 +267,11 @@ void Pipeline::Impl::render_multipass(const Rig& rig, const PmrParams& P, bool s
     if (snapped) geometry.select_view(Q, rig.view_coord(i), ev);
     else geometry.transform(Q, scene, ev);
     geometry.setup_and_bin(Q, scene, ev, t);
-    fine.run_volume(scene, geometry, num_tiles, ev);
+    if (transmission.active()) {  // as a conventional renderer: the view's opaque pass, then its own
+      fine.run_volume(scene, geometry, num_tiles, transmission.opaque_pass(), ev, &transmission.source());
+      transmission.mip(i, 1, ev);
+    }
+    fine.run_volume(scene, geometry, num_tiles, transmission.full_pass(), ev);
   }
   if (snapped) geometry.swap_snapped();
 }
@@ -316,7 +339,8 @@ void Pipeline::read_depth(std::vector<float>& depth) const {
 
 size_t Pipeline::device_bytes() const {
   const Impl& m = *impl_;
-  return m.scene.device_bytes() + m.geometry.device_bytes() + m.encode.device_bytes() + m.fine.device_bytes();
+  return m.scene.device_bytes() + m.geometry.device_bytes() + m.encode.device_bytes() + m.fine.device_bytes() +
+         m.transmission.device_bytes();
 }
 
 std::vector<PmrMta> Pipeline::read_mtas() const { return impl_->geometry.read_mtas(); }

@@ -65,7 +65,7 @@ struct PipelineConfig {
   // AnisotropyStrengthTest, TransmissionTest, --synthetic 100000; docs/PERFORMANCE.md).
   int tile_x = 16, tile_y = 2, tile_v = 16;
   bool debug_outputs = false;  // fine raster also writes per-voxel key, depth, count
-  int samples = 1;  // samples per pixel (DESIGN section 3b): 1, 4, 8 or 16 (the command line defaults to 4)
+  int samples = 1;             // samples per pixel (DESIGN section 3b): 1, 4, 8 or 16 (the command line defaults to 4)
   // The encoded-only job: fine raster writes the display image directly (cl/fine_encode.cl) and the
   // view volume is never allocated. Applies to PMR with a display, nearest sampling and no debug
   // outputs, when one screen tile's state for all views fits a work-item's private memory;

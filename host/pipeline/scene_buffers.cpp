@@ -23,7 +23,7 @@ std::vector<float> srgb_lut() {
 }  // namespace
 
 SceneBuffers::SceneBuffers(const ClRuntime& rt, const PipelineConfig& config)
-    : rt_(rt), mips_(config.texture_filter == TextureFilter::Trilinear) {
+    : rt_(rt), mips_(config.texture_filter == TextureFilter::Trilinear), pbr_(config.shading == Shading::Pbr) {
   lut_ = rt.upload(srgb_lut(), "sRGB table");
   // the split-sum table (pbr only: computing it costs about 0.5 s of CPU once per process)
   static_assert(kEnvSplitSumSize == PMR_SPLIT_SUM_N, "the kernels' split-sum table size");
@@ -59,6 +59,9 @@ void SceneBuffers::set_scene(const Scene& scene) {
   num_triangles_ = uint32_t(scene.triangles.size());
   const MaterialTables tables = make_material_tables(scene, mips_);
   has_tangents_ = scene.tangents.size() == scene.positions.size() && !scene.positions.empty();
+  transmissive_ = pbr_ && std::any_of(scene.triangles.begin(), scene.triangles.end(), [&](const PmrTriangle& t) {
+                    return t.material < tables.materials.size() && tables.materials[t.material].transmission > 0.0f;
+                  });
   const std::vector<glm::vec4> no_tangents(1, glm::vec4(0.0f));
   scene_lights_ = scene.lights;
   positions_ = rt_.upload(scene.positions, "vertex positions");
@@ -93,10 +96,10 @@ void SceneBuffers::upload_frame(const FrameDescription& frame) {
   rt_.rewrite(eyes_, eyes, "camera positions");
 }
 
-cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params) const {
-  const ClBuffer* inputs[] = {&params,     &tris_,     &attrs_,     &materials_, &textures_,
-                              &texels_,    &lut_,      &positions_, &eyes_,      &split_sum_,
-                              &texcoords_, &tangents_, &env_,       &env_data_,  &lights_};
+cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params, const SourceBinding& source) const {
+  const ClBuffer* inputs[] = {&params, &tris_,      &attrs_,  &materials_, &textures_,  &texels_,
+                              &lut_,   &positions_, &eyes_,   &split_sum_, &texcoords_, &tangents_,
+                              &env_,   &env_data_,  &lights_, source.data, source.info};
   cl_uint i = 0;
   for (const ClBuffer* b : inputs) k.arg(i++, *b);
   return i;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "pipeline/frame_description.h"
+#include "pipeline/transmission_stage.h"
 #include "pmr/scene.h"
 #include "runtime/cl_runtime.h"
 
@@ -23,11 +24,13 @@ class SceneBuffers {
   void update_geometry(const Scene& posed);
   // The frame's light table and each view's camera position in world space (the view vector of pbr).
   void upload_frame(const FrameDescription& frame);
-  // Binds the frame parameters `params` and the shading inputs as arguments 0 .. of `k` (the order of
-  // PMR_SHADE_PARAMS); returns the index of the kernel's next argument.
-  cl_uint bind_shading(ClKernel& k, const ClBuffer& params) const;
+  // Binds the frame parameters `params`, the shading inputs and the pass's transmission source as
+  // arguments 0 .. of `k` (the order of PMR_SHADE_PARAMS); returns the index of the kernel's next argument.
+  cl_uint bind_shading(ClKernel& k, const ClBuffer& params, const SourceBinding& source) const;
 
   uint32_t num_vertices() const { return num_vertices_; }
+  // pbr and a triangle with a transmissive material: frames need the transmission source
+  bool transmissive() const { return transmissive_; }
   uint32_t num_triangles() const { return num_triangles_; }
   const ClBuffer& positions() const { return positions_; }
   const ClBuffer& triangles() const { return tris_; }
@@ -40,6 +43,8 @@ class SceneBuffers {
 
   const ClRuntime& rt_;
   bool mips_;  // --texture-filter trilinear: the textures' mip chains are built and uploaded
+  bool pbr_;
+  bool transmissive_ = false;
   uint32_t num_vertices_ = 0, num_triangles_ = 0;
   bool has_tangents_ = false;
   std::vector<SceneLight> scene_lights_;

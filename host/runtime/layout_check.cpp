@@ -18,9 +18,13 @@ static_assert(sizeof(PmrVertex) == 64 && offsetof(PmrVertex, x0) == 32 && offset
 static_assert(sizeof(PmrMta) == 27 * 4, "PmrMta layout");
 static_assert(offsetof(PmrMta, bary) == 60 && offsetof(PmrMta, tri) == 84 && offsetof(PmrMta, flags) == 104,
               "PmrMta layout");
-static_assert(sizeof(PmrVertexAttr) == 28 && offsetof(PmrVertexAttr, color) == 12, "PmrVertexAttr layout");
+static_assert(sizeof(PmrVertexAttr) == 32 && offsetof(PmrVertexAttr, color) == 12, "PmrVertexAttr layout");
 static_assert(sizeof(PmrTriangle) == 32, "PmrTriangle layout");
-static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 12 && offsetof(PmrMaterial, maps) == 52, "PmrMaterial layout");
+static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 40 && offsetof(PmrMaterial, maps) == 52 &&
+                  offsetof(PmrMaterial, attenuation_color) == 52 + PMR_MAPS * 32 + 28,
+              "PmrMaterial layout");
+static_assert(sizeof(PmrSource) == 8 * PMR_SOURCE_MAX_LEVELS + 16 && offsetof(PmrSource, opaque_only) == 132,
+              "PmrSource layout");
 static_assert(sizeof(PmrTextureMap) == 32, "PmrTextureMap layout");
 static_assert(sizeof(PmrTexture) == 32 && offsetof(PmrTexture, levels) == 20, "PmrTexture layout");
 static_assert(sizeof(PmrEncodeParams) == 48 && offsetof(PmrEncodeParams, display_w) == 0, "PmrEncodeParams layout");

@@ -213,14 +213,15 @@ float extension_number(Loader& L, const tinygltf::Value& value, const std::strin
   return float(fallback);
 }
 
-// The factors of KHR_materials_transmission and KHR_materials_volume (DESIGN 4c),
-// read and checked for `pmr info` and the sidecar; the surfaces are still drawn by 4b alone.
-void read_layer_factors(Loader& L, const std::string& ext, const tinygltf::Value& value, const std::string& name,
-                        SceneMaterialInputs& m) {
+// The factors of KHR_materials_transmission and KHR_materials_volume (DESIGN 4c), checked.
+void read_volume_factors(Loader& L, const std::string& ext, const tinygltf::Value& value, const std::string& name,
+                         SceneMaterialInputs& m) {
   const double inf = std::numeric_limits<double>::infinity();
   if (ext == "KHR_materials_transmission") {
+    m.has_transmission = true;
     m.transmission = extension_number(L, value, ext, "transmissionFactor", 0.0, 0.0, 1.0, name);
   } else if (ext == "KHR_materials_volume") {
+    m.has_volume = true;
     m.thickness = extension_number(L, value, ext, "thicknessFactor", 0.0, 0.0, inf, name);
     m.attenuation_distance = extension_number(L, value, ext, "attenuationDistance", inf, 0.0, inf, name);
     if (!(m.attenuation_distance > 0.0f)) {
@@ -248,6 +249,39 @@ float read_ior(Loader& L, const tinygltf::Value& value, const std::string& name)
   return ior;
 }
 
+// A textureInfo inside a material extension (e.g. KHR_materials_transmission's transmissionTexture),
+// which tinygltf leaves as JSON values: its texture index (-1: none, or not a texture of the file, with
+// a warning), texCoord and extensions (KHR_texture_transform).
+struct NestedTextureInfo {
+  int index = -1, texcoord = 0;
+  tinygltf::ExtensionMap extensions;
+};
+
+NestedTextureInfo nested_texture_info(Loader& L, const tinygltf::Material& g, const char* ext, const char* key,
+                                      int material) {
+  NestedTextureInfo info;
+  auto e = g.extensions.find(ext);
+  if (e == g.extensions.end() || !e->second.IsObject() || !e->second.Has(key)) return info;
+  const tinygltf::Value& v = e->second.Get(key);
+  const std::string name = "material " + std::to_string(material) + " " + key;
+  const tinygltf::Value* index = v.IsObject() && v.Has("index") ? &v.Get("index") : nullptr;
+  const double t = index && index->IsNumber() ? index->GetNumberAsDouble() : -1.0;
+  if (!(t >= 0.0 && t < double(L.model.textures.size()) && t == std::floor(t))) {
+    L.warn(name + " names no texture of the file; ignored");
+    return info;
+  }
+  info.index = int(t);
+  if (v.Has("texCoord")) {
+    const tinygltf::Value& c = v.Get("texCoord");
+    const double set = c.IsNumber() ? c.GetNumberAsDouble() : -1.0;
+    info.texcoord = set >= 0.0 && set < 65536.0 && set == std::floor(set) ? int(set) : 0;
+    if (info.texcoord != set) L.warn(name + " has an invalid texCoord; using 0");
+  }
+  if (v.Has("extensions") && v.Get("extensions").IsObject())
+    for (const std::string& k : v.Get("extensions").Keys()) info.extensions[k] = v.Get("extensions").Get(k);
+  return info;
+}
+
 // The PBR inputs of glTF material i (DESIGN 4b). Records each slot's TEXCOORD set in L.slot_sets.
 SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int i) {
   const std::string name = "material " + std::to_string(i);
@@ -269,8 +303,9 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
       m.unlit = true;
     } else if (ext == "KHR_materials_ior") {
       m.ior = read_ior(L, value, name);
+    } else if (ext == "KHR_materials_transmission" || ext == "KHR_materials_volume") {
+      read_volume_factors(L, ext, value, name, m);
     } else if (material_extension_fallback(ext)) {
-      read_layer_factors(L, ext, value, name, m);
       m.unimplemented.push_back(ext);
     }
   }
@@ -279,13 +314,18 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
     const tinygltf::ExtensionMap* extensions;
   };
   const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
+  const NestedTextureInfo transmission =
+                              nested_texture_info(L, g, "KHR_materials_transmission", "transmissionTexture", i),
+                          thickness = nested_texture_info(L, g, "KHR_materials_volume", "thicknessTexture", i);
   const Info infos[kTextureSlots] = {
       {pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, &pbr.baseColorTexture.extensions},
       {pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
        &pbr.metallicRoughnessTexture.extensions},
       {g.normalTexture.index, g.normalTexture.texCoord, &g.normalTexture.extensions},
       {g.occlusionTexture.index, g.occlusionTexture.texCoord, &g.occlusionTexture.extensions},
-      {g.emissiveTexture.index, g.emissiveTexture.texCoord, &g.emissiveTexture.extensions}};
+      {g.emissiveTexture.index, g.emissiveTexture.texCoord, &g.emissiveTexture.extensions},
+      {transmission.index, transmission.texcoord, &transmission.extensions},
+      {thickness.index, thickness.texcoord, &thickness.extensions}};
   std::array<int, kTextureSlots> sets;
   for (int slot = 0; slot < kTextureSlots; ++slot) {
     SceneTextureSlot& out = m.slots[size_t(slot)];
@@ -338,10 +378,7 @@ void build_materials(Loader& L) {
     L.scene.material_inputs.push_back(material_inputs(L, g, int(i)));
     // the factors the kernels read, as material_inputs checked them
     const SceneMaterialInputs& in = L.scene.material_inputs.back();
-    PmrMaterial& dm = L.scene.materials.back();
-    dm.metallic = in.metallic, dm.roughness = in.roughness, dm.unlit = in.unlit ? 1u : 0u;
-    dm.f0_dielectric = dielectric_f0(in.ior);
-    for (int c = 0; c < 3; ++c) dm.emissive[c] = in.emissive[c] * in.emissive_strength;
+    apply_material_inputs(in, L.scene.materials.back());
   }
 }
 

@@ -49,10 +49,11 @@ constexpr uint64_t kJsonBytesPerValue = 200;
 
 // Extensions we implement. KHR_mesh_quantization only widens the component types the generic accessor
 // reader already accepts; KHR_texture_transform is applied per texture slot; the material and light
-// extensions are read into the scene (DESIGN 4b).
+// extensions are read into the scene (DESIGN 4b, 4c).
 bool extension_supported(const std::string& name) {
   return name == "KHR_mesh_quantization" || name == "KHR_texture_transform" || name == "KHR_lights_punctual" ||
-         name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit" || name == "KHR_materials_ior";
+         name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit" || name == "KHR_materials_ior" ||
+         name == "KHR_materials_transmission" || name == "KHR_materials_volume";
 }
 
 uint32_t read_u32le(const unsigned char* p) {
@@ -350,8 +351,8 @@ void read_sampled_images(const std::string& path, const json& doc, SourceFile& s
 }
 
 // Only images some implemented material slot samples are decoded (and read): base colour,
-// metallic-roughness, normal, occlusion, emissive. Images of unimplemented extensions (clear coat,
-// transmission, ...) never are.
+// metallic-roughness, normal, occlusion, emissive, transmission, thickness. Images of unimplemented
+// extensions (clear coat, sheen, ...) never are.
 std::set<int> sampled_images(const json& doc) {
   std::set<int> images;
   const json* materials = member(doc, "materials");
@@ -359,9 +360,16 @@ std::set<int> sampled_images(const json& doc) {
   if (!materials || !materials->is_array() || !textures || !textures->is_array()) return images;
   for (const json& m : *materials) {
     const json* pbr = member(m, "pbrMetallicRoughness");
+    const json* ext = member(m, "extensions");
+    const json* transmission = ext ? member(*ext, "KHR_materials_transmission") : nullptr;
+    const json* volume = ext ? member(*ext, "KHR_materials_volume") : nullptr;
     const json* infos[] = {pbr ? member(*pbr, "baseColorTexture") : nullptr,
-                           pbr ? member(*pbr, "metallicRoughnessTexture") : nullptr, member(m, "normalTexture"),
-                           member(m, "occlusionTexture"), member(m, "emissiveTexture")};
+                           pbr ? member(*pbr, "metallicRoughnessTexture") : nullptr,
+                           member(m, "normalTexture"),
+                           member(m, "occlusionTexture"),
+                           member(m, "emissiveTexture"),
+                           transmission ? member(*transmission, "transmissionTexture") : nullptr,
+                           volume ? member(*volume, "thicknessTexture") : nullptr};
     for (const json* info : infos) {
       const int64_t t = json_index(info ? member(*info, "index") : nullptr);
       if (t < 0 || size_t(t) >= textures->size()) continue;
@@ -483,8 +491,6 @@ std::string base_dir_of(const std::string& path) {
 
 const char* material_extension_fallback(const std::string& name) {
   static const std::pair<const char*, const char*> table[] = {
-      {"KHR_materials_transmission", "drawn opaque, without transmission"},
-      {"KHR_materials_volume", "drawn as thin surfaces, without volume absorption"},
       {"KHR_materials_clearcoat", "drawn without the clear coat layer"},
       {"KHR_materials_sheen", "drawn without sheen"},
       {"KHR_materials_specular", "drawn with the default specular (F0 0.04, white)"},
@@ -639,7 +645,7 @@ void check_materials(const tinygltf::Model& m, const std::string& file) {
         {mat.normalTexture.index, mat.normalTexture.texCoord},
         {mat.occlusionTexture.index, mat.occlusionTexture.texCoord},
         {mat.emissiveTexture.index, mat.emissiveTexture.texCoord}};
-    for (int slot = 0; slot < kTextureSlots; ++slot) {
+    for (int slot = 0; slot < int(std::size(infos)); ++slot) {  // the core slots (extensions': the loader)
       const std::string name = "material " + std::to_string(i) + " " + texture_slot_name(slot);
       const auto [index, texcoord] = infos[slot];
       if (index != -1 && !in_range(index, m.textures)) fail(file, ref_error(name, "texture", index, m.textures.size()));

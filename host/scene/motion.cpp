@@ -111,6 +111,7 @@ void deform_range(const DeformSource& src, const std::vector<float>& morph_weigh
   const bool skinned = joints && src.influences > 0;
   const glm::dmat3 m3(world);
   const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(m3));
+  const double world_scale = std::cbrt(std::fabs(glm::determinant(m3)));
   for (size_t v = begin; v < end; ++v) {
     glm::dvec3 p(src.pos[3 * v], src.pos[3 * v + 1], src.pos[3 * v + 2]);
     glm::dvec3 n(0.0);
@@ -133,6 +134,7 @@ void deform_range(const DeformSource& src, const std::vector<float>& morph_weigh
     glm::dvec3 wp, wn, wt;
     double tangent_sign = world_sign;
     double weight_sum = 0.0;
+    double scale = world_scale;
     glm::dmat4 skin(0.0);
     if (skinned) {
       for (int i = 0; i < src.influences; ++i) {
@@ -154,6 +156,7 @@ void deform_range(const DeformSource& src, const std::vector<float>& morph_weigh
       // Tangents are directions on the surface: they take the matrix itself, like edges do.
       wt = a * t.x + b * t.y + c * t.z;
       tangent_sign = det < 0.0 ? -1.0 : 1.0;
+      scale = std::cbrt(std::fabs(det));
     } else {  // rigid (or a skinned vertex without weights: it keeps its node's transform)
       wp = glm::dvec3(world * glm::dvec4(p, 1.0));
       wn = normal_matrix * n;
@@ -164,6 +167,7 @@ void deform_range(const DeformSource& src, const std::vector<float>& morph_weigh
     if (bad) pf = glm::vec3(0.0f);  // NaN in the data, or beyond float range
     if (bad_position) bad_position[v] = bad;
     positions[v] = pf;
+    attributes[v].scale = std::isfinite(scale) ? float(scale) : 1.0f;
     const bool ok = has_normals && store_normal(wn, attributes[v]);
     if (!has_normals)
       for (float& c : attributes[v].normal) c = 0.0f;

@@ -18,7 +18,21 @@ PmrMaterial default_material() {
   m.normal_scale = 1.0f;
   m.occlusion_strength = 1.0f;
   m.f0_dielectric = dielectric_f0(1.5);
+  m.ior = 1.5f;
+  m.transmission = 0.0f, m.thickness = 0.0f;  // opaque, thin
+  m.attenuation_distance = std::numeric_limits<float>::infinity();
+  for (float& c : m.attenuation_color) c = 1.0f;
   return m;
+}
+
+void apply_material_inputs(const SceneMaterialInputs& in, PmrMaterial& m) {
+  m.metallic = in.metallic, m.roughness = in.roughness, m.unlit = in.unlit ? 1u : 0u;
+  for (int c = 0; c < 3; ++c) m.emissive[c] = in.emissive[c] * in.emissive_strength;
+  m.normal_scale = in.normal_scale, m.occlusion_strength = in.occlusion_strength;
+  m.ior = in.ior, m.f0_dielectric = dielectric_f0(in.ior);
+  m.transmission = in.transmission, m.thickness = in.thickness;
+  m.attenuation_distance = in.attenuation_distance;
+  for (int c = 0; c < 3; ++c) m.attenuation_color[c] = in.attenuation_color[c];
 }
 
 float dielectric_f0(double ior) {
@@ -28,8 +42,9 @@ float dielectric_f0(double ior) {
 }
 
 const char* texture_slot_name(int slot) {
-  static const char* const names[kTextureSlots] = {"baseColorTexture", "metallicRoughnessTexture", "normalTexture",
-                                                   "occlusionTexture", "emissiveTexture"};
+  static const char* const names[kTextureSlots] = {
+      "baseColorTexture", "metallicRoughnessTexture", "normalTexture",   "occlusionTexture",
+      "emissiveTexture",  "transmissionTexture",      "thicknessTexture"};
   return slot >= 0 && slot < kTextureSlots ? names[slot] : "?";
 }
 

@@ -32,6 +32,7 @@ Scene make_synthetic_scene(size_t triangles, uint32_t seed) {
         const glm::vec3 n(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
         s.positions.push_back(c + r * n);
         PmrVertexAttr a{};
+        a.scale = 1.0f;
         a.normal[0] = n.x, a.normal[1] = n.y, a.normal[2] = n.z;
         for (int q = 0; q < 4; ++q) a.color[q] = col[q];
         s.attributes.push_back(a);
@@ -164,6 +165,7 @@ Scene make_objects_scene(size_t triangles, uint32_t seed) {
         n = glm::length(n) > 0 ? glm::normalize(n) : glm::vec3(0, 1, 0);
         s.positions.push_back(centre + rot * (scale * p));
         PmrVertexAttr a{};
+        a.scale = 1.0f;
         a.normal[0] = n.x, a.normal[1] = n.y, a.normal[2] = n.z;
         for (float& c : a.color) c = 1.0f;
         s.attributes.push_back(a);

@@ -32,7 +32,9 @@ enum SceneTextureSlotKind : int {
   kSlotNormal = 2,             // RGB tangent-space normal, linear
   kSlotOcclusion = 3,          // R occlusion, linear
   kSlotEmissive = 4,           // RGB, sRGB
-  kTextureSlots = 5
+  kSlotTransmission = 5,       // R transmission (KHR_materials_transmission), linear
+  kSlotThickness = 6,          // G thickness (KHR_materials_volume), linear
+  kTextureSlots = 7
 };
 const char* texture_slot_name(int slot);  // "baseColorTexture", ... (the glTF property names)
 
@@ -61,9 +63,10 @@ struct SceneMaterialInputs {
   float emissive_strength = 1.0f;           // KHR_materials_emissive_strength (1 without it)
   bool unlit = false;                       // KHR_materials_unlit
   float ior = 1.5f;                         // KHR_materials_ior: 0 or >= 1 (its F0: PmrMaterial::f0_dielectric)
-  // DESIGN 4c, read but not drawn yet (the surface is drawn by 4b, and the warning says so)
-  float transmission = 0.0f;  // KHR_materials_transmission transmissionFactor
-  float thickness = 0.0f;     // KHR_materials_volume thicknessFactor (0: thin)
+  // DESIGN 4c step 2 (pbr)
+  bool has_transmission = false, has_volume = false;  // the material has the extension
+  float transmission = 0.0f;                          // KHR_materials_transmission transmissionFactor
+  float thickness = 0.0f;                             // KHR_materials_volume thicknessFactor (0: thin)
   float attenuation_distance = std::numeric_limits<float>::infinity();  // KHR_materials_volume (none)
   float attenuation_color[3] = {1.0f, 1.0f, 1.0f};                      // KHR_materials_volume (linear)
   std::array<SceneTextureSlot, kTextureSlots> slots;                    // indexed by SceneTextureSlotKind
@@ -213,6 +216,8 @@ PmrMaterial default_material();
 // The reflectance at normal incidence of a dielectric of index of refraction `ior` in air,
 // ((ior - 1) / (ior + 1))^2 (KHR_materials_ior): 0.04 for glTF's default 1.5; 1 for ior 0.
 float dielectric_f0(double ior);
+// The factors of `in` (as the loader checked them) into the device material `m`; maps are not touched.
+void apply_material_inputs(const SceneMaterialInputs& in, PmrMaterial& m);
 
 // A procedural scene of about `triangles` triangles (1k to 1M): UV spheres of ~200 triangles with
 // random sizes and colours spread through a 4 x 2 x 3 box, so they cover the whole depth range in

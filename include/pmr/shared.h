@@ -33,6 +33,11 @@ typedef uint pmr_u32;
 typedef int32_t pmr_i32;
 typedef uint32_t pmr_u32;
 #endif
+#ifdef __OPENCL_VERSION__
+typedef ulong pmr_u64;
+#else
+typedef uint64_t pmr_u64;
+#endif
 
 #define PMR_X_FRAC_BITS 16
 #define PMR_Y_FRAC_BITS 8
@@ -95,6 +100,7 @@ typedef uint32_t pmr_u32;
 /* Mta.flags */
 #define PMR_MTA_BACK 1u /* back-facing in its view range (double-sided): shading flips the normal */
 #define PMR_MTA_MASK 2u /* material uses alphaMode MASK: visibility must evaluate alpha */
+#define PMR_MTA_TRANSMISSIVE 4u /* pbr, KHR_materials_transmission: left out of the opaque pass (PmrSource) */
 
 /* PmrParams.setup_mode: one MTA per orientation range (PMR), or one single-view MTA per view
  * (the geometry-duplication baseline). */
@@ -212,6 +218,8 @@ typedef struct {
 typedef struct {
   float normal[3]; /* world-space unit normal (unused when the triangle has none)     */
   float color[4];  /* COLOR_0 (linear), (1,1,1,1) when absent                         */
+  float scale;     /* the uniform scale of its world transform, |det M3|^(1/3) (the skin's
+                      blend if skinned): KHR_materials_volume's thickness is in the node's units */
 } PmrVertexAttr;
 
 /* Per-triangle data. Producer: host. */
@@ -230,7 +238,9 @@ typedef struct {
 #define PMR_MAP_NORMAL 2             /* tangent-space normal (linear)                          */
 #define PMR_MAP_OCCLUSION 3          /* R occlusion (linear)                                   */
 #define PMR_MAP_EMISSIVE 4           /* RGB (sRGB-encoded)                                     */
-#define PMR_MAPS 5
+#define PMR_MAP_TRANSMISSION 5       /* R transmission (KHR_materials_transmission, linear)     */
+#define PMR_MAP_THICKNESS 6          /* G thickness (KHR_materials_volume, linear)              */
+#define PMR_MAPS 7
 
 /* One texture map of a material: which texture, sampled at which TEXCOORD set, through which
  * KHR_texture_transform (the identity without one). Producer: host/pipeline (from the scene's material
@@ -255,6 +265,11 @@ typedef struct {
   float occlusion_strength;     /* occlusionTexture.strength                                     */
   float f0_dielectric;          /* F0 of the dielectric part: ((ior - 1) / (ior + 1))^2 for
                                    KHR_materials_ior (0.04 for the default 1.5; 1 for ior 0)       */
+  float ior;                    /* KHR_materials_ior (1.5 without it): bends the refracted ray      */
+  float transmission;           /* KHR_materials_transmission transmissionFactor (0: opaque)       */
+  float thickness;              /* KHR_materials_volume thicknessFactor x the node's scale (0: thin) */
+  float attenuation_distance;   /* KHR_materials_volume (+inf: none)                               */
+  float attenuation_color[3];   /* KHR_materials_volume (linear)                                   */
 } PmrMaterial;
 
 /* A texture and its mip chain: `levels` levels back to back from `offset`, level k of
@@ -351,5 +366,20 @@ typedef struct {
   float rotation_cos, rotation_sin; /* of the map's rotation (counter-clockwise seen from above) */
   PmrEnvLevel levels[PMR_ENV_MAX_LEVELS];
 } PmrEnvironment;
+
+/* pbr with transmissive surfaces (DESIGN section 4c step 2): the transmission source, each view's opaque
+ * image (premultiplied half RGBA, the volume's layout) with a mip chain. Level k holds every view at
+ * max(1, W >> k) x max(1, H >> k) texels from texel level_offset[k] ([view][y][x], 4 halves a texel); each
+ * level is the 2x2 box mean of the one before (the last row or column of an odd side is left out).
+ * Producer: host/pipeline/transmission_stage.cpp, one copy per pass: the opaque pass has opaque_only 1
+ * (transmissive MTAs are skipped, no level is read), the full pass levels > 0. levels 0 and opaque_only 0:
+ * a frame without transmission. */
+#define PMR_SOURCE_MAX_LEVELS 16
+typedef struct {
+  pmr_u64 level_offset[PMR_SOURCE_MAX_LEVELS];
+  pmr_u32 levels;      /* levels stored (0: none)                                          */
+  pmr_u32 opaque_only; /* 1: this pass draws the opaque image: transmissive MTAs are skipped */
+  pmr_u32 pad0, pad1;
+} PmrSource;
 
 #endif /* PMR_SHARED_H */

@@ -43,6 +43,9 @@ kernel void layout_probe(global uint* out) {
   out[43] = sizeof(PmrEnvLevel);
   PROBE(44, PmrParams, view_anchor);
   PROBE(45, PmrParams, view_coord);
+  PROBE(48, PmrMaterial, attenuation_color);
+  out[49] = sizeof(PmrSource);
+  PROBE(50, PmrSource, opaque_only);
   PROBE(46, PmrParams, lod_scale_x);
   PROBE(47, PmrTexture, levels);
 }

@@ -22,15 +22,18 @@ void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool bac
   sp.metallic = mat.metallic, sp.roughness = mat.roughness;
   sp.emissive = glm::dvec3(mat.emissive[0], mat.emissive[1], mat.emissive[2]);
   sp.unlit = mat.unlit != 0;
+  sp.ior = mat.ior, sp.transmission = mat.transmission;
   sp.ao = 1.0;
   if (t.material < scene.material_inputs.size()) {
     const SceneMaterialInputs& in = scene.material_inputs[t.material];
     sp.metallic = in.metallic, sp.roughness = in.roughness, sp.unlit = in.unlit, sp.ior = in.ior;
+    sp.transmission = in.transmission;
     sp.emissive = glm::dvec3(in.emissive[0], in.emissive[1], in.emissive[2]) * double(in.emissive_strength);
     glm::dvec4 s;
     if (sample_slot(scene, t, b, in.slots[kSlotMetallicRoughness], s)) sp.metallic *= s.z, sp.roughness *= s.y;
     if (sample_slot(scene, t, b, in.slots[kSlotOcclusion], s)) sp.ao = 1.0 + in.occlusion_strength * (s.x - 1.0);
     if (sample_slot(scene, t, b, in.slots[kSlotEmissive], s)) sp.emissive *= glm::dvec3(s);
+    if (sample_slot(scene, t, b, in.slots[kSlotTransmission], s)) sp.transmission *= s.x;
     if (!scene.tangents.empty() && sample_slot(scene, t, b, in.slots[kSlotNormal], s)) {
       glm::dvec4 tw(0.0);
       for (int k = 0; k < 3; ++k) tw += b[k] * glm::dvec4(scene.tangents[t.v[k]]);

@@ -20,7 +20,7 @@ glm::dvec3 f0_of(const glm::dvec3& base, double metallic, double ior) {
 }  // namespace
 
 glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
-                    const glm::dvec3& l, double ior) {
+                    const glm::dvec3& l, double ior, double transmission) {
   const double nl = clamp01(glm::dot(n, l));
   if (nl <= 0.0) return glm::dvec3(0.0);
   const double nv = clamp01(glm::dot(n, v));
@@ -34,7 +34,7 @@ glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm
   const double D = a2 / (kPi * dd * dd);
   const double s = nl * std::sqrt(nv * nv * (1.0 - a2) + a2) + nv * std::sqrt(nl * nl * (1.0 - a2) + a2);
   const double vis = s > 0.0 ? 0.5 / s : 0.0;
-  const glm::dvec3 c_diff = base * (1.0 - metallic);
+  const glm::dvec3 c_diff = base * (1.0 - metallic) * (1.0 - transmission);
   return ((1.0 - F) * c_diff / kPi + F * (D * vis)) * nl;
 }
 
@@ -71,12 +71,13 @@ glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& li
   for (const PunctualLight& light : lights) {
     glm::dvec3 l;
     const glm::dvec3 E = light_irradiance(light, s.p, l);
-    sum += brdf_cos(s.base, s.metallic, r, s.n, v, l, s.ior) * E;
+    sum += brdf_cos(s.base, s.metallic, r, s.n, v, l, s.ior, s.transmission) * E;
   }
   const glm::dvec3 f0 = f0_of(s.base, s.metallic, s.ior), c_diff = s.base * (1.0 - s.metallic);
   const glm::dvec2 ab = env.split_sum(clamp01(glm::dot(s.n, v)), r);
-  const glm::dvec3 reflected = glm::reflect(-v, s.n);
-  sum += s.ao * (c_diff * env.irradiance(s.n) + (f0 * ab.x + ab.y) * env.prefiltered(reflected, r));
+  const glm::dvec3 reflected = glm::reflect(-v, s.n), specular = f0 * ab.x + ab.y;
+  sum += s.ao * ((1.0 - s.transmission) * c_diff * env.irradiance(s.n) + specular * env.prefiltered(reflected, r));
+  sum += s.ao * s.transmission * (1.0 - specular) * c_diff * s.through;
   return glm::min(exposure * (sum + s.emissive), glm::dvec3(kHalfMax));  // saturates like the kernels' halves
 }
 

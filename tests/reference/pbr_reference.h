@@ -10,9 +10,10 @@
 namespace pmr::ref {
 
 // f(l, v) * dot(n, l) for unit n, v, l; r = the clamped roughness (alpha = r^2); the dielectric's F0
-// from its index of refraction ((ior - 1) / (ior + 1))^2 (KHR_materials_ior; 0.04 at glTF's 1.5).
+// from its index of refraction ((ior - 1) / (ior + 1))^2 (KHR_materials_ior; 0.04 at glTF's 1.5); the
+// diffuse lobe weighted by 1 - transmission (KHR_materials_transmission: that part transmits instead).
 glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
-                    const glm::dvec3& l, double ior = 1.5);
+                    const glm::dvec3& l, double ior = 1.5, double transmission = 0.0);
 
 enum class LightType { Directional = 0, Point = 1, Spot = 2 };
 
@@ -33,6 +34,8 @@ struct SurfacePoint {
   glm::dvec3 base{1.0};                    // base colour (rgb)
   double metallic = 0.0, roughness = 1.0;  // roughness before clamping
   double ior = 1.5;                        // KHR_materials_ior
+  double transmission = 0.0;               // KHR_materials_transmission
+  glm::dvec3 through{0.0};                 // the light arriving through it (transmission_reference.h)
   glm::dvec3 n{0.0, 0.0, 1.0};             // unit shading normal (back faces already flipped)
   glm::dvec3 p{0.0};                       // world position
   glm::dvec3 eye{0.0, 0.0, 1.0};           // the view's camera position (world)
@@ -49,7 +52,8 @@ struct EnvironmentTerms {
 };
 
 // exposure x (sum over lights of f E dot(n, l) + ao (c_diff I(n) + (F0 A + B) P(reflect(-v, n), r)) + e);
-// unlit: exposure x base.
+// unlit: exposure x base. With transmission T, the diffuse terms are weighted by 1 - T, and
+// ao T (1 - (F0 A + B)) c_diff `through` is added (KHR_materials_transmission's BTDF, DESIGN 4c).
 glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& lights, const EnvironmentTerms& env,
                      double exposure);
 

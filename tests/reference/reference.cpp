@@ -166,6 +166,7 @@ std::vector<ClippedTriangle> clip_triangles(const PmrParams& P, const Scene& sce
       c.key = (t << PMR_KEY_SUB_BITS) | uint32_t(k - 1);
       c.double_sided = mat.double_sided != 0;
       c.mask = mat.alpha_mode == PMR_ALPHA_MASK;
+      c.transmissive = P.shading == PMR_SHADING_PBR && mat.transmission > 0.0f;
       out.push_back(c);
     }
   }
@@ -205,7 +206,8 @@ std::vector<PmrMta> make_mtas(const PmrParams& P, const std::vector<ClippedTrian
       r.view_lo = lo;
       r.view_hi = hi;
       r.sign = sign;
-      r.flags = (c.mask ? PMR_MTA_MASK : 0u) | (sign < 0 ? PMR_MTA_BACK : 0u);
+      r.flags =
+          (c.mask ? PMR_MTA_MASK : 0u) | (c.transmissive ? PMR_MTA_TRANSMISSIVE : 0u) | (sign < 0 ? PMR_MTA_BACK : 0u);
       out.push_back(r);
     }
   }

@@ -20,7 +20,7 @@ struct ClippedTriangle {
   PmrVertex v[3];
   double bary[3][2];
   uint32_t tri = 0, key = 0;
-  bool double_sided = false, mask = false;
+  bool double_sided = false, mask = false, transmissive = false;
 };
 // Setup without the orientation split: culling, clipping, fan triangulation.
 std::vector<ClippedTriangle> clip_triangles(const PmrParams& P, const Scene& scene,

@@ -1,0 +1,61 @@
+#include "pipeline/transmission_stage.h"
+
+#include <algorithm>
+
+namespace pmr {
+
+namespace {
+
+// Levels down to 1 x 1, and each level's first texel (4 halves each) for `views` slices.
+unsigned source_levels(int w, int h, int views, PmrSource& S) {
+  S = PmrSource{};
+  uint64_t offset = 0;
+  unsigned k = 0;
+  for (; k < PMR_SOURCE_MAX_LEVELS; ++k) {
+    const uint64_t lw = uint64_t(std::max(1, w >> k)), lh = uint64_t(std::max(1, h >> k));
+    S.level_offset[k] = offset;
+    offset += lw * lh * uint64_t(views);
+    if (lw == 1 && lh == 1) break;
+  }
+  return std::min<unsigned>(k + 1, PMR_SOURCE_MAX_LEVELS);
+}
+
+}  // namespace
+
+TransmissionStage::TransmissionStage(Launcher& launcher, const ClProgram& program)
+    : launcher_(launcher), rt_(launcher.runtime()), mip_(program, "source_mip") {
+  configure(false, 1, 1, 1);
+}
+
+size_t TransmissionStage::bytes_for(int views, int w, int h) {
+  PmrSource S;
+  const unsigned levels = source_levels(w, h, views, S);
+  const uint64_t last = uint64_t(std::max(1, w >> (levels - 1))) * uint64_t(std::max(1, h >> (levels - 1)));
+  return size_t((S.level_offset[levels - 1] + last * uint64_t(views)) * 8);
+}
+
+void TransmissionStage::configure(bool needed, int views, int view_w, int view_h) {
+  PmrSource full{}, opaque{};
+  levels_ = 0;
+  if (needed) levels_ = source_levels(view_w, view_h, views, full);
+  full.levels = levels_;
+  opaque.opaque_only = 1;
+  w_ = view_w, h_ = view_h;
+  data_ = rt_.buffer(needed ? bytes_for(views, view_w, view_h) : 16, "transmission source");
+  opaque_info_ = rt_.buffer(sizeof(PmrSource), "transmission source (opaque pass)", CL_MEM_READ_ONLY);
+  full_info_ = rt_.buffer(sizeof(PmrSource), "transmission source", CL_MEM_READ_ONLY);
+  rt_.write(opaque_info_, &opaque, sizeof opaque);
+  rt_.write(full_info_, &full, sizeof full);
+}
+
+void TransmissionStage::mip(int slice0, int slices, FrameEvents& ev) {
+  for (unsigned k = 1; k < levels_; ++k) {
+    const int h = std::max(1, h_ >> k);
+    mip_.args(data_, full_info_, cl_uint(k), cl_uint(slice0), cl_uint(slices), cl_int(w_), cl_int(h_));
+    ev.add(kFine, launcher_.launch(mip_, size_t(slices) * size_t(h), 64));
+  }
+}
+
+size_t TransmissionStage::device_bytes() const { return data_.size() + opaque_info_.size() + full_info_.size(); }
+
+}  // namespace pmr

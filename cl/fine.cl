@@ -5,6 +5,19 @@
  * 0); the encoded-only job uses fine_encode.cl, which never writes the volume. */
 #include "fine_raster.h"
 
+/* The tile's voxels (nv views from v0, ny rows from y0, nx columns from x0) copied from the transmission
+ * source's level 0 (the same layout) into the volume. */
+inline void copy_source_tile(global const half* source, global half* volume, global const PmrParams* P, int x0, int y0,
+                             int v0, int nx, int ny, int nv) {
+  const size_t W = (size_t)P->view_w, H = (size_t)P->view_h, view_base = (size_t)P->view_base;
+  for (int lv = 0; lv < nv; ++lv)
+    for (int ly = 0; ly < ny; ++ly) {
+      const size_t row = (((size_t)(v0 + lv) + view_base) * H + (size_t)(y0 + ly)) * W + (size_t)x0;
+      for (int lx = 0; lx < nx; ++lx)
+        vstore4(vload4(row + (size_t)lx, (global const ushort*)source), row + (size_t)lx, (global ushort*)volume);
+    }
+}
+
 kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
                         global const uint* tile_queue, global half* volume, global uint* debug_key,
                         global float* debug_depth, global uint* debug_count) {
@@ -17,15 +30,23 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
   const int nx = min(PMR_TILE_X, P->view_w - x0), ny = min(PMR_TILE_Y, P->view_h - y0);
   const int nv = min(PMR_TILE_V, P->views - v0);
   ShadeInputs in = PMR_SHADE_INPUTS;
-  const bool debug = P->debug_outputs != 0 && !source_info->opaque_only; /* the frame's outputs: its last pass */
+  const bool opaque_pass = source_info->opaque_only != 0;
+  const bool debug = P->debug_outputs != 0 && !opaque_pass; /* the frame's outputs: its last pass */
+  if (!debug && source_info->levels > 0u && source_tiles[tile] == 0u) {
+    /* no glass here: the opaque pass drew this tile as this pass would */
+    copy_source_tile(source, volume, P, x0, y0, v0, nx, ny, nv);
+    return;
+  }
   vfloat best_depth[FINE_ROWS * NS];
   vuint best_key[FINE_ROWS * NS], best_mta[FINE_ROWS * NS], best_cover[NS > 1 ? FINE_ROWS * NS : 1];
   vint covered[FINE_ROWS * NS];
-  const FineState st = {best_depth, best_key, best_mta, best_cover, debug ? covered : 0};
+  uint glass = 0u;
+  const FineState st = {best_depth, best_key, best_mta, best_cover, debug ? covered : 0, opaque_pass ? &glass : 0};
   fine_clear_state(FINE_ROWS * NS, &st);
   for (int r = 0; r < FINE_ROWS * NS; ++r) covered[r] = (vint)(0);
   fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], &in, tris, materials, x0, y0, v0, nx,
                     ny, nv, v0, &st);
+  if (opaque_pass) source_tiles[tile] = glass;
 
   /* frame constants in registers: stores through the output pointers could alias P */
   const size_t W = (size_t)P->view_w, H = (size_t)P->view_h, view_base = (size_t)P->view_base;

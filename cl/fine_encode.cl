@@ -78,6 +78,60 @@ inline void fused_display_row(const DisplayOut* D, const FusedTile* T, const Pmr
   for (; 3 * j < s_hi; ++j) fused_pixel(D, T, row, i, ly, j, s_lo, s_hi);
 }
 
+/* The tile's voxels rasterized and shaded: colour[] as half bits, background zero, in the visibility
+ * state's order (FUSED_VIEW_STRIDE, FUSED_ROW_STRIDE). */
+inline void fused_raster_shade(const ShadeInputs* in, global const PmrMta* mtas, global const uint* tile_offsets,
+                               global const uint* tile_queue, uint tile_xy, int x0, int y0, int nx, int ny,
+                               ushort4* colour) {
+  global const PmrParams* P = in->P;
+  const int views = P->views;
+  vfloat best_depth[FUSED_ROWS * NS];
+  vuint best_key[FUSED_ROWS * NS], best_mta[FUSED_ROWS * NS], best_cover[NS > 1 ? FUSED_ROWS * NS : 1];
+  const FineState st = {best_depth, best_key, best_mta, best_cover, 0, 0};
+  fine_clear_state(FUSED_ROWS * NS, &st);
+  for (int tv = 0; tv < P->tiles_v; ++tv) {
+    const uint tile = ((uint)tv * (uint)P->tiles_y) * (uint)P->tiles_x + tile_xy;
+    const int v0 = tv * PMR_TILE_V;
+    fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], in, in->tris, in->materials, x0, y0,
+                      v0, nx, ny, min(PMR_TILE_V, views - v0), 0, &st);
+  }
+  const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
+  MtaCache cache;
+  cache.id = PMR_NO_KEY;
+  for (int view = 0; view < views; ++view)
+    for (int ly = 0; ly < ny; ++ly)
+      for (int c = 0; c * VW < nx; ++c) {
+        const int r = (view * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
+        vint won[NS];
+        for (int s = 0; s < NS; ++s) won[s] = best_key[FINE_SLOT(r, s)] != (vuint)(PMR_NO_KEY);
+        fine_shade_chunk(in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0),
+                         best_cover + (NS > 1 ? FINE_SLOT(r, 0) : 0), won, x0 + c * VW, y0 + ly, view, colour + r * VW);
+      }
+}
+
+/* With a transmission source, whether no 3D tile of screen tile tile_xy holds glass: the opaque pass
+ * then drew its voxels exactly as this pass would (the same core, the same MTAs). */
+inline bool glass_free(global const PmrParams* P, global const PmrSource* S, global const uint* source_tiles,
+                       uint tile_xy) {
+  if (S->levels == 0u) return false;
+  for (int tv = 0; tv < P->tiles_v; ++tv)
+    if (source_tiles[((uint)tv * (uint)P->tiles_y) * (uint)P->tiles_x + tile_xy] != 0u) return false;
+  return true;
+}
+
+/* The tile's voxels from the transmission source's level 0, in colour[]'s order. */
+inline void fused_source_colours(global const half* source, global const PmrParams* P, int x0, int y0, int nx, int ny,
+                                 ushort4* colour) {
+  const size_t W = (size_t)P->view_w, H = (size_t)P->view_h;
+  for (int view = 0; view < P->views; ++view)
+    for (int ly = 0; ly < ny; ++ly) {
+      const size_t row = ((size_t)view * H + (size_t)(y0 + ly)) * W + (size_t)x0;
+      for (int lx = 0; lx < nx; ++lx)
+        colour[view * FUSED_VIEW_STRIDE + ly * FUSED_ROW_STRIDE + lx] =
+            vload4(row + (size_t)lx, (global const ushort*)source);
+    }
+}
+
 kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
                         global const uint* tile_queue, global const PmrEncodeParams* E, global const int* column_soa,
                         global const PmrEncodeRow* rows, global const int* column_start, global const int* row_start,
@@ -87,38 +141,14 @@ kernel void fine_encode(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
   if (tile_xy >= tiles_x * tiles_y) return;
   const int x0 = (int)(tile_xy % tiles_x) * PMR_TILE_X, y0 = (int)(tile_xy / tiles_x) * PMR_TILE_Y;
   const int nx = min(PMR_TILE_X, P->view_w - x0), ny = min(PMR_TILE_Y, P->view_h - y0);
-  const int views = P->views;
-
   ShadeInputs in = PMR_SHADE_INPUTS;
-  vfloat best_depth[FUSED_ROWS * NS];
-  vuint best_key[FUSED_ROWS * NS], best_mta[FUSED_ROWS * NS], best_cover[NS > 1 ? FUSED_ROWS * NS : 1];
-  const FineState st = {best_depth, best_key, best_mta, best_cover, 0};
-  fine_clear_state(FUSED_ROWS * NS, &st);
-  for (int tv = 0; tv < P->tiles_v; ++tv) {
-    const uint tile = ((uint)tv * tiles_y) * tiles_x + tile_xy;
-    const int v0 = tv * PMR_TILE_V;
-    fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], &in, tris, materials, x0, y0, v0,
-                      nx, ny, min(PMR_TILE_V, views - v0), 0, &st);
-  }
-
-  /* the winners' colours as half bits, background zero */
-  const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
   ushort4 colour[FUSED_ROWS * VW];
-  MtaCache cache;
-  cache.id = PMR_NO_KEY;
-  for (int view = 0; view < views; ++view)
-    for (int ly = 0; ly < ny; ++ly)
-      for (int c = 0; c * VW < nx; ++c) {
-        const int r = (view * PMR_TILE_Y + ly) * FINE_CHUNKS + c;
-        vint won[NS];
-        for (int s = 0; s < NS; ++s) won[s] = best_key[FINE_SLOT(r, s)] != (vuint)(PMR_NO_KEY);
-        fine_shade_chunk(&in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0),
-                         best_cover + (NS > 1 ? FINE_SLOT(r, 0) : 0), won, x0 + c * VW, y0 + ly, view, colour + r * VW);
-      }
+  if (glass_free(P, source_info, source_tiles, tile_xy)) fused_source_colours(source, P, x0, y0, nx, ny, colour);
+  else fused_raster_shade(&in, mtas, tile_offsets, tile_queue, tile_xy, x0, y0, nx, ny, colour);
 
   /* the display pixels this tile owns, whole or in part */
   const DisplayOut D = {(global ushort*)display, sub_alpha, E->display_w};
-  const FusedTile T = {colour, column_soa, E->display_w, views, E->reversed, x0};
+  const FusedTile T = {colour, column_soa, E->display_w, P->views, E->reversed, x0};
   const int s_lo = column_start[x0], s_hi = column_start[x0 + nx];
   const int i_lo = row_start[y0], i_hi = row_start[y0 + ny];
   for (int i = i_lo; i < i_hi; ++i) {

@@ -166,6 +166,7 @@ typedef struct {
   vuint* mta;
   vuint* cover; /* NS > 1 */
   vint* covered;
+  uint* glass; /* the transmission source's opaque pass: set to 1 when a transmissive MTA is left out */
 } FineState;
 
 /* MTA m (queue entry id) in view i over the tile's row chunk (ly, c): every sample's coverage, depth
@@ -222,7 +223,10 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     }
     const uint id = tile_queue[q];
     const PmrMta m = mtas[id];
-    if ((m.flags & PMR_MTA_TRANSMISSIVE) && opaque_only) continue; /* the transmission source's pass */
+    if ((m.flags & PMR_MTA_TRANSMISSIVE) && opaque_only) { /* the transmission source's pass */
+      if (st->glass) *st->glass = 1u;
+      continue;
+    }
     const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
     /* the tile rows with a sample within the MTA's y extent (the same in every view) */
     const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));

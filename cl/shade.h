@@ -31,11 +31,11 @@
       global const float *srgb_lut, global const float *positions, global const float4 *eyes,              \
       global const float2 *split_sum, global const float2 *texcoords, global const float4 *tangents,       \
       global const PmrEnvironment *env, global const float4 *env_data, global const PmrLight *lights,      \
-      global const half *source, global const PmrSource *source_info
+      global const half *source, global const PmrSource *source_info, global uint *source_tiles
 #define PMR_SHADE_INPUTS                                                                                         \
   {                                                                                                              \
     tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, \
-        env_data, lights, source, source_info                                                                    \
+        env_data, lights, source, source_info, source_tiles                                                      \
   }
 
 typedef struct {
@@ -56,6 +56,7 @@ typedef struct {
   global const PmrLight* lights;       /* P->num_lights punctual lights, world space (pbr)           */
   global const half* source;           /* pbr: the transmission source (cl/transmission.h)           */
   global const PmrSource* source_info; /* ... its levels, and whether this is the opaque pass       */
+  global uint* source_tiles;           /* ... per 3D tile: 1 if the opaque pass left a transmissive MTA out  */
 } ShadeInputs;
 
 #define LANE3(a) s3(vload_s(0, (a)[0]), vload_s(0, (a)[1]), vload_s(0, (a)[2]))
@@ -79,7 +80,8 @@ typedef struct {
   sfloat metallic, roughness;
   sfloat f0d; /* pbr: the dielectric F0 (PmrMaterial.f0_dielectric)                  */
   sfloat3 emissive;
-  /* pbr, transmissive materials (lanes `glass`; the others keep lanes_clear's opaque values) */
+  /* pbr, transmissive materials: lanes `glass`; the fields below are set only when some lane is (and
+   * then hold the opaque values in the others) */
   sint glass;
   sfloat transmission, ior, thickness, att_dist; /* thickness in world units (x the node's scale) */
   sfloat3 att_color;
@@ -104,9 +106,7 @@ inline void lanes_clear(LaneWinners* L) {
   L->factor = s3(zero, zero, zero);
   L->metallic = L->roughness = L->f0d = zero;
   L->emissive = s3(zero, zero, zero);
-  L->glass = (sint)(0);
-  L->transmission = L->thickness = zero, L->ior = 1.5f, L->att_dist = INFINITY;
-  L->att_color = s3(one, one, one);
+  L->glass = (sint)(0); /* the transmission inputs are set when the first glass lane comes */
   L->textured = 0u;
 #if PMR_TRILINEAR
   for (int k = 0; k < 3; ++k) vstore_s(zero, 0, L->ex[k]), vstore_s(zero, 0, L->ey[k]);
@@ -119,6 +119,10 @@ inline sfloat3 blend3(sfloat3 a, float3 b, sint take) { return s3_select(a, s3_s
 /* The transmission inputs of material `mat` (triangle t) into lanes `take`. */
 inline void lanes_add_transmission(LaneWinners* L, const ShadeInputs* in, global const PmrMaterial* mat,
                                    const PmrTriangle* t, sint take) {
+  if (!any(L->glass)) { /* the opaque lanes' values */
+    L->transmission = L->thickness = (sfloat)(0.0f), L->ior = 1.5f, L->att_dist = INFINITY;
+    L->att_color = s3((sfloat)(1.0f), (sfloat)(1.0f), (sfloat)(1.0f));
+  }
   L->glass |= take;
   L->transmission = blend(L->transmission, mat->transmission, take);
   L->ior = blend(L->ior, mat->ior, take);
@@ -259,7 +263,7 @@ typedef struct {
   int mapped[SW];
   float s[3][SW], tw[4][SW], normal_scale[SW];
   float toksvig[SW];                     /* trilinear: the normal map's increment of alpha^2 (Toksvig), else 0 */
-  float transmission[SW], thickness[SW]; /* KHR_materials_transmission R, KHR_materials_volume G */
+  float transmission[SW], thickness[SW]; /* KHR_materials_transmission R, KHR_materials_volume G (glass) */
 } LaneTextures;
 
 /* The screen-space derivatives of SW lanes' source barycentrics, per output pixel in x and in y. */
@@ -399,10 +403,11 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
     for (int k = 0; k < 3; ++k) T->base[k][l] = T->emissive[k][l] = 1.0f, T->s[k][l] = 0.0f;
     for (int k = 0; k < 4; ++k) T->tw[k][l] = 0.0f;
     T->metallic[l] = T->roughness[l] = T->ao[l] = T->normal_scale[l] = 1.0f;
-    T->transmission[l] = T->thickness[l] = 1.0f;
     T->mapped[l] = 0;
     T->toksvig[l] = 0.0f;
   }
+  if (any(L->glass))
+    for (int l = 0; l < SW; ++l) T->transmission[l] = T->thickness[l] = 1.0f;
   uint material[SW];
   for (uint r = L->textured; r != 0u; r &= r - 1u) {
     const int l = 31 - (int)clz(r & (0u - r));
@@ -524,6 +529,11 @@ inline sfloat geometric_spread(const LaneWinners* L, const LaneBaryGrad* g, sflo
 
 #include "transmission.h" /* reads the inputs and lanes above */
 
+/* w (1 - (F0 A + B)) c: the weight of the light through a transmissive surface (w = ao T (1 - metallic)). */
+inline sfloat3 btdf_weight(sfloat w, sfloat3 f0, sfloat A, sfloat B, sfloat3 c) {
+  return s3(w * (1.0f - (f0.x * A + B)) * c.x, w * (1.0f - (f0.y * A + B)) * c.y, w * (1.0f - (f0.z * A + B)) * c.z);
+}
+
 /* glTF metallic-roughness of the lanes with unit normals n (already flipped for back faces, normal map
  * applied) and base colours `base`, seen from view `view`'s camera: the sum over the light table of
  * f E n.l (the file's punctual lights, or the default light, or none), the environment times the
@@ -532,13 +542,14 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
                          sfloat3 n, sfloat3 base, sfloat spread, int view) {
   global const PmrParams* P = in->P;
   const sfloat3 p = s3_interp_lanes(b, L->p);
-  sfloat metallic = L->metallic, roughness = L->roughness, ao = 1.0f, transmission = L->transmission;
-  sfloat thickness = L->thickness;
+  const bool glass = any(L->glass); /* the transmission terms cost nothing to opaque lanes */
+  sfloat metallic = L->metallic, roughness = L->roughness, ao = 1.0f;
+  sfloat transmission = glass ? L->transmission : 0.0f, thickness = glass ? L->thickness : 0.0f;
   sfloat3 emissive = L->emissive;
   if (textured) {
     metallic *= vload_s(0, T->metallic), roughness *= vload_s(0, T->roughness), ao = vload_s(0, T->ao);
     emissive = s3_mul(emissive, LANE3(T->emissive));
-    transmission *= vload_s(0, T->transmission), thickness *= vload_s(0, T->thickness);
+    if (glass) transmission *= vload_s(0, T->transmission), thickness *= vload_s(0, T->thickness);
   }
   const sfloat3 to_eye = s3_sub(s3_splat(in->eyes[view + (int)P->view_base].xyz), p);
   const sfloat3 v = s3_scale(to_eye, 1.0f / sqrt(s3_dot(to_eye, to_eye)));
@@ -551,7 +562,9 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
     const sfloat3 E =
         light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
                          vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, p, &l);
-    direct = s3_add(direct, s3_mul(brdf_cos_transmissive(base, metallic, L->f0d, r, n, v, l, transmission), E));
+    const sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, L->f0d, r, n, v, l, transmission)
+                            : brdf_cos(base, metallic, L->f0d, r, n, v, l);
+    direct = s3_add(direct, s3_mul(f, E));
   }
   const sfloat nv = s3_dot(n, v);
   sfloat A, B;
@@ -559,16 +572,15 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
   sfloat3 irradiance, prefiltered;
   environment_lanes(in, n, v, nv, metallic, r, L->act, &irradiance, &prefiltered);
   const sfloat3 f0 = pbr_f0(base, metallic, L->f0d);
-  const sfloat kd = (1.0f - metallic) * (1.0f - transmission); /* transmission replaces diffuse */
+  /* transmission replaces the diffuse lobe */
+  const sfloat kd = glass ? (1.0f - metallic) * (1.0f - transmission) : 1.0f - metallic;
   sfloat3 ambient = s3(ao * (base.x * kd * irradiance.x + (f0.x * A + B) * prefiltered.x),
                        ao * (base.y * kd * irradiance.y + (f0.y * A + B) * prefiltered.y),
                        ao * (base.z * kd * irradiance.z + (f0.z * A + B) * prefiltered.z));
-  if (any(L->glass)) { /* KHR_materials_transmission's BTDF: (1 - (F0 A + B)) c_diff x the light through */
-    const sfloat3 through = transmitted_lanes(in, L, p, n, v, r, thickness, view);
+  if (glass) { /* KHR_materials_transmission's BTDF: (1 - (F0 A + B)) c_diff x the light through */
     const sfloat w = select((sfloat)(0.0f), ao * transmission * (1.0f - metallic), L->glass);
-    ambient = s3_add(
-        ambient, s3(w * (1.0f - (f0.x * A + B)) * base.x * through.x, w * (1.0f - (f0.y * A + B)) * base.y * through.y,
-                    w * (1.0f - (f0.z * A + B)) * base.z * through.z));
+    ambient =
+        s3_add(ambient, s3_mul(btdf_weight(w, f0, A, B, base), transmitted_lanes(in, L, p, n, v, r, thickness, view)));
   }
   const sfloat3 lit = s3_add(s3_add(direct, ambient), emissive);
   return s3_select(lit, base, L->unlit);

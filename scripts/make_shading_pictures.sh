@@ -14,6 +14,8 @@
 #   docs/shading_studio.png             the Khronos sample model AnisotropyStrengthTest, center view,
 #                                       pbr with --environment uniform (the default light) | the studio
 #   docs/shading_environment_forest.png the same, --environment uniform | Blender's forest.exr
+#   docs/shading_glass_views.png        the Khronos sample model GlassHurricaneCandleHolder (transmission
+#                                       and volume), views 0, N/2 and N-1 of the default 96, the studio
 #
 # usage: scripts/make_shading_pictures.sh [GLTF_DIR]
 #   GLTF_DIR   folder of the Khronos sample models (GLTF_DIR/Suzanne/glTF/Suzanne.gltf, ...); default
@@ -100,6 +102,14 @@ if present "$ANISOTROPY" "$OUT/shading_environment_forest.png" "$MODELS_HINT" &&
     2> >(grep -v KHR_materials_anisotropy >&2)
   $PICTURES strip "$OUT/shading_environment_forest.png" "$(views light 4)" "$(views forest 4)" \
     --check-center "$(center light)" "$(center forest)"
+fi
+
+echo "== GlassHurricaneCandleHolder in views 0, 48 and 95 of 96"
+GLASS=$GLTF_DIR/GlassHurricaneCandleHolder/glTF/GlassHurricaneCandleHolder.gltf
+if present "$GLASS" "$OUT/shading_glass_views.png" "$MODELS_HINT"; then
+  render glass "$GLASS" --views 96 --view-size 498x279
+  $PICTURES strip "$OUT/shading_glass_views.png" "$(views glass 0)" "$(views glass 48)" "$(views glass 95)" \
+    --check-center - "$(center glass)" -
 fi
 
 if [ ${#skipped[@]} -gt 0 ]; then

@@ -91,7 +91,7 @@ struct Pipeline::Impl {
 
   void render_multipass(const Rig& rig, const PmrParams& P, bool snapped, FrameEvents& ev, StageTimes& t);
   void render_fine(FrameEvents& ev, int screen_tiles);
-  void configure_transmission() { transmission.configure(scene.transmissive(), views, view_w, view_h); }
+  void configure_transmission() { transmission.configure(scene.transmissive(), views, view_w, view_h, num_tiles); }
 };
 
 Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config) : config_(config) {

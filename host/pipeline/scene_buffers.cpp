@@ -99,7 +99,7 @@ void SceneBuffers::upload_frame(const FrameDescription& frame) {
 cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params, const SourceBinding& source) const {
   const ClBuffer* inputs[] = {&params, &tris_,      &attrs_,  &materials_, &textures_,  &texels_,
                               &lut_,   &positions_, &eyes_,   &split_sum_, &texcoords_, &tangents_,
-                              &env_,   &env_data_,  &lights_, source.data, source.info};
+                              &env_,   &env_data_,  &lights_, source.data, source.info, source.tiles};
   cl_uint i = 0;
   for (const ClBuffer* b : inputs) k.arg(i++, *b);
   return i;

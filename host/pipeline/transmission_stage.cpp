@@ -24,7 +24,7 @@ unsigned source_levels(int w, int h, int views, PmrSource& S) {
 
 TransmissionStage::TransmissionStage(Launcher& launcher, const ClProgram& program)
     : launcher_(launcher), rt_(launcher.runtime()), mip_(program, "source_mip") {
-  configure(false, 1, 1, 1);
+  configure(false, 1, 1, 1, 1);
 }
 
 size_t TransmissionStage::bytes_for(int views, int w, int h) {
@@ -34,7 +34,7 @@ size_t TransmissionStage::bytes_for(int views, int w, int h) {
   return size_t((S.level_offset[levels - 1] + last * uint64_t(views)) * 8);
 }
 
-void TransmissionStage::configure(bool needed, int views, int view_w, int view_h) {
+void TransmissionStage::configure(bool needed, int views, int view_w, int view_h, uint64_t num_tiles) {
   PmrSource full{}, opaque{};
   levels_ = 0;
   if (needed) levels_ = source_levels(view_w, view_h, views, full);
@@ -42,6 +42,7 @@ void TransmissionStage::configure(bool needed, int views, int view_w, int view_h
   opaque.opaque_only = 1;
   w_ = view_w, h_ = view_h;
   data_ = rt_.buffer(needed ? bytes_for(views, view_w, view_h) : 16, "transmission source");
+  tiles_ = rt_.buffer(needed ? size_t(num_tiles) * 4 : 16, "transmission source tiles");
   opaque_info_ = rt_.buffer(sizeof(PmrSource), "transmission source (opaque pass)", CL_MEM_READ_ONLY);
   full_info_ = rt_.buffer(sizeof(PmrSource), "transmission source", CL_MEM_READ_ONLY);
   rt_.write(opaque_info_, &opaque, sizeof opaque);
@@ -56,6 +57,8 @@ void TransmissionStage::mip(int slice0, int slices, FrameEvents& ev) {
   }
 }
 
-size_t TransmissionStage::device_bytes() const { return data_.size() + opaque_info_.size() + full_info_.size(); }
+size_t TransmissionStage::device_bytes() const {
+  return data_.size() + opaque_info_.size() + full_info_.size() + tiles_.size();
+}
 
 }  // namespace pmr

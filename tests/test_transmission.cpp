@@ -398,5 +398,19 @@ TEST(TransmissionCorpus, TheKhronosGlassModelsDrawTheirGlass) {
   }
 }
 
+// The transmission source is budgeted before anything is allocated or written: a glass scene whose
+// frame would fit the memory budget without it is refused with one line naming it.
+TEST(TransmissionCorpus, TheSourceIsUnderTheMemoryBudget) {
+  const std::string corpus = test::corpus_dir();
+  if (corpus.empty()) GTEST_SKIP() << "../shared/gltf not found: the glass model is not rendered";
+  const std::string out = test::temp_dir("glass_budget");
+  const test::CliRun r = test::run("render '" + corpus +
+                                   "/GlassHurricaneCandleHolder/glTF/GlassHurricaneCandleHolder.gltf' --limit "
+                                   "memory=2300M --out '" +
+                                   out + "/x'");
+  test::expect_one_error_line(r, "a 512 MiB transmission source for the glass");
+  EXPECT_FALSE(test::exists(out + "/x"));
+}
+
 }  // namespace
 }  // namespace pmr

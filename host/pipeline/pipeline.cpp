@@ -120,6 +120,9 @@ FrameDescription describe_frame(const Rig& rig, const std::vector<SceneLight>& s
 
 size_t Pipeline::volume_bytes() const { return impl_->fine.volume_bytes(); }
 size_t Pipeline::display_bytes() const { return impl_->encode.display_bytes(); }
+size_t Pipeline::transmission_bytes() const {
+  return impl_->transmission.active() ? impl_->transmission.source().size() : 0;
+}
 
 // Which forms of the fine raster a configuration renders (FinePaths).
 FinePaths Pipeline::choose_paths(const Rig& rig, const Display* display) const {

@@ -64,6 +64,8 @@ class Pipeline {
   int tiles_y() const { return tiles_y_; }
   int tiles_v() const { return tiles_v_; }
   size_t volume_bytes() const;
+  // Bytes of the transmission source (DESIGN 4c step 2), 0 for a scene without transmissive materials.
+  size_t transmission_bytes() const;
   bool fused() const;       // the last configure() chose the fused raster + encode path
   bool has_volume() const;  // the last configure() renders the view volume (read_volume works)
   size_t display_bytes() const;

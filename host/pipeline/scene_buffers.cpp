@@ -59,9 +59,7 @@ void SceneBuffers::set_scene(const Scene& scene) {
   num_triangles_ = uint32_t(scene.triangles.size());
   const MaterialTables tables = make_material_tables(scene, mips_);
   has_tangents_ = scene.tangents.size() == scene.positions.size() && !scene.positions.empty();
-  transmissive_ = pbr_ && std::any_of(scene.triangles.begin(), scene.triangles.end(), [&](const PmrTriangle& t) {
-                    return t.material < tables.materials.size() && tables.materials[t.material].transmission > 0.0f;
-                  });
+  transmissive_ = pbr_ && scene_transmissive(scene);
   const std::vector<glm::vec4> no_tangents(1, glm::vec4(0.0f));
   scene_lights_ = scene.lights;
   positions_ = rt_.upload(scene.positions, "vertex positions");

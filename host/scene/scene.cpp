@@ -35,6 +35,16 @@ void apply_material_inputs(const SceneMaterialInputs& in, PmrMaterial& m) {
   for (int c = 0; c < 3; ++c) m.attenuation_color[c] = in.attenuation_color[c];
 }
 
+bool scene_transmissive(const Scene& scene) {
+  auto transmission = [&](uint32_t m) {
+    return m < scene.material_inputs.size() ? scene.material_inputs[m].transmission
+                                            : (m < scene.materials.size() ? scene.materials[m].transmission : 0.0f);
+  };
+  for (const PmrTriangle& t : scene.triangles)
+    if (transmission(t.material) > 0.0f) return true;
+  return false;
+}
+
 float dielectric_f0(double ior) {
   if (ior == 1.5) return 0.04f;  // glTF's default, exactly as the core specification writes it
   const double f = (ior - 1.0) / (ior + 1.0);

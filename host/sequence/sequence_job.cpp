@@ -15,6 +15,7 @@
 
 #include "output/checksum.h"
 #include "output/interrupt.h"
+#include "pipeline/transmission_stage.h"
 #include "pmr/error.h"
 #include "pmr/memory_budget.h"
 #include "pmr/output.h"
@@ -180,17 +181,21 @@ void SequenceRun::choose_frames() {
 // volume on the device and, when written, up to three host copies (one read back, one queued, one
 // being written) plus the encoder's output; the display image (RGBA and the subpixels' alpha)
 // likewise; depth 12 bytes a voxel and sample on the device and as many read back, then 4 a voxel per
-// host copy. The device buffers are checked again as they are allocated.
+// host copy; with glass, the transmission source on the device. The device buffers are checked again as they are allocated.
 void SequenceRun::check_frame_memory() const {
   const Rig& rig = renderer_->rig();
   const uint64_t voxels = uint64_t(rig.views) * uint64_t(rig.view_w) * uint64_t(rig.view_h);
   const uint64_t display = products_.encoded ? uint64_t(job_.display.width) * uint64_t(job_.display.height) * 14 : 0;
   const uint64_t volume = need_volume_ ? voxels * 8 : 0;
   const uint64_t depth = need_volume_ && products_.depth ? voxels * (24 * uint64_t(pc_.samples) + 3 * 4) : 0;
-  check_memory(5 * volume + 5 * display + depth,
-               std::to_string(rig.views) + " views of " + std::to_string(rig.view_w) + "x" +
-                   std::to_string(rig.view_h) + " (" + std::to_string(volume >> 20) +
-                   " MiB a view volume, on the device and in up to four copies being written)");
+  const uint64_t glass = pc_.shading == Shading::Pbr && scene_transmissive(scene_)
+                             ? TransmissionStage::bytes_for(rig.views, rig.view_w, rig.view_h)
+                             : 0;
+  check_memory(
+      5 * volume + 5 * display + depth + glass,
+      std::to_string(rig.views) + " views of " + std::to_string(rig.view_w) + "x" + std::to_string(rig.view_h) + " (" +
+          std::to_string(volume >> 20) + " MiB a view volume, on the device and in up to four copies being written" +
+          (glass ? ", and a " + std::to_string(glass >> 20) + " MiB transmission source for the glass" : "") + ")");
 }
 
 // What every frame's sidecar shares: the job's configuration, the sequence as resolved, what the run
@@ -366,6 +371,11 @@ int SequenceRun::render_frames() {
     std::fprintf(stderr, "pmr: device %s; kernels built in %.2f s (%zu work-group functions: %s)\n",
                  runtime.device_name().c_str(), pipeline.kernel_build_seconds(), pipeline.kernel_variants().size(),
                  variants.c_str());
+    if (const size_t glass = pipeline.transmission_bytes())
+      std::fprintf(stderr,
+                   "pmr: glass: a transmission source of %zu MiB (each view's opaque image with its mips); every "
+                   "frame draws an opaque pass first\n",
+                   glass >> 20);
   }
 
   install_interrupt_handlers();

@@ -216,6 +216,9 @@ PmrMaterial default_material();
 // The reflectance at normal incidence of a dielectric of index of refraction `ior` in air,
 // ((ior - 1) / (ior + 1))^2 (KHR_materials_ior): 0.04 for glTF's default 1.5; 1 for ior 0.
 float dielectric_f0(double ior);
+// Whether a triangle's material transmits (KHR_materials_transmission): pbr then draws glass, with
+// the transmission source (DESIGN 4c step 2).
+bool scene_transmissive(const Scene& scene);
 // The factors of `in` (as the loader checked them) into the device material `m`; maps are not touched.
 void apply_material_inputs(const SceneMaterialInputs& in, PmrMaterial& m);
 

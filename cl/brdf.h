@@ -59,6 +59,25 @@ inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat f0d, sfloat r, sfl
   return brdf_cos_transmissive(base, metallic, f0d, r, n, v, l, (sfloat)(0.0f));
 }
 
+/* KHR_materials_transmission's BTDF for a punctual light seen through the surface (as the Khronos
+ * Sample Viewer's getPunctualRadianceTransmission): (1 - F(v.h)) D(n.h) Vis(n.l', n.v), l' the direction
+ * toward the light mirrored on the surface's plane, h = normalize(l' + v), GGX with the transmission
+ * roughness max(r clamp(2 ior - 2, 0, 1), 0.03) (alpha its square; the floor keeps ior 1 finite). Per
+ * unit irradiance E; the caller weights it by T (1 - metallic) c and Beer-Lambert. */
+inline sfloat3 btdf_light(sfloat3 f0, sfloat r, sfloat ior, sfloat3 n, sfloat3 v, sfloat3 l) {
+  const sfloat3 lm = s3_sub(l, s3_scale(n, 2.0f * s3_dot(n, l)));
+  const sfloat3 hv = s3_add(lm, v);
+  const sfloat hl = sqrt(s3_dot(hv, hv));
+  const sfloat3 h = s3_select(n, s3_scale(hv, 1.0f / hl), hl > 0.0f);
+  const sfloat rt = fmax(r * clamp(2.0f * ior - 2.0f, 0.0f, 1.0f), 0.03f), a2 = (rt * rt) * (rt * rt);
+  const sfloat nh = clamp(s3_dot(n, h), 0.0f, 1.0f), vh = clamp(s3_dot(v, h), 0.0f, 1.0f);
+  const sfloat nl = clamp(s3_dot(n, lm), 0.0f, 1.0f), nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
+  const sfloat k = 1.0f - vh, k2 = k * k, k5 = k2 * k2 * k;
+  const sfloat s = ggx_d(nh, a2) * smith_vis(nl, nv, a2);
+  return s3((1.0f - (f0.x + (1.0f - f0.x) * k5)) * s, (1.0f - (f0.y + (1.0f - f0.y) * k5)) * s,
+            (1.0f - (f0.z + (1.0f - f0.z) * k5)) * s);
+}
+
 /* KHR_lights_punctual at the surface points p: the unit directions toward the light (*l) and the
  * irradiance E it delivers on a surface facing it. Directional: colour x intensity (lux), travelling
  * along `direction` (the node's -Z). Point and spot: colour x intensity (candela) / d^2, times the range

@@ -554,7 +554,8 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
   const sfloat3 to_eye = s3_sub(s3_splat(in->eyes[view + (int)P->view_base].xyz), p);
   const sfloat3 v = s3_scale(to_eye, 1.0f / sqrt(s3_dot(to_eye, to_eye)));
   const sfloat r = widened_roughness(pbr_roughness(roughness), spread);
-  sfloat3 direct = s3_splat((float3)(0.0f));
+  const sfloat3 f0 = pbr_f0(base, metallic, L->f0d);
+  sfloat3 direct = s3_splat((float3)(0.0f)), lights_through = direct;
   const uint num_lights = P->num_lights;
   for (uint i = 0; i < num_lights; ++i) {
     global const PmrLight* light = &in->lights[i];
@@ -565,22 +566,24 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
     const sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, L->f0d, r, n, v, l, transmission)
                             : brdf_cos(base, metallic, L->f0d, r, n, v, l);
     direct = s3_add(direct, s3_mul(f, E));
+    if (glass) lights_through = s3_add(lights_through, s3_mul(btdf_light(f0, r, L->ior, n, v, l), E));
   }
   const sfloat nv = s3_dot(n, v);
   sfloat A, B;
   split_sum_lanes(in->split_sum, nv, r, &A, &B);
   sfloat3 irradiance, prefiltered;
   environment_lanes(in, n, v, nv, metallic, r, L->act, &irradiance, &prefiltered);
-  const sfloat3 f0 = pbr_f0(base, metallic, L->f0d);
   /* transmission replaces the diffuse lobe */
   const sfloat kd = glass ? (1.0f - metallic) * (1.0f - transmission) : 1.0f - metallic;
   sfloat3 ambient = s3(ao * (base.x * kd * irradiance.x + (f0.x * A + B) * prefiltered.x),
                        ao * (base.y * kd * irradiance.y + (f0.y * A + B) * prefiltered.y),
                        ao * (base.z * kd * irradiance.z + (f0.z * A + B) * prefiltered.z));
   if (glass) { /* KHR_materials_transmission's BTDF: (1 - (F0 A + B)) c_diff x the light through */
-    const sfloat w = select((sfloat)(0.0f), ao * transmission * (1.0f - metallic), L->glass);
-    ambient =
-        s3_add(ambient, s3_mul(btdf_weight(w, f0, A, B, base), transmitted_lanes(in, L, p, n, v, r, thickness, view)));
+    const sfloat w = select((sfloat)(0.0f), transmission * (1.0f - metallic), L->glass);
+    sfloat3 attenuation;
+    const sfloat3 through = transmitted_lanes(in, L, p, n, v, r, thickness, view, &attenuation);
+    ambient = s3_add(ambient, s3_mul(btdf_weight(ao * w, f0, A, B, base), through));
+    direct = s3_add(direct, s3_mul(s3_scale(s3_mul(base, attenuation), w), lights_through));
   }
   const sfloat3 lit = s3_add(s3_add(direct, ambient), emissive);
   return s3_select(lit, base, L->unlit);

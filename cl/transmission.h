@@ -65,10 +65,10 @@ inline sint project_lanes(global const PmrParams* P, sfloat3 q, int view, sfloat
  * weights: the view ray -v refracted at n (Snell, eta = 1 / ior; ior 0 or a thin surface: straight on),
  * travelled thickness along it, the end point's source (divided by the exposure it was drawn with) plus
  * (1 - its alpha) x the environment along the refracted ray, attenuated by Beer-Lambert,
- * attenuationColor^(distance / attenuationDistance). r: the roughness; thickness: the volume's, textured
- * and in world units. */
+ * attenuationColor^(distance / attenuationDistance) (*attenuation: that factor, which the lights seen
+ * through the surface take too). r: the roughness; thickness: the volume's, textured and in world units. */
 inline sfloat3 transmitted_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 p, sfloat3 n, sfloat3 v, sfloat r,
-                                 sfloat thickness, int view) {
+                                 sfloat thickness, int view, sfloat3* attenuation) {
   global const PmrParams* P = in->P;
   const sfloat ior = L->ior, nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
   const sfloat eta = select((sfloat)(1.0f), 1.0f / ior, ior >= 1.0f);
@@ -99,7 +99,8 @@ inline sfloat3 transmitted_lanes(const ShadeInputs* in, const LaneWinners* L, sf
   const sfloat3 light = s3_add(s3_scale(LANE3(c), inv_exposure), s3_scale(env, uncovered));
   const sfloat3 ac = L->att_color;
   const sfloat e = dist / L->att_dist; /* no attenuation (+inf distance): 0, and pow(c, 0) = 1 */
-  return s3(light.x * pow(ac.x, e), light.y * pow(ac.y, e), light.z * pow(ac.z, e));
+  *attenuation = s3(pow(ac.x, e), pow(ac.y, e), pow(ac.z, e));
+  return s3_mul(light, *attenuation);
 }
 
 #endif

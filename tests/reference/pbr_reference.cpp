@@ -38,6 +38,19 @@ glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm
   return ((1.0 - F) * c_diff / kPi + F * (D * vis)) * nl;
 }
 
+glm::dvec3 btdf_light(const glm::dvec3& f0, double r, double ior, const glm::dvec3& n, const glm::dvec3& v,
+                      const glm::dvec3& l) {
+  const glm::dvec3 lm = l - 2.0 * glm::dot(n, l) * n, hv = lm + v;
+  const glm::dvec3 h = glm::length(hv) > 0.0 ? glm::normalize(hv) : n;
+  const double rt = std::max(r * std::clamp(2.0 * ior - 2.0, 0.0, 1.0), 0.03), a2 = std::pow(rt, 4.0);
+  const double nh = clamp01(glm::dot(n, h)), vh = clamp01(glm::dot(v, h));
+  const double nl = clamp01(glm::dot(n, lm)), nv = clamp01(glm::dot(n, v));
+  const glm::dvec3 F = f0 + (1.0 - f0) * std::pow(1.0 - vh, 5.0);
+  const double dd = nh * nh * (a2 - 1.0) + 1.0;
+  const double s = nl * std::sqrt(nv * nv * (1.0 - a2) + a2) + nv * std::sqrt(nl * nl * (1.0 - a2) + a2);
+  return (1.0 - F) * (a2 / (kPi * dd * dd)) * (s > 0.0 ? 0.5 / s : 0.0);
+}
+
 glm::dvec3 light_irradiance(const PunctualLight& light, const glm::dvec3& p, glm::dvec3& l) {
   if (light.type == LightType::Directional) {
     l = -light.direction;
@@ -72,6 +85,9 @@ glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& li
     glm::dvec3 l;
     const glm::dvec3 E = light_irradiance(light, s.p, l);
     sum += brdf_cos(s.base, s.metallic, r, s.n, v, l, s.ior, s.transmission) * E;
+    if (s.transmission > 0.0)
+      sum += s.transmission * (s.base * (1.0 - s.metallic)) * s.attenuation *
+             btdf_light(f0_of(s.base, s.metallic, s.ior), r, s.ior, s.n, v, l) * E;
   }
   const glm::dvec3 f0 = f0_of(s.base, s.metallic, s.ior), c_diff = s.base * (1.0 - s.metallic);
   const glm::dvec2 ab = env.split_sum(clamp01(glm::dot(s.n, v)), r);

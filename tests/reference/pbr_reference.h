@@ -15,6 +15,12 @@ namespace pmr::ref {
 glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
                     const glm::dvec3& l, double ior = 1.5, double transmission = 0.0);
 
+// KHR_materials_transmission's BTDF for a light in direction l seen through the surface: (1 - F(v.h))
+// D(n.h) Vis(n.l', n.v), l' = l mirrored on the surface's plane, h = normalize(l' + v), GGX of roughness
+// max(r clamp(2 ior - 2, 0, 1), 0.03).
+glm::dvec3 btdf_light(const glm::dvec3& f0, double r, double ior, const glm::dvec3& n, const glm::dvec3& v,
+                      const glm::dvec3& l);
+
 enum class LightType { Directional = 0, Point = 1, Spot = 2 };
 
 struct PunctualLight {
@@ -36,6 +42,7 @@ struct SurfacePoint {
   double ior = 1.5;                        // KHR_materials_ior
   double transmission = 0.0;               // KHR_materials_transmission
   glm::dvec3 through{0.0};                 // the light arriving through it (transmission_reference.h)
+  glm::dvec3 attenuation{1.0};             // ... and its Beer-Lambert factor, which the lights take too
   glm::dvec3 n{0.0, 0.0, 1.0};             // unit shading normal (back faces already flipped)
   glm::dvec3 p{0.0};                       // world position
   glm::dvec3 eye{0.0, 0.0, 1.0};           // the view's camera position (world)
@@ -53,7 +60,9 @@ struct EnvironmentTerms {
 
 // exposure x (sum over lights of f E dot(n, l) + ao (c_diff I(n) + (F0 A + B) P(reflect(-v, n), r)) + e);
 // unlit: exposure x base. With transmission T, the diffuse terms are weighted by 1 - T, and
-// ao T (1 - (F0 A + B)) c_diff `through` is added (KHR_materials_transmission's BTDF, DESIGN 4c).
+// ao T (1 - (F0 A + B)) c_diff `through` is added (KHR_materials_transmission's BTDF, DESIGN 4c), and
+// per light T c_diff `attenuation` (1 - F) D Vis E, the GGX lobe about the light mirrored on the
+// surface (btdf_light).
 glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& lights, const EnvironmentTerms& env,
                      double exposure);
 

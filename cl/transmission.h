@@ -77,7 +77,8 @@ inline sfloat3 transmitted_lanes(const ShadeInputs* in, const LaneWinners* L, sf
   const sfloat tl = sqrt(s3_dot(t, t));
   const sint bend = L->glass & (thickness > 0.0f) & (tl > 0.0f);
   const sfloat3 d = s3_select(s3_neg(v), s3_scale(t, 1.0f / tl), bend);
-  const sfloat dist = select((sfloat)(0.0f), thickness, bend);
+  /* (a thickness beyond float range, or times a large node scale, walks far but stays finite) */
+  const sfloat dist = select((sfloat)(0.0f), fmin(thickness, 1e30f), bend);
   const sfloat3 q = s3_add(p, s3_scale(d, dist));
   sfloat x, y;
   const sint front = project_lanes(P, q, view, &x, &y);

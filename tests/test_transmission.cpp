@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 
 #include "pbr_support.h"
@@ -412,6 +413,27 @@ TEST(Transmission, RoughTransmissionBlursMonotonicallyWithRoughness) {
   EXPECT_GT(spread[0], 0.5);
   for (int k = 1; k < 4; ++k) EXPECT_LT(spread[k], spread[k - 1]) << "roughness " << roughness[k];
   EXPECT_LT(spread[3], 0.02);
+}
+
+// Volume values at the ends of the float range (an infinite thickness, a vanishing attenuation distance,
+// a colour channel of 0) give finite colours: the walk stays finite, the attenuation goes to 0 or 1.
+TEST(Transmission, ExtremeVolumeValuesGiveFiniteColours) {
+  const Rig rig = test::small_rig(3, 32, 20);
+  Scene s = test::empty_scene(true);
+  quad(s, -4.0f, -4.0f, 4.0f, 4.0f, kWallZ, add_material(s, unlit({0.6f, 0.7f, 0.8f})));
+  PmrMaterial g = glass(0.5f, 1.5f, std::numeric_limits<float>::infinity());
+  g.attenuation_distance = 1e-30f;
+  g.attenuation_color[0] = 0.5f, g.attenuation_color[1] = 1.0f, g.attenuation_color[2] = 0.0f;
+  quad(s, -0.7f, -0.5f, 0.7f, 0.5f, kGlassZ, add_material(s, g));
+  PmrMaterial huge = glass(0.2f, 2.0f, 3e38f);
+  quad(s, -0.5f, -0.3f, 0.5f, 0.3f, 0.5f, add_material(s, huge));
+  const test::Rendered out = test::render_with(s, rig, pbr_config());
+  size_t glass_voxels = 0;
+  for (size_t v = 0; v < out.key.size(); ++v) {
+    for (int c = 0; c < 4; ++c) ASSERT_TRUE(std::isfinite(channel(out.volume, v, c))) << "voxel " << v;
+    glass_voxels += out.key[v] != PMR_NO_KEY && (out.key[v] >> PMR_KEY_SUB_BITS) >= 2;
+  }
+  EXPECT_GT(glass_voxels, size_t(100));
 }
 
 // Every path draws the same glass: a thin pane in front of a wall, both covering every view. The fused

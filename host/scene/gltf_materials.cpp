@@ -1,6 +1,7 @@
 // The materials of a glTF file (DESIGN 4b, 4c): each material's factors, its texture slots with their
 // TEXCOORD sets and KHR_texture_transform, and the material extensions pmr reads.
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -199,7 +200,7 @@ float material_number(Loader& L, double value, double fallback, double lo, doubl
            (std::isfinite(hi) ? std::to_string(hi).substr(0, 3) : std::string("inf")) + "]; clamped");
     return float(clamped);
   }
-  return float(value);
+  return float(std::clamp(value, -double(FLT_MAX), double(FLT_MAX)));  // finite as a float too
 }
 
 // The number `key` of material extension `ext` (its JSON object `value`): `fallback` when absent, or,

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstring>
 #include <new>
 #include <stdexcept>
 #include <fstream>
@@ -111,28 +112,64 @@ TEST(ExitCodes, InternalErrorExitsThreeAndWritesNothing) {
   EXPECT_TRUE(exists(out));
 }
 
-// A render stopped by SIGTERM exits 128 + 15, as SIGINT exits 130 (test_sequence).
+// A render stopped by SIGTERM, SIGHUP (a closed terminal or SSH session) or SIGALRM exits 128 + the
+// signal, as SIGINT exits 130 (test_sequence), leaving whole frames only: every image on disk has its
+// sidecar, and no temporary file is left.
 TEST(ExitCodes, SignalNExits128PlusN) {
-  const std::string out = temp_dir("sigterm");
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const std::string cmd = std::string(PMR_BINARY) +
-                            " render -q --turntable 360:50 --frames 0:49 --views 16 "
-                            "--view-size 256x128 --display 640x360 --out " +
-                            out + " > /dev/null 2>&1";
-    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), (char*)nullptr);
-    _exit(127);
+  for (int sig : {SIGTERM, SIGHUP, SIGALRM}) {
+    SCOPED_TRACE(strsignal(sig));
+    const std::string out = temp_dir("signal_" + std::to_string(sig));
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      const std::string cmd = std::string(PMR_BINARY) +
+                              " render -q --turntable 360:50 --frames 0:49 --views 16 "
+                              "--view-size 256x128 --display 640x360 --out " +
+                              out + " > /dev/null 2>&1";
+      execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), (char*)nullptr);
+      _exit(127);
+    }
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (std::chrono::steady_clock::now() < deadline && !exists(out + "/frame_0000.json"))
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    kill(pid, sig);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status));
+    if (WEXITSTATUS(status) != 0)  // a very fast machine may have finished all 50 frames first
+      EXPECT_EQ(WEXITSTATUS(status), 128 + sig);
+    for (const std::string& name : test::listing(out)) {
+      EXPECT_EQ(name[0] == '.', false) << "left behind: " << name;
+      if (name.size() > 4 && name.compare(name.size() - 4, 4, ".exr") == 0)
+        EXPECT_TRUE(exists(out + "/" + name.substr(0, name.size() - 4) + ".json")) << name << " has no sidecar";
+    }
   }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (std::chrono::steady_clock::now() < deadline && !exists(out + "/frame_0000.exr"))
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  kill(pid, SIGTERM);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFEXITED(status));
-  if (WEXITSTATUS(status) != 0)  // a very fast machine may have finished all 50 frames first
-    EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM);
+}
+
+// A closed pipe (`pmr render ... 2>&1 | head -1`) does not kill the render: it finishes every frame and
+// exits 0, its later messages lost.
+TEST(ExitCodes, AClosedPipeDoesNotStopTheRender) {
+  const std::string out = temp_dir("sigpipe");
+  const std::string cmd = "bash -c 'set -o pipefail; " + std::string(PMR_BINARY) +
+                          " render --frames 0:5 --turntable 360:6 --out " + out + kSmall +
+                          " 2>&1 | head -1 > /dev/null'";
+  EXPECT_EQ(std::system(cmd.c_str()), 0);
+  for (int f = 0; f < 6; ++f) EXPECT_TRUE(exists(out + "/frame_000" + std::to_string(f) + ".exr")) << f;
+  for (const std::string& name : test::listing(out)) EXPECT_NE(name[0], '.') << "left behind: " << name;
+}
+
+// A file-size limit smaller than a frame (ulimit -f): one error line naming the file, exit 1, no partial
+// file and no lock left (the write fails instead of SIGXFSZ killing the process).
+TEST(ExitCodes, AFileSizeLimitIsAnErrorNotACrash) {
+  const std::string out = temp_dir("fsize");
+  const std::string big = " --views 32 --view-size 1024x256 --display 320x180 --write views";
+  const CliRun warm = run("render --frames 0 --out " + out + "/warm" + big);  // the kernel cache, written first
+  ASSERT_EQ(warm.status, 0) << warm.output;
+  const CliRun r = test::run_wrapped("prlimit --fsize=3000000", "render -q --frames 0 --out " + out + "/x" + big);
+  if (r.output.find("LLVM ERROR") != std::string::npos)
+    GTEST_SKIP() << "the OpenCL compiler itself wrote a file beyond the limit: " << r.output;
+  expect_one_error_line(r, "File too large");
+  for (const std::string& name : test::listing(out + "/x")) ADD_FAILURE() << "left behind: " << name;
 }
 
 TEST(ExitCodes, NothingIsCreatedBeforeTheInputsAreChecked) {

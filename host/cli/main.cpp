@@ -11,10 +11,12 @@
 #include "cli/quality_command.h"
 #include "cli/render_command.h"
 #include "cli/verify_command.h"
+#include "output/interrupt.h"
 #include "pmr/error.h"
 #include "pmr/version.h"
 
 int main(int argc, char** argv) {
+  pmr::ignore_write_signals();
   std::vector<std::string> args(argv + 1, argv + argc);
   return pmr::run_reporting_errors([&]() -> int {
     if (args.empty() || args[0] == "-h" || args[0] == "--help" || args[0] == "help") {

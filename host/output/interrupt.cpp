@@ -27,7 +27,7 @@ void on_signal(int sig) {
     if (g_slot_state[i].load() == 2) ::unlink(g_paths[i]);
   const char msg[] = "pmr: stopped at once; temporary files removed\n";
   (void)!::write(2, msg, sizeof msg - 1);
-  ::_exit(128 + (g_signal.load() == SIGTERM ? SIGTERM : SIGINT));
+  ::_exit(128 + g_signal.load());
 }
 
 }  // namespace
@@ -38,11 +38,30 @@ void install_interrupt_handlers() {
   sa.sa_handler = on_signal;
   sa.sa_flags = SA_RESTART;  // other threads' blocking writes go on instead of failing with EINTR
   sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGALRM}) sigaction(sig, &sa, nullptr);
+}
+
+void ignore_write_signals() {
+  ::signal(SIGPIPE, SIG_IGN);
+  ::signal(SIGXFSZ, SIG_IGN);
 }
 
 int interrupt_signal() { return g_signal.load(); }
+
+const char* interrupt_signal_name(int sig) {
+  switch (sig) {
+    case SIGINT:
+      return "SIGINT";
+    case SIGTERM:
+      return "SIGTERM";
+    case SIGHUP:
+      return "SIGHUP";
+    case SIGALRM:
+      return "SIGALRM";
+    default:
+      return "a signal";
+  }
+}
 
 int register_temp_file(const std::string& path) {
   if (path.size() >= kPathMax) return -1;

@@ -1,4 +1,4 @@
-// Clean interruption of long jobs (SIGINT, SIGTERM). The first signal sets a flag that the frame loop
+// Clean interruption of long jobs (SIGINT, SIGTERM, SIGHUP: a closed terminal or SSH session, SIGALRM). The first signal sets a flag that the frame loop
 // and the writer poll: the frame in flight is abandoned, finished files stay. A second signal exits at
 // once, after unlinking every temporary file still open (AtomicFile registers them here), so no partial
 // file is left either way. Everything the handler touches is async-signal-safe: fixed slots, atomics,
@@ -10,8 +10,15 @@ namespace pmr {
 
 // Installs the handlers (idempotent). Call once before a long job starts.
 void install_interrupt_handlers();
-// 0 while running, else the first signal received (SIGINT or SIGTERM).
+// A closed pipe (`pmr render ... 2>&1 | head`) and a file-size limit (SIGPIPE, SIGXFSZ) fail the write
+// instead of killing the process: messages to a closed pipe are lost, and a file that cannot be written
+// is reported by its writer (one error, no partial file, no stale lock). Called first by main().
+void ignore_write_signals();
+// 0 while running, else the first signal received (SIGINT, SIGTERM, SIGHUP or SIGALRM); a job stopped by
+// one exits 128 + it.
 int interrupt_signal();
+// "SIGINT", "SIGTERM", "SIGHUP", "SIGALRM".
+const char* interrupt_signal_name(int sig);
 
 // Temporary files open right now (AtomicFile). register returns a slot (-1 when all are busy: the file is
 // then only cleaned up by its destructor).

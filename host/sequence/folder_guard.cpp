@@ -10,6 +10,7 @@
 #include <cctype>
 #include <cerrno>
 #include <cstdint>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -294,6 +295,7 @@ FolderGuard::FolderGuard(const std::string& dir, const std::string& pattern, con
   const ConfigDifference difference(expected);
   lock_path_ = (fs::path(dir) / own_name).string();
   fd_ = take_own_lock(dir, own_name, expected, lock_path_);
+  release_at_exit(this);
   try {
     const FolderContents found = scan_folder(dir, pattern, job_frames, own_name);
     refuse_running_configurations(dir, found.locks, difference);
@@ -306,7 +308,24 @@ FolderGuard::FolderGuard(const std::string& dir, const std::string& pattern, con
 
 FolderGuard::~FolderGuard() { release(); }
 
+// A library that gives up calls exit() (PoCL's LLVM on a failed write: "LLVM ERROR: IO failure on output
+// stream"), which runs no destructor: the guard of the run, if any, is released by an exit handler then.
+void FolderGuard::release_at_exit(FolderGuard* guard) {
+  static std::atomic<FolderGuard*> live{nullptr};
+  static const int registered = std::atexit([] {
+    if (FolderGuard* g = live.exchange(nullptr)) g->release();
+  });
+  (void)registered;
+  live.store(guard);
+  guard->live_ = &live;
+}
+
 void FolderGuard::release() {
+  if (live_) {
+    FolderGuard* self = this;
+    live_->compare_exchange_strong(self, nullptr);
+    live_ = nullptr;
+  }
   if (fd_ < 0) return;
   // the last process of this configuration removes the file (exclusive = nobody else holds it)
   if (::flock(fd_, LOCK_EX | LOCK_NB) == 0 && same_file(fd_, lock_path_)) ::unlink(lock_path_.c_str());

@@ -18,6 +18,7 @@
 // Lock files start with a dot and do not end in ".json": --name patterns cannot produce them (stems
 // are never hidden), so --resume, `pmr verify` and the sidecar scan never see them.
 #pragma once
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -41,9 +42,11 @@ class FolderGuard {
 
  private:
   void release();
+  static void release_at_exit(FolderGuard* guard);
 
   std::string lock_path_;
   int fd_ = -1;
+  std::atomic<FolderGuard*>* live_ = nullptr;  // the exit handler's pointer to this guard
 };
 
 // The lock file's name (no folder) for a --name pattern and an expected sidecar text.

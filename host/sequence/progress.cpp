@@ -33,7 +33,8 @@ void Progress::frame_done(long k, long frame, double render_ms) {
                  clock_text(elapsed).c_str(), clock_text(eta).c_str());
     line_open_ = true;
   } else {
-    std::fprintf(stderr, "pmr: frame %ld done (%ld/%ld): render %.0f ms, elapsed %s, ETA %s\n", frame, k, total_,
+    // "rendered": its files are written after it, on the writer thread (an interrupt may drop them)
+    std::fprintf(stderr, "pmr: frame %ld rendered (%ld/%ld): render %.0f ms, elapsed %s, ETA %s\n", frame, k, total_,
                  render_ms, clock_text(elapsed).c_str(), clock_text(eta).c_str());
   }
   std::fflush(stderr);

@@ -412,10 +412,12 @@ int SequenceRun::render_frames() {
   loop_cpu_s_ = process_cpu_seconds() - cpu0;
   const long written = writer.frames_written();
   if (const int sig = interrupt_signal(); sig && written < total) {
+    const long dropped = rendered_ - written;  // rendered, not yet written when the signal came
     std::fprintf(stderr,
-                 "pmr: interrupted by %s: %ld of %ld frame(s) written (%ld already complete); nothing partial "
+                 "pmr: interrupted by %s: %ld of %ld frame(s) written (%ld already complete%s); nothing partial "
                  "was left: rerun with --resume to finish\n",
-                 sig == SIGTERM ? "SIGTERM" : "SIGINT", written, total, plan_.kept);
+                 interrupt_signal_name(sig), written, total, plan_.kept,
+                 dropped > 0 ? (", " + std::to_string(dropped) + " rendered but not written").c_str() : "");
     return 128 + sig;
   }
   print_summary(writer);

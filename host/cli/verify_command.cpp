@@ -117,7 +117,9 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
     return stem + ".json was rendered from another scene than " + reference_name +
            " and the folder's other frames (scene checksums differ)";
   const std::string diff = sidecar_config_difference(folder.reference_text, text);
-  if (!diff.empty()) return stem + ".json was rendered with another configuration (" + diff + " differs)";
+  if (!diff.empty())
+    return stem + ".json was rendered with another configuration (" +
+           config_difference_text(text, folder.reference_text, diff, stem + ".json", reference_name) + ")";
   if (prov.scene != folder.scene) return stem + ".json records no scene checksum, unlike " + reference_name;
   std::vector<std::pair<std::string, nlohmann::json>> listed;  // (kind, file name as listed)
   const nlohmann::json* outputs = j.contains("outputs") && j["outputs"].is_object() ? &j["outputs"] : nullptr;
@@ -204,10 +206,12 @@ int run_verify(const std::vector<std::string>& args) {
   for (const std::string& r : rest) explicit_kinds |= r == "--write" || r == "--preview";
   const FolderScene folder = folder_scene(dir, o, frames);
   std::vector<long> bad;
+  bool configuration = false;  // a frame of another configuration: --resume refuses it, --overwrite redoes it
   for (long f : frames) {
     const std::string problem = check_frame(dir, o, explicit_kinds, deep, f, folder);
     if (problem.empty()) continue;
     bad.push_back(f);
+    configuration |= problem.find("rendered with another configuration") != std::string::npos;
     std::fprintf(stderr, "pmr verify: frame %ld: %s\n", f, problem.c_str());
   }
   if (folder.versions.size() > 1) {  // not a problem: versions do not change pixels (docs/SEQUENCES.md)
@@ -217,7 +221,10 @@ int run_verify(const std::vector<std::string>& args) {
                  folder.versions.size(), list.c_str());
   }
   std::fprintf(stderr, "pmr verify: %zu of %zu frame(s) complete%s\n", frames.size() - bad.size(), frames.size(),
-               bad.empty() ? "" : "; resubmit the list below with --resume");
+               bad.empty()     ? ""
+               : configuration ? "; resubmit the list below with the folder's configuration and --overwrite (some "
+                                 "frames were rendered with another configuration, which --resume refuses)"
+                               : "; resubmit the list below with --resume");
   if (bad.empty()) return 0;
   std::printf("%s\n", format_frame_list(bad).c_str());
   return 1;

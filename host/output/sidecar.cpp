@@ -10,6 +10,7 @@
 #include "output/checksum.h"
 #include "pmr/error.h"
 #include "pmr/output.h"
+#include "pmr/printable.h"
 #include "pmr/version.h"
 #include "shading/lights.h"
 
@@ -328,6 +329,48 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   std::string text;
   emit(j, 0, text);
   return text + "\n";
+}
+
+namespace {
+
+// The path and values of the first leaf where a and b differ (objects by key, arrays by index).
+bool first_difference(const nlohmann::json& a, const nlohmann::json& b, std::string& path, std::string& va,
+                      std::string& vb) {
+  if (a == b) return false;
+  if (a.is_object() && b.is_object()) {
+    for (auto it = b.begin(); it != b.end(); ++it)
+      if (!a.contains(it.key()) || a[it.key()] != it.value()) {
+        path += "." + it.key();
+        return a.contains(it.key()) ? first_difference(a[it.key()], it.value(), path, va, vb)
+                                    : (va = "absent", vb = it.value().dump(), true);
+      }
+    for (auto it = a.begin(); it != a.end(); ++it)
+      if (!b.contains(it.key())) return path += "." + it.key(), va = it.value().dump(), vb = "absent", true;
+  }
+  if (a.is_array() && b.is_array() && a.size() == b.size())
+    for (size_t i = 0; i < a.size(); ++i)
+      if (a[i] != b[i]) return path += "[" + std::to_string(i) + "]", first_difference(a[i], b[i], path, va, vb);
+  va = a.dump(), vb = b.dump();
+  return true;
+}
+
+std::string short_value(const std::string& v) { return printable_text(v.size() > 40 ? v.substr(0, 37) + "..." : v); }
+
+}  // namespace
+
+std::string config_difference_text(const std::string& existing, const std::string& expected, const std::string& key,
+                                   const std::string& existing_label, const std::string& expected_label) {
+  const std::string plain = key + " differs";
+  try {
+    const nlohmann::json a = nlohmann::json::parse(existing), b = nlohmann::json::parse(expected);
+    if (!a.is_object() || !b.is_object() || !a.contains(key) || !b.contains(key)) return plain;
+    std::string path = key, va, vb;
+    if (!first_difference(a[key], b[key], path, va, vb)) return plain;
+    return plain + ": " + printable_text(path) + " " + short_value(va) + " in " + existing_label + ", " +
+           short_value(vb) + " in " + expected_label;
+  } catch (const std::exception&) {
+    return plain;
+  }
 }
 
 std::string sidecar_config_difference(const std::string& existing, const std::string& expected,

@@ -79,6 +79,11 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
 // scene (sidecar_provenance), only the configuration the user chose matters.
 std::string sidecar_config_difference(const std::string& existing, const std::string& expected,
                                       bool ignore_scene_derived = false);
+// The message for a difference `key` that sidecar_config_difference found: "KEY differs", and the first
+// differing value under it, e.g. "shading differs: shading.exposure_ev 0 in the folder, 1 in this run"
+// (labels: where `existing` and `expected` come from; values shortened and made printable).
+std::string config_difference_text(const std::string& existing, const std::string& expected, const std::string& key,
+                                   const std::string& existing_label, const std::string& expected_label);
 
 // Where a sidecar's frame came from. Never throws: a damaged or old sidecar gives empty strings.
 struct SidecarProvenance {

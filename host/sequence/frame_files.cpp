@@ -125,14 +125,15 @@ std::string frame_problem(const std::string& sidecar, const std::vector<std::str
     if (r != recorded.end()) {  // the quick check: size, structure, checksum
       const auto size = fs::file_size(p, ec);
       if (ec) return name(p) + " cannot be read";
-      if (uint64_t(size) < r->second.bytes)
+      const std::string problem = is_png(p) ? std::string() : exr_chunk_problem(p);
+      // a whole file of another size is another file (e.g. another frame's copied over it)
+      if (uint64_t(size) < r->second.bytes && !problem.empty())
         return name(p) + " is truncated (" + std::to_string(size) + " of " + std::to_string(r->second.bytes) +
                " bytes)";
       if (uint64_t(size) != r->second.bytes)
         return name(p) + " is not the file its sidecar records (" + std::to_string(size) + " bytes, recorded " +
                std::to_string(r->second.bytes) + ")";
-      if (!is_png(p))
-        if (const std::string problem = exr_chunk_problem(p); !problem.empty()) return problem;
+      if (!problem.empty()) return problem;
       std::string sum;
       try {
         sum = checksum_file(p);

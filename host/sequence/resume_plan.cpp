@@ -65,8 +65,9 @@ ResumePlan plan_resume(const std::vector<long>& frames, bool resume, bool overwr
         continue;
       }
       if (!diff.empty() && !overwrite)
-        throw Error("--resume: " + p.sidecar + " was rendered with a different configuration (" + diff +
-                    " differs); use --overwrite to re-render such frames, or another --out folder");
+        throw Error("--resume: " + p.sidecar + " was rendered with a different configuration (" +
+                    config_difference_text(existing, want, diff, "the folder", "this run") +
+                    "); use --overwrite to re-render such frames, or another --out folder");
       if (diff.empty()) {
         other_scene.push_back(base_name(p.sidecar));
         unrecorded += had.scene.empty();

@@ -188,6 +188,25 @@ TEST(Verify, SidecarRecordsEveryOutputsSizeAndChecksum) {
   }
 }
 
+// Without --frames, verify checks the frames whose sidecars the folder holds, and says that a frame
+// missing altogether is not found that way; a folder without any is one error line.
+TEST(Verify, WithoutFramesChecksTheFramesTheFolderHolds) {
+  const std::string out = test::temp_dir("verify_no_frames");
+  const std::string args = " --views 4 --view-size 64x32 --display 240x135 --turntable 360:6 --out " + out;
+  ASSERT_EQ(test::run("render --frames 0:3 -q" + args).status, 0);
+  fs::remove(out + "/frame_0003.json");  // frame 3 is then not a frame of the folder (its image stays)
+  fs::resize_file(out + "/frame_0001.exr", fs::file_size(out + "/frame_0001.exr") / 2);
+  const test::CliRun v = test::run("verify " + out);
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("no --frames: checking the 3 frame(s) the folder holds (0:2)"), std::string::npos)
+      << v.output;
+  EXPECT_NE(v.output.find("frame 1: frame_0001.exr is truncated"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("2 of 3 frame(s) complete"), std::string::npos) << v.output;
+  const std::string empty = test::temp_dir("verify_no_frames_empty");
+  fs::create_directories(empty);
+  test::expect_one_error_line(test::run("verify " + empty), "holds no frame sidecars");
+}
+
 TEST(Verify, QuickCheckFindsChangedAndDamagedFilesWithoutDecoding) {
   const std::string out = test::temp_dir("verify_quick");
   const std::string args = " --views 4 --view-size 64x32 --display 240x135 --turntable 360:6 --out " + out;
@@ -311,7 +330,7 @@ TEST(Verify, ReportsMissingAndBrokenFramesAsAFramesList) {
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("3 frame(s) in"), std::string::npos) << r.output;
   EXPECT_EQ(test::run("verify " + out + " --frames 0:7").status, 0);
-  test::expect_usage_error(test::run("verify " + out), "--frames");
+  test::expect_usage_error(test::run("verify " + out + " --frames all"), "--frames");
   test::expect_one_error_line(test::run("verify /nonexistent --frames 0"), "not a folder");
 }
 

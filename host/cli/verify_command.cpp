@@ -18,6 +18,7 @@
 #include "pmr/error.h"
 #include "output/sidecar.h"
 #include "pmr/output.h"
+#include "sequence/folder_guard.h"
 #include "sequence/frame_files.h"
 #include "sequence/frame_list.h"
 
@@ -28,15 +29,17 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string verify_help() {
-  return "usage: pmr verify DIR --frames LIST [--write LIST] [--name PATTERN] [--preview] [--deep]\n"
+  return "usage: pmr verify DIR [--frames LIST] [--write LIST] [--name PATTERN] [--preview] [--deep]\n"
          "Checks that every listed frame in DIR is complete: its sidecar names the frame and its time, was\n"
          "rendered from the same scene as the folder's other frames (the scene checksums it records; the\n"
          "scene most frames show counts as the folder's) and with the same configuration, and every output\n"
          "it lists exists as a regular file in DIR and is the file the sidecar records: its size and checksum,\n"
          "and for an EXR its chunk table, without decoding pixels. --deep decodes every pixel as well (as\n"
          "for frames whose sidecar records no checksums, written by an older pmr). --write LIST (and --preview\n"
-         "for the PNGs) checks just those kinds of output instead. Prints the missing or broken frames on\n"
-         "stdout as a --frames list to resubmit (with --resume); exit code 1 if there are any.\n";
+         "for the PNGs) checks just those kinds of output instead. Without --frames, the frames whose sidecars\n"
+         "DIR holds are checked (a frame missing altogether is then not found). Prints the missing or broken\n"
+         "frames on stdout as a --frames list to resubmit (with --resume; frames of another configuration\n"
+         "with --overwrite); exit code 1 if there are any.\n";
 }
 
 // A listed output must be a plain file name in the frame's folder.
@@ -163,6 +166,25 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
   return printable_text(frame_problem(sidecar, images, deep), std::string::npos);
 }
 
+// Without --frames: the frames whose sidecars the folder holds (under --name's pattern), said so, since
+// a frame missing altogether cannot be named then.
+std::vector<long> frames_in_folder(const std::string& dir, const RenderOptions& o) {
+  std::vector<long> frames;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir)) {
+    const long f = sidecar_frame(o.job.products.name, e.path().filename().string());
+    if (f >= 0) frames.push_back(f);
+  }
+  if (frames.empty())
+    throw Error(dir + " holds no frame sidecars named as --name " + printable_text(o.job.products.name) +
+                " makes them; give --frames LIST, the frames the job was asked for");
+  std::sort(frames.begin(), frames.end());
+  std::fprintf(stderr,
+               "pmr verify: no --frames: checking the %zu frame(s) the folder holds (%s); a frame missing altogether "
+               "is only found with --frames\n",
+               frames.size(), format_frame_list(frames).c_str());
+  return frames;
+}
+
 }  // namespace
 
 int run_verify(const std::vector<std::string>& args) {
@@ -194,14 +216,15 @@ int run_verify(const std::vector<std::string>& args) {
   if (dir.empty()) throw UsageError("pmr verify needs the output folder (see pmr verify --help)");
   bool frames_given = false;
   for (const std::string& r : rest) frames_given |= r == "--frames";
-  if (!frames_given) throw UsageError("pmr verify needs --frames LIST (the frames the job was asked for)");
   const RenderOptions o = parse_render_options(rest);
-  if (o.job.frames == "all")
+  if (frames_given && o.job.frames == "all")
     throw UsageError("pmr verify needs the frames as a list (--frames all depends on the scene)");
-  const std::vector<long> frames = as_usage([&] { return parse_frame_list(o.job.frames); });
-  as_usage([&] { check_name_covers_frames(o.job.products.name, frames.size()); });
+  std::vector<long> frames;  // a usage error in the list comes before any look at the folder
+  if (frames_given) frames = as_usage([&] { return parse_frame_list(o.job.frames); });
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) throw Error("cannot verify " + dir + ": not a folder");
+  if (!frames_given) frames = frames_in_folder(dir, o);
+  as_usage([&] { check_name_covers_frames(o.job.products.name, frames.size()); });
   bool explicit_kinds = false;
   for (const std::string& r : rest) explicit_kinds |= r == "--write" || r == "--preview";
   const FolderScene folder = folder_scene(dir, o, frames);

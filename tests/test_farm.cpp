@@ -207,6 +207,32 @@ TEST(Verify, WithoutFramesChecksTheFramesTheFolderHolds) {
   test::expect_one_error_line(test::run("verify " + empty), "holds no frame sidecars");
 }
 
+// The scene as it is now decides, not the folder's majority: after the scene changes, every frame is
+// stale; after one shard re-renders with --resume, its frames are complete and the others are listed;
+// resubmitting that list with --resume completes the folder (the loop ends).
+TEST(Verify, TheSceneAsItIsNowDecidesWhichFramesAreStale) {
+  const std::string dir = test::temp_dir("verify_scene_now");
+  fs::create_directories(dir);
+  const std::string scene = dir + "/scene.glb", out = dir + "/out";
+  fs::copy_file(std::string(PMR_SOURCE_DIR) + "/data/default_scene.glb", scene);
+  const std::string args = " --views 4 --view-size 64x32 --display 240x135 --turntable 360:6 -q --out " + out;
+  ASSERT_EQ(test::run("render '" + scene + "' --frames 0:5" + args).status, 0);
+  test::save_square_glb(scene);  // another version of the scene file
+  test::CliRun v = test::run("verify " + out + " --frames 0:5");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frame 0: frame_0000.json was rendered from another version of the scene (scene.glb "
+                          "differs now)"),
+            std::string::npos)
+      << v.output;
+  EXPECT_NE(v.output.find("0 of 6 frame(s) complete"), std::string::npos) << v.output;
+  ASSERT_EQ(test::run("render '" + scene + "' --frames 0:5 --shard 0/3 --resume" + args).status, 0);  // 0, 3
+  v = test::run("verify " + out + " --frames 0:5");
+  EXPECT_NE(v.output.find("2 of 6 frame(s) complete"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("\n1:2,4:5\n"), std::string::npos) << v.output;
+  ASSERT_EQ(test::run("render '" + scene + "' --frames 1:2,4:5 --resume" + args).status, 0);
+  EXPECT_EQ(test::run("verify " + out + " --frames 0:5").status, 0);
+}
+
 TEST(Verify, QuickCheckFindsChangedAndDamagedFilesWithoutDecoding) {
   const std::string out = test::temp_dir("verify_quick");
   const std::string args = " --views 4 --view-size 64x32 --display 240x135 --turntable 360:6 --out " + out;

@@ -16,6 +16,7 @@
 
 #include "cli/options.h"
 #include "pmr/error.h"
+#include "output/checksum.h"
 #include "output/sidecar.h"
 #include "pmr/output.h"
 #include "sequence/folder_guard.h"
@@ -31,8 +32,9 @@ namespace fs = std::filesystem;
 std::string verify_help() {
   return "usage: pmr verify DIR [--frames LIST] [--write LIST] [--name PATTERN] [--preview] [--deep]\n"
          "Checks that every listed frame in DIR is complete: its sidecar names the frame and its time, was\n"
-         "rendered from the same scene as the folder's other frames (the scene checksums it records; the\n"
-         "scene most frames show counts as the folder's) and with the same configuration, and every output\n"
+         "rendered from the scene as it is now (the checksums it records of the scene file and the files it\n"
+         "reads; where the scene cannot be read, the version most frames show) and with the same\n"
+         "configuration as the folder's other frames, and every output\n"
          "it lists exists as a regular file in DIR and is the file the sidecar records: its size and checksum,\n"
          "and for an EXR its chunk table, without decoding pixels. --deep decodes every pixel as well (as\n"
          "for frames whose sidecar records no checksums, written by an older pmr). --write LIST (and --preview\n"
@@ -94,10 +96,56 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
   return folder;
 }
 
+// The scene files as they are now, read once each: the scene the sidecars name and the files they list
+// beside it. Only regular files are read, listed files only inside the scene's folder.
+struct SceneNow {
+  std::map<std::string, std::string> sums;  // path -> XXH3-64, "" when it cannot be read
+  bool scene_unreadable = false;            // a sidecar's scene cannot be read: the folder's majority decides
+
+  std::string sum(const std::string& path) {
+    auto it = sums.find(path);
+    if (it != sums.end()) return it->second;
+    std::string s;
+    std::error_code ec;
+    if (fs::is_regular_file(path, ec)) try {
+        s = checksum_file(path);
+      } catch (const std::exception&) {}
+    return sums[path] = s;
+  }
+};
+
+bool inside_folder(const std::string& name) {
+  const fs::path p(name);
+  if (name.empty() || p.is_absolute()) return false;
+  for (const fs::path& part : p)
+    if (part == "..") return false;
+  return true;
+}
+
+// The first file of the scene a frame's sidecar records that differs now (changed, gone or not a plain
+// name), "" when every one is as recorded or the sidecar records no checksums.
+std::string changed_scene_file(const nlohmann::json& j, SceneNow& now) {
+  const auto c = j.find("checksums");
+  if (c == j.end() || !c->is_object() || c->value("algorithm", "") != "XXH3-64" || !j.contains("scene") ||
+      !j["scene"].is_string())
+    return "";
+  const std::string scene = j["scene"].get<std::string>();
+  const std::string sum = now.sum(scene);
+  if (sum.empty()) return now.scene_unreadable = true, "";
+  if (c->value("scene", "") != sum) return fs::path(scene).filename().string();
+  const auto files = c->find("scene_files");
+  if (files == c->end() || !files->is_object()) return "";
+  for (auto it = files->begin(); it != files->end(); ++it)
+    if (!inside_folder(it.key()) || !it.value().is_string() ||
+        now.sum((fs::path(scene).parent_path() / it.key()).string()) != it.value().get<std::string>())
+      return it.key();
+  return "";
+}
+
 // What is wrong with one frame ("" if nothing), given what the folder's frames were rendered from.
 // explicit_kinds: --write / --preview were given, check those kinds; else every output the sidecar lists.
 std::string check_frame(const std::string& dir, const RenderOptions& o, bool explicit_kinds, bool deep, long f,
-                        const FolderScene& folder) {
+                        const FolderScene& folder, SceneNow& now) {
   const std::string stem = frame_stem(o.job.products.name, f);
   const std::string sidecar = sidecar_path(dir, o, f);
   std::error_code ec;
@@ -116,14 +164,19 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
     return stem + ".json has a time that is not frame / fps";
   const SidecarProvenance prov = sidecar_provenance(text);
   const std::string reference_name = frame_stem(o.job.products.name, folder.reference_frame) + ".json";
-  if (!prov.scene.empty() && prov.scene != folder.scene)
+  // the scene as it is now decides; the folder's majority only where the scene cannot be read
+  if (const std::string changed = changed_scene_file(j, now); !changed.empty())
+    return stem + ".json was rendered from another version of the scene (" + printable_text(changed) + " differs now)";
+  if (now.scene_unreadable && !prov.scene.empty() && prov.scene != folder.scene)
     return stem + ".json was rendered from another scene than " + reference_name +
            " and the folder's other frames (scene checksums differ)";
-  const std::string diff = sidecar_config_difference(folder.reference_text, text);
+  // (frames of two versions of the scene differ in what follows from its content: bounds, pivot, lights)
+  const std::string diff = sidecar_config_difference(folder.reference_text, text, prov.scene != folder.scene);
   if (!diff.empty())
     return stem + ".json was rendered with another configuration (" +
            config_difference_text(text, folder.reference_text, diff, stem + ".json", reference_name) + ")";
-  if (prov.scene != folder.scene) return stem + ".json records no scene checksum, unlike " + reference_name;
+  if (prov.scene.empty() && !folder.scene.empty())
+    return stem + ".json records no scene checksum, unlike " + reference_name;
   std::vector<std::pair<std::string, nlohmann::json>> listed;  // (kind, file name as listed)
   const nlohmann::json* outputs = j.contains("outputs") && j["outputs"].is_object() ? &j["outputs"] : nullptr;
   if (explicit_kinds) {
@@ -229,14 +282,19 @@ int run_verify(const std::vector<std::string>& args) {
   for (const std::string& r : rest) explicit_kinds |= r == "--write" || r == "--preview";
   const FolderScene folder = folder_scene(dir, o, frames);
   std::vector<long> bad;
+  SceneNow now;
   bool configuration = false;  // a frame of another configuration: --resume refuses it, --overwrite redoes it
   for (long f : frames) {
-    const std::string problem = check_frame(dir, o, explicit_kinds, deep, f, folder);
+    const std::string problem = check_frame(dir, o, explicit_kinds, deep, f, folder, now);
     if (problem.empty()) continue;
     bad.push_back(f);
     configuration |= problem.find("rendered with another configuration") != std::string::npos;
     std::fprintf(stderr, "pmr verify: frame %ld: %s\n", f, problem.c_str());
   }
+  if (now.scene_unreadable)
+    std::fprintf(stderr,
+                 "pmr verify: note: the scene the sidecars name cannot be read from here: frames are compared with "
+                 "the scene most of them were rendered from\n");
   if (folder.versions.size() > 1) {  // not a problem: versions do not change pixels (docs/SEQUENCES.md)
     std::string list;
     for (const std::string& v : folder.versions) list += (list.empty() ? "" : ", ") + printable_text(v);

@@ -202,6 +202,11 @@ TEST(Verify, WithoutFramesChecksTheFramesTheFolderHolds) {
       << v.output;
   EXPECT_NE(v.output.find("frame 1: frame_0001.exr is truncated"), std::string::npos) << v.output;
   EXPECT_NE(v.output.find("2 of 3 frame(s) complete"), std::string::npos) << v.output;
+  // a writer killed with SIGKILL leaves its temporary file: named, though no frame needs it
+  std::ofstream(out + "/.frame_0002.exr.tmp-4242-7") << "partial";
+  EXPECT_NE(test::run("verify " + out)
+                .output.find("note: 1 temporary file(s) of writers that did not finish (.frame_0002.exr.tmp-4242-7)"),
+            std::string::npos);
   const std::string empty = test::temp_dir("verify_no_frames_empty");
   fs::create_directories(empty);
   test::expect_one_error_line(test::run("verify " + empty), "holds no frame sidecars");

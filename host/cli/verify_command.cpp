@@ -238,6 +238,26 @@ std::vector<long> frames_in_folder(const std::string& dir, const RenderOptions& 
   return frames;
 }
 
+// The temporary files writers leave when they are killed (AtomicFile's ".NAME.tmp-PID-N"): no frame
+// needs them, and a run in progress has its own; the names, sorted.
+std::vector<std::string> leftover_temporaries(const std::string& dir) {
+  std::vector<std::string> found;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    const size_t at = name.rfind(".tmp-");
+    if (name.size() < 2 || name[0] != '.' || at == std::string::npos || at < 2) continue;
+    const std::string tail = name.substr(at + 5);
+    const size_t dash = tail.find('-');
+    auto digits = [](const std::string& s) {
+      return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+    };
+    if (dash != std::string::npos && digits(tail.substr(0, dash)) && digits(tail.substr(dash + 1)))
+      found.push_back(name);
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
 }  // namespace
 
 int run_verify(const std::vector<std::string>& args) {
@@ -291,6 +311,12 @@ int run_verify(const std::vector<std::string>& args) {
     configuration |= problem.find("rendered with another configuration") != std::string::npos;
     std::fprintf(stderr, "pmr verify: frame %ld: %s\n", f, problem.c_str());
   }
+  if (const std::vector<std::string> temps = leftover_temporaries(dir); !temps.empty())
+    std::fprintf(stderr,
+                 "pmr verify: note: %zu temporary file(s) of writers that did not finish (%s%s): no frame needs "
+                 "them; remove them once no pmr process writes into %s\n",
+                 temps.size(), printable_text(temps[0]).c_str(), temps.size() > 1 ? ", ..." : "",
+                 printable_text(dir).c_str());
   if (now.scene_unreadable)
     std::fprintf(stderr,
                  "pmr verify: note: the scene the sidecars name cannot be read from here: frames are compared with "

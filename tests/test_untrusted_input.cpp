@@ -531,5 +531,35 @@ TEST_F(UntrustedInput, NamesFromFilesReachTheTerminalSanitized) {
   fs::remove(dir_.parent_path() / (evil + ".png"));
 }
 
+// The scene file's own name, a stranger's on a farm (ESC, CSI, BEL, CR and U+202E, the bidirectional
+// override): pmr info, every warning and the render's header print it escaped.
+TEST_F(UntrustedInput, TheScenesOwnFileNameReachesTheTerminalSanitized) {
+  EXPECT_EQ(terminal_text("a\xe2\x80\xae"
+                          "b"),
+            "a\\xe2\\x80\\xaeb")
+      << "U+202E";
+  EXPECT_EQ(terminal_text("\xe2\x81\xa6x\xe2\x80\x8f"), "\\xe2\\x81\\xa6x\\xe2\\x80\\x8f") << "U+2066, U+200F";
+  TexturedTriangle t;
+  t.g.doc["materials"][0]["pbrMetallicRoughness"]["metallicFactor"] = 3;  // a warning naming the file
+  const std::string evil =
+      "s\x1b[31m\x07\r\xe2\x80\xae"
+      "cene";
+  const std::string scene = t.write(dir_, evil, {{"uri", "names.png"}});
+  write_bytes(dir_ / "names.png", make_png(1, 1, 6, 8, {1, 2, 3, 4}));
+  auto raw = [](const std::string& out) {
+    for (unsigned char c : out)
+      if ((c < 0x20 && c != '\n') || c == 0x7f) return true;
+    return out.find("\xe2\x80\xae") != std::string::npos;
+  };
+  CliRun r = run("info '" + scene + "'");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_FALSE(raw(r.output)) << r.output;
+  EXPECT_TRUE(contains(r.output, "s\\x1b[31m\\x07\\x0d\\xe2\\x80\\xaecene")) << r.output;
+  r = run("render '" + scene + "' --views 4 --view-size 32x16 --display 64x36 --out '" + (dir_ / "out").string() + "'");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "pmr: warning:")) << r.output;
+  EXPECT_FALSE(raw(r.output)) << r.output;
+}
+
 }  // namespace
 }  // namespace pmr::test

@@ -7,6 +7,7 @@
 
 #include "cli/option_table.h"
 #include "cli/options.h"
+#include "pmr/printable.h"
 #include "pmr/error.h"
 
 namespace pmr {
@@ -202,7 +203,7 @@ BenchOptions parse_bench_options(const std::vector<std::string>& args) {
   std::vector<std::string> warnings;
   check_environment_options(o.environment_source, o.environment_given, o.environment_rotation_given, o.shading,
                             warnings);
-  for (const std::string& w : warnings) std::fprintf(stderr, "pmr: warning: %s\n", w.c_str());
+  for (const std::string& w : warnings) std::fprintf(stderr, "pmr: warning: %s\n", terminal_text(w).c_str());
   const bool subpixel = std::find(o.samplings.begin(), o.samplings.end(), Sampling::Subpixel) != o.samplings.end();
   // subpixel rows are measured for pmr alone (the other methods' rows are skipped)
   if (subpixel) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "pmr/printable.h"
 #include "pmr/error.h"
 #include "pmr/memory_budget.h"
 #include "pmr/scene.h"
@@ -116,7 +117,7 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
   set_memory_budget(limits.memory);
   const Scene s = load_scene(path, limits);
   const SceneStructure& d = s.structure;
-  std::printf("scene: %s%s\n", path.c_str(),
+  std::printf("scene: %s%s\n", terminal_text(path).c_str(),
               d.generator.empty() ? "" : (" (generator: " + printable_text(d.generator, 120) + ")").c_str());
   std::printf("triangles: %zu, vertices: %zu (%zu mesh instance(s) of %zu mesh(es), %zu primitive(s), %zu node(s))\n",
               s.triangles.size(), s.positions.size(), d.mesh_instances, d.meshes, d.primitives, d.nodes);
@@ -170,7 +171,7 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
                 0.5 * glm::length(hi - lo));
   else std::printf("bounds: none (no triangles)\n");
   std::printf("warnings: %zu\n", s.warnings.size());
-  for (const std::string& w : s.warnings) std::printf("  %s\n", w.c_str());
+  for (const std::string& w : s.warnings) std::printf("  %s\n", terminal_text(w).c_str());
 }
 
 }  // namespace

@@ -38,6 +38,9 @@ size_t printable_utf8_length(const std::string& text, size_t i) {
   static const uint32_t min_for_length[5] = {0, 0, 0x80, 0x800, 0x10000};
   if (cp < min_for_length[n] || cp > 0x10ffff || (cp >= 0xd800 && cp <= 0xdfff)) return 0;  // overlong, surrogate
   if (cp < 0xa0) return 0;  // C1 controls (U+009B is CSI)
+  // bidirectional formatting (U+202E turns the rest of a line around): shown as bytes, not obeyed
+  if (cp == 0x061c || cp == 0x200e || cp == 0x200f || (cp >= 0x202a && cp <= 0x202e) || (cp >= 0x2066 && cp <= 0x2069))
+    return 0;
   return n;
 }
 

@@ -52,7 +52,8 @@ double process_cpu_seconds() {
   return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
-void warn(const std::string& w) { std::fprintf(stderr, "pmr: warning: %s\n", w.c_str()); }
+// Warnings name the scene's file, which is a stranger's name on a farm: made safe for the terminal.
+void warn(const std::string& w) { std::fprintf(stderr, "pmr: warning: %s\n", terminal_text(w).c_str()); }
 
 // One run of a job, step by step (run()).
 class SequenceRun {
@@ -248,9 +249,10 @@ void SequenceRun::print_header() const {
   if (job_.quiet) return;
   const Rig& rig = renderer_->rig();
   std::fprintf(stderr, "pmr: %s: %zu triangles, %d views of %dx%d -> %dx%d display%s; %zu frame(s)%s\n",
-               job_.scene.c_str(), scene_.triangles.size(), rig.views, rig.view_w, rig.view_h, job_.display.width,
-               job_.display.height, job_.pipeline.sampling == Sampling::Subpixel ? " (subpixel sampling)" : "",
-               plan_.todo.size(), plan_.kept ? (", " + std::to_string(plan_.kept) + " already complete").c_str() : "");
+               terminal_text(job_.scene).c_str(), scene_.triangles.size(), rig.views, rig.view_w, rig.view_h,
+               job_.display.width, job_.display.height,
+               job_.pipeline.sampling == Sampling::Subpixel ? " (subpixel sampling)" : "", plan_.todo.size(),
+               plan_.kept ? (", " + std::to_string(plan_.kept) + " already complete").c_str() : "");
 }
 
 int SequenceRun::run() {

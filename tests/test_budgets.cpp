@@ -230,6 +230,34 @@ TEST_F(Budgets, JsonIsBoundedBySizeAndByWhatParsingItTakes) {
   expect_one_error_line(run("info " + glb + " --limit json-bytes=64"), "the JSON chunk has ");
 }
 
+// Decoded textures count against the memory budget before each is decoded: four 16-bit 2048x2048
+// images (8 MB files, 32 MB decoded each) under --limit memory=96M are refused in one line naming the
+// image, the same scene loads under the default budget.
+TEST_F(Budgets, DecodedTexturesAreInTheMemoryBudget) {
+  GltfFile g;
+  const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
+  const int uv = g.data<float>({0, 0, 1, 0, 0, 1}, kFloat, "VEC2");
+  const std::vector<uint8_t> grey(size_t(2048) * 2048 * 2, 0x80);
+  for (int k = 0; k < 4; ++k) {
+    write_bytes(dir_ / ("t" + std::to_string(k) + ".png"), make_png(2048, 2048, 0, 16, grey));
+    g.add("images", {{"uri", "t" + std::to_string(k) + ".png"}});
+    g.add("textures", {{"source", k}});
+  }
+  g.add("materials",
+        {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}, {"metallicRoughnessTexture", {{"index", 1}}}}},
+         {"occlusionTexture", {{"index", 2}}},
+         {"emissiveTexture", {{"index", 3}}}});
+  g.mesh(json::array({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"material", 0}}}));
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  write_bytes(dir_ / "textures.bin", g.bin);
+  std::ofstream(dir_ / "textures.gltf") << g.finished("textures.bin").dump();
+  const std::string scene = (dir_ / "textures.gltf").string();
+  expect_one_error_line(run("info " + scene + " --limit memory=96M"),
+                        "MiB, more than the memory budget leaves the scene's decoded images");
+  EXPECT_EQ(run("info " + scene).status, 0);
+}
+
 // ---- framing ----------------------------------------------------------------------------------------------
 
 // The 994-byte hang: implicit vertices and a translation 41,666 s long. The framing would pose the

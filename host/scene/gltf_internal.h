@@ -90,10 +90,11 @@ std::string resolve_uri(const std::string& base_dir, const std::string& uri);
 // ---- texture_decode.cpp -------------------------------------------------------------------------------
 
 // Decodes a PNG or JPEG into `image` as tinygltf's own loader does (4 channels of 8 or 16 bits, rows
-// top first) after reading its header: an image of more than `max_pixels` pixels is not decoded and
-// sets `over_limit`. Returns "" when decoded, else why not.
+// top first) after reading its header: an image of more than `max_pixels` pixels, or whose decoded
+// bytes exceed `memory_left` (what the memory budget leaves the decoded images), is not decoded and sets
+// `over_limit`. Returns "" when decoded, else why not.
 std::string decode_image(tinygltf::Image& image, const unsigned char* bytes, int size, uint64_t max_pixels,
-                         bool& over_limit);
+                         uint64_t memory_left, bool& over_limit);
 
 // ---- gltf_validate.cpp: after tinygltf ------------------------------------------------------------
 

@@ -96,7 +96,8 @@ bool load_image(tinygltf::Image* image, int index, std::string*, std::string*, i
     return true;
   }
   bool over = false;
-  const std::string why = decode_image(*image, bytes, size, ctx->max_pixels, over);
+  const std::string why = decode_image(*image, bytes, size, ctx->max_pixels, ctx->memory_left, over);
+  if (why.empty()) ctx->memory_left -= std::min<uint64_t>(ctx->memory_left, image->image.size());
   if (over) {
     const std::string name = image->uri.empty() || image->uri.rfind("data:", 0) == 0 ? image->name : image->uri;
     ctx->over_limit = "image " + std::to_string(index) + (name.empty() ? "" : " '" + one_line(name) + "'") + ": " + why;
@@ -678,6 +679,7 @@ Scene load_scene(const std::string& path, const InputLimits& limits) {
   tinygltf::Model model;
   ImageContext images;
   images.max_pixels = limits.texture_pixels;
+  images.memory_left = memory_budget() - std::min(memory_budget(), device_bytes_in_use());
   std::map<std::string, std::string> files_read;
   load_model(path, src, model, images, files_read);
   check_animation_budget(model, limits, path);

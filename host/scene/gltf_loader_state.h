@@ -20,6 +20,7 @@ struct ImageContext {
   const tinygltf::Model* model = nullptr;  // the model tinygltf is filling (buffers come before images)
   const std::set<int>* wanted = nullptr;   // images to decode
   uint64_t max_pixels = 0;                 // the texture-pixels budget
+  uint64_t memory_left = 0;                // the memory budget left for decoded images (less as they come)
   std::map<int, std::string> failures;     // image index -> why it could not be decoded
   std::string over_limit;                  // the first image over the budget: an error after parsing
 };

@@ -51,7 +51,7 @@ std::vector<unsigned char> without_empty_idat(const unsigned char* bytes, size_t
 }  // namespace
 
 std::string decode_image(tinygltf::Image& image, const unsigned char* bytes, int size, uint64_t max_pixels,
-                         bool& over_limit) {
+                         uint64_t memory_left, bool& over_limit) {
   over_limit = false;
   int w = 0, h = 0, comp = 0;
   if (!stbi_info_from_memory(bytes, size, &w, &h, &comp))
@@ -69,6 +69,12 @@ std::string decode_image(tinygltf::Image& image, const unsigned char* bytes, int
   if (decoded > uint64_t(INT_MAX))
     return size_text + " decodes to " + std::to_string(decoded) +
            " bytes, more than the image decoder can address (2 GiB)";
+  if (decoded > memory_left) {
+    over_limit = true;
+    return size_text + " decodes to " + std::to_string(decoded >> 20) +
+           " MiB, more than the memory budget leaves the scene's decoded images (" + std::to_string(memory_left >> 20) +
+           " MiB; raise it with --limit memory=N)";
+  }
   const std::vector<unsigned char> cleaned = without_empty_idat(bytes, size_t(size));
   if (!cleaned.empty()) bytes = cleaned.data(), size = int(cleaned.size());
   int dw = 0, dh = 0, dc = 0;

@@ -230,6 +230,22 @@ TEST_F(Budgets, JsonIsBoundedBySizeAndByWhatParsingItTakes) {
   expect_one_error_line(run("info " + glb + " --limit json-bytes=64"), "the JSON chunk has ");
 }
 
+// The scene's files are in the memory budget before they are read: a 300 MB buffer the mesh reads (a
+// sparse file) under --limit memory=256M is refused in one line; nothing of it is read.
+TEST_F(Budgets, BufferFilesAreInTheMemoryBudgetBeforeTheyAreRead) {
+  GltfFile g = one_triangle();
+  const uint64_t big = uint64_t(300) << 20;
+  write_bytes(dir_ / "big.bin", g.bin);
+  fs::resize_file(dir_ / "big.bin", big);
+  json d = g.finished("big.bin");
+  d["buffers"][0]["byteLength"] = big;
+  std::ofstream(dir_ / "big.gltf") << d.dump();
+  const std::string scene = (dir_ / "big.gltf").string();
+  expect_one_error_line(run("info " + scene + " --limit memory=256M"),
+                        "out of memory: reading the scene's files (buffer 0: file 'big.bin': 314572800 bytes)");
+  EXPECT_EQ(run("info " + scene + " --limit memory=1G").status, 0);
+}
+
 // Decoded textures count against the memory budget before each is decoded: four 16-bit 2048x2048
 // images (8 MB files, 32 MB decoded each) under --limit memory=96M are refused in one line naming the
 // image, the same scene loads under the default budget.

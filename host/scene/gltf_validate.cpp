@@ -70,8 +70,12 @@ std::vector<unsigned char> read_whole_file(const std::string& path, const InputL
   if (check.status != InputFile::Status::Ok) fail(path, check.reason);
   struct stat st {};
   // tinygltf takes the length as unsigned int; a GLB cannot exceed 4 GiB anyway.
-  if (stat(check.real_path.c_str(), &st) == 0 && uint64_t(st.st_size) > std::numeric_limits<uint32_t>::max())
+  const bool sized = stat(check.real_path.c_str(), &st) == 0;
+  if (sized && uint64_t(st.st_size) > std::numeric_limits<uint32_t>::max())
     fail(path, "file is larger than 4 GiB, which glTF loading does not support");
+  // held twice while the parser copies a GLB's BIN chunk into its model
+  if (sized)
+    check_memory(2 * uint64_t(st.st_size), "reading the scene file (" + std::to_string(st.st_size) + " bytes)");
   InputFile f = read_input_file(path, "", limits.file_bytes);
   if (f.status != InputFile::Status::Ok) fail(path, f.reason);
   if (f.bytes.empty()) fail(path, "file is empty");
@@ -280,8 +284,14 @@ bool read_external(const std::string& path, SourceFile& src, const std::string& 
                    "); --allow-outside-scene-folder reads it");
   if (check.status != InputFile::Status::Ok) fail(path, what + " " + check.reason);
   struct stat st {};
-  if (byte_length >= 0 && stat(check.real_path.c_str(), &st) == 0 && uint64_t(st.st_size) != uint64_t(byte_length))
+  const bool sized = stat(check.real_path.c_str(), &st) == 0;
+  if (byte_length >= 0 && sized && uint64_t(st.st_size) != uint64_t(byte_length))
     fail(path, what + " has " + std::to_string(st.st_size) + " bytes but byteLength is " + std::to_string(byte_length));
+  // the files read so far and this one, each held twice while the parser copies it into its model
+  uint64_t held = sized ? uint64_t(st.st_size) : 0;
+  for (const auto& [name, read] : src.external) held += read.bytes.size();
+  check_memory(2 * held,
+               "reading the scene's files (" + what + ": " + std::to_string(sized ? st.st_size : 0) + " bytes)");
   InputFile f = read_input_file(file, confine, limits.file_bytes);
   if (f.status != InputFile::Status::Ok) fail(path, what + " " + f.reason);
   if (byte_length >= 0 && uint64_t(byte_length) != f.bytes.size())

@@ -200,6 +200,22 @@ TEST(Displays, EveryPresetShowsEveryView) {
   EXPECT_THROW(find_display_preset("lg-99"), Error);
 }
 
+// A calibration file is a few KB: a 30 MB one (parsed, about a hundred times that) is refused from its
+// size before it is read, in one line.
+TEST(Displays, AHugeCalibrationFileIsRefusedBeforeItIsParsed) {
+  const std::string dir = test::temp_dir("calibration_huge");
+  fs::create_directories(dir);
+  write_file(dir + "/visual.json", "[" + std::string(30000000, ' ') + "]");
+  try {
+    read_looking_glass_calibration(dir + "/visual.json", nullptr, uint64_t(1) << 40);
+    ADD_FAILURE() << "a 30 MB calibration file was read";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("has 30000002 bytes; a Looking Glass calibration file has a few thousand"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Displays, MalformedCalibrationFilesFailNamingTheField) {
   const std::string dir = test::temp_dir("calibration");
   fs::create_directories(dir);

@@ -1,6 +1,8 @@
 // Looking Glass calibration files (visual.json) and their mapping onto DESIGN section 5 (derivation in
 // docs/DISPLAYS.md).
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <new>
 #include <cstdio>
 #include <fstream>
@@ -48,7 +50,15 @@ Rational exact_decimal(long double x, const std::string& what) {
 
 LookingGlassCalibration read_looking_glass_calibration(const std::string& path, std::vector<std::string>* warnings,
                                                        uint64_t max_bytes) {
-  const std::vector<unsigned char> file = read_user_file(path, max_bytes);
+  // A panel's calibration is a few KB; parsed, JSON takes about a hundred times its text, so a large
+  // file is refused before it is read rather than parsed into gigabytes.
+  constexpr uint64_t kMaxCalibrationBytes = uint64_t(1) << 20;
+  std::error_code ec;
+  const uint64_t size = std::filesystem::is_regular_file(path, ec) ? std::filesystem::file_size(path, ec) : 0;
+  if (!ec && size > kMaxCalibrationBytes)
+    throw Error(path + ": has " + std::to_string(size) +
+                " bytes; a Looking Glass calibration file has a few thousand (at most 1 MiB is read)");
+  const std::vector<unsigned char> file = read_user_file(path, std::min(max_bytes, kMaxCalibrationBytes));
   const std::string text(file.begin(), file.end());
   json doc;
   try {

@@ -238,6 +238,25 @@ TEST(Verify, TheSceneAsItIsNowDecidesWhichFramesAreStale) {
   EXPECT_EQ(test::run("verify " + out + " --frames 0:5").status, 0);
 }
 
+// A sidecar is parsed only within the memory budget (parsed JSON takes about a hundred times its text):
+// a 10 MB one under --limit memory=256M stops verify in one line before parsing it; --resume counts
+// that frame as unreadable and renders it again.
+TEST(Verify, SidecarsAreParsedWithinTheMemoryBudget) {
+  const std::string out = test::temp_dir("verify_sidecar_budget");
+  const std::string args = " --views 4 --view-size 64x32 --display 240x135 --out " + out;
+  ASSERT_EQ(test::run("render --frames 0:1 -q" + args).status, 0);
+  std::string numbers = "[";
+  for (int i = 0; i < 5000000; ++i) numbers += "0,";
+  numbers += "0]";
+  std::ofstream(out + "/frame_0001.json") << numbers;
+  test::expect_one_error_line(test::run("verify " + out + " --frames 0:1 --limit memory=256M"),
+                              "out of memory: parsing the sidecar frame_0001.json (10000003 bytes)");
+  const test::CliRun r = test::run("render --frames 0:1 --resume --limit memory=256M" + args);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("1 frame(s) in"), std::string::npos) << r.output;
+  EXPECT_EQ(test::run("verify " + out + " --frames 0:1").status, 0);
+}
+
 TEST(Verify, QuickCheckFindsChangedAndDamagedFilesWithoutDecoding) {
   const std::string out = test::temp_dir("verify_quick");
   const std::string args = " --views 4 --view-size 64x32 --display 240x135 --turntable 360:6 --out " + out;

@@ -16,6 +16,7 @@
 
 #include "cli/options.h"
 #include "pmr/error.h"
+#include "pmr/memory_budget.h"
 #include "output/checksum.h"
 #include "output/sidecar.h"
 #include "pmr/output.h"
@@ -31,6 +32,7 @@ namespace fs = std::filesystem;
 
 std::string verify_help() {
   return "usage: pmr verify DIR [--frames LIST] [--write LIST] [--name PATTERN] [--preview] [--deep]\n"
+         "                  [--limit memory=N]\n"
          "Checks that every listed frame in DIR is complete: its sidecar names the frame and its time, was\n"
          "rendered from the scene as it is now (the checksums it records of the scene file and the files it\n"
          "reads; where the scene cannot be read, the version most frames show) and with the same\n"
@@ -270,7 +272,7 @@ int run_verify(const std::vector<std::string>& args) {
       std::fputs(verify_help().c_str(), stdout);
       return 0;
     }
-    if (a == "--frames" || a == "--write" || a == "--name") {
+    if (a == "--frames" || a == "--write" || a == "--name" || a == "--limit") {
       if (i + 1 >= args.size()) throw UsageError("option " + a + " needs a value (see pmr verify --help)");
       rest.push_back(a);
       rest.push_back(args[++i]);
@@ -290,6 +292,7 @@ int run_verify(const std::vector<std::string>& args) {
   bool frames_given = false;
   for (const std::string& r : rest) frames_given |= r == "--frames";
   const RenderOptions o = parse_render_options(rest);
+  set_memory_budget(o.job.input_limits.memory);  // sidecars are parsed within it (0: automatic)
   if (frames_given && o.job.frames == "all")
     throw UsageError("pmr verify needs the frames as a list (--frames all depends on the scene)");
   std::vector<long> frames;  // a usage error in the list comes before any look at the folder

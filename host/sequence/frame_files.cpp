@@ -12,6 +12,7 @@
 
 #include "output/checksum.h"
 #include "pmr/error.h"
+#include "pmr/memory_budget.h"
 #include "output/sidecar.h"
 #include "pmr/output.h"
 #include "sequence/frame_names.h"
@@ -62,6 +63,9 @@ std::string read_sidecar_text(const std::string& path) {
   std::error_code ec;
   const auto size = fs::file_size(path, ec);
   if (ec || size > kMaxSidecarBytes) return "";
+  // parsed, JSON takes about a hundred times its text (a stranger's sidecar may be all numbers)
+  check_memory(uint64_t(size) * 100,
+               "parsing the sidecar " + fs::path(path).filename().string() + " (" + std::to_string(size) + " bytes)");
   return read_text_file(path);
 }
 

@@ -30,6 +30,12 @@ inline sfloat smith_vis(sfloat nl, sfloat nv, sfloat a2) {
   return select((sfloat)(0.0f), 0.5f / s, s > 0.0f);
 }
 
+/* Schlick's Fresnel per channel, F0 + (1 - F0) (1 - v.h)^5. */
+inline sfloat3 fresnel_schlick(sfloat3 f0, sfloat vh) {
+  const sfloat k = 1.0f - vh, k2 = k * k, k5 = k2 * k2 * k;
+  return s3(f0.x + (1.0f - f0.x) * k5, f0.y + (1.0f - f0.y) * k5, f0.z + (1.0f - f0.z) * k5);
+}
+
 /* f(l, v) * dot(n, l) per lane: the radiance reflected toward v per unit irradiance from the direction
  * l (unit, toward the light). n and v are unit vectors; r is the clamped roughness; f0d the dielectric
  * F0; `transmission` (KHR_materials_transmission) the part of the diffuse lobe that transmits instead
@@ -43,9 +49,7 @@ inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat f0d, 
   const sfloat3 h = s3_select(n, s3_scale(hv, 1.0f / hl), hl > 0.0f);
   const sfloat nh = clamp(s3_dot(n, h), 0.0f, 1.0f), vh = clamp(s3_dot(v, h), 0.0f, 1.0f);
   const sfloat alpha = r * r, a2 = alpha * alpha;
-  const sfloat3 f0 = pbr_f0(base, metallic, f0d);
-  const sfloat k = 1.0f - vh, k2 = k * k, k5 = k2 * k2 * k;
-  const sfloat3 F = s3(f0.x + (1.0f - f0.x) * k5, f0.y + (1.0f - f0.y) * k5, f0.z + (1.0f - f0.z) * k5);
+  const sfloat3 F = fresnel_schlick(pbr_f0(base, metallic, f0d), vh);
   const sfloat diffuse = (1.0f - metallic) * (1.0f - transmission) * (1.0f / PMR_PI_F),
                spec = ggx_d(nh, a2) * smith_vis(nl, nv, a2);
   const sfloat3 f = s3((1.0f - F.x) * base.x * diffuse + F.x * spec, (1.0f - F.y) * base.y * diffuse + F.y * spec,
@@ -72,10 +76,9 @@ inline sfloat3 btdf_light(sfloat3 f0, sfloat r, sfloat ior, sfloat3 n, sfloat3 v
   const sfloat rt = fmax(r * clamp(2.0f * ior - 2.0f, 0.0f, 1.0f), 0.03f), a2 = (rt * rt) * (rt * rt);
   const sfloat nh = clamp(s3_dot(n, h), 0.0f, 1.0f), vh = clamp(s3_dot(v, h), 0.0f, 1.0f);
   const sfloat nl = clamp(s3_dot(n, lm), 0.0f, 1.0f), nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
-  const sfloat k = 1.0f - vh, k2 = k * k, k5 = k2 * k2 * k;
+  const sfloat3 F = fresnel_schlick(f0, vh);
   const sfloat s = ggx_d(nh, a2) * smith_vis(nl, nv, a2);
-  return s3((1.0f - (f0.x + (1.0f - f0.x) * k5)) * s, (1.0f - (f0.y + (1.0f - f0.y) * k5)) * s,
-            (1.0f - (f0.z + (1.0f - f0.z) * k5)) * s);
+  return s3((1.0f - F.x) * s, (1.0f - F.y) * s, (1.0f - F.z) * s);
 }
 
 /* KHR_lights_punctual at the surface points p: the unit directions toward the light (*l) and the

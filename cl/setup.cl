@@ -142,12 +142,12 @@ kernel void setup_triangles(global const PmrParams* P, global const PmrTriangle*
   const PmrMaterial mat = materials[tri.material];
   /* the material's MTA flags: alphaMode MASK; pbr transmission (left out of the opaque pass) */
   const uint ds = mat.double_sided;
-  const uint mask = (mat.alpha_mode == PMR_ALPHA_MASK ? PMR_MTA_MASK : 0u) |
-                    (P->shading == PMR_SHADING_PBR && mat.transmission > 0.0f ? PMR_MTA_TRANSMISSIVE : 0u);
+  const uint mflag = (mat.alpha_mode == PMR_ALPHA_MASK ? PMR_MTA_MASK : 0u) |
+                     (P->shading == PMR_SHADING_PBR && mat.transmission > 0.0f ? PMR_MTA_TRANSMISSIVE : 0u);
   const double ident[3][2] = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
 
   if (!(oc_or & CLIP_BITS)) {
-    emit_triangle(P, mtas, counter, &v[0], &v[1], &v[2], ident[0], ident[1], ident[2], t, 0, ds, mask);
+    emit_triangle(P, mtas, counter, &v[0], &v[1], &v[2], ident[0], ident[1], ident[2], t, 0, ds, mflag);
     return;
   }
 
@@ -193,5 +193,5 @@ kernel void setup_triangles(global const PmrParams* P, global const PmrTriangle*
   }
   for (int k = 1; k + 1 < n; ++k)
     emit_triangle(P, mtas, counter, &pv[0], &pv[k], &pv[k + 1], poly[cur][0].b, poly[cur][k].b, poly[cur][k + 1].b, t,
-                  (uint)(k - 1), ds, mask);
+                  (uint)(k - 1), ds, mflag);
 }

@@ -6,18 +6,19 @@ namespace pmr {
 
 namespace {
 
-// Levels down to 1 x 1, and each level's first texel (4 halves each) for `views` slices.
-unsigned source_levels(int w, int h, int views, PmrSource& S) {
+// Levels down to 1 x 1 in S (each level's first texel for `views` slices, and their count); returns the
+// texels of all levels (4 halves each).
+uint64_t source_levels(int w, int h, int views, PmrSource& S) {
   S = PmrSource{};
   uint64_t offset = 0;
-  unsigned k = 0;
-  for (; k < PMR_SOURCE_MAX_LEVELS; ++k) {
+  for (unsigned k = 0; k < PMR_SOURCE_MAX_LEVELS; ++k) {
     const uint64_t lw = uint64_t(std::max(1, w >> k)), lh = uint64_t(std::max(1, h >> k));
     S.level_offset[k] = offset;
+    S.levels = k + 1;
     offset += lw * lh * uint64_t(views);
     if (lw == 1 && lh == 1) break;
   }
-  return std::min<unsigned>(k + 1, PMR_SOURCE_MAX_LEVELS);
+  return offset;
 }
 
 }  // namespace
@@ -29,19 +30,17 @@ TransmissionStage::TransmissionStage(Launcher& launcher, const ClProgram& progra
 
 size_t TransmissionStage::bytes_for(int views, int w, int h) {
   PmrSource S;
-  const unsigned levels = source_levels(w, h, views, S);
-  const uint64_t last = uint64_t(std::max(1, w >> (levels - 1))) * uint64_t(std::max(1, h >> (levels - 1)));
-  return size_t((S.level_offset[levels - 1] + last * uint64_t(views)) * 8);
+  return size_t(source_levels(w, h, views, S) * 8);
 }
 
 void TransmissionStage::configure(bool needed, int views, int view_w, int view_h, uint64_t num_tiles) {
   PmrSource full{}, opaque{};
-  levels_ = 0;
-  if (needed) levels_ = source_levels(view_w, view_h, views, full);
-  full.levels = levels_;
+  const uint64_t texels = needed ? source_levels(view_w, view_h, views, full) : 0;
+  levels_ = full.levels;
   opaque.opaque_only = 1;
   w_ = view_w, h_ = view_h;
-  data_ = rt_.buffer(needed ? bytes_for(views, view_w, view_h) : 16, "transmission source");
+  data_ = ClBuffer(), tiles_ = ClBuffer();  // freed first: the budget must not hold the old and the new
+  data_ = rt_.buffer(needed ? size_t(texels * 8) : 16, "transmission source");
   tiles_ = rt_.buffer(needed ? size_t(num_tiles) * 4 : 16, "transmission source tiles");
   opaque_info_ = rt_.buffer(sizeof(PmrSource), "transmission source (opaque pass)", CL_MEM_READ_ONLY);
   full_info_ = rt_.buffer(sizeof(PmrSource), "transmission source", CL_MEM_READ_ONLY);

@@ -3,7 +3,7 @@
  * the path for jobs that need the views themselves (--write views, bilinear encoding, the baselines,
  * the debug outputs) and for every path's transmission source (the opaque pass, into the source's level
  * 0); the encoded-only job uses fine_encode.cl, which never writes the volume. */
-#include "fine_raster.h"
+#include "blend.h"
 
 /* The tile's voxels (nv views from v0, ny rows from y0, nx columns from x0) copied from the transmission
  * source's level 0 (the same layout) into the volume. */
@@ -20,7 +20,7 @@ inline void copy_source_tile(global const half* source, global half* volume, glo
 
 kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
                         global const uint* tile_queue, global half* volume, global uint* debug_key,
-                        global float* debug_depth, global uint* debug_count) {
+                        global float* debug_depth, global uint* debug_count, global uint* blend_overflow) {
   const uint tile = pmr_item_id();
   const uint tiles_xy = (uint)P->tiles_x * (uint)P->tiles_y;
   if (tile >= tiles_xy * (uint)P->tiles_v) return;
@@ -40,13 +40,31 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
   vfloat best_depth[FINE_ROWS * NS];
   vuint best_key[FINE_ROWS * NS], best_mta[FINE_ROWS * NS], best_cover[NS > 1 ? FINE_ROWS * NS : 1];
   vint covered[FINE_ROWS * NS];
-  uint glass = 0u;
-  const FineState st = {best_depth, best_key, best_mta, best_cover, debug ? covered : 0, opaque_pass ? &glass : 0};
+  uint glass = 0u, blend = 0u;
+  /* the opaque walk: BLEND comes after it, and the transmission source's pass leaves the glass out */
+  FineState st = fine_state(best_depth, best_key, best_mta, best_cover, debug ? covered : 0,
+                            PMR_MTA_BLEND | (opaque_pass ? PMR_MTA_TRANSMISSIVE : 0u));
+  st.glass = opaque_pass ? &glass : 0;
+  st.blend = &blend;
   fine_clear_state(FINE_ROWS * NS, &st);
   for (int r = 0; r < FINE_ROWS * NS; ++r) covered[r] = (vint)(0);
-  fine_raster_queue(mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], &in, tris, materials, x0, y0, v0, nx,
-                    ny, nv, v0, &st);
+  const TileWalk walk = {mtas, tile_queue, tile_offsets[tile], tile_offsets[tile + 1], x0, y0, v0, nx, ny, nv};
+  walk_tile(&in, &walk, &st);
   if (opaque_pass) source_tiles[tile] = glass;
+  vfloat T[FINE_ROWS * NS], acc[4 * FINE_ROWS];
+  if (blend) {
+    /* the source's pass holds the BLEND fragments behind each sample's nearest glass */
+    vfloat glass_depth[FINE_ROWS * NS];
+    vuint glass_key[FINE_ROWS * NS], glass_mta[FINE_ROWS * NS], glass_cover[NS > 1 ? FINE_ROWS * NS : 1];
+    FineState front = fine_state(glass_depth, glass_key, glass_mta, glass_cover, 0, PMR_MTA_BLEND);
+    front.need = PMR_MTA_TRANSMISSIVE;
+    if (glass) {
+      fine_clear_state(FINE_ROWS * NS, &front);
+      walk_tile(&in, &walk, &front);
+    }
+    const uint beyond = blend_layers(&in, &walk, &st, glass ? &front : 0, T, acc);
+    if (beyond && !opaque_pass) atomic_add(blend_overflow, beyond);
+  }
 
   /* frame constants in registers: stores through the output pointers could alias P */
   const size_t W = (size_t)P->view_w, H = (size_t)P->view_h, view_base = (size_t)P->view_base;
@@ -64,8 +82,10 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
         ushort4 colour[VW];
         vint won[NS];
         for (int s = 0; s < NS; ++s) won[s] = best_key[FINE_SLOT(r, s)] != (vuint)(PMR_NO_KEY);
-        fine_shade_chunk(&in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0),
-                         best_cover + (NS > 1 ? FINE_SLOT(r, 0) : 0), won, x0 + c * VW, py, view, colour);
+        if (blend) blend_shade_chunk(&in, mtas, &cache, light, &st, T, acc, r, x0 + c * VW, py, view, won, colour);
+        else
+          fine_shade_chunk(&in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0),
+                           best_cover + (NS > 1 ? FINE_SLOT(r, 0) : 0), won, x0 + c * VW, py, view, colour);
         for (int l = 0; l < VW && c * VW + l < nx; ++l) {
           const int px = x0 + c * VW + l;
           const size_t voxel = (((size_t)view + view_base) * H + (size_t)py) * W + (size_t)px;

@@ -13,6 +13,14 @@
 #define PMR_SAMPLES 1
 #endif
 
+/* alphaMode BLEND (DESIGN section 4c step 3; blend.h): the nearest PMR_BLEND_LAYERS fragments of a
+ * sample are composited exactly, the rest as one layer behind them from sums in fixed point (so that
+ * their bytes do not depend on the order in which the fragments arrive) of a c, a and -ln(1 - a). */
+#define PMR_BLEND_LAYERS 8
+#define REST_ALPHA_ONE 16777216.0f /* 2^24: a and -ln(1 - a) */
+#define REST_COLOUR_ONE 65536.0f   /* 2^16: a c (c at most 65504) */
+#define REST_LN_MAX 40.0f          /* -ln(1 - a) for a = 1: a transmittance of 4e-18 */
+
 /* Where a vector's lanes sample the raster (16.16 / 24.8): lane l at (X + sx[l], Y + sy[l]), or, when
  * sx is null, along the pixel-center row (X + l PMR_X_ONE, Y). */
 typedef struct {
@@ -152,18 +160,21 @@ PMR_HOT void lanes_gather(const ShadeInputs* in, global const PmrMta* mtas, MtaC
   if (S->sx) L->e = LANE3(e);
 }
 
-/* SW winners (MTA ids where `act`) shaded at the raster points S of view `view`, as colours c[3][SW]. */
+/* SW winners (MTA ids where `act`) shaded at the raster points S of view `view`, as colours c[0..2][SW]
+ * and opacities c[3][SW] (lane_alpha). */
 inline void shade_sample_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                               sint act, sint ids, const SampleLanes* S, int view, float c[3][SW]) {
+                               sint act, sint ids, const SampleLanes* S, int view, float c[4][SW]) {
   LaneWinners L;
   lanes_gather(in, mtas, cache, act, ids, S, view, &L);
-  s3_store(shade_lanes(in, &L, light, view), c[0], c[1], c[2]);
+  sfloat alpha;
+  s3_store(shade_lanes(in, &L, light, view, &alpha), c[0], c[1], c[2]);
+  vstore_s(alpha, 0, c[3]);
 }
 
 /* A packed batch's first n lanes shaded: winner ids[l] at raster point (X + sx[l], Y + sy[l]); the lanes
  * from n on are set idle (their entries zeroed). */
 inline void shade_packed_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, long X,
-                               long Y, int view, int n, int* ids, int* sx, int* sy, float c[3][SW]) {
+                               long Y, int view, int n, int* ids, int* sx, int* sy, float c[4][SW]) {
   int on[SW];
   for (int l = 0; l < SW; ++l) {
     on[l] = l < n ? -1 : 0;

@@ -87,7 +87,7 @@ inline void fused_raster_shade(const ShadeInputs* in, global const PmrMta* mtas,
   const int views = P->views;
   vfloat best_depth[FUSED_ROWS * NS];
   vuint best_key[FUSED_ROWS * NS], best_mta[FUSED_ROWS * NS], best_cover[NS > 1 ? FUSED_ROWS * NS : 1];
-  const FineState st = {best_depth, best_key, best_mta, best_cover, 0, 0};
+  const FineState st = fine_state(best_depth, best_key, best_mta, best_cover, 0, 0u); /* (no BLEND here) */
   fine_clear_state(FUSED_ROWS * NS, &st);
   for (int tv = 0; tv < P->tiles_v; ++tv) {
     const uint tile = ((uint)tv * (uint)P->tiles_y) * (uint)P->tiles_x + tile_xy;

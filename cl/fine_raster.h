@@ -33,6 +33,10 @@ typedef PMR_CAT(float, PMR_VW) vfloat;
 #define vstore_vint PMR_CAT(vstore, PMR_VW)
 #define convert_vfloat PMR_CAT(convert_float, PMR_VW)
 #define as_vint PMR_CAT(as_int, PMR_VW)
+#define vload_vfloat PMR_CAT(vload, PMR_VW)
+#define vstore_vfloat PMR_CAT(vstore, PMR_VW)
+#define convert_vint PMR_CAT(convert_int, PMR_VW)
+#define as_vuint PMR_CAT(as_uint, PMR_VW)
 
 #define NS PMR_SAMPLES
 
@@ -166,8 +170,92 @@ typedef struct {
   vuint* mta;
   vuint* cover; /* NS > 1 */
   vint* covered;
-  uint* glass; /* the transmission source's opaque pass: set to 1 when a transmissive MTA is left out */
+  uint skip;   /* MTAs with one of these flags are left out of the walk (PMR_MTA_*) */
+  uint need;   /* ... and those without all of these */
+  uint* glass; /* if not null: set to 1 when a transmissive MTA is left out */
+  uint* blend; /* if not null: set to 1 when a BLEND MTA is left out */
+  /* a walk for a BLEND layer (blend.h), else null: only fragments after (after_depth, after_key) in the
+   * (depth, key) order and at or in front of `limit` (the opaque depth) compete; `found` is set to 1 when
+   * one wins somewhere; with `rest`, every such fragment is accumulated there instead of competing */
+  const vfloat* after_depth;
+  const vuint* after_key;
+  const vfloat* limit;
+  uint* found;
+  struct BlendRest* rest;
 } FineState;
+
+/* A state for a walk of every MTA but those with flags `skip`, over the arrays given (fine_clear_state
+ * clears them). */
+inline FineState fine_state(vfloat* depth, vuint* key, vuint* mta, vuint* cover, vint* covered, uint skip) {
+  const FineState st = {depth, key, mta, cover, covered, skip, 0u, 0, 0, 0, 0, 0, 0, 0};
+  return st;
+}
+
+/* The lanes of a row chunk where fragment (z, key) lies behind (after_depth, after_key) and not behind
+ * `limit`: a BLEND layer walk's candidates (every lane when the walk is not one). */
+inline vint layer_lanes(const FineState* st, int k, vfloat z, uint key) {
+  if (!st->after_depth) return (vint)(-1);
+  const vfloat ad = st->after_depth[k];
+  return ((z > ad) | ((z == ad) & ((vuint)(key) > st->after_key[k]))) & (z <= st->limit[k]);
+}
+
+/* alphaMode BLEND beyond a sample's PMR_BLEND_LAYERS nearest fragments (blend.h): the rest form one
+ * layer directly behind them (DESIGN section 4c step 3), from per-sample sums of a c, a and -ln(1 - a)
+ * in fixed point, so that their bytes do not depend on the order in which the fragments arrive. Arrays
+ * of the state's slots (FINE_SLOT). */
+typedef PMR_CAT(long, PMR_VW) vlong;
+#define convert_vlong PMR_CAT(convert_long, PMR_VW)
+#define convert_vlong_rte PMR_CAT(PMR_CAT(convert_long, PMR_VW), _rte)
+struct BlendRest {
+  vlong* ca[3];
+  vlong* a;
+  vlong* ln;
+};
+
+/* The lanes of a row chunk (first pixel center (X, Y), state row r) where MTA m (queue entry id) won
+ * sample s (win[s]) of a walk for the rest: m shaded once per pixel at its shading point (cover: bits,
+ * cover_bits) and added to the sums of those samples. */
+inline void blend_rest_chunk(const ShadeInputs* in, const PmrMta* m, uint id, vuint bits, const vint* win, long X,
+                             long Y, int view, int r, struct BlendRest* rest) {
+  global const PmrParams* P = in->P;
+  vint any_win = (vint)(0);
+  for (int s = 0; s < NS; ++s) any_win |= win[s];
+  int w[VW];
+  uint cover[VW];
+  float c[4][VW];
+  vstore_vint(any_win, 0, w);
+  vstore_vint(as_vint(bits), 0, (int*)cover);
+  MtaCache one; /* the shading's MTA cache, holding m */
+  one.id = id, one.m = *m;
+  const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
+  for (int h = 0; h < VW; h += SW) {
+    int sx[SW], sy[SW];
+    for (int l = 0; l < SW; ++l) {
+      sx[l] = (h + l) * PMR_X_ONE, sy[l] = 0;
+      int ox = 0, oy = 0;
+      if (NS > 1 && h + l < VW && w[h + l])
+        shading_point(P, (cover[h + l] & FINE_CENTER) != 0u, cover[h + l] & FINE_SAMPLE_BITS, &ox, &oy);
+      sx[l] += ox, sy[l] += oy;
+    }
+    const SampleLanes S = NS == 1 ? row_samples(X + (long)h * PMR_X_ONE, Y) : offset_samples(X, Y, sx, sy);
+    float cs[4][SW];
+    shade_sample_lanes(in, 0, &one, light, vload_s(0, w + h) != 0, (sint)((int)id), &S, view, cs);
+    for (int k = 0; k < 4; ++k)
+      for (int l = 0; l < SW && h + l < VW; ++l) c[k][h + l] = cs[k][l];
+  }
+  const vfloat a = vload_vfloat(0, c[3]);
+  vlong add[5];
+  add[3] = convert_vlong_rte(a * REST_ALPHA_ONE);
+  add[4] = convert_vlong_rte(fmin(-log1p(-a), (vfloat)(REST_LN_MAX)) * REST_ALPHA_ONE);
+  for (int k = 0; k < 3; ++k) add[k] = convert_vlong_rte(vload_vfloat(0, c[k]) * a * REST_COLOUR_ONE);
+  for (int s = 0; s < NS; ++s) {
+    const int k = FINE_SLOT(r, s);
+    const vlong on = convert_vlong(win[s]);
+    for (int j = 0; j < 3; ++j) rest->ca[j][k] += select((vlong)(0), add[j], on);
+    rest->a[k] += select((vlong)(0), add[3], on);
+    rest->ln[k] += select((vlong)(0), add[4], on);
+  }
+}
 
 /* MTA m (queue entry id) in view i over the tile's row chunk (ly, c): every sample's coverage, depth
  * (the one formula of DepthPlane, whose row term zrow[s] the caller keeps per row) and (depth, key) test. */
@@ -181,10 +269,21 @@ PMR_HOT void raster_chunk(const ShadeInputs* in, const PmrMta* m, uint id, const
     const int k = FINE_SLOT(r, s);
     z[s] = (vfloat)(zrow[s]) + (vfloat)(dp->gx) * (column + (vfloat)(sample_dx(in->P, s)));
     if (st->covered) st->covered[k] -= hit[s];
-    win[s] = hit[s] & ((z[s] < st->depth[k]) | ((z[s] == st->depth[k]) & ((vuint)(m->key) < st->key[k])));
+    win[s] = hit[s] & layer_lanes(st, k, z[s], m->key);
+    if (!st->rest) win[s] &= (z[s] < st->depth[k]) | ((z[s] == st->depth[k]) & ((vuint)(m->key) < st->key[k]));
   }
   const vuint bits = NS > 1 ? cover_bits(hit, chunk_hits(R, F, 0, 0, in_tile, lane)) : (vuint)(0u);
   if (m->flags & PMR_MTA_MASK) mask_chunk(in, m, bits, X, Y, view, cutoff, win);
+  if (st->found || st->rest) {
+    vint any_win = (vint)(0);
+    for (int s = 0; s < NS; ++s) any_win |= win[s];
+    if (!any(any_win)) return;
+    if (st->found) *st->found = 1u;
+    if (st->rest) {
+      blend_rest_chunk(in, m, id, bits, win, X, Y, view, r, st->rest);
+      return;
+    }
+  }
   for (int s = 0; s < NS; ++s) {
     const int k = FINE_SLOT(r, s);
     st->depth[k] = select(st->depth[k], z[s], win[s]);
@@ -195,14 +294,13 @@ PMR_HOT void raster_chunk(const ShadeInputs* in, const PmrMta* m, uint id, const
 }
 
 /* Rasterizes the queue entries [q0, q1) of the 3D tile at (x0, y0, v0) (nx x ny x nv voxels inside
- * the raster) into the visibility state `st`, each pixel at its NS samples (P->sample_x/y); the
- * transmission source's opaque pass leaves the transmissive MTAs out. */
+ * the raster) into the visibility state `st`, each pixel at its NS samples (P->sample_x/y), leaving out
+ * the MTAs st->skip and st->need name. */
 inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile_queue, uint q0, uint q1,
                               const ShadeInputs* in, global const PmrTriangle* tris,
                               global const PmrMaterial* materials, int x0, int y0, int v0, int nx, int ny, int nv,
                               int vbase, const FineState* st) {
   global const PmrParams* P = in->P;
-  const bool opaque_only = in->source_info->opaque_only != 0u;
   const long X0 = (long)x0 * PMR_X_ONE + PMR_HALF_X, Y0 = (long)y0 * PMR_Y_ONE + PMR_HALF_Y;
   const vint lane = vload_vint(0, lane_index);
   vint in_tile[FINE_CHUNKS]; /* lanes inside the raster (edge tiles are narrower) */
@@ -223,10 +321,12 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
     }
     const uint id = tile_queue[q];
     const PmrMta m = mtas[id];
-    if ((m.flags & PMR_MTA_TRANSMISSIVE) && opaque_only) { /* the transmission source's pass */
-      if (st->glass) *st->glass = 1u;
+    if (m.flags & st->skip) {
+      if (st->glass && (m.flags & PMR_MTA_TRANSMISSIVE)) *st->glass = 1u;
+      if (st->blend && (m.flags & PMR_MTA_BLEND)) *st->blend = 1u;
       continue;
     }
+    if ((m.flags & st->need) != st->need) continue;
     const int i_lo = max(v0, m.view_lo), i_hi = min(v0 + nv - 1, m.view_hi);
     /* the tile rows with a sample within the MTA's y extent (the same in every view) */
     const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));
@@ -285,7 +385,7 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
 /* SW winners of a row chunk shaded at the pixel centers (px0 + h + l, py), l < SW, where `act`, as
  * colours c[3][SW]. */
 inline void shade_center_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                               sint act, sint ids, int px0, int py, int view, float c[3][SW]) {
+                               sint act, sint ids, int px0, int py, int view, float c[4][SW]) {
   const SampleLanes S = row_samples((long)px0 * PMR_X_ONE + PMR_HALF_X, (long)py * PMR_Y_ONE + PMR_HALF_Y);
   shade_sample_lanes(in, mtas, cache, light, act, ids, &S, view, c);
 }
@@ -294,7 +394,7 @@ inline void shade_center_lanes(const ShadeInputs* in, global const PmrMta* mtas,
  * winner covers it (all of them: the row form above), else the centroid of its covered samples
  * (cover[l], cover_bits). */
 inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, sint act,
-                              sint ids, const uint* cover, int px0, int py, int view, float c[3][SW]) {
+                              sint ids, const uint* cover, int px0, int py, int view, float c[4][SW]) {
   const long X = (long)px0 * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
   int on[SW], sx[SW], sy[SW];
   vstore_s(act, 0, on);
@@ -315,94 +415,145 @@ inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, 
   shade_sample_lanes(in, mtas, cache, light, act, ids, &S, view, c);
 }
 
-/* Shading jobs of a row chunk beyond its pixels' first winners (pixel `lane`, winner `ids`, shading point
- * (sx, sy) from the chunk's first pixel center, its share `weight` of the samples), packed SW to a batch:
- * edge pixels are few, and shading them lane by lane in the pixels' own positions would run a whole
- * vector for each. */
+/* Shading jobs of a row chunk beyond its pixels' first winners (pixel `lane`, winner `ids` first met at
+ * sample `sample`, shading point (sx, sy) from the chunk's first pixel center, its share `weight` of the
+ * pixel), packed SW to a batch: edge pixels are few, and shading them lane by lane in the pixels' own
+ * positions would run a whole vector for each. */
 typedef struct {
   int n;
-  int lane[SW], ids[SW], sx[SW], sy[SW];
+  int lane[SW], sample[SW], ids[SW], sx[SW], sy[SW];
   float weight[SW];
 } ShadeBatch;
 
-/* Shades the batch's jobs and adds their weighted colours and alpha into acc; empties it. */
+/* A pixel's sum (premultiplied RGBA, acc[k][p]) gains a winner's colour c[0..2] with opacity c[3] and
+ * share `weight` (of the samples, times their transmittance for a BLEND layer); its opacity goes to
+ * alpha_of[sample][p] when that is kept (a BLEND layer). */
+inline void shade_add(float acc[4][VW], float* alpha_of, int p, int sample, float weight, const float* c) {
+  const float wa = weight * c[3];
+  for (int k = 0; k < 3; ++k) acc[k][p] += wa * c[k];
+  acc[3][p] += wa;
+  if (alpha_of) alpha_of[sample * VW + p] = c[3];
+}
+
+/* Shades the batch's jobs and adds them into acc (shade_add); empties it. */
 inline void shade_batch(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, long X, long Y,
-                        int view, ShadeBatch* B, float acc[4][VW]) {
+                        int view, ShadeBatch* B, float acc[4][VW], float* alpha_of) {
   if (B->n == 0) return;
-  float c[3][SW];
+  float c[4][SW];
   shade_packed_lanes(in, mtas, cache, light, X, Y, view, B->n, B->ids, B->sx, B->sy, c);
   for (int l = 0; l < B->n; ++l) {
-    const int p = B->lane[l];
-    for (int k = 0; k < 3; ++k) acc[k][p] += B->weight[l] * c[k][l];
-    acc[3][p] += B->weight[l];
+    const float cl[4] = {c[0][l], c[1][l], c[2][l], c[3][l]};
+    shade_add(acc, alpha_of, B->lane[l], B->sample[l], B->weight[l], cl);
   }
   B->n = 0;
 }
 
-/* The lanes w of a row chunk whose winners (ids, covering `bits`, of n samples) are shaded in pixel order,
- * each lane its own pixel (the row forms of shade_center_lanes and shade_point_lanes), into acc. */
+/* The lanes w of a row chunk whose winners (ids, covering `bits`, first met at sample 0, shares `weight`)
+ * are shaded in pixel order, each lane its own pixel (the row forms of shade_center_lanes and
+ * shade_point_lanes), into acc. One sample and no layers (`assign`): the winner's colour as shaded. */
 inline void shade_pixel_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                              const int* ids, const int* w, const int* n, const uint* bits, int px0, int py, int view,
-                              float acc[4][VW]) {
+                              const int* ids, const int* w, const float* weight, const uint* bits, int px0, int py,
+                              int view, bool assign, float acc[4][VW], float* alpha_of) {
   for (int h = 0; h < VW; h += SW) {
     const sint act = vload_s(0, w + h) != 0;
     if (!any(act)) continue;
-    float c[3][SW];
+    float c[4][SW];
     if (NS == 1) shade_center_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), px0 + h, py, view, c);
     else shade_point_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), bits + h, px0 + h, py, view, c);
     for (int l = 0; l < SW && h + l < VW; ++l) {
       if (!w[h + l]) continue;
-      const float weight = (float)n[h + l] / (float)NS; /* one sample: 1, and the colour as shaded */
-      for (int k = 0; k < 3; ++k) acc[k][h + l] = NS == 1 ? c[k][l] : acc[k][h + l] + weight * c[k][l];
-      acc[3][h + l] += weight;
+      if (assign) {
+        for (int k = 0; k < 3; ++k) acc[k][h + l] = c[k][l];
+        acc[3][h + l] += 1.0f;
+        continue;
+      }
+      const float cl[4] = {c[0][l], c[1][l], c[2][l], c[3][l]};
+      shade_add(acc, alpha_of, h + l, 0, weight[h + l], cl);
     }
   }
 }
 
-/* The winners of a row chunk shaded and resolved, as half RGBA bits: lane l is pixel (px0 + l, py) of
- * view `view`, whose sample s was won by MTA mta[s][l] where won[s]. Each pixel shades each distinct
- * winner once, at its shading point, weighted by the share of the samples it won; the pixel is their sum,
- * premultiplied, so alpha is the covered fraction (DESIGN section 3b). With one sample: the winner's
- * colour at the pixel center, alpha 1, or zero (background). The winners first met at sample 0 are shaded
- * in pixel order, the others packed into batches; each pixel adds its winners in sample order either way. */
-inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                             const vuint* mta, const vuint* cover, const vint* won, int px0, int py, int view,
-                             ushort4* out) {
-  float acc[4][VW];
-  for (int k = 0; k < 4; ++k)
-    for (int l = 0; l < VW; ++l) acc[k][l] = 0.0f;
+/* Lanes where sample s is the first of the pixel's samples won by its winner (won, mta), and, in
+ * *share, that winner's share of the pixel: the samples it won over NS, or with transmittances T the sum
+ * of theirs over NS. */
+inline vint first_winner(const vuint* mta, const vint* won, const vfloat* T, int s, vfloat* share) {
+  vint first = won[s], count = (vint)(0);
+  vfloat sum = (vfloat)(0.0f);
+  for (int t = 0; t < NS; ++t) {
+    const vint same = won[t] & (mta[t] == mta[s]);
+    if (t < s) first &= ~same;
+    else if (T) sum += select((vfloat)(0.0f), T[t], same);
+    else count -= same;
+  }
+  *share = (T ? sum : convert_vfloat(count)) / (float)NS;
+  return first;
+}
+
+/* A BLEND layer's samples behind their winners: T[t] times 1 - the opacity of the winner of sample t,
+ * shaded where it was first met (alpha_of[s], first_winner). */
+inline void layer_transmittance(const vuint* mta, const vint* won, const float* alpha_of, vfloat* T) {
+  for (int s = 0; s < NS; ++s) {
+    vfloat share;
+    const vint first = first_winner(mta, won, 0, s, &share);
+    const vfloat a = vload_vfloat(0, alpha_of + s * VW);
+    for (int t = s; t < NS; ++t) T[t] = select(T[t], T[t] * (1.0f - a), first & won[t] & (mta[t] == mta[s]));
+  }
+}
+
+/* The winners of a row chunk shaded and added into acc (premultiplied RGBA per pixel): lane l is pixel
+ * (px0 + l, py) of view `view`, whose sample s was won by MTA mta[s][l] where won[s]. Each pixel shades
+ * each distinct winner once, at its shading point, weighted by its share (first_winner) times its
+ * opacity (1 but for a BLEND layer), so that alpha is the covered fraction (DESIGN section 3b). T: the
+ * samples' transmittance through the BLEND layers in front (null: none), which a BLEND layer then
+ * multiplies by 1 - its opacity (blend.h); without T and with one sample a pixel is its winner's
+ * colour at the pixel center, alpha 1, or unchanged (background). The winners first met at sample 0 are
+ * shaded in pixel order, the others packed into batches; each pixel adds its winners in sample order. */
+inline void fine_shade_winners(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
+                               const vuint* mta, const vuint* cover, const vint* won, vfloat* T, bool layer, int px0,
+                               int py, int view, float acc[4][VW]) {
+  float alpha_of[NS * VW];
   ShadeBatch B;
   B.n = 0;
   const long X = (long)px0 * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
   for (int s = 0; s < NS; ++s) {
-    vint first = won[s], count = (vint)(0); /* lanes where s is the winner's first sample; its samples */
-    for (int t = 0; t < NS; ++t) {
-      const vint same = won[t] & (mta[t] == mta[s]);
-      if (t < s) first &= ~same;
-      else count -= same;
-    }
+    vfloat share;
+    const vint first = first_winner(mta, won, T, s, &share);
     if (!any(first)) continue;
-    int ids[VW + SW], w[VW + SW], n[VW + SW];
+    int ids[VW + SW], w[VW + SW];
+    float weight[VW + SW];
     uint bits[VW + SW];
     vstore_vint(as_vint(mta[s]), 0, ids);
     vstore_vint(first, 0, w);
-    vstore_vint(count, 0, n);
+    vstore_vfloat(share, 0, weight);
     vstore_vint(as_vint(NS > 1 ? cover[s] : (vuint)(1u)), 0, (int*)bits);
-    for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = n[l] = 0, bits[l] = 0u;
+    for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = 0, bits[l] = 0u, weight[l] = 0.0f;
     if (s == 0) {
-      shade_pixel_lanes(in, mtas, cache, light, ids, w, n, bits, px0, py, view, acc);
+      shade_pixel_lanes(in, mtas, cache, light, ids, w, weight, bits, px0, py, view, NS == 1 && !T, acc,
+                        layer ? alpha_of : 0);
       continue;
     }
     for (int l = 0; l < VW; ++l) {
       if (!w[l]) continue;
       int ox, oy;
       shading_point(in->P, (bits[l] & FINE_CENTER) != 0u, bits[l] & FINE_SAMPLE_BITS, &ox, &oy);
-      B.lane[B.n] = l, B.ids[B.n] = ids[l], B.sx[B.n] = l * PMR_X_ONE + ox, B.sy[B.n] = oy;
-      B.weight[B.n] = (float)n[l] / (float)NS;
-      if (++B.n == SW) shade_batch(in, mtas, cache, light, X, Y, view, &B, acc);
+      B.lane[B.n] = l, B.sample[B.n] = s, B.ids[B.n] = ids[l], B.sx[B.n] = l * PMR_X_ONE + ox, B.sy[B.n] = oy;
+      B.weight[B.n] = weight[l];
+      if (++B.n == SW) shade_batch(in, mtas, cache, light, X, Y, view, &B, acc, layer ? alpha_of : 0);
     }
   }
-  shade_batch(in, mtas, cache, light, X, Y, view, &B, acc);
+  shade_batch(in, mtas, cache, light, X, Y, view, &B, acc, layer ? alpha_of : 0);
+  if (layer) layer_transmittance(mta, won, alpha_of, T);
+}
+
+/* The winners of a row chunk with nothing in front, shaded and resolved (fine_shade_winners), as half
+ * RGBA bits. */
+inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
+                             const vuint* mta, const vuint* cover, const vint* won, int px0, int py, int view,
+                             ushort4* out) {
+  float acc[4][VW];
+  for (int k = 0; k < 4; ++k)
+    for (int l = 0; l < VW; ++l) acc[k][l] = 0.0f;
+  fine_shade_winners(in, mtas, cache, light, mta, cover, won, 0, false, px0, py, view, acc);
   for (int l = 0; l < VW; ++l) vstore_half4((float4)(acc[0][l], acc[1][l], acc[2][l], acc[3][l]), l, (half*)out);
 }
 

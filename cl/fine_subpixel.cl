@@ -196,10 +196,72 @@ inline int8 sp_mask(const ShadeInputs* in, const PmrMta* m, int8 win, int j, int
   return vload8(0, w);
 }
 
+/* What a walk of the queues takes (blend.h's scheme, per sample of the chunk): every MTA but those with
+ * flags `skip` and without `need`; for a BLEND layer only fragments after (after_depth, after_key) and
+ * not behind `limit`, `found` set where one wins, and with `rest` every such fragment accumulated there
+ * (sp_rest_add) instead of competing. `blend` is set when a BLEND MTA is left out. */
+typedef struct {
+  long* ca; /* a c of the subpixel's channel (REST_COLOUR_ONE) */
+  long* a;  /* a and -ln(1 - a) (REST_ALPHA_ONE) */
+  long* ln;
+} SpRest;
+
+typedef struct {
+  uint skip, need;
+  uint* blend;
+  const float* after_depth;
+  const uint* after_key;
+  const float* limit;
+  uint* found;
+  SpRest* rest;
+} SpWalk;
+
+/* A subpixel's shading point for MTA m, as an offset from the chunk's first sample: its own sample
+ * (vector slot j of the run, offsets sx, sy) where m covers that, else the centroid of the subpixel's
+ * samples m covers (shading_point); one sample: the sample itself. */
+inline void sp_shading_point(global const PmrParams* P, const PmrMta* m, int j, int v, int sx, int sy, const SpChunk* C,
+                             int* ox, int* oy) {
+  *ox = sx, *oy = sy;
+  if (NS == 1) return;
+  const int t = j % NS; /* the lane's sample of its subpixel */
+  const long X = C->Xc + sx - P->sample_x[t], Y = C->Yc + sy - P->sample_y[t];
+  bool center;
+  const uint bits = mta_sample_cover(P, m, X, Y, view_coord(P, v), &center);
+  int dx, dy;
+  shading_point(P, center, bits, &dx, &dy);
+  *ox = (int)(X - C->Xc) + dx, *oy = (int)(Y - C->Yc) + dy;
+}
+
+/* The rest beyond the exact BLEND layers (blend.h): MTA m (queue entry id) shaded at the shading points
+ * of the samples `win` of a vector (slots k.., the run's j-th on, view v) and added to their sums. */
+inline void sp_rest_add(const ShadeInputs* in, const PmrMta* m, uint id, int8 win, int k, int j, int v,
+                        const SpChunk* C, SpRest* R) {
+  int w[SP_LANES], sx[SW], sy[SW];
+  vstore8(win, 0, w);
+  for (int l = 0; l < SW; ++l) {
+    sx[l] = sy[l] = 0;
+    if (w[l]) sp_shading_point(in->P, m, j + l, v, C->sx[k + l], C->sy[k + l], C, sx + l, sy + l);
+  }
+  MtaCache one; /* the shading's MTA cache, holding m */
+  one.id = id, one.m = *m;
+  global const PmrParams* P = in->P;
+  const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
+  const SampleLanes S = offset_samples(C->Xc, C->Yc, sx, sy);
+  float c[4][SW];
+  shade_sample_lanes(in, 0, &one, light, vload8(0, w) != 0, (sint)((int)id), &S, v, c);
+  for (int l = 0; l < SP_LANES; ++l) {
+    if (!w[l]) continue;
+    const float a = c[3][l];
+    R->ca[k + l] += convert_long_rte(c[C->channel[k + l]][l] * a * REST_COLOUR_ONE);
+    R->a[k + l] += convert_long_rte(a * REST_ALPHA_ONE);
+    R->ln[k + l] += convert_long_rte(fmin(-log1p(-a), REST_LN_MAX) * REST_ALPHA_ONE);
+  }
+}
+
 /* MTA m (queue entry id) in view v against the view's run of samples, SP_LANES at a time, into the
  * visibility state. */
 PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, const SpEdges* S, int v, float cutoff,
-                            SpChunk* C) {
+                            const SpWalk* W, SpChunk* C) {
   const int k0 = C->first[v], k1 = k0 + C->count[v];
   if (k0 == k1) return;
   long xv[3];
@@ -236,8 +298,19 @@ PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, con
     const float8 z = sp_depth(&p, C, x, xi, y);
     const float8 bd = vload8(0, C->best_depth + k);
     const uint8 bk = vload8(0, C->best_key + k);
-    int8 win = convert_int8(hit) & ((z < bd) | ((z == bd) & ((uint8)(m->key) < bk)));
+    int8 win = convert_int8(hit);
+    if (W->after_depth) {
+      const float8 ad = vload8(0, W->after_depth + k);
+      win &=
+          ((z > ad) | ((z == ad) & ((uint8)(m->key) > vload8(0, W->after_key + k)))) & (z <= vload8(0, W->limit + k));
+    }
+    if (!W->rest) win &= (z < bd) | ((z == bd) & ((uint8)(m->key) < bk));
     if ((m->flags & PMR_MTA_MASK) && any(win)) win = sp_mask(in, m, win, k - k0, v, cutoff, C->sx + k, C->sy + k, C);
+    if (W->found && any(win)) *W->found = 1u;
+    if (W->rest) {
+      if (any(win)) sp_rest_add(in, m, id, win, k, k - k0, v, C, W->rest);
+      continue;
+    }
     vstore8(select(bd, z, win), 0, C->best_depth + k);
     vstore8(select(bk, (uint8)(m->key), as_uint8(win)), 0, C->best_key + k);
     vstore8(select(vload8(0, C->best_mta + k), (uint8)(id), as_uint8(win)), 0, C->best_mta + k);
@@ -247,7 +320,7 @@ PMR_HOT void sp_raster_view(const ShadeInputs* in, const PmrMta* m, uint id, con
 /* Step 2, visibility: the queues of the chunk's screen tile, every view slab; per MTA the views whose
  * x extent can reach the chunk's samples. */
 inline void sp_visibility(const ShadeInputs* in, global const PmrMta* mtas, global const uint* tile_offsets,
-                          global const uint* tile_queue, int tile_xy, SpChunk* C) {
+                          global const uint* tile_queue, int tile_xy, const SpWalk* W, SpChunk* C) {
   global const PmrParams* P = in->P;
   const int views = P->views;
   for (int tv = 0; tv < P->tiles_v; ++tv) {
@@ -258,6 +331,11 @@ inline void sp_visibility(const ShadeInputs* in, global const PmrMta* mtas, glob
     for (uint q = tile_offsets[tile]; q < q1; ++q) {
       const uint id = tile_queue[q];
       const PmrMta m = mtas[id];
+      if (m.flags & W->skip) {
+        if (W->blend && (m.flags & PMR_MTA_BLEND)) *W->blend = 1u;
+        continue;
+      }
+      if ((m.flags & W->need) != W->need) continue;
       const long ylo = min(m.y[0], min(m.y[1], m.y[2])), yhi = max(m.y[0], max(m.y[1], m.y[2]));
       if (yhi < C->Yc + C->oy0 || ylo > C->Yl + C->oy1) continue;
       const int i_lo = max(v0, m.view_lo), i_hi = min(v1, m.view_hi);
@@ -270,7 +348,7 @@ inline void sp_visibility(const ShadeInputs* in, global const PmrMta* mtas, glob
         while (pass != 0) { /* the passing views, lowest first */
           const int v = ib + (31 - (int)clz(pass & (0u - pass)));
           pass &= pass - 1u;
-          sp_raster_view(in, &m, id, &S, v, cutoff, C);
+          sp_raster_view(in, &m, id, &S, v, cutoff, W, C);
         }
       }
     }
@@ -278,32 +356,41 @@ inline void sp_visibility(const ShadeInputs* in, global const PmrMta* mtas, glob
 }
 
 /* Shading points of one view waiting for a vector of SW lanes: per lane the winning MTA, the point as
- * an offset from (Xc, Yc), and the subpixel (sid, channel) it adds `weight` of its colour to. */
+ * an offset from (Xc, Yc), the subpixel (sid, channel) it adds `weight` of its colour to, and the slot of
+ * the subpixel's first sample. */
 typedef struct {
   int n;
-  int ids[SW], sx[SW], sy[SW], sid[SW], channel[SW];
+  int ids[SW], sx[SW], sy[SW], sid[SW], channel[SW], slot[SW];
   float weight[SW];
 } SpBatch;
 
-/* Shades a batch's points and adds them into their subpixels' premultiplied colour and coverage. With
- * one sample each subpixel gets exactly its winner's colour (0 + 1 x c). */
+/* Shades a batch's points and adds them into their subpixels' premultiplied colour and coverage, with
+ * their opacity (1 but for BLEND); with one sample and no layers each subpixel gets exactly its winner's
+ * colour (0 + 1 x 1 x c). For a BLEND layer (T not null) the samples each point's winner won then see
+ * T (1 - a) behind it. */
 inline void sp_flush(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, int v,
-                     const SpChunk* C, SpBatch* B, float* acc, float* alpha) {
+                     const SpChunk* C, SpBatch* B, float* T, float* acc, float* alpha) {
   if (B->n == 0) return;
-  float c[3][SW];
+  float c[4][SW];
   shade_packed_lanes(in, mtas, cache, light, C->Xc, C->Yc, v, B->n, B->ids, B->sx, B->sy, c);
   for (int l = 0; l < B->n; ++l) {
-    acc[B->sid[l]] += B->weight[l] * c[B->channel[l]][l];
-    alpha[B->sid[l]] += B->weight[l];
+    const float wa = B->weight[l] * c[3][l];
+    acc[B->sid[l]] += wa * c[B->channel[l]][l];
+    alpha[B->sid[l]] += wa;
+    for (int t = 0; t < NS && T; ++t) {
+      const int k = B->slot[l] + t;
+      if (C->best_key[k] != PMR_NO_KEY && C->best_mta[k] == (uint)B->ids[l]) T[k] *= 1.0f - c[3][l];
+    }
   }
   B->n = 0;
 }
 
 /* The subpixel whose samples are slots k .. k + NS - 1: each distinct winner (first occurrence) into the
- * batch at its shading point, weighted by its share of the samples. A winner of all NS samples covers the
- * subpixel's own sample, inside the samples' convex hull (as in shade_point_lanes); others are tested. */
+ * batch at its shading point, weighted by its share of the samples (times their transmittance T through
+ * the BLEND layers in front, where given). A winner of all NS samples covers the subpixel's own sample,
+ * inside the samples' convex hull (as in shade_point_lanes); others are tested. */
 inline void sp_queue_subpixel(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, int v,
-                              int k, const SpChunk* C, SpBatch* B, float* acc, float* alpha) {
+                              int k, const SpChunk* C, SpBatch* B, float* T, bool layer, float* acc, float* alpha) {
   global const PmrParams* P = in->P;
   const int bx = C->sx[k] - P->sample_x[0], by = C->sy[k] - P->sample_y[0]; /* the subpixel's own sample */
   for (int s = 0; s < NS; ++s) {
@@ -311,10 +398,12 @@ inline void sp_queue_subpixel(const ShadeInputs* in, global const PmrMta* mtas, 
     const uint id = C->best_mta[k + s];
     bool first = true;
     int count = 0;
+    float share = 0.0f;
     for (int t = 0; t < NS; ++t) {
       const bool same = C->best_key[k + t] != PMR_NO_KEY && C->best_mta[k + t] == id;
       first = first && !(same && t < s);
       count += same ? 1 : 0;
+      if (same && T) share += T[k + t];
     }
     if (!first) continue;
     int ox = 0, oy = 0;
@@ -325,27 +414,29 @@ inline void sp_queue_subpixel(const ShadeInputs* in, global const PmrMta* mtas, 
       shading_point(P, center, bits, &ox, &oy);
     }
     const int l = B->n++;
-    B->ids[l] = (int)id, B->sx[l] = bx + ox, B->sy[l] = by + oy;
-    B->sid[l] = C->sid[k], B->channel[l] = C->channel[k], B->weight[l] = (float)count / (float)NS;
-    if (B->n == SW) sp_flush(in, mtas, cache, light, v, C, B, acc, alpha);
+    B->ids[l] = (int)id, B->sx[l] = bx + ox, B->sy[l] = by + oy, B->slot[l] = k;
+    B->sid[l] = C->sid[k], B->channel[l] = C->channel[k];
+    B->weight[l] = (T ? share : (float)count) / (float)NS;
+    if (B->n == SW) sp_flush(in, mtas, cache, light, v, C, B, layer ? T : 0, acc, alpha);
   }
 }
 
 /* Step 3, the winners shaded and resolved (DESIGN section 3b): channel k of subpixel s = 3 j + k as the
- * box mean of its samples' premultiplied colours into acc[n], its covered fraction into alpha[n]. */
-inline void sp_shade(const ShadeInputs* in, global const PmrMta* mtas, const SpChunk* C, int subpixels, float* acc,
-                     float* alpha) {
+ * box mean of its samples' premultiplied colours added into acc[n], its covered fraction into alpha[n].
+ * T: the samples' transmittance through the BLEND layers in front (null: none); `layer`: the winners are
+ * a BLEND layer's, which multiplies T by 1 - their opacity. */
+inline void sp_shade(const ShadeInputs* in, global const PmrMta* mtas, const SpChunk* C, float* T, bool layer,
+                     float* acc, float* alpha) {
   global const PmrParams* P = in->P;
   const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
-  for (int n = 0; n < subpixels; ++n) acc[n] = alpha[n] = 0.0f;
   MtaCache cache;
   cache.id = PMR_NO_KEY;
   SpBatch B;
   B.n = 0;
   for (int v = 0; v < P->views; ++v) {
     for (int k = C->first[v]; k < C->first[v] + C->count[v]; k += NS)
-      sp_queue_subpixel(in, mtas, &cache, light, v, k, C, &B, acc, alpha);
-    sp_flush(in, mtas, &cache, light, v, C, &B, acc, alpha);
+      sp_queue_subpixel(in, mtas, &cache, light, v, k, C, &B, T, layer, acc, alpha);
+    sp_flush(in, mtas, &cache, light, v, C, &B, layer ? T : 0, acc, alpha);
   }
 }
 
@@ -383,12 +474,69 @@ inline void sp_write_display(const DisplayOut* D, const PmrSampleChunk* ch, cons
   }
 }
 
+/* The rest beyond the exact BLEND layers (after_depth, after_key) of the chunk's samples, one layer
+ * behind them (DESIGN section 4c step 3, as blend_rest in blend.h), into acc, alpha and T. Returns the
+ * number of samples with such fragments. */
+inline uint sp_blend_rest(const ShadeInputs* in, global const PmrMta* mtas, global const uint* tile_offsets,
+                          global const uint* tile_queue, int tile_xy, SpWalk* W, SpChunk* C, float* T, float* acc,
+                          float* alpha) {
+  const int run = C->first[in->P->views];
+  long ca[SP_SLOTS], a[SP_SLOTS], ln[SP_SLOTS];
+  for (int k = 0; k < run; ++k) ca[k] = a[k] = ln[k] = 0;
+  SpRest R = {ca, a, ln};
+  uint found = 0u;
+  W->found = &found, W->rest = &R;
+  sp_visibility(in, mtas, tile_offsets, tile_queue, tile_xy, W, C);
+  uint samples = 0u;
+  for (int k = 0; k < run && found; ++k) {
+    if (a[k] <= 0) continue;
+    const float A = 1.0f - exp(-(float)ln[k] / REST_ALPHA_ONE);
+    const float w = T[k] * A / (float)NS;
+    acc[C->sid[k]] += w * ((float)ca[k] / REST_COLOUR_ONE) / ((float)a[k] / REST_ALPHA_ONE);
+    alpha[C->sid[k]] += w;
+    T[k] *= 1.0f - A;
+    ++samples;
+  }
+  return samples;
+}
+
+/* alphaMode BLEND over a chunk whose opaque walk met BLEND MTAs, by depth peeling per sample (blend.h's
+ * scheme): the layers composited into acc and alpha and the samples' transmittance T, with which sp_shade
+ * then adds the opaque winners, restored into C. Returns the number of samples with more than
+ * PMR_BLEND_LAYERS fragments. */
+inline uint sp_blend(const ShadeInputs* in, global const PmrMta* mtas, global const uint* tile_offsets,
+                     global const uint* tile_queue, int tile_xy, SpChunk* C, float* T, float* acc, float* alpha) {
+  const int run = C->first[in->P->views];
+  float limit[SP_SLOTS], after_depth[SP_SLOTS];
+  uint opaque_key[SP_SLOTS], opaque_mta[SP_SLOTS], after_key[SP_SLOTS];
+  for (int k = 0; k < run; ++k) {
+    limit[k] = C->best_depth[k], opaque_key[k] = C->best_key[k], opaque_mta[k] = C->best_mta[k];
+    T[k] = 1.0f, after_depth[k] = -INFINITY, after_key[k] = 0u;
+  }
+  uint found = 0u, beyond = 0u;
+  SpWalk W = {0u, PMR_MTA_BLEND, 0, after_depth, after_key, limit, &found, 0};
+  int layer = 0;
+  for (; layer < PMR_BLEND_LAYERS; ++layer) {
+    found = 0u;
+    for (int k = 0; k < run; ++k) C->best_depth[k] = INFINITY, C->best_key[k] = PMR_NO_KEY;
+    sp_visibility(in, mtas, tile_offsets, tile_queue, tile_xy, &W, C);
+    if (!found) break;
+    sp_shade(in, mtas, C, T, true, acc, alpha);
+    for (int k = 0; k < run; ++k) after_depth[k] = C->best_depth[k], after_key[k] = C->best_key[k];
+  }
+  if (layer == PMR_BLEND_LAYERS)
+    beyond = sp_blend_rest(in, mtas, tile_offsets, tile_queue, tile_xy, &W, C, T, acc, alpha);
+  for (int k = 0; k < run; ++k)
+    C->best_depth[k] = limit[k], C->best_key[k] = opaque_key[k], C->best_mta[k] = opaque_mta[k];
+  return beyond;
+}
+
 kernel void fine_subpixel(PMR_SHADE_PARAMS, global const PmrMta* mtas, global const uint* tile_offsets,
                           global const uint* tile_queue, global const PmrEncodeParams* E, global const int* column_a,
                           global const int* column_b, global const PmrEncodeRow* rows, global const int* sample_x,
                           global const int* sample_y, global const PmrSampleChunk* chunks, uint num_chunks,
                           global half* display, global ushort* sub_alpha, uint debug, global uint* dbg_key,
-                          global float* dbg_depth) {
+                          global float* dbg_depth, global uint* blend_overflow) {
   const uint chunk = pmr_item_id();
   if (chunk >= num_chunks) return;
   const PmrSampleChunk ch = chunks[chunk];
@@ -396,10 +544,17 @@ kernel void fine_subpixel(PMR_SHADE_PARAMS, global const PmrMta* mtas, global co
   sp_sort_samples(P, E, column_a, column_b, rows, sample_x, sample_y, &ch, &C);
   sp_boxes(P->views, &C);
   ShadeInputs in = PMR_SHADE_INPUTS;
-  sp_visibility(&in, mtas, tile_offsets, tile_queue, ch.tile, &C);
+  uint blend = 0u;
+  const SpWalk opaque = {PMR_MTA_BLEND, 0u, &blend, 0, 0, 0, 0, 0}; /* BLEND comes after */
+  sp_visibility(&in, mtas, tile_offsets, tile_queue, ch.tile, &opaque, &C);
   if (debug) sp_write_debug(&ch, P->views, E->display_w, &C, dbg_key, dbg_depth);
-  float acc[PMR_SUBPIXEL_CAP], alpha[PMR_SUBPIXEL_CAP];
-  sp_shade(&in, mtas, &C, (ch.s1 - ch.s0) * (ch.i1 - ch.i0), acc, alpha);
+  float acc[PMR_SUBPIXEL_CAP], alpha[PMR_SUBPIXEL_CAP], T[SP_SLOTS];
+  for (int n = 0; n < (ch.s1 - ch.s0) * (ch.i1 - ch.i0); ++n) acc[n] = alpha[n] = 0.0f;
+  if (blend) {
+    const uint beyond = sp_blend(&in, mtas, tile_offsets, tile_queue, ch.tile, &C, T, acc, alpha);
+    if (beyond) atomic_add(blend_overflow, beyond);
+  }
+  sp_shade(&in, mtas, &C, blend ? T : 0, false, acc, alpha);
   const DisplayOut D = {(global ushort*)display, sub_alpha, E->display_w};
   sp_write_display(&D, &ch, acc, alpha);
 }

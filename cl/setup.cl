@@ -140,10 +140,12 @@ kernel void setup_triangles(global const PmrParams* P, global const PmrTriangle*
   const uint oc_or = v[0].outcode | v[1].outcode | v[2].outcode;
   if (oc_and & CULL_BITS) return;
   const PmrMaterial mat = materials[tri.material];
-  /* the material's MTA flags: alphaMode MASK; pbr transmission (left out of the opaque pass) */
+  /* the material's MTA flags: alphaMode MASK; pbr transmission (left out of the opaque pass); alphaMode
+   * BLEND, which a transmissive material leaves to its transmission (blended_material, scene.cpp) */
   const uint ds = mat.double_sided;
-  const uint mflag = (mat.alpha_mode == PMR_ALPHA_MASK ? PMR_MTA_MASK : 0u) |
-                     (P->shading == PMR_SHADING_PBR && mat.transmission > 0.0f ? PMR_MTA_TRANSMISSIVE : 0u);
+  const bool glass = P->shading == PMR_SHADING_PBR && mat.transmission > 0.0f;
+  const uint mflag = (mat.alpha_mode == PMR_ALPHA_MASK ? PMR_MTA_MASK : 0u) | (glass ? PMR_MTA_TRANSMISSIVE : 0u) |
+                     (mat.alpha_mode == PMR_ALPHA_BLEND && !glass ? PMR_MTA_BLEND : 0u);
   const double ident[3][2] = {{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}};
 
   if (!(oc_or & CLIP_BITS)) {

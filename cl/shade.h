@@ -74,8 +74,10 @@ typedef struct {
   sfloat inv_w[3];    /* the MTA vertices' 1 / w                                         */
   sfloat bary[3][2];  /* ... and barycentrics in the source triangle                     */
   sfloat3 face, n[3]; /* face normal, vertex normals                                     */
-  sfloat3 c[3];       /* vertex colours (COLOR_0, RGB: alpha only decides alphaMode MASK) */
+  sfloat3 c[3];       /* vertex colours (COLOR_0, RGB)                                   */
   sfloat3 factor;     /* baseColorFactor (RGB)                                           */
+  sint blended;       /* alphaMode BLEND: lanes whose alpha is their opacity, not 1      */
+  sfloat alpha[4];    /* ... their baseColorFactor alpha and vertex colour alphas        */
   sfloat3 p[3];       /* pbr: vertex positions, world space                              */
   sfloat metallic, roughness;
   sfloat f0d; /* pbr: the dielectric F0 (PmrMaterial.f0_dielectric)                  */
@@ -104,6 +106,8 @@ inline void lanes_clear(LaneWinners* L) {
     L->n[k] = L->face, L->c[k] = s3(one, one, one), L->p[k] = s3(zero, zero, zero);
   }
   L->factor = s3(zero, zero, zero);
+  L->blended = (sint)(0);
+  for (int k = 0; k < 4; ++k) L->alpha[k] = one;
   L->metallic = L->roughness = L->f0d = zero;
   L->emissive = s3(zero, zero, zero);
   L->glass = (sint)(0); /* the transmission inputs are set when the first glass lane comes */
@@ -152,6 +156,11 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
     if (pbr) L->p[k] = blend3(L->p[k], vload3(t.v[k], in->positions), take);
   }
   L->factor = blend3(L->factor, vload3(0, mat->base_color), take);
+  if (m->flags & PMR_MTA_BLEND) {
+    L->blended |= take;
+    L->alpha[0] = blend(L->alpha[0], mat->base_color[3], take);
+    for (int k = 0; k < 3; ++k) L->alpha[k + 1] = blend(L->alpha[k + 1], in->attrs[t.v[k]].color[3], take);
+  }
   /* lambert reads the base colour map alone, pbr every map */
   bool textured = mat->maps[PMR_MAP_BASE_COLOR].texture >= 0;
   if (pbr) {
@@ -259,7 +268,7 @@ inline sfloat3 s3_interp_lanes(sfloat3 b, const sfloat3* a) {
  * (RGB), metallic and roughness, occlusion, emissive; and the normal map's sample with the interpolated
  * tangent, where there is one (mapped). Untextured lanes get factors of 1 and no normal map. */
 typedef struct {
-  float base[3][SW], metallic[SW], roughness[SW], ao[SW], emissive[3][SW];
+  float base[3][SW], base_alpha[SW], metallic[SW], roughness[SW], ao[SW], emissive[3][SW];
   int mapped[SW];
   float s[3][SW], tw[4][SW], normal_scale[SW];
   float toksvig[SW];                     /* trilinear: the normal map's increment of alpha^2 (Toksvig), else 0 */
@@ -353,6 +362,7 @@ inline void sample_material_lanes(const ShadeInputs* in, global const PmrMateria
   if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
     sample_map_lanes(in, &mat->maps[PMR_MAP_BASE_COLOR], L->tri, bits, take, b, g, true, C, c);
     for (int k = 0; k < 3; ++k) lanes_put(T->base[k], c[k], take);
+    lanes_put(T->base_alpha, c[3], take);
   }
   if (!pbr) return;
   if (mat->maps[PMR_MAP_METALLIC_ROUGHNESS].texture >= 0) {
@@ -402,7 +412,7 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
   for (int l = 0; l < SW; ++l) {
     for (int k = 0; k < 3; ++k) T->base[k][l] = T->emissive[k][l] = 1.0f, T->s[k][l] = 0.0f;
     for (int k = 0; k < 4; ++k) T->tw[k][l] = 0.0f;
-    T->metallic[l] = T->roughness[l] = T->ao[l] = T->normal_scale[l] = 1.0f;
+    T->base_alpha[l] = T->metallic[l] = T->roughness[l] = T->ao[l] = T->normal_scale[l] = 1.0f;
     T->mapped[l] = 0;
     T->toksvig[l] = 0.0f;
   }
@@ -602,10 +612,20 @@ inline sfloat3 s3_half_range(sfloat3 c) {
   return s3(fmin(c.x, m), fmin(c.y, m), fmin(c.z, m));
 }
 
-/* Lit colours (RGB; alpha is coverage, 1) of the winners L in view `view` of the pass (the volume's
- * view + P->view_base), at most 65504. `light`: the unit direction toward Lambert's one light (pbr
- * reads the light table instead). Each lane's value depends on its own winner and voxel alone. */
-inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 light, int view) {
+/* The opacity of each lane: 1, or for alphaMode BLEND baseColorFactor alpha x COLOR_0 alpha x the base
+ * colour texture's alpha, clamped to [0, 1] (the MASK test's alpha, mta_alpha_passes, in lanes). */
+inline sfloat lane_alpha(const LaneWinners* L, const LaneTextures* T, bool textured, sfloat3 b) {
+  if (!any(L->blended)) return (sfloat)(1.0f);
+  sfloat a = L->alpha[0] * (b.x * L->alpha[1] + b.y * L->alpha[2] + b.z * L->alpha[3]);
+  if (textured) a *= vload_s(0, T->base_alpha);
+  return select((sfloat)(1.0f), clamp(a, 0.0f, 1.0f), L->blended);
+}
+
+/* Lit colours (RGB) of the winners L in view `view` of the pass (the volume's view + P->view_base), at
+ * most 65504, and their opacity (*alpha: lane_alpha). `light`: the unit direction toward Lambert's one
+ * light (pbr reads the light table instead). Each lane's value depends on its own winner and voxel
+ * alone. */
+inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 light, int view, sfloat* alpha) {
   const bool pbr = in->P->shading == PMR_SHADING_PBR;
   const sfloat3 b = lane_barycentrics(L);
   LaneTextures T;
@@ -617,6 +637,7 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
 #endif
   if (textured) sample_lanes(in, L, b, grad, pbr, &T);
   const sfloat3 base = lane_base_color(L, &T, textured, b);
+  *alpha = lane_alpha(L, &T, textured, b);
   const sfloat3 ni = s3_interp_lanes(b, L->n);
   const sfloat len = sqrt(s3_dot(ni, ni));
   sfloat3 n = s3_select(L->face, s3_scale(ni, 1.0f / len), L->smooth & (len > 0.0f));

@@ -16,6 +16,8 @@
 #   docs/shading_environment_forest.png the same, --environment uniform | Blender's forest.exr
 #   docs/shading_glass_views.png        the Khronos sample model GlassHurricaneCandleHolder (transmission
 #                                       and volume), views 0, N/2 and N-1 of the default 96, the studio
+#   docs/shading_blend.png              the Khronos sample model AlphaBlendModeTest (alphaMode BLEND
+#                                       next to OPAQUE and MASK), views 0 and N-1 of 9, the studio
 #
 # usage: scripts/make_shading_pictures.sh [GLTF_DIR]
 #   GLTF_DIR   folder of the Khronos sample models (GLTF_DIR/Suzanne/glTF/Suzanne.gltf, ...); default
@@ -110,6 +112,13 @@ if present "$GLASS" "$OUT/shading_glass_views.png" "$MODELS_HINT"; then
   render glass "$GLASS" --views 96 --view-size 498x279
   $PICTURES strip "$OUT/shading_glass_views.png" "$(views glass 0)" "$(views glass 48)" "$(views glass 95)" \
     --check-center - "$(center glass)" -
+fi
+
+echo "== AlphaBlendModeTest in views 0 and 8 of 9"
+BLEND=$GLTF_DIR/AlphaBlendModeTest/glTF/AlphaBlendModeTest.gltf
+if present "$BLEND" "$OUT/shading_blend.png" "$MODELS_HINT"; then
+  render blend "$BLEND" --views 9 --view-size 664x372
+  $PICTURES strip "$OUT/shading_blend.png" "$(views blend 0)" "$(views blend 8)" --check-center - -
 fi
 
 if [ ${#skipped[@]} -gt 0 ]; then

@@ -54,4 +54,21 @@ ref::EnvironmentTerms uniform_environment(double radiance) {
   return env;
 }
 
+void quad(Scene& s, float x0, float y0, float x1, float y1, float z, uint32_t material) {
+  add_triangle(s, {x0, y0, z}, {x1, y0, z}, {x1, y1, z}, material);
+  add_triangle(s, {x0, y0, z}, {x1, y1, z}, {x0, y1, z}, material);
+}
+
+uint32_t add_material(Scene& s, const PmrMaterial& m) {
+  s.materials.push_back(m);
+  return uint32_t(s.materials.size() - 1);
+}
+
+PmrMaterial unlit(glm::vec3 c) {
+  PmrMaterial m = default_material();
+  m.unlit = 1;
+  m.base_color[0] = c.x, m.base_color[1] = c.y, m.base_color[2] = c.z;
+  return m;
+}
+
 }  // namespace pmr::test

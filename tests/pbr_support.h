@@ -1,6 +1,6 @@
 // Helpers of the --shading pbr tests against the double-precision reference (tests/reference): the
 // model's inputs at a voxel, the default light and uniform environment as the reference states them,
-// and the 1% + 1e-3 bound per channel.
+// the 1% + 1e-3 bound per channel, and scenes of flat layers.
 #pragma once
 #include <string>
 #include <vector>
@@ -28,5 +28,11 @@ struct BoundCheck {
 // environment of radiance 0.2 (I = P = 0.2) and the split-sum table the kernels are given.
 std::vector<ref::PunctualLight> default_light(const Rig& rig);
 ref::EnvironmentTerms uniform_environment(double radiance);
+
+// Scenes of flat layers: a rectangle [x0, x1] x [y0, y1] at depth z facing +Z (the camera) as two
+// triangles; a material appended (its index returned); an unlit material of colour c (alpha 1).
+void quad(Scene& s, float x0, float y0, float x1, float y1, float z, uint32_t material);
+uint32_t add_material(Scene& s, const PmrMaterial& m);
+PmrMaterial unlit(glm::vec3 c);
 
 }  // namespace pmr::test

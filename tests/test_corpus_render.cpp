@@ -55,15 +55,13 @@ TEST(Corpus, EverySupportedModelRenders) {
     }
     Scene scene = load_scene(f);
     // The only warnings real models may give: a named material extension drawn without its effect or
-    // not implemented (KHR_materials_variants: the default materials are drawn), KHR_xmp (metadata),
-    // and alphaMode BLEND drawn opaque.
+    // not implemented (KHR_materials_variants: the default materials are drawn) and KHR_xmp (metadata).
     for (const std::string& w : scene.warnings) {
       const bool material = w.find("KHR_materials_") != std::string::npos;
       const bool allowed = (material && w.find("drawn") != std::string::npos) ||
                            (material && w.find("not implemented, ignored: KHR_materials_") != std::string::npos) ||
                            (w.size() > 7 && w.compare(w.size() - 7, 7, "KHR_xmp") == 0 &&
-                            w.find("not implemented, ignored: KHR_xmp") != std::string::npos) ||
-                           w.find("alphaMode BLEND drawn as opaque") != std::string::npos;
+                            w.find("not implemented, ignored: KHR_xmp") != std::string::npos);
       EXPECT_TRUE(allowed) << "unexpected warning: " << w;
     }
     glm::dvec3 lo, hi;

@@ -39,6 +39,8 @@ void FineStage::configure(const FinePaths& paths, int views, int view_w, int vie
   dbg_depth_ = rt_.buffer(debug_entries_ * 4, "debug depth");
   dbg_count_ = rt_.buffer(debug_entries_ * 4, "debug counts");
   if (paths.debug && !paths.volume) rt_.fill_zero(dbg_count_);  // the subpixel kernel keeps no counts
+  blend_overflow_ = rt_.buffer(16, "BLEND overflow count");
+  begin_frame();
   if (paths.fused) configure_fused(views, *encode);
   if (paths.subpixel) configure_subpixel(views, *encode);
 }
@@ -101,7 +103,7 @@ void FineStage::run_volume(const SceneBuffers& scene, const GeometryStage& geome
                            const SourceBinding& source, FrameEvents& ev, const ClBuffer* out) {
   const cl_uint next = scene.bind_shading(fine_, geometry.params(), source);
   fine_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(), out ? *out : volume_, dbg_key_,
-                  dbg_depth_, dbg_count_);
+                  dbg_depth_, dbg_count_, blend_overflow_);
   ev.add(kFine, launcher_.launch(fine_, size_t(num_tiles), kFineGroup));
 }
 
@@ -122,7 +124,7 @@ void FineStage::run_subpixel(const SceneBuffers& scene, const GeometryStage& geo
   fine_subpixel_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(),
                            encode.params_buffer(), column_a_, column_b_, encode.rows_buffer(), sample_x_, sample_y_,
                            chunks_, num_chunks_, encode.display(), encode.sub_alpha(), cl_uint(debug), dbg_key_,
-                           dbg_depth_);
+                           dbg_depth_, blend_overflow_);
   ev.add(kFine, launcher_.launch(fine_subpixel_, num_chunks_, 1));
   encode.straddle_alpha(ev);
 }
@@ -141,6 +143,12 @@ void FineStage::read_debug(std::vector<uint32_t>& keys, std::vector<float>& dept
   rt_.read(dbg_key_, keys.data(), debug_entries_ * 4);
   rt_.read(dbg_depth_, depth.data(), debug_entries_ * 4);
   rt_.read(dbg_count_, count.data(), debug_entries_ * 4);
+}
+
+uint32_t FineStage::blend_overflow() const {
+  uint32_t n = 0;
+  rt_.read(blend_overflow_, &n, sizeof n);
+  return n;
 }
 
 size_t FineStage::device_bytes() const {

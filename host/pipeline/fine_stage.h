@@ -47,6 +47,10 @@ class FineStage {
   size_t volume_bytes() const { return volume_bytes_; }
   void read_volume(std::vector<uint16_t>& out) const;
   void read_debug(std::vector<uint32_t>& keys, std::vector<float>& depth, std::vector<uint32_t>& count) const;
+  // The count of samples with more BLEND fragments than the exact layers (cl/blend.h): zeroed by
+  // begin_frame, read once the frame is done.
+  void begin_frame() const { rt_.fill_zero(blend_overflow_); }
+  uint32_t blend_overflow() const;
   size_t device_bytes() const;
 
  private:
@@ -60,7 +64,7 @@ class FineStage {
   ClKernel fine_;
   FinePaths paths_;
   size_t volume_bytes_ = 0, debug_entries_ = 1;
-  ClBuffer volume_, dbg_key_, dbg_depth_, dbg_count_;
+  ClBuffer volume_, dbg_key_, dbg_depth_, dbg_count_, blend_overflow_;
   // fused raster + encode, built per view count
   ClProgram fused_program_;
   int fused_views_ = 0;

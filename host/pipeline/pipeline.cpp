@@ -5,6 +5,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <limits>
+#include <memory>
 #include <mutex>
 
 #include "pipeline/encode_stage.h"
@@ -85,6 +86,8 @@ struct Pipeline::Impl {
   TransmissionStage transmission;
   FinePaths paths;
   int views = 0, view_w = 0, view_h = 0;  // as configured
+  Rig rig;                                // ... the rig and display of the last configure()
+  std::unique_ptr<Display> display;
   // PmrParams.lod_scale_x/y: view pixels per output pixel (subpixel sampling: a display pixel's)
   float lod_scale[2] = {1.0f, 1.0f};
   uint64_t num_tiles = 0;
@@ -104,6 +107,11 @@ Pipeline::~Pipeline() = default;
 
 void Pipeline::set_scene(const Scene& scene) {
   impl_->scene.set_scene(scene);
+  Impl& m = *impl_;
+  if (m.views > 0 && m.paths.fused && m.scene.blended()) {  // BLEND needs the volume path: choose again
+    const std::unique_ptr<Display> display = std::move(m.display);
+    configure(Rig(m.rig), display.get());
+  }
   if (impl_->views > 0) impl_->configure_transmission();
   impl_->geometry.set_scene(impl_->scene, config_.method == Method::Multipass && config_.multipass_snapped);
 }
@@ -136,9 +144,10 @@ FinePaths Pipeline::choose_paths(const Rig& rig, const Display* display) const {
   const int lanes = fine_lanes(tile[0]);
   const size_t fused_private =
       size_t(tile[0] + lanes - 1) / lanes * lanes * tile[1] * rig.views * fused_bytes_per_voxel(config_.samples);
+  // BLEND layers are composited by the volume form alone (cl/blend.h): its tiles are small
   p.fused = !p.subpixel && config_.fuse_encode && display && !display->bilinear && !display->blend_views &&
             display->cell_rows <= 1 && config_.method == Method::Pmr && !config_.debug_outputs &&
-            fused_private <= kFusedPrivateBudget;
+            fused_private <= kFusedPrivateBudget && !impl_->scene.blended();
   p.volume = !p.fused && !(p.subpixel && config_.fuse_encode);
   p.debug = config_.debug_outputs;
   p.samples = config_.samples;
@@ -156,6 +165,8 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
   m.num_tiles = uint64_t(tiles_x_) * tiles_y_ * tiles_v_;
   if (m.num_tiles >= (uint64_t(1) << 32)) throw Error("too many tiles; use larger --tile");
   m.views = rig.views, m.view_w = rig.view_w, m.view_h = rig.view_h;
+  m.rig = rig;
+  m.display = display ? std::make_unique<Display>(*display) : nullptr;
   m.paths = choose_paths(rig, display);
   // A display pixel covers view_w / display_w view pixels across (and view_h / display_h down): the
   // texture footprint of a subpixel's sample is the display pixel's, not its view pixel's.
@@ -219,6 +230,7 @@ StageTimes Pipeline::render_frame(const FrameDescription& frame, bool empty) {
   FrameEvents ev;
   PmrParams P = frame_params(frame, empty);
   m.scene.upload_frame(frame);
+  m.fine.begin_frame();
   if (config_.method == Method::Multipass) {
     m.render_multipass(frame.rig, P, config_.multipass_snapped, ev, times);
   } else {
@@ -230,6 +242,7 @@ StageTimes Pipeline::render_frame(const FrameDescription& frame, bool empty) {
   if (config_.slow_frame && !empty) wait_reporting(ev, times, t_start);
   m.launcher.runtime().finish();
   ev.collect(times);
+  if (m.scene.blended()) times.blend_beyond = m.fine.blend_overflow();
   times.wall = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_start).count();
   return times;
 }

@@ -25,11 +25,12 @@ struct FinePaths;
 
 struct StageTimes {  // milliseconds
   double vertex = 0, setup = 0, bin = 0, fine = 0, encode = 0;
-  double device_total = 0;   // first kernel start to last kernel end (includes host work in between)
-  double wall = 0;           // host wall-clock time of render()
-  int retries = 0;           // frames redone because a queue was full
-  uint32_t mtas = 0;         // MTAs produced by setup
-  uint64_t bin_entries = 0;  // (tile, MTA) pairs produced by the tile raster
+  double device_total = 0;    // first kernel start to last kernel end (includes host work in between)
+  double wall = 0;            // host wall-clock time of render()
+  int retries = 0;            // frames redone because a queue was full
+  uint32_t mtas = 0;          // MTAs produced by setup
+  uint64_t bin_entries = 0;   // (tile, MTA) pairs produced by the tile raster
+  uint32_t blend_beyond = 0;  // samples with more alphaMode BLEND fragments than the 8 composited exactly
 };
 
 class Pipeline {

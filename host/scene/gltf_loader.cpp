@@ -646,13 +646,6 @@ void summary_warnings(Loader& L, const SourceFile& src) {
   for (const auto& [ext, count] : unimplemented)
     L.warn(ext + " (" + std::to_string(count) + (count == 1 ? " material" : " materials") +
            "): " + material_extension_fallback(ext));
-  std::vector<std::string> blend;
-  for (int m : L.used_materials)
-    if (L.model.materials[size_t(m)].alphaMode == "BLEND") blend.push_back(std::to_string(m));
-  if (!blend.empty()) {
-    if (blend.size() > 8) blend.resize(8), blend.push_back("...");
-    L.warn("alphaMode BLEND drawn as opaque (material " + join(blend) + ")");
-  }
 }
 
 void describe_structure(Loader& L, const std::vector<int>& roots) {

@@ -45,6 +45,16 @@ bool scene_transmissive(const Scene& scene) {
   return false;
 }
 
+bool scene_blended(const Scene& scene, bool pbr) {
+  for (const PmrTriangle& t : scene.triangles) {
+    if (t.material >= scene.materials.size() || scene.materials[t.material].alpha_mode != PMR_ALPHA_BLEND) continue;
+    const bool glass = t.material < scene.material_inputs.size() ? scene.material_inputs[t.material].transmission > 0.0f
+                                                                 : scene.materials[t.material].transmission > 0.0f;
+    if (!(pbr && glass)) return true;
+  }
+  return false;
+}
+
 float dielectric_f0(double ior) {
   if (ior == 1.5) return 0.04f;  // glTF's default, exactly as the core specification writes it
   const double f = (ior - 1.0) / (ior + 1.0);

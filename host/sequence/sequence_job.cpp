@@ -187,11 +187,12 @@ void SequenceRun::check_frame_memory() const {
   const Rig& rig = renderer_->rig();
   const uint64_t voxels = uint64_t(rig.views) * uint64_t(rig.view_w) * uint64_t(rig.view_h);
   const uint64_t display = products_.encoded ? uint64_t(job_.display.width) * uint64_t(job_.display.height) * 14 : 0;
-  const uint64_t volume = need_volume_ ? voxels * 8 : 0;
+  // (BLEND layers are composited in the view volume: such a scene keeps one even for the encoded image)
+  const bool pbr = pc_.shading == Shading::Pbr;
+  const uint64_t volume = need_volume_ || scene_blended(scene_, pbr) ? voxels * 8 : 0;
   const uint64_t depth = need_volume_ && products_.depth ? voxels * (24 * uint64_t(pc_.samples) + 3 * 4) : 0;
-  const uint64_t glass = pc_.shading == Shading::Pbr && scene_transmissive(scene_)
-                             ? TransmissionStage::bytes_for(rig.views, rig.view_w, rig.view_h)
-                             : 0;
+  const uint64_t glass =
+      pbr && scene_transmissive(scene_) ? TransmissionStage::bytes_for(rig.views, rig.view_w, rig.view_h) : 0;
   check_memory(
       5 * volume + 5 * display + depth + glass,
       std::to_string(rig.views) + " views of " + std::to_string(rig.view_w) + "x" + std::to_string(rig.view_h) + " (" +
@@ -404,6 +405,10 @@ int SequenceRun::render_frames() {
     if (!fr.visible)
       progress.message("pmr: warning: frame " + std::to_string(f) +
                        ": nothing visible, written as a transparent image");
+    if (fr.times.blend_beyond > 0)
+      progress.message("pmr: note: frame " + std::to_string(f) + ": " + std::to_string(fr.times.blend_beyond) +
+                       " samples had more than 8 alphaMode BLEND fragments; those behind the nearest 8 were "
+                       "composited as one layer");
     if (job_.verbose) print_frame_stages(f, fr, pipeline, progress);
     writer.submit(frame_files(f, fr, pipeline, writer));
     ++rendered_;

@@ -219,6 +219,9 @@ float dielectric_f0(double ior);
 // Whether a triangle's material transmits (KHR_materials_transmission): pbr then draws glass, with
 // the transmission source (DESIGN 4c step 2).
 bool scene_transmissive(const Scene& scene);
+// Whether a triangle's material is alphaMode BLEND and (with pbr shading) not transmissive: frames then
+// composite BLEND layers (DESIGN 4c step 3), which the fused fine raster does not (they keep a volume).
+bool scene_blended(const Scene& scene, bool pbr);
 // The factors of `in` (as the loader checked them) into the device material `m`; maps are not touched.
 void apply_material_inputs(const SceneMaterialInputs& in, PmrMaterial& m);
 

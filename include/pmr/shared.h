@@ -101,6 +101,7 @@ typedef uint64_t pmr_u64;
 #define PMR_MTA_BACK 1u /* back-facing in its view range (double-sided): shading flips the normal */
 #define PMR_MTA_MASK 2u /* material uses alphaMode MASK: visibility must evaluate alpha */
 #define PMR_MTA_TRANSMISSIVE 4u /* pbr, KHR_materials_transmission: left out of the opaque pass (PmrSource) */
+#define PMR_MTA_BLEND 8u /* alphaMode BLEND (not transmissive): composited over the opaque result (DESIGN 4c) */
 
 /* PmrParams.setup_mode: one MTA per orientation range (PMR), or one single-view MTA per view
  * (the geometry-duplication baseline). */

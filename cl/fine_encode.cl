@@ -12,6 +12,8 @@
  * subpixel's owner and its alpha, the mean of the subpixels' own alphas, from encode_straddle_alpha
  * once all tiles are done (write_display_pixel in fine_core.h, which fine_subpixel.cl's display pixels
  * go through too). */
+/* BLEND scenes never come here (Pipeline::choose_paths): compiled without its work */
+#define PMR_WITH_BLEND 0
 #include "fine_raster.h"
 
 #define FUSED_ROWS (PMR_TILE_Y * PMR_FUSED_VIEWS * FINE_CHUNKS)
@@ -87,7 +89,7 @@ inline void fused_raster_shade(const ShadeInputs* in, global const PmrMta* mtas,
   const int views = P->views;
   vfloat best_depth[FUSED_ROWS * NS];
   vuint best_key[FUSED_ROWS * NS], best_mta[FUSED_ROWS * NS], best_cover[NS > 1 ? FUSED_ROWS * NS : 1];
-  const FineState st = fine_state(best_depth, best_key, best_mta, best_cover, 0, 0u); /* (no BLEND here) */
+  const FineState st = fine_state(best_depth, best_key, best_mta, best_cover, 0, 0u);
   fine_clear_state(FUSED_ROWS * NS, &st);
   for (int tv = 0; tv < P->tiles_v; ++tv) {
     const uint tile = ((uint)tv * (uint)P->tiles_y) * (uint)P->tiles_x + tile_xy;

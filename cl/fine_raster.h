@@ -269,12 +269,13 @@ PMR_HOT void raster_chunk(const ShadeInputs* in, const PmrMta* m, uint id, const
     const int k = FINE_SLOT(r, s);
     z[s] = (vfloat)(zrow[s]) + (vfloat)(dp->gx) * (column + (vfloat)(sample_dx(in->P, s)));
     if (st->covered) st->covered[k] -= hit[s];
-    win[s] = hit[s] & layer_lanes(st, k, z[s], m->key);
-    if (!st->rest) win[s] &= (z[s] < st->depth[k]) | ((z[s] == st->depth[k]) & ((vuint)(m->key) < st->key[k]));
+    win[s] = PMR_WITH_BLEND ? hit[s] & layer_lanes(st, k, z[s], m->key) : hit[s];
+    if (!PMR_WITH_BLEND || !st->rest)
+      win[s] &= (z[s] < st->depth[k]) | ((z[s] == st->depth[k]) & ((vuint)(m->key) < st->key[k]));
   }
   const vuint bits = NS > 1 ? cover_bits(hit, chunk_hits(R, F, 0, 0, in_tile, lane)) : (vuint)(0u);
   if (m->flags & PMR_MTA_MASK) mask_chunk(in, m, bits, X, Y, view, cutoff, win);
-  if (st->found || st->rest) {
+  if (PMR_WITH_BLEND && (st->found || st->rest)) {
     vint any_win = (vint)(0);
     for (int s = 0; s < NS; ++s) any_win |= win[s];
     if (!any(any_win)) return;
@@ -428,7 +429,7 @@ typedef struct {
 /* A pixel's sum (premultiplied RGBA, acc[k][p]) gains a winner's colour c[0..2] with opacity c[3] and
  * share `weight` (of the samples, times their transmittance for a BLEND layer); its opacity goes to
  * alpha_of[sample][p] when that is kept (a BLEND layer). */
-inline void shade_add(float acc[4][VW], float* alpha_of, int p, int sample, float weight, const float* c) {
+PMR_HOT void shade_add(float acc[4][VW], float* alpha_of, int p, int sample, float weight, const float* c) {
   const float wa = weight * c[3];
   for (int k = 0; k < 3; ++k) acc[k][p] += wa * c[k];
   acc[3][p] += wa;
@@ -476,7 +477,7 @@ inline void shade_pixel_lanes(const ShadeInputs* in, global const PmrMta* mtas, 
 /* Lanes where sample s is the first of the pixel's samples won by its winner (won, mta), and, in
  * *share, that winner's share of the pixel: the samples it won over NS, or with transmittances T the sum
  * of theirs over NS. */
-inline vint first_winner(const vuint* mta, const vint* won, const vfloat* T, int s, vfloat* share) {
+PMR_HOT vint first_winner(const vuint* mta, const vint* won, const vfloat* T, int s, vfloat* share) {
   vint first = won[s], count = (vint)(0);
   vfloat sum = (vfloat)(0.0f);
   for (int t = 0; t < NS; ++t) {
@@ -508,9 +509,9 @@ inline void layer_transmittance(const vuint* mta, const vint* won, const float* 
  * multiplies by 1 - its opacity (blend.h); without T and with one sample a pixel is its winner's
  * colour at the pixel center, alpha 1, or unchanged (background). The winners first met at sample 0 are
  * shaded in pixel order, the others packed into batches; each pixel adds its winners in sample order. */
-inline void fine_shade_winners(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                               const vuint* mta, const vuint* cover, const vint* won, vfloat* T, bool layer, int px0,
-                               int py, int view, float acc[4][VW]) {
+PMR_HOT void fine_shade_winners(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
+                                const vuint* mta, const vuint* cover, const vint* won, vfloat* T, bool layer, int px0,
+                                int py, int view, float acc[4][VW]) {
   float alpha_of[NS * VW];
   ShadeBatch B;
   B.n = 0;

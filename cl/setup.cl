@@ -141,7 +141,7 @@ kernel void setup_triangles(global const PmrParams* P, global const PmrTriangle*
   if (oc_and & CULL_BITS) return;
   const PmrMaterial mat = materials[tri.material];
   /* the material's MTA flags: alphaMode MASK; pbr transmission (left out of the opaque pass); alphaMode
-   * BLEND, which a transmissive material leaves to its transmission (blended_material, scene.cpp) */
+   * BLEND, which a transmissive material leaves to its transmission (scene_blended, scene.cpp) */
   const uint ds = mat.double_sided;
   const bool glass = P->shading == PMR_SHADING_PBR && mat.transmission > 0.0f;
   const uint mflag = (mat.alpha_mode == PMR_ALPHA_MASK ? PMR_MTA_MASK : 0u) | (glass ? PMR_MTA_TRANSMISSIVE : 0u) |

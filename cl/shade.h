@@ -59,6 +59,12 @@ typedef struct {
   global uint* source_tiles;           /* ... per 3D tile: 1 if the opaque pass left a transmissive MTA out  */
 } ShadeInputs;
 
+/* 0 in programs that never see alphaMode BLEND (the fused raster + encode: the host renders BLEND
+ * scenes through the view volume), which then carry none of its per-lane work. */
+#ifndef PMR_WITH_BLEND
+#define PMR_WITH_BLEND 1
+#endif
+
 #define LANE3(a) s3(vload_s(0, (a)[0]), vload_s(0, (a)[1]), vload_s(0, (a)[2]))
 
 /* SW winners to shade, one per lane (a row of 8 voxels of a real model holds a few small triangles):
@@ -77,7 +83,7 @@ typedef struct {
   sfloat3 c[3];       /* vertex colours (COLOR_0, RGB)                                   */
   sfloat3 factor;     /* baseColorFactor (RGB)                                           */
   sint blended;       /* alphaMode BLEND: lanes whose alpha is their opacity, not 1      */
-  sfloat alpha[4];    /* ... their baseColorFactor alpha and vertex colour alphas        */
+  sfloat alpha[4];    /* ... their baseColorFactor and vertex colour alphas (if any is) */
   sfloat3 p[3];       /* pbr: vertex positions, world space                              */
   sfloat metallic, roughness;
   sfloat f0d; /* pbr: the dielectric F0 (PmrMaterial.f0_dielectric)                  */
@@ -106,8 +112,7 @@ inline void lanes_clear(LaneWinners* L) {
     L->n[k] = L->face, L->c[k] = s3(one, one, one), L->p[k] = s3(zero, zero, zero);
   }
   L->factor = s3(zero, zero, zero);
-  L->blended = (sint)(0);
-  for (int k = 0; k < 4; ++k) L->alpha[k] = one;
+  L->blended = (sint)(0); /* the alpha inputs are set when the first BLEND lane comes */
   L->metallic = L->roughness = L->f0d = zero;
   L->emissive = s3(zero, zero, zero);
   L->glass = (sint)(0); /* the transmission inputs are set when the first glass lane comes */
@@ -156,7 +161,9 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
     if (pbr) L->p[k] = blend3(L->p[k], vload3(t.v[k], in->positions), take);
   }
   L->factor = blend3(L->factor, vload3(0, mat->base_color), take);
-  if (m->flags & PMR_MTA_BLEND) {
+  if (PMR_WITH_BLEND && (m->flags & PMR_MTA_BLEND)) {
+    if (!any(L->blended))
+      for (int k = 0; k < 4; ++k) L->alpha[k] = (sfloat)(1.0f);
     L->blended |= take;
     L->alpha[0] = blend(L->alpha[0], mat->base_color[3], take);
     for (int k = 0; k < 3; ++k) L->alpha[k + 1] = blend(L->alpha[k + 1], in->attrs[t.v[k]].color[3], take);
@@ -362,7 +369,7 @@ inline void sample_material_lanes(const ShadeInputs* in, global const PmrMateria
   if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
     sample_map_lanes(in, &mat->maps[PMR_MAP_BASE_COLOR], L->tri, bits, take, b, g, true, C, c);
     for (int k = 0; k < 3; ++k) lanes_put(T->base[k], c[k], take);
-    lanes_put(T->base_alpha, c[3], take);
+    if (PMR_WITH_BLEND && any(L->blended)) lanes_put(T->base_alpha, c[3], take);
   }
   if (!pbr) return;
   if (mat->maps[PMR_MAP_METALLIC_ROUGHNESS].texture >= 0) {
@@ -412,12 +419,14 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
   for (int l = 0; l < SW; ++l) {
     for (int k = 0; k < 3; ++k) T->base[k][l] = T->emissive[k][l] = 1.0f, T->s[k][l] = 0.0f;
     for (int k = 0; k < 4; ++k) T->tw[k][l] = 0.0f;
-    T->base_alpha[l] = T->metallic[l] = T->roughness[l] = T->ao[l] = T->normal_scale[l] = 1.0f;
+    T->metallic[l] = T->roughness[l] = T->ao[l] = T->normal_scale[l] = 1.0f;
     T->mapped[l] = 0;
     T->toksvig[l] = 0.0f;
   }
   if (any(L->glass))
     for (int l = 0; l < SW; ++l) T->transmission[l] = T->thickness[l] = 1.0f;
+  if (PMR_WITH_BLEND && any(L->blended))
+    for (int l = 0; l < SW; ++l) T->base_alpha[l] = 1.0f;
   uint material[SW];
   for (uint r = L->textured; r != 0u; r &= r - 1u) {
     const int l = 31 - (int)clz(r & (0u - r));
@@ -615,7 +624,7 @@ inline sfloat3 s3_half_range(sfloat3 c) {
 /* The opacity of each lane: 1, or for alphaMode BLEND baseColorFactor alpha x COLOR_0 alpha x the base
  * colour texture's alpha, clamped to [0, 1] (the MASK test's alpha, mta_alpha_passes, in lanes). */
 inline sfloat lane_alpha(const LaneWinners* L, const LaneTextures* T, bool textured, sfloat3 b) {
-  if (!any(L->blended)) return (sfloat)(1.0f);
+  if (!PMR_WITH_BLEND || !any(L->blended)) return (sfloat)(1.0f);
   sfloat a = L->alpha[0] * (b.x * L->alpha[1] + b.y * L->alpha[2] + b.z * L->alpha[3]);
   if (textured) a *= vload_s(0, T->base_alpha);
   return select((sfloat)(1.0f), clamp(a, 0.0f, 1.0f), L->blended);

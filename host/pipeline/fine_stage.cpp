@@ -109,6 +109,8 @@ void FineStage::run_volume(const SceneBuffers& scene, const GeometryStage& geome
 
 void FineStage::run_fused(const SceneBuffers& scene, const GeometryStage& geometry, size_t screen_tiles,
                           EncodeStage& encode, const SourceBinding& source, FrameEvents& ev) {
+  // the fused program is compiled without BLEND compositing (cl/fine_encode.cl)
+  if (scene.blended()) throw InternalError("a scene with alphaMode BLEND on the fused path");
   const cl_uint next = scene.bind_shading(fine_encode_, geometry.params(), source);
   fine_encode_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(), encode.params_buffer(),
                          column_soa_, encode.rows_buffer(), column_start_, row_start_, encode.display(),

@@ -474,19 +474,16 @@ inline void shade_pixel_lanes(const ShadeInputs* in, global const PmrMta* mtas, 
   }
 }
 
-/* Lanes where sample s is the first of the pixel's samples won by its winner (won, mta), and, in
- * *share, that winner's share of the pixel: the samples it won over NS, or with transmittances T the sum
- * of theirs over NS. */
-PMR_HOT vint first_winner(const vuint* mta, const vint* won, const vfloat* T, int s, vfloat* share) {
-  vint first = won[s], count = (vint)(0);
-  vfloat sum = (vfloat)(0.0f);
+/* Lanes where sample s is the first of the pixel's samples won by its winner (won, mta), and in *count
+ * the number of samples that winner won. */
+inline vint first_winner(const vuint* mta, const vint* won, int s, vint* count) {
+  vint first = won[s], n = (vint)(0);
   for (int t = 0; t < NS; ++t) {
     const vint same = won[t] & (mta[t] == mta[s]);
     if (t < s) first &= ~same;
-    else if (T) sum += select((vfloat)(0.0f), T[t], same);
-    else count -= same;
+    else n -= same;
   }
-  *share = (T ? sum : convert_vfloat(count)) / (float)NS;
+  *count = n;
   return first;
 }
 
@@ -494,8 +491,8 @@ PMR_HOT vint first_winner(const vuint* mta, const vint* won, const vfloat* T, in
  * shaded where it was first met (alpha_of[s], first_winner). */
 inline void layer_transmittance(const vuint* mta, const vint* won, const float* alpha_of, vfloat* T) {
   for (int s = 0; s < NS; ++s) {
-    vfloat share;
-    const vint first = first_winner(mta, won, 0, s, &share);
+    vint count;
+    const vint first = first_winner(mta, won, s, &count);
     const vfloat a = vload_vfloat(0, alpha_of + s * VW);
     for (int t = s; t < NS; ++t) T[t] = select(T[t], T[t] * (1.0f - a), first & won[t] & (mta[t] == mta[s]));
   }
@@ -503,7 +500,7 @@ inline void layer_transmittance(const vuint* mta, const vint* won, const float* 
 
 /* The winners of a row chunk shaded and added into acc (premultiplied RGBA per pixel): lane l is pixel
  * (px0 + l, py) of view `view`, whose sample s was won by MTA mta[s][l] where won[s]. Each pixel shades
- * each distinct winner once, at its shading point, weighted by its share (first_winner) times its
+ * each distinct winner once, at its shading point, weighted by its share (its samples, or with T their transmittances, over NS) times its
  * opacity (1 but for a BLEND layer), so that alpha is the covered fraction (DESIGN section 3b). T: the
  * samples' transmittance through the BLEND layers in front (null: none), which a BLEND layer then
  * multiplies by 1 - its opacity (blend.h); without T and with one sample a pixel is its winner's
@@ -517,17 +514,24 @@ PMR_HOT void fine_shade_winners(const ShadeInputs* in, global const PmrMta* mtas
   B.n = 0;
   const long X = (long)px0 * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
   for (int s = 0; s < NS; ++s) {
-    vfloat share;
-    const vint first = first_winner(mta, won, T, s, &share);
+    vint count;
+    const vint first = first_winner(mta, won, s, &count);
     if (!any(first)) continue;
-    int ids[VW + SW], w[VW + SW];
-    float weight[VW + SW];
+    int ids[VW + SW], w[VW + SW], n[VW + SW];
+    float weight[VW + SW]; /* the winner's share: its samples (times their transmittance T) over NS */
     uint bits[VW + SW];
     vstore_vint(as_vint(mta[s]), 0, ids);
     vstore_vint(first, 0, w);
-    vstore_vfloat(share, 0, weight);
+    vstore_vint(count, 0, n);
     vstore_vint(as_vint(NS > 1 ? cover[s] : (vuint)(1u)), 0, (int*)bits);
-    for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = 0, bits[l] = 0u, weight[l] = 0.0f;
+    for (int l = VW; l < VW + SW; ++l) ids[l] = w[l] = n[l] = 0, bits[l] = 0u;
+    if (T) {
+      vfloat sum = (vfloat)(0.0f);
+      for (int t = s; t < NS; ++t) sum += select((vfloat)(0.0f), T[t], won[t] & (mta[t] == mta[s]));
+      vstore_vfloat(sum / (float)NS, 0, weight);
+    }
+    for (int l = 0; l < VW; ++l)
+      if (!T) weight[l] = (float)n[l] / (float)NS;
     if (s == 0) {
       shade_pixel_lanes(in, mtas, cache, light, ids, w, weight, bits, px0, py, view, NS == 1 && !T, acc,
                         layer ? alpha_of : 0);

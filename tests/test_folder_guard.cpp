@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <fcntl.h>
 #include <unistd.h>
@@ -207,6 +208,32 @@ TEST(FolderGuard, ALiveProcessOfAnotherConfigurationRefusesTheSecond) {
     r = run("render --frames 0:1" + kSmall + "--out " + out);
     EXPECT_EQ(r.status, 0) << r.output;
     EXPECT_EQ(lock_files(out).size(), 1u) << "the held lock stays, this run's own is removed";
+  }
+}
+
+// Planted lock names (docs/SECURITY.md): a symlink to /dev/zero held with flock, a FIFO and a held lock of
+// 8 MiB are neither followed, nor waited on, nor read to their end.
+TEST(FolderGuard, PlantedLockFilesAreNotFollowedNorReadWithoutBound) {
+  const std::string out = temp_dir("guard_planted");
+  fs::create_directories(out);
+  const std::string other = sidecar_of("guard_planted_other", " --fps 30" + kSmall);
+  const std::string name = folder_lock_name("frame_%04d", other);
+  const int zero = ::open("/dev/zero", O_RDONLY);
+  ASSERT_GE(zero, 0);
+  ASSERT_EQ(::flock(zero, LOCK_SH), 0) << std::strerror(errno);
+  fs::create_symlink("/dev/zero", out + "/" + name);
+  CliRun r = run("render --frames 0" + kSmall + "--out " + out);
+  EXPECT_EQ(r.status, 0) << r.output;
+  ::close(zero);
+  fs::remove(out + "/" + name);
+  ASSERT_EQ(::mkfifo((out + "/" + name).c_str(), 0644), 0) << std::strerror(errno);
+  r = run("render --frames 0 --overwrite" + kSmall + "--out " + out);
+  EXPECT_EQ(r.status, 0) << r.output;
+  fs::remove(out + "/" + name);
+  {
+    const HeldLock huge(out, other + std::string(size_t(8) << 20, ' '));
+    expect_one_error_line(run("render --frames 0 --overwrite" + kSmall + "--out " + out),
+                          "being rendered right now by a pmr process with another configuration (unrecorded");
   }
 }
 

@@ -58,10 +58,19 @@ bool same_file(int fd, const std::string& path) {
 }
 
 // Opens for reading and writing (fcntl-emulated flock over NFS needs write access for an exclusive
-// lock), else read-only (someone else's file).
+// lock), else read-only (someone else's file). A lock is a regular file that pmr created: a symlink is
+// not followed (ELOOP), a FIFO does not block the open, and anything but a regular file is refused
+// (EINVAL), so a planted name cannot make pmr read a device or wait on a pipe.
 int open_lock(const std::string& path) {
-  int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
-  if (fd < 0 && errno == EACCES) fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  const int flags = O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK;
+  int fd = ::open(path.c_str(), O_RDWR | flags);
+  if (fd < 0 && errno == EACCES) fd = ::open(path.c_str(), O_RDONLY | flags);
+  struct stat st;
+  if (fd >= 0 && (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))) {
+    ::close(fd);
+    errno = EINVAL;
+    return -1;
+  }
   return fd;
 }
 
@@ -105,7 +114,11 @@ int create_lock_file(const std::string& path, const std::string& text) {
   return err;
 }
 
-std::string read_fd(int fd) {
+// A lock's text: its configuration (a sidecar, a few KB per view count's matrices). One longer than
+// kLockTextLimit is not pmr's: read no further, and report it as unrecorded (empty).
+constexpr off_t kLockTextLimit = off_t(4) << 20;
+
+std::string read_lock_text(int fd) {
   std::string text;
   char buf[65536];
   off_t at = 0;
@@ -115,6 +128,7 @@ std::string read_fd(int fd) {
     if (n <= 0) break;
     text.append(buf, size_t(n));
     at += n;
+    if (at > kLockTextLimit) return std::string();
   }
   return text;
 }
@@ -151,7 +165,10 @@ int take_own_lock(const std::string& dir, const std::string& own_name, const std
     const int fd = open_lock(lock_path);
     if (fd < 0) {
       if (errno == ENOENT) continue;  // removed as stale by another process meanwhile
-      throw Error("cannot lock output folder " + dir + ": cannot open " + own_name + ": " + std::strerror(errno));
+      throw Error("cannot lock output folder " + dir + ": cannot open " + own_name + ": " +
+                  (errno == ELOOP    ? std::string("it is a symbolic link, not a lock pmr made")
+                   : errno == EINVAL ? std::string("it is not a regular file")
+                                     : std::string(std::strerror(errno))));
     }
     int rc;
     while ((rc = ::flock(fd, LOCK_SH)) != 0 && errno == EINTR) {}
@@ -213,7 +230,7 @@ void refuse_running_configurations(const std::string& dir, const std::vector<std
       continue;
     }
     const bool held = errno == EWOULDBLOCK;
-    const std::string text = held ? read_fd(fd) : std::string();
+    const std::string text = held ? read_lock_text(fd) : std::string();
     ::close(fd);
     if (!held) continue;  // cannot tell (e.g. a read-only file over NFS)
     const std::string diff = difference(text);

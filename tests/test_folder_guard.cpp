@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "output/sidecar.h"
+#include "pmr/error.h"
 #include "pmr/output.h"
 #include "sequence/folder_guard.h"
 #include "sequence/range_warning.h"
@@ -234,6 +235,23 @@ TEST(FolderGuard, PlantedLockFilesAreNotFollowedNorReadWithoutBound) {
     const HeldLock huge(out, other + std::string(size_t(8) << 20, ' '));
     expect_one_error_line(run("render --frames 0 --overwrite" + kSmall + "--out " + out),
                           "being rendered right now by a pmr process with another configuration (unrecorded");
+  }
+  // this run's own lock name planted as a symlink or a FIFO: refused, not followed, not waited on
+  const std::string expected = "{\"a configuration\": 1}";
+  const std::string own = out + "/" + folder_lock_name("frame_%04d", expected);
+  for (bool fifo : {false, true}) {
+    fs::remove(own);
+    if (fifo) ASSERT_EQ(::mkfifo(own.c_str(), 0644), 0) << std::strerror(errno);
+    else fs::create_symlink("/dev/zero", own);
+    try {
+      FolderGuard guard(out, "frame_%04d", {0}, expected, false, true);
+      ADD_FAILURE() << "a planted own lock was taken";
+    } catch (const Error& e) {
+      EXPECT_NE(
+          std::string(e.what()).find(fifo ? "it is not a regular file" : "it is a symbolic link, not a lock pmr made"),
+          std::string::npos)
+          << e.what();
+    }
   }
 }
 

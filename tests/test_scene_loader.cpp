@@ -19,6 +19,7 @@
 #include "pmr/scene.h"
 #include "gltf_builder.h"
 #include "reference/shade_reference.h"
+#include "test_util.h"
 
 namespace pmr {
 namespace {
@@ -433,6 +434,25 @@ TEST_F(SceneLoaderTest, CamerasArePlacedByTheirNodes) {
   EXPECT_FALSE(s.cameras[1].perspective);
   EXPECT_FALSE(s.cameras[2].placed);  // no node uses it
   EXPECT_DOUBLE_EQ(s.cameras[2].aspect, 2.0);
+}
+
+// A placed camera whose yfov cannot drive the rig is reported as that: a warning naming yfov, and
+// --camera refused with the same reason (not as "not placed").
+TEST_F(SceneLoaderTest, ACameraWithABadYfovSaysSo) {
+  GltfFile g = unit_triangle();
+  g.add("cameras", {{"type", "perspective"}, {"perspective", {{"yfov", 4.0}, {"znear", 0.1}}}});
+  g.add("nodes", {{"mesh", 0}});
+  g.add("nodes", {{"camera", 0}, {"translation", {0, 0, 5}}});
+  g.scene({0, 1});
+  const std::string path = g.write(dir_, "bad_yfov");
+  const Scene s = load_scene(path);
+  ASSERT_EQ(s.cameras.size(), 1u);
+  EXPECT_TRUE(s.cameras[0].placed);
+  EXPECT_EQ(s.cameras[0].invalid, "its yfov must lie between 0 and pi radians");
+  EXPECT_TRUE(any_warning(s, "camera 0 has invalid perspective parameters (its yfov must lie between 0 and pi"));
+  const test::CliRun r =
+      test::run("render " + path + " --camera 0 --views 2 --view-size 16x8 --out " + (dir_ / "bad_yfov_out").string());
+  test::expect_one_error_line(r, "--camera 0 has invalid perspective parameters: its yfov must lie between 0 and pi");
 }
 
 // Animated nodes: a camera node moving (LINEAR translation) is followed by the pose; a mesh whose scale

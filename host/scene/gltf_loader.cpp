@@ -605,19 +605,24 @@ void build_cameras(Loader& L) {
   }
 }
 
-// A perspective camera with unusable parameters cannot drive the rig: unplace it, with a warning.
+// Why a perspective camera's parameters cannot drive the rig, or empty.
+std::string camera_problem(const SceneCamera& c) {
+  const double pi = 3.14159265358979323846;
+  if (!(std::isfinite(c.yfov) && c.yfov > 0 && c.yfov < pi)) return "its yfov must lie between 0 and pi radians";
+  if (!(std::isfinite(c.znear) && c.znear > 0)) return "its znear must be positive";
+  if (!(std::isfinite(c.zfar) && (c.zfar == 0 || c.zfar > c.znear))) return "its zfar must be 0 or beyond znear";
+  if (!(std::isfinite(c.aspect) && c.aspect >= 0)) return "its aspectRatio must be 0 or positive";
+  return std::string();
+}
+
+// A perspective camera with unusable parameters cannot drive the rig: it says why, with a warning.
 void check_cameras(Loader& L) {
   for (size_t i = 0; i < L.scene.cameras.size(); ++i) {
     SceneCamera& c = L.scene.cameras[i];
     if (!c.placed || !c.perspective) continue;
-    const double pi = 3.14159265358979323846;
-    const bool ok = std::isfinite(c.yfov) && c.yfov > 0 && c.yfov < pi && std::isfinite(c.znear) && c.znear > 0 &&
-                    std::isfinite(c.zfar) && (c.zfar == 0 || c.zfar > c.znear) && std::isfinite(c.aspect) &&
-                    c.aspect >= 0;
-    if (!ok) {
-      c.placed = false;
-      L.warn("camera " + std::to_string(i) + " has invalid perspective parameters; ignored");
-    }
+    c.invalid = camera_problem(c);
+    if (!c.invalid.empty())
+      L.warn("camera " + std::to_string(i) + " has invalid perspective parameters (" + c.invalid + "); ignored");
   }
 }
 

@@ -134,8 +134,10 @@ FrameRenderer::FrameRenderer(const Scene& rest, const SequenceSpec& spec, const 
       throw Error("--camera " + std::to_string(rig_config.camera) + ": the scene has " +
                   std::to_string(rest.cameras.size()) + " camera(s)");
     const SceneCamera& cam = rest.cameras[size_t(rig_config.camera)];
-    if (!cam.perspective || !cam.placed)
-      throw Error("--camera " + std::to_string(rig_config.camera) + " is not a perspective camera placed in the scene");
+    const std::string k = "--camera " + std::to_string(rig_config.camera);
+    if (!cam.perspective) throw Error(k + " is an orthographic camera: only perspective cameras drive the rig");
+    if (!cam.placed) throw Error(k + " is not placed by any node of the scene");
+    if (!cam.invalid.empty()) throw Error(k + " has invalid perspective parameters: " + cam.invalid);
   }
   // Framing: the union of the bounds of the animation's first and last pose (what frames outside its
   // keys repeat) and of every frame inside its keys, without the turntable (its sphere is centered on

@@ -102,6 +102,7 @@ struct SceneCamera {
   double aspect = 0.0;      // 0 = not given
   bool perspective = true;  // orthographic cameras are listed but cannot drive the rig
   bool placed = false;      // true: a node of the scene places it (world_from_camera valid)
+  std::string invalid;      // why its perspective parameters cannot drive the rig (empty: they can)
 };
 
 struct SceneMotion;  // node hierarchy, clips, skins, moving instances (host/scene/motion.h)

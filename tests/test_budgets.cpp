@@ -358,6 +358,7 @@ TEST_F(Budgets, ManyLargeTrianglesRenderUnlessTheTileQueueBudgetSaysNo) {
                             "than the tile-queue limit of " +
                             std::to_string(entries - 1) + " (raise it with --limit tile-queue=N)");
   expect_no_frames(out);
+  EXPECT_FALSE(fs::exists(out)) << "the refused run left the folder it created";
 }
 
 // A frame still rendering after `slow_frame_seconds` reports how long it has run and its tile-queue

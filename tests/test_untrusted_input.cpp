@@ -218,6 +218,23 @@ TEST_F(UntrustedInput, TexturePixelsBudgetIsConfigurable) {
 
 // ---- 2. files a scene names: confined, regular, within the budget --------------------------------------
 
+// A %00 in a buffer's URI would cut the name where the C library reads it (to "data.bin", which exists
+// here): refused in one error naming the buffer, not loaded from the shorter name.
+TEST_F(UntrustedInput, ANulByteInAUriIsRefused) {
+  GltfFile g;
+  const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
+  g.mesh(json::array({{{"attributes", {{"POSITION", pos}}}}}));
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  write_bytes(dir_ / "data.bin", g.bin);
+  const fs::path scene = dir_ / "nul.gltf";
+  std::ofstream(scene) << g.finished("data.bin%00.png").dump();
+  EXPECT_TRUE(contains(load_error_with(scene.string(), InputLimits()),
+                       "buffer 0: file 'data.bin%00.png' names a file with a NUL byte (%00)"));
+  std::ofstream(scene) << g.finished("data.bin").dump();
+  EXPECT_EQ(load_scene(scene.string()).positions.size(), 3u) << "the same file without the %00 loads";
+}
+
 // Buffer URIs that leave the scene's folder: "..", percent-encoded "..", a symlink inside the folder
 // pointing out, an absolute climb to /etc/passwd. Each is one error naming the buffer and the option;
 // nothing is read or written. With --allow-outside-scene-folder the file outside loads, and the

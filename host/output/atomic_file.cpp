@@ -88,13 +88,14 @@ void write_text_atomic(const std::string& path, const std::string& text) {
   file.commit();
 }
 
-void prepare_output_dir(const std::string& dir) {
+bool prepare_output_dir(const std::string& dir) {
   const std::string what = "cannot write to output folder " + dir + ": ";
   if (dir.empty()) throw Error("cannot write to output folder '': empty path");
   std::error_code ec;
   const fs::path p(dir);
   const fs::file_status st = fs::status(p, ec);
-  if (fs::exists(st)) {
+  const bool created = !fs::exists(st);
+  if (!created) {
     if (!fs::is_directory(st)) throw Error(what + "exists and is not a folder");
   } else {
     fs::create_directories(p, ec);
@@ -108,6 +109,7 @@ void prepare_output_dir(const std::string& dir) {
   if (err != 0) throw Error(what + std::strerror(err));
   if (::unlink(probe.c_str()) != 0)
     throw Error(what + "cannot remove the probe file " + probe + ": " + std::strerror(errno));
+  return created;
 }
 
 void check_output_dir(const std::string& dir) {

@@ -267,6 +267,8 @@ void read_lights(const std::string& path, const json& doc, SourceFile& src) {
 // messages ("buffer 0: file 'a.bin'"). Returns false when the file does not exist and `missing_ok`.
 bool read_external(const std::string& path, SourceFile& src, const std::string& file, const std::string& what,
                    const std::string& confine, const InputLimits& limits, int64_t byte_length, bool missing_ok) {
+  // a %00 would cut the name where the C library reads it: another file than the URI says
+  if (file.find('\0') != std::string::npos) fail(path, what + " names a file with a NUL byte (%00)");
   if (auto known = src.external.find(file); known != src.external.end()) {
     ++known->second.uses;
     if (byte_length >= 0 && uint64_t(byte_length) != known->second.bytes.size())

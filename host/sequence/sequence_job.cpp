@@ -60,6 +60,7 @@ class SequenceRun {
  public:
   explicit SequenceRun(const SequenceJob& job) : job_(job), products_(job.products) {}
   int run();
+  int guarded_run();  // run() once the output folder exists
 
  private:
   void check_before_loading();
@@ -261,7 +262,18 @@ int SequenceRun::run() {
   load_inputs();
   choose_frames();
   prepare_frames();
-  prepare_output_dir(products_.out_dir);
+  // A run refused before it wrote anything (a budget met in the first frame) leaves no folder it made.
+  const bool created = prepare_output_dir(products_.out_dir);
+  try {
+    return guarded_run();
+  } catch (...) {
+    std::error_code ec;
+    if (created) fs::remove(products_.out_dir, ec);  // only if empty (its own lock is gone by now)
+    throw;
+  }
+}
+
+int SequenceRun::guarded_run() {
   // One folder, one configuration: no other configuration rendering into it now, none left beside
   // this run's frames (folder_guard.h). Held until the end of the run.
   const FolderGuard folder_guard(products_.out_dir, products_.name, job_frames_.empty() ? frames_ : job_frames_,

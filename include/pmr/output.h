@@ -23,7 +23,8 @@ const char* to_string(ExrCompression c);
 
 // Ensures the directory exists (creating it and its parents) and is writable (creates and removes a
 // probe file). Throws pmr::Error "cannot write to output folder X: <reason>". Call it before long work.
-void prepare_output_dir(const std::string& dir);
+// Returns whether it created the folder (a caller refused before writing removes it again).
+bool prepare_output_dir(const std::string& dir);
 // What prepare_output_dir can tell without creating anything: throws the same pmr::Error when `dir` is
 // empty, exists and is not a folder, or lies below something that is not a folder. For a check before
 // the inputs are read.

@@ -169,7 +169,9 @@ TEST(ExitCodes, AFileSizeLimitIsAnErrorNotACrash) {
   if (r.output.find("LLVM ERROR") != std::string::npos)
     GTEST_SKIP() << "the OpenCL compiler itself wrote a file beyond the limit: " << r.output;
   expect_one_error_line(r, "File too large");
-  for (const std::string& name : test::listing(out + "/x")) ADD_FAILURE() << "left behind: " << name;
+  // (the run made the folder; refused before any frame was complete, it removes it again)
+  if (exists(out + "/x"))
+    for (const std::string& name : test::listing(out + "/x")) ADD_FAILURE() << "left behind: " << name;
 }
 
 TEST(ExitCodes, NothingIsCreatedBeforeTheInputsAreChecked) {

@@ -218,14 +218,21 @@ TEST_F(UntrustedInput, TexturePixelsBudgetIsConfigurable) {
 
 // ---- 2. files a scene names: confined, regular, within the budget --------------------------------------
 
-// A %00 in a buffer's URI would cut the name where the C library reads it (to "data.bin", which exists
-// here): refused in one error naming the buffer, not loaded from the shorter name.
-TEST_F(UntrustedInput, ANulByteInAUriIsRefused) {
+// One triangle whose positions are the file's one buffer (its bytes in g.bin, its uri given later by
+// finished()).
+GltfFile one_buffer_triangle() {
   GltfFile g;
   const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
   g.mesh(json::array({{{"attributes", {{"POSITION", pos}}}}}));
   g.add("nodes", {{"mesh", 0}});
   g.scene({0});
+  return g;
+}
+
+// A %00 in a buffer's URI would cut the name where the C library reads it (to "data.bin", which exists
+// here): refused in one error naming the buffer, not loaded from the shorter name.
+TEST_F(UntrustedInput, ANulByteInAUriIsRefused) {
+  GltfFile g = one_buffer_triangle();
   write_bytes(dir_ / "data.bin", g.bin);
   const fs::path scene = dir_ / "nul.gltf";
   std::ofstream(scene) << g.finished("data.bin%00.png").dump();
@@ -240,11 +247,7 @@ TEST_F(UntrustedInput, ANulByteInAUriIsRefused) {
 // nothing is read or written. With --allow-outside-scene-folder the file outside loads, and the
 // sidecar says so.
 TEST_F(UntrustedInput, BufferOutsideTheSceneFolderIsRefused) {
-  GltfFile g;
-  const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
-  g.mesh(json::array({{{"attributes", {{"POSITION", pos}}}}}));
-  g.add("nodes", {{"mesh", 0}});
-  g.scene({0});
+  GltfFile g = one_buffer_triangle();
   write_bytes(dir_ / "outside.bin", g.bin);
   fs::create_directories(dir_ / "scene");
   fs::create_symlink(dir_ / "outside.bin", dir_ / "scene" / "link.bin");
@@ -310,11 +313,7 @@ TEST_F(UntrustedInput, ImageOutsideTheSceneFolderIsRefused) {
 // A directory, a FIFO, a device as a buffer or image: "not a regular file", named as such; the FIFO is
 // never opened (no writer exists: opening it for reading would block forever).
 TEST_F(UntrustedInput, OnlyRegularFilesAreRead) {
-  GltfFile g;
-  const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
-  g.mesh(json::array({{{"attributes", {{"POSITION", pos}}}}}));
-  g.add("nodes", {{"mesh", 0}});
-  g.scene({0});
+  GltfFile g = one_buffer_triangle();
   fs::create_directories(dir_ / "dir.bin");
   ASSERT_EQ(mkfifo((dir_ / "fifo.bin").c_str(), 0600), 0);
   fs::create_symlink("/dev/zero", dir_ / "zero.bin");
@@ -338,11 +337,7 @@ TEST_F(UntrustedInput, OnlyRegularFilesAreRead) {
 // Bytes read per file: checked on the file's size before reading. A sparse 5 GiB buffer is refused at
 // the default budget of 4 GiB in an instant; --limit file-bytes lowers it.
 TEST_F(UntrustedInput, FileBytesBudgetIsCheckedBeforeReading) {
-  GltfFile g;
-  const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
-  g.mesh(json::array({{{"attributes", {{"POSITION", pos}}}}}));
-  g.add("nodes", {{"mesh", 0}});
-  g.scene({0});
+  GltfFile g = one_buffer_triangle();
   const uint64_t five_gib = uint64_t(5) << 30;
   {
     std::ofstream(dir_ / "big.bin", std::ios::binary)

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
@@ -199,7 +200,8 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
     if (!outputs || outputs->empty()) return stem + ".json lists no outputs";
     for (auto it = outputs->begin(); it != outputs->end(); ++it) listed.push_back({it.key(), it.value()});
   }
-  std::vector<std::string> images;
+  std::vector<std::string> images;  // each file once, however many kinds list it: the work is bounded by the files
+  std::set<std::string> seen;
   for (const auto& [kind, value] : listed) {
     if (!value.is_string()) return stem + ".json lists a " + printable_text(kind) + " output that is not a file name";
     const std::string name = value.get<std::string>();
@@ -215,7 +217,7 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
               : st.type() == fs::file_type::directory ? "a folder"
                                                       : "a special file") +
              ")";
-    images.push_back(path.string());
+    if (seen.insert(path.string()).second) images.push_back(path.string());
   }
   // frame_problem names the files by their (plain, but maybe not ASCII) names
   return printable_text(frame_problem(sidecar, images, deep), std::string::npos);

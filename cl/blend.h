@@ -70,7 +70,7 @@ inline uint blend_rest(const ShadeInputs* in, const TileWalk* W, FineState* L, v
       const int k = FINE_SLOT(r, s);
       const vfloat sum_a = convert_vfloat(a[k]) / REST_ALPHA_ONE;
       const vint some = convert_vint(sum_a > 0.0f);
-      const vfloat alpha = 1.0f - exp(-convert_vfloat(ln[k]) / REST_ALPHA_ONE);
+      const vfloat alpha = REST_OPACITY(convert_vfloat(ln[k]));
       const vfloat w = T[k] * alpha / (float)NS;
       for (int j = 0; j < 3; ++j) {
         const vfloat c = convert_vfloat(ca[j][k]) / REST_COLOUR_ONE / sum_a;
@@ -116,18 +116,6 @@ inline uint blend_layers(const ShadeInputs* in, const TileWalk* W, const FineSta
     for (int k = 0; k < FINE_ROWS * NS; ++k) after_depth[k] = depth[k], after_key[k] = key[k];
   }
   return blend_rest(in, W, &L, T, acc);
-}
-
-/* Row chunk r's opaque winners (st) added behind its BLEND layers (the sums acc, transmittances T) and
- * resolved, as half RGBA bits. */
-inline void blend_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                              const FineState* st, vfloat* T, const vfloat* acc, int r, int px0, int py, int view,
-                              const vint* won, ushort4* out) {
-  float sum[4][VW];
-  for (int k = 0; k < 4; ++k) vstore_vfloat(acc[4 * r + k], 0, sum[k]);
-  fine_shade_winners(in, mtas, cache, light, st->mta + FINE_SLOT(r, 0), st->cover + (NS > 1 ? FINE_SLOT(r, 0) : 0), won,
-                     T + FINE_SLOT(r, 0), false, px0, py, view, sum);
-  for (int l = 0; l < VW; ++l) vstore_half4((float4)(sum[0][l], sum[1][l], sum[2][l], sum[3][l]), l, (half*)out);
 }
 
 #endif

@@ -82,10 +82,9 @@ kernel void fine_raster(PMR_SHADE_PARAMS, global const PmrMta* mtas, global cons
         ushort4 colour[VW];
         vint won[NS];
         for (int s = 0; s < NS; ++s) won[s] = best_key[FINE_SLOT(r, s)] != (vuint)(PMR_NO_KEY);
-        if (blend) blend_shade_chunk(&in, mtas, &cache, light, &st, T, acc, r, x0 + c * VW, py, view, won, colour);
-        else
-          fine_shade_chunk(&in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0),
-                           best_cover + (NS > 1 ? FINE_SLOT(r, 0) : 0), won, x0 + c * VW, py, view, colour);
+        fine_shade_chunk(&in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0),
+                         best_cover + (NS > 1 ? FINE_SLOT(r, 0) : 0), won, blend ? acc + 4 * r : 0,
+                         blend ? T + FINE_SLOT(r, 0) : 0, x0 + c * VW, py, view, colour);
         for (int l = 0; l < VW && c * VW + l < nx; ++l) {
           const int px = x0 + c * VW + l;
           const size_t voxel = (((size_t)view + view_base) * H + (size_t)py) * W + (size_t)px;

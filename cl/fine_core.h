@@ -20,6 +20,11 @@
 #define REST_ALPHA_ONE 16777216.0f /* 2^24: a and -ln(1 - a) */
 #define REST_COLOUR_ONE 65536.0f   /* 2^16: a c (c at most 65504) */
 #define REST_LN_MAX 40.0f          /* -ln(1 - a) for a = 1: a transmittance of 4e-18 */
+/* The rule's terms, for scalars and vectors alike (the subpixel raster sums per sample, the pixel-center
+ * raster per vector): a fragment's -ln(1 - a), capped; the layer's opacity 1 - prod(1 - a_k) from the
+ * fixed-point sum of those. */
+#define REST_LN(a) fmin(-log1p(-(a)), REST_LN_MAX)
+#define REST_OPACITY(ln_sum) (1.0f - exp(-(ln_sum) / REST_ALPHA_ONE))
 
 /* Where a vector's lanes sample the raster (16.16 / 24.8): lane l at (X + sx[l], Y + sy[l]), or, when
  * sx is null, along the pixel-center row (X + l PMR_X_ONE, Y). */

@@ -107,7 +107,8 @@ inline void fused_raster_shade(const ShadeInputs* in, global const PmrMta* mtas,
         vint won[NS];
         for (int s = 0; s < NS; ++s) won[s] = best_key[FINE_SLOT(r, s)] != (vuint)(PMR_NO_KEY);
         fine_shade_chunk(in, mtas, &cache, light, best_mta + FINE_SLOT(r, 0),
-                         best_cover + (NS > 1 ? FINE_SLOT(r, 0) : 0), won, x0 + c * VW, y0 + ly, view, colour + r * VW);
+                         best_cover + (NS > 1 ? FINE_SLOT(r, 0) : 0), won, 0, 0, x0 + c * VW, y0 + ly, view,
+                         colour + r * VW);
       }
 }
 

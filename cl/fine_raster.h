@@ -212,41 +212,68 @@ struct BlendRest {
   vlong* ln;
 };
 
-/* The lanes of a row chunk (first pixel center (X, Y), state row r) where MTA m (queue entry id) won
+/* SW winners of a row chunk shaded at the pixel centers (px0 + h + l, py), l < SW, where `act`, as
+ * colours c[3][SW]. */
+inline void shade_center_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
+                               sint act, sint ids, int px0, int py, int view, float c[4][SW]) {
+  const SampleLanes S = row_samples((long)px0 * PMR_X_ONE + PMR_HALF_X, (long)py * PMR_Y_ONE + PMR_HALF_Y);
+  shade_sample_lanes(in, mtas, cache, light, act, ids, &S, view, c);
+}
+
+/* The same at each lane's shading point for its winner (shading_point): the pixel center where the
+ * winner covers it (all of them: the row form above), else the centroid of its covered samples
+ * (cover[l], cover_bits). */
+inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, sint act,
+                              sint ids, const uint* cover, int px0, int py, int view, float c[4][SW]) {
+  const long X = (long)px0 * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
+  int on[SW], sx[SW], sy[SW];
+  vstore_s(act, 0, on);
+  bool centers = true;
+  for (int l = 0; l < SW; ++l) {
+    sx[l] = l * PMR_X_ONE, sy[l] = 0;
+    if (!on[l] || (cover[l] & FINE_CENTER)) continue;
+    int ox, oy;
+    shading_point(in->P, false, cover[l] & FINE_SAMPLE_BITS, &ox, &oy);
+    sx[l] += ox, sy[l] += oy;
+    centers = false;
+  }
+  if (centers) {
+    shade_center_lanes(in, mtas, cache, light, act, ids, px0, py, view, c);
+    return;
+  }
+  const SampleLanes S = offset_samples(X, Y, sx, sy);
+  shade_sample_lanes(in, mtas, cache, light, act, ids, &S, view, c);
+}
+
+/* The lanes of a row chunk (pixels (px0 + l, py), state row r) where MTA m (queue entry id) won
  * sample s (win[s]) of a walk for the rest: m shaded once per pixel at its shading point (cover: bits,
  * cover_bits) and added to the sums of those samples. */
-inline void blend_rest_chunk(const ShadeInputs* in, const PmrMta* m, uint id, vuint bits, const vint* win, long X,
-                             long Y, int view, int r, struct BlendRest* rest) {
+inline void blend_rest_chunk(const ShadeInputs* in, const PmrMta* m, uint id, vuint bits, const vint* win, int px0,
+                             int py, int view, int r, struct BlendRest* rest) {
   global const PmrParams* P = in->P;
   vint any_win = (vint)(0);
   for (int s = 0; s < NS; ++s) any_win |= win[s];
-  int w[VW];
-  uint cover[VW];
+  int w[VW + SW]; /* (SW lanes are read at a time: VW may be less) */
+  uint cover[VW + SW];
   float c[4][VW];
   vstore_vint(any_win, 0, w);
   vstore_vint(as_vint(bits), 0, (int*)cover);
+  for (int l = VW; l < VW + SW; ++l) w[l] = 0, cover[l] = 0u;
   MtaCache one; /* the shading's MTA cache, holding m */
   one.id = id, one.m = *m;
   const float3 light = (float3)(P->light_world[0], P->light_world[1], P->light_world[2]);
   for (int h = 0; h < VW; h += SW) {
-    int sx[SW], sy[SW];
-    for (int l = 0; l < SW; ++l) {
-      sx[l] = (h + l) * PMR_X_ONE, sy[l] = 0;
-      int ox = 0, oy = 0;
-      if (NS > 1 && h + l < VW && w[h + l])
-        shading_point(P, (cover[h + l] & FINE_CENTER) != 0u, cover[h + l] & FINE_SAMPLE_BITS, &ox, &oy);
-      sx[l] += ox, sy[l] += oy;
-    }
-    const SampleLanes S = NS == 1 ? row_samples(X + (long)h * PMR_X_ONE, Y) : offset_samples(X, Y, sx, sy);
+    const sint act = vload_s(0, w + h) != 0, ids = (sint)((int)id);
     float cs[4][SW];
-    shade_sample_lanes(in, 0, &one, light, vload_s(0, w + h) != 0, (sint)((int)id), &S, view, cs);
+    if (NS == 1) shade_center_lanes(in, 0, &one, light, act, ids, px0 + h, py, view, cs);
+    else shade_point_lanes(in, 0, &one, light, act, ids, cover + h, px0 + h, py, view, cs);
     for (int k = 0; k < 4; ++k)
       for (int l = 0; l < SW && h + l < VW; ++l) c[k][h + l] = cs[k][l];
   }
   const vfloat a = vload_vfloat(0, c[3]);
   vlong add[5];
   add[3] = convert_vlong_rte(a * REST_ALPHA_ONE);
-  add[4] = convert_vlong_rte(fmin(-log1p(-a), (vfloat)(REST_LN_MAX)) * REST_ALPHA_ONE);
+  add[4] = convert_vlong_rte(REST_LN(a) * REST_ALPHA_ONE);
   for (int k = 0; k < 3; ++k) add[k] = convert_vlong_rte(vload_vfloat(0, c[k]) * a * REST_COLOUR_ONE);
   for (int s = 0; s < NS; ++s) {
     const int k = FINE_SLOT(r, s);
@@ -281,7 +308,7 @@ PMR_HOT void raster_chunk(const ShadeInputs* in, const PmrMta* m, uint id, const
     if (!any(any_win)) return;
     if (st->found) *st->found = 1u;
     if (st->rest) {
-      blend_rest_chunk(in, m, id, bits, win, X, Y, view, r, st->rest);
+      blend_rest_chunk(in, m, id, bits, win, px0, (int)((Y - PMR_HALF_Y) >> PMR_Y_FRAC_BITS), view, r, st->rest);
       return;
     }
   }
@@ -383,39 +410,6 @@ inline void fine_raster_queue(global const PmrMta* mtas, global const uint* tile
   }
 }
 
-/* SW winners of a row chunk shaded at the pixel centers (px0 + h + l, py), l < SW, where `act`, as
- * colours c[3][SW]. */
-inline void shade_center_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                               sint act, sint ids, int px0, int py, int view, float c[4][SW]) {
-  const SampleLanes S = row_samples((long)px0 * PMR_X_ONE + PMR_HALF_X, (long)py * PMR_Y_ONE + PMR_HALF_Y);
-  shade_sample_lanes(in, mtas, cache, light, act, ids, &S, view, c);
-}
-
-/* The same at each lane's shading point for its winner (shading_point): the pixel center where the
- * winner covers it (all of them: the row form above), else the centroid of its covered samples
- * (cover[l], cover_bits). */
-inline void shade_point_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light, sint act,
-                              sint ids, const uint* cover, int px0, int py, int view, float c[4][SW]) {
-  const long X = (long)px0 * PMR_X_ONE + PMR_HALF_X, Y = (long)py * PMR_Y_ONE + PMR_HALF_Y;
-  int on[SW], sx[SW], sy[SW];
-  vstore_s(act, 0, on);
-  bool centers = true;
-  for (int l = 0; l < SW; ++l) {
-    sx[l] = l * PMR_X_ONE, sy[l] = 0;
-    if (!on[l] || (cover[l] & FINE_CENTER)) continue;
-    int ox, oy;
-    shading_point(in->P, false, cover[l] & FINE_SAMPLE_BITS, &ox, &oy);
-    sx[l] += ox, sy[l] += oy;
-    centers = false;
-  }
-  if (centers) {
-    shade_center_lanes(in, mtas, cache, light, act, ids, px0, py, view, c);
-    return;
-  }
-  const SampleLanes S = offset_samples(X, Y, sx, sy);
-  shade_sample_lanes(in, mtas, cache, light, act, ids, &S, view, c);
-}
-
 /* Shading jobs of a row chunk beyond its pixels' first winners (pixel `lane`, winner `ids` first met at
  * sample `sample`, shading point (sx, sy) from the chunk's first pixel center, its share `weight` of the
  * pixel), packed SW to a batch: edge pixels are few, and shading them lane by lane in the pixels' own
@@ -500,8 +494,9 @@ inline void layer_transmittance(const vuint* mta, const vint* won, const float* 
 
 /* The winners of a row chunk shaded and added into acc (premultiplied RGBA per pixel): lane l is pixel
  * (px0 + l, py) of view `view`, whose sample s was won by MTA mta[s][l] where won[s]. Each pixel shades
- * each distinct winner once, at its shading point, weighted by its share (its samples, or with T their transmittances, over NS) times its
- * opacity (1 but for a BLEND layer), so that alpha is the covered fraction (DESIGN section 3b). T: the
+ * each distinct winner once, at its shading point, weighted by its share (its samples, or with T their
+ * transmittances, over NS) times its opacity (1 but for a BLEND layer), so that alpha is the covered
+ * fraction (DESIGN section 3b). T: the
  * samples' transmittance through the BLEND layers in front (null: none), which a BLEND layer then
  * multiplies by 1 - its opacity (blend.h); without T and with one sample a pixel is its winner's
  * colour at the pixel center, alpha 1, or unchanged (background). The winners first met at sample 0 are
@@ -529,9 +524,9 @@ PMR_HOT void fine_shade_winners(const ShadeInputs* in, global const PmrMta* mtas
       vfloat sum = (vfloat)(0.0f);
       for (int t = s; t < NS; ++t) sum += select((vfloat)(0.0f), T[t], won[t] & (mta[t] == mta[s]));
       vstore_vfloat(sum / (float)NS, 0, weight);
+    } else {
+      for (int l = 0; l < VW; ++l) weight[l] = (float)n[l] / (float)NS;
     }
-    for (int l = 0; l < VW; ++l)
-      if (!T) weight[l] = (float)n[l] / (float)NS;
     if (s == 0) {
       shade_pixel_lanes(in, mtas, cache, light, ids, w, weight, bits, px0, py, view, NS == 1 && !T, acc,
                         layer ? alpha_of : 0);
@@ -550,15 +545,19 @@ PMR_HOT void fine_shade_winners(const ShadeInputs* in, global const PmrMta* mtas
   if (layer) layer_transmittance(mta, won, alpha_of, T);
 }
 
-/* The winners of a row chunk with nothing in front, shaded and resolved (fine_shade_winners), as half
- * RGBA bits. */
+/* The winners of a row chunk (fine_shade_winners) added behind what is in front of them, and resolved as
+ * half RGBA bits: with BLEND, the layers' sums `front` (4 vectors, premultiplied RGBA) and the samples'
+ * transmittances T (blend.h); else (null) nothing. */
 inline void fine_shade_chunk(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
-                             const vuint* mta, const vuint* cover, const vint* won, int px0, int py, int view,
-                             ushort4* out) {
+                             const vuint* mta, const vuint* cover, const vint* won, const vfloat* front, vfloat* T,
+                             int px0, int py, int view, ushort4* out) {
   float acc[4][VW];
-  for (int k = 0; k < 4; ++k)
-    for (int l = 0; l < VW; ++l) acc[k][l] = 0.0f;
-  fine_shade_winners(in, mtas, cache, light, mta, cover, won, 0, false, px0, py, view, acc);
+  for (int k = 0; k < 4; ++k) {
+    if (front) vstore_vfloat(front[k], 0, acc[k]);
+    else
+      for (int l = 0; l < VW; ++l) acc[k][l] = 0.0f;
+  }
+  fine_shade_winners(in, mtas, cache, light, mta, cover, won, T, false, px0, py, view, acc);
   for (int l = 0; l < VW; ++l) vstore_half4((float4)(acc[0][l], acc[1][l], acc[2][l], acc[3][l]), l, (half*)out);
 }
 

@@ -170,6 +170,22 @@ PMR_HOT float8 sp_depth(const DepthPlane* d, const SpChunk* C, double8 x, int8 x
   return convert_float8((double8)(d->zr) + (double8)(d->gy) * rows) + (float8)(d->gx) * columns;
 }
 
+/* A subpixel's shading point for MTA m, as an offset from the chunk's first sample: its own sample
+ * (vector slot j of the run, offsets sx, sy) where m covers that, else the centroid of the subpixel's
+ * samples m covers (shading_point); one sample: the sample itself. */
+inline void sp_shading_point(global const PmrParams* P, const PmrMta* m, int j, int v, int sx, int sy, const SpChunk* C,
+                             int* ox, int* oy) {
+  *ox = sx, *oy = sy;
+  if (NS == 1) return;
+  const int t = j % NS; /* the lane's sample of its subpixel */
+  const long X = C->Xc + sx - P->sample_x[t], Y = C->Yc + sy - P->sample_y[t];
+  bool center;
+  const uint bits = mta_sample_cover(P, m, X, Y, view_coord(P, v), &center);
+  int dx, dy;
+  shading_point(P, center, bits, &dx, &dy);
+  *ox = (int)(X - C->Xc) + dx, *oy = (int)(Y - C->Yc) + dy;
+}
+
 /* alphaMode MASK for the winning lanes `win` of a vector (its first sample the run's j-th, at offsets
  * sx, sy): tested at each lane's sample, or with several samples once per subpixel at its shading point
  * (shading_point around the subpixel's own sample), so that a failure leaves all its samples. */
@@ -182,16 +198,11 @@ inline int8 sp_mask(const ShadeInputs* in, const PmrMta* m, int8 win, int j, int
     mask_alpha_lanes(in, m, w, SP_LANES, &L, v, cutoff);
     return vload8(0, w);
   }
-  global const PmrParams* P = in->P;
   for (int l = 0; l < SP_LANES; ++l) {
     if (!w[l]) continue;
-    const int t = (j + l) % NS; /* the lane's sample of its subpixel */
-    const long X = C->Xc + sx[l] - P->sample_x[t], Y = C->Yc + sy[l] - P->sample_y[t];
-    bool center;
-    const uint bits = mta_sample_cover(P, m, X, Y, view_coord(P, v), &center);
     int ox, oy;
-    shading_point(P, center, bits, &ox, &oy);
-    if (!mta_alpha_passes(in, m, X + ox, Y + oy, v, cutoff)) w[l] = 0;
+    sp_shading_point(in->P, m, j + l, v, sx[l], sy[l], C, &ox, &oy);
+    if (!mta_alpha_passes(in, m, C->Xc + ox, C->Yc + oy, v, cutoff)) w[l] = 0;
   }
   return vload8(0, w);
 }
@@ -216,22 +227,6 @@ typedef struct {
   SpRest* rest;
 } SpWalk;
 
-/* A subpixel's shading point for MTA m, as an offset from the chunk's first sample: its own sample
- * (vector slot j of the run, offsets sx, sy) where m covers that, else the centroid of the subpixel's
- * samples m covers (shading_point); one sample: the sample itself. */
-inline void sp_shading_point(global const PmrParams* P, const PmrMta* m, int j, int v, int sx, int sy, const SpChunk* C,
-                             int* ox, int* oy) {
-  *ox = sx, *oy = sy;
-  if (NS == 1) return;
-  const int t = j % NS; /* the lane's sample of its subpixel */
-  const long X = C->Xc + sx - P->sample_x[t], Y = C->Yc + sy - P->sample_y[t];
-  bool center;
-  const uint bits = mta_sample_cover(P, m, X, Y, view_coord(P, v), &center);
-  int dx, dy;
-  shading_point(P, center, bits, &dx, &dy);
-  *ox = (int)(X - C->Xc) + dx, *oy = (int)(Y - C->Yc) + dy;
-}
-
 /* The rest beyond the exact BLEND layers (blend.h): MTA m (queue entry id) shaded at the shading points
  * of the samples `win` of a vector (slots k.., the run's j-th on, view v) and added to their sums. */
 inline void sp_rest_add(const ShadeInputs* in, const PmrMta* m, uint id, int8 win, int k, int j, int v,
@@ -254,7 +249,7 @@ inline void sp_rest_add(const ShadeInputs* in, const PmrMta* m, uint id, int8 wi
     const float a = c[3][l];
     R->ca[k + l] += convert_long_rte(c[C->channel[k + l]][l] * a * REST_COLOUR_ONE);
     R->a[k + l] += convert_long_rte(a * REST_ALPHA_ONE);
-    R->ln[k + l] += convert_long_rte(fmin(-log1p(-a), REST_LN_MAX) * REST_ALPHA_ONE);
+    R->ln[k + l] += convert_long_rte(REST_LN(a) * REST_ALPHA_ONE);
   }
 }
 
@@ -490,7 +485,7 @@ inline uint sp_blend_rest(const ShadeInputs* in, global const PmrMta* mtas, glob
   uint samples = 0u;
   for (int k = 0; k < run && found; ++k) {
     if (a[k] <= 0) continue;
-    const float A = 1.0f - exp(-(float)ln[k] / REST_ALPHA_ONE);
+    const float A = REST_OPACITY((float)ln[k]);
     const float w = T[k] * A / (float)NS;
     acc[C->sid[k]] += w * ((float)ca[k] / REST_COLOUR_ONE) / ((float)a[k] / REST_ALPHA_ONE);
     alpha[C->sid[k]] += w;

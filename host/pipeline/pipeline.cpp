@@ -106,14 +106,14 @@ Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config) : con
 Pipeline::~Pipeline() = default;
 
 void Pipeline::set_scene(const Scene& scene) {
-  impl_->scene.set_scene(scene);
   Impl& m = *impl_;
+  m.scene.set_scene(scene);
   if (m.views > 0 && m.paths.fused && m.scene.blended()) {  // BLEND needs the volume path: choose again
     const std::unique_ptr<Display> display = std::move(m.display);
     configure(Rig(m.rig), display.get());
   }
-  if (impl_->views > 0) impl_->configure_transmission();
-  impl_->geometry.set_scene(impl_->scene, config_.method == Method::Multipass && config_.multipass_snapped);
+  if (m.views > 0) m.configure_transmission();
+  m.geometry.set_scene(m.scene, config_.method == Method::Multipass && config_.multipass_snapped);
 }
 
 void Pipeline::update_geometry(const Scene& posed) { impl_->scene.update_geometry(posed); }

@@ -88,6 +88,10 @@ class Budgets : public ::testing::Test {
       EXPECT_TRUE(ext != ".exr" && ext != ".json" && ext != ".png") << "written: " << e.path();
     }
   }
+  // A quick render of frame 0 into `out`, the scene's path to follow.
+  static std::string render_into(const fs::path& out) {
+    return "render --views 2 --view-size 32x16 --display 64x36 --frames 0 -q --out " + out.string() + " ";
+  }
   fs::path dir_;
 };
 
@@ -278,7 +282,7 @@ TEST_F(Budgets, DecodedTexturesAreInTheMemoryBudget) {
 
 // The 994-byte hang: implicit vertices and a translation 41,666 s long. The framing would pose the
 // scene at each of a million frames before the first one renders; refused at once, nothing written.
-// (2^20 vertices here rather than 2^24: the load stays quick, the work is still 10^12 vertex-poses.)
+// (2^20 vertices here rather than 2^24: the load stays quick, the work is still 10^12 units.)
 TEST_F(Budgets, FramingWorkIsBounded) {
   GltfFile g = implicit_mesh(uint64_t(1) << 20);
   const int input = g.data<float>({0.0f, 41666.0f}, kFloat, "SCALAR");
@@ -292,18 +296,18 @@ TEST_F(Budgets, FramingWorkIsBounded) {
          {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}});
   const std::string scene = g.write(dir_, "hang");
   const fs::path out = dir_ / "out";
-  const std::string render =
-      "render --views 2 --view-size 32x16 --display 64x36 --frames 0 -q --out " + out.string() + " ";
   const auto t0 = std::chrono::steady_clock::now();
-  expect_one_error_line(
-      run(render + scene),
-      "framing the animation poses the scene's 1048576 vertices 999987 times (every frame of its keys "
-      "at 24.000000 fps), more than the framing-work limit of 17179869184 vertex-poses (raise it "
-      "with --limit framing-work=N)");
+  expect_one_error_line(run(render_into(out) + scene),
+                        "framing the animation poses the scene 999987 times (every frame of its keys at 24.000000 "
+                        "fps), ");
   EXPECT_LT(seconds_since(t0), 20.0);
   expect_no_frames(out);
-  // At the edge: a triangle moving for 1 s at 24 fps is posed 27 times (frames 0..24, and the first
-  // and last key), 81 vertex-poses: framed and rendered at 81, refused at 80.
+}
+
+// The units at the edge. A triangle moving for 1 s at 24 fps is framed by 27 poses (frames 0..24, and
+// the first and last key). One pose costs 42 units: its 3 vertices copied, 32 for its node, the 3
+// animated values, its 3 vertices moved (no morph targets) and its triangle's normal.
+TEST_F(Budgets, PoseAndFramingWorkAreCountedInUnits) {
   GltfFile t = one_triangle();
   const int in1 = t.data<float>({0.0f, 1.0f}, kFloat, "SCALAR");
   t.doc["accessors"][size_t(in1)]["min"] = {0.0};
@@ -313,13 +317,76 @@ TEST_F(Budgets, FramingWorkIsBounded) {
         {{"samplers", json::array({{{"input", in1}, {"output", out1}}})},
          {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}})}});
   const std::string moving = t.write(dir_, "moving");
-  expect_one_error_line(run(render + moving + " --limit framing-work=80"),
-                        "poses the scene's 3 vertices 27 times (every frame of its keys at 24.000000 fps), more than "
-                        "the framing-work limit of 80 vertex-poses");
+  const fs::path out = dir_ / "out";
+  expect_one_error_line(run(render_into(out) + moving + " --limit pose-work=41"),
+                        "posing one frame of the scene takes 42 units (docs/SECURITY.md, \"Posing\"), more than the "
+                        "pose-work limit of 41 (raise it with --limit pose-work=N)");
+  expect_one_error_line(run(render_into(out) + moving + " --limit framing-work=1133"),
+                        "poses the scene 27 times (every frame of its keys at 24.000000 fps), 42 units "
+                        "(docs/SECURITY.md, \"Posing\") each, more than the framing-work limit of 1133");
   expect_no_frames(out);
-  const CliRun ok = run(render + moving + " --limit framing-work=81");
+  const CliRun ok = run(render_into(out) + moving + " --limit framing-work=1134,pose-work=42");
   EXPECT_EQ(ok.status, 0) << ok.output;
   EXPECT_TRUE(exists((out / "frame_0000.json").string()));
+}
+
+// Issue 31's three posing bombs, each refused within seconds by the default budgets, where each would
+// have posed for hours: 2000 morph targets sharing one accessor on 10k vertices with keys over 200 s
+// (a 40 KB file), a chain of 200k nodes whose root moves for 2000 s, and a skin of 60k chained joints
+// moving for 2000 s.
+TEST_F(Budgets, PosingBombsAreRefusedBeforePosing) {
+  const int frames = 2000 * 24 + 1 + 2;  // frames 0..48000 and the first and last key
+  const auto animated = [](GltfFile& g, int node, const char* path, float seconds, const std::vector<float>& values) {
+    const int in = g.data<float>({0.0f, seconds}, kFloat, "SCALAR");
+    g.doc["accessors"][size_t(in)]["min"] = {0.0};
+    g.doc["accessors"][size_t(in)]["max"] = {double(seconds)};
+    const int value = g.data<float>(values, kFloat, path == std::string("weights") ? "SCALAR" : "VEC3");
+    g.add("animations", {{"samplers", json::array({{{"input", in}, {"output", value}}})},
+                         {"channels", json::array({{{"sampler", 0}, {"target", {{"node", node}, {"path", path}}}}})}});
+  };
+  GltfFile morph = implicit_mesh(10002);
+  const int zero = morph.accessor(-1, kFloat, "VEC3", 10002);
+  morph.doc["meshes"][0]["primitives"][0]["targets"] = json::array();
+  for (int k = 0; k < 2000; ++k) morph.doc["meshes"][0]["primitives"][0]["targets"].push_back({{"POSITION", zero}});
+  morph.add("nodes", {{"mesh", 0}});
+  morph.scene({0});
+  animated(morph, 0, "weights", 200.0f, std::vector<float>(4000, 0.5f));
+  GltfFile chain = one_triangle();
+  chain.doc["scenes"][0]["nodes"] = {1};
+  for (int n = 1; n <= 200000; ++n)
+    chain.add("nodes", n < 200000 ? json{{"children", {n + 1}}} : json{{"children", {0}}});
+  animated(chain, 1, "translation", 2000.0f, {0, 0, 0, 1, 0, 0});
+  GltfFile skin = one_triangle();
+  skin.doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] =
+      skin.data<uint16_t>(std::vector<uint16_t>(12, 0), kUShort, "VEC4");
+  skin.doc["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] =
+      skin.data<float>({1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}, kFloat, "VEC4");
+  skin.doc["nodes"][0]["skin"] = 0;
+  json joints = json::array();
+  for (int n = 1; n <= 60000; ++n) {
+    skin.add("nodes", n < 60000 ? json{{"children", {n + 1}}} : json::object());
+    joints.push_back(n);
+  }
+  skin.add("skins", {{"joints", joints}});
+  skin.doc["scenes"][0]["nodes"] = {0, 1};
+  animated(skin, 1, "translation", 2000.0f, {0, 0, 0, 1, 0, 0});
+  const fs::path out = dir_ / "out";
+  // Units of one pose, by hand: the chain's 3 vertices, 200001 nodes of 32, 3 animated values, 3
+  // vertices moved and 1 triangle; the skin's 3 vertices, 60001 nodes of 32, 60000 joints of 8, 3
+  // values, 3 vertices and 1 triangle.
+  const std::pair<const GltfFile*, std::string> bombs[] = {
+      {&morph, "poses the scene 4803 times"},
+      {&chain, "poses the scene " + std::to_string(frames) + " times (every frame of its keys at 24.000000 fps), " +
+                   std::to_string(3 + 32 * 200001 + 3 + 3 + 1) + " units"},
+      {&skin, "poses the scene " + std::to_string(frames) + " times (every frame of its keys at 24.000000 fps), " +
+                  std::to_string(3 + 32 * 60001 + 8 * 60000 + 3 + 3 + 1) + " units"}};
+  for (const auto& [file, expected] : bombs) {
+    const std::string scene = file->write(dir_, "bomb");
+    const auto t0 = std::chrono::steady_clock::now();
+    expect_one_error_line(run(render_into(out) + scene), expected);
+    EXPECT_LT(seconds_since(t0), 20.0) << expected;
+    expect_no_frames(out);
+  }
 }
 
 // ---- tile queue -----------------------------------------------------------------------------------------
@@ -448,14 +515,15 @@ TEST(MemoryBudget, AutomaticBudgetIsTheSmallestLimitLessAMargin) {
 TEST(BudgetKeys, HelpListsEveryKey) {
   const CliRun r = run("render --help");
   for (const char* key : {"file-bytes:", "texture-pixels:", "vertex-data:", "animation-data:", "json-bytes:",
-                          "framing-work:", "tile-queue:", "memory:"})
+                          "pose-work:", "framing-work:", "tile-queue:", "memory:"})
     EXPECT_TRUE(contains(r.output, key)) << key << " in " << r.output;
   InputLimits l;
-  parse_limits("vertex-data=1G,animation-data=2M,json-bytes=3K,framing-work=4,tile-queue=5,memory=6G", l);
+  parse_limits("vertex-data=1G,animation-data=2M,json-bytes=3K,framing-work=4,tile-queue=5,memory=6G,pose-work=7", l);
   EXPECT_EQ(l.vertex_data, kGiB);
   EXPECT_EQ(l.animation_data, uint64_t(2) << 20);
   EXPECT_EQ(l.json_bytes, 3072u);
   EXPECT_EQ(l.framing_work, 4u);
+  EXPECT_EQ(l.pose_work, 7u);
   EXPECT_EQ(l.tile_queue, 5u);
   EXPECT_EQ(l.memory, 6 * kGiB);
 }

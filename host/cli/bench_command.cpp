@@ -143,7 +143,7 @@ void bench_point(const BenchPoint& b, const ClRuntime& rt, double bw, std::vecto
 // row) per point.
 void bench_scene(const BenchOptions& o, const ClRuntime& rt, double bw, const Scene& scene,
                  const std::string& scene_name, std::ofstream* csv) {
-  const SequenceSpec spec = resolve_sequence(scene, o.sequence, o.limits.framing_work);
+  const SequenceSpec spec = resolve_sequence(scene, o.sequence, o.limits);
   std::printf("# %s: %zu triangles; device %s; copy bandwidth %.1f GB/s\n", scene_name.c_str(), scene.triangles.size(),
               rt.device_name().c_str(), bw * 1e-9);
   std::printf("%-10s %-8s %3s %5s %9s %9s %9s %9s %8s %8s %8s %8s %9s %8s %7s %8s\n", "method", "sampling", "spp",

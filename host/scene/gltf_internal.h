@@ -86,6 +86,8 @@ void check_schema(const std::string& path, const nlohmann::json& doc);
 
 // Percent-decodes a relative URI the way tinygltf does and joins it to base_dir.
 std::string resolve_uri(const std::string& base_dir, const std::string& uri);
+// The URI's file name as tinygltf decodes it ('+' a space, %XX a byte), relative to the scene's folder.
+std::string decode_uri(const std::string& uri);
 
 // ---- texture_decode.cpp -------------------------------------------------------------------------------
 

@@ -63,23 +63,20 @@ uint32_t read_u32le(const unsigned char* p) {
 // The scene file itself is the user's choice (no confinement), but still a regular file under the
 // file-bytes budget: /dev/zero or a FIFO is refused, not read.
 std::vector<unsigned char> read_whole_file(const std::string& path, const InputLimits& limits) {
-  const InputFile check = check_input_file(path, "", limits.file_bytes);
-  if (check.status == InputFile::Status::NotFound) fail(path, "file not found");
-  if (check.status == InputFile::Status::NotRegular && check.reason.find("directory") != std::string::npos)
+  OpenInput in = open_input(path, nullptr, limits.file_bytes);
+  if (in.status == InputFile::Status::NotFound) fail(path, "file not found");
+  if (in.status == InputFile::Status::NotRegular && in.reason.find("directory") != std::string::npos)
     fail(path, "is a directory, not a glTF file");
-  if (check.status != InputFile::Status::Ok) fail(path, check.reason);
-  struct stat st {};
+  if (in.status != InputFile::Status::Ok) fail(path, in.reason);
   // tinygltf takes the length as unsigned int; a GLB cannot exceed 4 GiB anyway.
-  const bool sized = stat(check.real_path.c_str(), &st) == 0;
-  if (sized && uint64_t(st.st_size) > std::numeric_limits<uint32_t>::max())
+  if (in.size > std::numeric_limits<uint32_t>::max())
     fail(path, "file is larger than 4 GiB, which glTF loading does not support");
   // held twice while the parser copies a GLB's BIN chunk into its model
-  if (sized)
-    check_memory(2 * uint64_t(st.st_size), "reading the scene file (" + std::to_string(st.st_size) + " bytes)");
-  InputFile f = read_input_file(path, "", limits.file_bytes);
-  if (f.status != InputFile::Status::Ok) fail(path, f.reason);
-  if (f.bytes.empty()) fail(path, "file is empty");
-  return std::move(f.bytes);
+  check_memory(2 * in.size, "reading the scene file (" + std::to_string(in.size) + " bytes)");
+  std::vector<unsigned char> bytes;
+  if (!in.read(bytes)) fail(path, in.reason);
+  if (bytes.empty()) fail(path, "file is empty");
+  return bytes;
 }
 
 // Validates the GLB container strictly (tinygltf 2.7 lets the BIN chunk header run past the end) and
@@ -262,11 +259,13 @@ void read_lights(const std::string& path, const json& doc, SourceFile& src) {
 }
 
 // Reads an external file the scene names into src.external (once, however many buffers and images
-// name it): confined to the scene's folder (`confine`, "" = anywhere), a regular file, within the
-// file-bytes budget and, for a buffer, exactly `byte_length` bytes (-1: any). `what` names it in
-// messages ("buffer 0: file 'a.bin'"). Returns false when the file does not exist and `missing_ok`.
-bool read_external(const std::string& path, SourceFile& src, const std::string& file, const std::string& what,
-                   const std::string& confine, const InputLimits& limits, int64_t byte_length, bool missing_ok) {
+// name it): the URI's file, opened beneath `folder` (nullptr = anywhere) and kept under the path
+// tinygltf asks for (resolve_uri); a regular file, within the file-bytes budget and, for a buffer,
+// exactly `byte_length` bytes (-1: any). `what` names it in messages ("buffer 0: file 'a.bin'").
+// Returns false when the file does not exist and `missing_ok`.
+bool read_external(const std::string& path, SourceFile& src, const std::string& uri, const std::string& what,
+                   const InputFolder* folder, const InputLimits& limits, int64_t byte_length, bool missing_ok) {
+  const std::string relative = decode_uri(uri), file = resolve_uri(src.base_dir, uri);
   // a %00 would cut the name where the C library reads it: another file than the URI says
   if (file.find('\0') != std::string::npos) fail(path, what + " names a file with a NUL byte (%00)");
   if (auto known = src.external.find(file); known != src.external.end()) {
@@ -276,39 +275,36 @@ bool read_external(const std::string& path, SourceFile& src, const std::string& 
                      std::to_string(byte_length));
     return true;
   }
-  const InputFile check = check_input_file(file, confine, limits.file_bytes);
-  if (check.status == InputFile::Status::NotFound) {
+  // What was opened is what is read: no path is resolved twice.
+  OpenInput in =
+      folder ? open_input(relative, folder, limits.file_bytes) : open_input(file, nullptr, limits.file_bytes);
+  if (in.status == InputFile::Status::NotFound) {
     if (missing_ok) return false;
     fail(path, what + " not found (looked for " + one_line(file) + ")");
   }
-  if (check.status == InputFile::Status::Outside)
-    fail(path, what + " lies outside the scene folder (it resolves to " + one_line(check.real_path) +
-                   "); --allow-outside-scene-folder reads it");
-  if (check.status != InputFile::Status::Ok) fail(path, what + " " + check.reason);
-  struct stat st {};
-  const bool sized = stat(check.real_path.c_str(), &st) == 0;
-  if (byte_length >= 0 && sized && uint64_t(st.st_size) != uint64_t(byte_length))
-    fail(path, what + " has " + std::to_string(st.st_size) + " bytes but byteLength is " + std::to_string(byte_length));
+  if (in.status == InputFile::Status::Outside) {
+    const std::string real = real_folder(file);  // for the message only
+    fail(path, what + " " + in.reason + (real.empty() ? "" : " (it resolves to " + one_line(real) + ")") +
+                   "; --allow-outside-scene-folder reads it");
+  }
+  if (in.status != InputFile::Status::Ok) fail(path, what + " " + in.reason);
+  if (byte_length >= 0 && in.size != uint64_t(byte_length))
+    fail(path, what + " has " + std::to_string(in.size) + " bytes but byteLength is " + std::to_string(byte_length));
   // the files read so far and this one, each held twice while the parser copies it into its model
-  uint64_t held = sized ? uint64_t(st.st_size) : 0;
+  uint64_t held = in.size;
   for (const auto& [name, read] : src.external) held += read.bytes.size();
-  check_memory(2 * held,
-               "reading the scene's files (" + what + ": " + std::to_string(sized ? st.st_size : 0) + " bytes)");
-  InputFile f = read_input_file(file, confine, limits.file_bytes);
-  if (f.status != InputFile::Status::Ok) fail(path, what + " " + f.reason);
-  if (byte_length >= 0 && uint64_t(byte_length) != f.bytes.size())
-    fail(path,
-         what + " has " + std::to_string(f.bytes.size()) + " bytes but byteLength is " + std::to_string(byte_length));
-  SourceFile::External& e = src.external[file];
-  e.bytes = std::move(f.bytes);
+  check_memory(2 * held, "reading the scene's files (" + what + ": " + std::to_string(in.size) + " bytes)");
+  SourceFile::External e;
+  if (!in.read(e.bytes)) fail(path, what + " " + in.reason);
   e.uses = 1;
+  src.external[file] = std::move(e);
   return true;
 }
 
 // Buffers are checked here so that a missing or short .bin gets a message naming the file (tinygltf
 // would say "File not found", or fail later with an unrelated error), and read here (read_external).
 void check_buffers(const std::string& path, const json& doc, SourceFile& src, int64_t bin_length,
-                   const std::string& confine, const InputLimits& limits) {
+                   const InputFolder* folder, const InputLimits& limits) {
   const json* buffers = member(doc, "buffers");
   if (!buffers || !buffers->is_array()) return;
   for (size_t i = 0; i < buffers->size(); ++i) {
@@ -340,14 +336,13 @@ void check_buffers(const std::string& path, const json& doc, SourceFile& src, in
       src.unread_buffers[int(i)] = byte_length;
       continue;
     }
-    read_external(path, src, resolve_uri(src.base_dir, u), name + ": file '" + one_line(u) + "'", confine, limits,
-                  int64_t(byte_length), false);
+    read_external(path, src, u, name + ": file '" + one_line(u) + "'", folder, limits, int64_t(byte_length), false);
   }
 }
 
 // The files of the images some material samples (sampled_images), read like buffers; a missing one
 // is a warning later (the material is drawn untextured), any other refusal an error.
-void read_sampled_images(const std::string& path, const json& doc, SourceFile& src, const std::string& confine,
+void read_sampled_images(const std::string& path, const json& doc, SourceFile& src, const InputFolder* folder,
                          const InputLimits& limits) {
   const json* images = member(doc, "images");
   if (!images || !images->is_array()) return;
@@ -357,8 +352,8 @@ void read_sampled_images(const std::string& path, const json& doc, SourceFile& s
     if (!uri || !uri->is_string()) continue;
     const std::string u = uri->get<std::string>();
     if (u.empty() || u.rfind("data:", 0) == 0) continue;  // tinygltf decodes data URIs
-    read_external(path, src, resolve_uri(src.base_dir, u),
-                  "image " + std::to_string(i) + ": file '" + one_line(u) + "'", confine, limits, -1, true);
+    read_external(path, src, u, "image " + std::to_string(i) + ": file '" + one_line(u) + "'", folder, limits, -1,
+                  true);
   }
 }
 
@@ -522,7 +517,7 @@ const json* member(const json& object, const char* key) {
   return it == object.end() ? nullptr : &*it;
 }
 
-std::string resolve_uri(const std::string& base_dir, const std::string& uri) {
+std::string decode_uri(const std::string& uri) {
   // Same decoding as tinygltf's dlib::urldecode ('+' is a space, %XX a byte), so that the file checked
   // here is the file tinygltf then opens.
   auto hex = [](char c) -> int {
@@ -542,6 +537,11 @@ std::string resolve_uri(const std::string& base_dir, const std::string& uri) {
       decoded += uri[i];
     }
   }
+  return decoded;
+}
+
+std::string resolve_uri(const std::string& base_dir, const std::string& uri) {
+  const std::string decoded = decode_uri(uri);
   if (base_dir.empty()) return decoded;
   return base_dir.back() == '/' ? base_dir + decoded : base_dir + "/" + decoded;
 }
@@ -585,11 +585,12 @@ SourceFile read_source(const std::string& path, const InputLimits& limits) {
   if (v.rfind("2.", 0) != 0) fail(path, "glTF version " + one_line(v) + " is not supported (2.x only)");
   check_schema(path, doc);
   check_extensions(path, doc, src);
-  std::string confine;  // the scene folder's real path, "" when files may lie anywhere
+  InputFolder folder;  // the scene's folder, unless files may lie anywhere
   if (!limits.allow_outside_scene_folder) {
-    confine = real_folder(src.base_dir);
-    if (confine.empty()) fail(path, "cannot resolve the scene's folder " + one_line(src.base_dir));
+    folder = InputFolder(src.base_dir.empty() ? "." : src.base_dir);
+    if (!folder.ok()) fail(path, "cannot open the scene's folder " + one_line(src.base_dir));
   }
+  const InputFolder* confine = folder.ok() ? &folder : nullptr;
   src.sampled_images = sampled_images(doc);
   src.needed_buffers = needed_buffers(doc, src.sampled_images);
   check_buffers(path, doc, src, bin_length, confine, limits);

@@ -182,6 +182,22 @@ void pose_cameras_and_lights(const Scene& rest, const PoseRequest& r, Scene& out
   if (r.turntable) turn_lights(r, out.lights);
 }
 
+uint64_t pose_work(const Scene& rest, int animation) {
+  uint64_t work = rest.positions.size();
+  if (!rest.motion || animation == kNoAnimation) return work;
+  const SceneMotion& m = *rest.motion;
+  // Sums of sizes the loader has already allocated: none of them can overflow 64 bits.
+  work += kPoseNodeUnits * m.nodes.size();
+  for (const MotionNode& n : m.nodes) work += n.weights.size();
+  for (const MotionSkin& s : m.skins) work += kPoseJointUnits * s.joints.size();
+  for (size_t c = 0; c < m.clips.size(); ++c)
+    if (clip_selected(int(c), animation))
+      for (const MotionChannel& ch : m.clips[c].channels) work += m.clips[c].samplers[size_t(ch.sampler)].width;
+  for (const Deformable& d : m.deformables)
+    work += d.source->vertices * (1 + d.source->target_pos.size()) + (d.triangle_end - d.triangle_begin);
+  return work;
+}
+
 bool pose_scene(const Scene& rest, const PoseRequest& r, Scene& out) {
   check_request(rest, r);
   const bool animated = animates(rest, r);

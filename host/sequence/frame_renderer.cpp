@@ -48,9 +48,10 @@ void select_animation(const Scene& scene, const std::string& choice, SequenceSpe
       (a.empty() ? std::string("the scene has no animations") : "no such animation (the scene has " + known + ")"));
 }
 
-SequenceSpec resolve_sequence(const Scene& scene, const SequenceChoice& choice, uint64_t framing_work) {
+SequenceSpec resolve_sequence(const Scene& scene, const SequenceChoice& choice, const InputLimits& limits) {
   SequenceSpec spec;
-  spec.framing_work = framing_work;
+  spec.framing_work = limits.framing_work;
+  spec.pose_work = limits.pose_work;
   select_animation(scene, choice.animation, spec);
   spec.fps = choice.fps;
   spec.turntable = choice.turntable;
@@ -125,6 +126,62 @@ PoseRequest FrameRenderer::request(long frame) const {
   return r;
 }
 
+namespace {
+
+// True when the sequence's animation moves something (the turntable aside): frames are posed, and the
+// framing poses the animation's range.
+bool animates_at_all(const Scene& rest, const SequenceSpec& spec) {
+  return pose_moves(rest, PoseRequest{0.0, spec.animation});
+}
+
+// Both posing budgets, before any posing: one pose (every frame poses once) against pose-work, and
+// the framing's poses (the first and last key and every frame between) against framing-work.
+void check_pose_work(const Scene& rest, const SequenceSpec& spec) {
+  if (!pose_moves(rest, PoseRequest{0.0, spec.animation, spec.turntable})) return;
+  const uint64_t work = pose_work(rest, spec.animation);
+  const std::string units = " units (docs/SECURITY.md, \"Posing\")";
+  if (work > spec.pose_work)
+    throw Error("posing one frame of the scene takes " + std::to_string(work) + units +
+                ", more than the pose-work limit of " + std::to_string(spec.pose_work) +
+                " (raise it with --limit pose-work=N)");
+  if (!animates_at_all(rest, spec)) return;
+  long first = 0, last = -1;
+  animation_key_frames(rest, spec, first, last);
+  const uint64_t poses = uint64_t(2 + std::max(0L, last - first + 1));
+  if (poses > spec.framing_work / std::max<uint64_t>(1, work))
+    throw Error("framing the animation poses the scene " + std::to_string(poses) +
+                " times (every frame of its keys at " + std::to_string(spec.fps) + " fps), " + std::to_string(work) +
+                units + " each, more than the framing-work limit of " + std::to_string(spec.framing_work) +
+                " (raise it with --limit framing-work=N)");
+}
+
+// Framing: the union of the bounds of the animation's first and last pose (what frames outside its
+// keys repeat) and of every frame inside its keys, without the turntable (its sphere is centered on
+// the pivot, so turning does not change it). False when nothing has bounds (no triangles).
+bool frame_bounds(const Scene& rest, const SequenceSpec& spec, glm::dvec3& lo, glm::dvec3& hi) {
+  if (!animates_at_all(rest, spec)) return scene_bounds(rest, lo, hi);
+  double start = 0.0, end = 0.0;
+  key_range(rest, spec.animation, start, end);
+  long first = 0, last = -1;
+  animation_key_frames(rest, spec, first, last);
+  std::vector<double> times{start, end};
+  for (long f = first; f <= last; ++f) times.push_back(double(f) / spec.fps);
+  bool any = false;
+  Scene posed;
+  for (double t : times) {
+    pose_scene(rest, PoseRequest{t, spec.animation}, posed);
+    glm::dvec3 l, h;
+    if (scene_bounds(posed, l, h)) {
+      lo = any ? glm::min(lo, l) : l;
+      hi = any ? glm::max(hi, h) : h;
+      any = true;
+    }
+  }
+  return any;
+}
+
+}  // namespace
+
 FrameRenderer::FrameRenderer(const Scene& rest, const SequenceSpec& spec, const RigConfig& rig_config,
                              const Display& display, std::vector<std::string>* warnings)
     : rest_(rest), spec_(spec), rig_config_(rig_config), display_(display) {
@@ -139,41 +196,9 @@ FrameRenderer::FrameRenderer(const Scene& rest, const SequenceSpec& spec, const 
     if (!cam.placed) throw Error(k + " is not placed by any node of the scene");
     if (!cam.invalid.empty()) throw Error(k + " has invalid perspective parameters: " + cam.invalid);
   }
-  // Framing: the union of the bounds of the animation's first and last pose (what frames outside its
-  // keys repeat) and of every frame inside its keys, without the turntable (its sphere is centered on
-  // the pivot, so turning does not change it).
-  bool any = false;
+  check_pose_work(rest, spec);
   glm::dvec3 lo, hi;
-  if (pose_moves(rest, PoseRequest{0.0, spec.animation})) {
-    double start = 0.0, end = 0.0;
-    key_range(rest, spec.animation, start, end);
-    long first = 0, last = -1;
-    animation_key_frames(rest, spec, first, last);
-    std::vector<double> times{start, end};
-    const uint64_t poses = uint64_t(2 + std::max(0L, last - first + 1));
-    const uint64_t vertices = std::max<uint64_t>(1, rest.positions.size());
-    if (poses > spec.framing_work / vertices)
-      throw Error("framing the animation poses the scene's " + std::to_string(rest.positions.size()) + " vertices " +
-                  std::to_string(poses) + " times (every frame of its keys at " + std::to_string(spec.fps) +
-                  " fps), more than the framing-work limit of " + std::to_string(spec.framing_work) +
-                  " vertex-poses (raise it with --limit framing-work=N)");
-    for (long f = first; f <= last; ++f) times.push_back(double(f) / spec.fps);
-    Scene posed;
-    for (double t : times) {
-      PoseRequest r;
-      r.time = t;
-      r.animation = spec.animation;
-      pose_scene(rest, r, posed);
-      glm::dvec3 l, h;
-      if (scene_bounds(posed, l, h)) {
-        lo = any ? glm::min(lo, l) : l;
-        hi = any ? glm::max(hi, h) : h;
-        any = true;
-      }
-    }
-  } else {
-    any = scene_bounds(rest, lo, hi);
-  }
+  const bool any = frame_bounds(rest, spec, lo, hi);
   if (any) lo_ = lo, hi_ = hi;
   else if (warnings) warnings->push_back("nothing to frame (no triangles): framing a unit cube at the origin");
   moves_ = pose_moves(rest, request(0));

@@ -22,7 +22,7 @@ namespace pmr {
 void select_animation(const Scene& scene, const std::string& choice, SequenceSpec& spec);
 // The sequence `choice` makes of `scene`: its animation selected (select_animation), one turntable frame
 // without a turntable, `framing_work` the framing's budget.
-SequenceSpec resolve_sequence(const Scene& scene, const SequenceChoice& choice, uint64_t framing_work);
+SequenceSpec resolve_sequence(const Scene& scene, const SequenceChoice& choice, const InputLimits& limits);
 
 // The frames whose times f / fps lie inside the chosen animation's key range: ceil(start * fps) to
 // floor(end * fps) (within 1e-6 of a frame: float key times). Outside it a frame repeats the first or

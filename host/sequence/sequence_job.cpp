@@ -144,7 +144,7 @@ void SequenceRun::load_inputs() {
 
 // The animation, --frames all, this shard's part; then the framing (FrameRenderer) and the layout.
 void SequenceRun::choose_frames() {
-  spec_ = resolve_sequence(scene_, job_.sequence, job_.input_limits.framing_work);
+  spec_ = resolve_sequence(scene_, job_.sequence, job_.input_limits);
   if (job_.frames == "all") {
     long first = 0, last = 0;
     animation_frame_range(scene_, spec_, first, last);

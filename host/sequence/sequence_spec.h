@@ -26,8 +26,10 @@ struct SequenceSpec {
   bool turntable = false;
   double turntable_deg = 0.0;  // DEG of DEG:FRAMES
   long turntable_frames = 1;   // FRAMES of DEG:FRAMES
-  // --limit framing-work: the framing poses the scene at every frame of the animation before the first
-  // frame renders; poses x the scene's vertices above this are refused (FrameRenderer).
+  // --limit pose-work and framing-work: the work of one pose (pose_work, pmr/scene.h), and of all the
+  // poses the framing takes (every frame of the animation, before the first frame renders). Checked by
+  // FrameRenderer before it poses anything.
+  uint64_t pose_work = InputLimits().pose_work;
   uint64_t framing_work = InputLimits().framing_work;
 };
 

@@ -194,6 +194,15 @@ void pose_cameras_and_lights(const Scene& rest, const PoseRequest& request, Scen
 // turntable). A static request's frames are the rest scene.
 bool pose_moves(const Scene& rest, const PoseRequest& request);
 
+// The work of one pose_scene call for `animation` (kNoAnimation: the turntable only), in units of about
+// one vertex's deformation by one shape (docs/SECURITY.md, "Posing"): every vertex once (copied or
+// turned), each moving instance's vertices once more for the base shape and once per morph target it
+// has, and its triangles once, every animated value sampled, and the transforms of nodes and skin joints, weighted by
+// their measured cost relative to a vertex (kPoseNodeUnits, kPoseJointUnits). Checked before posing
+// (FrameRenderer) so that a crafted file cannot make framing or frames run for hours.
+inline constexpr uint64_t kPoseNodeUnits = 32, kPoseJointUnits = 8;
+uint64_t pose_work(const Scene& rest, int animation);
+
 // The turntable angle of frame f for DEG:FRAMES, in [0, 360), exact for whole multiples of 360.
 double turntable_angle(long frame, double degrees, long frames);
 

@@ -1,6 +1,10 @@
 // Render-farm pieces that need no scheduler: the shard arithmetic for every scheduler's array
 // environment (each frame to exactly one task), and `pmr verify` on broken folders.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cctype>
 
 #include <filesystem>
 #include <fstream>
@@ -202,14 +206,51 @@ TEST(Verify, WithoutFramesChecksTheFramesTheFolderHolds) {
       << v.output;
   EXPECT_NE(v.output.find("frame 1: frame_0001.exr is truncated"), std::string::npos) << v.output;
   EXPECT_NE(v.output.find("2 of 3 frame(s) complete"), std::string::npos) << v.output;
-  // a writer killed with SIGKILL leaves its temporary file: named, though no frame needs it
-  std::ofstream(out + "/.frame_0002.exr.tmp-4242-7") << "partial";
-  EXPECT_NE(test::run("verify " + out)
-                .output.find("note: 1 temporary file(s) of writers that did not finish (.frame_0002.exr.tmp-4242-7)"),
-            std::string::npos);
   const std::string empty = test::temp_dir("verify_no_frames_empty");
   fs::create_directories(empty);
   test::expect_one_error_line(test::run("verify " + empty), "holds no frame sidecars");
+}
+
+// Temporary files carry their writer's host and pid. A writer killed with SIGKILL leaves its file;
+// verify names each kind of owner (this host's dead writers, this host's running ones, other hosts'
+// and names from before the host was recorded), and the next run in the folder removes only this
+// host's dead writers' files: on a folder shared by nodes (NFS) another host's writer may be running.
+TEST(Verify, TemporaryFilesAreNamedByOwnerAndOnlyThisHostsDeadOnesRemoved) {
+  const std::string out = test::temp_dir("verify_temporaries");
+  const std::string args = " --views 4 --view-size 64x32 --display 240x135 --turntable 360:6 --frames 0:1 --out " + out;
+  ASSERT_EQ(test::run("render -q" + args).status, 0);
+  char buf[256] = {};
+  ASSERT_EQ(gethostname(buf, sizeof buf - 1), 0);
+  std::string host;  // as pmr records it: letters, digits, '.' and '-', others '_', at most 32 bytes
+  for (const char* c = buf; *c && host.size() < 32; ++c)
+    host += std::isalnum((unsigned char)*c) || *c == '.' || *c == '-' ? *c : '_';
+  const pid_t dead = fork();  // a pid that no longer runs
+  if (dead == 0) _exit(0);
+  ASSERT_GT(dead, 0);
+  waitpid(dead, nullptr, 0);
+  const std::string mine_dead = ".frame_0002.exr.tmp-" + host + "-" + std::to_string(dead) + "-7",
+                    mine_running = ".frame_0003.exr.tmp-" + host + "-" + std::to_string(getpid()) + "-1",
+                    other = ".frame_0004.exr.tmp-node-17.farm-4242-7", old = ".frame_0005.exr.tmp-4242-7";
+  for (const std::string& name : {mine_dead, mine_running, other, old}) std::ofstream(out + "/" + name) << "partial";
+  const std::string v = test::run("verify " + out).output;
+  EXPECT_NE(v.find("note: 1 temporary file(s) of writers on this host that no longer run (" + mine_dead +
+                   "): no frame needs them, and the next pmr run in this folder on this host removes them"),
+            std::string::npos)
+      << v;
+  EXPECT_NE(v.find("note: 1 temporary file(s) of pmr processes running on this host now (" + mine_running + ")"),
+            std::string::npos)
+      << v;
+  EXPECT_NE(v.find("note: 2 temporary file(s) of writers on other hosts (an unrecorded host, node-17.farm: " + other +
+                   ", ...): no frame needs them; remove them once no pmr process there writes into " + out),
+            std::string::npos)
+      << v;
+  const test::CliRun again = test::run("render --resume" + args);
+  EXPECT_EQ(again.status, 0) << again.output;
+  EXPECT_NE(again.output.find("removed 1 temporary file(s) that writers on this host left when they were killed"),
+            std::string::npos)
+      << again.output;
+  EXPECT_FALSE(fs::exists(out + "/" + mine_dead));
+  for (const std::string& name : {mine_running, other, old}) EXPECT_TRUE(fs::exists(out + "/" + name)) << name;
 }
 
 // The scene as it is now decides, not the folder's majority: after the scene changes, every frame is

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -123,8 +124,9 @@ TEST(Sequence, FramesAreIndependentOfTheSequence) {
   EXPECT_EQ(j["animation"]["index"], 0);
 }
 
-// Interrupted with SIGINT from here: exit 130, only whole frames on disk; --resume then renders exactly
-// the missing frames; a changed configuration is refused unless --overwrite.
+// Interrupted with SIGINT from here: exit 130, only whole frames on disk, and the log's progress counts
+// exactly those (a frame is counted once its files are written, not when it is rendered); --resume then
+// renders exactly the missing frames; a changed configuration is refused unless --overwrite.
 TEST(Sequence, ResumeAfterInterruptRendersOnlyTheMissingFrames) {
   const std::string out = temp_dir("seq_resume");
   const std::string args =
@@ -132,7 +134,7 @@ TEST(Sequence, ResumeAfterInterruptRendersOnlyTheMissingFrames) {
   const pid_t pid = fork();
   ASSERT_GE(pid, 0);
   if (pid == 0) {
-    const std::string cmd = std::string(PMR_BINARY) + " render -q" + args + " > /dev/null 2>&1";
+    const std::string cmd = std::string(PMR_BINARY) + " render" + args + " > " + out + ".log 2>&1";
     execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), (char*)nullptr);
     _exit(127);
   }
@@ -159,6 +161,21 @@ TEST(Sequence, ResumeAfterInterruptRendersOnlyTheMissingFrames) {
     complete += n.size() > 4 && n.substr(n.size() - 4) == ".exr";
   }
   EXPECT_GE(complete, 2u);
+  // the log: "pmr: frame F written (k/10)" for each frame on disk, in order, and its summary agrees
+  std::istringstream log(read_text(out + ".log"));
+  size_t counted = 0;
+  for (std::string line; std::getline(log, line);) {
+    long frame = -1, k = -1, n = -1;
+    if (std::sscanf(line.c_str(), "pmr: frame %ld written (%ld/%ld)", &frame, &k, &n) != 3) continue;
+    EXPECT_EQ(size_t(k), ++counted) << line;
+    char stem[32];
+    std::snprintf(stem, sizeof stem, "frame_%04ld", frame);
+    EXPECT_TRUE(before.count(std::string(stem) + ".json")) << line << ": not on disk";
+  }
+  EXPECT_EQ(counted, complete) << read_text(out + ".log");
+  if (!finished_first)
+    EXPECT_NE(read_text(out + ".log").find(std::to_string(complete) + " of 10 frame(s) written"), std::string::npos)
+        << read_text(out + ".log");
   const auto mtime = fs::last_write_time(out + "/frame_0000.exr");
   const CliRun r = run("render --resume" + args);
   ASSERT_EQ(r.status, 0) << r.output;

@@ -242,24 +242,34 @@ std::vector<long> frames_in_folder(const std::string& dir, const RenderOptions& 
   return frames;
 }
 
-// The temporary files writers leave when they are killed (AtomicFile's ".NAME.tmp-PID-N"): no frame
-// needs them, and a run in progress has its own; the names, sorted.
-std::vector<std::string> leftover_temporaries(const std::string& dir) {
-  std::vector<std::string> found;
+// The temporary files writers leave when they are killed (temporary_name's ".NAME.tmp-HOST-PID-N"): no
+// frame needs them. One note per kind of owner, each naming the first file: this host's dead processes
+// (the next run here removes them), this host's running ones, and other hosts' (verify cannot tell
+// whether those still run).
+void note_leftover_temporaries(const std::string& dir) {
+  std::map<std::string, std::vector<std::string>> kinds;  // note -> names, sorted
+  std::set<std::string> hosts;
   for (const fs::directory_entry& e : fs::directory_iterator(dir)) {
     const std::string name = e.path().filename().string();
-    const size_t at = name.rfind(".tmp-");
-    if (name.size() < 2 || name[0] != '.' || at == std::string::npos || at < 2) continue;
-    const std::string tail = name.substr(at + 5);
-    const size_t dash = tail.find('-');
-    auto digits = [](const std::string& s) {
-      return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
-    };
-    if (dash != std::string::npos && digits(tail.substr(0, dash)) && digits(tail.substr(dash + 1)))
-      found.push_back(name);
+    TemporaryOwner owner;
+    if (!parse_temporary_name(name, owner)) continue;
+    if (!owner.this_host) hosts.insert(owner.host.empty() ? "an unrecorded host" : owner.host);
+    kinds[!owner.this_host ? "c" : owner.running ? "b" : "a"].push_back(name);
   }
-  std::sort(found.begin(), found.end());
-  return found;
+  const std::string folder = printable_text(dir);
+  for (auto& [kind, names] : kinds) {
+    std::sort(names.begin(), names.end());
+    const std::string first = printable_text(names[0]) + (names.size() > 1 ? ", ..." : "");
+    std::string host_list;
+    for (const std::string& h : hosts) host_list += (host_list.empty() ? "" : ", ") + printable_text(h);
+    const std::string why =
+        kind == "a" ? "of writers on this host that no longer run (" + first +
+                          "): no frame needs them, and the next pmr run in this folder on this host removes them"
+        : kind == "b" ? "of pmr processes running on this host now (" + first + ")"
+                      : "of writers on other hosts (" + host_list + ": " + first +
+                            "): no frame needs them; remove them once no pmr process there writes into " + folder;
+    std::fprintf(stderr, "pmr verify: note: %zu temporary file(s) %s\n", names.size(), why.c_str());
+  }
 }
 
 }  // namespace
@@ -316,12 +326,7 @@ int run_verify(const std::vector<std::string>& args) {
     configuration |= problem.find("rendered with another configuration") != std::string::npos;
     std::fprintf(stderr, "pmr verify: frame %ld: %s\n", f, problem.c_str());
   }
-  if (const std::vector<std::string> temps = leftover_temporaries(dir); !temps.empty())
-    std::fprintf(stderr,
-                 "pmr verify: note: %zu temporary file(s) of writers that did not finish (%s%s): no frame needs "
-                 "them; remove them once no pmr process writes into %s\n",
-                 temps.size(), printable_text(temps[0]).c_str(), temps.size() > 1 ? ", ..." : "",
-                 printable_text(dir).c_str());
+  note_leftover_temporaries(dir);
   if (now.scene_unreadable)
     std::fprintf(stderr,
                  "pmr verify: note: the scene the sidecars name cannot be read from here: frames are compared with "

@@ -45,7 +45,7 @@ void guarded(const char* verb, const std::string& path, const std::string& temp,
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {  // Iex::BaseExc derives from std::exception
-    throw Error(std::string(verb) + " " + path + ": " + clean_message(e.what(), temp, path));
+    throw Error(std::string(verb) + " " + path + ": " + write_failure(clean_message(e.what(), temp, path)));
   } catch (...) {
     throw Error(std::string(verb) + " " + path + ": unknown error");
   }

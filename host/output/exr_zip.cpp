@@ -28,6 +28,7 @@
 #include <thread>
 
 #include "pmr/error.h"
+#include "pmr/output.h"
 
 namespace pmr {
 namespace {
@@ -390,7 +391,7 @@ std::vector<std::vector<unsigned char>> encode_chunks(const FileLayout& F, ZipEn
 void write_file(const std::string& path, const std::string& shown_path, const FileLayout& F,
                 const std::vector<std::vector<unsigned char>>& chunks) {
   std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (!file) throw Error("cannot write " + shown_path + ": " + std::strerror(errno));
+  if (!file) throw Error("cannot write " + shown_path + ": " + write_failure(errno));
   {
     Imf::StdOFStream os(file, path.c_str());
     std::vector<unsigned char> head;
@@ -411,7 +412,7 @@ void write_file(const std::string& path, const std::string& shown_path, const Fi
     for (const std::vector<unsigned char>& d : chunks) os.write(reinterpret_cast<const char*>(d.data()), int(d.size()));
   }
   file.flush();
-  if (!file) throw Error("cannot write " + shown_path + ": " + std::strerror(errno));
+  if (!file) throw Error("cannot write " + shown_path + ": " + write_failure(errno));
 }
 
 }  // namespace

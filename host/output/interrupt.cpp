@@ -38,7 +38,8 @@ void install_interrupt_handlers() {
   sa.sa_handler = on_signal;
   sa.sa_flags = SA_RESTART;  // other threads' blocking writes go on instead of failing with EINTR
   sigemptyset(&sa.sa_mask);
-  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGALRM}) sigaction(sig, &sa, nullptr);
+  // what schedulers send before a kill: SGE's -notify (USR1, USR2), Slurm's --signal, a CPU-time limit (XCPU)
+  for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGALRM, SIGXCPU, SIGUSR1, SIGUSR2}) sigaction(sig, &sa, nullptr);
 }
 
 void ignore_write_signals() {
@@ -58,6 +59,12 @@ const char* interrupt_signal_name(int sig) {
       return "SIGHUP";
     case SIGALRM:
       return "SIGALRM";
+    case SIGXCPU:
+      return "SIGXCPU";
+    case SIGUSR1:
+      return "SIGUSR1";
+    case SIGUSR2:
+      return "SIGUSR2";
     default:
       return "a signal";
   }

@@ -72,7 +72,7 @@ void write_png_preview(const std::string& path, int width, int height, const uin
   }();
   AtomicFile file(path);
   FILE* f = std::fopen(file.temp_path().c_str(), "wb");
-  if (!f) throw Error("cannot write " + path + ": " + std::strerror(errno));
+  if (!f) throw Error("cannot write " + path + ": " + write_failure(errno));
   PngError err;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, on_error, on_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
@@ -111,7 +111,8 @@ void write_png_preview(const std::string& path, int width, int height, const uin
   png_destroy_write_struct(png ? &png : nullptr, info ? &info : nullptr);
   const bool closed = std::fclose(f) == 0;
   if (!ok || !closed)
-    throw Error("cannot write " + path + ": " + (err.message[0] ? err.message : std::strerror(errno)));
+    throw Error("cannot write " + path + ": " +
+                write_failure(err.message[0] ? std::string(err.message) : std::strerror(errno)));
   file.commit();
 }
 

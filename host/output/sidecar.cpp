@@ -502,7 +502,7 @@ void write_sidecar(const std::string& path, const Rig& rig, const Display& displ
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {  // e.g. nlohmann::json::type_error on a name that is not UTF-8
-    throw Error("cannot write " + path + ": " + e.what());
+    throw Error("cannot write " + path + ": " + write_failure(e.what()));
   }
   write_text_atomic(path, text);
 }

@@ -89,9 +89,9 @@ bool write_all(int fd, const std::string& text) {
 // name, then hard-linked: link never replaces a file that another process created meanwhile). Returns
 // errno (0 also when someone else created it first).
 int create_lock_file(const std::string& path, const std::string& text) {
-  const std::string temp = path + ".tmp-" + std::to_string(::getpid());
+  const std::string temp = temporary_name(path);
   int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0 && errno == EEXIST) {  // left by a dead process that had our process id
+  if (fd < 0 && errno == EEXIST) {  // left by a dead process of this host that had our process id
     ::unlink(temp.c_str());
     fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
   }

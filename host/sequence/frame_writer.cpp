@@ -35,7 +35,8 @@ struct Abandoned {};
 
 }  // namespace
 
-FrameWriter::FrameWriter(int exr_threads) : exr_threads_(exr_threads), thread_([this] { run(); }) {}
+FrameWriter::FrameWriter(int exr_threads, std::function<void(long)> on_written)
+    : exr_threads_(exr_threads), on_written_(std::move(on_written)), thread_([this] { run(); }) {}
 
 FrameWriter::~FrameWriter() {
   {
@@ -127,6 +128,7 @@ void FrameWriter::run() {
       for (std::vector<uint16_t>* b : {&f.display, &f.volume, &f.sub_alpha})
         if (!b->empty() && spare_.size() < 6) spare_.push_back(std::move(*b));
     }
+    if (done && on_written_) on_written_(f.frame);
     changed_.notify_all();
   }
 }

@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <exception>
 #include <mutex>
 #include <string>
@@ -58,7 +59,8 @@ struct FrameFiles {
 
 class FrameWriter {
  public:
-  explicit FrameWriter(int exr_threads);
+  // on_written (if set) is called on the writer thread with each frame whose files are all on disk.
+  explicit FrameWriter(int exr_threads, std::function<void(long frame)> on_written = {});
   ~FrameWriter();  // abandons whatever is queued (the frame being written finishes or is rolled back)
 
   // Queues a frame; blocks while the queue is full. Rethrows an earlier write error.
@@ -81,6 +83,7 @@ class FrameWriter {
   void rethrow();
 
   int exr_threads_;
+  std::function<void(long)> on_written_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
   std::deque<FrameFiles> queue_;

@@ -23,7 +23,17 @@ double Progress::elapsed_seconds() const {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
 }
 
-void Progress::frame_done(long k, long frame, double render_ms) {
+void Progress::frame_rendered(long frame, double render_ms) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  render_ms_[frame] = render_ms;
+}
+
+void Progress::frame_written(long frame) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const long k = ++written_;
+  const auto it = render_ms_.find(frame);
+  const double render_ms = it == render_ms_.end() ? NAN : it->second;
+  if (it != render_ms_.end()) render_ms_.erase(it);
   if (quiet_) return;
   const double elapsed = elapsed_seconds();
   const double fps = elapsed > 0 ? double(k) / elapsed : 0.0;
@@ -33,20 +43,21 @@ void Progress::frame_done(long k, long frame, double render_ms) {
                  clock_text(elapsed).c_str(), clock_text(eta).c_str());
     line_open_ = true;
   } else {
-    // "rendered": its files are written after it, on the writer thread (an interrupt may drop them)
-    std::fprintf(stderr, "pmr: frame %ld rendered (%ld/%ld): render %.0f ms, elapsed %s, ETA %s\n", frame, k, total_,
+    std::fprintf(stderr, "pmr: frame %ld written (%ld/%ld): render %.0f ms, elapsed %s, ETA %s\n", frame, k, total_,
                  render_ms, clock_text(elapsed).c_str(), clock_text(eta).c_str());
   }
   std::fflush(stderr);
 }
 
 void Progress::message(const std::string& line) {
+  std::lock_guard<std::mutex> lock(mutex_);
   if (line_open_) std::fputs("\r\033[K", stderr);
   std::fprintf(stderr, "%s\n", line.c_str());
   line_open_ = false;
 }
 
 void Progress::close() {
+  std::lock_guard<std::mutex> lock(mutex_);
   if (line_open_) std::fputc('\n', stderr);
   line_open_ = false;
 }

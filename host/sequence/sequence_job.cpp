@@ -278,6 +278,10 @@ int SequenceRun::guarded_run() {
   // this run's frames (folder_guard.h). Held until the end of the run.
   const FolderGuard folder_guard(products_.out_dir, products_.name, job_frames_.empty() ? frames_ : job_frames_,
                                  expected_sidecar(0, paths(0)), job_.overwrite, job_.quiet);
+  // what writers of this host left when killed (SIGKILL); other hosts' may still be writing (NFS)
+  if (const size_t removed = remove_dead_temporaries(products_.out_dir); removed > 0 && !job_.quiet)
+    std::fprintf(stderr, "pmr: removed %zu temporary file(s) that writers on this host left when they were killed\n",
+                 removed);
   plan_ = plan_resume(
       frames_, job_.resume, job_.overwrite, [&](long f) { return paths(f); },
       [&](long f, const FramePaths& p) { return expected_sidecar(f, p); });
@@ -394,9 +398,9 @@ int SequenceRun::render_frames() {
   }
 
   install_interrupt_handlers();
-  FrameWriter writer(2);
   const long total = long(plan_.todo.size());
   Progress progress(total, job_.quiet);
+  FrameWriter writer(2, [&progress](long frame) { progress.frame_written(frame); });
   progress_ = &progress;
   const auto t_loop = std::chrono::steady_clock::now();
   const double cpu0 = process_cpu_seconds();
@@ -422,9 +426,9 @@ int SequenceRun::render_frames() {
                        " samples had more than 8 alphaMode BLEND fragments; those behind the nearest 8 were "
                        "composited as one layer");
     if (job_.verbose) print_frame_stages(f, fr, pipeline, progress);
+    progress.frame_rendered(f, fr.times.wall);
     writer.submit(frame_files(f, fr, pipeline, writer));
     ++rendered_;
-    progress.frame_done(rendered_, f, fr.times.wall);
   }
   finish_writing(writer, progress);
   loop_s_ = seconds_since(t_loop);

@@ -32,6 +32,24 @@ void check_output_dir(const std::string& dir);
 // The longest file name an AtomicFile can write: NAME_MAX (255 bytes) less what its temporary name adds.
 size_t max_output_file_name();
 
+// Temporary names, for AtomicFile and the folder lock: "<dir>/.<name>.tmp-<host>-<pid>-<n>", hidden, in
+// the destination's folder (so the rename stays on one file system). The host is gethostname's,
+// limited to letters, digits, '.' and '-' (others become '_') and 32 bytes; n counts up per process.
+std::string temporary_name(const std::string& final_path);
+// Who left a temporary file, from its name (false: not a temporary name). Names from before the host
+// was recorded (".<name>.tmp-<pid>-<n>") parse with an empty host.
+struct TemporaryOwner {
+  std::string host;
+  long pid = 0;
+  bool this_host = false;  // the host is this machine's
+  bool running = false;    // this host's, and its process is alive (or not ours to signal)
+};
+bool parse_temporary_name(const std::string& file_name, TemporaryOwner& owner);
+// Removes the temporary files in `dir` that this host's processes left and that no longer run (a
+// SIGKILL); another host's are left alone, since the folder may be shared by nodes (NFS). Returns how
+// many it removed.
+size_t remove_dead_temporaries(const std::string& dir);
+
 // A file written under a temporary name in the same folder as `final_path` and renamed into place by
 // commit(). The constructor creates the (empty) temporary file, so an unwritable or missing folder
 // fails early with pmr::Error. The destructor removes the temporary if commit() was not reached.
@@ -55,6 +73,11 @@ class AtomicFile {
   bool committed_ = false;
   int slot_ = -1;  // registration with the interrupt handler (output/interrupt.h)
 };
+
+// A write's failure as a message: strerror(err) for an errno, or a library's message; a file-size limit
+// (EFBIG: `ulimit -f`, SIGXFSZ being ignored) is named as such, whoever reported it.
+std::string write_failure(int err);
+std::string write_failure(const std::string& reason);
 
 // Writes `text` to `path` through an AtomicFile. Throws pmr::Error naming the file (and the reason:
 // a full disk shows here) on failure.

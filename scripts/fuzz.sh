@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Fuzzes the readers of files from strangers (docs/SECURITY.md) with libFuzzer, AddressSanitizer and
 # UndefinedBehaviorSanitizer: the glTF/GLB loader with its images, the environment image reader, the
-# Looking Glass calibration reader and the sidecar reader (tests/fuzz).
-# Usage: scripts/fuzz.sh SECONDS [TARGET...]   (TARGET: gltf environment calibration sidecar; default all)
+# Looking Glass calibration reader, the sidecar reader, a planted lock file and posing (tests/fuzz).
+# Usage: scripts/fuzz.sh SECONDS [TARGET...]   (TARGET: gltf environment calibration sidecar lock posing; default all)
 #   Installs clang-14 and its runtime if missing, builds the targets in build-fuzz/ (-DPMR_FUZZ=ON), runs
 #   every input of tests/fuzz/regressions/TARGET once, then fuzzes each target for SECONDS (0: only the
 #   regression inputs). The corpus grows in build-fuzz/fuzz-corpus/TARGET, seeded with the crafted
@@ -12,14 +12,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ $# -lt 1 ] || ! [[ "$1" =~ ^[0-9]+$ ]]; then
-  echo "usage: scripts/fuzz.sh SECONDS [gltf|environment|calibration|sidecar ...]" >&2
+  echo "usage: scripts/fuzz.sh SECONDS [gltf|environment|calibration|sidecar|lock|posing ...]" >&2
   exit 2
 fi
 SECONDS_EACH=$1
 TARGETS=("${@:2}")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(gltf environment calibration sidecar)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(gltf environment calibration sidecar lock posing)
 for t in "${TARGETS[@]}"; do
-  case "$t" in gltf|environment|calibration|sidecar) ;; *) echo "fuzz.sh: unknown target '$t'" >&2; exit 2 ;; esac
+  case "$t" in gltf|environment|calibration|sidecar|lock|posing) ;; *) echo "fuzz.sh: unknown target '$t'" >&2; exit 2 ;; esac
 done
 
 # the project's libraries, and clang with its sanitizer and libFuzzer runtimes
@@ -38,7 +38,11 @@ rm -rf "$BUILD/fuzz-seeds"
 GLTF_DIR=${PMR_GLTF_DIR:-../shared/gltf}
 if [ -d "$GLTF_DIR" ]; then
   find "$GLTF_DIR" -type f \( \( -name '*.glb' -size -256k \) -o \( -name '*.gltf' -size -64k \) \) |
-    while read -r f; do cp "$f" "$BUILD/fuzz-seeds/gltf/corpus_$(basename "$(dirname "$(dirname "$f")")")_$(basename "$f")"; done
+    while read -r f; do
+      for t in gltf posing; do
+        cp "$f" "$BUILD/fuzz-seeds/$t/corpus_$(basename "$(dirname "$(dirname "$f")")")_$(basename "$f")"
+      done
+    done
 else
   echo "fuzz: $GLTF_DIR not found: the glTF target starts from the crafted seeds only"
 fi
@@ -65,7 +69,7 @@ for t in "${TARGETS[@]}"; do
   mkdir -p "$BUILD/fuzz-corpus/$t" "$BUILD/fuzz-crashes/$t"
   echo "fuzz: $t: ${SECONDS_EACH}s"
   if ! "$bin" "${LIMITS[@]}" -max_total_time="$SECONDS_EACH" -close_fd_mask=3 -print_final_stats=1 \
-       -dict=tests/fuzz/"$t".dict -artifact_prefix="$BUILD/fuzz-crashes/$t/" \
+       -dict=tests/fuzz/"$(case $t in lock) echo sidecar ;; posing) echo gltf ;; *) echo "$t" ;; esac)".dict -artifact_prefix="$BUILD/fuzz-crashes/$t/" \
        "$BUILD/fuzz-corpus/$t" "$BUILD/fuzz-seeds/$t" >"$BUILD/fuzz-$t.log" 2>&1; then
     echo "fuzz: $t: found a problem (log: $BUILD/fuzz-$t.log; inputs: $BUILD/fuzz-crashes/$t/)" >&2
     failed+=("$t")

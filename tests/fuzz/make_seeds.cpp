@@ -1,6 +1,6 @@
 // pmr_fuzz_seeds OUT: writes the crafted seed inputs of the fuzz targets (the files of issue 21 "Safe on
-// files from strangers", at sizes that load quickly) into OUT/gltf, OUT/environment, OUT/calibration and
-// OUT/sidecar. scripts/fuzz.sh adds the small models of the glTF sample corpus when it is present.
+// files from strangers", at sizes that load quickly, and issue 31's lock files and posing bombs) into
+// OUT/gltf, OUT/environment, OUT/calibration, OUT/sidecar, OUT/lock and OUT/posing. scripts/fuzz.sh adds the small models of the glTF sample corpus when it is present.
 // The fuzzer mutates these into the full-size cases (counts, dimensions and indices are numbers in them).
 #include <cstdio>
 #include <filesystem>
@@ -255,6 +255,65 @@ void sidecar_seeds(const fs::path& out) {
   save(out / "frame_huge.json", with("\"frame\": 0", "\"frame\": 1e308"));
 }
 
+// A lock file's text is a sidecar: this run's configuration, another one's, and text that is none.
+void lock_seeds(const fs::path& out) {
+  const std::string frame0 = pmr::fuzz::reference_sidecar(0);
+  save(out / "same.json", frame0);
+  std::string other = frame0;
+  other.replace(other.find("\"fps\": 24"), 9, "\"fps\": 30");
+  save(out / "other_fps.json", other);
+  save(out / "empty", std::string());
+  save(out / "not_json", std::string("pmr lock"));
+}
+
+// Small versions of issue 31's posing bombs (each names a node, skin and animation the fuzzer can
+// grow): morph targets sharing one accessor with animated weights, a chain of nodes whose root moves,
+// a skin of chained joints.
+void posing_seeds(const fs::path& out) {
+  auto moving = [](GltfFile& g, int node, const char* path, const std::vector<float>& values, const char* type) {
+    const int in = g.data<float>({0.0f, 2.0f}, kFloat, "SCALAR");
+    g.doc["accessors"][size_t(in)]["min"] = {0.0};
+    g.doc["accessors"][size_t(in)]["max"] = {2.0};
+    const int v = g.data<float>(values, kFloat, type);
+    g.add("animations", {{"samplers", nlohmann::json::array({{{"input", in}, {"output", v}}})},
+                         {"channels", nlohmann::json::array({{{"sampler", 0},
+                                                               {"target", {{"node", node}, {"path", path}}}}})}});
+  };
+  auto triangle = [] {
+    GltfFile g;
+    const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
+    g.mesh(nlohmann::json::array({{{"attributes", {{"POSITION", pos}}}}}));
+    g.add("nodes", {{"mesh", 0}});
+    g.scene({0});
+    return g;
+  };
+  GltfFile morph = triangle();
+  const int delta = morph.data<float>({0, 0, 1, 0, 0, 1, 0, 0, 1}, kFloat, "VEC3");
+  for (int k = 0; k < 20; ++k) morph.doc["meshes"][0]["primitives"][0]["targets"].push_back({{"POSITION", delta}});
+  moving(morph, 0, "weights", std::vector<float>(40, 0.25f), "SCALAR");
+  save(out / "morph.glb", morph.glb());
+  GltfFile chain = triangle();
+  chain.doc["scenes"][0]["nodes"] = {1};
+  for (int n = 1; n <= 50; ++n)
+    chain.add("nodes", n < 50 ? nlohmann::json{{"children", {n + 1}}} : nlohmann::json{{"children", {0}}});
+  moving(chain, 1, "translation", {0, 0, 0, 1, 0, 0}, "VEC3");
+  save(out / "chain.glb", chain.glb());
+  GltfFile skin = triangle();
+  auto& attributes = skin.doc["meshes"][0]["primitives"][0]["attributes"];
+  attributes["JOINTS_0"] = skin.data<uint16_t>({0, 0, 0, 0, 1, 0, 0, 0, 19, 0, 0, 0}, kUShort, "VEC4");
+  attributes["WEIGHTS_0"] = skin.data<float>({1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}, kFloat, "VEC4");
+  skin.doc["nodes"][0]["skin"] = 0;
+  nlohmann::json joints = nlohmann::json::array();
+  for (int n = 1; n <= 20; ++n) {
+    skin.add("nodes", n < 20 ? nlohmann::json{{"children", {n + 1}}} : nlohmann::json::object());
+    joints.push_back(n);
+  }
+  skin.add("skins", {{"joints", joints}});
+  skin.doc["scenes"][0]["nodes"] = {0, 1};
+  moving(skin, 1, "rotation", {0, 0, 0, 1, 0, 0.7071f, 0, 0.7071f}, "VEC4");
+  save(out / "skin.glb", skin.glb());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -268,6 +327,8 @@ int main(int argc, char** argv) {
     environment_seeds(out / "environment");
     calibration_seeds(out / "calibration");
     sidecar_seeds(out / "sidecar");
+    lock_seeds(out / "lock");
+    posing_seeds(out / "posing");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pmr_fuzz_seeds: %s\n", e.what());
     return 1;

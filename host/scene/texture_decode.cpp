@@ -6,6 +6,7 @@
 // channels needs 4 x 32768 x 16385 x 2 bytes, which wraps to 262,144, and the decoder then writes
 // gigabytes into that buffer. So an image is decoded only when its pixels are within the
 // texture-pixels budget and its decoded size (4 channels of 1 or 2 bytes) fits in an int.
+#include <algorithm>
 #include <climits>
 #include <cstring>
 #include <string>
@@ -69,11 +70,15 @@ std::string decode_image(tinygltf::Image& image, const unsigned char* bytes, int
   if (decoded > uint64_t(INT_MAX))
     return size_text + " decodes to " + std::to_string(decoded) +
            " bytes, more than the image decoder can address (2 GiB)";
-  if (decoded > memory_left) {
+  // While it decodes, the decoder holds the inflated rows (or JPEG planes) in the file's channels and its
+  // own RGBA buffer, which is then copied into the kept image: all of it must fit, not just what stays.
+  const uint64_t decoding = decoded + pixels * uint64_t(std::max(comp, 1)) * channel_bytes + uint64_t(h);
+  if (decoded + decoding > memory_left) {
     over_limit = true;
-    return size_text + " decodes to " + std::to_string(decoded >> 20) +
-           " MiB, more than the memory budget leaves the scene's decoded images (" + std::to_string(memory_left >> 20) +
-           " MiB; raise it with --limit memory=N)";
+    return size_text + " decodes to " + std::to_string(decoded >> 20) + " MiB (" +
+           std::to_string((decoded + decoding) >> 20) +
+           " MiB while decoding), more than the memory budget leaves the scene's decoded images (" +
+           std::to_string(memory_left >> 20) + " MiB; raise it with --limit memory=N)";
   }
   const std::vector<unsigned char> cleaned = without_empty_idat(bytes, size_t(size));
   if (!cleaned.empty()) bytes = cleaned.data(), size = int(cleaned.size());

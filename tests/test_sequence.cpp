@@ -181,6 +181,10 @@ TEST(Sequence, ResumeAfterInterruptRendersOnlyTheMissingFrames) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find(std::to_string(complete) + " already complete"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find(std::to_string(10 - complete) + " frame(s) in"), std::string::npos) << r.output;
+  // one line per reason says which frames are rendered again: here only missing ones
+  EXPECT_NE(r.output.find("--resume: " + std::to_string(10 - complete) + " frame(s) are missing ("), std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("are incomplete"), std::string::npos) << r.output;
   EXPECT_EQ(fs::last_write_time(out + "/frame_0000.exr"), mtime) << "a complete frame was rendered again";
   EXPECT_EQ(listing(out).size(), 20u);
 

@@ -181,6 +181,10 @@ TEST(Trust, VerifyChecksEveryListedOutput) {
   const test::CliRun again =
       run("render " + scene + " --frames 0:2 --resume --write encoded,views,quilt" + kSmall + "--out " + out);
   EXPECT_EQ(again.status, 0) << again.output;
+  EXPECT_NE(again.output.find("--resume: 2 frame(s) are incomplete (a file missing, cut short or not the one their "
+                              "sidecar lists) (frame_0000.json, frame_0001.json): rendering them"),
+            std::string::npos)
+      << again.output;
   EXPECT_EQ(run("verify " + out + " --frames 0:2").status, 0);
 }
 

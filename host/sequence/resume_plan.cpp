@@ -35,6 +35,9 @@ ResumePlan plan_resume(const std::vector<long>& frames, bool resume, bool overwr
                        const std::function<FramePaths(long)>& paths,
                        const std::function<std::string(long, const FramePaths&)>& expected) {
   ResumePlan plan;
+  // the frames rendered again, by reason: sidecars absent, frames present but incomplete, files of
+  // another frame (a --name without a frame field), another configuration (--overwrite)
+  std::vector<std::string> missing, incomplete, other_frame, other_config;
   std::vector<std::string> other_scene;   // sidecars of frames rendered from another scene
   long unrecorded = 0;                    // ... of them recording no scene checksum
   std::vector<std::string> old_versions;  // versions of kept frames other than this program's
@@ -44,9 +47,13 @@ ResumePlan plan_resume(const std::vector<long>& frames, bool resume, bool overwr
     const FramePaths p = paths(f);
     // complete = every file present and readable (a node may have died during a rename on a network
     // file system); anything less is rendered again
-    if (resume && frame_problem(p.sidecar, p.images()).empty()) {
+    const std::string problem = resume ? frame_problem(p.sidecar, p.images()) : std::string();
+    if (resume && !problem.empty())
+      (std::filesystem::exists(p.sidecar) ? incomplete : missing).push_back(base_name(p.sidecar));
+    if (resume && problem.empty()) {
       const std::string existing = read_sidecar_text(p.sidecar);
       if (!records_frame(existing, f)) {  // a --name without a frame field: another frame's files
+        other_frame.push_back(base_name(p.sidecar));
         plan.todo.push_back(f);
         continue;
       }
@@ -71,10 +78,21 @@ ResumePlan plan_resume(const std::vector<long>& frames, bool resume, bool overwr
       if (diff.empty()) {
         other_scene.push_back(base_name(p.sidecar));
         unrecorded += had.scene.empty();
+      } else {
+        other_config.push_back(base_name(p.sidecar));
       }
     }
     plan.todo.push_back(f);
   }
+  auto note = [&](const std::vector<std::string>& frames, const std::string& why) {
+    if (!frames.empty())
+      plan.notes.push_back("--resume: " + std::to_string(frames.size()) + " frame(s) " + why + " (" +
+                           first_few(frames) + "): rendering them");
+  };
+  note(missing, "are missing");
+  note(incomplete, "are incomplete (a file missing, cut short or not the one their sidecar lists)");
+  note(other_frame, "hold another frame's files");
+  note(other_config, "were rendered with another configuration (--overwrite)");
   if (!other_scene.empty())
     plan.notes.push_back("--resume: " + std::to_string(other_scene.size()) +
                          " frame(s) were rendered from a different scene" +

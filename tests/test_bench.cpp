@@ -106,3 +106,27 @@ TEST(Bench, SyntheticSceneHasAboutTheRequestedTriangles) {
 
 }  // namespace
 }  // namespace pmr
+
+namespace pmr {
+namespace {
+
+// --queue-stats prints the last frame's histograms. The duplicate baseline emits one MTA per view, so
+// its views-per-MTA histogram is all ones; PMR's MTAs span several of the 8 views.
+TEST(Bench, QueueStatsDescribeTheLastFrame) {
+  const std::string common =
+      "bench --synthetic 2000 --views 8 --frames 1 --view-size 64x32 --display 320x180 "
+      "--no-check --queue-stats --method ";
+  const test::CliRun dup = test::run(common + "duplicate");
+  ASSERT_EQ(dup.status, 0) << dup.output;
+  EXPECT_NE(dup.output.find("# queue stats of the last frame: "), std::string::npos) << dup.output;
+  EXPECT_NE(dup.output.find("views per MTA (mean 1.00): 0-1: 100.0%"), std::string::npos) << dup.output;
+  const test::CliRun pmr = test::run(common + "pmr");
+  ASSERT_EQ(pmr.status, 0) << pmr.output;
+  const size_t at = pmr.output.find("views per MTA (mean ");
+  ASSERT_NE(at, std::string::npos) << pmr.output;
+  EXPECT_GT(std::stod(pmr.output.substr(at + 20)), 1.5) << pmr.output;
+  EXPECT_NE(pmr.output.find("ns/entry"), std::string::npos) << pmr.output;
+}
+
+}  // namespace
+}  // namespace pmr

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "cli/bench_options.h"
+#include "cli/queue_stats.h"
 #include "cli/render_command.h"
 #include "pipeline/pipeline.h"
 #include "pmr/error.h"
@@ -102,9 +103,10 @@ void bench_point(const BenchPoint& b, const ClRuntime& rt, double bw, std::vecto
   b.renderer.attach(p, &b.display);
   b.renderer.render(0);  // warm-up: first-touch of buffers, queue growth
   std::vector<double> wall, setup, tile, fine, encode, pose, upload;
+  StageTimes t;
   for (int f = 0; f < o.frames; ++f) {
     const FrameRenderer::Frame fr = b.renderer.render(f);
-    const StageTimes& t = fr.times;
+    t = fr.times;
     wall.push_back(t.wall), pose.push_back(fr.pose_ms), upload.push_back(fr.upload_ms);
     setup.push_back(t.vertex + t.setup), tile.push_back(t.bin), fine.push_back(t.fine), encode.push_back(t.encode);
   }
@@ -129,6 +131,7 @@ void bench_point(const BenchPoint& b, const ClRuntime& rt, double bw, std::vecto
   if (median(pose) > 0.0)
     std::printf("#   on the host per frame (not in ms_median): pose %.2f ms, upload %.2f ms\n", median(pose),
                 median(upload));
+  if (o.queue_stats) print_queue_stats(p, t);
   std::fflush(stdout);
   if (csv)
     *csv << b.scene_name << ',' << to_string(b.method) << ',' << b.views << ',' << rig.view_w << ',' << rig.view_h

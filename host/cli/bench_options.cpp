@@ -137,6 +137,11 @@ const BenchSection kMeasureOptions = {
          [](BenchOptions& o, const std::string& v, const std::string&) { o.save_scene = v; }},
         {"--no-check", nullptr, nullptr, "skip comparing the methods' images",
          [](BenchOptions& o, const std::string&, const std::string&) { o.check = false; }},
+        {"--queue-stats", nullptr, nullptr,
+         "after each point, histograms of its last frame's work (tile-queue entries\n"
+         "per MTA and per tile, views and bounding-box pixels per MTA) and the stage\n"
+         "times per unit of it",
+         [](BenchOptions& o, const std::string&, const std::string&) { o.queue_stats = true; }},
     }};
 
 // Not listed one by one: the heading names them.

@@ -36,6 +36,7 @@ struct BenchOptions {
   Display display;
   int tile[3] = {16, 2, 16};
   bool check = true;
+  bool queue_stats = false;  // --queue-stats: histograms of the last frame's work (cli/queue_stats.h)
   bool help = false;
   // Timed frames are frames 0..K-1 of this sequence (animation and turntable as for pmr render).
   SequenceChoice sequence;

@@ -162,6 +162,9 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
     std::printf("  %zu %s: %zu channel(s), keys %.3f to %.3f s; --frames all at 24 fps: %s\n", i,
                 quoted(a.name).c_str(), a.channels, a.start, a.end, frames.c_str());
   }
+  if (!s.animations.empty())
+    std::printf("posing: %llu units a frame with --animation all (--limit pose-work; docs/SECURITY.md, \"Posing\")\n",
+                (unsigned long long)pose_work(s, kAllAnimations));
   std::printf("skins: %zu\n", d.skin_joints.size());
   for (size_t i = 0; i < d.skin_joints.size(); ++i) std::printf("  %zu: %zu joint(s)\n", i, d.skin_joints[i]);
   std::printf("morph targets: %zu mesh(es)\n", d.morph_meshes.size());

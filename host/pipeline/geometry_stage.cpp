@@ -152,6 +152,12 @@ void GeometryStage::read_tile_queues(std::vector<uint32_t>& offsets, std::vector
   rt_.read(tile_queue_, queue.data(), queue.size() * 4);
 }
 
+PmrParams GeometryStage::read_params() const {
+  PmrParams P;
+  rt_.read(params_, &P, sizeof P);
+  return P;
+}
+
 std::vector<PmrVertex> GeometryStage::read_vertices() const {
   std::vector<PmrVertex> out(num_vertices_);
   rt_.read(vertices_, out.data(), out.size() * sizeof(PmrVertex));

@@ -36,6 +36,7 @@ class GeometryStage {
   void setup_and_bin(PmrParams& P, const SceneBuffers& scene, FrameEvents& ev, StageTimes& t);
 
   const ClBuffer& params() const { return params_; }
+  PmrParams read_params() const;  // the last frame's
   const ClBuffer& mtas() const { return mtas_; }
   const ClBuffer& tile_offsets() const { return tile_offsets_; }
   const ClBuffer& tile_queue() const { return tile_queue_; }

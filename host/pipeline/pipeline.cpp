@@ -364,5 +364,6 @@ void Pipeline::read_tile_queues(std::vector<uint32_t>& offsets, std::vector<uint
   impl_->geometry.read_tile_queues(offsets, queue);
 }
 std::vector<PmrVertex> Pipeline::read_vertices() const { return impl_->geometry.read_vertices(); }
+PmrParams Pipeline::read_params() const { return impl_->geometry.read_params(); }
 
 }  // namespace pmr

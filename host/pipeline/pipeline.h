@@ -87,6 +87,8 @@ class Pipeline {
   // per tile plus one; queue[offsets[t] .. offsets[t+1]) are MTA indices).
   std::vector<PmrMta> read_mtas() const;
   void read_tile_queues(std::vector<uint32_t>& offsets, std::vector<uint32_t>& queue) const;
+  // The last frame's parameters as the kernels saw them (view coordinates, tile grid).
+  PmrParams read_params() const;
   // Vertex-stage output of the last frame.
   std::vector<PmrVertex> read_vertices() const;
   // Encodes a given view volume ([view][y][x][RGBA] halves) without rendering: the encoder alone.

@@ -127,7 +127,7 @@ log "4-task array: ${t_array} s wall; one process: ${t_single} s wall (16 frames
 
 "$PMR" verify "$TMP/out/a" --frames "$FRAMES" >/dev/null || fail "pmr verify reports missing frames after the array"
 # every frame rendered exactly once over the 4 tasks' logs
-done_lines=$(cat "$TMP"/pmr-render-"$jid"_*.log | grep -oE 'frame [0-9]+ rendered' | sort)
+done_lines=$(cat "$TMP"/pmr-render-"$jid"_*.log | grep -oE 'frame [0-9]+ written' | sort)
 [ "$(echo "$done_lines" | wc -l)" -eq 16 ] || fail "expected 16 rendered frames in the task logs, got: $done_lines"
 [ "$(echo "$done_lines" | uniq | wc -l)" -eq 16 ] || fail "a frame was rendered twice: $done_lines"
 for f in $(seq 0 15); do

@@ -191,7 +191,12 @@ constexpr uint32_t kFastLevel = 2, kFastLevelBuf = ISAL_DEF_LVL2_DEFAULT;  // IS
 // files 1.000-1.018x of libdeflate-only ones for 0.62-0.66x of its deflate time (docs/SEQUENCES.md).
 constexpr size_t kKeepFastRatio = 16;
 
-constexpr size_t kInputSlack = 64;  // zeroed bytes after a chunk's input (compress_fast)
+// Zeroed bytes after a chunk's input (compress_fast): ISA-L's encoder may look up to ISAL_LOOK_AHEAD
+// (288) bytes past a position, plus a vector load, so the whole look-ahead is defined. (Once, under
+// ctest -j2, a views file came out 3 bytes longer than the same file rendered again, same pixels;
+// stale bytes past 64 are one suspect, not proven: ExrZip.TheSamePixelsGiveTheSameBytesWhateverCameBefore
+// does not reproduce it with 64.)
+constexpr size_t kInputSlack = ISAL_LOOK_AHEAD + 64;
 
 // Room for the compressed chunk of `n` raw bytes; a chunk that needs more is stored raw.
 size_t packed_bound(size_t n) { return n + n / 8 + 1024; }

@@ -173,9 +173,10 @@ TEST(Sequence, ResumeAfterInterruptRendersOnlyTheMissingFrames) {
     EXPECT_TRUE(before.count(std::string(stem) + ".json")) << line << ": not on disk";
   }
   EXPECT_EQ(counted, complete) << read_text(out + ".log");
-  if (!finished_first)
+  if (!finished_first) {
     EXPECT_NE(read_text(out + ".log").find(std::to_string(complete) + " of 10 frame(s) written"), std::string::npos)
         << read_text(out + ".log");
+  }
   const auto mtime = fs::last_write_time(out + "/frame_0000.exr");
   const CliRun r = run("render --resume" + args);
   ASSERT_EQ(r.status, 0) << r.output;

@@ -249,6 +249,17 @@ TEST(Sequence, AbsurdAnimationRangesAreRefused) {
   EXPECT_THROW(animation_frame_range(s, spec, first, last), Error);
   expect_one_error_line(run("render --turntable 360:100000000 --frames all" + kSmall + "--out " + temp_dir("seq_long")),
                         "give a range");
+  // keys wholly beyond every frame number, or wholly before frame 0, even beyond a long's range (the
+  // posing fuzzer's find: the frame numbers were converted from doubles out of range): no frame inside
+  s.animations = {{"far", 1e30, 1e30, 1}, {"past", -1e30, -1e29, 1}, {"late", 9999998.0 / 24.0, 10000005.0 / 24.0, 1}};
+  for (int a : {0, 1}) {
+    spec.animation = a;
+    EXPECT_FALSE(animation_key_frames(s, spec, first, last)) << a;
+  }
+  spec.animation = 2;  // from frame 9999998 to the last frame number
+  ASSERT_TRUE(animation_key_frames(s, spec, first, last));
+  EXPECT_EQ(first, 9999998);
+  EXPECT_EQ(last, kMaxFrame);
 }
 
 TEST(Sequence, BadSequenceOptionsFailWithOneLine) {

@@ -92,9 +92,13 @@ bool animation_key_frames(const Scene& scene, const SequenceSpec& spec, long& fi
   if (!(b - std::max(a, 0.0) < double(kMaxFramesPerRun)))
     throw Error("the animation's keys span " + std::to_string(start) + " to " + std::to_string(end) + " s, over " +
                 std::to_string(kMaxFramesPerRun) + " frames at " + std::to_string(spec.fps) + " fps");
-  first = std::max(0L, long(a));
-  last = std::max(first - 1, long(b));
-  return first <= last;
+  // Frames are numbers 0..kMaxFrame: keys wholly before 0 or after kMaxFrame hold none (and a or b
+  // beyond a long's range must not be converted at all)
+  const double lo = std::max(a, 0.0), hi = std::min(b, double(kMaxFrame));
+  if (!(lo <= hi)) return false;
+  first = long(lo);
+  last = long(hi);
+  return true;
 }
 
 void animation_frame_range(const Scene& scene, const SequenceSpec& spec, long& first, long& last) {

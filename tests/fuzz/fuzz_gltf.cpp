@@ -32,14 +32,7 @@ const std::string& scene_path() {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string& path = scene_path();
   pmr::fuzz::write_file(path, data, size);
-  // Budgets far below the defaults, so that an input the budgets allow stays fast to load; the
-  // budget checks themselves run the same code at any size.
-  pmr::InputLimits limits;
-  limits.file_bytes = uint64_t(1) << 20;
-  limits.texture_pixels = uint64_t(1) << 20;
-  limits.vertex_data = uint64_t(64) << 20;
-  limits.animation_data = uint64_t(16) << 20;
-  limits.json_bytes = uint64_t(1) << 20;
+  const pmr::InputLimits limits = pmr::fuzz::small_limits();
   try {
     const pmr::Scene scene = pmr::load_scene(path, limits);
     glm::dvec3 lo, hi;

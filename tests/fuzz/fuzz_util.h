@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <string>
 
+#include "pmr/input_files.h"
+
 namespace pmr::fuzz {
 
 // A new folder under $TMPDIR (or /tmp), removed when the process exits normally.
@@ -41,6 +43,18 @@ inline void write_file(const std::string& path, const uint8_t* data, size_t size
 
 inline void write_file(const std::string& path, const std::string& text) {
   write_file(path, reinterpret_cast<const uint8_t*>(text.data()), text.size());
+}
+
+// Budgets far below the defaults, so that an input the budgets allow stays fast to load; the budget
+// checks themselves run the same code at any size.
+inline InputLimits small_limits() {
+  InputLimits limits;
+  limits.file_bytes = uint64_t(1) << 20;
+  limits.texture_pixels = uint64_t(1) << 20;
+  limits.vertex_data = uint64_t(64) << 20;
+  limits.animation_data = uint64_t(16) << 20;
+  limits.json_bytes = uint64_t(1) << 20;
+  return limits;
 }
 
 }  // namespace pmr::fuzz

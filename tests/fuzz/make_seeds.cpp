@@ -275,9 +275,9 @@ void posing_seeds(const fs::path& out) {
     g.doc["accessors"][size_t(in)]["min"] = {0.0};
     g.doc["accessors"][size_t(in)]["max"] = {2.0};
     const int v = g.data<float>(values, kFloat, type);
-    g.add("animations", {{"samplers", nlohmann::json::array({{{"input", in}, {"output", v}}})},
-                         {"channels", nlohmann::json::array({{{"sampler", 0},
-                                                               {"target", {{"node", node}, {"path", path}}}}})}});
+    g.add("animations",
+          {{"samplers", nlohmann::json::array({{{"input", in}, {"output", v}}})},
+           {"channels", nlohmann::json::array({{{"sampler", 0}, {"target", {{"node", node}, {"path", path}}}}})}});
   };
   auto triangle = [] {
     GltfFile g;

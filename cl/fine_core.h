@@ -47,36 +47,45 @@ inline SampleLanes offset_samples(long X, long Y, const int* sx, const int* sy) 
 inline long sample_lane_x(const SampleLanes* S, int l) { return S->sx ? S->X + S->sx[l] : S->X + (long)l * PMR_X_ONE; }
 inline long sample_lane_y(const SampleLanes* S, int l) { return S->sx ? S->Y + S->sy[l] : S->Y; }
 
+/* Bit l set where lane l of `mask` is true (a comparison's -1). */
+inline uint mask_bits16(int16 mask) {
+  const int16 bits = select((int16)(0), (int16)(1) << vload16(0, lane_index), mask);
+  const int8 a = bits.lo | bits.hi;
+  const int4 b = a.lo | a.hi;
+  const int2 c = b.lo | b.hi;
+  return (uint)(c.x | c.y);
+}
+
+/* Each vertex's raster x relative to X0 in views ib + l (l < 16; lanes from `count` on repeat the last
+ * view's, view_coord_lanes), exact in 32 bits, when that provably fits: base, disparity over the views
+ * and their sum each below 2^29 in magnitude. Else false (the caller falls back to 64-bit work). */
+inline bool view_x_lanes(global const PmrParams* P, const PmrMta* m, int ib, int count, long X0, int16* x) {
+  long span;
+  const int16 l = view_coord_lanes(P, ib, count, &span);
+  const long fib = view_coord(P, ib);
+  for (int k = 0; k < 3; ++k) {
+    const long base = (long)m->x0[k] + fib * m->dx[k] - X0;
+    if (base <= -(1L << 29) || base >= (1L << 29) || (long)abs(m->dx[k]) * span >= (1L << 29)) return false;
+    x[k] = (int16)((int)base) + l * m->dx[k];
+  }
+  return true;
+}
+
 /* Bit l set: in view ib + l (l < count <= 16) some sample x of the form X0 + k 2^shift, 0 <= k <= last,
  * lies within the MTA's x extent: a tile's pixel-center columns (shift PMR_X_FRAC_BITS, last = columns
  * - 1), or any raster x of a span (shift 0). Views failing it cannot hold a covered sample; a sub-pixel
  * MTA passes in an irregular part of the views, so testing 16 views at once (lanes = views) replaces 16
- * unpredictable branches. Vertex x relative to X0 in 32 bits when that provably fits (base, disparity
- * over the views and `last` each below 2^29), else every view is passed on (the edge tests decide
- * exactly either way). Arithmetic shifts floor. */
+ * unpredictable branches. Every view is passed on when the vertices do not fit view_x_lanes or `last`
+ * is 2^29 or more (the edge tests decide exactly either way). Arithmetic shifts floor. */
 PMR_HOT uint view_pass_mask(global const PmrParams* P, const PmrMta* m, int ib, int count, long X0, int shift,
                             long last) {
   const uint all = (1u << count) - 1u; /* count <= 16 */
-  long span;
-  const int16 l = view_coord_lanes(P, ib, count, &span);
-  const long fib = view_coord(P, ib);
-  long base[3];
-  bool fits = last < (1L << 29);
-  for (int k = 0; k < 3; ++k) {
-    base[k] = (long)m->x0[k] + fib * m->dx[k] - X0;
-    fits = fits && base[k] > -(1L << 29) && base[k] < (1L << 29) && (long)abs(m->dx[k]) * span < (1L << 29);
-  }
-  if (!fits) return all;
-  const int16 xa = (int16)((int)base[0]) + l * m->dx[0], xb = (int16)((int)base[1]) + l * m->dx[1];
-  const int16 xc = (int16)((int)base[2]) + l * m->dx[2];
-  const int16 kmax = max(xa, max(xb, xc)) >> shift;
-  const int16 kmin = -((-min(xa, min(xb, xc))) >> shift);
+  int16 x[3];
+  if (last >= (1L << 29) || !view_x_lanes(P, m, ib, count, X0, x)) return all;
+  const int16 kmax = max(x[0], max(x[1], x[2])) >> shift;
+  const int16 kmin = -((-min(x[0], min(x[1], x[2]))) >> shift);
   const int16 pass = max(kmin, 0) <= min(kmax, (int16)((int)last));
-  const int16 bits = select((int16)(0), (int16)(1) << vload16(0, lane_index), pass);
-  const int8 r8 = bits.lo | bits.hi;
-  const int4 r4 = r8.lo | r8.hi;
-  const int2 r2 = r4.lo | r4.hi;
-  return (uint)(r2.x | r2.y) & all;
+  return mask_bits16(pass) & all;
 }
 
 /* The shading point of a pixel and triangle (DESIGN section 3b), as an offset from the pixel center

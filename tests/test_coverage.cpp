@@ -30,70 +30,100 @@ size_t expect_matches_reference(const Scene& scene, const Rig& rig, const test::
   return covered;
 }
 
-// A mesh of shared-edge triangles covering the whole screen in every view, vertices at varying depths:
-// every sample of every voxel of every view is covered exactly once, for 1, 4 and 16 samples per
-// pixel, and every pixel resolves to alpha 1 (no seam along shared edges).
+// A mesh of G x G cells of shared-edge triangles covering the whole screen in every view (its border
+// vertices two cells beyond it), inner vertices jittered by up to `jitter` cells and, but for every third,
+// off the focal plane by up to `depth` focal lengths (0: exact in every view), the whole grid shifted by
+// `offset` pixels (half a pixel puts the vertices of a grid of whole-pixel cells on pixel centers).
+Scene grid_mesh(const Rig& rig, int G, double jitter_cells, double depth_range, uint32_t seed, double offset = 0.0) {
+  Scene s = test::empty_scene();
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-jitter_cells, jitter_cells), depth(-depth_range, depth_range);
+  std::vector<uint32_t> grid((G + 1) * (G + 1));
+  for (int j = 0; j <= G; ++j)
+    for (int i = 0; i <= G; ++i) {
+      // raster position of the vertex in the center view, beyond the screen at the border
+      const bool inner = i > 0 && i < G && j > 0 && j < G;
+      const double x = (i - 2.0 + (inner && jitter_cells > 0 ? jitter(rng) : 0.0)) * rig.view_w / (G - 4.0) + offset;
+      const double y = (j - 2.0 + (inner && jitter_cells > 0 ? jitter(rng) : 0.0)) * rig.view_h / (G - 4.0) + offset;
+      glm::vec3 p = test::focal_point(rig, x, y);
+      const double dz = (i + j) % 3 == 0 || depth_range == 0 ? 0.0 : depth(rng) * rig.focal;
+      p.x *= float((rig.focal + dz) / rig.focal);  // along the ray through the camera at (0,0,D)...
+      p.y *= float((rig.focal + dz) / rig.focal);
+      p.z = float(-dz);  // ...keeps the centre-view raster position
+      grid[j * (G + 1) + i] = uint32_t(s.positions.size());
+      s.positions.push_back(p);
+      PmrVertexAttr a{};
+      a.normal[2] = 1.0f;
+      for (int k = 0; k < 4; ++k) a.color[k] = 1.0f;
+      s.attributes.push_back(a);
+    }
+  for (int j = 0; j < G; ++j)
+    for (int i = 0; i < G; ++i) {
+      const uint32_t a = grid[j * (G + 1) + i], b = grid[j * (G + 1) + i + 1];
+      const uint32_t c = grid[(j + 1) * (G + 1) + i], d = grid[(j + 1) * (G + 1) + i + 1];
+      // raster y grows downwards, world y upwards: (a, c, b) is counter-clockwise in the world
+      PmrTriangle t{};
+      t.has_normals = 1;
+      if ((i + j) % 2) {
+        t.v[0] = a, t.v[1] = c, t.v[2] = b;
+        s.triangles.push_back(t);
+        t.v[0] = b, t.v[1] = c, t.v[2] = d;
+        s.triangles.push_back(t);
+      } else {
+        t.v[0] = a, t.v[1] = c, t.v[2] = d;
+        s.triangles.push_back(t);
+        t.v[0] = a, t.v[1] = d, t.v[2] = b;
+        s.triangles.push_back(t);
+      }
+    }
+  return s;
+}
+
+// Every sample of every voxel covered exactly once, every pixel of alpha 1 (no seam along shared edges),
+// and the reference's result.
+void expect_watertight(const Scene& s, const Rig& rig, const PipelineConfig& pc, const std::string& what) {
+  SCOPED_TRACE(what + ", N = " + std::to_string(rig.views) + ", S = " + std::to_string(pc.samples));
+  const test::Rendered out = test::render_with(s, rig, pc);
+  size_t bad = 0, seams = 0;
+  for (size_t v = 0; v < out.count.size(); ++v) bad += out.count[v] != 1;
+  for (size_t v = 0; v < out.volume.size(); v += 4) seams += out.volume[v + 3] != 0x3c00;  // alpha 1
+  EXPECT_EQ(bad, 0u) << "samples not covered exactly once";
+  EXPECT_EQ(seams, 0u) << "pixels whose samples' coverage does not sum to 1";
+  expect_matches_reference(s, rig, out, pc.samples);
+}
+
+// Cells of about 10 pixels at varying depths, for 1, 4 and 16 samples per pixel.
 TEST(Coverage, WatertightMeshCoversEveryVoxelExactlyOnce) {
   for (bool angular : test::kSpacings)
     for (int views : {1, 7, 96}) {
       const Rig rig = test::small_rig(views, 61, 37, angular);
-      Scene s = test::empty_scene();
-      const int G = 10;  // cells per side
-      std::mt19937 rng(7);
-      std::uniform_real_distribution<double> jitter(-0.15, 0.15), depth(-0.008, 0.008);
-      std::vector<uint32_t> grid((G + 1) * (G + 1));
-      for (int j = 0; j <= G; ++j)
-        for (int i = 0; i <= G; ++i) {
-          // raster position of the vertex in the center view, beyond the screen at the border
-          const bool inner = i > 0 && i < G && j > 0 && j < G;
-          const double x = (i - 2.0 + (inner ? jitter(rng) : 0.0)) * rig.view_w / (G - 4.0);
-          const double y = (j - 2.0 + (inner ? jitter(rng) : 0.0)) * rig.view_h / (G - 4.0);
-          glm::vec3 p = test::focal_point(rig, x, y);
-          const double dz = (i + j) % 3 == 0 ? 0.0 : depth(rng) * rig.focal;  // some on the focal plane
-          p.x *= float((rig.focal + dz) / rig.focal);  // along the ray through the camera at (0,0,D)...
-          p.y *= float((rig.focal + dz) / rig.focal);
-          p.z = float(-dz);  // ...keeps the centre-view raster position
-          grid[j * (G + 1) + i] = uint32_t(s.positions.size());
-          s.positions.push_back(p);
-          PmrVertexAttr a{};
-          a.normal[2] = 1.0f;
-          for (int k = 0; k < 4; ++k) a.color[k] = 1.0f;
-          s.attributes.push_back(a);
-        }
-      for (int j = 0; j < G; ++j)
-        for (int i = 0; i < G; ++i) {
-          const uint32_t a = grid[j * (G + 1) + i], b = grid[j * (G + 1) + i + 1];
-          const uint32_t c = grid[(j + 1) * (G + 1) + i], d = grid[(j + 1) * (G + 1) + i + 1];
-          // raster y grows downwards, world y upwards: (a, c, b) is counter-clockwise in the world
-          PmrTriangle t{};
-          t.has_normals = 1;
-          if ((i + j) % 2) {
-            t.v[0] = a, t.v[1] = c, t.v[2] = b;
-            s.triangles.push_back(t);
-            t.v[0] = b, t.v[1] = c, t.v[2] = d;
-            s.triangles.push_back(t);
-          } else {
-            t.v[0] = a, t.v[1] = c, t.v[2] = d;
-            s.triangles.push_back(t);
-            t.v[0] = a, t.v[1] = d, t.v[2] = b;
-            s.triangles.push_back(t);
-          }
-        }
+      const Scene s = grid_mesh(rig, 10, 0.15, 0.008, 7);
       for (int samples : {1, 4, 16}) {
         if (samples == 16 && views != 7) continue;  // (time)
         PipelineConfig pc;
         pc.tile_x = pc.tile_y = pc.tile_v = 4;
         pc.samples = samples;
-        const test::Rendered out = test::render_with(s, rig, pc);
-        size_t bad = 0, seams = 0;
-        for (size_t v = 0; v < out.count.size(); ++v) bad += out.count[v] != 1;
-        for (size_t v = 0; v < out.volume.size(); v += 4) seams += out.volume[v + 3] != 0x3c00;  // alpha 1
-        EXPECT_EQ(bad, 0u) << "samples not covered exactly once with N = " << views << ", "
-                           << test::spacing_name(angular) << ", S = " << samples;
-        EXPECT_EQ(seams, 0u) << "pixels whose samples' coverage does not sum to 1, S = " << samples;
-        expect_matches_reference(s, rig, out, samples);
+        expect_watertight(s, rig, pc, test::spacing_name(angular));
       }
     }
+}
+
+// Cells of one to two pixels in the default tiles, where the fine raster's small-triangle path takes
+// most queue entries: jittered at varying depths, and unjittered on the focal plane in cells of 2 x 2
+// pixels with every vertex on a pixel center and every edge through pixel centers (the top-left rule
+// decides each of those samples).
+TEST(Coverage, TinyTrianglesCoverEveryVoxelExactlyOnce) {
+  for (bool angular : test::kSpacings) {
+    const Rig rig = test::small_rig(24, 40, 40, angular);
+    PipelineConfig pc;  // the default tiles
+    for (int samples : {1, 4}) {
+      pc.samples = samples;
+      expect_watertight(grid_mesh(rig, 30, 0.2, 0.002, 11), rig, pc,
+                        std::string("jittered, ") + test::spacing_name(angular));
+      expect_watertight(grid_mesh(rig, 24, 0.0, 0.0, 0, 0.5), rig, pc,
+                        std::string("on pixel centers, ") + test::spacing_name(angular));
+    }
+  }
 }
 
 // Triangles whose vertices and edges pass exactly through pixel centers (focal plane: zero disparity,

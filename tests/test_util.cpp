@@ -71,10 +71,10 @@ glm::vec2& texcoord(Scene& s, int set, size_t v) {
   return s.texcoords[size_t(set)][v];
 }
 
-Scene random_scene(int n, uint32_t seed, bool double_sided) {
+Scene random_scene(int n, uint32_t seed, bool double_sided, float max_size) {
   Scene s = empty_scene(double_sided);
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f), size(0.002f, 0.6f);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), size(0.002f, max_size);
   for (int i = 0; i < n; ++i) {
     const glm::vec3 c(u(rng), u(rng), u(rng));
     const float r = size(rng);

@@ -37,7 +37,7 @@ SceneTextureSlot& base_colour_texture(Scene& s, uint32_t material, int texture, 
 // where not given. Call after the last vertex is added.
 glm::vec2& texcoord(Scene& s, int set, size_t v);
 // `n` random triangles inside the box [-1,1]^3, sizes from sub-pixel to a good part of the screen.
-Scene random_scene(int n, uint32_t seed, bool double_sided);
+Scene random_scene(int n, uint32_t seed, bool double_sided, float max_size = 0.6f);
 
 // The default rig (paper-8k display, framing the unit box [-1,1]^3) with a small view raster, with
 // linear or angular camera spacing.

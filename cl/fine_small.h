@@ -21,8 +21,9 @@
  * as row-chunk hit vectors, the one depth, mask, blend and winner update of every path; the results do
  * not depend on which path, or in which order, a voxel was tested. */
 
-/* At most this many candidate pixel columns in every view of a block (measured: docs/PERFORMANCE.md). */
-#define FINE_SMALL_COLUMNS 4
+/* At most this many candidate pixel columns in every view of a block: 2, 4, 8, 16 and 32 measured on
+ * three scenes (docs/PERFORMANCE.md); from 8 on the 32-bit bound decides and the times are equal. */
+#define FINE_SMALL_COLUMNS 8
 /* Column sets are 32-bit masks: the path serves tiles up to 32 pixels wide. */
 #define FINE_SMALL (PMR_TILE_X <= 32)
 

@@ -96,6 +96,33 @@ inline int16 view_coord_lanes(global const PmrParams* P, int ib, int count, long
   return min(f, (int16)((int)*span)); /* lanes past `count` never exceed the span */
 }
 
+/* Lane l holds l: the lane numbers of a vector of up to 16 lanes (vload from here). */
+constant int lane_index[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
+
+/* Bit l set where lane l of `mask` is true (a comparison's -1). */
+inline uint mask_bits16(int16 mask) {
+  const int16 bits = select((int16)(0), (int16)(1) << vload16(0, lane_index), mask);
+  const int8 a = bits.lo | bits.hi;
+  const int4 b = a.lo | a.hi;
+  const int2 c = b.lo | b.hi;
+  return (uint)(c.x | c.y);
+}
+
+/* Each vertex's raster x relative to X0 in views ib + l (l < 16; lanes from `count` on repeat the last
+ * view's, view_coord_lanes), exact in 32 bits, when that provably fits: base, disparity over the views
+ * and their sum each below 2^29 in magnitude. Else false (the caller falls back to 64-bit work). */
+inline bool view_x_lanes(global const PmrParams* P, const PmrMta* m, int ib, int count, long X0, int16* x) {
+  long span;
+  const int16 l = view_coord_lanes(P, ib, count, &span);
+  const long fib = view_coord(P, ib);
+  for (int k = 0; k < 3; ++k) {
+    const long base = (long)m->x0[k] + fib * m->dx[k] - X0;
+    if (base <= -(1L << 29) || base >= (1L << 29) || (long)abs(m->dx[k]) * span >= (1L << 29)) return false;
+    x[k] = (int16)((int)base) + l * m->dx[k];
+  }
+  return true;
+}
+
 /* Edge function of edge (a -> b) of an MTA at raster point (X, Y) (16.16 / 24.8) in the view with view
  * coordinate f:
  *   E = (yb - ya) (X - xa(f)) - (xb(f) - xa(f)) (Y - ya),   xa(f) = x0a + f * dxa.

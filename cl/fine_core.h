@@ -47,30 +47,6 @@ inline SampleLanes offset_samples(long X, long Y, const int* sx, const int* sy) 
 inline long sample_lane_x(const SampleLanes* S, int l) { return S->sx ? S->X + S->sx[l] : S->X + (long)l * PMR_X_ONE; }
 inline long sample_lane_y(const SampleLanes* S, int l) { return S->sx ? S->Y + S->sy[l] : S->Y; }
 
-/* Bit l set where lane l of `mask` is true (a comparison's -1). */
-inline uint mask_bits16(int16 mask) {
-  const int16 bits = select((int16)(0), (int16)(1) << vload16(0, lane_index), mask);
-  const int8 a = bits.lo | bits.hi;
-  const int4 b = a.lo | a.hi;
-  const int2 c = b.lo | b.hi;
-  return (uint)(c.x | c.y);
-}
-
-/* Each vertex's raster x relative to X0 in views ib + l (l < 16; lanes from `count` on repeat the last
- * view's, view_coord_lanes), exact in 32 bits, when that provably fits: base, disparity over the views
- * and their sum each below 2^29 in magnitude. Else false (the caller falls back to 64-bit work). */
-inline bool view_x_lanes(global const PmrParams* P, const PmrMta* m, int ib, int count, long X0, int16* x) {
-  long span;
-  const int16 l = view_coord_lanes(P, ib, count, &span);
-  const long fib = view_coord(P, ib);
-  for (int k = 0; k < 3; ++k) {
-    const long base = (long)m->x0[k] + fib * m->dx[k] - X0;
-    if (base <= -(1L << 29) || base >= (1L << 29) || (long)abs(m->dx[k]) * span >= (1L << 29)) return false;
-    x[k] = (int16)((int)base) + l * m->dx[k];
-  }
-  return true;
-}
-
 /* Bit l set: in view ib + l (l < count <= 16) some sample x of the form X0 + k 2^shift, 0 <= k <= last,
  * lies within the MTA's x extent: a tile's pixel-center columns (shift PMR_X_FRAC_BITS, last = columns
  * - 1), or any raster x of a span (shift 0). Views failing it cannot hold a covered sample; a sub-pixel
@@ -123,12 +99,20 @@ inline uint mta_sample_cover(global const PmrParams* P, const PmrMta* m, long X,
 }
 
 /* alphaMode MASK: of the lanes l < n with w[l] set (candidate winners at samples S of view `view`), clears
- * those whose base colour alpha fails the cutoff. Rare path, one lane at a time with the exact edge
- * functions. */
+ * those whose base colour alpha fails the cutoff, SW candidates at a time (mta_alpha_lanes). */
 inline void mask_alpha_lanes(const ShadeInputs* in, const PmrMta* m, int* w, int n, const SampleLanes* S, int view,
                              float cutoff) {
-  for (int l = 0; l < n; ++l)
-    if (w[l] && !mta_alpha_passes(in, m, sample_lane_x(S, l), sample_lane_y(S, l), view, cutoff)) w[l] = 0;
+  long X[SW], Y[SW];
+  int lane_of[SW], pass[SW], k = 0;
+  for (int l = 0; l < n; ++l) {
+    if (w[l]) X[k] = sample_lane_x(S, l), Y[k] = sample_lane_y(S, l), lane_of[k++] = l;
+    if (k == SW || (k > 0 && l == n - 1)) {
+      mta_alpha_lanes(in, m, X, Y, k, view, cutoff, pass);
+      for (int j = 0; j < k; ++j)
+        if (!pass[j]) w[lane_of[j]] = 0;
+      k = 0;
+    }
+  }
 }
 
 /* The winners of SW samples S of view `view` for shade_lanes, one per lane: MTA ids[l] where `act`. Each

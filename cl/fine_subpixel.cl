@@ -191,19 +191,14 @@ inline void sp_shading_point(global const PmrParams* P, const PmrMta* m, int j, 
  * (shading_point around the subpixel's own sample), so that a failure leaves all its samples. */
 inline int8 sp_mask(const ShadeInputs* in, const PmrMta* m, int8 win, int j, int v, float cutoff, const int* sx,
                     const int* sy, const SpChunk* C) {
-  int w[SP_LANES];
+  int w[SP_LANES], ox[SP_LANES], oy[SP_LANES];
   vstore8(win, 0, w);
-  if (NS == 1) {
-    const SampleLanes L = offset_samples(C->Xc, C->Yc, sx, sy);
-    mask_alpha_lanes(in, m, w, SP_LANES, &L, v, cutoff);
-    return vload8(0, w);
-  }
   for (int l = 0; l < SP_LANES; ++l) {
-    if (!w[l]) continue;
-    int ox, oy;
-    sp_shading_point(in->P, m, j + l, v, sx[l], sy[l], C, &ox, &oy);
-    if (!mta_alpha_passes(in, m, C->Xc + ox, C->Yc + oy, v, cutoff)) w[l] = 0;
+    ox[l] = sx[l], oy[l] = sy[l];
+    if (NS > 1 && w[l]) sp_shading_point(in->P, m, j + l, v, sx[l], sy[l], C, ox + l, oy + l);
   }
+  const SampleLanes L = offset_samples(C->Xc, C->Yc, ox, oy);
+  mask_alpha_lanes(in, m, w, SP_LANES, &L, v, cutoff);
   return vload8(0, w);
 }
 

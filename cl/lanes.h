@@ -16,9 +16,6 @@ typedef struct {
   sfloat x, y, z;
 } sfloat3;
 
-/* Lane l holds l: the lane numbers of a vector of up to 16 lanes (vload from here). */
-constant int lane_index[16] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15};
-
 inline sfloat3 s3(sfloat x, sfloat y, sfloat z) {
   sfloat3 r = {x, y, z};
   return r;

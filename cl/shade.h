@@ -622,7 +622,7 @@ inline sfloat3 s3_half_range(sfloat3 c) {
 }
 
 /* The opacity of each lane: 1, or for alphaMode BLEND baseColorFactor alpha x COLOR_0 alpha x the base
- * colour texture's alpha, clamped to [0, 1] (the MASK test's alpha, mta_alpha_passes, in lanes). */
+ * colour texture's alpha, clamped to [0, 1] (the MASK test's alpha, mta_alpha_lanes). */
 inline sfloat lane_alpha(const LaneWinners* L, const LaneTextures* T, bool textured, sfloat3 b) {
   if (!PMR_WITH_BLEND || !any(L->blended)) return (sfloat)(1.0f);
   sfloat a = L->alpha[0] * (b.x * L->alpha[1] + b.y * L->alpha[2] + b.z * L->alpha[3]);
@@ -665,48 +665,53 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
   return s3_half_range(s3(base.x * lambert * exposure, base.y * lambert * exposure, base.z * lambert * exposure));
 }
 
-/* The barycentrics' derivatives of MTA m in the view with view coordinate f where its exact edge
- * functions are e, in every lane (one voxel: the MASK test). */
-inline LaneBaryGrad mta_bary_gradient(global const PmrParams* P, const PmrMta* m, long f, const long* e) {
-  float3 ex, ey;
-  mta_edge_derivatives(P, m, f, &ex, &ey);
-  return bary_gradient_lanes(s3_splat((float3)((float)e[0], (float)e[1], (float)e[2])), s3_splat(ex), s3_splat(ey),
-                             s3_splat((float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2])),
-                             s3_splat((float3)(m->bary[0][0], m->bary[1][0], m->bary[2][0])),
-                             s3_splat((float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1])));
-}
-
-/* alphaMode MASK: the base colour alpha of MTA m at raster point (X, Y) of view `view` passes the cutoff:
- * one voxel, scalar (the raster asks this of a few candidate voxels; its inputs are the same as the
- * lanes' base colour: the factor, COLOR_0 and the base colour map through sample_map_lanes). */
-inline bool mta_alpha_passes(const ShadeInputs* in, const PmrMta* m, long X, long Y, int view, float cutoff) {
+/* alphaMode MASK: whether the base colour alpha of MTA m at raster points (X[j], Y[j]), j < n <= SW, of
+ * view `view` passes the cutoff (pass[j]). Each point is one lane of the lanes' base colour (the factor,
+ * COLOR_0 and the base colour map through sample_map_lanes; lanes are independent), so how the raster
+ * batches its candidate voxels changes no outcome. Lanes from n on repeat point 0 (finite, unused). */
+inline void mta_alpha_lanes(const ShadeInputs* in, const PmrMta* m, const long* X, const long* Y, int n, int view,
+                            float cutoff, int* pass) {
   const long f = view_coord(in->P, view);
-  const long e[3] = {m->sign * mta_edge(m, 1, 2, X, Y, f), m->sign * mta_edge(m, 2, 0, X, Y, f),
-                     m->sign * mta_edge(m, 0, 1, X, Y, f)};
-  const float pa = (float)e[0] * m->inv_w[0], pb = (float)e[1] * m->inv_w[1], pc = (float)e[2] * m->inv_w[2];
-  const float inv = 1.0f / (pa + pb + pc);
-  const float la = pa * inv, lb = pb * inv, lc = pc * inv;
-  const float b1 = la * m->bary[0][0] + lb * m->bary[1][0] + lc * m->bary[2][0];
-  const float b2 = la * m->bary[0][1] + lb * m->bary[1][1] + lc * m->bary[2][1];
-  const float3 b = (float3)(1.0f - b1 - b2, b1, b2);
   const PmrTriangle t = in->tris[m->tri];
   global const PmrMaterial* mat = &in->materials[t.material];
-  float alpha = mat->base_color[3] * (b.x * in->attrs[t.v[0]].color[3] + b.y * in->attrs[t.v[1]].color[3] +
-                                      b.z * in->attrs[t.v[2]].color[3]);
+  float alpha[SW], b[3][SW], e[3][SW];
+  uint tri[SW];
+  for (int j = 0; j < SW; ++j) {
+    const int k = j < n ? j : 0;
+    const long ej[3] = {m->sign * mta_edge(m, 1, 2, X[k], Y[k], f), m->sign * mta_edge(m, 2, 0, X[k], Y[k], f),
+                        m->sign * mta_edge(m, 0, 1, X[k], Y[k], f)};
+    const float pa = (float)ej[0] * m->inv_w[0], pb = (float)ej[1] * m->inv_w[1], pc = (float)ej[2] * m->inv_w[2];
+    const float inv = 1.0f / (pa + pb + pc);
+    const float la = pa * inv, lb = pb * inv, lc = pc * inv;
+    const float b1 = la * m->bary[0][0] + lb * m->bary[1][0] + lc * m->bary[2][0];
+    const float b2 = la * m->bary[0][1] + lb * m->bary[1][1] + lc * m->bary[2][1];
+    b[0][j] = 1.0f - b1 - b2, b[1][j] = b1, b[2][j] = b2;
+    alpha[j] = mat->base_color[3] * (b[0][j] * in->attrs[t.v[0]].color[3] + b[1][j] * in->attrs[t.v[1]].color[3] +
+                                     b[2][j] * in->attrs[t.v[2]].color[3]);
+    for (int i = 0; i < 3; ++i) e[i][j] = (float)ej[i];
+    tri[j] = m->tri;
+  }
   if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
-    /* the lanes' sampling with lane 0 alone: the MASK test asks it of a few voxels */
     LaneBaryGrad g;
     const bool trilinear = PMR_USE_TRILINEAR(in->P);
-    if (trilinear) g = mta_bary_gradient(in->P, m, f, e);
-    const uint tri[SW] = {m->tri, 0, 0, 0, 0, 0, 0, 0};
+    if (trilinear) {
+      float3 ex, ey;
+      mta_edge_derivatives(in->P, m, f, &ex, &ey);
+      g = bary_gradient_lanes(LANE3(e), s3_splat(ex), s3_splat(ey),
+                              s3_splat((float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2])),
+                              s3_splat((float3)(m->bary[0][0], m->bary[1][0], m->bary[2][0])),
+                              s3_splat((float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1])));
+    }
     LaneTexcoords C;
     C.set = PMR_NO_KEY;
     sfloat c[4];
-    sample_map_lanes(in, &mat->maps[PMR_MAP_BASE_COLOR], tri, 1u, vload_s(0, lane_index) == 0, s3_splat(b),
-                     trilinear ? &g : 0, true, &C, c);
-    alpha *= c[3].s0;
+    sample_map_lanes(in, &mat->maps[PMR_MAP_BASE_COLOR], tri, (1u << n) - 1u, vload_s(0, lane_index) < (sint)(n),
+                     LANE3(b), trilinear ? &g : 0, true, &C, c);
+    float a[SW];
+    vstore_s(c[3], 0, a);
+    for (int j = 0; j < n; ++j) alpha[j] *= a[j];
   }
-  return alpha >= cutoff;
+  for (int j = 0; j < n; ++j) pass[j] = alpha[j] >= cutoff;
 }
 
 /* The MTA loaded last for shading: neighbouring voxels and samples mostly share their winner, and an

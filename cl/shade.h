@@ -668,28 +668,32 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
 /* alphaMode MASK: whether the base colour alpha of MTA m at raster points (X[j], Y[j]), j < n <= SW, of
  * view `view` passes the cutoff (pass[j]). Each point is one lane of the lanes' base colour (the factor,
  * COLOR_0 and the base colour map through sample_map_lanes; lanes are independent), so how the raster
- * batches its candidate voxels changes no outcome. Lanes from n on repeat point 0 (finite, unused). */
+ * batches its candidate voxels changes no outcome. Lanes from n on copy lane 0 (finite, unused). */
 inline void mta_alpha_lanes(const ShadeInputs* in, const PmrMta* m, const long* X, const long* Y, int n, int view,
                             float cutoff, int* pass) {
   const long f = view_coord(in->P, view);
   const PmrTriangle t = in->tris[m->tri];
   global const PmrMaterial* mat = &in->materials[t.material];
+  const float ca[3] = {in->attrs[t.v[0]].color[3], in->attrs[t.v[1]].color[3], in->attrs[t.v[2]].color[3]};
   float alpha[SW], b[3][SW], e[3][SW];
   uint tri[SW];
   for (int j = 0; j < SW; ++j) {
-    const int k = j < n ? j : 0;
-    const long ej[3] = {m->sign * mta_edge(m, 1, 2, X[k], Y[k], f), m->sign * mta_edge(m, 2, 0, X[k], Y[k], f),
-                        m->sign * mta_edge(m, 0, 1, X[k], Y[k], f)};
+    tri[j] = m->tri;
+    if (j >= n) { /* idle: a copy of lane 0, evaluated once */
+      alpha[j] = alpha[0];
+      for (int i = 0; i < 3; ++i) b[i][j] = b[i][0], e[i][j] = e[i][0];
+      continue;
+    }
+    const long ej[3] = {m->sign * mta_edge(m, 1, 2, X[j], Y[j], f), m->sign * mta_edge(m, 2, 0, X[j], Y[j], f),
+                        m->sign * mta_edge(m, 0, 1, X[j], Y[j], f)};
     const float pa = (float)ej[0] * m->inv_w[0], pb = (float)ej[1] * m->inv_w[1], pc = (float)ej[2] * m->inv_w[2];
     const float inv = 1.0f / (pa + pb + pc);
     const float la = pa * inv, lb = pb * inv, lc = pc * inv;
     const float b1 = la * m->bary[0][0] + lb * m->bary[1][0] + lc * m->bary[2][0];
     const float b2 = la * m->bary[0][1] + lb * m->bary[1][1] + lc * m->bary[2][1];
     b[0][j] = 1.0f - b1 - b2, b[1][j] = b1, b[2][j] = b2;
-    alpha[j] = mat->base_color[3] * (b[0][j] * in->attrs[t.v[0]].color[3] + b[1][j] * in->attrs[t.v[1]].color[3] +
-                                     b[2][j] * in->attrs[t.v[2]].color[3]);
+    alpha[j] = mat->base_color[3] * (b[0][j] * ca[0] + b[1][j] * ca[1] + b[2][j] * ca[2]);
     for (int i = 0; i < 3; ++i) e[i][j] = (float)ej[i];
-    tri[j] = m->tri;
   }
   if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
     LaneBaryGrad g;

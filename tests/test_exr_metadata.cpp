@@ -134,6 +134,12 @@ void expect_frame_attributes(const Imf::Header& h, const char* output, int view)
   ASSERT_TRUE(Imf::hasFramesPerSecond(h));
   EXPECT_EQ(Imf::framesPerSecond(h).n, 24);
   EXPECT_EQ(Imf::framesPerSecond(h).d, 1u);
+  // the colour is linear Rec. 709 (ITU-R BT.709 primaries, D65 white)
+  ASSERT_TRUE(Imf::hasChromaticities(h));
+  const Imf::Chromaticities c = Imf::chromaticities(h);
+  const float want[8] = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+  const float got[8] = {c.red.x, c.red.y, c.green.x, c.green.y, c.blue.x, c.blue.y, c.white.x, c.white.y};
+  for (int k = 0; k < 8; ++k) EXPECT_FLOAT_EQ(got[k], want[k]) << "chromaticity " << k;
   ASSERT_TRUE(Imf::hasTimeCode(h));
   const Imf::TimeCode tc = Imf::timeCode(h);
   EXPECT_EQ(tc.hours(), 0);
@@ -342,7 +348,8 @@ TEST(ExrMetadata, ExrheaderShowsTheAttributes) {
          {std::string("software (type string): \"pmr ") + program_version() + "\"",
           std::string("framesPerSecond (type rational): 24/1"), std::string("timeCode (type timecode)"),
           std::string("pmrFrame (type int): 37"), std::string("pmrSidecar (type string): \"frame_0037.json\""),
-          std::string("worldToCamera (type m44f)"), std::string("worldToNDC (type m44f)")})
+          std::string("worldToCamera (type m44f)"), std::string("worldToNDC (type m44f)"),
+          std::string("chromaticities (type chromaticities)")})
       EXPECT_NE(out.find(s), std::string::npos) << "missing: " << s << "\n" << out;
     if (file == f.views) {
       EXPECT_NE(out.find("view (type string): \"view_000\""), std::string::npos) << out;

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli/options.h"
+#include "sequence/frame_names.h"
 #include "pmr/error.h"
 #include "test_util.h"
 
@@ -80,6 +81,48 @@ TEST(Names, RefusedSpellingsShowAnAcceptedExample) {
   EXPECT_THROW(check_name_covers_frames("duck", 2), Error);
 }
 
+// The frame number as sequence readers take it: the last run of digits in the file name without its
+// extension (Blender's BLI_path_sequence_decode, fileseq, pyseq); -1 when there is none.
+long last_digit_group(const std::string& file) {
+  const std::string stem = file.substr(0, file.rfind('.'));
+  const size_t end = stem.find_last_of("0123456789");
+  if (end == std::string::npos) return -1;
+  const size_t begin = stem.find_last_not_of("0123456789", end) + 1;
+  return std::stol(stem.substr(begin, end + 1 - begin));
+}
+
+// A quilt's Looking Glass tag: at %q, else at the end of a still's stem, else before a sequence's frame
+// number, which stays the last digit group of the file name.
+TEST(Names, QuiltTagPlacement) {
+  const std::string tag = "_qs8x6a0.75";
+  EXPECT_EQ(quilt_file_stem("frame_%04d", 5, false, tag), "frame_0005_qs8x6a0.75");  // Looking Glass's own
+  EXPECT_EQ(quilt_file_stem("frame_%04d", 5, true, tag), "frame_qs8x6a0.75_0005");
+  EXPECT_EQ(quilt_file_stem("fox.####", 5, true, tag), "fox_qs8x6a0.75.0005");
+  EXPECT_EQ(quilt_file_stem("shot%04d", 5, true, tag), "shot_qs8x6a0.75_0005");
+  EXPECT_EQ(quilt_file_stem("a_-.%d_v", 5, true, tag), "a_qs8x6a0.75_-.5_v");
+  EXPECT_EQ(quilt_file_stem("%03d", 5, true, tag), "_qs8x6a0.75_005");
+  EXPECT_EQ(quilt_file_stem("duck", 5, true, tag), "duck_qs8x6a0.75");  // one frame's name
+  for (bool sequence : {false, true}) {
+    EXPECT_EQ(quilt_file_stem("fox%q.####", 5, sequence, tag), "fox_qs8x6a0.75.0005");
+    EXPECT_EQ(quilt_file_stem("fox.%d%q", 5, sequence, tag), "fox.5_qs8x6a0.75");  // where asked
+    EXPECT_EQ(quilt_file_stem("%qduck", 5, sequence, tag), "_qs8x6a0.75duck");
+  }
+  EXPECT_EQ(frame_stem("fox%q.####", 5), "fox.0005") << "the other files have nothing at %q";
+  EXPECT_EQ(frame_stem("fox.%d_%q_x", 5), "fox.5__x");
+  EXPECT_EQ(canonical_name_pattern("fox%q.####"), "fox%q.%04d");
+  EXPECT_EQ(canonical_name_pattern("f_%d%q%%"), "f_%d%q%%");
+  EXPECT_NE(refusal("a%q%q_%d").find("more than one %q"), std::string::npos) << refusal("a%q%q_%d");
+  EXPECT_NE(refusal("%q").find("empty"), std::string::npos) << "the other files' stems would be empty";
+  // every default sequence name reads back as its frame, whatever the aspect's digits
+  for (const char* pattern : {"frame_%04d", "fox.####", "shot%d", "take2_%03d", "fox%q.####"})
+    for (const std::string& t : {tag, std::string("_qs5x9a1.7849"), std::string("_qs10x10a1")})
+      for (long f : {0L, 1L, 9L, 10L, 75L, 1234L}) {
+        const std::string file = quilt_file_stem(pattern, f, true, t) + ".exr";
+        EXPECT_EQ(last_digit_group(file), f) << file;
+      }
+  EXPECT_EQ(last_digit_group("fox.0005_qs8x6a0.75.exr"), 75) << "the old sequence name is misread";
+}
+
 // The command lines a user types: a still named without a frame number, Blender's ####, refusals
 // with nothing written, -o.
 TEST(Names, FromTheCommandLine) {
@@ -100,6 +143,25 @@ TEST(Names, FromTheCommandLine) {
   expect_usage_error(run("render --name shot_%x" + kSmall + "--out " + c), "e.g. --name shot_%04d");
   EXPECT_FALSE(test::exists(c)) << "nothing written for a refused name";
   expect_usage_error(run("verify " + a + " --frames 0:1 --name duck"), "names one frame");
+
+  // quilts: a still keeps the Looking Glass name, a sequence puts the frame number last, %q places the tag
+  const std::string q = temp_dir("names_quilt");
+  ASSERT_EQ(run("render --write quilt" + kSmall + "--out " + q + "/still").status, 0);
+  EXPECT_EQ(listing(q + "/still"), (std::set<std::string>{"frame_0000_qs2x2a1.7849.exr", "frame_0000.json"}));
+  r = run("render --write quilt,encoded --turntable 360:3 --frames 0:2" + kSmall + "--out " + q + "/seq");
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::set<std::string> want;
+  for (const char* f : {"0000", "0001", "0002"})
+    want.insert({std::string("frame_qs2x2a1.7849_") + f + ".exr", std::string("frame_") + f + ".exr",
+                 std::string("frame_") + f + ".json"});
+  EXPECT_EQ(listing(q + "/seq"), want);
+  r = run("render --write quilt --name 'fox%q.##' --turntable 360:3 --frames 1" + kSmall + "--out " + q + "/fox");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(listing(q + "/fox"), (std::set<std::string>{"fox_qs2x2a1.7849.01.exr", "fox.01.json"}));
+  EXPECT_EQ(sidecar(q + "/fox/fox.01.json")["outputs"]["quilt"], "fox_qs2x2a1.7849.01.exr");
+  r = run("render --write quilt --name 'fox%q.##' --turntable 360:3 --frames 1 --resume" + kSmall + "--out " + q +
+          "/fox");
+  EXPECT_NE(r.output.find("nothing to do"), std::string::npos) << r.output;
   EXPECT_NE(run("render --help").output.find("-o DIR"), std::string::npos);
 }
 

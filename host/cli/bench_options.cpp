@@ -157,7 +157,7 @@ const BenchSection kInputOptions = {
 
 // Not listed one by one: the heading names them.
 const BenchSection kRenderOptions = {
-    "  --preset, --camera-spacing, --view-size, --display, --tile and the display options are as for\n"
+    "  --preset, --camera-spacing, --orbit, --view-size, --display, --tile and the display options are as for\n"
     "  pmr render (a preset as a user gets it: its view count, camera spacing and default sampling\n"
     "  unless --views, --camera-spacing, --sampling), and so are\n"
     "  --animation, --fps and --turntable: the timed frames are then frames 0..K-1 of that sequence.",
@@ -175,6 +175,7 @@ const BenchSection kRenderOptions = {
         {"--reverse-views", nullptr, nullptr, "", pass_flag_to_render},
         {"--cone", nullptr, "DEG", "", pass_to_render},
         {"--yfov", nullptr, "DEG", "", pass_to_render},
+        {"--orbit", nullptr, "AZ,EL", "", pass_to_render},
         {"--animation", nullptr, "A", "", pass_to_render},
         {"--fps", nullptr, "F", "", pass_to_render},
         {"--turntable", nullptr, "DEG:FRAMES", "", pass_to_render},

@@ -139,12 +139,13 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
     }
     char zfar[32] = "infinite";
     if (c.zfar > 0) std::snprintf(zfar, sizeof zfar, "%g", c.zfar);
-    std::printf("  %zu %s: perspective, yfov %.2f deg, znear %g, zfar %s%s\n", i, quoted(c.name).c_str(),
-                c.yfov * 180.0 / 3.14159265358979323846, c.znear, zfar,
-                (!c.placed            ? ", not placed by any node of the scene"
-                 : !c.invalid.empty() ? ", invalid: " + c.invalid
-                                      : ", placed (--camera " + std::to_string(i) + ")")
-                    .c_str());
+    std::printf(
+        "  %zu %s: perspective, yfov %.2f deg, znear %g, zfar %s%s\n", i, quoted(c.name).c_str(),
+        c.yfov * 180.0 / 3.14159265358979323846, c.znear, zfar,
+        (!c.placed            ? ", not placed by any node of the scene"
+         : !c.invalid.empty() ? ", invalid: " + c.invalid
+                              : ", placed by node " + quoted(c.node_name) + " (--camera " + std::to_string(i) + ")")
+            .c_str());
   }
   std::printf("animations: %zu\n", s.animations.size());
   for (size_t i = 0; i < s.animations.size(); ++i) {

@@ -197,7 +197,8 @@ const RenderSection kOutputOptions = {
          "any of encoded, views, quilt, depth (default: encoded). DIR/frame_NNNN.exr is\n"
          "the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view,\n"
          "DIR/frame_NNNN_qsCxRaA.exr the views as a Looking Glass quilt (view 0 bottom\n"
-         "left), depth a float Z channel (view-space depth, +inf where empty) in the\n"
+         "left; in a sequence DIR/frame_qsCxRaA_NNNN.exr, see --name), depth a float Z channel (view-space depth, +inf "
+         "where empty) in the\n"
          "views and quilt files; DIR/frame_NNNN.json (rig, display, every view's\n"
          "matrices) is always written",
          set_write},
@@ -211,7 +212,11 @@ const RenderSection kOutputOptions = {
         {"--name", nullptr, "PATTERN",
          "file stem (default frame_%04d); the frame number as %d, zero-padded %0Nd or\n"
          "Blender's #### (N '#': N digits), %% for a percent sign; without a frame\n"
-         "number the stem of a single frame as given (--name duck: duck.exr)",
+         "number the stem of a single frame as given (--name duck: duck.exr). %q\n"
+         "places the quilt's Looking Glass tag _qsCxRaA (fox%q.####: fox_qs8x6a0.75.0005\n"
+         "for the quilt, fox.0005 for the other files); without it a still's quilt ends\n"
+         "with the tag, and a sequence's has it before the frame number, which stays\n"
+         "the last digit group, as Blender and other sequence readers expect",
          [](RenderOptions& o, const std::string& v, const std::string&) {
            check_name_pattern(v);
            o.job.products.name = v;
@@ -327,11 +332,14 @@ const RenderSection kRigOptions = {
              throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
            o.job.rig.angular_spacing = v == "angular";
          }},
-        {"--camera", nullptr, "K",
-         "use the scene's glTF camera K (pose and field of view) instead of framing\n"
-         "the scene's bounding sphere",
+        {"--camera", nullptr, "K|NAME",
+         "use the scene's glTF camera (pose and field of view) instead of framing the\n"
+         "scene's bounding sphere: K its index, else NAME the name of the node that\n"
+         "places it (as Blender names the camera object), else the camera's own name;\n"
+         "a name several match is an error (pmr info lists the cameras)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
-           o.job.rig.camera = parse_int(v, name, 0, 1 << 30);
+           if (v.empty()) throw Error("invalid " + name + ": expected a camera index or name");
+           o.job.camera = v;
          }},
         {"--background", nullptr, "R,G,B[,A]",
          "a linear colour behind the encoded image, views, quilt and previews (default\n"
@@ -348,6 +356,20 @@ const RenderSection kRigOptions = {
            if (!(o.job.rig.zoom >= 0.001 && o.job.rig.zoom <= 1000.0))
              throw Error("invalid --zoom: expected a factor from 0.001 to 1000");
            o.zoom_given = true;
+         }},
+        {"--orbit", nullptr, "AZ,EL",
+         "move the framing camera around the scene (degrees; default 0,0 looks down -Z):\n"
+         "EL > 0 looks down on it (-90 < EL < 90), AZ > 0 turns counter-clockwise seen\n"
+         "from above; the view stays level, the parallax horizontal. Not with --camera",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           const size_t comma = v.find(',');
+           if (comma == std::string::npos) throw Error("invalid " + name + " '" + v + "': expected AZ,EL in degrees");
+           o.job.rig.orbit_az_deg = parse_double(v.substr(0, comma), name);
+           o.job.rig.orbit_el_deg = parse_double(v.substr(comma + 1), name);
+           if (!(std::abs(o.job.rig.orbit_az_deg) <= 360.0) || !(std::abs(o.job.rig.orbit_el_deg) < 90.0))
+             throw Error("invalid " + name + " '" + v +
+                         "': the azimuth must lie in [-360, 360], the elevation in (-90, 90) degrees");
+           o.orbit_given = true;
          }},
     }};
 
@@ -514,9 +536,17 @@ const OptionTable<RenderOptions> kRenderTable = {"render",
 // The options after apply_display_source: anything they throw is a usage error (they read no file).
 void parse_arguments(RenderOptions& o, const std::vector<std::string>& args) {
   parse_by_table(kRenderTable, o, args);
-  if (o.zoom_given && o.job.rig.camera >= 0)
+  // a still is one frame asked for by its number; anything else is (part of) a sequence, whose quilts
+  // are named for sequence readers (frame_names.h)
+  o.job.products.sequence =
+      !o.job.shard.empty() || o.job.frames.empty() || o.job.frames.find_first_not_of("0123456789") != std::string::npos;
+  if (o.zoom_given && !o.job.camera.empty())
     throw Error(
         "--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own: "
+        "give one of them");
+  if (o.orbit_given && !o.job.camera.empty())
+    throw Error(
+        "--orbit moves the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own: "
         "give one of them");
 }
 

@@ -35,7 +35,8 @@ struct RenderOptions {
   bool method_given = false;       // --method was on the command line
   bool environment_given = false;  // --environment was on the command line
   bool environment_rotation_given = false;
-  bool zoom_given = false;  // --zoom was on the command line (rig.zoom)
+  bool zoom_given = false;   // --zoom was on the command line (rig.zoom)
+  bool orbit_given = false;  // --orbit was on the command line (rig.orbit_*)
   // --sampling was on the command line; else pipeline.sampling is the preset's default, and subpixel
   // sampling gives way to view sampling (with a notice) where other options need the views
   bool sampling_given = false;

@@ -9,6 +9,7 @@
 #include <ImfOutputPart.h>
 #include <ImfPartType.h>
 #include <ImfRgbaFile.h>
+#include <ImfStandardAttributes.h>
 #include <ImfThreading.h>
 
 #include <cmath>
@@ -70,6 +71,13 @@ Imf::Compression to_imf(ExrCompression c, const std::string& path) {
 // The header's compression. zip and zip-fast are both ZIP; they differ in the encoder our writer uses
 // (zip_encoder). Readers need nothing new: neither the encoder nor its level is stored in the file.
 void set_compression(Imf::Header& h, ExrCompression c, const std::string& path) { h.compression() = to_imf(c, path); }
+
+// What every image pmr writes shares: its compression, and its colour space stated (linear Rec. 709, D65
+// white: OpenEXR's default Chromaticities), so readers need not assume it.
+void start_header(Imf::Header& h, ExrCompression c, const std::string& path) {
+  set_compression(h, c, path);
+  Imf::addChromaticities(h, Imf::Chromaticities());
+}
 
 // OpenEXR's per-channel alpha names for R, G, B
 const char* const kSubpixelAlpha[3] = {"AR", "AG", "AB"};
@@ -178,7 +186,7 @@ void write_rgba_exr(const std::string& path, int width, int height, const uint16
     set_threads(threads);
     // display and data window (0,0)-(w-1,h-1), INCREASING_Y
     Imf::Header header(width, height, pixel_aspect);
-    set_compression(header, c, path);
+    start_header(header, c, path);
     if (meta) add_exr_metadata(header, *meta, image, meta->center_view);
     if (c == ExrCompression::Zip || c == ExrCompression::ZipFast) {  // our own chunk writer (exr_zip.h)
       ExrZipPart part = zip_rgba_part(header, rgba_half, depth, width);
@@ -239,7 +247,7 @@ void write_views_exr(const std::string& path, int width, int height, int views, 
     headers.reserve(size_t(views));
     for (int i = 0; i < views; ++i) {
       Imf::Header h(width, height, pixel_aspect);
-      set_compression(h, c, path);
+      start_header(h, c, path);
       h.setName(view_part_name(i, views));
       h.setType(Imf::SCANLINEIMAGE);
       if (meta) add_exr_metadata(h, *meta, ExrImage::Views, i);

@@ -230,6 +230,7 @@ json rig_json(const Rig& rig) {
   r["baseline"] = rig.baseline();
   r["camera_spacing"] = rig.angular ? "angular" : "linear";
   r["zoom"] = rig.zoom;
+  r["orbit_deg"] = {rig.orbit_az_deg, rig.orbit_el_deg};
   r["near"] = rig.near;
   r["near_used"] = rig.near_eff;
   r["far"] = rig.far;
@@ -301,6 +302,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["shading"] = shading_json(info);
   j["tile"] = {{"x", info.pipeline.tile_x}, {"y", info.pipeline.tile_y}, {"v", info.pipeline.tile_v}};
   j["camera"] = info.rig_config.camera;
+  if (info.rig_config.camera >= 0) j["camera_name"] = info.camera_name;
   if (info.has_bounds) j["scene_bounds"] = {{"min", vec3_json(info.bounds_lo)}, {"max", vec3_json(info.bounds_hi)}};
   if (info.compression) j["compression"] = to_string(*info.compression);
   json outputs = json::object();
@@ -456,6 +458,9 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   // sidecars written before --zoom existed framed at 1
   auto zoom = [&](const json& r) { return get(r, "zoom").is_null() ? json(1.0) : get(r, "zoom"); };
   if (zoom(ra) != zoom(rb)) return "rig.zoom";
+  // and before --orbit existed at 0,0
+  auto orbit = [&](const json& r) { return get(r, "orbit_deg").is_null() ? json({0.0, 0.0}) : get(r, "orbit_deg"); };
+  if (orbit(ra) != orbit(rb)) return "rig.orbit_deg";
   // the framing (it follows from the scene file's content and the animation)
   if (!ignore_scene_derived && (!a.contains("scene_bounds") || get(a, "scene_bounds") != get(b, "scene_bounds")))
     return "scene_bounds";

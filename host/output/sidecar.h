@@ -33,6 +33,7 @@ struct SidecarInfo {
   // the job's configuration
   std::string scene;                          // the scene file as given (empty = the bundled default scene)
   RigConfig rig_config;                       // its glTF camera (the rig itself is recorded as resolved)
+  std::string camera_name;                    // that camera's node name (informational; "" = none)
   PipelineConfig pipeline;                    // method, sampling, shading and exposure, tile
   DisplaySource display_source;               // the display's source and its calibration's values
   SequenceSpec sequence;                      // fps, animation, turntable

@@ -96,6 +96,21 @@ void choose_spacing_q(Rig& rig, std::vector<std::string>* warnings) {
                         " view pixels of disparity from their exact positions (the depth range is very deep)");
 }
 
+// The framing camera's view matrix (DESIGN section 2): at distance D from c along the orbit's direction
+// b = (sin az cos el, sin el, cos az cos el), looking at c, its +X (cos az, 0, -sin az) horizontal. At
+// az = el = 0 the basis is exactly the identity and the matrix the translation by -(c + (0, 0, D)).
+glm::dmat4 orbit_view(const glm::dvec3& c, double focal, double az_deg, double el_deg) {
+  const double az = glm::radians(az_deg), el = glm::radians(el_deg);
+  const glm::dvec3 back(std::sin(az) * std::cos(el), std::sin(el), std::cos(az) * std::cos(el));
+  const glm::dvec3 right(std::cos(az), 0.0, -std::sin(az));
+  const glm::dvec3 up = glm::cross(back, right);
+  const glm::dvec3 eye = c + focal * back;
+  glm::dmat4 v(1.0);
+  for (int k = 0; k < 3; ++k) v[k] = glm::dvec4(right[k], up[k], back[k], 0.0);
+  v[3] = glm::dvec4(-glm::dot(right, eye), -glm::dot(up, eye), -glm::dot(back, eye), 1.0);
+  return v;
+}
+
 }  // namespace
 
 Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo, const glm::dvec3& hi,
@@ -112,6 +127,10 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
   check_positive(config.zoom, "--zoom");
   if (camera_pose && config.zoom != 1.0)
     throw Error("--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own");
+  if (!(std::abs(config.orbit_el_deg) < 90.0) || !(std::abs(config.orbit_az_deg) <= 360.0))
+    throw Error("invalid --orbit: the azimuth must lie in [-360, 360] and the elevation in (-90, 90) degrees");
+  if (camera_pose && (config.orbit_az_deg != 0.0 || config.orbit_el_deg != 0.0))
+    throw Error("--orbit moves the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own");
 
   Rig rig;
   rig.views = config.views;
@@ -143,7 +162,8 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
     // half-width A D tan(phi/2)) in both directions: a portrait display frames by its width.
     rig.focal = R / std::min(tan_half, rig.aspect * tan_half) / config.zoom;
     rig.zoom = config.zoom;
-    rig.center_view = glm::translate(glm::dmat4(1.0), -(c + glm::dvec3(0.0, 0.0, rig.focal)));
+    rig.orbit_az_deg = config.orbit_az_deg, rig.orbit_el_deg = config.orbit_el_deg;
+    rig.center_view = orbit_view(c, rig.focal, config.orbit_az_deg, config.orbit_el_deg);
   }
   rig.near = std::max(rig.focal - 1.001 * R, 1e-3 * rig.focal);
   rig.far = rig.focal + 1.001 * R;

@@ -200,6 +200,7 @@ std::vector<Instance> walk(Loader& L, const std::vector<int>& roots) {
     if (node.camera >= 0 && !L.scene.cameras[size_t(node.camera)].placed) {
       L.scene.cameras[size_t(node.camera)].placed = true;
       L.scene.cameras[size_t(node.camera)].world_from_camera = world;
+      L.scene.cameras[size_t(node.camera)].node_name = node.name;
       L.motion->camera_node[size_t(node.camera)] = index;
     }
     for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back(*c);

@@ -2,6 +2,7 @@
 #include <limits>
 
 #include "pmr/error.h"
+#include "pmr/printable.h"
 #include "pmr/scene.h"
 
 namespace pmr {
@@ -82,6 +83,36 @@ bool scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi) {
   }
   if (any) lo = l, hi = h;
   return any;
+}
+
+namespace {
+
+// The cameras whose node name (or camera name) is `name`.
+std::vector<int> cameras_named(const Scene& scene, const std::string& name, bool node) {
+  std::vector<int> found;
+  for (size_t i = 0; i < scene.cameras.size(); ++i)
+    if ((node ? scene.cameras[i].node_name : scene.cameras[i].name) == name) found.push_back(int(i));
+  return found;
+}
+
+}  // namespace
+
+int find_camera(const Scene& scene, const std::string& name) {
+  const std::string shown = "--camera '" + printable_text(name, 60) + "'";
+  if (!name.empty() && name.find_first_not_of("0123456789") == std::string::npos) {
+    if (name.size() > 9 || std::stol(name) >= long(scene.cameras.size()))
+      throw Error("--camera " + printable_text(name, 12) + ": the scene has " + std::to_string(scene.cameras.size()) +
+                  " camera(s)");
+    return int(std::stol(name));
+  }
+  for (bool node : {true, false}) {
+    const std::vector<int> found = cameras_named(scene, name, node);
+    if (found.size() == 1) return found[0];
+    if (found.size() > 1)
+      throw Error(shown + " is ambiguous: " + std::to_string(found.size()) + (node ? " camera nodes" : " cameras") +
+                  " have that name (give the camera's index; pmr info lists them)");
+  }
+  throw Error(shown + ": no camera node or camera of the scene has that name (pmr info lists them)");
 }
 
 }  // namespace pmr

@@ -37,7 +37,8 @@ FramePaths frame_paths(const FrameProducts& o, long frame, const QuiltLayout& qu
   if (o.encoded) p.encoded = base + ".exr";
   if (o.views) p.views = base + ".views.exr";
   if (o.quilt || o.preview) {
-    const std::string quilt_base = (fs::path(o.out_dir) / quilt_stem(stem, quilt, aspect)).string();
+    const std::string quilt_name = quilt_file_stem(o.name, frame, o.sequence, quilt_stem("", quilt, aspect));
+    const std::string quilt_base = (fs::path(o.out_dir) / quilt_name).string();
     if (o.quilt) p.quilt = quilt_base + ".exr";
     if (o.preview && o.quilt) p.quilt_png = quilt_base + ".png";
   }

@@ -11,10 +11,11 @@
 namespace pmr {
 
 // Which files a sequence writes per frame, and where: DIR/STEM.json (the sidecar), STEM.exr (encoded),
-// STEM.views.exr, the quilt STEM_qsCxRaA.exr, and with `preview` the PNGs beside them (docs/OUTPUTS.md).
+// STEM.views.exr, the quilt STEM_qsCxRaA.exr (a sequence's: quilt_file_stem), and with `preview` the PNGs beside them (docs/OUTPUTS.md).
 struct FrameProducts {
   std::string out_dir = "out";
   std::string name = "frame_%04d";  // --name pattern (frame_names.h)
+  bool sequence = false;            // a sequence's names: the quilt's frame number last (quilt_file_stem)
   bool encoded = true, views = false, quilt = false;
   bool depth = false;    // a Z channel in the views and quilt EXRs
   bool preview = false;  // PNG previews of the encoded image, the center view and the quilt

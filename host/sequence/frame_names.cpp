@@ -45,6 +45,12 @@ NamePattern parse_name_pattern(const std::string& p) {
       ++i;
       continue;
     }
+    if (i + 1 < p.size() && p[i + 1] == 'q') {
+      if (n.has_quilt) throw refuse("more than one %q");
+      n.has_quilt = true, n.quilt_in_suffix = n.has_field, n.quilt_at = out.size();
+      ++i;
+      continue;
+    }
     size_t j = i + 1;
     const bool zero = j < p.size() && p[j] == '0';
     if (zero) ++j;
@@ -52,7 +58,8 @@ NamePattern parse_name_pattern(const std::string& p) {
     while (j < p.size() && std::isdigit((unsigned char)p[j])) ++j, ++digits;
     const std::string spec = p.substr(i, std::min(j + 1, p.size()) - i);
     if (j >= p.size() || p[j] != 'd')
-      throw refuse("'" + spec + "' is not a frame number field (%d, %0Nd or ####; %% for a percent sign)");
+      throw refuse("'" + spec +
+                   "' is not a frame number field (%d, %0Nd or ####; %q for the quilt tag, %% for a percent sign)");
     if (!zero && digits > 0)
       throw refuse("'" + spec + "' pads with spaces; use %0" + spec.substr(1) + " (zero-padded)");
     if (digits > 2) throw refuse("'" + spec + "': at most 99 digits");
@@ -68,12 +75,32 @@ void check_name_pattern(const std::string& p) {
     throw Error("invalid --name '" + p + "': the file stem would be empty or hidden; " + kNameExample);
 }
 
-std::string frame_stem(const std::string& pattern, long frame) {
-  const NamePattern n = parse_name_pattern(pattern);
+namespace {
+
+// The stem of `frame` with `tag` at the pattern's %q.
+std::string stem_with(NamePattern n, long frame, const std::string& tag) {
+  if (n.has_quilt) (n.quilt_in_suffix ? n.suffix : n.prefix).insert(n.quilt_at, tag);
   if (!n.has_field) return n.prefix;
   std::string number = std::to_string(frame);
   if (number.size() < size_t(n.width)) number.insert(0, size_t(n.width) - number.size(), '0');
   return n.prefix + number + n.suffix;
+}
+
+}  // namespace
+
+std::string frame_stem(const std::string& pattern, long frame) {
+  return stem_with(parse_name_pattern(pattern), frame, "");
+}
+
+std::string quilt_file_stem(const std::string& pattern, long frame, bool sequence, const std::string& tag) {
+  NamePattern n = parse_name_pattern(pattern);
+  if (!n.has_quilt && sequence && n.has_field) {
+    const size_t cut = n.prefix.find_last_not_of("._-") + 1;  // npos + 1 = 0: all separators
+    n.has_quilt = true, n.quilt_in_suffix = false, n.quilt_at = cut;
+    if (cut == n.prefix.size()) n.prefix += '_';
+  }
+  if (!n.has_quilt) return stem_with(n, frame, "") + tag;
+  return stem_with(n, frame, tag);
 }
 
 std::string canonical_name_pattern(const std::string& pattern) {
@@ -83,9 +110,13 @@ std::string canonical_name_pattern(const std::string& pattern) {
     for (char c : text) out += c == '%' ? std::string("%%") : std::string(1, c);
     return out;
   };
-  if (!n.has_field) return escaped(n.prefix);
+  auto with_quilt = [&](const std::string& text, bool in_suffix) {
+    if (!n.has_quilt || n.quilt_in_suffix != in_suffix) return escaped(text);
+    return escaped(text.substr(0, n.quilt_at)) + "%q" + escaped(text.substr(n.quilt_at));
+  };
+  if (!n.has_field) return with_quilt(n.prefix, false);
   const std::string field = n.width ? "%0" + std::to_string(n.width) + "d" : "%d";
-  return escaped(n.prefix) + field + escaped(n.suffix);
+  return with_quilt(n.prefix, false) + field + with_quilt(n.suffix, true);
 }
 
 void check_name_covers_frames(const std::string& pattern, size_t frame_count) {

@@ -90,6 +90,7 @@ class SequenceRun {
   SequenceSpec spec_;
   std::vector<long> frames_;      // this shard's frames, in job order
   std::vector<long> job_frames_;  // every shard's frames (the folder guard's "this job"); empty: no shards
+  RigConfig rig_config_;          // the job's, its --camera resolved against the scene
   std::unique_ptr<FrameRenderer> renderer_;
   std::vector<std::string> rig_warnings_;
   QuiltLayout quilt_;
@@ -165,7 +166,9 @@ void SequenceRun::choose_frames() {
       std::fprintf(stderr, "pmr: %s: shard %ld of %ld, %zu of %zu frame(s)\n", shard.source.c_str(), shard.index,
                    shard.count, frames_.size(), all);
   }
-  renderer_ = std::make_unique<FrameRenderer>(scene_, spec_, job_.rig, job_.display, &rig_warnings_);
+  rig_config_ = job_.rig;
+  if (!job_.camera.empty()) rig_config_.camera = find_camera(scene_, job_.camera);
+  renderer_ = std::make_unique<FrameRenderer>(scene_, spec_, rig_config_, job_.display, &rig_warnings_);
   for (const auto& w : rig_warnings_) warn(w);
   if (const std::string w = frames_outside_animation(scene_, spec_, frames_, job_.frames == "all"); !w.empty()) warn(w);
   const Rig& rig = renderer_->rig();
@@ -206,7 +209,8 @@ void SequenceRun::check_frame_memory() const {
 void SequenceRun::prepare_frames() {
   SidecarInfo& info = info_;
   info.scene = job_.scene;
-  info.rig_config = job_.rig;
+  info.rig_config = rig_config_;
+  if (rig_config_.camera >= 0) info.camera_name = scene_.cameras[size_t(rig_config_.camera)].node_name;
   info.pipeline = job_.pipeline;
   info.display_source = job_.display_source;
   info.sequence = spec_;

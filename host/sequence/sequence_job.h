@@ -25,6 +25,7 @@ struct SequenceJob {
   double environment_rotation_deg = 0.0;
   // cameras, display, pipeline
   RigConfig rig;
+  std::string camera;  // --camera: a glTF camera's index or name (find_camera); "" = rig.camera
   Display display;
   DisplaySource display_source;  // what the display came from: a preset or a calibration file (sidecar)
   PipelineConfig pipeline;

@@ -61,19 +61,23 @@ struct RigConfig {
   // The scene appears `zoom` times larger: D = D_fit / zoom, the focal plane still through the
   // sphere's center (only when framing the bounding sphere, camera < 0).
   double zoom = 1.0;
+  // --orbit AZ,EL (degrees): the framing camera sits at c + D (sin az cos el, sin el, cos az cos el),
+  // looking at c with +Y up (only when framing the bounding sphere, camera < 0).
+  double orbit_az_deg = 0.0, orbit_el_deg = 0.0;
 };
 
 // The resolved rig of one frame.
 struct Rig {
   int views = 0, view_w = 0, view_h = 0;
-  double yfov = 0, cone = 0;    // radians
-  double aspect = 0;            // display physical aspect A
-  double focal = 0;             // D
-  double near = 0, far = 0;     // the planes as requested (default or camera)
-  double near_eff = 0;          // near raised (if needed) to keep disparity inside the guard band
-  bool angular = false;         // camera spacing (RigConfig::angular_spacing)
-  glm::dmat4 center_view{1.0};  // world -> center view space
-  double zoom = 1.0;            // RigConfig::zoom (1 with a glTF camera)
+  double yfov = 0, cone = 0;                      // radians
+  double aspect = 0;                              // display physical aspect A
+  double focal = 0;                               // D
+  double near = 0, far = 0;                       // the planes as requested (default or camera)
+  double near_eff = 0;                            // near raised (if needed) to keep disparity inside the guard band
+  bool angular = false;                           // camera spacing (RigConfig::angular_spacing)
+  glm::dmat4 center_view{1.0};                    // world -> center view space
+  double zoom = 1.0;                              // RigConfig::zoom (1 with a glTF camera)
+  double orbit_az_deg = 0.0, orbit_el_deg = 0.0;  // RigConfig's orbit (0 with a glTF camera)
 
   // Angular spacing's view-coordinate resolution Q (1 with linear spacing): camera i sits at
   // view_coord(i) / Q view spacings B / (N - 1) from the center camera (make_rig chooses Q).

@@ -95,6 +95,7 @@ struct SceneLight {
 // node of the rendered scene uses, or whose perspective parameters are invalid, keep placed = false.
 struct SceneCamera {
   std::string name;
+  std::string node_name;  // the name of the node that places it (the first, when several do)
   glm::dmat4 world_from_camera{1.0};  // the node's world matrix (camera looks along its -Z)
   double yfov = 0.0;                  // radians
   double znear = 0.0;
@@ -217,6 +218,10 @@ Scene load_scene(const std::string& path, const InputLimits& limits);
 // World-space axis-aligned bounds of all vertices referenced by triangles. Returns false (lo, hi
 // untouched) when there are none.
 bool scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi);
+
+// The glTF camera `--camera` names: an index (digits only), else the camera whose node has that name,
+// else the one whose camera object has it. Throws pmr::Error when none or several match.
+int find_camera(const Scene& scene, const std::string& name);
 
 }  // namespace pmr
 

@@ -126,6 +126,11 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
   std::printf("materials: %zu (with the default one; %zu textured), textures: %zu\n", s.materials.size(), textured,
               s.textures.size());
   describe_materials(s);
+  if (!s.variants.empty()) {
+    std::printf("material variants: %zu (KHR_materials_variants; --variant NAME or K, default: none)\n",
+                s.variants.size());
+    for (size_t i = 0; i < s.variants.size(); ++i) std::printf("  %zu %s\n", i, quoted(s.variants[i]).c_str());
+  }
   if (d.generated_tangent_primitives)
     std::printf("tangents: generated for %zu primitive(s) with a normal texture and no TANGENT\n",
                 d.generated_tangent_primitives);

@@ -461,6 +461,13 @@ const RenderSection kPipelineOptions = {
 const RenderSection kShadingOptions = {
     "shading (docs/SHADING.md):",
     {
+        {"--variant", nullptr, "NAME|K",
+         "draw the scene's material variant NAME (or index K; KHR_materials_variants,\n"
+         "pmr info lists them) instead of its default materials",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           if (v.empty()) throw Error("invalid " + name + ": expected a variant's name or index");
+           o.job.variant = v;
+         }},
         {"--shading", nullptr, "S",
          "pbr (default): glTF metallic-roughness with every material map, seen from\n"
          "each view's own camera, so highlights move across the views; lit by the\n"

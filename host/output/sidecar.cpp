@@ -303,6 +303,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["tile"] = {{"x", info.pipeline.tile_x}, {"y", info.pipeline.tile_y}, {"v", info.pipeline.tile_v}};
   j["camera"] = info.rig_config.camera;
   if (info.rig_config.camera >= 0) j["camera_name"] = info.camera_name;
+  if (info.variant) j["variant"] = *info.variant;
   if (info.has_bounds) j["scene_bounds"] = {{"min", vec3_json(info.bounds_lo)}, {"max", vec3_json(info.bounds_hi)}};
   if (info.compression) j["compression"] = to_string(*info.compression);
   json outputs = json::object();
@@ -395,6 +396,7 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   auto get = [](const json& o, const char* key) { return o.is_object() && o.contains(key) ? o[key] : json(); };
   for (const char* key : {"format", "scene", "method", "tile", "camera", "display", "fps", "depth_channel"})
     if (!a.contains(key) || get(a, key) != get(b, key)) return key;
+  if (get(a, "variant") != get(b, "variant")) return "variant";  // absent: the default materials
   // the animation (its name comes from the scene file)
   auto anim = [&](json t) {
     if (ignore_scene_derived && t.is_object()) t.erase("name");

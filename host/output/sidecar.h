@@ -34,6 +34,7 @@ struct SidecarInfo {
   std::string scene;                          // the scene file as given (empty = the bundled default scene)
   RigConfig rig_config;                       // its glTF camera (the rig itself is recorded as resolved)
   std::string camera_name;                    // that camera's node name (informational; "" = none)
+  std::optional<std::string> variant;         // the material variant drawn (none: the default materials)
   PipelineConfig pipeline;                    // method, sampling, shading and exposure, tile
   DisplaySource display_source;               // the display's source and its calibration's values
   SequenceSpec sequence;                      // fps, animation, turntable

@@ -67,8 +67,18 @@ struct SourceFile {
   // with an external file are handed to tinygltf as one byte: their declared byteLength, per index.
   std::set<int> needed_buffers;
   std::map<int, uint64_t> unread_buffers;
+  // KHR_materials_variants: the variants' names, and the one chosen (-1: the default materials)
+  std::vector<std::string> variants;
+  int variant = -1;
 };
-SourceFile read_source(const std::string& path, const InputLimits& limits);
+// `variant`: --variant, a material variant's name or index ("" = the default materials).
+SourceFile read_source(const std::string& path, const InputLimits& limits, const std::string& variant = "");
+
+// KHR_materials_variants (gltf_variants.cpp): the variants' names into src.variants and every
+// primitive's mappings checked; with `choice` (a variant's name or index, "" = none) src.variant is set
+// and each primitive that maps it takes its material in `doc`. Returns whether `doc` changed. Each
+// problem is a one-line pmr::Error.
+bool apply_material_variant(const std::string& path, nlohmann::json& doc, const std::string& choice, SourceFile& src);
 
 // For a material extension the renderer does not implement but can draw without (its appearance
 // changes, nothing else): what is drawn instead, e.g. "drawn opaque, without transmission". nullptr

@@ -673,8 +673,10 @@ void describe_structure(Loader& L, const std::vector<int>& roots) {
 
 Scene load_scene(const std::string& path) { return load_scene(path, InputLimits()); }
 
-Scene load_scene(const std::string& path, const InputLimits& limits) {
-  SourceFile src = read_source(path, limits);
+Scene load_scene(const std::string& path, const InputLimits& limits) { return load_scene(path, limits, ""); }
+
+Scene load_scene(const std::string& path, const InputLimits& limits, const std::string& variant) {
+  SourceFile src = read_source(path, limits, variant);
   tinygltf::Model model;
   ImageContext images;
   images.max_pixels = limits.texture_pixels;
@@ -710,6 +712,8 @@ Scene load_scene(const std::string& path, const InputLimits& limits) {
     scene.animations.push_back({clip.name, clip.start, clip.end, clip.channels.size()});
   describe_structure(L, roots);
   if (!L.motion->clips.empty()) scene.motion = L.motion;
+  scene.variants = src.variants;
+  scene.variant = src.variant;
   scene.source_checksum = src.checksum;
   for (const auto& [file, sum] : files_read) scene.input_files.push_back({file, sum});
   return scene;

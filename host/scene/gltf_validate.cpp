@@ -53,7 +53,7 @@ constexpr uint64_t kJsonBytesPerValue = 200;
 bool extension_supported(const std::string& name) {
   return name == "KHR_mesh_quantization" || name == "KHR_texture_transform" || name == "KHR_lights_punctual" ||
          name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit" || name == "KHR_materials_ior" ||
-         name == "KHR_materials_transmission" || name == "KHR_materials_volume";
+         name == "KHR_materials_transmission" || name == "KHR_materials_volume" || name == "KHR_materials_variants";
 }
 
 uint32_t read_u32le(const unsigned char* p) {
@@ -441,9 +441,13 @@ std::set<int> needed_buffers(const json& doc, const std::set<int>& sampled) {
 // tinygltf loads every buffer it is given. An unread one is handed over as one byte in a data URI
 // (validate_model checks its bufferViews against the length the file declares instead): the JSON
 // text, or the GLB's JSON chunk, is rewritten for it.
-void replace_unread_buffers(json& doc, SourceFile& src) {
+void replace_unread_buffers(json& doc, const SourceFile& src) {
   for (const auto& [index, length] : src.unread_buffers)
     doc["buffers"][size_t(index)] = {{"byteLength", 1}, {"uri", "data:application/octet-stream;base64,AA=="}};
+}
+
+// What tinygltf parses becomes `doc` (the GLB's BIN chunk kept as it was).
+void replace_json(const json& doc, SourceFile& src) {
   std::string text = doc.dump();
   if (!src.glb) {
     src.bytes.assign(text.begin(), text.end());
@@ -546,7 +550,7 @@ std::string resolve_uri(const std::string& base_dir, const std::string& uri) {
   return base_dir.back() == '/' ? base_dir + decoded : base_dir + "/" + decoded;
 }
 
-SourceFile read_source(const std::string& path, const InputLimits& limits) {
+SourceFile read_source(const std::string& path, const InputLimits& limits, const std::string& variant) {
   SourceFile src;
   src.bytes = read_whole_file(path, limits);
   src.checksum = checksum_hex(src.bytes.data(), src.bytes.size());
@@ -585,6 +589,7 @@ SourceFile read_source(const std::string& path, const InputLimits& limits) {
   if (v.rfind("2.", 0) != 0) fail(path, "glTF version " + one_line(v) + " is not supported (2.x only)");
   check_schema(path, doc);
   check_extensions(path, doc, src);
+  bool rewrite = apply_material_variant(path, doc, variant, src);
   InputFolder folder;  // the scene's folder, unless files may lie anywhere
   if (!limits.allow_outside_scene_folder) {
     folder = InputFolder(src.base_dir.empty() ? "." : src.base_dir);
@@ -597,7 +602,8 @@ SourceFile read_source(const std::string& path, const InputLimits& limits) {
   read_lights(path, doc, src);
   src.unused_image_files = unused_image_files(doc, src.base_dir, src.sampled_images);
   read_sampled_images(path, doc, src, confine, limits);
-  if (!src.unread_buffers.empty()) replace_unread_buffers(doc, src);
+  if (!src.unread_buffers.empty()) replace_unread_buffers(doc, src), rewrite = true;
+  if (rewrite) replace_json(doc, src);
   return src;
 }
 

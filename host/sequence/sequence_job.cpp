@@ -139,7 +139,7 @@ void SequenceRun::load_inputs() {
     if (job_.verbose)
       std::fprintf(stderr, "pmr: environment %s\n", environment_summary(source, pc_.environment.get()).c_str());
   }
-  scene_ = load_scene(job_.scene, job_.input_limits);
+  scene_ = load_scene(job_.scene, job_.input_limits, job_.variant);
   for (const auto& w : scene_.warnings) warn(w);
 }
 
@@ -211,6 +211,7 @@ void SequenceRun::prepare_frames() {
   info.scene = job_.scene;
   info.rig_config = rig_config_;
   if (rig_config_.camera >= 0) info.camera_name = scene_.cameras[size_t(rig_config_.camera)].node_name;
+  if (scene_.variant >= 0) info.variant = scene_.variants[size_t(scene_.variant)];
   info.pipeline = job_.pipeline;
   info.display_source = job_.display_source;
   info.sequence = spec_;

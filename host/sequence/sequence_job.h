@@ -21,6 +21,7 @@ struct SequenceJob {
   // inputs
   std::string scene;              // the glTF or GLB file
   InputLimits input_limits;       // budgets and folder confinement (docs/SECURITY.md)
+  std::string variant;            // --variant: a material variant's name or index ("" = default materials)
   EnvironmentSource environment;  // pbr: the studio (default), the uniform one or an image
   double environment_rotation_deg = 0.0;
   // cameras, display, pipeline

@@ -95,7 +95,7 @@ struct SceneLight {
 // node of the rendered scene uses, or whose perspective parameters are invalid, keep placed = false.
 struct SceneCamera {
   std::string name;
-  std::string node_name;  // the name of the node that places it (the first, when several do)
+  std::string node_name;              // the name of the node that places it (the first, when several do)
   glm::dmat4 world_from_camera{1.0};  // the node's world matrix (camera looks along its -Z)
   double yfov = 0.0;                  // radians
   double znear = 0.0;
@@ -151,8 +151,12 @@ struct Scene {
   std::vector<SceneMaterialInputs> material_inputs;
   std::vector<std::vector<glm::vec2>> texcoords;
   std::vector<glm::vec4> tangents;
-  std::vector<SceneLight> lights;     // KHR_lights_punctual, in scene traversal order
-  std::vector<SceneCamera> cameras;   // one per glTF camera, same order (see SceneCamera::placed)
+  std::vector<SceneLight> lights;    // KHR_lights_punctual, in scene traversal order
+  std::vector<SceneCamera> cameras;  // one per glTF camera, same order (see SceneCamera::placed)
+  // KHR_materials_variants: the file's variants, and the one the materials were loaded for (-1: none,
+  // the primitives' default materials)
+  std::vector<std::string> variants;
+  int variant = -1;
   std::vector<std::string> warnings;  // non-fatal problems, one line each
   // The arrays above hold the rest pose: no animation applied, default morph weights, skins bound to
   // their skeleton's rest transforms. pose_scene() places a frame.
@@ -214,6 +218,9 @@ Scene load_scene(const std::string& path);
 // names lies inside the scene's folder (unless limits.allow_outside_scene_folder), is a regular file
 // within limits.file_bytes, and no texture image over limits.texture_pixels is decoded.
 Scene load_scene(const std::string& path, const InputLimits& limits);
+// The same with the material variant `variant` (KHR_materials_variants; its name or index, "" = the
+// default materials): each primitive that maps it is drawn with its material.
+Scene load_scene(const std::string& path, const InputLimits& limits, const std::string& variant);
 
 // World-space axis-aligned bounds of all vertices referenced by triangles. Returns false (lo, hi
 // untouched) when there are none.

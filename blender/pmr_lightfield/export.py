@@ -37,7 +37,27 @@ def export_gltf(folder):
         raise RuntimeError("the glTF export failed (see the console)")
     if not has_mode:
         _rewrite_light_intensities(path)
+    _relax_required_extensions(path)
     return path
+
+
+# Extensions the exporter marks required although a renderer without them draws the scene correctly:
+# KHR_materials_variants (from imported glTF files) only names alternative materials, and every
+# primitive keeps its default one. pmr refuses unknown required extensions.
+IGNORABLE = {"KHR_materials_variants"}
+
+
+def _relax_required_extensions(path):
+    with open(path, encoding="utf-8") as f:
+        doc = json.load(f)
+    required = doc.get("extensionsRequired", [])
+    if not IGNORABLE.intersection(required):
+        return
+    doc["extensionsRequired"] = [e for e in required if e not in IGNORABLE]
+    if not doc["extensionsRequired"]:
+        del doc["extensionsRequired"]
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(doc, f)
 
 
 def _rewrite_light_intensities(path):

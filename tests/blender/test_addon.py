@@ -330,12 +330,11 @@ def main():
     log("PASSED")
 
 
-try:
-    main()
-except SystemExit:
-    raise
-except BaseException:
-    traceback.print_exc()
-    fail("exception (above)")
-sys.stdout.flush()
-os._exit(0)
+if __name__ == "__main__":
+    try:
+        main()
+    except BaseException:
+        traceback.print_exc()
+        fail("exception (above)")
+    sys.stdout.flush()
+    os._exit(0)

@@ -83,10 +83,10 @@ def run_pmr(scene, ops_module, out):
     return sidecar, total, r["elapsed"], summary
 
 
-def view_camera(scene, sidecar, index):
+def view_camera(scene, base, sidecar, index):
     """A camera for view `index`: moved along the center camera's x, lens-shifted so that the focal
     plane (the rig's focal_distance) stays where the center view has it."""
-    rig, base = sidecar["rig"], scene.camera
+    rig = sidecar["rig"]
     offset = sidecar["views"][index]["offset"]
     cam = bpy.data.objects.new("View%03d" % index, base.data.copy())
     scene.collection.objects.link(cam)
@@ -110,7 +110,7 @@ def render_views(scene, sidecar, engine, samples, indices, path):
     scene.render.image_settings.color_depth = "32"
     base, times = scene.camera, []
     for i in indices:
-        scene.camera = view_camera(scene, sidecar, i)
+        scene.camera = view_camera(scene, base, sidecar, i)
         scene.render.filepath = "%s_view%02d.exr" % (path, i)
         t0 = time.monotonic()
         bpy.ops.render.render(write_still=True)
@@ -189,6 +189,7 @@ def main():
         print("BENCH side by side: %s" % os.path.join(out, "side_by_side.png"), flush=True)
 
 
-main()
-sys.stdout.flush()
-os._exit(0)
+if __name__ == "__main__":
+    main()
+    sys.stdout.flush()
+    os._exit(0)

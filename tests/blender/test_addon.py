@@ -275,6 +275,62 @@ def check_point_light(scene, ops_module, work):
     return ratios
 
 
+def environment_image(path):
+    """An equirectangular EXR, black but for a bright patch at Blender's image center (azimuth +-45
+    degrees, elevation +-45 degrees), which Blender shows around +X."""
+    w, h = 64, 32
+    img = bpy.data.images.new("env_probe", w, h, float_buffer=True)
+    px = []
+    for y in range(h):  # bottom row first
+        for x in range(w):
+            bright = 0.375 <= (x + 0.5) / w <= 0.625 and 0.25 <= (y + 0.5) / h <= 0.75
+            px += [4.0, 4.0, 4.0, 1.0] if bright else [0.0, 0.0, 0.0, 1.0]
+    img.pixels = px
+    img.filepath_raw, img.file_format = path, "OPEN_EXR"
+    img.save()
+    return path
+
+
+def check_environment(scene, ops_module, work):
+    """A grey cube lit only by a world HDRI bright toward +X: its +X and -Y faces in pmr against
+    Cycles. An image turned wrongly by pmr (90 or 180 degrees) swaps which face is lit."""
+    from bpy_extras.object_utils import world_to_camera_view
+    for obj in scene.objects:
+        obj.hide_render = obj.type != "CAMERA"
+    bpy.ops.mesh.primitive_cube_add(size=1, location=(0, 0, 0))
+    probe = bpy.context.object
+    probe.data.materials.append(bpy.data.materials["Grey"])
+    scene.camera = scene.objects["ShotCam"]
+    nodes, links = scene.world.node_tree.nodes, scene.world.node_tree.links
+    tex = nodes.new("ShaderNodeTexEnvironment")
+    tex.image = bpy.data.images.load(environment_image(os.path.join(work, "env_probe.exr")))
+    links.new(tex.outputs["Color"], nodes["Background"].inputs["Color"])
+    out = os.path.join(work, "env")
+    settings_for(scene, out, "STILL", LIGHT_VIEW)
+    run_operator(ops_module)
+    sidecar = read_sidecar(out, FRAMES[0])
+    check(sidecar["shading"]["environment"]["kind"] == "image", "pmr got no environment image: %s"
+          % sidecar["shading"]["environment"])
+    q = sidecar["quilt"]
+    quilt = bpy.data.images.load(os.path.join(out, sidecar["outputs"]["quilt"]))
+    center = VIEWS // 2
+    col, row, tw, th = center % q["columns"], center // q["columns"], q["tile_width"], q["tile_height"]
+    scene.cycles.samples = 128
+    ref = cycles_render(scene, os.path.join(work, "cycles_env.exr"))
+    result = {}
+    for face, point in (("+X", (0.5, 0, 0)), ("-Y", (0, -0.5, 0))):
+        uv = world_to_camera_view(scene, scene.camera, Vector(point))
+        a = patch_mean(quilt, col * tw, row * th, tw, th, uv.x, uv.y, frac=0.06)
+        b = patch_mean(ref, 0, 0, *LIGHT_VIEW, uv.x, uv.y, frac=0.06)
+        result[face] = (a, b)
+        log("environment: %s face pmr %.4f, Cycles %.4f" % (face, a, b))
+    (px, cx), (py, cy) = result["+X"], result["-Y"]
+    check(cx > 3 * cy, "Cycles does not light the +X face most (%.3f vs %.3f)" % (cx, cy))
+    check(0.75 <= px / cx <= 1.25 and px > 3 * py,
+          "pmr lights the cube from another side than Blender: +X %.3f / %.3f, -Y %.3f / %.3f "
+          "(--environment-rotation)" % (px, cx, py, cy))
+
+
 def check_blender_sequence(out, sidecars):
     """Blender's own sequence logic (the last digit group of the file name is the frame) finds the
     quilt of every frame from the first file."""
@@ -324,6 +380,9 @@ def main():
 
     check_point_light(scene, ops_module, work)
     log("point light matches Cycles within %.0f%%" % (100 * LIGHT_TOLERANCE))
+
+    check_environment(scene, ops_module, work)
+    log("the world's HDRI lights the cube from the side Blender shows it")
 
     check_blender_sequence(out, sidecars)
     log("Blender reads the quilt sequence as frames %d..%d" % FRAMES)

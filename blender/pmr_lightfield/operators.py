@@ -34,11 +34,14 @@ class RenderJob:
         self.fps = scene.render.fps / scene.render.fps_base
         self.export_dir, self.temporary = _export_dir(context, self.out_dir)
         self.scene_path = self._export(context)
+        self.environment, more = self._world(scene)
+        self.warnings += more
         self.args = command.render_args(settings, self.scene_path, self.out_dir, self.camera,
                                         self.frames, self.fps, self.environment,
                                         export.has_animations(self.scene_path))
 
     def _export(self, context):
+        """The glTF for pmr; notes every light it cannot carry in self.warnings."""
         scene = context.scene
         path = export.export_gltf(self.export_dir)
         if scene.render.fps_base != 1.0:
@@ -46,8 +49,6 @@ class RenderJob:
         for name in export.dropped_lights(scene, context.view_layer):
             self.warnings.append("light %s is not exported: glTF has only point, spot and sun "
                                  "lights" % name)
-        self.environment, more = self._world(scene)
-        self.warnings += more
         return path
 
     def _world(self, scene):

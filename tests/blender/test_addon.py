@@ -331,6 +331,31 @@ def check_environment(scene, ops_module, work):
           "(--environment-rotation)" % (px, cx, py, cy))
 
 
+def check_fps_base(scene, ops_module, work):
+    """With fps 30 / 1.001 the kept export's key times are frame / 29.97 (the exporter alone writes
+    frame / 30) and pmr gets --fps 29.97: pmr's frame F is Blender's frame F."""
+    prefs = bpy.context.preferences.addons[ADDON].preferences
+    prefs.keep_export = True
+    scene.render.fps, scene.render.fps_base = 30, 1.001
+    for obj in scene.objects:
+        obj.hide_render = obj.name not in ("Mover", "Ground", "Sun", "ShotCam")
+    scene.camera = scene.objects["ShotCam"]
+    out = os.path.join(work, "fps")
+    settings_for(scene, out, "STILL", SEQ_VIEW)
+    run_operator(ops_module)
+    fps = scene.render.fps / scene.render.fps_base  # fps_base is a float32: 1.00100004673
+    prefs.keep_export = False
+    scene.render.fps, scene.render.fps_base = 24, 1.0
+    check(abs(read_sidecar(out, FRAMES[0])["fps"] - fps) < 1e-6, "pmr's fps is not 30 / 1.001")
+    with open(os.path.join(out, "pmr_scene", "scene.gltf"), encoding="utf-8") as f:
+        doc = json.load(f)
+    acc = doc["accessors"][doc["animations"][0]["samplers"][0]["input"]]
+    want = (FRAMES[0] / fps, FRAMES[1] / fps)
+    got = (acc["min"][0], acc["max"][0])
+    check(all(abs(g - w) < 1e-5 for g, w in zip(got, want)),
+          "key times %s, expected frame / 29.97 = %s" % (got, want))
+
+
 def check_blender_sequence(out, sidecars):
     """Blender's own sequence logic (the last digit group of the file name is the frame) finds the
     quilt of every frame from the first file."""
@@ -383,6 +408,9 @@ def main():
 
     check_environment(scene, ops_module, work)
     log("the world's HDRI lights the cube from the side Blender shows it")
+
+    check_fps_base(scene, ops_module, work)
+    log("fps 30 / 1.001: pmr --fps 29.97, the exported key times frame / 29.97")
 
     check_blender_sequence(out, sidecars)
     log("Blender reads the quilt sequence as frames %d..%d" % FRAMES)

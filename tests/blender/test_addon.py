@@ -126,6 +126,10 @@ def build_scene():
     point.data.shadow_soft_size = 0.0  # a true point light, as glTF's
     point.location = (0, 0, 3)
     scene.collection.objects.link(point)
+    # glTF has no area lights: the add-on must say that this one is left out
+    panel = bpy.data.objects.new("Panel", bpy.data.lights.new("Panel", "AREA"))
+    panel.location = (0, 2, 3)
+    scene.collection.objects.link(panel)
     scene.frame_set(FRAMES[0])
     return scene
 
@@ -236,7 +240,7 @@ def cycles_render(scene, path):
 
 def check_point_light(scene, ops_module, work):
     """A grey plane lit only by the point light: pmr's center view against Cycles."""
-    for name in ("Mover", "Sun"):
+    for name in ("Mover", "Sun", "Panel"):
         scene.objects[name].hide_render = True
     # Seen and lit from near the normal, where Cycles' Disney diffuse is Lambert's (its grazing
     # retro-reflection term vanishes); switching the active camera also tests that it is followed.
@@ -331,6 +335,28 @@ def check_environment(scene, ops_module, work):
           "(--environment-rotation)" % (px, cx, py, cy))
 
 
+def check_errors(scene, ops_module, work):
+    """A missing pmr names the preference to set; pmr's own error lines reach Blender's reports."""
+    prefs = bpy.context.preferences.addons[ADDON].preferences
+    pmr, prefs.pmr_path = prefs.pmr_path, os.path.join(work, "no-such-pmr")
+    settings_for(scene, os.path.join(work, "err"), "STILL", SEQ_VIEW)
+    try:
+        bpy.ops.pmr.render_lightfield()
+        fail("a missing pmr did not raise an error report")
+    except RuntimeError as e:
+        check("Preferences" in str(e) and "pmr executable" in str(e),
+              "the missing-pmr error does not say where to set the path: %s" % e)
+    prefs.pmr_path = pmr
+    scene.pmr_lightfield.extra_args = "--bogus-option"
+    try:
+        bpy.ops.pmr.render_lightfield()
+        fail("pmr's error did not become an error report")
+    except RuntimeError as e:
+        check("unknown option --bogus-option" in str(e), "pmr's error line is not reported: %s" % e)
+    scene.pmr_lightfield.extra_args = ""
+    check(ops_module.last_result["returncode"] == 2, "pmr's usage error did not exit 2")
+
+
 def check_fps_base(scene, ops_module, work):
     """With fps 30 / 1.001 the kept export's key times are frame / 29.97 (the exporter alone writes
     frame / 30) and pmr gets --fps 29.97: pmr's frame F is Blender's frame F."""
@@ -394,6 +420,8 @@ def main():
     log("sequence of %d frames rendered through the add-on in %.1f s" % (len(r["outputs"]), r["elapsed"]))
     check("--camera" in r["argv"] and r["argv"][r["argv"].index("--camera") + 1] == "ShotCam",
           "pmr was not given --camera ShotCam: %s" % r["argv"])
+    check(any("Panel (area)" in w for w in r["warnings"]), "no warning for the area light: %s"
+          % r["warnings"])
     sidecars = {f: read_sidecar(out, f) for f in range(FRAMES[0], FRAMES[1] + 1)}
     quilts = [check_quilt(out, f, sc) for f, sc in sidecars.items()]
     check(list(quilts[0].pixels) != list(quilts[-1].pixels),
@@ -408,6 +436,9 @@ def main():
 
     check_environment(scene, ops_module, work)
     log("the world's HDRI lights the cube from the side Blender shows it")
+
+    check_errors(scene, ops_module, work)
+    log("a missing pmr names its preference; pmr's error lines become error reports")
 
     check_fps_base(scene, ops_module, work)
     log("fps 30 / 1.001: pmr --fps 29.97, the exported key times frame / 29.97")

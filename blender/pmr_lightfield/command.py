@@ -39,28 +39,20 @@ def render_args(settings, scene_path, out_dir, camera, frames, fps, environment,
     return args
 
 
-def frame_stem(pattern, frame):
-    """The file stem pmr writes for a frame (--name: ####, %0Nd, %d, %%)."""
-    def hashes(m):
-        return "%0*d" % (len(m.group(0)), frame)
+# --name's frame number forms: %% (a percent sign), %d or %0Nd, a run of N '#'
+_NAME_TOKEN = re.compile(r"%%|%(?:0(\d+))?d|#+")
 
-    out, i = [], 0
-    while i < len(pattern):
-        m = re.compile(r"%(0(\d+))?d").match(pattern, i)
-        if pattern.startswith("%%", i):
-            out.append("%")
-            i += 2
-        elif m:
-            out.append("%0*d" % (int(m.group(2) or 0), frame))
-            i = m.end()
-        elif pattern[i] == "#":
-            m = re.compile(r"#+").match(pattern, i)
-            out.append(hashes(m))
-            i = m.end()
-        else:
-            out.append(pattern[i])
-            i += 1
-    return "".join(out)
+
+def frame_stem(pattern, frame):
+    """The file stem pmr writes for a frame, from its --name pattern."""
+    def expand(m):
+        token = m.group(0)
+        if token == "%%":
+            return "%"
+        width = len(token) if token[0] == "#" else int(m.group(1) or 0)
+        return "%0*d" % (width, frame)
+
+    return _NAME_TOKEN.sub(expand, pattern)
 
 
 PROGRESS = re.compile(r"^pmr: frame (\d+) written \((\d+)/(\d+)\)")

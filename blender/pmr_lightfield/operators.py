@@ -22,7 +22,8 @@ class RenderJob:
     def __init__(self, context):
         scene = context.scene
         settings = scene.pmr_lightfield
-        self.settings = settings
+        self.settings = settings  # read during set-up only: undo may replace it while pmr runs
+        self.name = settings.name
         self.warnings = []
         self.program = runner.resolve_program(addon_prefs(context).pmr_path)
         if scene.camera is None:
@@ -33,8 +34,12 @@ class RenderJob:
         self.frames = _frame_range(scene, settings)
         self.fps = scene.render.fps / scene.render.fps_base
         self.export_dir, self.temporary = _export_dir(context, self.out_dir)
-        self.scene_path = self._export(context)
-        self.environment, more = self._world(scene)
+        try:
+            self.scene_path = self._export(context)
+            self.environment, more = self._world(scene)
+        except Exception:
+            self.cleanup()
+            raise
         self.warnings += more
         self.args = command.render_args(settings, self.scene_path, self.out_dir, self.camera,
                                         self.frames, self.fps, self.environment,
@@ -71,7 +76,7 @@ class RenderJob:
         """The files pmr wrote, per frame: {frame: sidecar's outputs}, from the sidecars present."""
         found = {}
         for frame in range(self.frames[0], self.frames[1] + 1):
-            sidecar = os.path.join(self.out_dir, command.frame_stem(self.settings.name, frame) + ".json")
+            sidecar = os.path.join(self.out_dir, command.frame_stem(self.name, frame) + ".json")
             if os.path.isfile(sidecar):
                 with open(sidecar, encoding="utf-8") as f:
                     found[frame] = json.load(f).get("outputs", {})

@@ -36,9 +36,38 @@ def export_gltf(folder):
     if "FINISHED" not in result or not os.path.exists(path):
         raise RuntimeError("the glTF export failed (see the console)")
     if not has_mode:
-        _rewrite_light_intensities(path)
-    _relax_required_extensions(path)
+        _edit_json(path, _rewrite_light_intensities)
+    _edit_json(path, _relax_required_extensions)
+    _edit_json(path, _unshare_cameras)
     return path
+
+
+def _edit_json(path, edit):
+    """Applies edit(doc) to the .gltf; rewrites the file when edit returns True."""
+    with open(path, encoding="utf-8") as f:
+        doc = json.load(f)
+    if edit(doc):
+        with open(path, "w", encoding="utf-8") as f:
+            json.dump(doc, f)
+
+
+def _unshare_cameras(doc):
+    """Gives every camera node its own glTF camera.
+
+    Camera objects sharing their data (Alt+D) export as one glTF camera placed by several nodes; pmr
+    (0.22) looks a camera up through the first node that places it, so --camera NAME of any other
+    node would not be found. A copy per further node keeps every camera object renderable."""
+    seen, changed = set(), False
+    for node in doc.get("nodes", []):
+        index = node.get("camera")
+        if index is None:
+            continue
+        if index in seen:
+            doc["cameras"].append(dict(doc["cameras"][index]))
+            node["camera"] = len(doc["cameras"]) - 1
+            changed = True
+        seen.add(node["camera"])
+    return changed
 
 
 # Extensions the exporter marks required although a renderer without them draws the scene correctly:
@@ -47,34 +76,24 @@ def export_gltf(folder):
 IGNORABLE = {"KHR_materials_variants"}
 
 
-def _relax_required_extensions(path):
-    with open(path, encoding="utf-8") as f:
-        doc = json.load(f)
+def _relax_required_extensions(doc):
     required = doc.get("extensionsRequired", [])
     if not IGNORABLE.intersection(required):
-        return
+        return False
     doc["extensionsRequired"] = [e for e in required if e not in IGNORABLE]
     if not doc["extensionsRequired"]:
         del doc["extensionsRequired"]
-    with open(path, "w", encoding="utf-8") as f:
-        json.dump(doc, f)
+    return True
 
 
-def _rewrite_light_intensities(path):
+def _rewrite_light_intensities(doc):
     """For exporters without convert_lighting_mode: intensities from the Blender lights, by name."""
-    with open(path, encoding="utf-8") as f:
-        doc = json.load(f)
     lights = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
     for light in lights:
         data = bpy.data.lights.get(light.get("name", ""))
-        if data is None:
-            continue
-        if data.type == "SUN":
-            light["intensity"] = data.energy
-        else:
-            light["intensity"] = data.energy / (4.0 * math.pi)
-    with open(path, "w", encoding="utf-8") as f:
-        json.dump(doc, f)
+        if data is not None:
+            light["intensity"] = data.energy / (1.0 if data.type == "SUN" else 4.0 * math.pi)
+    return bool(lights)
 
 
 def has_animations(path):

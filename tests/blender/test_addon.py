@@ -197,6 +197,8 @@ def check_camera(sidecar, cam):
     check(err < 1e-4, "center view is not the active camera's (max error %.3g)\n%s\n%s"
           % (err, got, want))
     check(sidecar.get("camera") not in (-1, None), "the sidecar says no glTF camera was used")
+    check(sidecar.get("camera_name", cam.name) == cam.name, "the sidecar's camera_name is %r, not %r"
+          % (sidecar.get("camera_name"), cam.name))
     return err
 
 
@@ -244,7 +246,9 @@ def check_point_light(scene, ops_module, work):
         scene.objects[name].hide_render = True
     # Seen and lit from near the normal, where Cycles' Disney diffuse is Lambert's (its grazing
     # retro-reflection term vanishes); switching the active camera also tests that it is followed.
-    top = bpy.data.objects.new("TopCam", scene.camera.data.copy())
+    # TopCam shares ShotCam's camera data (Alt+D in Blender): one glTF camera placed by two nodes,
+    # so only the node's name (--camera NAME) tells them apart, not the camera's index or name
+    top = bpy.data.objects.new("TopCam", scene.camera.data)
     scene.collection.objects.link(top)
     top.location = (0.0, -1.0, 6.0)
     look_at(top, (0, 0, 0))

@@ -10,7 +10,6 @@ class PMR_PT_lightfield(bpy.types.Panel):
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "render"
-    bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
         s = context.scene.pmr_lightfield

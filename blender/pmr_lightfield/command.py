@@ -1,0 +1,78 @@
+"""pmr's command line: the arguments for a render, and reading what pmr prints. No bpy here."""
+
+import re
+import shlex
+
+WRITE = {"QUILT": "quilt", "ENCODED": "encoded", "BOTH": "encoded,quilt"}
+
+
+def render_args(settings, scene_path, out_dir, camera, frames, fps, environment, animated):
+    """The argument list of `pmr render` (without the program).
+
+    settings: the scene's pmr_lightfield settings; camera: the camera object's name (its glTF node
+    name); frames: (first, last); fps: frames per second; environment: its options from the world;
+    animated: whether the glTF has animations (pmr refuses --animation all without any)."""
+    args = ["render", scene_path, "--out", out_dir, "--name", settings.name or "frame_####"]
+    if settings.display_source == "CONFIG" and settings.display_config:
+        args += ["--display-config", settings.display_config]
+    else:
+        args += ["--preset", settings.preset]
+    if settings.views > 0:
+        args += ["--views", str(settings.views)]
+    if settings.view_width > 0 and settings.view_height > 0:
+        args += ["--view-size", "%dx%d" % (settings.view_width, settings.view_height)]
+    if settings.sampling != "DEFAULT":
+        args += ["--sampling", settings.sampling]
+    args += ["--samples", settings.samples, "--texture-filter", settings.texture_filter]
+    args += ["--write", WRITE[settings.write]]
+    args += ["--camera", camera]
+    if animated:
+        # Blender's exporter writes one glTF animation per action: play them all, as Blender does.
+        args += ["--animation", "all"]
+    args += ["--fps", "%.10g" % fps]
+    first, last = frames
+    args += ["--frames", str(first) if first == last else "%d:%d" % (first, last)]
+    args += environment
+    # a folder is one configuration for pmr; re-rendering with changed settings is the normal case here
+    args += ["--overwrite"]
+    args += shlex.split(settings.extra_args)
+    return args
+
+
+# --name's fields: %% (a percent sign), %q (the quilt's tag: nothing in the other files' names),
+# %d or %0Nd, a run of N '#'
+_NAME_TOKEN = re.compile(r"%%|%q|%(?:0(\d+))?d|#+")
+
+
+def frame_stem(pattern, frame):
+    """The file stem pmr writes for a frame's sidecar, from its --name pattern."""
+    def expand(m):
+        token = m.group(0)
+        if token == "%%":
+            return "%"
+        if token == "%q":
+            return ""
+        width = len(token) if token[0] == "#" else int(m.group(1) or 0)
+        return "%0*d" % (width, frame)
+
+    return _NAME_TOKEN.sub(expand, pattern)
+
+
+PROGRESS = re.compile(r"^pmr: frame (\d+) written \((\d+)/(\d+)\)")
+ERROR = re.compile(r"^pmr: error: (.*)$")
+WARNING = re.compile(r"^pmr: warning: (.*)$")
+
+
+def parse_line(line):
+    """('progress', (frame, done, total)) | ('error', text) | ('warning', text) | ('info', line)."""
+    line = line.rstrip("\r\n")
+    m = PROGRESS.match(line)
+    if m:
+        return "progress", tuple(int(g) for g in m.groups())
+    m = ERROR.match(line)
+    if m:
+        return "error", m.group(1)
+    m = WARNING.match(line)
+    if m:
+        return "warning", m.group(1)
+    return "info", line

@@ -1,0 +1,208 @@
+"""Exporting the scene for pmr: glTF with cameras, lights and animation, and the world as an image."""
+
+import array
+import json
+import math
+import os
+
+import bpy
+
+SCENE_FILE = "scene.gltf"
+
+# Blender's glTF exporter in 3.4 converts lights with 'SPEC' by default: point and spot lights come out
+# 683 times brighter (lm per W) than Blender renders them. 'COMPAT' writes W / (4 pi) for point and
+# spot and W / m^2 for sun, which are the units pmr's shading and Cycles agree on.
+LIGHTING_MODE = "COMPAT"
+
+
+def export_gltf(folder):
+    """Writes folder/scene.gltf (+ .bin and textures); returns its path."""
+    path = os.path.join(folder, SCENE_FILE)
+    options = dict(
+        filepath=path,
+        export_format="GLTF_SEPARATE",  # plain JSON: pmr reads it, and so can the light fix below
+        export_cameras=True,
+        export_lights=True,
+        use_renderable=True,  # what the render would show: hide_render objects stay out
+        export_apply=True,  # modifiers applied, as rendered
+        export_animations=True,
+        export_yup=True,
+        check_existing=False,
+    )
+    has_mode = "convert_lighting_mode" in bpy.ops.export_scene.gltf.get_rna_type().properties
+    if has_mode:
+        options["convert_lighting_mode"] = LIGHTING_MODE
+    result = bpy.ops.export_scene.gltf(**options)
+    if "FINISHED" not in result or not os.path.exists(path):
+        raise RuntimeError("the glTF export failed (see the console)")
+    if not has_mode:
+        _edit_json(path, _rewrite_light_intensities)
+    _edit_json(path, _unshare_cameras)
+    return path
+
+
+def _edit_json(path, edit):
+    """Applies edit(doc) to the .gltf; rewrites the file when edit returns True."""
+    with open(path, encoding="utf-8") as f:
+        doc = json.load(f)
+    if edit(doc):
+        with open(path, "w", encoding="utf-8") as f:
+            json.dump(doc, f)
+
+
+def _unshare_cameras(doc):
+    """Gives every camera node its own glTF camera.
+
+    Camera objects sharing their data (Alt+D) export as one glTF camera placed by several nodes; pmr
+    (0.22) looks a camera up through the first node that places it, so --camera NAME of any other
+    node would not be found. A copy per further node keeps every camera object renderable."""
+    seen, changed = set(), False
+    for node in doc.get("nodes", []):
+        index = node.get("camera")
+        if index is None:
+            continue
+        if index in seen:
+            doc["cameras"].append(dict(doc["cameras"][index]))
+            node["camera"] = len(doc["cameras"]) - 1
+            changed = True
+        seen.add(node["camera"])
+    return changed
+
+
+def _rewrite_light_intensities(doc):
+    """For exporters without convert_lighting_mode: intensities from the Blender lights, by name."""
+    lights = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
+    for light in lights:
+        data = bpy.data.lights.get(light.get("name", ""))
+        if data is not None:
+            light["intensity"] = data.energy / (1.0 if data.type == "SUN" else 4.0 * math.pi)
+    return bool(lights)
+
+
+def has_animations(path):
+    with open(path, encoding="utf-8") as f:
+        return bool(json.load(f).get("animations"))
+
+
+def retime_animations(path, factor):
+    """Multiplies every animation key time of the exported .gltf by factor, in its .bin.
+
+    The 3.4 exporter writes frame f at f / scene.render.fps, ignoring fps_base; pmr samples frame f at
+    f / --fps. With factor = fps_base and --fps = fps / fps_base both give frame f the same time."""
+    with open(path, encoding="utf-8") as f:
+        doc = json.load(f)
+    inputs = {s["input"] for a in doc.get("animations", []) for s in a["samplers"]}
+    folder = os.path.dirname(path)
+    for index in sorted(inputs):
+        acc = doc["accessors"][index]
+        view = doc["bufferViews"][acc["bufferView"]]
+        bin_path = os.path.join(folder, doc["buffers"][view["buffer"]]["uri"])
+        offset = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
+        times = array.array("f")
+        with open(bin_path, "r+b") as f:
+            f.seek(offset)
+            times.frombytes(f.read(4 * acc["count"]))
+            times = array.array("f", (t * factor for t in times))
+            f.seek(offset)
+            f.write(times.tobytes())  # float32, little-endian like glTF on every machine Blender runs on
+        acc["min"], acc["max"] = [min(times)], [max(times)]
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(doc, f)
+
+
+def dropped_lights(scene, view_layer):
+    """Names of the rendered lights glTF cannot carry (KHR_lights_punctual has no area lights)."""
+    names = []
+    for obj in scene.objects:
+        if obj.type != "LIGHT" or obj.hide_render or obj.name not in view_layer.objects:
+            continue
+        if obj.data.type not in ("POINT", "SPOT", "SUN"):
+            names.append("%s (%s)" % (obj.name, obj.data.type.lower()))
+    return names
+
+
+# ---- the world ----------------------------------------------------------------------------------
+
+def _background_node(world):
+    """The Background node feeding the world's active output, or None."""
+    if world is None or not world.use_nodes or world.node_tree is None:
+        return None
+    for node in world.node_tree.nodes:
+        if node.type == "OUTPUT_WORLD" and node.is_active_output:
+            link = node.inputs["Surface"].links
+            if link and link[0].from_node.type == "BACKGROUND":
+                return link[0].from_node
+    return None
+
+
+def world_environment(world, folder):
+    """pmr's environment options for the world: (arguments, warnings).
+
+    An Environment Texture image becomes --environment FILE (turned to Blender's orientation, see
+    environment_rotation), a plain colour a small constant image, a black or missing world none."""
+    node = _background_node(world)
+    if node is None:
+        return ["--environment-intensity", "0"], []
+    strength = node.inputs["Strength"].default_value
+    color_in = node.inputs["Color"]
+    if color_in.links:
+        tex = color_in.links[0].from_node
+        if tex.type == "TEX_ENVIRONMENT" and tex.image is not None:
+            image_path, warnings = _environment_file(tex.image, folder)
+            args = ["--environment", image_path,
+                    "--environment-rotation", "%.6g" % environment_rotation(tex),
+                    "--environment-intensity", "%.6g" % strength]
+            return args, warnings
+        return ["--environment-intensity", "0"], [
+            "the world's colour comes from a %s node, which pmr cannot use: no environment light"
+            % tex.bl_label]
+    rgb = [c * strength for c in color_in.default_value[:3]]
+    if max(rgb) <= 0.0:
+        return ["--environment-intensity", "0"], []
+    path = os.path.join(folder, "world_color.exr")
+    _write_exr(path, 8, 4, list(rgb) + [1.0])
+    return ["--environment", path], []
+
+
+def environment_rotation(tex):
+    """pmr's --environment-rotation (degrees) that shows an equirectangular image as Blender does.
+
+    Blender reads direction d at u = 1/2 + atan2(z, x) / (2 pi) in glTF axes (its image center looks
+    along +X), pmr at u = 1/2 + atan2(x, -z) / (2 pi) (center along -Z): pmr must turn the image by
+    -90 degrees (its rotation is counter-clockwise seen from above). A Mapping node's Z rotation r
+    turns Blender's lookup vector, which moves the image the other way."""
+    rz = 0.0
+    vec = tex.inputs["Vector"].links
+    if vec and vec[0].from_node.type == "MAPPING":
+        rz = vec[0].from_node.inputs["Rotation"].default_value[2]
+    return -90.0 - math.degrees(rz)
+
+
+def _environment_file(image, folder):
+    """A file pmr can read for the image: its own .hdr/.exr, or a float EXR copy."""
+    path = bpy.path.abspath(image.filepath, library=image.library) if image.filepath else ""
+    ext = os.path.splitext(path)[1].lower()
+    if not image.packed_file and ext in (".hdr", ".exr") and os.path.isfile(path):
+        return os.path.abspath(path), []
+    width, height = image.size
+    if width == 0 or height == 0:
+        raise RuntimeError("the world's image %r has no pixels" % image.name)
+    copy = os.path.join(folder, "world.exr")
+    _write_exr(copy, width, height, list(image.pixels))
+    warnings = []
+    if ext not in (".hdr", ".exr"):
+        warnings.append("the world's image %r is not HDR: pmr gets its pixels as linear values"
+                        % image.name)
+    return copy, warnings
+
+
+def _write_exr(path, width, height, rgba):
+    """A float RGBA EXR; rgba is the pixels bottom row first (a single RGBA fills the image)."""
+    img = bpy.data.images.new("pmr_env_tmp", width, height, alpha=True, float_buffer=True)
+    try:
+        img.pixels = rgba * (width * height) if len(rgba) == 4 else rgba
+        img.filepath_raw = path
+        img.file_format = "OPEN_EXR"
+        img.save()
+    finally:
+        bpy.data.images.remove(img)

@@ -5,7 +5,7 @@ blender -b --factory-startup --python tests/blender/bench_views.py -- \
 
 (Eevee needs an OpenGL context: run under xvfb-run -a.) Imports MODEL onto a ground plane with a sun,
 a point light and a grey world, frames it with a camera, installs the add-on (as test_addon.py does;
-set BLENDER_USER_SCRIPTS / BLENDER_USER_CONFIG to temporary folders) and renders the lg-portrait
+set BLENDER_USER_SCRIPTS / BLENDER_USER_CONFIG to folders inside DIR) and renders the lg-portrait
 preset's 48 views of 420x560 with pmr; then renders K of those views (evenly spread, the center view
 among them) with each Blender engine from cameras placed as pmr's sidecar says (offset along the
 camera's x axis, lens shift keeping the focal plane). Prints a table row per engine and writes

@@ -28,7 +28,9 @@ using test::temp_dir;
 //   camera 0 'cam'   on node 'Front' at (0, 0, 5);
 //   camera 1 'Front' on node 'Side'  at (5, 0, 0), turned to look at the origin;
 //   cameras 2 and 3 on two nodes both named 'Twin';
-//   camera 4 'Solo'  on an unnamed node at (0, 0, 3).
+//   camera 4 'Solo'  on an unnamed node at (0, 0, 3);
+//   camera 0 again on node 'Second' at (0, 0, 7): scene camera 5, its own pose (Blender exports camera
+//   objects that share their data so).
 std::string cameras_file(const std::string& dir) {
   test::GltfFile g;
   const int p = g.data<float>({-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}, test::kFloat, "VEC3");
@@ -43,7 +45,8 @@ std::string cameras_file(const std::string& dir) {
   g.add("nodes", {{"name", "Twin"}, {"camera", 2}, {"translation", {0, 1, 5}}});
   g.add("nodes", {{"name", "Twin"}, {"camera", 3}, {"translation", {0, -1, 5}}});
   g.add("nodes", {{"camera", 4}, {"translation", {0, 0, 3}}});
-  g.scene({0, 1, 2, 3, 4, 5});
+  g.add("nodes", {{"name", "Second"}, {"camera", 0}, {"translation", {0, 0, 7}}});
+  g.scene({0, 1, 2, 3, 4, 5, 6});
   return g.write(dir, "cameras");
 }
 
@@ -51,7 +54,11 @@ TEST(CameraChoice, ByIndexNodeNameOrCameraName) {
   const std::string dir = temp_dir("camera_choice");
   std::filesystem::create_directories(dir);
   const Scene scene = load_scene(cameras_file(dir));
-  ASSERT_EQ(scene.cameras.size(), 5u);
+  ASSERT_EQ(scene.cameras.size(), 6u) << "five cameras, and camera 0 placed a second time";
+  EXPECT_EQ(scene.cameras[5].shared_with, 0);
+  EXPECT_EQ(scene.cameras[5].world_from_camera[3], glm::dvec4(0, 0, 7, 1));
+  EXPECT_EQ(scene.cameras[0].world_from_camera[3], glm::dvec4(0, 0, 5, 1));
+  EXPECT_EQ(find_camera(scene, "Second"), 5);
   EXPECT_EQ(find_camera(scene, "0"), 0);
   EXPECT_EQ(find_camera(scene, "4"), 4);
   EXPECT_EQ(find_camera(scene, "Side"), 1);
@@ -68,8 +75,9 @@ TEST(CameraChoice, ByIndexNodeNameOrCameraName) {
     return std::string("(no error)");
   };
   EXPECT_NE(message("Twin").find("ambiguous"), std::string::npos) << message("Twin");
-  EXPECT_NE(message("5").find("the scene has 5 camera(s)"), std::string::npos) << message("5");
-  EXPECT_NE(message("99999999999999999999").find("5 camera(s)"), std::string::npos);
+  EXPECT_EQ(find_camera(scene, "cam"), 0) << "a camera's own name is the file's camera, not a further node's";
+  EXPECT_NE(message("6").find("the scene has 6 camera(s)"), std::string::npos) << message("6");
+  EXPECT_NE(message("99999999999999999999").find("6 camera(s)"), std::string::npos);
   EXPECT_NE(message("side").find("no camera node or camera"), std::string::npos) << "names are case-sensitive";
   EXPECT_NE(message("\x1b[2J").find("\\x1b"), std::string::npos) << "the name is made printable";
 }
@@ -103,7 +111,15 @@ TEST(CameraChoice, NamedCameraFromTheCommandLine) {
                         "--camera 'Nobody': no camera node");
   EXPECT_FALSE(test::exists(dir + "/twin"));
   EXPECT_FALSE(test::exists(dir + "/nobody"));
-  EXPECT_NE(run("info " + file).output.find("placed by node 'Side' (--camera 1)"), std::string::npos);
+  const std::string info = run("info " + file).output;
+  EXPECT_NE(info.find("placed by node 'Side' (--camera 1)"), std::string::npos) << info;
+  EXPECT_NE(info.find("placed by node 'Second', a further node of camera 0 (--camera 5)"), std::string::npos) << info;
+  // the further node drives the rig from its own pose
+  ASSERT_EQ(run("render " + file + small + "--camera Second --out " + dir + "/second").status, 0);
+  const json second = json::parse(test::read_file(dir + "/second/frame_0000.json"));
+  EXPECT_EQ(second["camera"], 5);
+  EXPECT_EQ(second["camera_name"], "Second");
+  EXPECT_NEAR(second["rig"]["focal_distance"].get<double>(), 7.0, 1e-9);
 }
 
 // A box whose sphere has center (1, 0, -1) and radius 2 sqrt(3), seen by the center camera alone.

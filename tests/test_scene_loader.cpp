@@ -407,7 +407,8 @@ TEST_F(SceneLoaderTest, GlbDetectedByContentNotExtension) {
   EXPECT_EQ(load_scene((dir_ / "text.glb").string()).triangles.size(), 1u);
 }
 
-// Cameras: kept in glTF order; placed by the first node using them, with that node's world matrix.
+// Cameras: kept in glTF order; placed by the first node using them, with that node's world matrix; a
+// further node using one gets an entry of its own after them, with its own matrix.
 TEST_F(SceneLoaderTest, CamerasArePlacedByTheirNodes) {
   GltfFile g = unit_triangle();
   g.add("cameras", {{"type", "perspective"}, {"name", "main"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}});
@@ -418,10 +419,14 @@ TEST_F(SceneLoaderTest, CamerasArePlacedByTheirNodes) {
   g.add("nodes", {{"mesh", 0}, {"translation", {1, 0, 0}}, {"children", {1}}});
   g.add("nodes", {{"camera", 0}, {"translation", {0, 0, 5}}});
   g.add("nodes", {{"camera", 1}});
-  g.add("nodes", {{"camera", 0}, {"translation", {7, 7, 7}}});  // second user of camera 0: ignored
+  g.add("nodes", {{"camera", 0}, {"translation", {7, 7, 7}}});  // second user of camera 0: entry 3
   g.scene({0, 2, 3});
   const Scene s = load_scene(g.write(dir_, "cameras"));
-  ASSERT_EQ(s.cameras.size(), 3u);
+  ASSERT_EQ(s.cameras.size(), 4u);
+  EXPECT_EQ(s.cameras[3].shared_with, 0);
+  EXPECT_EQ(s.cameras[3].world_from_camera[3], glm::dvec4(7, 7, 7, 1));
+  EXPECT_DOUBLE_EQ(s.cameras[3].yfov, 0.8);
+  EXPECT_EQ(s.cameras[0].shared_with, -1);
   EXPECT_TRUE(s.cameras[0].placed);
   EXPECT_TRUE(s.cameras[0].perspective);
   EXPECT_EQ(s.cameras[0].name, "main");

@@ -37,7 +37,6 @@ def export_gltf(folder):
         raise RuntimeError("the glTF export failed (see the console)")
     if not has_mode:
         _edit_json(path, _rewrite_light_intensities)
-    _edit_json(path, _unshare_cameras)
     return path
 
 
@@ -48,25 +47,6 @@ def _edit_json(path, edit):
     if edit(doc):
         with open(path, "w", encoding="utf-8") as f:
             json.dump(doc, f)
-
-
-def _unshare_cameras(doc):
-    """Gives every camera node its own glTF camera.
-
-    Camera objects sharing their data (Alt+D) export as one glTF camera placed by several nodes; pmr
-    (0.22) looks a camera up through the first node that places it, so --camera NAME of any other
-    node would not be found. A copy per further node keeps every camera object renderable."""
-    seen, changed = set(), False
-    for node in doc.get("nodes", []):
-        index = node.get("camera")
-        if index is None:
-            continue
-        if index in seen:
-            doc["cameras"].append(dict(doc["cameras"][index]))
-            node["camera"] = len(doc["cameras"]) - 1
-            changed = True
-        seen.add(node["camera"])
-    return changed
 
 
 def _rewrite_light_intensities(doc):

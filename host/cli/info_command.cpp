@@ -149,7 +149,10 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
         c.yfov * 180.0 / 3.14159265358979323846, c.znear, zfar,
         (!c.placed            ? ", not placed by any node of the scene"
          : !c.invalid.empty() ? ", invalid: " + c.invalid
-                              : ", placed by node " + quoted(c.node_name) + " (--camera " + std::to_string(i) + ")")
+                              : ", placed by node " + quoted(c.node_name) +
+                                    (c.shared_with >= 0 ? ", a further node of camera " + std::to_string(c.shared_with)
+                                                        : std::string()) +
+                                    " (--camera " + std::to_string(i) + ")")
             .c_str());
   }
   std::printf("animations: %zu\n", s.animations.size());

@@ -168,8 +168,26 @@ struct Instance {
   int node;
 };
 
+// The glTF camera a node places: the first node placing a camera gives its entry (same index) its pose
+// and name; every further node placing it gets an entry of its own, after the file's cameras, so that
+// each camera node can drive the rig (Blender exports camera objects sharing their data this way).
+void place_camera(Loader& L, const tinygltf::Node& node, int index, const glm::dmat4& world) {
+  SceneCamera* cam = &L.scene.cameras[size_t(node.camera)];
+  if (cam->placed) {
+    const SceneCamera shared = *cam;
+    L.scene.cameras.push_back(shared);
+    L.motion->camera_node.push_back(-1);
+    cam = &L.scene.cameras.back();
+    cam->shared_with = node.camera;
+  }
+  cam->placed = true;
+  cam->world_from_camera = world;
+  cam->node_name = node.name;
+  L.motion->camera_node[size_t(cam - L.scene.cameras.data())] = index;
+}
+
 // Pre-order walk, children in their listed order: the instances in the order they are emitted, and
-// which node places each camera (the first in this order).
+// the cameras' nodes (place_camera, in this order).
 std::vector<Instance> walk(Loader& L, const std::vector<int>& roots) {
   std::vector<Instance> instances;
   std::vector<int> stack(roots.rbegin(), roots.rend());
@@ -197,12 +215,7 @@ std::vector<Instance> walk(Loader& L, const std::vector<int>& roots) {
       L.scene.lights.push_back(l);
       L.motion->light_node.push_back(index);
     }
-    if (node.camera >= 0 && !L.scene.cameras[size_t(node.camera)].placed) {
-      L.scene.cameras[size_t(node.camera)].placed = true;
-      L.scene.cameras[size_t(node.camera)].world_from_camera = world;
-      L.scene.cameras[size_t(node.camera)].node_name = node.name;
-      L.motion->camera_node[size_t(node.camera)] = index;
-    }
+    if (node.camera >= 0) place_camera(L, node, index, world);
     for (auto c = node.children.rbegin(); c != node.children.rend(); ++c) stack.push_back(*c);
   }
   return instances;

@@ -90,8 +90,10 @@ namespace {
 // The cameras whose node name (or camera name) is `name`.
 std::vector<int> cameras_named(const Scene& scene, const std::string& name, bool node) {
   std::vector<int> found;
-  for (size_t i = 0; i < scene.cameras.size(); ++i)
-    if ((node ? scene.cameras[i].node_name : scene.cameras[i].name) == name) found.push_back(int(i));
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    const SceneCamera& c = scene.cameras[i];
+    if (node ? c.placed && c.node_name == name : c.shared_with < 0 && c.name == name) found.push_back(int(i));
+  }
   return found;
 }
 

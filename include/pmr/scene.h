@@ -95,7 +95,8 @@ struct SceneLight {
 // node of the rendered scene uses, or whose perspective parameters are invalid, keep placed = false.
 struct SceneCamera {
   std::string name;
-  std::string node_name;              // the name of the node that places it (the first, when several do)
+  std::string node_name;              // the name of the node that places it
+  int shared_with = -1;               // a further node placing glTF camera `shared_with` (entries after the file's)
   glm::dmat4 world_from_camera{1.0};  // the node's world matrix (camera looks along its -Z)
   double yfov = 0.0;                  // radians
   double znear = 0.0;
@@ -151,8 +152,10 @@ struct Scene {
   std::vector<SceneMaterialInputs> material_inputs;
   std::vector<std::vector<glm::vec2>> texcoords;
   std::vector<glm::vec4> tangents;
-  std::vector<SceneLight> lights;    // KHR_lights_punctual, in scene traversal order
-  std::vector<SceneCamera> cameras;  // one per glTF camera, same order (see SceneCamera::placed)
+  std::vector<SceneLight> lights;  // KHR_lights_punctual, in scene traversal order
+  // One per glTF camera, same order (see SceneCamera::placed), then one per further node that places a
+  // camera already placed (SceneCamera::shared_with)
+  std::vector<SceneCamera> cameras;
   // KHR_materials_variants: the file's variants, and the one the materials were loaded for (-1: none,
   // the primitives' default materials)
   std::vector<std::string> variants;

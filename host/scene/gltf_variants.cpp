@@ -1,5 +1,6 @@
 // KHR_materials_variants on the raw JSON, before tinygltf (gltf_internal.h).
 #include <algorithm>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -53,7 +54,8 @@ int mapped_material(const std::string& path, const json& p, const std::string& w
   const json* mappings = member(*khr, "mappings");
   if (!mappings || !mappings->is_array()) fail(path, where + " KHR_materials_variants: mappings is not an array");
   int found = -1;
-  std::vector<bool> seen(variants, false);
+  std::set<int64_t> seen;  // this primitive's mapped variants (not one flag per variant of the file: a
+                           // hostile file with many of both would cost their product)
   for (size_t m = 0; m < mappings->size(); ++m) {
     const std::string at = where + " KHR_materials_variants mapping " + std::to_string(m);
     const json* material = member((*mappings)[m], "material");
@@ -65,9 +67,8 @@ int mapped_material(const std::string& path, const json& p, const std::string& w
     for (const json& v : *list) {
       if (!v.is_number_integer() || v.get<int64_t>() < 0 || v.get<int64_t>() >= int64_t(variants))
         fail(path, at + " names a variant the file does not have (it has " + std::to_string(variants) + ")");
-      if (seen[size_t(v.get<int64_t>())])
+      if (!seen.insert(v.get<int64_t>()).second)
         fail(path, at + " maps variant " + std::to_string(v.get<int64_t>()) + " a second time");
-      seen[size_t(v.get<int64_t>())] = true;
       if (v.get<int64_t>() == variant) found = int(material->get<int64_t>());
     }
   }

@@ -18,6 +18,8 @@
 #                                       and volume), views 0, N/2 and N-1 of the default 96, the studio
 #   docs/shading_blend.png              the Khronos sample model AlphaBlendModeTest (alphaMode BLEND
 #                                       next to OPAQUE and MASK), views 0 and N-1 of 9, the studio
+#   docs/shading_variants.png           the Khronos sample model MaterialsVariantsShoe, center view: its
+#                                       default materials | --variant midnight | beach | street
 #
 # usage: scripts/make_shading_pictures.sh [GLTF_DIR]
 #   GLTF_DIR   folder of the Khronos sample models (GLTF_DIR/Suzanne/glTF/Suzanne.gltf, ...); default
@@ -119,6 +121,17 @@ BLEND=$GLTF_DIR/AlphaBlendModeTest/glTF/AlphaBlendModeTest.gltf
 if present "$BLEND" "$OUT/shading_blend.png" "$MODELS_HINT"; then
   render blend "$BLEND" --views 9 --view-size 664x372
   $PICTURES strip "$OUT/shading_blend.png" "$(views blend 0)" "$(views blend 8)" --check-center - -
+fi
+
+echo "== MaterialsVariantsShoe: its default materials and each variant (KHR_materials_variants)"
+SHOE=$GLTF_DIR/MaterialsVariantsShoe/glTF/MaterialsVariantsShoe.gltf
+if present "$SHOE" "$OUT/shading_variants.png" "$MODELS_HINT"; then
+  panels=() checks=()
+  for variant in "" midnight beach street; do
+    render "shoe$variant" "$SHOE" --views 9 --view-size 498x279 ${variant:+--variant $variant}
+    panels+=("$(views "shoe$variant" 4)") checks+=("$(center "shoe$variant")")
+  done
+  $PICTURES strip "$OUT/shading_variants.png" "${panels[@]}" --check-center "${checks[@]}"
 fi
 
 if [ ${#skipped[@]} -gt 0 ]; then

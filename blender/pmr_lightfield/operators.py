@@ -191,21 +191,24 @@ class PMR_OT_render(bpy.types.Operator):
     def poll(cls, context):
         return _job is None
 
-    def _prepare(self, context):
+    def _start(self, context):
+        """The job prepared and pmr started (the running job); None after an error report."""
+        global _job
         try:
-            return RenderJob(context)
+            job = RenderJob(context)
         except (runner.PmrNotFound, RuntimeError, OSError) as e:
             self.report({"ERROR"}, str(e))
             return None
+        job.start()
+        _job = job
+        return job
 
     def execute(self, context):
         """Blocking run: pmr's progress goes to the console."""
         global _job
-        job = self._prepare(context)
+        job = self._start(context)
         if job is None:
             return {"CANCELLED"}
-        job.start()
-        _job = job
         try:
             while not job.process.finished():
                 for kind, value in job.process.poll():
@@ -223,12 +226,8 @@ class PMR_OT_render(bpy.types.Operator):
     def invoke(self, context, event):
         if self.blocking or bpy.app.background:
             return self.execute(context)
-        global _job
-        job = self._prepare(context)
-        if job is None:
+        if self._start(context) is None:
             return {"CANCELLED"}
-        job.start()
-        _job = job
         self._timer = context.window_manager.event_timer_add(0.2, window=context.window)
         context.window_manager.modal_handler_add(self)
         context.window_manager.progress_begin(0, 1)

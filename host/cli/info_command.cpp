@@ -112,6 +112,15 @@ void describe_lights(const Scene& s) {
   }
 }
 
+// Whether a perspective camera can drive the rig, and how to select it.
+std::string camera_use(const SceneCamera& c, size_t index) {
+  if (!c.placed) return "not placed by any node of the scene";
+  if (!c.invalid.empty()) return "invalid: " + c.invalid;
+  const std::string shared =
+      c.shared_with >= 0 ? ", a further node of camera " + std::to_string(c.shared_with) : std::string();
+  return "placed by node " + quoted(c.node_name) + shared + " (--camera " + std::to_string(index) + ")";
+}
+
 // What a user needs to pick --camera and --animation, and to see what the loader made of the file.
 void describe_scene(const std::string& path, const InputLimits& limits) {
   set_memory_budget(limits.memory);
@@ -144,16 +153,8 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
     }
     char zfar[32] = "infinite";
     if (c.zfar > 0) std::snprintf(zfar, sizeof zfar, "%g", c.zfar);
-    std::printf(
-        "  %zu %s: perspective, yfov %.2f deg, znear %g, zfar %s%s\n", i, quoted(c.name).c_str(),
-        c.yfov * 180.0 / 3.14159265358979323846, c.znear, zfar,
-        (!c.placed            ? ", not placed by any node of the scene"
-         : !c.invalid.empty() ? ", invalid: " + c.invalid
-                              : ", placed by node " + quoted(c.node_name) +
-                                    (c.shared_with >= 0 ? ", a further node of camera " + std::to_string(c.shared_with)
-                                                        : std::string()) +
-                                    " (--camera " + std::to_string(i) + ")")
-            .c_str());
+    std::printf("  %zu %s: perspective, yfov %.2f deg, znear %g, zfar %s, %s\n", i, quoted(c.name).c_str(),
+                c.yfov * 180.0 / 3.14159265358979323846, c.znear, zfar, camera_use(c, i).c_str());
   }
   std::printf("animations: %zu\n", s.animations.size());
   for (size_t i = 0; i < s.animations.size(); ++i) {

@@ -11,6 +11,7 @@
 #include "cli/option_table.h"
 #include "pmr/error.h"
 #include "pmr/limits.h"
+#include "pmr/rig.h"
 #include "pmr/shared.h"
 
 namespace pmr {
@@ -197,10 +198,9 @@ const RenderSection kOutputOptions = {
          "any of encoded, views, quilt, depth (default: encoded). DIR/frame_NNNN.exr is\n"
          "the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view,\n"
          "DIR/frame_NNNN_qsCxRaA.exr the views as a Looking Glass quilt (view 0 bottom\n"
-         "left; in a sequence DIR/frame_qsCxRaA_NNNN.exr, see --name), depth a float Z channel (view-space depth, +inf "
-         "where empty) in the\n"
-         "views and quilt files; DIR/frame_NNNN.json (rig, display, every view's\n"
-         "matrices) is always written",
+         "left; in a sequence DIR/frame_qsCxRaA_NNNN.exr, see --name), depth a float\n"
+         "Z channel (view-space depth, +inf where empty) in the views and quilt files;\n"
+         "DIR/frame_NNNN.json (rig, display, every view's matrices) is always written",
          set_write},
         {"--quilt", nullptr, "CxR", "quilt layout in tiles (default: the most square layout, e.g. 8x6 for 48)",
          [](RenderOptions& o, const std::string& v, const std::string&) { o.job.quilt_layout = v; }},
@@ -366,9 +366,7 @@ const RenderSection kRigOptions = {
            if (comma == std::string::npos) throw Error("invalid " + name + " '" + v + "': expected AZ,EL in degrees");
            o.job.rig.orbit_az_deg = parse_double(v.substr(0, comma), name);
            o.job.rig.orbit_el_deg = parse_double(v.substr(comma + 1), name);
-           if (!(std::abs(o.job.rig.orbit_az_deg) <= 360.0) || !(std::abs(o.job.rig.orbit_el_deg) < 90.0))
-             throw Error("invalid " + name + " '" + v +
-                         "': the azimuth must lie in [-360, 360], the elevation in (-90, 90) degrees");
+           check_orbit(o.job.rig.orbit_az_deg, o.job.rig.orbit_el_deg);
            o.orbit_given = true;
          }},
     }};

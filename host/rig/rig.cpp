@@ -113,6 +113,11 @@ glm::dmat4 orbit_view(const glm::dvec3& c, double focal, double az_deg, double e
 
 }  // namespace
 
+void check_orbit(double az_deg, double el_deg) {
+  if (!(std::abs(el_deg) < 90.0) || !(std::abs(az_deg) <= 360.0))
+    throw Error("invalid --orbit: the azimuth must lie in [-360, 360] and the elevation in (-90, 90) degrees");
+}
+
 Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo, const glm::dvec3& hi,
              const glm::dmat4* camera_pose, double camera_yfov, std::vector<std::string>* warnings) {
   if (config.views < 1) throw Error("invalid --views: need at least 1 view");
@@ -127,8 +132,7 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
   check_positive(config.zoom, "--zoom");
   if (camera_pose && config.zoom != 1.0)
     throw Error("--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own");
-  if (!(std::abs(config.orbit_el_deg) < 90.0) || !(std::abs(config.orbit_az_deg) <= 360.0))
-    throw Error("invalid --orbit: the azimuth must lie in [-360, 360] and the elevation in (-90, 90) degrees");
+  check_orbit(config.orbit_az_deg, config.orbit_el_deg);
   if (camera_pose && (config.orbit_az_deg != 0.0 || config.orbit_el_deg != 0.0))
     throw Error("--orbit moves the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own");
 

@@ -111,6 +111,9 @@ SpacingError spacing_error(const Rig& rig);
 // +-PMR_MAX_VIEW_COORD cannot hold it; make_rig warns then).
 constexpr double kSpacingErrorPx = 0.01;
 
+// Throws pmr::Error unless |az| <= 360 and |el| < 90 degrees (RigConfig's orbit).
+void check_orbit(double az_deg, double el_deg);
+
 // Builds the rig for a scene whose world bounds are [lo, hi]. `camera_pose` (world_from_camera) and
 // `camera_yfov` are used when config.camera >= 0. Throws pmr::Error on an impossible configuration.
 Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo, const glm::dvec3& hi,

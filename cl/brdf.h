@@ -13,10 +13,22 @@
 /* Roughness as the material gives it (factor x texture G) clamped to [0.03, 1]; alpha = r^2. */
 inline sfloat pbr_roughness(sfloat r) { return clamp(r, 0.03f, 1.0f); }
 
-/* F0 = mix(f0d, base, metallic) per channel, f0d the dielectric's (0.04, or from KHR_materials_ior) */
-inline sfloat3 pbr_f0(sfloat3 base, sfloat metallic, sfloat f0d) {
-  return s3(f0d + (base.x - f0d) * metallic, f0d + (base.y - f0d) * metallic, f0d + (base.z - f0d) * metallic);
+/* F0 = mix(f0d, base, metallic) per channel, f0d the dielectric's (0.04, or from KHR_materials_ior,
+ * times KHR_materials_specular's colour and weight) */
+inline sfloat3 pbr_f0(sfloat3 base, sfloat metallic, sfloat3 f0d) {
+  return s3(f0d.x + (base.x - f0d.x) * metallic, f0d.y + (base.y - f0d.y) * metallic,
+            f0d.z + (base.z - f0d.z) * metallic);
 }
+
+/* KHR_materials_specular: the dielectric's F0 min(f0_ior x colour, 1) x weight per channel, f0_ior
+ * from the ior (0.04 at 1.5), colour and weight the extension's factors times their textures. */
+inline sfloat3 specular_f0(sfloat f0_ior, sfloat3 color, sfloat weight) {
+  return s3(fmin(f0_ior * color.x, 1.0f) * weight, fmin(f0_ior * color.y, 1.0f) * weight,
+            fmin(f0_ior * color.z, 1.0f) * weight);
+}
+
+/* ... and F90 = mix(weight, 1, metallic) (a metal's Fresnel stays the base colour's). */
+inline sfloat pbr_f90(sfloat weight, sfloat metallic) { return weight + (1.0f - weight) * metallic; }
 
 /* GGX normal distribution D for cos(n, h) = nh and a2 = alpha^2. */
 inline sfloat ggx_d(sfloat nh, sfloat a2) {
@@ -30,18 +42,30 @@ inline sfloat smith_vis(sfloat nl, sfloat nv, sfloat a2) {
   return select((sfloat)(0.0f), 0.5f / s, s > 0.0f);
 }
 
-/* Schlick's Fresnel per channel, F0 + (1 - F0) (1 - v.h)^5. */
-inline sfloat3 fresnel_schlick(sfloat3 f0, sfloat vh) {
+/* Schlick's Fresnel per channel, F0 + (F90 - F0) (1 - v.h)^5; F90 = mix(the specular weight, 1,
+ * metallic) (1 without KHR_materials_specular). */
+inline sfloat3 fresnel_schlick(sfloat3 f0, sfloat f90, sfloat vh) {
   const sfloat k = 1.0f - vh, k2 = k * k, k5 = k2 * k2 * k;
-  return s3(f0.x + (1.0f - f0.x) * k5, f0.y + (1.0f - f0.y) * k5, f0.z + (1.0f - f0.z) * k5);
+  return s3(f0.x + (f90 - f0.x) * k5, f0.y + (f90 - f0.y) * k5, f0.z + (f90 - f0.z) * k5);
+}
+
+/* D Vis n.l per lane: a GGX lobe about n (alpha^2 = a2) without Fresnel, as KHR_materials_clearcoat's
+ * coat layer uses it (its Fresnel weights the layer); 0 where the light is behind the surface. */
+inline sfloat ggx_lobe_cos(sfloat3 n, sfloat3 v, sfloat3 l, sfloat a2) {
+  const sfloat nl = clamp(s3_dot(n, l), 0.0f, 1.0f), nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
+  const sfloat3 hv = s3_add(l, v);
+  const sfloat hl = sqrt(s3_dot(hv, hv));
+  const sfloat3 h = s3_select(n, s3_scale(hv, 1.0f / hl), hl > 0.0f);
+  const sfloat nh = clamp(s3_dot(n, h), 0.0f, 1.0f);
+  return select((sfloat)(0.0f), ggx_d(nh, a2) * smith_vis(nl, nv, a2) * nl, nl > 0.0f);
 }
 
 /* f(l, v) * dot(n, l) per lane: the radiance reflected toward v per unit irradiance from the direction
- * l (unit, toward the light). n and v are unit vectors; r is the clamped roughness; f0d the dielectric
- * F0; `transmission` (KHR_materials_transmission) the part of the diffuse lobe that transmits instead
+ * l (unit, toward the light). n and v are unit vectors; r is the clamped roughness; f0 and f90 the
+ * Fresnel term's (pbr_f0); `transmission` (KHR_materials_transmission) the part of the diffuse lobe that transmits instead
  * (the environment's transmission term takes its place: cl/transmission.h). */
-inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat f0d, sfloat r, sfloat3 n, sfloat3 v,
-                                     sfloat3 l, sfloat transmission) {
+inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat3 f0, sfloat f90, sfloat r, sfloat3 n,
+                                     sfloat3 v, sfloat3 l, sfloat transmission) {
   const sfloat nl = clamp(s3_dot(n, l), 0.0f, 1.0f);
   const sfloat nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
   const sfloat3 hv = s3_add(l, v);
@@ -49,7 +73,7 @@ inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat f0d, 
   const sfloat3 h = s3_select(n, s3_scale(hv, 1.0f / hl), hl > 0.0f);
   const sfloat nh = clamp(s3_dot(n, h), 0.0f, 1.0f), vh = clamp(s3_dot(v, h), 0.0f, 1.0f);
   const sfloat alpha = r * r, a2 = alpha * alpha;
-  const sfloat3 F = fresnel_schlick(pbr_f0(base, metallic, f0d), vh);
+  const sfloat3 F = fresnel_schlick(f0, f90, vh);
   const sfloat diffuse = (1.0f - metallic) * (1.0f - transmission) * (1.0f / PMR_PI_F),
                spec = ggx_d(nh, a2) * smith_vis(nl, nv, a2);
   const sfloat3 f = s3((1.0f - F.x) * base.x * diffuse + F.x * spec, (1.0f - F.y) * base.y * diffuse + F.y * spec,
@@ -59,8 +83,9 @@ inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat f0d, 
 }
 
 /* The same for an opaque surface. */
-inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat f0d, sfloat r, sfloat3 n, sfloat3 v, sfloat3 l) {
-  return brdf_cos_transmissive(base, metallic, f0d, r, n, v, l, (sfloat)(0.0f));
+inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat3 f0, sfloat f90, sfloat r, sfloat3 n, sfloat3 v,
+                        sfloat3 l) {
+  return brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, (sfloat)(0.0f));
 }
 
 /* KHR_materials_transmission's BTDF for a punctual light seen through the surface (as the Khronos
@@ -68,7 +93,7 @@ inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat f0d, sfloat r, sfl
  * toward the light mirrored on the surface's plane, h = normalize(l' + v), GGX with the transmission
  * roughness max(r clamp(2 ior - 2, 0, 1), 0.03) (alpha its square; the floor keeps ior 1 finite). Per
  * unit irradiance E; the caller weights it by T (1 - metallic) c and Beer-Lambert. */
-inline sfloat3 btdf_light(sfloat3 f0, sfloat r, sfloat ior, sfloat3 n, sfloat3 v, sfloat3 l) {
+inline sfloat3 btdf_light(sfloat3 f0, sfloat f90, sfloat r, sfloat ior, sfloat3 n, sfloat3 v, sfloat3 l) {
   const sfloat3 lm = s3_sub(l, s3_scale(n, 2.0f * s3_dot(n, l)));
   const sfloat3 hv = s3_add(lm, v);
   const sfloat hl = sqrt(s3_dot(hv, hv));
@@ -76,7 +101,7 @@ inline sfloat3 btdf_light(sfloat3 f0, sfloat r, sfloat ior, sfloat3 n, sfloat3 v
   const sfloat rt = fmax(r * clamp(2.0f * ior - 2.0f, 0.0f, 1.0f), 0.03f), a2 = (rt * rt) * (rt * rt);
   const sfloat nh = clamp(s3_dot(n, h), 0.0f, 1.0f), vh = clamp(s3_dot(v, h), 0.0f, 1.0f);
   const sfloat nl = clamp(s3_dot(n, lm), 0.0f, 1.0f), nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
-  const sfloat3 F = fresnel_schlick(f0, vh);
+  const sfloat3 F = fresnel_schlick(f0, f90, vh);
   const sfloat s = ggx_d(nh, a2) * smith_vis(nl, nv, a2);
   return s3((1.0f - F.x) * s, (1.0f - F.y) * s, (1.0f - F.z) * s);
 }

@@ -93,6 +93,15 @@ typedef struct {
   sint glass;
   sfloat transmission, ior, thickness, att_dist; /* thickness in world units (x the node's scale) */
   sfloat3 att_color;
+  /* pbr, KHR_materials_clearcoat: lanes `coated`; their factors are set only when some lane is (0 in
+   * the others) */
+  sint coated;
+  sfloat coat, coat_roughness;
+  /* pbr, KHR_materials_specular: lanes `specular`; the factors are set only when some lane is (1 in the
+   * others) */
+  sint specular;
+  sfloat spec_weight;
+  sfloat3 spec_color;
   uint textured; /* bit l: lane l's material has a map the model reads (lambert: base colour) */
   uint tri[SW];  /* lane l's triangle, where textured                               */
 #if PMR_TRILINEAR
@@ -115,7 +124,9 @@ inline void lanes_clear(LaneWinners* L) {
   L->blended = (sint)(0); /* the alpha inputs are set when the first BLEND lane comes */
   L->metallic = L->roughness = L->f0d = zero;
   L->emissive = s3(zero, zero, zero);
-  L->glass = (sint)(0); /* the transmission inputs are set when the first glass lane comes */
+  L->glass = (sint)(0);  /* the transmission inputs are set when the first glass lane comes */
+  L->coated = (sint)(0); /* ... and the clear coat's when the first coated lane comes */
+  L->specular = (sint)(0);
   L->textured = 0u;
 #if PMR_TRILINEAR
   for (int k = 0; k < 3; ++k) vstore_s(zero, 0, L->ex[k]), vstore_s(zero, 0, L->ey[k]);
@@ -138,6 +149,29 @@ inline void lanes_add_transmission(LaneWinners* L, const ShadeInputs* in, global
   L->thickness = blend(L->thickness, mat->thickness * in->attrs[t->v[0]].scale, take);
   L->att_dist = blend(L->att_dist, mat->attenuation_distance, take);
   L->att_color = blend3(L->att_color, vload3(0, mat->attenuation_color), take);
+}
+
+/* The clear coat factors of material `mat` into lanes `take`. */
+inline void lanes_add_coat(LaneWinners* L, global const PmrMaterial* mat, sint take) {
+  if (!any(L->coated)) L->coat = L->coat_roughness = (sfloat)(0.0f);
+  L->coated |= take;
+  L->coat = blend(L->coat, mat->clearcoat, take);
+  L->coat_roughness = blend(L->coat_roughness, mat->clearcoat_roughness, take);
+}
+
+/* Whether material `mat` changes the dielectric's Fresnel term (KHR_materials_specular). */
+inline bool material_specular(global const PmrMaterial* mat) {
+  return mat->specular != 1.0f || mat->specular_color[0] != 1.0f || mat->specular_color[1] != 1.0f ||
+         mat->specular_color[2] != 1.0f || mat->maps[PMR_MAP_SPECULAR].texture >= 0 ||
+         mat->maps[PMR_MAP_SPECULAR_COLOR].texture >= 0;
+}
+
+/* The specular factors of material `mat` into lanes `take`. */
+inline void lanes_add_specular(LaneWinners* L, global const PmrMaterial* mat, sint take) {
+  if (!any(L->specular)) L->spec_weight = (sfloat)(1.0f), L->spec_color = s3_splat((float3)(1.0f));
+  L->specular |= take;
+  L->spec_weight = blend(L->spec_weight, mat->specular, take);
+  L->spec_color = blend3(L->spec_color, vload3(0, mat->specular_color), take);
 }
 
 /* Lanes `take` (bits: the same as bits) are won by MTA m: its values blended into them (the edge
@@ -177,6 +211,8 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
     L->emissive = blend3(L->emissive, vload3(0, mat->emissive), take);
     if (mat->unlit) L->unlit |= take;
     if (mat->transmission > 0.0f) lanes_add_transmission(L, in, mat, &t, take);
+    if (mat->clearcoat > 0.0f) lanes_add_coat(L, mat, take);
+    if (material_specular(mat)) lanes_add_specular(L, mat, take);
     for (int k = 0; k < PMR_MAPS; ++k) textured = textured || mat->maps[k].texture >= 0;
   }
   if (textured) {
@@ -271,15 +307,24 @@ inline sfloat3 s3_interp_lanes(sfloat3 b, const sfloat3* a) {
   return s3_add(s3_add(s3_scale(a[0], b.x), s3_scale(a[1], b.y)), s3_scale(a[2], b.z));
 }
 
-/* The texture lookups of the textured lanes as factors: base colour
- * (RGB), metallic and roughness, occlusion, emissive; and the normal map's sample with the interpolated
- * tangent, where there is one (mapped). Untextured lanes get factors of 1 and no normal map. */
+/* A tangent-space normal map's sample in the lanes that have one (mapped), with its scale and, trilinear,
+ * its increment of alpha^2 (Toksvig; else 0). */
+typedef struct {
+  int mapped[SW];
+  float s[3][SW], scale[SW], toksvig[SW];
+} LaneNormalMap;
+
+/* The texture lookups of the textured lanes as factors: base colour (RGB), metallic and roughness,
+ * occlusion, emissive; the normal maps' samples with the interpolated tangent (tw) where there is one.
+ * Untextured lanes get factors of 1 and no normal map. */
 typedef struct {
   float base[3][SW], base_alpha[SW], metallic[SW], roughness[SW], ao[SW], emissive[3][SW];
-  int mapped[SW];
-  float s[3][SW], tw[4][SW], normal_scale[SW];
-  float toksvig[SW];                     /* trilinear: the normal map's increment of alpha^2 (Toksvig), else 0 */
-  float transmission[SW], thickness[SW]; /* KHR_materials_transmission R, KHR_materials_volume G (glass) */
+  float tw[4][SW];
+  LaneNormalMap normal;
+  float transmission[SW], thickness[SW];    /* KHR_materials_transmission R, KHR_materials_volume G (glass) */
+  float coat[SW], coat_roughness[SW];       /* KHR_materials_clearcoat R, G (coated) */
+  LaneNormalMap coat_normal;                /* ... clearcoatNormalTexture (coated) */
+  float spec_weight[SW], spec_color[3][SW]; /* KHR_materials_specular A, RGB (specular) */
 } LaneTextures;
 
 /* The screen-space derivatives of SW lanes' source barycentrics, per output pixel in x and in y. */
@@ -361,6 +406,45 @@ inline void sample_map_lanes(const ShadeInputs* in, global const PmrTextureMap* 
 /* Where `take`, array x (SW floats) gets the lanes of value. */
 inline void lanes_put(float* x, sfloat value, sint take) { vstore_s(select(vload_s(0, x), value, take), 0, x); }
 
+/* Normal map `k` of material `mat` (scale `scale`) for its lanes `bits` (`take`) into M. */
+inline void sample_normal_map_lanes(const ShadeInputs* in, global const PmrMaterial* mat, int k, float scale,
+                                    const LaneWinners* L, uint bits, sint take, sfloat3 b, const LaneBaryGrad* g,
+                                    LaneTexcoords* C, LaneNormalMap* M) {
+  sfloat c[4];
+  sample_map_lanes(in, &mat->maps[k], L->tri, bits, take, b, g, false, C, c);
+  for (int i = 0; i < 3; ++i) lanes_put(M->s[i], c[i], take);
+  lanes_put(M->scale, (sfloat)(scale), take);
+  vstore_s(select(vload_s(0, M->mapped), (sint)(-1), take), 0, M->mapped);
+  /* the chain's alpha is the square root of the increment for unit normals (MipKind::Normal); a
+   * scale shrinks the normals' spread in x and y with their slopes */
+  if (g) lanes_put(M->toksvig, c[3] * c[3] * fmin(1.0f, scale * scale), take);
+}
+
+/* The clear coat maps of material `mat` (KHR_materials_clearcoat) for its lanes `bits` (`take`). */
+inline void sample_coat_lanes(const ShadeInputs* in, global const PmrMaterial* mat, const LaneWinners* L, uint bits,
+                              sint take, sfloat3 b, const LaneBaryGrad* g, LaneTexcoords* C, LaneTextures* T) {
+  sfloat c[4];
+  if (mat->maps[PMR_MAP_CLEARCOAT].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_CLEARCOAT], L->tri, bits, take, b, g, false, C, c);
+    lanes_put(T->coat, c[0], take);
+  }
+  if (mat->maps[PMR_MAP_CLEARCOAT_ROUGHNESS].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_CLEARCOAT_ROUGHNESS], L->tri, bits, take, b, g, false, C, c);
+    lanes_put(T->coat_roughness, c[1], take);
+  }
+  if (mat->maps[PMR_MAP_CLEARCOAT_NORMAL].texture >= 0)
+    sample_normal_map_lanes(in, mat, PMR_MAP_CLEARCOAT_NORMAL, mat->clearcoat_normal_scale, L, bits, take, b, g, C,
+                            &T->coat_normal);
+}
+
+/* No normal map in any lane. */
+inline void normal_map_clear(LaneNormalMap* M) {
+  for (int l = 0; l < SW; ++l) {
+    for (int k = 0; k < 3; ++k) M->s[k][l] = 0.0f;
+    M->scale[l] = 1.0f, M->mapped[l] = 0, M->toksvig[l] = 0.0f;
+  }
+}
+
 /* The maps of material `mat` for its lanes `bits` (`take`). */
 inline void sample_material_lanes(const ShadeInputs* in, global const PmrMaterial* mat, const LaneWinners* L, uint bits,
                                   sint take, sfloat3 b, const LaneBaryGrad* g, bool pbr, LaneTexcoords* C,
@@ -392,14 +476,18 @@ inline void sample_material_lanes(const ShadeInputs* in, global const PmrMateria
     sample_map_lanes(in, &mat->maps[PMR_MAP_THICKNESS], L->tri, bits, take, b, g, false, C, c);
     lanes_put(T->thickness, c[1], take);
   }
-  if (mat->maps[PMR_MAP_NORMAL].texture >= 0) {
-    sample_map_lanes(in, &mat->maps[PMR_MAP_NORMAL], L->tri, bits, take, b, g, false, C, c);
-    for (int k = 0; k < 3; ++k) lanes_put(T->s[k], c[k], take);
-    lanes_put(T->normal_scale, (sfloat)(mat->normal_scale), take);
-    vstore_s(select(vload_s(0, T->mapped), (sint)(-1), take), 0, T->mapped);
-    /* the chain's alpha is the square root of the increment for unit normals (MipKind::Normal); a
-     * scale shrinks the normals' spread in x and y with their slopes */
-    if (g) lanes_put(T->toksvig, c[3] * c[3] * fmin(1.0f, mat->normal_scale * mat->normal_scale), take);
+  if (mat->clearcoat > 0.0f) sample_coat_lanes(in, mat, L, bits, take, b, g, C, T);
+  if (mat->maps[PMR_MAP_SPECULAR].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_SPECULAR], L->tri, bits, take, b, g, false, C, c);
+    lanes_put(T->spec_weight, c[3], take);
+  }
+  if (mat->maps[PMR_MAP_SPECULAR_COLOR].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_SPECULAR_COLOR], L->tri, bits, take, b, g, true, C, c);
+    for (int k = 0; k < 3; ++k) lanes_put(T->spec_color[k], c[k], take);
+  }
+  const bool normal = mat->maps[PMR_MAP_NORMAL].texture >= 0;
+  if (normal) sample_normal_map_lanes(in, mat, PMR_MAP_NORMAL, mat->normal_scale, L, bits, take, b, g, C, &T->normal);
+  if (normal || (mat->clearcoat > 0.0f && mat->maps[PMR_MAP_CLEARCOAT_NORMAL].texture >= 0)) {
     float bs[3][SW];
     s3_store(b, bs[0], bs[1], bs[2]);
     for (uint r = bits; r != 0u; r &= r - 1u) { /* the interpolated tangent, lane by lane (a gather) */
@@ -417,14 +505,20 @@ inline void sample_material_lanes(const ShadeInputs* in, global const PmrMateria
 inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b, const LaneBaryGrad* grad, bool pbr,
                          LaneTextures* T) {
   for (int l = 0; l < SW; ++l) {
-    for (int k = 0; k < 3; ++k) T->base[k][l] = T->emissive[k][l] = 1.0f, T->s[k][l] = 0.0f;
+    for (int k = 0; k < 3; ++k) T->base[k][l] = T->emissive[k][l] = 1.0f;
     for (int k = 0; k < 4; ++k) T->tw[k][l] = 0.0f;
-    T->metallic[l] = T->roughness[l] = T->ao[l] = T->normal_scale[l] = 1.0f;
-    T->mapped[l] = 0;
-    T->toksvig[l] = 0.0f;
+    T->metallic[l] = T->roughness[l] = T->ao[l] = 1.0f;
   }
+  normal_map_clear(&T->normal);
   if (any(L->glass))
     for (int l = 0; l < SW; ++l) T->transmission[l] = T->thickness[l] = 1.0f;
+  if (any(L->coated)) {
+    for (int l = 0; l < SW; ++l) T->coat[l] = T->coat_roughness[l] = 1.0f;
+    normal_map_clear(&T->coat_normal);
+  }
+  if (any(L->specular))
+    for (int l = 0; l < SW; ++l)
+      T->spec_weight[l] = T->spec_color[0][l] = T->spec_color[1][l] = T->spec_color[2][l] = 1.0f;
   if (PMR_WITH_BLEND && any(L->blended))
     for (int l = 0; l < SW; ++l) T->base_alpha[l] = 1.0f;
   uint material[SW];
@@ -449,22 +543,22 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
   }
 }
 
-/* The normal map applied to the unit normals n (before any back-face flip), in the lanes that have
- * one: the interpolated tangent made orthogonal to n, the bitangent sign(w) * cross(n, t),
+/* Normal map M applied to the unit normals n (before any back-face flip), in the lanes that have one:
+ * the interpolated tangent made orthogonal to n, the bitangent sign(w) * cross(n, t),
  * m = (2 s - 1) * (scale, scale, 1). A lane without a tangent (zero) keeps n. */
-inline sfloat3 mapped_normal(const LaneTextures* T, sfloat3 n) {
+inline sfloat3 mapped_normal(const LaneTextures* T, const LaneNormalMap* M, sfloat3 n) {
   const sfloat3 tw = LANE3(T->tw);
   sfloat3 tangent = s3_sub(tw, s3_scale(n, s3_dot(n, tw)));
   const sfloat len = sqrt(s3_dot(tangent, tangent));
   tangent = s3_scale(tangent, 1.0f / len);
   const sfloat3 bitangent =
       s3_scale(s3_cross(n, tangent), select((sfloat)(1.0f), (sfloat)(-1.0f), vload_s(0, T->tw[3]) < 0.0f));
-  const sfloat scale = vload_s(0, T->normal_scale);
-  const sfloat3 s = LANE3(T->s);
+  const sfloat scale = vload_s(0, M->scale);
+  const sfloat3 s = LANE3(M->s);
   const sfloat3 m = s3((2.0f * s.x - 1.0f) * scale, (2.0f * s.y - 1.0f) * scale, 2.0f * s.z - 1.0f);
   const sfloat3 mapped = s3_add(s3_add(s3_scale(tangent, m.x), s3_scale(bitangent, m.y)), s3_scale(n, m.z));
   const sfloat mlen = sqrt(s3_dot(mapped, mapped));
-  return s3_select(n, s3_scale(mapped, 1.0f / mlen), vload_s(0, T->mapped) & (len > 1e-12f) & (mlen > 0.0f));
+  return s3_select(n, s3_scale(mapped, 1.0f / mlen), vload_s(0, M->mapped) & (len > 1e-12f) & (mlen > 0.0f));
 }
 
 /* The environment's P(d, r) per lane where `act` (0 elsewhere), or the uniform default's radiance. */
@@ -548,44 +642,104 @@ inline sfloat geometric_spread(const LaneWinners* L, const LaneBaryGrad* g, sflo
 
 #include "transmission.h" /* reads the inputs and lanes above */
 
-/* w (1 - (F0 A + B)) c: the weight of the light through a transmissive surface (w = ao T (1 - metallic)). */
-inline sfloat3 btdf_weight(sfloat w, sfloat3 f0, sfloat A, sfloat B, sfloat3 c) {
-  return s3(w * (1.0f - (f0.x * A + B)) * c.x, w * (1.0f - (f0.y * A + B)) * c.y, w * (1.0f - (f0.z * A + B)) * c.z);
+/* w (1 - (F0 A + F90 B)) c: the weight of the light through a transmissive surface (w = ao T (1 - metallic)). */
+inline sfloat3 btdf_weight(sfloat w, sfloat3 f0, sfloat f90, sfloat A, sfloat B, sfloat3 c) {
+  return s3(w * (1.0f - (f0.x * A + f90 * B)) * c.x, w * (1.0f - (f0.y * A + f90 * B)) * c.y,
+            w * (1.0f - (f0.z * A + f90 * B)) * c.z);
 }
 
-/* glTF metallic-roughness of the lanes with unit normals n (already flipped for back faces, normal map
- * applied) and base colours `base`, seen from view `view`'s camera: the sum over the light table of
- * f E n.l (the file's punctual lights, or the default light, or none), the environment times the
- * occlusion, plus the emissive term; an unlit material is its base colour. */
-inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const LaneTextures* T, bool textured, sfloat3 b,
-                         sfloat3 n, sfloat3 base, sfloat spread, int view) {
-  global const PmrParams* P = in->P;
-  const sfloat3 p = s3_interp_lanes(b, L->p);
-  const bool glass = any(L->glass); /* the transmission terms cost nothing to opaque lanes */
+/* What the lobes read of each lane's surface, filled once per batch of lanes (pbr_surface): the one
+ * place a material input is combined with its texture. */
+typedef struct {
+  sfloat3 p, v;    /* world position, unit direction toward the view's camera                      */
+  sfloat3 n, base; /* unit shading normal (normal map applied, back faces flipped), base colour     */
+  sfloat3 f0, emissive;
+  sfloat f90;                     /* the Fresnel term's F0 and F90 (pbr_f0, pbr_f90)                          */
+  sfloat metallic, r, ao;         /* r: the clamped, widened roughness                                        */
+  sfloat transmission, thickness; /* glass lanes (0 elsewhere)                                        */
+  sfloat coat, coat_r;            /* KHR_materials_clearcoat (coated lanes): intensity, roughness  */
+  sfloat3 coat_n;                 /* ... the coat's unit normal (its own normal map, or the geometric one) */
+} Surface;
+
+/* The surface of the lanes seen from view `view`: n and coat_n are unit normals, flipped for back faces;
+ * spread and coat_spread the specular antialiasing increments of the two lobes. */
+inline Surface pbr_surface(const ShadeInputs* in, const LaneWinners* L, const LaneTextures* T, bool textured, sfloat3 b,
+                           sfloat3 n, sfloat3 coat_n, sfloat3 base, sfloat spread, sfloat coat_spread, int view) {
+  Surface S;
+  S.p = s3_interp_lanes(b, L->p);
+  const bool glass = any(L->glass), coated = any(L->coated);
   sfloat metallic = L->metallic, roughness = L->roughness, ao = 1.0f;
   sfloat transmission = glass ? L->transmission : 0.0f, thickness = glass ? L->thickness : 0.0f;
+  sfloat coat = coated ? L->coat : 0.0f, coat_roughness = coated ? L->coat_roughness : 0.0f;
   sfloat3 emissive = L->emissive;
   if (textured) {
     metallic *= vload_s(0, T->metallic), roughness *= vload_s(0, T->roughness), ao = vload_s(0, T->ao);
     emissive = s3_mul(emissive, LANE3(T->emissive));
     if (glass) transmission *= vload_s(0, T->transmission), thickness *= vload_s(0, T->thickness);
+    if (coated) coat *= vload_s(0, T->coat), coat_roughness *= vload_s(0, T->coat_roughness);
   }
-  const sfloat3 to_eye = s3_sub(s3_splat(in->eyes[view + (int)P->view_base].xyz), p);
-  const sfloat3 v = s3_scale(to_eye, 1.0f / sqrt(s3_dot(to_eye, to_eye)));
-  const sfloat r = widened_roughness(pbr_roughness(roughness), spread);
-  const sfloat3 f0 = pbr_f0(base, metallic, L->f0d);
-  sfloat3 direct = s3_splat((float3)(0.0f)), lights_through = direct;
+  const sfloat3 to_eye = s3_sub(s3_splat(in->eyes[view + (int)in->P->view_base].xyz), S.p);
+  S.v = s3_scale(to_eye, 1.0f / sqrt(s3_dot(to_eye, to_eye)));
+  S.n = n, S.base = base, S.emissive = emissive;
+  S.metallic = metallic, S.ao = ao, S.transmission = transmission, S.thickness = thickness;
+  S.r = widened_roughness(pbr_roughness(roughness), spread);
+  if (any(L->specular)) { /* KHR_materials_specular */
+    sfloat weight = L->spec_weight;
+    sfloat3 color = L->spec_color;
+    if (textured) weight *= vload_s(0, T->spec_weight), color = s3_mul(color, LANE3(T->spec_color));
+    S.f0 = pbr_f0(base, metallic, specular_f0(L->f0d, color, weight));
+    S.f90 = pbr_f90(weight, metallic);
+  } else {
+    S.f0 = pbr_f0(base, metallic, s3(L->f0d, L->f0d, L->f0d));
+    S.f90 = 1.0f;
+  }
+  S.coat = coat, S.coat_n = coat_n;
+  S.coat_r = coated ? widened_roughness(pbr_roughness(coat_roughness), coat_spread) : (sfloat)(1.0f);
+  return S;
+}
+
+/* KHR_materials_clearcoat's layering (its specification's fresnel_coat): the material's colour `under`
+ * seen through a coat of intensity c and ior 1.5, mix(under, coat lobe, c Fc), Fc = 0.04 + 0.96
+ * (1 - |coat_n . v|)^5; the coat lobe is `lights` (the GGX lobe about coat_n of roughness coat_r with no
+ * Fresnel of its own, summed over the lights) plus ao (A + B) P(reflect(-v, coat_n), coat_r). Lanes
+ * without a coat keep `under` bit for bit. */
+inline sfloat3 coated_lanes(const ShadeInputs* in, const LaneWinners* L, const Surface* S, sfloat3 under,
+                            sfloat3 lights) {
+  const sfloat nv = s3_dot(S->coat_n, S->v);
+  const sfloat k = 1.0f - fmin(fabs(nv), 1.0f), k2 = k * k;
+  const sfloat w = S->coat * (0.04f + 0.96f * (k2 * k2 * k));
+  sfloat A, B;
+  split_sum_lanes(in->split_sum, nv, S->coat_r, &A, &B);
+  const sint act = L->act & L->coated;
+  const sfloat3 env = environment_along(in, s3_sub(s3_scale(S->coat_n, 2.0f * nv), S->v), S->coat_r, act);
+  const sfloat3 coat = s3_add(lights, s3_scale(env, S->ao * (A + B)));
+  return s3_select(under, s3_add(s3_scale(under, 1.0f - w), s3_scale(coat, w)), L->coated);
+}
+
+/* glTF metallic-roughness of the lanes' surfaces S seen from view `view`'s camera: the sum over the
+ * light table of f E n.l (the file's punctual lights, or the default light, or none), the environment
+ * times the occlusion, plus the emissive term, under the clear coat where there is one; an unlit material
+ * is its base colour. */
+inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surface* S, int view) {
+  global const PmrParams* P = in->P;
+  const bool glass = any(L->glass), coated = any(L->coated); /* their terms cost nothing to other lanes */
+  const sfloat3 n = S->n, v = S->v, base = S->base, f0 = S->f0;
+  const sfloat f90 = S->f90;
+  const sfloat metallic = S->metallic, r = S->r, transmission = S->transmission;
+  const sfloat coat_a2 = coated ? (S->coat_r * S->coat_r) * (S->coat_r * S->coat_r) : 0.0f;
+  sfloat3 direct = s3_splat((float3)(0.0f)), lights_through = direct, coat_lights = direct;
   const uint num_lights = P->num_lights;
   for (uint i = 0; i < num_lights; ++i) {
     global const PmrLight* light = &in->lights[i];
     sfloat3 l;
     const sfloat3 E =
         light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
-                         vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, p, &l);
-    const sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, L->f0d, r, n, v, l, transmission)
-                            : brdf_cos(base, metallic, L->f0d, r, n, v, l);
+                         vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, S->p, &l);
+    const sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, transmission)
+                            : brdf_cos(base, metallic, f0, f90, r, n, v, l);
     direct = s3_add(direct, s3_mul(f, E));
-    if (glass) lights_through = s3_add(lights_through, s3_mul(btdf_light(f0, r, L->ior, n, v, l), E));
+    if (glass) lights_through = s3_add(lights_through, s3_mul(btdf_light(f0, f90, r, L->ior, n, v, l), E));
+    if (coated) coat_lights = s3_add(coat_lights, s3_scale(E, ggx_lobe_cos(S->coat_n, v, l, coat_a2)));
   }
   const sfloat nv = s3_dot(n, v);
   sfloat A, B;
@@ -594,17 +748,20 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Lane
   environment_lanes(in, n, v, nv, metallic, r, L->act, &irradiance, &prefiltered);
   /* transmission replaces the diffuse lobe */
   const sfloat kd = glass ? (1.0f - metallic) * (1.0f - transmission) : 1.0f - metallic;
-  sfloat3 ambient = s3(ao * (base.x * kd * irradiance.x + (f0.x * A + B) * prefiltered.x),
-                       ao * (base.y * kd * irradiance.y + (f0.y * A + B) * prefiltered.y),
-                       ao * (base.z * kd * irradiance.z + (f0.z * A + B) * prefiltered.z));
+  const sfloat ao = S->ao;
+  const sfloat f90B = f90 * B;
+  sfloat3 ambient = s3(ao * (base.x * kd * irradiance.x + (f0.x * A + f90B) * prefiltered.x),
+                       ao * (base.y * kd * irradiance.y + (f0.y * A + f90B) * prefiltered.y),
+                       ao * (base.z * kd * irradiance.z + (f0.z * A + f90B) * prefiltered.z));
   if (glass) { /* KHR_materials_transmission's BTDF: (1 - (F0 A + B)) c_diff x the light through */
     const sfloat w = select((sfloat)(0.0f), transmission * (1.0f - metallic), L->glass);
     sfloat3 attenuation;
-    const sfloat3 through = transmitted_lanes(in, L, p, n, v, r, thickness, view, &attenuation);
-    ambient = s3_add(ambient, s3_mul(btdf_weight(ao * w, f0, A, B, base), through));
+    const sfloat3 through = transmitted_lanes(in, L, S->p, n, v, r, S->thickness, view, &attenuation);
+    ambient = s3_add(ambient, s3_mul(btdf_weight(ao * w, f0, f90, A, B, base), through));
     direct = s3_add(direct, s3_mul(s3_scale(s3_mul(base, attenuation), w), lights_through));
   }
-  const sfloat3 lit = s3_add(s3_add(direct, ambient), emissive);
+  sfloat3 lit = s3_add(s3_add(direct, ambient), S->emissive);
+  if (coated) lit = coated_lanes(in, L, S, lit, coat_lights);
   return s3_select(lit, base, L->unlit);
 }
 
@@ -652,13 +809,24 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
   sfloat3 n = s3_select(L->face, s3_scale(ni, 1.0f / len), L->smooth & (len > 0.0f));
   const float exposure = in->P->exposure;
   if (pbr) {
-    sfloat spread = 0.0f;
+    sfloat spread = 0.0f, coat_spread = 0.0f;
 #if PMR_TRILINEAR
-    if (grad) spread = geometric_spread(L, grad, n, len) + (textured ? vload_s(0, T.toksvig) : 0.0f);
+    if (grad) {
+      spread = coat_spread = geometric_spread(L, grad, n, len);
+      if (textured) spread += vload_s(0, T.normal.toksvig);
+      if (textured && any(L->coated)) coat_spread += vload_s(0, T.coat_normal.toksvig);
+    }
 #endif
-    if (textured) n = mapped_normal(&T, n);
+    /* the coat has its own normal map, or none: it follows the geometric normal */
+    sfloat3 coat_n = n;
+    if (any(L->coated)) {
+      if (textured) coat_n = mapped_normal(&T, &T.coat_normal, n);
+      coat_n = s3_select(coat_n, s3_neg(coat_n), L->back);
+    }
+    if (textured) n = mapped_normal(&T, &T.normal, n);
     n = s3_select(n, s3_neg(n), L->back); /* t, b and n together */
-    return s3_half_range(s3_scale(shade_pbr(in, L, &T, textured, b, n, base, spread, view), exposure));
+    const Surface S = pbr_surface(in, L, &T, textured, b, n, coat_n, base, spread, coat_spread, view);
+    return s3_half_range(s3_scale(shade_pbr(in, L, &S, view), exposure));
   }
   n = s3_select(n, s3_neg(n), L->back);
   const sfloat lambert = 0.2f + 0.8f * max(s3_dot(n, s3_splat(light)), 0.0f);

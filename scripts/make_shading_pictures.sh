@@ -20,6 +20,8 @@
 #                                       next to OPAQUE and MASK), views 0 and N-1 of 9, the studio
 #   docs/shading_variants.png           the Khronos sample model MaterialsVariantsShoe, center view: its
 #                                       default materials | --variant midnight | beach | street
+#   docs/shading_clearcoat.png          the Khronos sample models ClearCoatTest (center view) and
+#                                       ClearCoatCarPaint (views 0 and N-1 of 9), the studio
 #
 # usage: scripts/make_shading_pictures.sh [GLTF_DIR]
 #   GLTF_DIR   folder of the Khronos sample models (GLTF_DIR/Suzanne/glTF/Suzanne.gltf, ...); default
@@ -132,6 +134,17 @@ if present "$SHOE" "$OUT/shading_variants.png" "$MODELS_HINT"; then
     panels+=("$(views "shoe$variant" 4)") checks+=("$(center "shoe$variant")")
   done
   $PICTURES strip "$OUT/shading_variants.png" "${panels[@]}" --check-center "${checks[@]}"
+fi
+
+echo "== ClearCoatTest and ClearCoatCarPaint (KHR_materials_clearcoat)"
+COAT=$GLTF_DIR/ClearCoatTest/glTF/ClearCoatTest.gltf
+PAINT=$GLTF_DIR/ClearCoatCarPaint/glTF/ClearCoatCarPaint.gltf
+if present "$COAT" "$OUT/shading_clearcoat.png" "$MODELS_HINT" &&
+   present "$PAINT" "$OUT/shading_clearcoat.png" "$MODELS_HINT"; then
+  render coat "$COAT" --views 9 --view-size 498x279
+  render paint "$PAINT" --views 9 --view-size 498x279 --zoom 1.6
+  $PICTURES strip "$OUT/shading_clearcoat.png" "$(views coat 4)" "$(views paint 0)" "$(views paint 8)" \
+    --check-center "$(center coat)" - -
 fi
 
 if [ ${#skipped[@]} -gt 0 ]; then

@@ -1,7 +1,10 @@
 // Helpers of the --shading pbr tests against the double-precision reference (tests/reference): the
 // model's inputs at a voxel, the default light and uniform environment as the reference states them,
-// the 1% + 1e-3 bound per channel, and scenes of flat layers.
+// the 1% + 1e-3 bound per channel, the checks of a material feature's voxels, and scenes of flat layers.
 #pragma once
+#include <functional>
+#include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,6 +31,79 @@ struct BoundCheck {
 // environment of radiance 0.2 (I = P = 0.2) and the split-sum table the kernels are given.
 std::vector<ref::PunctualLight> default_light(const Rig& rig);
 ref::EnvironmentTerms uniform_environment(double radiance);
+
+// The reference colour of every covered voxel of a render (volume index v), under `lights` and `env`
+// (by default the default light and environment): the winning MTA found by its key and view, then the
+// model at its barycentrics.
+struct VoxelReference {
+  const Scene& scene;
+  const Rig& rig;
+  const Rendered& out;
+  std::multimap<uint32_t, PmrMta> by_key;
+  std::vector<ref::PunctualLight> lights = default_light(rig);
+  ref::EnvironmentTerms env = uniform_environment(0.2);
+
+  VoxelReference(const Scene& s, const Rig& r, const Rendered& o);
+  // The winner of voxel v (null if none matches its key and view).
+  const PmrMta* mta(size_t v) const;
+  glm::dvec3 colour(size_t v, const PmrMta& m) const;
+};
+
+// The rig of the highlight tests: N views of 160 x 100 over a 60 degree cone, framing [-1, 1]^3.
+Rig highlight_rig(int views);
+// The brightest covered pixel (green channel) of view `view` of the render, or of the reference when
+// `reference` is given, outside a radius of `away` pixels around `avoid` (in the view's pixels).
+glm::dvec2 brightest_pixel(const Rendered& out, const VoxelReference* reference, const Rig& rig, int view,
+                           glm::dvec2 avoid = glm::dvec2(-1e9), double away = 0.0);
+
+// The reference's light for a scene light, from its definition (colour, intensity, cone angles in
+// double precision), not from the kernels' table; and a scene light of the given kind.
+ref::PunctualLight reference_light(const SceneLight& l);
+SceneLight make_light(SceneLightType type, const glm::dvec3& position, const glm::dvec3& direction, float intensity,
+                      float range = 0.0f);
+
+// --shading pbr with 4 x 4 x 4 tiles, `method` (multipass snapped to PMR's vertices, so that the two
+// agree bit for bit), `filter` and `env` (null: the default), and one frame rendered with it.
+PipelineConfig pbr_config(Method method = Method::Pmr, TextureFilter filter = TextureFilter::Bilinear,
+                          const std::shared_ptr<const Environment>& env = nullptr);
+Rendered render_pbr(const Scene& s, const Rig& rig, Method method = Method::Pmr,
+                    TextureFilter filter = TextureFilter::Bilinear,
+                    const std::shared_ptr<const Environment>& env = nullptr);
+// An environment image of radiance 1 in every direction (an image: no default light).
+std::shared_ptr<const Environment> white_environment();
+// Appends a 16 x 16 texture whose texel (x, y) is f(x, y) (RGBA in [0, 1], rounded to 8 bits); its index.
+int add_texture16(Scene& s, const std::function<glm::dvec4(int, int)>& f);
+
+// A material feature against the reference: every covered voxel of `with.out` within the bound of
+// `with`, and per material the voxels and those where `without` (the reference of the scene without
+// the feature) is outside twice the bound, i.e. where a kernel ignoring the feature would fail.
+struct FeatureCheck {
+  BoundCheck check;
+  std::map<uint32_t, size_t> voxels, changed;
+};
+FeatureCheck check_feature(const VoxelReference& with, const VoxelReference& without);
+
+// A material feature's voxel test: `s` (its lights in `lights`) rendered; every voxel within the bound of
+// the reference; materials 1..n each drawn on over 300 voxels; those with the feature (1..n-1) changed by
+// it (`without`: the scene without it) on more than 1/divisor of their voxels, material n (without it) on
+// none. Returns the largest error as a fraction of the bound.
+double expect_feature_matches_reference(const Scene& s, const Scene& without,
+                                        const std::vector<ref::PunctualLight>& lights, uint32_t n, size_t divisor);
+
+// Every path draws `s` (pbr configuration `pc`) alike: multipass (snapped) equals PMR's volume bit for
+// bit; at a 240 x 135 display the fused raster + encode equals the encoded volume, and subpixel
+// sampling's image sum is within 5% of view sampling's. Over 1000 channels are lit; with `other` (the
+// scene without some feature), its fused image differs from s's on more than a quarter of them.
+void expect_paths_agree(const Scene& s, const Rig& rig, const PipelineConfig& pc, const Scene* other = nullptr);
+
+// Every covered voxel of a render of a real model whose surface point passes `include` against the
+// reference; `counted`: how many of those pass `count` too.
+struct ModelCheck {
+  BoundCheck check;
+  size_t compared = 0, counted = 0;
+};
+using SurfaceTest = std::function<bool(const ref::SurfacePoint&)>;
+ModelCheck check_model(const VoxelReference& reference, const SurfaceTest& include, const SurfaceTest& count);
 
 // Scenes of flat layers: a rectangle [x0, x1] x [y0, y1] at depth z facing +Z (the camera) as two
 // triangles; a material appended (its index returned); an unlit material of colour c (alpha 1).

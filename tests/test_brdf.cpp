@@ -38,15 +38,16 @@ glm::dvec3 random_unit(std::mt19937& g) {
 
 glm::dvec3 as_float(const glm::dvec3& v) { return glm::dvec3(glm::vec3(v)); }
 
-// Random inputs, mostly lit; float kernel within 1e-3 relative (+1e-5 absolute) of the double reference
-// evaluated on the same float inputs, for roughness >= 0.2 (the model's accuracy bound starts there).
+// Random inputs, mostly lit, two thirds with a KHR_materials_specular weight and colour; float kernel
+// within 1e-3 relative (+1e-5 absolute) of the double reference evaluated on the same float inputs, for
+// roughness >= 0.2 (the model's accuracy bound starts there).
 TEST(Brdf, KernelMatchesTheReference) {
   std::mt19937 g(7);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   std::vector<float> in;
   struct Case {
-    glm::dvec3 base, n, v, l;
-    double metallic, r;
+    glm::dvec3 base, n, v, l, specular_color{1.0};
+    double metallic, r, specular = 1.0;
   };
   std::vector<Case> cases;
   for (int i = 0; i < 4000; ++i) {
@@ -62,16 +63,21 @@ TEST(Brdf, KernelMatchesTheReference) {
     }
     if (i % 50 == 0) l = glm::reflect(-v, c.n);  // the specular peak
     c.v = as_float(v), c.l = as_float(l);
+    if (i % 3 != 0) {  // KHR_materials_specular: a weight, a colour (up to 30, where min(0.04 c, 1) clips)
+      c.specular = float(U(g));
+      c.specular_color = as_float(glm::dvec3(U(g), U(g), U(g)) * (i % 3 == 1 ? 2.0 : 30.0));
+    }
     cases.push_back(c);
-    for (double x :
-         {c.base.x, c.base.y, c.base.z, c.metallic, c.r, c.n.x, c.n.y, c.n.z, c.v.x, c.v.y, c.v.z, c.l.x, c.l.y, c.l.z})
+    for (double x : {c.base.x, c.base.y, c.base.z, c.metallic, c.r, c.n.x, c.n.y, c.n.z, c.v.x, c.v.y, c.v.z, c.l.x,
+                     c.l.y, c.l.z, c.specular, c.specular_color.x, c.specular_color.y, c.specular_color.z})
       in.push_back(float(x));
   }
-  const std::vector<float> out = run_probe("brdf_probe", in, 14, 3);
+  const std::vector<float> out = run_probe("brdf_probe", in, 18, 3);
   int lit = 0;
   for (size_t i = 0; i < cases.size(); ++i) {
     const Case& c = cases[i];
-    const glm::dvec3 want = ref::brdf_cos(c.base, c.metallic, c.r, c.n, c.v, c.l);
+    const glm::dvec3 want =
+        ref::brdf_cos(c.base, c.metallic, c.r, c.n, c.v, c.l, 1.5, 0.0, c.specular, c.specular_color);
     lit += want.x + want.y + want.z > 0.0;
     for (int k = 0; k < 3; ++k)
       ASSERT_NEAR(out[3 * i + k], want[k], 1e-3 * std::fabs(want[k]) + 1e-5) << "case " << i << " channel " << k;

@@ -9,6 +9,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -44,34 +45,7 @@ using test::default_light;
 using test::surface_at;
 using test::uniform_environment;
 
-// The reference colour of every covered voxel of a render (volume index v), under the default light
-// and environment: the winning MTA found by its key and view, then the model at its barycentrics.
-struct VoxelReference {
-  const Scene& scene;
-  const Rig& rig;
-  const test::Rendered& out;
-  std::multimap<uint32_t, PmrMta> by_key;
-  std::vector<ref::PunctualLight> lights = default_light(rig);
-  ref::EnvironmentTerms env = uniform_environment(0.2);
-
-  VoxelReference(const Scene& s, const Rig& r, const test::Rendered& o) : scene(s), rig(r), out(o) {
-    for (const PmrMta& m : out.mtas) by_key.emplace(m.key, m);
-  }
-  // The winner of voxel v (null if none matches its key and view).
-  const PmrMta* mta(size_t v) const {
-    const int view = int(v / (size_t(rig.view_w) * size_t(rig.view_h)));
-    auto range = by_key.equal_range(out.key[v]);
-    for (auto it = range.first; it != range.second; ++it)
-      if (view >= it->second.view_lo && view <= it->second.view_hi) return &it->second;
-    return nullptr;
-  }
-  glm::dvec3 colour(size_t v, const PmrMta& m) const {
-    const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
-    const int px = int(v % W), py = int((v / W) % H), view = int(v / (W * H));
-    const glm::dvec3 b = ref::source_barycentrics(m, px, py, view);
-    return ref::pbr_color(surface_at(scene, rig, m.tri, b, (m.flags & PMR_MTA_BACK) != 0, view), lights, env, 1.0);
-  }
-};
+using test::VoxelReference;
 
 // Quads with curved normals and vertex colours, one material each: metals and dielectrics over
 // roughness 0.2 .. 1, an emissive one, an unlit one, a double-sided back face.
@@ -136,17 +110,7 @@ TEST(Pbr, EveryShadedVoxelMatchesTheReference) {
 Scene mapped_quads() {
   Scene s = test::empty_scene(false);
   s.material_inputs.resize(1);
-  auto texture = [&](auto texel_of) {
-    SceneTexture t;
-    t.width = 16, t.height = 16;
-    for (int y = 0; y < 16; ++y)
-      for (int x = 0; x < 16; ++x) {
-        const glm::dvec4 c = texel_of(x, y);
-        for (int k = 0; k < 4; ++k) t.rgba.push_back(uint8_t(std::lround(255.0 * glm::clamp(c[k], 0.0, 1.0))));
-      }
-    s.textures.push_back(t);
-    return int(s.textures.size() - 1);
-  };
+  auto texture = [&](const std::function<glm::dvec4(int, int)>& texel_of) { return test::add_texture16(s, texel_of); };
   const int mr = texture([](int x, int y) { return glm::dvec4(0.0, 0.3 + 0.045 * x, y / 15.0, 1.0); });
   const int normal = texture([](int x, int y) {
     return glm::dvec4(0.5 + 0.35 * std::sin(0.8 * x), 0.5 + 0.35 * std::cos(0.6 * y), 0.85, 1.0);
@@ -409,30 +373,15 @@ Scene sphere(float radius, const glm::vec3& c, float metallic, float roughness) 
 // is within 1 px of the reference's, and it moves between views 0 and N-1 by the predicted amount.
 TEST(Pbr, SpecularHighlightMovesWithTheViews) {
   const int N = 9;
-  RigConfig rc;
-  rc.views = N, rc.view_w = 160, rc.view_h = 100, rc.cone_deg = 60.0;
-  const Rig rig = make_rig(rc, Display{}, glm::dvec3(-1.0), glm::dvec3(1.0));
+  const Rig rig = test::highlight_rig(N);
   const Scene s = sphere(0.8f, glm::vec3(0.0f), 1.0f, 0.2f);
   const test::Rendered out = render_pbr(s, rig);
   const VoxelReference reference(s, rig, out);
-  const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
   double moved_got = 0.0, moved_want = 0.0;
   glm::dvec2 first_got(0.0), first_want(0.0);
   for (int view : {0, N / 2, N - 1}) {
-    double best_got = -1.0, best_want = -1.0;
-    glm::dvec2 at_got(0.0), at_want(0.0);
-    for (size_t py = 0; py < H; ++py)
-      for (size_t px = 0; px < W; ++px) {
-        const size_t v = (size_t(view) * H + py) * W + px;
-        if (out.key[v] == PMR_NO_KEY) continue;
-        half g;
-        g.setBits(out.volume[v * 4 + 1]);
-        if (float(g) > best_got) best_got = float(g), at_got = glm::dvec2(px, py);
-        const PmrMta* m = reference.mta(v);
-        ASSERT_NE(m, nullptr);
-        const double want = reference.colour(v, *m).y;
-        if (want > best_want) best_want = want, at_want = glm::dvec2(px, py);
-      }
+    const glm::dvec2 at_got = test::brightest_pixel(out, nullptr, rig, view),
+                     at_want = test::brightest_pixel(out, &reference, rig, view);
     EXPECT_LE(glm::length(at_got - at_want), 1.0 + 1e-9)
         << "view " << view << ": highlight at (" << at_got.x << "," << at_got.y << "), reference (" << at_want.x << ","
         << at_want.y << ")";
@@ -844,66 +793,13 @@ TEST(PbrEnvironment, PathsShadeAlike) {
   const Rig rig = test::small_rig(5, 48, 32);
   const Scene s = material_quads();
   const std::shared_ptr<const Environment> e = sky_environment(30.0, 1.0);
-  PipelineConfig pc;
-  pc.shading = Shading::Pbr, pc.environment = e;
-  pc.tile_x = 4, pc.tile_y = 4, pc.tile_v = 4;
-  const test::Rendered pmr = test::render_with(s, rig, pc);
-  PipelineConfig snapped = pc;
-  snapped.method = Method::Multipass, snapped.multipass_snapped = true;
-  const test::Rendered multipass = test::render_with(s, rig, snapped);
-  EXPECT_EQ(pmr.volume, multipass.volume);
-  Display d;
-  d.width = 240, d.height = 135;
-  d.offset = default_offset(d.lens_pitch, rig.views);
-  PipelineConfig fused = pc;
-  fused.fuse_encode = true;
-  const test::EncodedRender f = test::render_encoded(s, rig, d, fused), u = test::render_encoded(s, rig, d, pc);
-  ASSERT_TRUE(f.fused);
-  EXPECT_EQ(f.image, u.image);
-  PipelineConfig subpixel = fused;
-  subpixel.sampling = Sampling::Subpixel;
-  const test::EncodedRender sp = test::render_encoded(s, rig, d, subpixel);
-  double sum_view = 0.0, sum_subpixel = 0.0;
-  size_t lit = 0;
-  for (size_t i = 0; i < f.image.size(); ++i) {
-    if (i % 4 == 3) continue;
-    half x, y;
-    x.setBits(f.image[i]), y.setBits(sp.image[i]);
-    sum_view += float(x), sum_subpixel += float(y);
-    lit += float(x) > 0.0f;
-  }
-  EXPECT_GT(lit, size_t(1000));
-  EXPECT_NEAR(sum_subpixel, sum_view, 0.05 * sum_view);
+  test::expect_paths_agree(s, rig, test::pbr_config(Method::Pmr, TextureFilter::Bilinear, e));
 }
 
 // ---- KHR_lights_punctual -----------------------------------------------------------------------------
 
-// The reference's light for a scene light, from its definition (colour, intensity, cone angles in
-// double precision), not from the kernels' table.
-ref::PunctualLight reference_light(const SceneLight& l) {
-  ref::PunctualLight r;
-  r.type = l.type == SceneLightType::Point  ? ref::LightType::Point
-           : l.type == SceneLightType::Spot ? ref::LightType::Spot
-                                            : ref::LightType::Directional;
-  r.color_intensity = glm::dvec3(l.color[0], l.color[1], l.color[2]) * double(l.intensity);
-  r.position = l.position;
-  r.direction = l.direction;
-  r.range = l.range;
-  r.cos_inner = std::cos(double(l.inner_cone));
-  r.cos_outer = std::cos(double(l.outer_cone));
-  return r;
-}
-
-SceneLight make_light(SceneLightType type, const glm::dvec3& position, const glm::dvec3& direction, float intensity,
-                      float range = 0.0f) {
-  SceneLight l;
-  l.type = type;
-  l.position = position;
-  l.direction = glm::normalize(direction);
-  l.intensity = intensity;
-  l.range = range;
-  return l;
-}
+using test::make_light;
+using test::reference_light;
 
 // Every covered voxel of `out` against the reference (1% + 1e-3 per channel); returns how many were
 // compared. `lit`, when given, counts the voxels the reference's lights brighten by more than 0.02

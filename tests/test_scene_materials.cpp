@@ -79,16 +79,16 @@ Quad quad(GltfFile& g) {
 TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   GltfFile g;
   g.doc["extensionsUsed"] = {"KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_materials_unlit",
-                             "KHR_materials_clearcoat"};
+                             "KHR_materials_sheen"};
   const Quad q = quad(g);
   const int uv1 = g.data<float>({0, 2, 2, 2, 2, 0, 0, 0}, kFloat, "VEC2");
   write_bytes(dir_ / "normal.png", make_png(1, 1, 2, 8, {128, 128, 255}));
-  write_bytes(dir_ / "clearcoat.png", make_png(1, 1, 0, 8, {7}));
+  write_bytes(dir_ / "sheen.png", make_png(1, 1, 0, 8, {7}));
   g.add("images", {{"uri", png_uri(make_png(1, 1, 6, 8, {200, 100, 50, 255}))}});  // 0 base colour
   g.add("images", {{"uri", png_uri(make_png(1, 1, 2, 8, {255, 128, 64}))}});       // 1 ORM
   g.add("images", {{"uri", "normal.png"}});                                        // 2 normal (a file)
   g.add("images", {{"uri", png_uri(make_png(1, 1, 2, 8, {10, 20, 30}))}});         // 3 emissive
-  g.add("images", {{"uri", "clearcoat.png"}});                                     // 4 only clear coat samples it
+  g.add("images", {{"uri", "sheen.png"}});                                         // 4 only sheen samples it
   for (int i : {0, 1, 2, 3, 1, 4}) g.add("textures", {{"source", i}});             // texture 4 = image 1 again
   json mr_transform = {{"offset", {0.5, 0}}, {"rotation", 0.25}, {"scale", {2, 3}}};
   g.add("materials",
@@ -105,7 +105,7 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
          {"emissiveFactor", {1, 0.5, 0.25}},
          {"extensions",
           {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}},
-           {"KHR_materials_clearcoat", {{"clearcoatFactor", 1}, {"clearcoatTexture", {{"index", 5}}}}}}}});
+           {"KHR_materials_sheen", {{"sheenColorFactor", {1, 1, 1}}, {"sheenColorTexture", {{"index", 5}}}}}}}});
   g.add("materials", {{"name", "Flat"}, {"extensions", {{"KHR_materials_unlit", json::object()}}}});
   g.mesh(json::array(
       {{{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}, {"TEXCOORD_1", uv1}}},
@@ -127,7 +127,7 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   EXPECT_EQ(glm::vec3(m.emissive[0], m.emissive[1], m.emissive[2]), glm::vec3(1, 0.5f, 0.25f));
   EXPECT_EQ(m.emissive_strength, 4.0f);
   EXPECT_FALSE(m.unlit);
-  EXPECT_EQ(m.unimplemented, std::vector<std::string>{"KHR_materials_clearcoat"});
+  EXPECT_EQ(m.unimplemented, std::vector<std::string>{"KHR_materials_sheen"});
   EXPECT_TRUE(s.material_inputs[2].unlit);
   EXPECT_EQ(s.material_inputs[2].slots[kSlotBaseColor].texture, -1);
   // defaults of the glTF default material
@@ -158,7 +158,7 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   EXPECT_EQ(sl[kSlotEmissive].scale[0], 1.0f);
 
   // Images: one texture per (image, wrap modes); the ORM image serves two textures and two slots; the
-  // clear coat image is neither decoded nor read.
+  // sheen image is neither decoded nor read.
   ASSERT_EQ(s.textures.size(), 4u);
   EXPECT_EQ(sl[kSlotOcclusion].texture, sl[kSlotMetallicRoughness].texture);
   EXPECT_EQ(s.textures[size_t(sl[kSlotOcclusion].texture)].slots,
@@ -169,7 +169,7 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   std::vector<std::string> read;
   for (const SceneInputFile& f : s.input_files) read.push_back(f.path);
   EXPECT_EQ(read, (std::vector<std::string>{"materials.bin", "normal.png"}))
-      << "the normal map is a file read, the clear coat image is not";
+      << "the normal map is a file read, the sheen image is not";
 
   // TEXCOORD_0 and _1 as stored, for every vertex; the second primitive has no TEXCOORD_1 (its material
   // samples none): zeros.
@@ -188,9 +188,8 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   for (int v = 4; v < 8; ++v) EXPECT_EQ(s.tangents[size_t(v)], glm::vec4(0, 0, 0, 0)) << v;
   EXPECT_EQ(s.structure.generated_tangent_primitives, 1u);
 
-  EXPECT_EQ(warnings_with(s, "KHR_materials_clearcoat"), 1u) << all_warnings(s);
-  EXPECT_EQ(warnings_with(s, "KHR_materials_clearcoat (1 material): drawn without the clear coat layer"), 1u)
-      << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "KHR_materials_sheen"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "KHR_materials_sheen (1 material): drawn without sheen"), 1u) << all_warnings(s);
 }
 
 TEST_F(SceneMaterialsTest, OutOfRangeFactorsAreClampedWithAWarning) {
@@ -271,6 +270,129 @@ TEST_F(SceneMaterialsTest, TransmissionVolumeAndIorFactorsAreRead) {
   EXPECT_EQ(warnings_with(s, "material 2 ior 0.5 is neither 0 nor at least 1; using 1.5"), 1u) << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "KHR_materials_transmission ("), 0u) << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "KHR_materials_volume ("), 0u) << all_warnings(s);
+}
+
+// KHR_materials_clearcoat (DESIGN 4c): its factors, its three textures (each with its own set and
+// transform) and the coat normal's scale read; absent factors are the extension's 0; bad ones replaced
+// with a warning; drawn, so not warned as unimplemented. The coat normal map alone makes the loader
+// generate tangents, on the coat normal's set.
+TEST_F(SceneMaterialsTest, ClearcoatFactorsAndTexturesAreRead) {
+  GltfFile g;
+  g.doc["extensionsUsed"] = {"KHR_materials_clearcoat", "KHR_texture_transform"};
+  g.doc["extensionsRequired"] = {"KHR_materials_clearcoat"};
+  const Quad q = quad(g);
+  const int uv1 = g.data<float>({0, 2, 2, 2, 2, 0, 0, 0}, kFloat, "VEC2");
+  g.add("images", {{"uri", png_uri(make_png(1, 1, 2, 8, {200, 100, 50}))}});
+  g.add("images", {{"uri", png_uri(make_png(1, 1, 2, 8, {128, 128, 255}))}});
+  g.add("textures", {{"source", 0}});
+  g.add("textures", {{"source", 1}});
+  g.add("materials", {{"name", "Lacquer"},
+                      {"extensions",
+                       {{"KHR_materials_clearcoat",
+                         {{"clearcoatFactor", 0.75},
+                          {"clearcoatTexture", {{"index", 0}}},
+                          {"clearcoatRoughnessFactor", 0.3},
+                          {"clearcoatRoughnessTexture",
+                           {{"index", 0}, {"extensions", {{"KHR_texture_transform", {{"offset", {0.5, 0}}}}}}}},
+                          {"clearcoatNormalTexture", {{"index", 1}, {"texCoord", 1}, {"scale", 0.4}}}}}}}});
+  g.add("materials", {{"name", "Defaults"}, {"extensions", {{"KHR_materials_clearcoat", json::object()}}}});
+  g.add("materials",
+        {{"name", "Bad"},
+         {"extensions",
+          {{"KHR_materials_clearcoat",
+            {{"clearcoatFactor", 2}, {"clearcoatRoughnessFactor", "x"}, {"clearcoatTexture", {{"index", 9}}}}}}}});
+  json prims = json::array();
+  prims.push_back({{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}, {"TEXCOORD_1", uv1}}},
+                   {"indices", q.idx},
+                   {"material", 0}});
+  for (int m : {1, 2}) prims.push_back({{"attributes", {{"POSITION", q.pos}}}, {"indices", q.idx}, {"material", m}});
+  g.mesh(prims);
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  const Scene s = load_scene(g.write(dir_, "coat"));
+  ASSERT_EQ(s.material_inputs.size(), 4u);
+  const SceneMaterialInputs &lacquer = s.material_inputs[1], &defaults = s.material_inputs[2],
+                            &bad = s.material_inputs[3];
+  EXPECT_TRUE(lacquer.has_clearcoat);
+  EXPECT_EQ(lacquer.clearcoat, 0.75f);
+  EXPECT_EQ(lacquer.clearcoat_roughness, 0.3f);
+  EXPECT_EQ(lacquer.clearcoat_normal_scale, 0.4f);
+  const auto& sl = lacquer.slots;
+  EXPECT_GE(sl[kSlotClearcoat].texture, 0);
+  EXPECT_EQ(sl[kSlotClearcoatRoughness].texture, sl[kSlotClearcoat].texture);
+  EXPECT_TRUE(sl[kSlotClearcoatRoughness].transform);
+  EXPECT_EQ(sl[kSlotClearcoatRoughness].offset[0], 0.5f);
+  EXPECT_FALSE(sl[kSlotClearcoat].transform);
+  EXPECT_EQ(sl[kSlotClearcoatNormal].texcoord, 1);
+  EXPECT_FALSE(sl[kSlotClearcoat].srgb || sl[kSlotClearcoatRoughness].srgb || sl[kSlotClearcoatNormal].srgb);
+  EXPECT_EQ(s.textures[size_t(sl[kSlotClearcoatNormal].texture)].rgba, (std::vector<uint8_t>{128, 128, 255, 255}));
+  EXPECT_EQ(s.materials[1].clearcoat, 0.75f) << "the kernels' copy";
+  EXPECT_EQ(s.materials[1].clearcoat_normal_scale, 0.4f);
+  EXPECT_TRUE(defaults.has_clearcoat);
+  EXPECT_EQ(defaults.clearcoat, 0.0f);
+  EXPECT_EQ(defaults.clearcoat_roughness, 0.0f);
+  EXPECT_EQ(bad.clearcoat, 1.0f) << "clamped";
+  EXPECT_EQ(bad.clearcoat_roughness, 0.0f);
+  EXPECT_EQ(bad.slots[kSlotClearcoat].texture, -1);
+  EXPECT_EQ(warnings_with(s, "material 2 clearcoatFactor is outside [0.0, 1.0]; clamped"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "material 2 KHR_materials_clearcoat has no valid clearcoatRoughnessFactor"), 1u)
+      << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "material 2 clearcoatTexture names no texture of the file"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "drawn without"), 0u) << all_warnings(s);
+  // tangents for the coat's normal map, generated on its set (TEXCOORD_1 runs along +x and up +y too)
+  ASSERT_EQ(s.tangents.size(), s.positions.size());
+  EXPECT_EQ(s.tangents[0], glm::vec4(1, 0, 0, 1));
+  EXPECT_EQ(s.structure.generated_tangent_primitives, 1u);
+}
+
+// KHR_materials_specular (DESIGN 4c): the weight and colour factors and their textures (the colour's
+// sRGB-decoded) read; absent factors are 1; bad ones replaced with a warning; drawn, so not warned.
+TEST_F(SceneMaterialsTest, SpecularFactorsAndTexturesAreRead) {
+  GltfFile g;
+  g.doc["extensionsUsed"] = {"KHR_materials_specular"};
+  g.doc["extensionsRequired"] = {"KHR_materials_specular"};
+  const Quad q = quad(g);
+  g.add("images", {{"uri", png_uri(make_png(1, 1, 6, 8, {200, 100, 50, 128}))}});
+  g.add("textures", {{"source", 0}});
+  g.add("materials", {{"name", "Tinted"},
+                      {"extensions",
+                       {{"KHR_materials_specular",
+                         {{"specularFactor", 0.5},
+                          {"specularTexture", {{"index", 0}}},
+                          {"specularColorFactor", {2, 1, 0.25}},
+                          {"specularColorTexture", {{"index", 0}, {"texCoord", 0}}}}}}}});
+  g.add("materials", {{"name", "Defaults"}, {"extensions", {{"KHR_materials_specular", json::object()}}}});
+  g.add("materials",
+        {{"name", "Bad"},
+         {"extensions", {{"KHR_materials_specular", {{"specularFactor", -1}, {"specularColorFactor", {1, 2}}}}}}});
+  json prims = json::array();
+  prims.push_back({{"attributes", {{"POSITION", q.pos}, {"TEXCOORD_0", q.uv0}}}, {"indices", q.idx}, {"material", 0}});
+  for (int m : {1, 2}) prims.push_back({{"attributes", {{"POSITION", q.pos}}}, {"indices", q.idx}, {"material", m}});
+  g.mesh(prims);
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  const Scene s = load_scene(g.write(dir_, "specular"));
+  ASSERT_EQ(s.material_inputs.size(), 4u);
+  const SceneMaterialInputs &tinted = s.material_inputs[1], &defaults = s.material_inputs[2],
+                            &bad = s.material_inputs[3];
+  EXPECT_TRUE(tinted.has_specular);
+  EXPECT_EQ(tinted.specular, 0.5f);
+  EXPECT_EQ(glm::vec3(tinted.specular_color[0], tinted.specular_color[1], tinted.specular_color[2]),
+            glm::vec3(2.0f, 1.0f, 0.25f));
+  EXPECT_GE(tinted.slots[kSlotSpecular].texture, 0);
+  EXPECT_FALSE(tinted.slots[kSlotSpecular].srgb);
+  EXPECT_EQ(tinted.slots[kSlotSpecularColor].texture, tinted.slots[kSlotSpecular].texture);
+  EXPECT_TRUE(tinted.slots[kSlotSpecularColor].srgb);
+  EXPECT_EQ(s.materials[1].specular, 0.5f) << "the kernels' copy";
+  EXPECT_EQ(s.materials[1].specular_color[0], 2.0f);
+  EXPECT_EQ(defaults.specular, 1.0f);
+  EXPECT_EQ(defaults.specular_color[2], 1.0f);
+  EXPECT_EQ(bad.specular, 0.0f) << "clamped";
+  EXPECT_EQ(bad.specular_color[1], 1.0f);
+  EXPECT_EQ(warnings_with(s, "material 2 specularFactor is outside [0.0, 1.0]; clamped"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "material 2 KHR_materials_specular has no valid specularColorFactor"), 1u)
+      << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "drawn with"), 0u) << all_warnings(s);
 }
 
 TEST_F(SceneMaterialsTest, ATexCoordSetTheMeshLacksIsAnError) {

@@ -31,8 +31,11 @@ std::string number(double v) {
 
 // "normal (set 1, transform offset (0, 1) rotation 1.571 scale (0.5, 0.5))"
 std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
-  static const char* const short_names[kTextureSlots] = {"base colour", "metallic-roughness", "normal", "occlusion",
-                                                         "emissive"};
+  static const char* const short_names[kTextureSlots] = {
+      "base colour",       "metallic-roughness", "normal",
+      "occlusion",         "emissive",           "transmission",
+      "thickness",         "clear coat",         "clear coat roughness",
+      "clear coat normal", "specular",           "specular colour"};
   std::string t = std::string(short_names[kind]) + " (texture " + std::to_string(slot.texture);
   if (slot.texture >= 0 && size_t(slot.texture) < s.textures.size())
     t += " " + std::to_string(s.textures[size_t(slot.texture)].width) + "x" +
@@ -44,8 +47,8 @@ std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
   return t + ")";
 }
 
-// KHR_materials_transmission and _volume where the material has them, and KHR_materials_ior's ior
-// where it is not the default 1.5.
+// KHR_materials_transmission, _volume, _clearcoat and _specular where the material has them, and
+// KHR_materials_ior's ior where it is not the default 1.5.
 std::string layer_text(const SceneMaterialInputs& in) {
   std::string t;
   if (in.has_transmission) t += ", transmission " + number(in.transmission);
@@ -55,6 +58,13 @@ std::string layer_text(const SceneMaterialInputs& in) {
          number(in.attenuation_distance);
   }
   if (in.ior != 1.5f) t += ", ior " + number(in.ior);
+  if (in.has_clearcoat) {
+    t += ", clear coat " + number(in.clearcoat) + " roughness " + number(in.clearcoat_roughness);
+    if (in.slots[kSlotClearcoatNormal].texture >= 0) t += " normal scale " + number(in.clearcoat_normal_scale);
+  }
+  if (in.has_specular)
+    t += ", specular " + number(in.specular) + " colour (" + number(in.specular_color[0]) + ", " +
+         number(in.specular_color[1]) + ", " + number(in.specular_color[2]) + ")";
   return t;
 }
 

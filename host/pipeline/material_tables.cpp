@@ -13,7 +13,11 @@ namespace pmr {
 // A material's map k is its texture slot k (make_material_tables copies them by index).
 static_assert(PMR_MAP_BASE_COLOR == kSlotBaseColor && PMR_MAP_METALLIC_ROUGHNESS == kSlotMetallicRoughness &&
                   PMR_MAP_NORMAL == kSlotNormal && PMR_MAP_OCCLUSION == kSlotOcclusion &&
-                  PMR_MAP_EMISSIVE == kSlotEmissive && PMR_MAPS == kTextureSlots,
+                  PMR_MAP_EMISSIVE == kSlotEmissive && PMR_MAP_TRANSMISSION == kSlotTransmission &&
+                  PMR_MAP_THICKNESS == kSlotThickness && PMR_MAP_CLEARCOAT == kSlotClearcoat &&
+                  PMR_MAP_CLEARCOAT_ROUGHNESS == kSlotClearcoatRoughness &&
+                  PMR_MAP_CLEARCOAT_NORMAL == kSlotClearcoatNormal && PMR_MAP_SPECULAR == kSlotSpecular &&
+                  PMR_MAP_SPECULAR_COLOR == kSlotSpecularColor && PMR_MAPS == kTextureSlots,
               "PMR_MAP_* follow SceneTextureSlotKind");
 
 void texture_transform_matrix(const SceneTextureSlot& slot, float out[6]) {
@@ -31,9 +35,9 @@ void texture_transform_matrix(const SceneTextureSlot& slot, float out[6]) {
 
 namespace {
 
-// The chain a texture slot samples: colour maps (sRGB), the normal map, or the other data maps.
+// The chain a texture slot samples: colour maps (sRGB), normal maps, or the other data maps.
 MipKind slot_kind(const SceneTextureSlot& slot, int k) {
-  return slot.srgb ? MipKind::Colour : k == PMR_MAP_NORMAL ? MipKind::Normal : MipKind::Data;
+  return slot.srgb ? MipKind::Colour : texture_slot_is_normal_map(k) ? MipKind::Normal : MipKind::Data;
 }
 constexpr int kMipKinds = 3;
 
@@ -144,7 +148,7 @@ MaterialTables make_material_tables(const Scene& scene, bool mips) {
           size_t(slot.texcoord) >= scene.texcoords.size())
         throw InternalError("material " + std::to_string(i) + "'s " + texture_slot_name(k) +
                             " names a texture or TEXCOORD set the scene does not have");
-      if (k == PMR_MAP_NORMAL && !has_tangents) continue;
+      if (texture_slot_is_normal_map(k) && !has_tangents) continue;
       PmrTextureMap& map = m.maps[k];
       map.texture = entry[size_t(slot_kind(slot, k))][size_t(slot.texture)];
       map.texcoord = uint32_t(slot.texcoord);

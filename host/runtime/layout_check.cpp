@@ -6,7 +6,7 @@
 #include "pmr/shared.h"
 
 static_assert(sizeof(PmrParams) == 16 * 8 + 9 * 8 + 16 + 22 * 4 + 2 * PMR_MAX_SAMPLES * 4 + 2 * 8 +
-                                        4 * (PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK),
+                                       4 * (PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK),
               "PmrParams layout");
 static_assert(offsetof(PmrParams, sample_x) == 304 && offsetof(PmrParams, view_anchor) == 432 &&
                   offsetof(PmrParams, view_coord) == 448 && offsetof(PmrParams, lod_scale_x) == 292,
@@ -20,8 +20,10 @@ static_assert(offsetof(PmrMta, bary) == 60 && offsetof(PmrMta, tri) == 84 && off
               "PmrMta layout");
 static_assert(sizeof(PmrVertexAttr) == 32 && offsetof(PmrVertexAttr, color) == 12, "PmrVertexAttr layout");
 static_assert(sizeof(PmrTriangle) == 32, "PmrTriangle layout");
-static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 40 && offsetof(PmrMaterial, maps) == 52 &&
-                  offsetof(PmrMaterial, attenuation_color) == 52 + PMR_MAPS * 32 + 28,
+static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 68 && offsetof(PmrMaterial, maps) == 52 &&
+                  offsetof(PmrMaterial, attenuation_color) == 52 + PMR_MAPS * 32 + 28 &&
+                  offsetof(PmrMaterial, clearcoat) == 52 + PMR_MAPS * 32 + 40 &&
+                  offsetof(PmrMaterial, specular_color) == 52 + PMR_MAPS * 32 + 56,
               "PmrMaterial layout");
 static_assert(sizeof(PmrSource) == 8 * PMR_SOURCE_MAX_LEVELS + 16 && offsetof(PmrSource, opaque_only) == 132,
               "PmrSource layout");

@@ -310,7 +310,8 @@ void read_skin_influences(const PrimitiveAttributes& attrs, DeformSource& geo) {
 }
 
 // Every set a texture slot of the material samples, untransformed (Scene::texcoords); each must exist.
-// Returns the normal texture's set (-1: none).
+// Returns the set the tangents follow (-1: none): the normal texture's, else the clear coat normal
+// texture's (both maps share the vertex's one tangent).
 int read_texcoord_sets(const PrimitiveAttributes& attrs, int mesh, int index, Decoded& d) {
   Loader& L = attrs.L;
   const tinygltf::Primitive& p = attrs.p;
@@ -331,7 +332,7 @@ int read_texcoord_sets(const PrimitiveAttributes& attrs, int mesh, int index, De
                        std::to_string(index) + " does not have");
     }
   }
-  return sets[kSlotNormal];
+  return sets[kSlotNormal] >= 0 ? sets[kSlotNormal] : sets[kSlotClearcoatNormal];
 }
 
 // 3 vertex indices per triangle, strips and fans unrolled, each index checked against POSITION.

@@ -239,6 +239,36 @@ void read_volume_factors(Loader& L, const std::string& ext, const tinygltf::Valu
   }
 }
 
+// KHR_materials_clearcoat's factors and its normal texture's scale, checked.
+void read_clearcoat(Loader& L, const tinygltf::Value& value, const std::string& name, SceneMaterialInputs& m) {
+  const std::string ext = "KHR_materials_clearcoat";
+  m.has_clearcoat = true;
+  m.clearcoat = extension_number(L, value, ext, "clearcoatFactor", 0.0, 0.0, 1.0, name);
+  m.clearcoat_roughness = extension_number(L, value, ext, "clearcoatRoughnessFactor", 0.0, 0.0, 1.0, name);
+  if (!value.IsObject() || !value.Has("clearcoatNormalTexture")) return;
+  const tinygltf::Value& normal = value.Get("clearcoatNormalTexture");
+  if (normal.IsObject() && normal.Has("scale"))
+    m.clearcoat_normal_scale =
+        extension_number(L, normal, ext, "scale", 1.0, -std::numeric_limits<double>::infinity(),
+                         std::numeric_limits<double>::infinity(), name + " clearcoatNormalTexture");
+}
+
+// KHR_materials_specular's factors, checked: the weight in [0, 1], the colour's channels at least 0.
+void read_specular(Loader& L, const tinygltf::Value& value, const std::string& name, SceneMaterialInputs& m) {
+  const std::string ext = "KHR_materials_specular";
+  m.has_specular = true;
+  m.specular = extension_number(L, value, ext, "specularFactor", 1.0, 0.0, 1.0, name);
+  if (!value.IsObject() || !value.Has("specularColorFactor")) return;
+  double c[3];
+  if (!finite_numbers(value.Get("specularColorFactor"), 3, c)) {
+    L.warn(name + " KHR_materials_specular has no valid specularColorFactor; using (1, 1, 1)");
+    return;
+  }
+  for (int k = 0; k < 3; ++k)
+    m.specular_color[k] =
+        material_number(L, c[k], 1.0, 0.0, std::numeric_limits<double>::infinity(), name + " specularColorFactor");
+}
+
 // KHR_materials_ior's ior: 0 or at least 1 (0: the extension's compatibility mode, a Fresnel term of 1).
 float read_ior(Loader& L, const tinygltf::Value& value, const std::string& name) {
   const float ior =
@@ -306,6 +336,10 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
       m.ior = read_ior(L, value, name);
     } else if (ext == "KHR_materials_transmission" || ext == "KHR_materials_volume") {
       read_volume_factors(L, ext, value, name, m);
+    } else if (ext == "KHR_materials_clearcoat") {
+      read_clearcoat(L, value, name, m);
+    } else if (ext == "KHR_materials_specular") {
+      read_specular(L, value, name, m);
     } else if (material_extension_fallback(ext)) {
       m.unimplemented.push_back(ext);
     }
@@ -315,24 +349,25 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
     const tinygltf::ExtensionMap* extensions;
   };
   const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
-  const NestedTextureInfo transmission =
-                              nested_texture_info(L, g, "KHR_materials_transmission", "transmissionTexture", i),
-                          thickness = nested_texture_info(L, g, "KHR_materials_volume", "thicknessTexture", i);
-  const Info infos[kTextureSlots] = {
-      {pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, &pbr.baseColorTexture.extensions},
-      {pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
-       &pbr.metallicRoughnessTexture.extensions},
-      {g.normalTexture.index, g.normalTexture.texCoord, &g.normalTexture.extensions},
-      {g.occlusionTexture.index, g.occlusionTexture.texCoord, &g.occlusionTexture.extensions},
-      {g.emissiveTexture.index, g.emissiveTexture.texCoord, &g.emissiveTexture.extensions},
-      {transmission.index, transmission.texcoord, &transmission.extensions},
-      {thickness.index, thickness.texcoord, &thickness.extensions}};
+  std::array<Info, kTextureSlots> infos = {
+      Info{pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord, &pbr.baseColorTexture.extensions},
+      Info{pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+           &pbr.metallicRoughnessTexture.extensions},
+      Info{g.normalTexture.index, g.normalTexture.texCoord, &g.normalTexture.extensions},
+      Info{g.occlusionTexture.index, g.occlusionTexture.texCoord, &g.occlusionTexture.extensions},
+      Info{g.emissiveTexture.index, g.emissiveTexture.texCoord, &g.emissiveTexture.extensions}};
+  std::array<NestedTextureInfo, kTextureSlots> nested;  // the extensions' slots, which tinygltf leaves as JSON
+  for (int slot = kSlotEmissive + 1; slot < kTextureSlots; ++slot) {
+    NestedTextureInfo& n = nested[size_t(slot)];
+    n = nested_texture_info(L, g, texture_slot_extension(slot), texture_slot_name(slot), i);
+    infos[size_t(slot)] = Info{n.index, n.texcoord, &n.extensions};
+  }
   std::array<int, kTextureSlots> sets;
   for (int slot = 0; slot < kTextureSlots; ++slot) {
     SceneTextureSlot& out = m.slots[size_t(slot)];
-    out.srgb = slot == kSlotBaseColor || slot == kSlotEmissive;
+    out.srgb = texture_slot_is_srgb(slot);
     sets[size_t(slot)] = -1;
-    const Info& info = infos[slot];
+    const Info& info = infos[size_t(slot)];
     if (info.index < 0) continue;
     // the base colour slot's messages name no slot (they predate the other slots)
     const MaterialUv uv =
@@ -358,7 +393,8 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
 void build_materials(Loader& L) {
   L.scene.materials.push_back(default_material());
   L.scene.material_inputs.emplace_back();
-  L.scene.material_inputs[0].slots[kSlotBaseColor].srgb = L.scene.material_inputs[0].slots[kSlotEmissive].srgb = true;
+  for (int slot = 0; slot < kTextureSlots; ++slot)
+    L.scene.material_inputs[0].slots[size_t(slot)].srgb = texture_slot_is_srgb(slot);
   for (size_t i = 0; i < L.model.materials.size(); ++i) {
     const tinygltf::Material& g = L.model.materials[i];
     const std::string name = "material " + std::to_string(i);

@@ -12,6 +12,7 @@
 #include "pmr/error.h"
 #include "pmr/memory_budget.h"
 #include "pmr/printable.h"
+#include "pmr/scene.h"
 #include "scene/gltf_internal.h"
 
 namespace pmr::gltf {
@@ -53,7 +54,8 @@ constexpr uint64_t kJsonBytesPerValue = 200;
 bool extension_supported(const std::string& name) {
   return name == "KHR_mesh_quantization" || name == "KHR_texture_transform" || name == "KHR_lights_punctual" ||
          name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit" || name == "KHR_materials_ior" ||
-         name == "KHR_materials_transmission" || name == "KHR_materials_volume" || name == "KHR_materials_variants";
+         name == "KHR_materials_transmission" || name == "KHR_materials_volume" || name == "KHR_materials_variants" ||
+         name == "KHR_materials_clearcoat" || name == "KHR_materials_specular";
 }
 
 uint32_t read_u32le(const unsigned char* p) {
@@ -357,9 +359,9 @@ void read_sampled_images(const std::string& path, const json& doc, SourceFile& s
   }
 }
 
-// Only images some implemented material slot samples are decoded (and read): base colour,
-// metallic-roughness, normal, occlusion, emissive, transmission, thickness. Images of unimplemented
-// extensions (clear coat, sheen, ...) never are.
+// Only images some implemented material slot samples are decoded (and read): the core slots and those
+// of the material extensions pmr draws (texture_slot_extension). Images of unimplemented extensions
+// (sheen, ...) never are.
 std::set<int> sampled_images(const json& doc) {
   std::set<int> images;
   const json* materials = member(doc, "materials");
@@ -368,15 +370,13 @@ std::set<int> sampled_images(const json& doc) {
   for (const json& m : *materials) {
     const json* pbr = member(m, "pbrMetallicRoughness");
     const json* ext = member(m, "extensions");
-    const json* transmission = ext ? member(*ext, "KHR_materials_transmission") : nullptr;
-    const json* volume = ext ? member(*ext, "KHR_materials_volume") : nullptr;
-    const json* infos[] = {pbr ? member(*pbr, "baseColorTexture") : nullptr,
-                           pbr ? member(*pbr, "metallicRoughnessTexture") : nullptr,
-                           member(m, "normalTexture"),
-                           member(m, "occlusionTexture"),
-                           member(m, "emissiveTexture"),
-                           transmission ? member(*transmission, "transmissionTexture") : nullptr,
-                           volume ? member(*volume, "thicknessTexture") : nullptr};
+    std::vector<const json*> infos = {
+        pbr ? member(*pbr, "baseColorTexture") : nullptr, pbr ? member(*pbr, "metallicRoughnessTexture") : nullptr,
+        member(m, "normalTexture"), member(m, "occlusionTexture"), member(m, "emissiveTexture")};
+    for (int slot = kSlotEmissive + 1; slot < kTextureSlots; ++slot) {
+      const json* holder = ext ? member(*ext, texture_slot_extension(slot)) : nullptr;
+      infos.push_back(holder ? member(*holder, texture_slot_name(slot)) : nullptr);
+    }
     for (const json* info : infos) {
       const int64_t t = json_index(info ? member(*info, "index") : nullptr);
       if (t < 0 || size_t(t) >= textures->size()) continue;
@@ -502,9 +502,7 @@ std::string base_dir_of(const std::string& path) {
 
 const char* material_extension_fallback(const std::string& name) {
   static const std::pair<const char*, const char*> table[] = {
-      {"KHR_materials_clearcoat", "drawn without the clear coat layer"},
       {"KHR_materials_sheen", "drawn without sheen"},
-      {"KHR_materials_specular", "drawn with the default specular (F0 0.04, white)"},
       {"KHR_materials_iridescence", "drawn without iridescence"},
       {"KHR_materials_anisotropy", "drawn with isotropic highlights"},
       {"KHR_materials_pbrSpecularGlossiness",

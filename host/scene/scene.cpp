@@ -23,6 +23,9 @@ PmrMaterial default_material() {
   m.transmission = 0.0f, m.thickness = 0.0f;  // opaque, thin
   m.attenuation_distance = std::numeric_limits<float>::infinity();
   for (float& c : m.attenuation_color) c = 1.0f;
+  m.clearcoat = 0.0f, m.clearcoat_roughness = 0.0f, m.clearcoat_normal_scale = 1.0f;  // no coat
+  m.specular = 1.0f;
+  for (float& c : m.specular_color) c = 1.0f;
   return m;
 }
 
@@ -34,6 +37,10 @@ void apply_material_inputs(const SceneMaterialInputs& in, PmrMaterial& m) {
   m.transmission = in.transmission, m.thickness = in.thickness;
   m.attenuation_distance = in.attenuation_distance;
   for (int c = 0; c < 3; ++c) m.attenuation_color[c] = in.attenuation_color[c];
+  m.clearcoat = in.clearcoat, m.clearcoat_roughness = in.clearcoat_roughness;
+  m.clearcoat_normal_scale = in.clearcoat_normal_scale;
+  m.specular = in.specular;
+  for (int c = 0; c < 3; ++c) m.specular_color[c] = in.specular_color[c];
 }
 
 bool scene_transmissive(const Scene& scene) {
@@ -64,9 +71,32 @@ float dielectric_f0(double ior) {
 
 const char* texture_slot_name(int slot) {
   static const char* const names[kTextureSlots] = {
-      "baseColorTexture", "metallicRoughnessTexture", "normalTexture",   "occlusionTexture",
-      "emissiveTexture",  "transmissionTexture",      "thicknessTexture"};
+      "baseColorTexture",          "metallicRoughnessTexture", "normalTexture",    "occlusionTexture",
+      "emissiveTexture",           "transmissionTexture",      "thicknessTexture", "clearcoatTexture",
+      "clearcoatRoughnessTexture", "clearcoatNormalTexture",   "specularTexture",  "specularColorTexture"};
   return slot >= 0 && slot < kTextureSlots ? names[slot] : "?";
+}
+
+const char* texture_slot_extension(int slot) {
+  static const char* const extensions[kTextureSlots] = {nullptr,
+                                                        nullptr,
+                                                        nullptr,
+                                                        nullptr,
+                                                        nullptr,
+                                                        "KHR_materials_transmission",
+                                                        "KHR_materials_volume",
+                                                        "KHR_materials_clearcoat",
+                                                        "KHR_materials_clearcoat",
+                                                        "KHR_materials_clearcoat",
+                                                        "KHR_materials_specular",
+                                                        "KHR_materials_specular"};
+  return slot >= 0 && slot < kTextureSlots ? extensions[slot] : nullptr;
+}
+
+bool texture_slot_is_normal_map(int slot) { return slot == kSlotNormal || slot == kSlotClearcoatNormal; }
+
+bool texture_slot_is_srgb(int slot) {
+  return slot == kSlotBaseColor || slot == kSlotEmissive || slot == kSlotSpecularColor;
 }
 
 bool scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi) {

@@ -27,16 +27,27 @@ struct SceneTexture {
 
 // The texture slots of a glTF metallic-roughness material (DESIGN section 4b), in this order.
 enum SceneTextureSlotKind : int {
-  kSlotBaseColor = 0,          // RGBA, sRGB
-  kSlotMetallicRoughness = 1,  // B metallic, G roughness, linear
-  kSlotNormal = 2,             // RGB tangent-space normal, linear
-  kSlotOcclusion = 3,          // R occlusion, linear
-  kSlotEmissive = 4,           // RGB, sRGB
-  kSlotTransmission = 5,       // R transmission (KHR_materials_transmission), linear
-  kSlotThickness = 6,          // G thickness (KHR_materials_volume), linear
-  kTextureSlots = 7
+  kSlotBaseColor = 0,           // RGBA, sRGB
+  kSlotMetallicRoughness = 1,   // B metallic, G roughness, linear
+  kSlotNormal = 2,              // RGB tangent-space normal, linear
+  kSlotOcclusion = 3,           // R occlusion, linear
+  kSlotEmissive = 4,            // RGB, sRGB
+  kSlotTransmission = 5,        // R transmission (KHR_materials_transmission), linear
+  kSlotThickness = 6,           // G thickness (KHR_materials_volume), linear
+  kSlotClearcoat = 7,           // R clear coat intensity (KHR_materials_clearcoat), linear
+  kSlotClearcoatRoughness = 8,  // G clear coat roughness, linear
+  kSlotClearcoatNormal = 9,     // RGB the clear coat's tangent-space normal, linear
+  kSlotSpecular = 10,           // A specular weight (KHR_materials_specular), linear
+  kSlotSpecularColor = 11,      // RGB specular colour, sRGB
+  kTextureSlots = 12
 };
 const char* texture_slot_name(int slot);  // "baseColorTexture", ... (the glTF property names)
+// The material extension whose object holds slot `slot`'s textureInfo; nullptr for the core slots.
+const char* texture_slot_extension(int slot);
+// Whether the slot holds a tangent-space normal map (normalTexture, clearcoatNormalTexture).
+bool texture_slot_is_normal_map(int slot);
+// Whether the slot's texels are sRGB-encoded colours (base colour, emissive, specular colour).
+bool texture_slot_is_srgb(int slot);
 
 // One textureInfo of a material. texcoord is the TEXCOORD_n set sampled (the KHR_texture_transform
 // texCoord override already applied); the transform maps that set's stored (untransformed) values:
@@ -69,7 +80,16 @@ struct SceneMaterialInputs {
   float thickness = 0.0f;                             // KHR_materials_volume thicknessFactor (0: thin)
   float attenuation_distance = std::numeric_limits<float>::infinity();  // KHR_materials_volume (none)
   float attenuation_color[3] = {1.0f, 1.0f, 1.0f};                      // KHR_materials_volume (linear)
-  std::array<SceneTextureSlot, kTextureSlots> slots;                    // indexed by SceneTextureSlotKind
+  // KHR_materials_clearcoat (pbr): a second specular lobe over the material, with its own roughness
+  // and normal map
+  bool has_clearcoat = false;
+  float clearcoat = 0.0f, clearcoat_roughness = 0.0f;  // the factors (validated to [0, 1])
+  float clearcoat_normal_scale = 1.0f;                 // clearcoatNormalTexture.scale
+  // KHR_materials_specular (pbr): the dielectric's Fresnel weight and colour
+  bool has_specular = false;
+  float specular = 1.0f;                              // specularFactor (validated to [0, 1])
+  float specular_color[3] = {1.0f, 1.0f, 1.0f};       // specularColorFactor (linear, >= 0)
+  std::array<SceneTextureSlot, kTextureSlots> slots;  // indexed by SceneTextureSlotKind
   std::vector<std::string> unimplemented;  // material extensions present but not drawn (warned once per scene)
 };
 

@@ -241,7 +241,12 @@ typedef struct {
 #define PMR_MAP_EMISSIVE 4           /* RGB (sRGB-encoded)                                     */
 #define PMR_MAP_TRANSMISSION 5       /* R transmission (KHR_materials_transmission, linear)     */
 #define PMR_MAP_THICKNESS 6          /* G thickness (KHR_materials_volume, linear)              */
-#define PMR_MAPS 7
+#define PMR_MAP_CLEARCOAT 7          /* R clear coat intensity (KHR_materials_clearcoat, linear)  */
+#define PMR_MAP_CLEARCOAT_ROUGHNESS 8 /* G clear coat roughness (linear)                         */
+#define PMR_MAP_CLEARCOAT_NORMAL 9   /* the clear coat's tangent-space normal (linear)          */
+#define PMR_MAP_SPECULAR 10          /* A specular weight (KHR_materials_specular, linear)      */
+#define PMR_MAP_SPECULAR_COLOR 11    /* RGB specular colour (sRGB-encoded)                      */
+#define PMR_MAPS 12
 
 /* One texture map of a material: which texture, sampled at which TEXCOORD set, through which
  * KHR_texture_transform (the identity without one). Producer: host/pipeline (from the scene's material
@@ -271,6 +276,11 @@ typedef struct {
   float thickness;              /* KHR_materials_volume thicknessFactor x the node's scale (0: thin) */
   float attenuation_distance;   /* KHR_materials_volume (+inf: none)                               */
   float attenuation_color[3];   /* KHR_materials_volume (linear)                                   */
+  float clearcoat;              /* KHR_materials_clearcoat clearcoatFactor (0: no coat)             */
+  float clearcoat_roughness;    /* ... clearcoatRoughnessFactor                                    */
+  float clearcoat_normal_scale; /* ... clearcoatNormalTexture.scale                                */
+  float specular;               /* KHR_materials_specular specularFactor (1 without it)             */
+  float specular_color[3];      /* ... specularColorFactor (linear; (1, 1, 1) without it)          */
 } PmrMaterial;
 
 /* A texture and its mip chain: `levels` levels back to back from `offset`, level k of

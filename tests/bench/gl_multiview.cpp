@@ -699,6 +699,10 @@ void bind_slot(const GlScene& g, GLuint program, int k, const pmr::SceneTextureS
   glUniform3f(glGetUniformLocation(program, (name + "v").c_str()), -sx * sn, sy * c, slot.offset[1]);
 }
 
+// The maps the baseline's shader samples (maps[5]): the core metallic-roughness slots. It draws no
+// material extension (transmission, clear coat, specular), so its scenes should have none.
+constexpr int kGlMaps = pmr::kSlotEmissive + 1;
+
 // One material's uniforms and state (DESIGN 4: MASK discards below the cutoff, BLEND is drawn opaque;
 // single-sided materials are culled on back faces). Lambert reads the base colour slot alone.
 void bind_material(const pmr::Scene& s, const GlScene& g, GLuint program, int m, bool pbr) {
@@ -710,7 +714,7 @@ void bind_material(const pmr::Scene& s, const GlScene& g, GLuint program, int m,
   else glEnable(GL_CULL_FACE);
   const pmr::SceneMaterialInputs in =
       size_t(m) < s.material_inputs.size() ? s.material_inputs[size_t(m)] : pmr::SceneMaterialInputs();
-  for (int k = 0; k < pmr::kTextureSlots; ++k)
+  for (int k = 0; k < kGlMaps; ++k)
     bind_slot(g, program, k, k == pmr::kSlotBaseColor || pbr ? in.slots[size_t(k)] : pmr::SceneTextureSlot());
   glActiveTexture(GL_TEXTURE0);
   if (!pbr) return;
@@ -725,10 +729,10 @@ void bind_material(const pmr::Scene& s, const GlScene& g, GLuint program, int m,
 // The frame's shading uniforms: Lambert's light, or pbr's lights, environment and split-sum table.
 void set_shading_uniforms(const Frame& f, GLuint program, GLuint split_sum) {
   glUseProgram(program);
-  for (int k = 0; k < pmr::kTextureSlots; ++k)
+  for (int k = 0; k < kGlMaps; ++k)
     glUniform1i(glGetUniformLocation(program, ("maps[" + std::to_string(k) + "]").c_str()), k);
-  glUniform1i(glGetUniformLocation(program, "split_sum"), pmr::kTextureSlots);
-  glActiveTexture(GL_TEXTURE0 + pmr::kTextureSlots);
+  glUniform1i(glGetUniformLocation(program, "split_sum"), kGlMaps);
+  glActiveTexture(GL_TEXTURE0 + kGlMaps);
   glBindTexture(GL_TEXTURE_2D, split_sum);
   glActiveTexture(GL_TEXTURE0);
   glUniform1i(glGetUniformLocation(program, "pbr"), f.shading == "pbr");

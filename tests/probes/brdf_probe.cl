@@ -7,17 +7,19 @@
 /* Case (first + l) of lane l, as a lane's index into the inputs. */
 inline int probe_case(uint first, int l, uint n) { return (int)min(first + (uint)l, n - 1u); }
 
-/* in: 14 floats per case (base rgb, metallic, roughness, n xyz, v xyz, l xyz); out: f * dot(n, l), rgb */
+/* in: 18 floats per case (base rgb, metallic, roughness, n xyz, v xyz, l xyz, KHR_materials_specular's
+ * weight and colour rgb, ior 1.5); out: f * dot(n, l), rgb */
 kernel void brdf_probe(global const float* in, global float* out, uint n) {
   const uint first = get_global_id(0) * SW;
   if (first >= n) return;
-  float c[14][SW];
+  float c[18][SW];
   for (int l = 0; l < SW; ++l)
-    for (int k = 0; k < 14; ++k) c[k][l] = in[14 * probe_case(first, l, n) + k];
+    for (int k = 0; k < 18; ++k) c[k][l] = in[18 * probe_case(first, l, n) + k];
 #define LANES(k) vload_s(0, c[k])
 #define LANES3(k) s3(LANES(k), LANES(k + 1), LANES(k + 2))
-  const sfloat3 r =
-      brdf_cos(LANES3(0), LANES(3), (sfloat)(0.04f), pbr_roughness(LANES(4)), LANES3(5), LANES3(8), LANES3(11));
+  const sfloat3 f0 = pbr_f0(LANES3(0), LANES(3), specular_f0((sfloat)(0.04f), LANES3(15), LANES(14)));
+  const sfloat3 r = brdf_cos(LANES3(0), LANES(3), f0, pbr_f90(LANES(14), LANES(3)), pbr_roughness(LANES(4)), LANES3(5),
+                             LANES3(8), LANES3(11));
   float o[3][SW];
   vstore_s(r.x, 0, o[0]), vstore_s(r.y, 0, o[1]), vstore_s(r.z, 0, o[2]);
   for (int l = 0; l < SW && first + (uint)l < n; ++l)

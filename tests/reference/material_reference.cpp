@@ -6,6 +6,28 @@
 
 namespace pmr::ref {
 
+namespace {
+
+// Normal map `slot` (scale `scale`) applied to unit normal n: the interpolated tangent made orthogonal to
+// n, the bitangent sign(w) cross(n, t), m = (2 s - 1) (scale, scale, 1). n itself without the map, a
+// tangent or a usable result.
+glm::dvec3 mapped_normal(const Scene& scene, const PmrTriangle& t, const glm::dvec3& b, const SceneTextureSlot& slot,
+                         double scale, const glm::dvec3& n) {
+  glm::dvec4 s;
+  if (scene.tangents.empty() || !sample_slot(scene, t, b, slot, s)) return n;
+  glm::dvec4 tw(0.0);
+  for (int k = 0; k < 3; ++k) tw += b[k] * glm::dvec4(scene.tangents[t.v[k]]);
+  glm::dvec3 tangent = glm::dvec3(tw) - n * glm::dot(n, glm::dvec3(tw));
+  if (glm::length(tangent) <= 1e-9) return n;
+  tangent = glm::normalize(tangent);
+  const glm::dvec3 bitangent = (tw.w < 0.0 ? -1.0 : 1.0) * glm::cross(n, tangent);
+  const glm::dvec3 m = (2.0 * glm::dvec3(s) - 1.0) * glm::dvec3(scale, scale, 1.0);
+  const glm::dvec3 mapped = tangent * m.x + bitangent * m.y + n * m.z;
+  return glm::length(mapped) > 0.0 ? glm::normalize(mapped) : n;
+}
+
+}  // namespace
+
 void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool back, SurfacePoint& sp) {
   const PmrTriangle& t = scene.triangles[tri];
   const PmrMaterial& mat = scene.materials[t.material];
@@ -24,6 +46,10 @@ void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool bac
   sp.unlit = mat.unlit != 0;
   sp.ior = mat.ior, sp.transmission = mat.transmission;
   sp.ao = 1.0;
+  sp.clearcoat = mat.clearcoat, sp.clearcoat_roughness = mat.clearcoat_roughness;
+  sp.specular = mat.specular;
+  sp.specular_color = glm::dvec3(mat.specular_color[0], mat.specular_color[1], mat.specular_color[2]);
+  glm::dvec3 coat_n = n;  // no coat normal map: the coat follows the interpolated normal
   if (t.material < scene.material_inputs.size()) {
     const SceneMaterialInputs& in = scene.material_inputs[t.material];
     sp.metallic = in.metallic, sp.roughness = in.roughness, sp.unlit = in.unlit, sp.ior = in.ior;
@@ -34,20 +60,21 @@ void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool bac
     if (sample_slot(scene, t, b, in.slots[kSlotOcclusion], s)) sp.ao = 1.0 + in.occlusion_strength * (s.x - 1.0);
     if (sample_slot(scene, t, b, in.slots[kSlotEmissive], s)) sp.emissive *= glm::dvec3(s);
     if (sample_slot(scene, t, b, in.slots[kSlotTransmission], s)) sp.transmission *= s.x;
-    if (!scene.tangents.empty() && sample_slot(scene, t, b, in.slots[kSlotNormal], s)) {
-      glm::dvec4 tw(0.0);
-      for (int k = 0; k < 3; ++k) tw += b[k] * glm::dvec4(scene.tangents[t.v[k]]);
-      glm::dvec3 tangent = glm::dvec3(tw) - n * glm::dot(n, glm::dvec3(tw));
-      if (glm::length(tangent) > 1e-9) {
-        tangent = glm::normalize(tangent);
-        const glm::dvec3 bitangent = (tw.w < 0.0 ? -1.0 : 1.0) * glm::cross(n, tangent);
-        const glm::dvec3 m = (2.0 * glm::dvec3(s) - 1.0) * glm::dvec3(in.normal_scale, in.normal_scale, 1.0);
-        const glm::dvec3 mapped = tangent * m.x + bitangent * m.y + n * m.z;
-        if (glm::length(mapped) > 0.0) n = glm::normalize(mapped);
-      }
+    const glm::dvec3 geometric = n;
+    n = mapped_normal(scene, t, b, in.slots[kSlotNormal], in.normal_scale, geometric);
+    sp.specular = in.specular;
+    sp.specular_color = glm::dvec3(in.specular_color[0], in.specular_color[1], in.specular_color[2]);
+    if (sample_slot(scene, t, b, in.slots[kSlotSpecular], s)) sp.specular *= s.w;
+    if (sample_slot(scene, t, b, in.slots[kSlotSpecularColor], s)) sp.specular_color *= glm::dvec3(s);
+    sp.clearcoat = in.clearcoat, sp.clearcoat_roughness = in.clearcoat_roughness;
+    if (in.clearcoat > 0.0f) {
+      if (sample_slot(scene, t, b, in.slots[kSlotClearcoat], s)) sp.clearcoat *= s.x;
+      if (sample_slot(scene, t, b, in.slots[kSlotClearcoatRoughness], s)) sp.clearcoat_roughness *= s.y;
+      coat_n = mapped_normal(scene, t, b, in.slots[kSlotClearcoatNormal], in.clearcoat_normal_scale, geometric);
     }
   }
   sp.n = back ? -n : n;
+  sp.clearcoat_n = back ? -coat_n : coat_n;
 }
 
 }  // namespace pmr::ref

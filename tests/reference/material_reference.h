@@ -13,8 +13,9 @@
 namespace pmr::ref {
 
 // Fills base, metallic, roughness, ior, transmission, n (the interpolated normal, the normal map, then
-// the back-face flip), ao, emissive and unlit of `sp` for source barycentrics b of triangle `tri`. p and eye are left
-// to the caller.
+// the back-face flip), ao, emissive, unlit, the specular weight and colour, and the clear coat (its normal: its own map on the
+// interpolated normal, or that normal) of `sp` for source barycentrics b of triangle `tri`. p and eye
+// are left to the caller.
 void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool back, SurfacePoint& sp);
 
 }  // namespace pmr::ref

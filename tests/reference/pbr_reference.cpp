@@ -12,15 +12,20 @@ constexpr double kPi = 3.14159265358979323846;
 double clamp01(double x) { return std::min(1.0, std::max(0.0, x)); }
 
 // F0 = mix(dielectric, base, metallic), the dielectric's ((ior - 1) / (ior + 1))^2 (0.04 at ior 1.5)
-glm::dvec3 f0_of(const glm::dvec3& base, double metallic, double ior) {
+// times KHR_materials_specular's colour (at most 1) and weight
+glm::dvec3 f0_of(const glm::dvec3& base, double metallic, double ior, double specular = 1.0,
+                 const glm::dvec3& specular_color = glm::dvec3(1.0)) {
   const double f = (ior - 1.0) / (ior + 1.0);
-  return glm::mix(glm::dvec3(f * f), base, metallic);
+  return glm::mix(glm::min(f * f * specular_color, glm::dvec3(1.0)) * specular, base, metallic);
 }
+
+double f90_of(double metallic, double specular) { return specular + (1.0 - specular) * metallic; }
 
 }  // namespace
 
 glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
-                    const glm::dvec3& l, double ior, double transmission) {
+                    const glm::dvec3& l, double ior, double transmission, double specular,
+                    const glm::dvec3& specular_color) {
   const double nl = clamp01(glm::dot(n, l));
   if (nl <= 0.0) return glm::dvec3(0.0);
   const double nv = clamp01(glm::dot(n, v));
@@ -28,8 +33,8 @@ glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm
   const glm::dvec3 h = glm::length(hv) > 0.0 ? glm::normalize(hv) : n;
   const double nh = clamp01(glm::dot(n, h)), vh = clamp01(glm::dot(v, h));
   const double alpha = r * r, a2 = alpha * alpha;
-  const glm::dvec3 f0 = f0_of(base, metallic, ior);
-  const glm::dvec3 F = f0 + (1.0 - f0) * std::pow(1.0 - vh, 5.0);
+  const glm::dvec3 f0 = f0_of(base, metallic, ior, specular, specular_color);
+  const glm::dvec3 F = f0 + (f90_of(metallic, specular) - f0) * std::pow(1.0 - vh, 5.0);
   const double dd = nh * nh * (a2 - 1.0) + 1.0;
   const double D = a2 / (kPi * dd * dd);
   const double s = nl * std::sqrt(nv * nv * (1.0 - a2) + a2) + nv * std::sqrt(nl * nl * (1.0 - a2) + a2);
@@ -38,17 +43,29 @@ glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm
   return ((1.0 - F) * c_diff / kPi + F * (D * vis)) * nl;
 }
 
-glm::dvec3 btdf_light(const glm::dvec3& f0, double r, double ior, const glm::dvec3& n, const glm::dvec3& v,
+glm::dvec3 btdf_light(const glm::dvec3& f0, double f90, double r, double ior, const glm::dvec3& n, const glm::dvec3& v,
                       const glm::dvec3& l) {
   const glm::dvec3 lm = l - 2.0 * glm::dot(n, l) * n, hv = lm + v;
   const glm::dvec3 h = glm::length(hv) > 0.0 ? glm::normalize(hv) : n;
   const double rt = std::max(r * std::clamp(2.0 * ior - 2.0, 0.0, 1.0), 0.03), a2 = std::pow(rt, 4.0);
   const double nh = clamp01(glm::dot(n, h)), vh = clamp01(glm::dot(v, h));
   const double nl = clamp01(glm::dot(n, lm)), nv = clamp01(glm::dot(n, v));
-  const glm::dvec3 F = f0 + (1.0 - f0) * std::pow(1.0 - vh, 5.0);
+  const glm::dvec3 F = f0 + (f90 - f0) * std::pow(1.0 - vh, 5.0);
   const double dd = nh * nh * (a2 - 1.0) + 1.0;
   const double s = nl * std::sqrt(nv * nv * (1.0 - a2) + a2) + nv * std::sqrt(nl * nl * (1.0 - a2) + a2);
   return (1.0 - F) * (a2 / (kPi * dd * dd)) * (s > 0.0 ? 0.5 / s : 0.0);
+}
+
+double ggx_lobe_cos(double r, const glm::dvec3& n, const glm::dvec3& v, const glm::dvec3& l) {
+  const double nl = clamp01(glm::dot(n, l));
+  if (nl <= 0.0) return 0.0;
+  const double nv = clamp01(glm::dot(n, v));
+  const glm::dvec3 hv = l + v;
+  const glm::dvec3 h = glm::length(hv) > 0.0 ? glm::normalize(hv) : n;
+  const double nh = clamp01(glm::dot(n, h)), a2 = std::pow(r, 4.0);
+  const double dd = nh * nh * (a2 - 1.0) + 1.0;
+  const double s = nl * std::sqrt(nv * nv * (1.0 - a2) + a2) + nv * std::sqrt(nl * nl * (1.0 - a2) + a2);
+  return a2 / (kPi * dd * dd) * (s > 0.0 ? 0.5 / s : 0.0) * nl;
 }
 
 glm::dvec3 light_irradiance(const PunctualLight& light, const glm::dvec3& p, glm::dvec3& l) {
@@ -80,21 +97,37 @@ glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& li
   if (s.unlit) return glm::min(exposure * s.base, glm::dvec3(kHalfMax));
   const double r = std::min(1.0, std::max(0.03, s.roughness));
   const glm::dvec3 v = glm::normalize(s.eye - s.p);
+  const glm::dvec3 f0 = f0_of(s.base, s.metallic, s.ior, s.specular, s.specular_color);
+  const double f90 = f90_of(s.metallic, s.specular);
   glm::dvec3 sum(0.0);
   for (const PunctualLight& light : lights) {
     glm::dvec3 l;
     const glm::dvec3 E = light_irradiance(light, s.p, l);
-    sum += brdf_cos(s.base, s.metallic, r, s.n, v, l, s.ior, s.transmission) * E;
+    sum += brdf_cos(s.base, s.metallic, r, s.n, v, l, s.ior, s.transmission, s.specular, s.specular_color) * E;
     if (s.transmission > 0.0)
-      sum += s.transmission * (s.base * (1.0 - s.metallic)) * s.attenuation *
-             btdf_light(f0_of(s.base, s.metallic, s.ior), r, s.ior, s.n, v, l) * E;
+      sum +=
+          s.transmission * (s.base * (1.0 - s.metallic)) * s.attenuation * btdf_light(f0, f90, r, s.ior, s.n, v, l) * E;
   }
-  const glm::dvec3 f0 = f0_of(s.base, s.metallic, s.ior), c_diff = s.base * (1.0 - s.metallic);
+  const glm::dvec3 c_diff = s.base * (1.0 - s.metallic);
   const glm::dvec2 ab = env.split_sum(clamp01(glm::dot(s.n, v)), r);
-  const glm::dvec3 reflected = glm::reflect(-v, s.n), specular = f0 * ab.x + ab.y;
+  const glm::dvec3 reflected = glm::reflect(-v, s.n), specular = f0 * ab.x + f90 * ab.y;
   sum += s.ao * ((1.0 - s.transmission) * c_diff * env.irradiance(s.n) + specular * env.prefiltered(reflected, r));
   sum += s.ao * s.transmission * (1.0 - specular) * c_diff * s.through;
-  return glm::min(exposure * (sum + s.emissive), glm::dvec3(kHalfMax));  // saturates like the kernels' halves
+  glm::dvec3 color = sum + s.emissive;
+  if (s.clearcoat > 0.0) {
+    const double rc = std::min(1.0, std::max(0.03, s.clearcoat_roughness)), nv = glm::dot(s.clearcoat_n, v);
+    glm::dvec3 coat(0.0);
+    for (const PunctualLight& light : lights) {
+      glm::dvec3 l;
+      const glm::dvec3 E = light_irradiance(light, s.p, l);
+      coat += ggx_lobe_cos(rc, s.clearcoat_n, v, l) * E;
+    }
+    const glm::dvec2 cab = env.split_sum(clamp01(nv), rc);
+    coat += s.ao * (cab.x + cab.y) * env.prefiltered(glm::reflect(-v, s.clearcoat_n), rc);
+    const double w = s.clearcoat * (0.04 + 0.96 * std::pow(1.0 - std::min(1.0, std::abs(nv)), 5.0));
+    color = color * (1.0 - w) + coat * w;
+  }
+  return glm::min(exposure * color, glm::dvec3(kHalfMax));  // saturates like the kernels' halves
 }
 
 }  // namespace pmr::ref

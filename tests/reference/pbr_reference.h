@@ -12,13 +12,16 @@ namespace pmr::ref {
 // f(l, v) * dot(n, l) for unit n, v, l; r = the clamped roughness (alpha = r^2); the dielectric's F0
 // from its index of refraction ((ior - 1) / (ior + 1))^2 (KHR_materials_ior; 0.04 at glTF's 1.5); the
 // diffuse lobe weighted by 1 - transmission (KHR_materials_transmission: that part transmits instead).
+// KHR_materials_specular's weight and colour scale the dielectric's Fresnel term: F0 = mix(min(f0_ior
+// colour, 1) weight, base, metallic), F90 = mix(weight, 1, metallic), F = F0 + (F90 - F0) (1 - v.h)^5.
 glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
-                    const glm::dvec3& l, double ior = 1.5, double transmission = 0.0);
+                    const glm::dvec3& l, double ior = 1.5, double transmission = 0.0, double specular = 1.0,
+                    const glm::dvec3& specular_color = glm::dvec3(1.0));
 
 // KHR_materials_transmission's BTDF for a light in direction l seen through the surface: (1 - F(v.h))
 // D(n.h) Vis(n.l', n.v), l' = l mirrored on the surface's plane, h = normalize(l' + v), GGX of roughness
 // max(r clamp(2 ior - 2, 0, 1), 0.03).
-glm::dvec3 btdf_light(const glm::dvec3& f0, double r, double ior, const glm::dvec3& n, const glm::dvec3& v,
+glm::dvec3 btdf_light(const glm::dvec3& f0, double f90, double r, double ior, const glm::dvec3& n, const glm::dvec3& v,
                       const glm::dvec3& l);
 
 enum class LightType { Directional = 0, Point = 1, Spot = 2 };
@@ -49,6 +52,12 @@ struct SurfacePoint {
   double ao = 1.0;
   glm::dvec3 emissive{0.0};
   bool unlit = false;
+  // KHR_materials_clearcoat: intensity, roughness (before clamping) and the coat's unit normal (its
+  // own normal map applied, or the interpolated one; back faces already flipped)
+  double clearcoat = 0.0, clearcoat_roughness = 0.0;
+  glm::dvec3 clearcoat_n{0.0, 0.0, 1.0};
+  double specular = 1.0;  // KHR_materials_specular: weight and colour (factor x texture)
+  glm::dvec3 specular_color{1.0};
 };
 
 // The environment's precomputed terms: I(n) (irradiance / pi), P(d, r) and the split-sum (A, B).
@@ -58,11 +67,18 @@ struct EnvironmentTerms {
   std::function<glm::dvec2(double, double)> split_sum;  // (dot(n, v), r) -> (A, B)
 };
 
-// exposure x (sum over lights of f E dot(n, l) + ao (c_diff I(n) + (F0 A + B) P(reflect(-v, n), r)) + e);
+// exposure x (sum over lights of f E dot(n, l) + ao (c_diff I(n) + (F0 A + F90 B) P(reflect(-v, n), r)) + e);
 // unlit: exposure x base. With transmission T, the diffuse terms are weighted by 1 - T, and
 // ao T (1 - (F0 A + B)) c_diff `through` is added (KHR_materials_transmission's BTDF, DESIGN 4c), and
 // per light T c_diff `attenuation` (1 - F) D Vis E, the GGX lobe about the light mirrored on the
 // surface (btdf_light).
+// D(n.h) Vis(n.l, n.v) n.l of GGX with roughness r (alpha = r^2), no Fresnel: the clear coat's lobe.
+double ggx_lobe_cos(double r, const glm::dvec3& n, const glm::dvec3& v, const glm::dvec3& l);
+
+// With a clear coat of intensity c (KHR_materials_clearcoat's fresnel_coat, ior 1.5) that colour C
+// becomes C (1 - c Fc) + c Fc (sum over lights of ggx_lobe_cos(rc, nc) E + ao (A + B)(nc.v, rc)
+// P(reflect(-v, nc), rc)), Fc = 0.04 + 0.96 (1 - |nc.v|)^5, rc the clamped coat roughness, nc its
+// normal.
 glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& lights, const EnvironmentTerms& env,
                      double exposure);
 

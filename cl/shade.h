@@ -159,13 +159,6 @@ inline void lanes_add_coat(LaneWinners* L, global const PmrMaterial* mat, sint t
   L->coat_roughness = blend(L->coat_roughness, mat->clearcoat_roughness, take);
 }
 
-/* Whether material `mat` changes the dielectric's Fresnel term (KHR_materials_specular). */
-inline bool material_specular(global const PmrMaterial* mat) {
-  return mat->specular != 1.0f || mat->specular_color[0] != 1.0f || mat->specular_color[1] != 1.0f ||
-         mat->specular_color[2] != 1.0f || mat->maps[PMR_MAP_SPECULAR].texture >= 0 ||
-         mat->maps[PMR_MAP_SPECULAR_COLOR].texture >= 0;
-}
-
 /* The specular factors of material `mat` into lanes `take`. */
 inline void lanes_add_specular(LaneWinners* L, global const PmrMaterial* mat, sint take) {
   if (!any(L->specular)) L->spec_weight = (sfloat)(1.0f), L->spec_color = s3_splat((float3)(1.0f));
@@ -212,8 +205,8 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
     if (mat->unlit) L->unlit |= take;
     if (mat->transmission > 0.0f) lanes_add_transmission(L, in, mat, &t, take);
     if (mat->clearcoat > 0.0f) lanes_add_coat(L, mat, take);
-    if (material_specular(mat)) lanes_add_specular(L, mat, take);
-    for (int k = 0; k < PMR_MAPS; ++k) textured = textured || mat->maps[k].texture >= 0;
+    if (mat->flags & PMR_MATERIAL_SPECULAR) lanes_add_specular(L, mat, take);
+    textured = (mat->flags & PMR_MATERIAL_MAPS) != 0;
   }
   if (textured) {
     L->textured |= bits;

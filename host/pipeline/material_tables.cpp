@@ -119,6 +119,22 @@ std::array<std::vector<int>, kMipKinds> add_textures(MaterialTables& t, const Sc
 
 }  // namespace
 
+namespace {
+
+// PmrMaterial.flags of a material whose maps are set.
+uint32_t material_flags(const PmrMaterial& m) {
+  uint32_t flags = 0;
+  for (const PmrTextureMap& map : m.maps)
+    if (map.texture >= 0) flags |= PMR_MATERIAL_MAPS;
+  const bool white = m.specular_color[0] == 1.0f && m.specular_color[1] == 1.0f && m.specular_color[2] == 1.0f;
+  if (m.specular != 1.0f || !white || m.maps[PMR_MAP_SPECULAR].texture >= 0 ||
+      m.maps[PMR_MAP_SPECULAR_COLOR].texture >= 0)
+    flags |= PMR_MATERIAL_SPECULAR;
+  return flags;
+}
+
+}  // namespace
+
 MaterialTables make_material_tables(const Scene& scene, bool mips) {
   MaterialTables t;
   const size_t vertices = scene.positions.size();
@@ -155,6 +171,7 @@ MaterialTables make_material_tables(const Scene& scene, bool mips) {
       texture_transform_matrix(slot, map.uv_transform);
     }
   }
+  for (PmrMaterial& m : t.materials) m.flags = material_flags(m);
   return t;
 }
 

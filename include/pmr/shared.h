@@ -92,6 +92,10 @@ typedef uint64_t pmr_u64;
 #define PMR_ALPHA_MASK 1
 #define PMR_ALPHA_BLEND 2
 
+/* PmrMaterial.flags: what the host found once, so that shading reads one word per winner */
+#define PMR_MATERIAL_MAPS 1u     /* some map (PMR_MAP_*) is sampled                                 */
+#define PMR_MATERIAL_SPECULAR 2u /* KHR_materials_specular changes the Fresnel term (a factor or a map) */
+
 /* Texture wrap modes (glTF sampler enums). */
 #define PMR_WRAP_REPEAT 10497
 #define PMR_WRAP_CLAMP 33071
@@ -281,6 +285,7 @@ typedef struct {
   float clearcoat_normal_scale; /* ... clearcoatNormalTexture.scale                                */
   float specular;               /* KHR_materials_specular specularFactor (1 without it)             */
   float specular_color[3];      /* ... specularColorFactor (linear; (1, 1, 1) without it)          */
+  pmr_u32 flags;                /* PMR_MATERIAL_*, set with the maps (host/pipeline/material_tables.cpp) */
 } PmrMaterial;
 
 /* A texture and its mip chain: `levels` levels back to back from `offset`, level k of

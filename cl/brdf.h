@@ -60,12 +60,38 @@ inline sfloat ggx_lobe_cos(sfloat3 n, sfloat3 v, sfloat3 l, sfloat a2) {
   return select((sfloat)(0.0f), ggx_d(nh, a2) * smith_vis(nl, nv, a2) * nl, nl > 0.0f);
 }
 
+/* KHR_materials_anisotropy's lobe (its specification's implementation section): the tangent t and
+ * bitangent b of the anisotropy direction, strength s; GGX stretched to alpha_t = mix(alpha, 1, s^2)
+ * along t and alpha_b = alpha along b, with its height-correlated Smith visibility. `on`: the lanes
+ * that have it (the others keep the isotropic lobe). */
+typedef struct {
+  sint on;
+  sfloat3 t, b;
+  sfloat s;
+} Anisotropy;
+
+/* D Vis of the anisotropic lobe for alpha = r^2, at the dot products of n, h, v and l given. */
+inline sfloat ggx_aniso_dv(const Anisotropy* A, sfloat alpha, sfloat3 h, sfloat3 v, sfloat3 l, sfloat nh, sfloat nv,
+                           sfloat nl) {
+  const sfloat at = alpha + (1.0f - alpha) * A->s * A->s, ab = alpha, a2 = at * ab;
+  const sfloat th = s3_dot(A->t, h), bh = s3_dot(A->b, h);
+  const sfloat fx = th * ab, fy = bh * at, fz = a2 * nh;
+  const sfloat w2 = a2 / (fx * fx + fy * fy + fz * fz);
+  const sfloat D = a2 * w2 * w2 * (1.0f / PMR_PI_F);
+  const sfloat tv = s3_dot(A->t, v), bv = s3_dot(A->b, v), tl = s3_dot(A->t, l), bl = s3_dot(A->b, l);
+  const sfloat gv = nl * sqrt(at * at * tv * tv + ab * ab * bv * bv + nv * nv),
+               gl = nv * sqrt(at * at * tl * tl + ab * ab * bl * bl + nl * nl);
+  const sfloat s = gv + gl;
+  return D * select((sfloat)(0.0f), 0.5f / s, s > 0.0f);
+}
+
 /* f(l, v) * dot(n, l) per lane: the radiance reflected toward v per unit irradiance from the direction
  * l (unit, toward the light). n and v are unit vectors; r is the clamped roughness; f0 and f90 the
- * Fresnel term's (pbr_f0); `transmission` (KHR_materials_transmission) the part of the diffuse lobe that transmits instead
- * (the environment's transmission term takes its place: cl/transmission.h). */
+ * Fresnel term's (pbr_f0); `transmission` (KHR_materials_transmission) the part of the diffuse lobe
+ * that transmits instead (the environment's transmission term takes its place: cl/transmission.h);
+ * `aniso` the anisotropic lobe where it is on (0: none). */
 inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat3 f0, sfloat f90, sfloat r, sfloat3 n,
-                                     sfloat3 v, sfloat3 l, sfloat transmission) {
+                                     sfloat3 v, sfloat3 l, sfloat transmission, const Anisotropy* aniso) {
   const sfloat nl = clamp(s3_dot(n, l), 0.0f, 1.0f);
   const sfloat nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
   const sfloat3 hv = s3_add(l, v);
@@ -75,7 +101,8 @@ inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat3 f0, 
   const sfloat alpha = r * r, a2 = alpha * alpha;
   const sfloat3 F = fresnel_schlick(f0, f90, vh);
   const sfloat diffuse = (1.0f - metallic) * (1.0f - transmission) * (1.0f / PMR_PI_F),
-               spec = ggx_d(nh, a2) * smith_vis(nl, nv, a2);
+               iso = ggx_d(nh, a2) * smith_vis(nl, nv, a2);
+  const sfloat spec = aniso ? select(iso, ggx_aniso_dv(aniso, alpha, h, v, l, nh, nv, nl), aniso->on) : iso;
   const sfloat3 f = s3((1.0f - F.x) * base.x * diffuse + F.x * spec, (1.0f - F.y) * base.y * diffuse + F.y * spec,
                        (1.0f - F.z) * base.z * diffuse + F.z * spec);
   /* nl = 0 (the light behind the surface) gives 0, whatever the rest computed */
@@ -84,8 +111,8 @@ inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat3 f0, 
 
 /* The same for an opaque surface. */
 inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat3 f0, sfloat f90, sfloat r, sfloat3 n, sfloat3 v,
-                        sfloat3 l) {
-  return brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, (sfloat)(0.0f));
+                        sfloat3 l, const Anisotropy* aniso) {
+  return brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, (sfloat)(0.0f), aniso);
 }
 
 /* KHR_materials_transmission's BTDF for a punctual light seen through the surface (as the Khronos

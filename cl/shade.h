@@ -102,6 +102,10 @@ typedef struct {
   sint specular;
   sfloat spec_weight;
   sfloat3 spec_color;
+  /* pbr, KHR_materials_anisotropy: lanes `aniso` (strength, cos and sin of the rotation); set only when
+   * some lane is (strength 0 in the others). Their lanes count as textured: they read the tangent. */
+  sint aniso;
+  sfloat aniso_strength, aniso_cos, aniso_sin;
   uint textured; /* bit l: lane l's material has a map the model reads (lambert: base colour) */
   uint tri[SW];  /* lane l's triangle, where textured                               */
 #if PMR_TRILINEAR
@@ -126,7 +130,7 @@ inline void lanes_clear(LaneWinners* L) {
   L->emissive = s3(zero, zero, zero);
   L->glass = (sint)(0);  /* the transmission inputs are set when the first glass lane comes */
   L->coated = (sint)(0); /* ... and the clear coat's when the first coated lane comes */
-  L->specular = (sint)(0);
+  L->specular = L->aniso = (sint)(0);
   L->textured = 0u;
 #if PMR_TRILINEAR
   for (int k = 0; k < 3; ++k) vstore_s(zero, 0, L->ex[k]), vstore_s(zero, 0, L->ey[k]);
@@ -165,6 +169,15 @@ inline void lanes_add_specular(LaneWinners* L, global const PmrMaterial* mat, si
   L->specular |= take;
   L->spec_weight = blend(L->spec_weight, mat->specular, take);
   L->spec_color = blend3(L->spec_color, vload3(0, mat->specular_color), take);
+}
+
+/* The anisotropy factors of material `mat` into lanes `take`. */
+inline void lanes_add_anisotropy(LaneWinners* L, global const PmrMaterial* mat, sint take) {
+  if (!any(L->aniso)) L->aniso_strength = L->aniso_sin = (sfloat)(0.0f), L->aniso_cos = (sfloat)(1.0f);
+  L->aniso |= take;
+  L->aniso_strength = blend(L->aniso_strength, mat->anisotropy[0], take);
+  L->aniso_cos = blend(L->aniso_cos, mat->anisotropy[1], take);
+  L->aniso_sin = blend(L->aniso_sin, mat->anisotropy[2], take);
 }
 
 /* Lanes `take` (bits: the same as bits) are won by MTA m: its values blended into them (the edge
@@ -206,7 +219,8 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
     if (mat->transmission > 0.0f) lanes_add_transmission(L, in, mat, &t, take);
     if (mat->clearcoat > 0.0f) lanes_add_coat(L, mat, take);
     if (mat->flags & PMR_MATERIAL_SPECULAR) lanes_add_specular(L, mat, take);
-    textured = (mat->flags & PMR_MATERIAL_MAPS) != 0;
+    if (mat->flags & PMR_MATERIAL_ANISOTROPY) lanes_add_anisotropy(L, mat, take);
+    textured = (mat->flags & (PMR_MATERIAL_MAPS | PMR_MATERIAL_ANISOTROPY)) != 0;
   }
   if (textured) {
     L->textured |= bits;
@@ -314,10 +328,11 @@ typedef struct {
   float base[3][SW], base_alpha[SW], metallic[SW], roughness[SW], ao[SW], emissive[3][SW];
   float tw[4][SW];
   LaneNormalMap normal;
-  float transmission[SW], thickness[SW];    /* KHR_materials_transmission R, KHR_materials_volume G (glass) */
-  float coat[SW], coat_roughness[SW];       /* KHR_materials_clearcoat R, G (coated) */
-  LaneNormalMap coat_normal;                /* ... clearcoatNormalTexture (coated) */
-  float spec_weight[SW], spec_color[3][SW]; /* KHR_materials_specular A, RGB (specular) */
+  float transmission[SW], thickness[SW];      /* KHR_materials_transmission R, KHR_materials_volume G (glass) */
+  float coat[SW], coat_roughness[SW];         /* KHR_materials_clearcoat R, G (coated) */
+  LaneNormalMap coat_normal;                  /* ... clearcoatNormalTexture (coated) */
+  float spec_weight[SW], spec_color[3][SW];   /* KHR_materials_specular A, RGB (specular) */
+  float aniso_dir[2][SW], aniso_strength[SW]; /* KHR_materials_anisotropy: 2 RG - 1, B (aniso) */
 } LaneTextures;
 
 /* The screen-space derivatives of SW lanes' source barycentrics, per output pixel in x and in y. */
@@ -478,9 +493,15 @@ inline void sample_material_lanes(const ShadeInputs* in, global const PmrMateria
     sample_map_lanes(in, &mat->maps[PMR_MAP_SPECULAR_COLOR], L->tri, bits, take, b, g, true, C, c);
     for (int k = 0; k < 3; ++k) lanes_put(T->spec_color[k], c[k], take);
   }
+  if (mat->maps[PMR_MAP_ANISOTROPY].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_ANISOTROPY], L->tri, bits, take, b, g, false, C, c);
+    lanes_put(T->aniso_dir[0], 2.0f * c[0] - 1.0f, take), lanes_put(T->aniso_dir[1], 2.0f * c[1] - 1.0f, take);
+    lanes_put(T->aniso_strength, c[2], take);
+  }
   const bool normal = mat->maps[PMR_MAP_NORMAL].texture >= 0;
   if (normal) sample_normal_map_lanes(in, mat, PMR_MAP_NORMAL, mat->normal_scale, L, bits, take, b, g, C, &T->normal);
-  if (normal || (mat->clearcoat > 0.0f && mat->maps[PMR_MAP_CLEARCOAT_NORMAL].texture >= 0)) {
+  if (normal || (mat->clearcoat > 0.0f && mat->maps[PMR_MAP_CLEARCOAT_NORMAL].texture >= 0) ||
+      (mat->flags & PMR_MATERIAL_ANISOTROPY)) {
     float bs[3][SW];
     s3_store(b, bs[0], bs[1], bs[2]);
     for (uint r = bits; r != 0u; r &= r - 1u) { /* the interpolated tangent, lane by lane (a gather) */
@@ -512,6 +533,8 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
   if (any(L->specular))
     for (int l = 0; l < SW; ++l)
       T->spec_weight[l] = T->spec_color[0][l] = T->spec_color[1][l] = T->spec_color[2][l] = 1.0f;
+  if (any(L->aniso))
+    for (int l = 0; l < SW; ++l) T->aniso_dir[0][l] = T->aniso_strength[l] = 1.0f, T->aniso_dir[1][l] = 0.0f;
   if (PMR_WITH_BLEND && any(L->blended))
     for (int l = 0; l < SW; ++l) T->base_alpha[l] = 1.0f;
   uint material[SW];
@@ -536,22 +559,43 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
   }
 }
 
-/* Normal map M applied to the unit normals n (before any back-face flip), in the lanes that have one:
- * the interpolated tangent made orthogonal to n, the bitangent sign(w) * cross(n, t),
- * m = (2 s - 1) * (scale, scale, 1). A lane without a tangent (zero) keeps n. */
-inline sfloat3 mapped_normal(const LaneTextures* T, const LaneNormalMap* M, sfloat3 n) {
+/* The tangent frame about the unit normals n (before any back-face flip): the interpolated tangent made
+ * orthogonal to n and normalized (*t), the bitangent sign(w) * cross(n, t) (*b); returns the length of
+ * the orthogonalized tangent (a lane without a tangent: 0, and t, b of no use). */
+inline sfloat tangent_frame(const LaneTextures* T, sfloat3 n, sfloat3* t, sfloat3* b) {
   const sfloat3 tw = LANE3(T->tw);
-  sfloat3 tangent = s3_sub(tw, s3_scale(n, s3_dot(n, tw)));
-  const sfloat len = sqrt(s3_dot(tangent, tangent));
-  tangent = s3_scale(tangent, 1.0f / len);
-  const sfloat3 bitangent =
-      s3_scale(s3_cross(n, tangent), select((sfloat)(1.0f), (sfloat)(-1.0f), vload_s(0, T->tw[3]) < 0.0f));
+  const sfloat3 o = s3_sub(tw, s3_scale(n, s3_dot(n, tw)));
+  const sfloat len = sqrt(s3_dot(o, o));
+  *t = s3_scale(o, 1.0f / len);
+  *b = s3_scale(s3_cross(n, *t), select((sfloat)(1.0f), (sfloat)(-1.0f), vload_s(0, T->tw[3]) < 0.0f));
+  return len;
+}
+
+/* Normal map M applied to the unit normals n (before any back-face flip), in the lanes that have one:
+ * m = (2 s - 1) * (scale, scale, 1) in the tangent frame. A lane without a tangent (zero) keeps n. */
+inline sfloat3 mapped_normal(const LaneTextures* T, const LaneNormalMap* M, sfloat3 n) {
+  sfloat3 tangent, bitangent;
+  const sfloat len = tangent_frame(T, n, &tangent, &bitangent);
   const sfloat scale = vload_s(0, M->scale);
   const sfloat3 s = LANE3(M->s);
   const sfloat3 m = s3((2.0f * s.x - 1.0f) * scale, (2.0f * s.y - 1.0f) * scale, 2.0f * s.z - 1.0f);
   const sfloat3 mapped = s3_add(s3_add(s3_scale(tangent, m.x), s3_scale(bitangent, m.y)), s3_scale(n, m.z));
   const sfloat mlen = sqrt(s3_dot(mapped, mapped));
   return s3_select(n, s3_scale(mapped, 1.0f / mlen), vload_s(0, M->mapped) & (len > 1e-12f) & (mlen > 0.0f));
+}
+
+/* KHR_materials_anisotropy's direction in world space, for the lanes L->aniso: (cos, sin) of the
+ * material's rotation applied to the texture's direction 2 RG - 1 (else (1, 0)), in the tangent frame
+ * about the interpolated normal n (before any normal map or back-face flip), normalized; 0 where a lane
+ * has no tangent (it is drawn isotropic). */
+inline sfloat3 anisotropy_direction(const LaneWinners* L, const LaneTextures* T, sfloat3 n) {
+  sfloat3 t, b;
+  const sfloat len = tangent_frame(T, n, &t, &b);
+  const sfloat dx = vload_s(0, T->aniso_dir[0]), dy = vload_s(0, T->aniso_dir[1]);
+  const sfloat rx = L->aniso_cos * dx - L->aniso_sin * dy, ry = L->aniso_sin * dx + L->aniso_cos * dy;
+  const sfloat3 d = s3_add(s3_scale(t, rx), s3_scale(b, ry));
+  const sfloat dl = sqrt(s3_dot(d, d));
+  return s3_select(s3_splat((float3)(0.0f)), s3_scale(d, 1.0f / dl), (len > 1e-12f) & (dl > 0.0f));
 }
 
 /* The environment's P(d, r) per lane where `act` (0 elsewhere), or the uniform default's radiance. */
@@ -565,11 +609,11 @@ inline sfloat3 environment_along(const ShadeInputs* in, sfloat3 d, sfloat r, sin
                    env_prefiltered(in->env, in->env_data, u, v, select((sfloat)(1.0f), r, act)), act);
 }
 
-/* The environment's I(n) and P(reflect(-v, n), r) per lane where `act` (cl/environment.h), or the
- * uniform default of radiance L, for which I(n) = P = L and no table is read. I is not needed (0) where
- * metallic is 1 (c_diff = 0). */
-inline void environment_lanes(const ShadeInputs* in, sfloat3 n, sfloat3 v, sfloat nv, sfloat metallic, sfloat r,
-                              sint act, sfloat3* irradiance, sfloat3* prefiltered) {
+/* The environment's I(n) and P(d, r) per lane where `act` (cl/environment.h), d the reflected direction
+ * (reflected_direction), or the uniform default of radiance L, for which I(n) = P = L and no table is
+ * read. I is not needed (0) where metallic is 1 (c_diff = 0). */
+inline void environment_lanes(const ShadeInputs* in, sfloat3 n, sfloat3 d, sfloat metallic, sfloat r, sint act,
+                              sfloat3* irradiance, sfloat3* prefiltered) {
   if (in->env->level_count == 0) {
     *irradiance = *prefiltered = s3_splat((float3)(in->P->env_radiance));
     return;
@@ -581,7 +625,7 @@ inline void environment_lanes(const ShadeInputs* in, sfloat3 n, sfloat3 v, sfloa
   const sint diffuse = act & (metallic < 1.0f);
   const sfloat3 zero = s3_splat((float3)(0.0f));
   *irradiance = any(diffuse) ? s3_select(zero, env_irradiance(in->env, in->env_data, un, vn), diffuse) : zero;
-  *prefiltered = environment_along(in, s3_sub(s3_scale(n, 2.0f * nv), v), r, act); /* reflect(-v, n) */
+  *prefiltered = environment_along(in, d, r, act);
 }
 
 /* The split-sum table's bilinear lookup for every lane, as pmr::split_sum (host/shading/environment.cpp)
@@ -652,12 +696,14 @@ typedef struct {
   sfloat transmission, thickness; /* glass lanes (0 elsewhere)                                        */
   sfloat coat, coat_r;            /* KHR_materials_clearcoat (coated lanes): intensity, roughness  */
   sfloat3 coat_n;                 /* ... the coat's unit normal (its own normal map, or the geometric one) */
+  Anisotropy aniso;               /* KHR_materials_anisotropy (lanes aniso.on)                       */
 } Surface;
 
 /* The surface of the lanes seen from view `view`: n and coat_n are unit normals, flipped for back faces;
  * spread and coat_spread the specular antialiasing increments of the two lobes. */
 inline Surface pbr_surface(const ShadeInputs* in, const LaneWinners* L, const LaneTextures* T, bool textured, sfloat3 b,
-                           sfloat3 n, sfloat3 coat_n, sfloat3 base, sfloat spread, sfloat coat_spread, int view) {
+                           sfloat3 n, sfloat3 coat_n, sfloat3 aniso_t, sfloat3 base, sfloat spread, sfloat coat_spread,
+                           int view) {
   Surface S;
   S.p = s3_interp_lanes(b, L->p);
   const bool glass = any(L->glass), coated = any(L->coated);
@@ -688,6 +734,13 @@ inline Surface pbr_surface(const ShadeInputs* in, const LaneWinners* L, const La
   }
   S.coat = coat, S.coat_n = coat_n;
   S.coat_r = coated ? widened_roughness(pbr_roughness(coat_roughness), coat_spread) : (sfloat)(1.0f);
+  if (any(L->aniso)) { /* the bitangent from the shading normal, as the specification's implementation */
+    const sfloat3 ab = s3_cross(n, aniso_t);
+    const sfloat len = sqrt(s3_dot(ab, ab));
+    S.aniso.on = L->aniso & (len > 0.0f);
+    S.aniso.t = aniso_t, S.aniso.b = s3_scale(ab, 1.0f / len);
+    S.aniso.s = L->aniso_strength * vload_s(0, T->aniso_strength);
+  }
   return S;
 }
 
@@ -709,6 +762,19 @@ inline sfloat3 coated_lanes(const ShadeInputs* in, const LaneWinners* L, const S
   return s3_select(under, s3_add(s3_scale(under, 1.0f - w), s3_scale(coat, w)), L->coated);
 }
 
+/* reflect(-v, n), or for anisotropic lanes about the Sample Viewer's bent normal: n bent toward the
+ * normal of the plane through the anisotropy bitangent b and v, normalize(mix(cross(cross(b, v), b), n,
+ * (1 - s (1 - r))^4)), s the strength and r the roughness. */
+inline sfloat3 reflected_direction(const Surface* S, const LaneWinners* L, sfloat nv) {
+  const sfloat3 mirror = s3_sub(s3_scale(S->n, 2.0f * nv), S->v);
+  if (!any(L->aniso)) return mirror;
+  const sfloat3 b = S->aniso.b, an = s3_cross(s3_cross(b, S->v), b);
+  const sfloat k = 1.0f - S->aniso.s * (1.0f - S->r), k2 = k * k, bend = k2 * k2;
+  const sfloat3 m = s3_add(s3_scale(an, 1.0f - bend), s3_scale(S->n, bend));
+  const sfloat3 bent = s3_scale(m, 1.0f / sqrt(s3_dot(m, m)));
+  return s3_select(mirror, s3_sub(s3_scale(bent, 2.0f * s3_dot(bent, S->v)), S->v), S->aniso.on);
+}
+
 /* glTF metallic-roughness of the lanes' surfaces S seen from view `view`'s camera: the sum over the
  * light table of f E n.l (the file's punctual lights, or the default light, or none), the environment
  * times the occlusion, plus the emissive term, under the clear coat where there is one; an unlit material
@@ -716,6 +782,7 @@ inline sfloat3 coated_lanes(const ShadeInputs* in, const LaneWinners* L, const S
 inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surface* S, int view) {
   global const PmrParams* P = in->P;
   const bool glass = any(L->glass), coated = any(L->coated); /* their terms cost nothing to other lanes */
+  const Anisotropy* aniso = any(L->aniso) ? &S->aniso : 0;
   const sfloat3 n = S->n, v = S->v, base = S->base, f0 = S->f0;
   const sfloat f90 = S->f90;
   const sfloat metallic = S->metallic, r = S->r, transmission = S->transmission;
@@ -728,8 +795,8 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
     const sfloat3 E =
         light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
                          vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, S->p, &l);
-    const sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, transmission)
-                            : brdf_cos(base, metallic, f0, f90, r, n, v, l);
+    const sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, transmission, aniso)
+                            : brdf_cos(base, metallic, f0, f90, r, n, v, l, aniso);
     direct = s3_add(direct, s3_mul(f, E));
     if (glass) lights_through = s3_add(lights_through, s3_mul(btdf_light(f0, f90, r, L->ior, n, v, l), E));
     if (coated) coat_lights = s3_add(coat_lights, s3_scale(E, ggx_lobe_cos(S->coat_n, v, l, coat_a2)));
@@ -738,7 +805,7 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
   sfloat A, B;
   split_sum_lanes(in->split_sum, nv, r, &A, &B);
   sfloat3 irradiance, prefiltered;
-  environment_lanes(in, n, v, nv, metallic, r, L->act, &irradiance, &prefiltered);
+  environment_lanes(in, n, reflected_direction(S, L, nv), metallic, r, L->act, &irradiance, &prefiltered);
   /* transmission replaces the diffuse lobe */
   const sfloat kd = glass ? (1.0f - metallic) * (1.0f - transmission) : 1.0f - metallic;
   const sfloat ao = S->ao;
@@ -810,6 +877,7 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
       if (textured && any(L->coated)) coat_spread += vload_s(0, T.coat_normal.toksvig);
     }
 #endif
+    const sfloat3 aniso_t = any(L->aniso) ? anisotropy_direction(L, &T, n) : s3_splat((float3)(0.0f));
     /* the coat has its own normal map, or none: it follows the geometric normal */
     sfloat3 coat_n = n;
     if (any(L->coated)) {
@@ -818,7 +886,7 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
     }
     if (textured) n = mapped_normal(&T, &T.normal, n);
     n = s3_select(n, s3_neg(n), L->back); /* t, b and n together */
-    const Surface S = pbr_surface(in, L, &T, textured, b, n, coat_n, base, spread, coat_spread, view);
+    const Surface S = pbr_surface(in, L, &T, textured, b, n, coat_n, aniso_t, base, spread, coat_spread, view);
     return s3_half_range(s3_scale(shade_pbr(in, L, &S, view), exposure));
   }
   n = s3_select(n, s3_neg(n), L->back);

@@ -96,6 +96,21 @@ std::shared_ptr<const Environment> white_environment() {
       Environment::from_image(make_map(32, 16, [](glm::dvec3) { return glm::dvec3(1.0); }), "white"));
 }
 
+ref::EnvironmentTerms image_environment(const Environment& e) {
+  ref::EnvironmentTerms env;
+  env.irradiance = [&e](const glm::dvec3& n) { return e.irradiance(n); };
+  env.prefiltered = [&e](const glm::dvec3& d, double r) { return e.prefiltered(d, r); };
+  env.split_sum = [](double nv, double r) { return split_sum(nv, r); };
+  return env;
+}
+
+std::shared_ptr<Environment> sky_environment(double rotation_deg, double intensity) {
+  auto e = std::make_shared<Environment>(Environment::from_image(make_map(64, 32, sun_sky), "sky"));
+  e->set_rotation(rotation_deg);
+  e->set_intensity(intensity);
+  return e;
+}
+
 int add_texture16(Scene& s, const std::function<glm::dvec4(int, int)>& f) {
   SceneTexture t;
   t.width = t.height = 16;
@@ -106,6 +121,36 @@ int add_texture16(Scene& s, const std::function<glm::dvec4(int, int)>& f) {
     }
   s.textures.push_back(t);
   return int(s.textures.size() - 1);
+}
+
+void add_feature_quads(Scene& s, const std::array<glm::vec3, 4>& bases,
+                       const std::function<void(int, SceneMaterialInputs&)>& inputs) {
+  if (s.material_inputs.empty()) s.material_inputs.resize(s.materials.size());
+  const size_t first = s.positions.size();
+  for (int q = 0; q < 4; ++q) {
+    PmrMaterial m = s.materials[0];
+    for (int c = 0; c < 3; ++c) m.base_color[c] = bases[size_t(q)][c];
+    s.materials.push_back(m);
+    SceneMaterialInputs in;
+    for (int slot = 0; slot < kTextureSlots; ++slot) in.slots[size_t(slot)].srgb = texture_slot_is_srgb(slot);
+    inputs(q, in);
+    s.material_inputs.push_back(in);
+    const uint32_t material = uint32_t(s.materials.size() - 1);
+    const float x0 = -1.3f + 0.66f * float(q), x1 = x0 + 0.6f, z = 0.2f * float(q % 2) - 0.1f;
+    add_triangle(s, {x0, -0.9f, z + 0.2f}, {x1, -0.8f, z - 0.2f}, {x1, 0.9f, z}, material);
+    add_triangle(s, {x0, -0.9f, z + 0.2f}, {x1, 0.9f, z}, {x0, 1.0f, z + 0.1f}, material);
+  }
+  s.texcoords.resize(1), s.texcoords[0].resize(s.positions.size());
+  s.tangents.resize(s.positions.size());
+  for (size_t k = first; k < s.positions.size(); ++k) {
+    const glm::vec3 p = s.positions[k];
+    s.texcoords[0][k] = glm::vec2(1.2f * p.x + 0.7f, 0.5f - 0.5f * p.y);
+    s.tangents[k] = glm::vec4(1.0f, 0.2f * float(k % 3), 0.1f, k % 2 ? 1.0f : -1.0f);
+    PmrVertexAttr& a = s.attributes[k];
+    const glm::vec3 n = glm::normalize(glm::vec3(0.4f * float(k % 3) - 0.4f, 0.3f * float(k % 2) - 0.15f, 1.0f));
+    a.normal[0] = n.x, a.normal[1] = n.y, a.normal[2] = n.z;
+  }
+  s.lights = {make_light(SceneLightType::Point, glm::dvec3(0.3, 0.6, 1.6), glm::dvec3(0, 0, -1), 4.0f)};
 }
 
 FeatureCheck check_feature(const VoxelReference& with, const VoxelReference& without) {

@@ -2,6 +2,7 @@
 // model's inputs at a voxel, the default light and uniform environment as the reference states them,
 // the 1% + 1e-3 bound per channel, the checks of a material feature's voxels, and scenes of flat layers.
 #pragma once
+#include <array>
 #include <functional>
 #include <map>
 #include <memory>
@@ -71,6 +72,13 @@ Rendered render_pbr(const Scene& s, const Rig& rig, Method method = Method::Pmr,
                     const std::shared_ptr<const Environment>& env = nullptr);
 // An environment image of radiance 1 in every direction (an image: no default light).
 std::shared_ptr<const Environment> white_environment();
+// The environment terms the kernels must reproduce for an image: the host lookups of the very
+// Environment they are given (which must outlive the terms).
+ref::EnvironmentTerms image_environment(const Environment& e);
+// A 64x32 sky: a gradient, a darker ground and one sun texel about 1000 times brighter (tests/
+// environment_maps.h), seen in reflection by the default rig's camera on +Z.
+std::shared_ptr<Environment> sky_environment(double rotation_deg, double intensity);
+
 // Appends a 16 x 16 texture whose texel (x, y) is f(x, y) (RGBA in [0, 1], rounded to 8 bits); its index.
 int add_texture16(Scene& s, const std::function<glm::dvec4(int, int)>& f);
 
@@ -82,6 +90,12 @@ struct FeatureCheck {
   std::map<uint32_t, size_t> voxels, changed;
 };
 FeatureCheck check_feature(const VoxelReference& with, const VoxelReference& without);
+
+// Four quads side by side (x from -1.3 to 1.3) with curved normals, TEXCOORD_0 and tangents (w
+// alternating), the quad q drawn with material q + 1 of base colour bases[q] and the inputs `inputs(q,
+// in)` sets (the sRGB flags set beforehand), lit by one point light. `s` may hold textures already.
+void add_feature_quads(Scene& s, const std::array<glm::vec3, 4>& bases,
+                       const std::function<void(int, SceneMaterialInputs&)>& inputs);
 
 // A material feature's voxel test: `s` (its lights in `lights`) rendered; every voxel within the bound of
 // the reference; materials 1..n each drawn on over 300 voxels; those with the feature (1..n-1) changed by

@@ -34,7 +34,7 @@ void use_texture(SceneMaterialInputs& in, int slot, int texture) {
   in.slots[size_t(slot)].texture = texture, in.slots[size_t(slot)].texcoord = 0;
 }
 
-// Four quads with curved normals, tangents and TEXCOORD_0, one material each:
+// test::add_feature_quads:
 // 1. a red dielectric (roughness 0.5) under a coat of roughness 0.2;
 // 2. a gold metal under a coat of intensity 0.8 x a clearcoatTexture and roughness 0.9 x a
 //    clearcoatRoughnessTexture;
@@ -42,7 +42,6 @@ void use_texture(SceneMaterialInputs& in, int slot, int texture) {
 // 4. material 1 without its coat (its lanes mix with coated ones).
 Scene coated_quads() {
   Scene s = test::empty_scene(false);
-  s.material_inputs.resize(1);
   const int coat = add_texture16(s, [](int x, int) { return glm::dvec4(0.2 + 0.05 * x, 0.0, 0.0, 1.0); });
   const int coat_rough = add_texture16(s, [](int, int y) { return glm::dvec4(0.0, 0.3 + 0.045 * y, 0.0, 1.0); });
   const int coat_normal = add_texture16(s, [](int x, int y) {
@@ -51,39 +50,22 @@ Scene coated_quads() {
   const int base_normal = add_texture16(s, [](int x, int y) {
     return glm::dvec4(0.5 + 0.35 * std::cos(0.5 * y), 0.5 + 0.35 * std::sin(0.8 * x), 0.85, 1.0);
   });
-  const glm::vec3 colours[4] = {{0.8f, 0.1f, 0.05f}, {0.9f, 0.6f, 0.3f}, {0.1f, 0.2f, 0.7f}, {0.8f, 0.1f, 0.05f}};
-  for (int q = 0; q < 4; ++q) {
-    PmrMaterial m = s.materials[0];
-    for (int c = 0; c < 3; ++c) m.base_color[c] = colours[q][c];
-    s.materials.push_back(m);
-    SceneMaterialInputs in;
-    in.slots[kSlotBaseColor].srgb = in.slots[kSlotEmissive].srgb = true;
-    in.metallic = q == 1 ? 1.0f : 0.0f;
-    in.roughness = q == 1 ? 0.35f : q == 2 ? 0.6f : 0.5f;
-    in.has_clearcoat = q < 3;
-    in.clearcoat = q == 1 ? 0.8f : q < 3 ? 1.0f : 0.0f;
-    in.clearcoat_roughness = q == 1 ? 0.9f : q == 2 ? 0.25f : 0.2f;
-    if (q == 1) use_texture(in, kSlotClearcoat, coat), use_texture(in, kSlotClearcoatRoughness, coat_rough);
-    if (q == 2) {
-      use_texture(in, kSlotNormal, base_normal), in.normal_scale = 0.8f;
-      use_texture(in, kSlotClearcoatNormal, coat_normal), in.clearcoat_normal_scale = 0.6f;
-    }
-    s.material_inputs.push_back(in);
-    const float x0 = -1.3f + 0.66f * q, x1 = x0 + 0.6f, z = 0.2f * float(q % 2) - 0.1f;
-    test::add_triangle(s, {x0, -0.9f, z + 0.2f}, {x1, -0.8f, z - 0.2f}, {x1, 0.9f, z}, uint32_t(q + 1));
-    test::add_triangle(s, {x0, -0.9f, z + 0.2f}, {x1, 0.9f, z}, {x0, 1.0f, z + 0.1f}, uint32_t(q + 1));
-  }
-  s.texcoords.assign(1, std::vector<glm::vec2>(s.positions.size()));
-  s.tangents.resize(s.positions.size());
-  for (size_t k = 0; k < s.positions.size(); ++k) {
-    const glm::vec3 p = s.positions[k];
-    s.texcoords[0][k] = glm::vec2(1.2f * p.x + 0.7f, 0.5f - 0.5f * p.y);
-    s.tangents[k] = glm::vec4(1.0f, 0.1f * float(k % 3), 0.0f, k % 2 ? 1.0f : -1.0f);
-    PmrVertexAttr& a = s.attributes[k];
-    const glm::vec3 n = glm::normalize(glm::vec3(0.4f * float(k % 3) - 0.4f, 0.3f * float(k % 2) - 0.15f, 1.0f));
-    a.normal[0] = n.x, a.normal[1] = n.y, a.normal[2] = n.z;
-  }
-  s.lights = {test::make_light(SceneLightType::Point, glm::dvec3(0.3, 0.6, 1.6), glm::dvec3(0, 0, -1), 4.0f)};
+  test::add_feature_quads(s, {{{0.8f, 0.1f, 0.05f}, {0.9f, 0.6f, 0.3f}, {0.1f, 0.2f, 0.7f}, {0.8f, 0.1f, 0.05f}}},
+                          [&](int q, SceneMaterialInputs& in) {
+                            in.metallic = q == 1 ? 1.0f : 0.0f;
+                            in.roughness = q == 1 ? 0.35f : q == 2 ? 0.6f : 0.5f;
+                            in.has_clearcoat = q < 3;
+                            in.clearcoat = q == 1 ? 0.8f : q < 3 ? 1.0f : 0.0f;
+                            in.clearcoat_roughness = q == 1 ? 0.9f : q == 2 ? 0.25f : 0.2f;
+                            if (q == 1) {
+                              use_texture(in, kSlotClearcoat, coat);
+                              use_texture(in, kSlotClearcoatRoughness, coat_rough);
+                            }
+                            if (q == 2) {
+                              use_texture(in, kSlotNormal, base_normal), in.normal_scale = 0.8f;
+                              use_texture(in, kSlotClearcoatNormal, coat_normal), in.clearcoat_normal_scale = 0.6f;
+                            }
+                          });
   return s;
 }
 

@@ -483,23 +483,8 @@ TEST(Pbr, MethodsShadeAlike) {
 
 // ---- environment images (--environment) ------------------------------------------------------------
 
-// The terms the kernels must reproduce: the host lookups of the very Environment they are given.
-ref::EnvironmentTerms image_environment(const Environment& e) {
-  ref::EnvironmentTerms env;
-  env.irradiance = [&e](const glm::dvec3& n) { return e.irradiance(n); };
-  env.prefiltered = [&e](const glm::dvec3& d, double r) { return e.prefiltered(d, r); };
-  env.split_sum = [](double nv, double r) { return split_sum(nv, r); };
-  return env;
-}
-
-// A 64x32 sky: a gradient, a darker ground and one sun texel about 1000 times brighter (tests/
-// environment_maps.h), seen in reflection by the default rig's camera on +Z.
-std::shared_ptr<Environment> sky_environment(double rotation_deg, double intensity) {
-  auto e = std::make_shared<Environment>(Environment::from_image(test::make_map(64, 32, test::sun_sky), "sky"));
-  e->set_rotation(rotation_deg);
-  e->set_intensity(intensity);
-  return e;
-}
+using test::image_environment;
+using test::sky_environment;
 
 test::Rendered render_environment(const Scene& scene, const Rig& rig, const std::shared_ptr<const Environment>& e,
                                   Method method = Method::Pmr) {

@@ -395,6 +395,54 @@ TEST_F(SceneMaterialsTest, SpecularFactorsAndTexturesAreRead) {
   EXPECT_EQ(warnings_with(s, "drawn with"), 0u) << all_warnings(s);
 }
 
+// KHR_materials_anisotropy (DESIGN 4c): strength, rotation and texture read; bad values replaced with a
+// warning; drawn, so not warned. An anisotropic material without a normal map gets tangents (from
+// TEXCOORD_0, which no slot samples), and its strength and rotation reach the kernels' material.
+TEST_F(SceneMaterialsTest, AnisotropyIsReadAndGetsTangents) {
+  GltfFile g;
+  g.doc["extensionsUsed"] = {"KHR_materials_anisotropy"};
+  g.doc["extensionsRequired"] = {"KHR_materials_anisotropy"};
+  const Quad q = quad(g);
+  g.add("images", {{"uri", png_uri(make_png(1, 1, 2, 8, {255, 128, 200}))}});
+  g.add("textures", {{"source", 0}});
+  g.add("materials",
+        {{"name", "Brushed"},
+         {"extensions", {{"KHR_materials_anisotropy", {{"anisotropyStrength", 0.8}, {"anisotropyRotation", 1.5}}}}}});
+  g.add("materials",
+        {{"name", "Textured"},
+         {"extensions",
+          {{"KHR_materials_anisotropy", {{"anisotropyStrength", 1}, {"anisotropyTexture", {{"index", 0}}}}}}}});
+  g.add("materials",
+        {{"name", "Bad"},
+         {"extensions", {{"KHR_materials_anisotropy", {{"anisotropyStrength", 3}, {"anisotropyRotation", "x"}}}}}});
+  json prims = json::array();
+  for (int m : {0, 1, 2})
+    prims.push_back({{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}}},
+                     {"indices", q.idx},
+                     {"material", m}});
+  g.mesh(prims);
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  const Scene s = load_scene(g.write(dir_, "aniso"));
+  ASSERT_EQ(s.material_inputs.size(), 4u);
+  EXPECT_TRUE(s.material_inputs[1].has_anisotropy);
+  EXPECT_EQ(s.material_inputs[1].anisotropy_strength, 0.8f);
+  EXPECT_EQ(s.material_inputs[1].anisotropy_rotation, 1.5f);
+  EXPECT_FLOAT_EQ(s.materials[1].anisotropy[1], std::cos(1.5f));
+  EXPECT_FLOAT_EQ(s.materials[1].anisotropy[2], std::sin(1.5f));
+  EXPECT_GE(s.material_inputs[2].slots[kSlotAnisotropy].texture, 0);
+  EXPECT_FALSE(s.material_inputs[2].slots[kSlotAnisotropy].srgb);
+  EXPECT_EQ(s.material_inputs[3].anisotropy_strength, 1.0f) << "clamped";
+  EXPECT_EQ(s.material_inputs[3].anisotropy_rotation, 0.0f);
+  EXPECT_EQ(warnings_with(s, "material 2 anisotropyStrength is outside [0.0, 1.0]; clamped"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "material 2 KHR_materials_anisotropy has no valid anisotropyRotation"), 1u)
+      << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "isotropic"), 0u) << all_warnings(s);
+  ASSERT_EQ(s.tangents.size(), s.positions.size());
+  for (size_t v = 0; v < s.tangents.size(); ++v) EXPECT_EQ(s.tangents[v], glm::vec4(1, 0, 0, 1)) << v;
+  EXPECT_EQ(s.structure.generated_tangent_primitives, 3u);
+}
+
 TEST_F(SceneMaterialsTest, ATexCoordSetTheMeshLacksIsAnError) {
   GltfFile g;
   const Quad q = quad(g);

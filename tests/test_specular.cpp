@@ -24,47 +24,31 @@ using test::VoxelReference;
 using test::add_texture16;
 using test::render_pbr;
 
-// Quads with curved normals, one material each (roughness 0.3 .. 0.5):
+// test::add_feature_quads, roughness 0.3 .. 0.5:
 // 1. a dark dielectric (where the specular term shows), specular weight 0.5 and colour (1, 0.6, 0.2);
 // 2. a grey dielectric of ior 1.8 whose colour (3, 10, 30) clips F0 to 1 in green and blue;
 // 3. a half-metal with a specularTexture (A) and an sRGB specularColorTexture on TEXCOORD_0;
 // 4. material 1 without the extension.
 Scene specular_quads() {
   Scene s = test::empty_scene(false);
-  s.material_inputs.resize(1);
   const int weight =
       add_texture16(s, [](int x, int y) { return glm::dvec4(0.0, 0.0, 0.0, 0.1 + 0.05 * x + 0.01 * y); });
   const int colour = add_texture16(s, [](int x, int y) { return glm::dvec4(x / 15.0, 0.3 + 0.04 * y, 0.8, 1.0); });
-  const glm::vec3 bases[4] = {{0.1f, 0.1f, 0.1f}, {0.4f, 0.4f, 0.4f}, {0.7f, 0.3f, 0.2f}, {0.1f, 0.1f, 0.1f}};
-  for (int q = 0; q < 4; ++q) {
-    PmrMaterial m = s.materials[0];
-    for (int c = 0; c < 3; ++c) m.base_color[c] = bases[q][c];
-    s.materials.push_back(m);
-    SceneMaterialInputs in;
-    for (int slot = 0; slot < kTextureSlots; ++slot) in.slots[size_t(slot)].srgb = texture_slot_is_srgb(slot);
-    in.metallic = q == 2 ? 0.5f : 0.0f;
-    in.roughness = 0.3f + 0.1f * float(q % 3);
-    in.has_specular = q < 3;
-    if (q == 0) in.specular = 0.5f, in.specular_color[1] = 0.6f, in.specular_color[2] = 0.2f;
-    if (q == 1) in.ior = 1.8f, in.specular_color[0] = 3.0f, in.specular_color[1] = 10.0f, in.specular_color[2] = 30.0f;
-    if (q == 2) {
-      in.slots[kSlotSpecular].texture = weight, in.slots[kSlotSpecular].texcoord = 0;
-      in.slots[kSlotSpecularColor].texture = colour, in.slots[kSlotSpecularColor].texcoord = 0;
-    }
-    s.material_inputs.push_back(in);
-    const float x0 = -1.3f + 0.66f * q, x1 = x0 + 0.6f, z = 0.2f * float(q % 2) - 0.1f;
-    test::add_triangle(s, {x0, -0.9f, z + 0.2f}, {x1, -0.8f, z - 0.2f}, {x1, 0.9f, z}, uint32_t(q + 1));
-    test::add_triangle(s, {x0, -0.9f, z + 0.2f}, {x1, 0.9f, z}, {x0, 1.0f, z + 0.1f}, uint32_t(q + 1));
-  }
-  s.texcoords.assign(1, std::vector<glm::vec2>(s.positions.size()));
-  for (size_t k = 0; k < s.positions.size(); ++k) {
-    const glm::vec3 p = s.positions[k];
-    s.texcoords[0][k] = glm::vec2(1.2f * p.x + 0.7f, 0.5f - 0.5f * p.y);
-    PmrVertexAttr& a = s.attributes[k];
-    const glm::vec3 n = glm::normalize(glm::vec3(0.4f * float(k % 3) - 0.4f, 0.3f * float(k % 2) - 0.15f, 1.0f));
-    a.normal[0] = n.x, a.normal[1] = n.y, a.normal[2] = n.z;
-  }
-  s.lights = {test::make_light(SceneLightType::Point, glm::dvec3(0.3, 0.6, 1.6), glm::dvec3(0, 0, -1), 4.0f)};
+  test::add_feature_quads(s, {{{0.1f, 0.1f, 0.1f}, {0.4f, 0.4f, 0.4f}, {0.7f, 0.3f, 0.2f}, {0.1f, 0.1f, 0.1f}}},
+                          [&](int q, SceneMaterialInputs& in) {
+                            in.metallic = q == 2 ? 0.5f : 0.0f;
+                            in.roughness = 0.3f + 0.1f * float(q % 3);
+                            in.has_specular = q < 3;
+                            if (q == 0) in.specular = 0.5f, in.specular_color[1] = 0.6f, in.specular_color[2] = 0.2f;
+                            if (q == 1) {
+                              in.ior = 1.8f;
+                              in.specular_color[0] = 3.0f, in.specular_color[1] = 10.0f, in.specular_color[2] = 30.0f;
+                            }
+                            if (q == 2) {
+                              in.slots[kSlotSpecular].texture = weight, in.slots[kSlotSpecular].texcoord = 0;
+                              in.slots[kSlotSpecularColor].texture = colour, in.slots[kSlotSpecularColor].texcoord = 0;
+                            }
+                          });
   return s;
 }
 

@@ -17,7 +17,8 @@ static_assert(PMR_MAP_BASE_COLOR == kSlotBaseColor && PMR_MAP_METALLIC_ROUGHNESS
                   PMR_MAP_THICKNESS == kSlotThickness && PMR_MAP_CLEARCOAT == kSlotClearcoat &&
                   PMR_MAP_CLEARCOAT_ROUGHNESS == kSlotClearcoatRoughness &&
                   PMR_MAP_CLEARCOAT_NORMAL == kSlotClearcoatNormal && PMR_MAP_SPECULAR == kSlotSpecular &&
-                  PMR_MAP_SPECULAR_COLOR == kSlotSpecularColor && PMR_MAPS == kTextureSlots,
+                  PMR_MAP_SPECULAR_COLOR == kSlotSpecularColor && PMR_MAP_ANISOTROPY == kSlotAnisotropy &&
+                  PMR_MAPS == kTextureSlots,
               "PMR_MAP_* follow SceneTextureSlotKind");
 
 void texture_transform_matrix(const SceneTextureSlot& slot, float out[6]) {
@@ -130,6 +131,7 @@ uint32_t material_flags(const PmrMaterial& m) {
   if (m.specular != 1.0f || !white || m.maps[PMR_MAP_SPECULAR].texture >= 0 ||
       m.maps[PMR_MAP_SPECULAR_COLOR].texture >= 0)
     flags |= PMR_MATERIAL_SPECULAR;
+  if (m.anisotropy[0] > 0.0f) flags |= PMR_MATERIAL_ANISOTROPY;
   return flags;
 }
 

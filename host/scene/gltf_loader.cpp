@@ -311,7 +311,8 @@ void read_skin_influences(const PrimitiveAttributes& attrs, DeformSource& geo) {
 
 // Every set a texture slot of the material samples, untransformed (Scene::texcoords); each must exist.
 // Returns the set the tangents follow (-1: none): the normal texture's, else the clear coat normal
-// texture's (both maps share the vertex's one tangent).
+// texture's, else the anisotropy texture's (the maps share the vertex's one tangent), else TEXCOORD_0
+// for an anisotropic material when the primitive has it.
 int read_texcoord_sets(const PrimitiveAttributes& attrs, int mesh, int index, Decoded& d) {
   Loader& L = attrs.L;
   const tinygltf::Primitive& p = attrs.p;
@@ -332,7 +333,11 @@ int read_texcoord_sets(const PrimitiveAttributes& attrs, int mesh, int index, De
                        std::to_string(index) + " does not have");
     }
   }
-  return sets[kSlotNormal] >= 0 ? sets[kSlotNormal] : sets[kSlotClearcoatNormal];
+  for (int slot : {kSlotNormal, kSlotClearcoatNormal, kSlotAnisotropy})
+    if (sets[size_t(slot)] >= 0) return sets[size_t(slot)];
+  if (L.scene.material_inputs[size_t(p.material) + 1].anisotropy_strength <= 0.0f) return -1;
+  if (d.sets[0].empty()) d.sets[0] = attrs.read("TEXCOORD_0", Semantic::Texcoord);
+  return d.sets[0].empty() ? -1 : 0;
 }
 
 // 3 vertex indices per triangle, strips and fans unrolled, each index checked against POSITION.

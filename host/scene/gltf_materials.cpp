@@ -269,6 +269,15 @@ void read_specular(Loader& L, const tinygltf::Value& value, const std::string& n
         material_number(L, c[k], 1.0, 0.0, std::numeric_limits<double>::infinity(), name + " specularColorFactor");
 }
 
+// KHR_materials_anisotropy's strength (in [0, 1]) and rotation (finite), checked.
+void read_anisotropy(Loader& L, const tinygltf::Value& value, const std::string& name, SceneMaterialInputs& m) {
+  const std::string ext = "KHR_materials_anisotropy";
+  const double inf = std::numeric_limits<double>::infinity();
+  m.has_anisotropy = true;
+  m.anisotropy_strength = extension_number(L, value, ext, "anisotropyStrength", 0.0, 0.0, 1.0, name);
+  m.anisotropy_rotation = extension_number(L, value, ext, "anisotropyRotation", 0.0, -inf, inf, name);
+}
+
 // KHR_materials_ior's ior: 0 or at least 1 (0: the extension's compatibility mode, a Fresnel term of 1).
 float read_ior(Loader& L, const tinygltf::Value& value, const std::string& name) {
   const float ior =
@@ -340,6 +349,8 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
       read_clearcoat(L, value, name, m);
     } else if (ext == "KHR_materials_specular") {
       read_specular(L, value, name, m);
+    } else if (ext == "KHR_materials_anisotropy") {
+      read_anisotropy(L, value, name, m);
     } else if (material_extension_fallback(ext)) {
       m.unimplemented.push_back(ext);
     }
@@ -384,6 +395,7 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
     L.texcoord_sets = std::max(L.texcoord_sets, uv.set + 1);
   }
   L.slot_sets.push_back(sets);
+  if (m.anisotropy_strength > 0.0f) L.texcoord_sets = std::max(L.texcoord_sets, 1);  // its tangents' set
   return m;
 }
 

@@ -1,4 +1,5 @@
 // Scene-wide helpers shared by the loader, the synthetic scenes and the renderer.
+#include <cmath>
 #include <limits>
 
 #include "pmr/error.h"
@@ -26,6 +27,7 @@ PmrMaterial default_material() {
   m.clearcoat = 0.0f, m.clearcoat_roughness = 0.0f, m.clearcoat_normal_scale = 1.0f;  // no coat
   m.specular = 1.0f;
   for (float& c : m.specular_color) c = 1.0f;
+  m.anisotropy[0] = 0.0f, m.anisotropy[1] = 1.0f, m.anisotropy[2] = 0.0f;  // isotropic
   return m;
 }
 
@@ -41,6 +43,9 @@ void apply_material_inputs(const SceneMaterialInputs& in, PmrMaterial& m) {
   m.clearcoat_normal_scale = in.clearcoat_normal_scale;
   m.specular = in.specular;
   for (int c = 0; c < 3; ++c) m.specular_color[c] = in.specular_color[c];
+  m.anisotropy[0] = in.anisotropy_strength;
+  m.anisotropy[1] = float(std::cos(double(in.anisotropy_rotation)));
+  m.anisotropy[2] = float(std::sin(double(in.anisotropy_rotation)));
 }
 
 bool scene_transmissive(const Scene& scene) {
@@ -73,7 +78,8 @@ const char* texture_slot_name(int slot) {
   static const char* const names[kTextureSlots] = {
       "baseColorTexture",          "metallicRoughnessTexture", "normalTexture",    "occlusionTexture",
       "emissiveTexture",           "transmissionTexture",      "thicknessTexture", "clearcoatTexture",
-      "clearcoatRoughnessTexture", "clearcoatNormalTexture",   "specularTexture",  "specularColorTexture"};
+      "clearcoatRoughnessTexture", "clearcoatNormalTexture",   "specularTexture",  "specularColorTexture",
+      "anisotropyTexture"};
   return slot >= 0 && slot < kTextureSlots ? names[slot] : "?";
 }
 
@@ -89,7 +95,8 @@ const char* texture_slot_extension(int slot) {
                                                         "KHR_materials_clearcoat",
                                                         "KHR_materials_clearcoat",
                                                         "KHR_materials_specular",
-                                                        "KHR_materials_specular"};
+                                                        "KHR_materials_specular",
+                                                        "KHR_materials_anisotropy"};
   return slot >= 0 && slot < kTextureSlots ? extensions[slot] : nullptr;
 }
 

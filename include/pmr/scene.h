@@ -39,7 +39,8 @@ enum SceneTextureSlotKind : int {
   kSlotClearcoatNormal = 9,     // RGB the clear coat's tangent-space normal, linear
   kSlotSpecular = 10,           // A specular weight (KHR_materials_specular), linear
   kSlotSpecularColor = 11,      // RGB specular colour, sRGB
-  kTextureSlots = 12
+  kSlotAnisotropy = 12,         // RG direction, B strength (KHR_materials_anisotropy), linear
+  kTextureSlots = 13
 };
 const char* texture_slot_name(int slot);  // "baseColorTexture", ... (the glTF property names)
 // The material extension whose object holds slot `slot`'s textureInfo; nullptr for the core slots.
@@ -87,8 +88,12 @@ struct SceneMaterialInputs {
   float clearcoat_normal_scale = 1.0f;                 // clearcoatNormalTexture.scale
   // KHR_materials_specular (pbr): the dielectric's Fresnel weight and colour
   bool has_specular = false;
-  float specular = 1.0f;                              // specularFactor (validated to [0, 1])
-  float specular_color[3] = {1.0f, 1.0f, 1.0f};       // specularColorFactor (linear, >= 0)
+  float specular = 1.0f;                         // specularFactor (validated to [0, 1])
+  float specular_color[3] = {1.0f, 1.0f, 1.0f};  // specularColorFactor (linear, >= 0)
+  // KHR_materials_anisotropy (pbr): GGX stretched along a direction of the tangent frame
+  bool has_anisotropy = false;
+  float anisotropy_strength = 0.0f;                   // anisotropyStrength (validated to [0, 1])
+  float anisotropy_rotation = 0.0f;                   // anisotropyRotation, radians counter-clockwise from the tangent
   std::array<SceneTextureSlot, kTextureSlots> slots;  // indexed by SceneTextureSlotKind
   std::vector<std::string> unimplemented;  // material extensions present but not drawn (warned once per scene)
 };

@@ -8,22 +8,48 @@ namespace pmr::ref {
 
 namespace {
 
-// Normal map `slot` (scale `scale`) applied to unit normal n: the interpolated tangent made orthogonal to
-// n, the bitangent sign(w) cross(n, t), m = (2 s - 1) (scale, scale, 1). n itself without the map, a
-// tangent or a usable result.
+// The tangent frame about unit normal n at barycentrics b: the interpolated tangent made orthogonal to n
+// and normalized, the bitangent sign(w) cross(n, t). False without a usable tangent.
+bool tangent_frame(const Scene& scene, const PmrTriangle& t, const glm::dvec3& b, const glm::dvec3& n,
+                   glm::dvec3& tangent, glm::dvec3& bitangent) {
+  if (scene.tangents.empty()) return false;
+  glm::dvec4 tw(0.0);
+  for (int k = 0; k < 3; ++k) tw += b[k] * glm::dvec4(scene.tangents[t.v[k]]);
+  tangent = glm::dvec3(tw) - n * glm::dot(n, glm::dvec3(tw));
+  if (glm::length(tangent) <= 1e-9) return false;
+  tangent = glm::normalize(tangent);
+  bitangent = (tw.w < 0.0 ? -1.0 : 1.0) * glm::cross(n, tangent);
+  return true;
+}
+
+// Normal map `slot` (scale `scale`) applied to unit normal n: m = (2 s - 1) (scale, scale, 1) in the
+// tangent frame. n itself without the map, a tangent or a usable result.
 glm::dvec3 mapped_normal(const Scene& scene, const PmrTriangle& t, const glm::dvec3& b, const SceneTextureSlot& slot,
                          double scale, const glm::dvec3& n) {
   glm::dvec4 s;
-  if (scene.tangents.empty() || !sample_slot(scene, t, b, slot, s)) return n;
-  glm::dvec4 tw(0.0);
-  for (int k = 0; k < 3; ++k) tw += b[k] * glm::dvec4(scene.tangents[t.v[k]]);
-  glm::dvec3 tangent = glm::dvec3(tw) - n * glm::dot(n, glm::dvec3(tw));
-  if (glm::length(tangent) <= 1e-9) return n;
-  tangent = glm::normalize(tangent);
-  const glm::dvec3 bitangent = (tw.w < 0.0 ? -1.0 : 1.0) * glm::cross(n, tangent);
+  glm::dvec3 tangent, bitangent;
+  if (!sample_slot(scene, t, b, slot, s) || !tangent_frame(scene, t, b, n, tangent, bitangent)) return n;
   const glm::dvec3 m = (2.0 * glm::dvec3(s) - 1.0) * glm::dvec3(scale, scale, 1.0);
   const glm::dvec3 mapped = tangent * m.x + bitangent * m.y + n * m.z;
   return glm::length(mapped) > 0.0 ? glm::normalize(mapped) : n;
+}
+
+// KHR_materials_anisotropy's strength and unit direction at barycentrics b about the interpolated normal
+// n: the rotation applied to the texture's 2 RG - 1 (else (1, 0)) in the tangent frame; strength 0
+// without a tangent.
+void anisotropy_at(const Scene& scene, const PmrTriangle& t, const glm::dvec3& b, const SceneMaterialInputs& in,
+                   const glm::dvec3& n, SurfacePoint& sp) {
+  glm::dvec4 s;
+  glm::dvec2 d(1.0, 0.0);
+  sp.anisotropy = in.anisotropy_strength;
+  if (sample_slot(scene, t, b, in.slots[kSlotAnisotropy], s)) d = 2.0 * glm::dvec2(s) - 1.0, sp.anisotropy *= s.z;
+  const double c = std::cos(double(in.anisotropy_rotation)), sn = std::sin(double(in.anisotropy_rotation));
+  glm::dvec3 tangent, bitangent;
+  const glm::dvec3 dir = tangent_frame(scene, t, b, n, tangent, bitangent)
+                             ? tangent * (c * d.x - sn * d.y) + bitangent * (sn * d.x + c * d.y)
+                             : glm::dvec3(0.0);
+  if (glm::length(dir) > 0.0) sp.anisotropy_t = glm::normalize(dir);
+  else sp.anisotropy = 0.0;
 }
 
 }  // namespace
@@ -61,6 +87,7 @@ void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool bac
     if (sample_slot(scene, t, b, in.slots[kSlotEmissive], s)) sp.emissive *= glm::dvec3(s);
     if (sample_slot(scene, t, b, in.slots[kSlotTransmission], s)) sp.transmission *= s.x;
     const glm::dvec3 geometric = n;
+    if (in.anisotropy_strength > 0.0f) anisotropy_at(scene, t, b, in, geometric, sp);
     n = mapped_normal(scene, t, b, in.slots[kSlotNormal], in.normal_scale, geometric);
     sp.specular = in.specular;
     sp.specular_color = glm::dvec3(in.specular_color[0], in.specular_color[1], in.specular_color[2]);

@@ -25,7 +25,7 @@ double f90_of(double metallic, double specular) { return specular + (1.0 - specu
 
 glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
                     const glm::dvec3& l, double ior, double transmission, double specular,
-                    const glm::dvec3& specular_color) {
+                    const glm::dvec3& specular_color, double anisotropy, const glm::dvec3& anisotropy_t) {
   const double nl = clamp01(glm::dot(n, l));
   if (nl <= 0.0) return glm::dvec3(0.0);
   const double nv = clamp01(glm::dot(n, v));
@@ -38,9 +38,19 @@ glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm
   const double dd = nh * nh * (a2 - 1.0) + 1.0;
   const double D = a2 / (kPi * dd * dd);
   const double s = nl * std::sqrt(nv * nv * (1.0 - a2) + a2) + nv * std::sqrt(nl * nl * (1.0 - a2) + a2);
-  const double vis = s > 0.0 ? 0.5 / s : 0.0;
+  double dv = D * (s > 0.0 ? 0.5 / s : 0.0);
+  const glm::dvec3 bt = glm::cross(n, anisotropy_t);
+  if (anisotropy > 0.0 && glm::length(bt) > 0.0) {
+    const glm::dvec3 t = anisotropy_t, b = glm::normalize(bt);
+    const double at = glm::mix(alpha, 1.0, anisotropy * anisotropy), ab = alpha;
+    const double x = glm::dot(t, h) / at, y = glm::dot(b, h) / ab, q = x * x + y * y + nh * nh;
+    const double Da = 1.0 / (kPi * at * ab * q * q);
+    const double gv = nl * glm::length(glm::dvec3(at * glm::dot(t, v), ab * glm::dot(b, v), nv)),
+                 gl = nv * glm::length(glm::dvec3(at * glm::dot(t, l), ab * glm::dot(b, l), nl));
+    dv = Da * (gv + gl > 0.0 ? 0.5 / (gv + gl) : 0.0);
+  }
   const glm::dvec3 c_diff = base * (1.0 - metallic) * (1.0 - transmission);
-  return ((1.0 - F) * c_diff / kPi + F * (D * vis)) * nl;
+  return ((1.0 - F) * c_diff / kPi + F * dv) * nl;
 }
 
 glm::dvec3 btdf_light(const glm::dvec3& f0, double f90, double r, double ior, const glm::dvec3& n, const glm::dvec3& v,
@@ -103,14 +113,23 @@ glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& li
   for (const PunctualLight& light : lights) {
     glm::dvec3 l;
     const glm::dvec3 E = light_irradiance(light, s.p, l);
-    sum += brdf_cos(s.base, s.metallic, r, s.n, v, l, s.ior, s.transmission, s.specular, s.specular_color) * E;
+    sum += brdf_cos(s.base, s.metallic, r, s.n, v, l, s.ior, s.transmission, s.specular, s.specular_color, s.anisotropy,
+                    s.anisotropy_t) *
+           E;
     if (s.transmission > 0.0)
       sum +=
           s.transmission * (s.base * (1.0 - s.metallic)) * s.attenuation * btdf_light(f0, f90, r, s.ior, s.n, v, l) * E;
   }
   const glm::dvec3 c_diff = s.base * (1.0 - s.metallic);
   const glm::dvec2 ab = env.split_sum(clamp01(glm::dot(s.n, v)), r);
-  const glm::dvec3 reflected = glm::reflect(-v, s.n), specular = f0 * ab.x + f90 * ab.y;
+  glm::dvec3 reflected = glm::reflect(-v, s.n);
+  const glm::dvec3 bt = glm::cross(s.n, s.anisotropy_t);
+  if (s.anisotropy > 0.0 && glm::length(bt) > 0.0) {  // the bent normal
+    const glm::dvec3 b = glm::normalize(bt), bent_to = glm::cross(glm::cross(b, v), b);
+    const double bend = std::pow(1.0 - s.anisotropy * (1.0 - r), 4.0);
+    reflected = glm::reflect(-v, glm::normalize(glm::mix(bent_to, s.n, bend)));
+  }
+  const glm::dvec3 specular = f0 * ab.x + f90 * ab.y;
   sum += s.ao * ((1.0 - s.transmission) * c_diff * env.irradiance(s.n) + specular * env.prefiltered(reflected, r));
   sum += s.ao * s.transmission * (1.0 - specular) * c_diff * s.through;
   glm::dvec3 color = sum + s.emissive;

@@ -14,9 +14,12 @@ namespace pmr::ref {
 // diffuse lobe weighted by 1 - transmission (KHR_materials_transmission: that part transmits instead).
 // KHR_materials_specular's weight and colour scale the dielectric's Fresnel term: F0 = mix(min(f0_ior
 // colour, 1) weight, base, metallic), F90 = mix(weight, 1, metallic), F = F0 + (F90 - F0) (1 - v.h)^5.
+// KHR_materials_anisotropy (strength s > 0, unit direction t): GGX with alpha_t = mix(alpha, 1, s^2)
+// along t and alpha_b = alpha along b = normalize(cross(n, t)), and its height-correlated visibility.
 glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
                     const glm::dvec3& l, double ior = 1.5, double transmission = 0.0, double specular = 1.0,
-                    const glm::dvec3& specular_color = glm::dvec3(1.0));
+                    const glm::dvec3& specular_color = glm::dvec3(1.0), double anisotropy = 0.0,
+                    const glm::dvec3& anisotropy_t = glm::dvec3(1.0, 0.0, 0.0));
 
 // KHR_materials_transmission's BTDF for a light in direction l seen through the surface: (1 - F(v.h))
 // D(n.h) Vis(n.l', n.v), l' = l mirrored on the surface's plane, h = normalize(l' + v), GGX of roughness
@@ -58,6 +61,8 @@ struct SurfacePoint {
   glm::dvec3 clearcoat_n{0.0, 0.0, 1.0};
   double specular = 1.0;  // KHR_materials_specular: weight and colour (factor x texture)
   glm::dvec3 specular_color{1.0};
+  double anisotropy = 0.0;                 // KHR_materials_anisotropy: strength (factor x texture B) and
+  glm::dvec3 anisotropy_t{1.0, 0.0, 0.0};  // the unit direction in world space (strength 0: isotropic)
 };
 
 // The environment's precomputed terms: I(n) (irradiance / pi), P(d, r) and the split-sum (A, B).
@@ -68,6 +73,8 @@ struct EnvironmentTerms {
 };
 
 // exposure x (sum over lights of f E dot(n, l) + ao (c_diff I(n) + (F0 A + F90 B) P(reflect(-v, n), r)) + e);
+// an anisotropic surface reflects the environment about the bent normal normalize(mix(cross(cross(b, v),
+// b), n, (1 - s (1 - r))^4)) instead of n;
 // unlit: exposure x base. With transmission T, the diffuse terms are weighted by 1 - T, and
 // ao T (1 - (F0 A + B)) c_diff `through` is added (KHR_materials_transmission's BTDF, DESIGN 4c), and
 // per light T c_diff `attenuation` (1 - F) D Vis E, the GGX lobe about the light mirrored on the

@@ -70,6 +70,65 @@ typedef struct {
   sfloat s;
 } Anisotropy;
 
+/* KHR_materials_iridescence: the Fresnel term F of a thin film, w the iridescence factor (0 in lanes
+ * without), F = mix(Schlick's F, this F, w) in every lobe of the material. */
+typedef struct {
+  sfloat3 F;
+  sfloat w;
+} Iridescence;
+
+/* The spectral sensitivity term of the thin film's analytic spectral integration (the extension's
+ * evalSensitivity: Gaussian fits of the CIE XYZ curves in Fourier space, then XYZ to Rec. 709) for
+ * optical path difference opd (nm) and phase shift `shift` per channel. */
+inline sfloat3 film_sensitivity(sfloat opd, sfloat3 shift) {
+  const sfloat phase = 2.0f * PMR_PI_F * opd * 1.0e-9f, p2 = phase * phase;
+  const float two_pi = 2.0f * PMR_PI_F;
+  const sfloat x = 5.4856e-13f * sqrt(two_pi * 4.3278e9f) * cos(1.6810e6f * phase + shift.x) * exp(-4.3278e9f * p2) +
+                   9.7470e-14f * sqrt(two_pi * 4.5282e9f) * cos(2.2399e6f * phase + shift.x) * exp(-4.5282e9f * p2);
+  const sfloat y = 4.4201e-13f * sqrt(two_pi * 9.3046e9f) * cos(1.7953e6f * phase + shift.y) * exp(-9.3046e9f * p2);
+  const sfloat z = 5.2481e-13f * sqrt(two_pi * 6.6121e9f) * cos(2.2084e6f * phase + shift.z) * exp(-6.6121e9f * p2);
+  const float k = 1.0f / 1.0685e-7f;
+  return s3(k * (3.2404542f * x - 1.5371385f * y - 0.4985314f * z),
+            k * (-0.9692660f * x + 1.8760108f * y + 0.0415560f * z),
+            k * (0.0556434f * x - 0.2040259f * y + 1.0572252f * z));
+}
+
+/* The thin film's Fresnel term (the extension's implementation notes, Belcour and Barla 2017), one
+ * reflection at cos1 = n.v: a film of ior `film` (eased to `outside` as the thickness goes to 0) and
+ * thickness d nm between a medium of ior `outside` and the base of Fresnel F0 f0 (its ior from F0).
+ * Schlick's Fresnel at both interfaces, the phase shifts of 0 or pi, and two orders of the Fourier
+ * series. Total internal reflection in the film gives 1. */
+inline sfloat3 thin_film_fresnel(sfloat outside, sfloat film, sfloat cos1, sfloat d, sfloat3 f0) {
+  const sfloat ior = outside + (film - outside) * smoothstep(0.0f, 0.03f, d);
+  const sfloat ratio = outside / ior, sin2sq = ratio * ratio * (1.0f - cos1 * cos1), cos2sq = 1.0f - sin2sq;
+  const sfloat cos2 = sqrt(fmax(cos2sq, 0.0f));
+  const sfloat q0 = (ior - outside) / (ior + outside), r0 = q0 * q0;
+  const sfloat k1 = 1.0f - cos1, k2 = 1.0f - cos2;
+  const sfloat R12 = r0 + (1.0f - r0) * (k1 * k1) * (k1 * k1) * k1, T121 = 1.0f - R12;
+  const sfloat phi21 = select((sfloat)(PMR_PI_F), (sfloat)(0.0f), ior < outside);
+  const sfloat opd = 2.0f * ior * d * cos2, k2_5 = (k2 * k2) * (k2 * k2) * k2;
+  const sfloat f0c[3] = {f0.x, f0.y, f0.z};
+  sfloat R23[3], phi[3];
+  for (int c = 0; c < 3; ++c) {
+    const sfloat s0 = sqrt(clamp(f0c[c], 0.0f, 0.9999f)), base = (1.0f + s0) / (1.0f - s0);
+    const sfloat q1 = (base - ior) / (base + ior), r1 = q1 * q1;
+    R23[c] = r1 + (1.0f - r1) * k2_5;
+    phi[c] = phi21 + select((sfloat)(0.0f), (sfloat)(PMR_PI_F), base < ior);
+  }
+  const sfloat3 s1 = film_sensitivity(opd, s3(phi[0], phi[1], phi[2]));
+  const sfloat3 s2 = film_sensitivity(2.0f * opd, s3(2.0f * phi[0], 2.0f * phi[1], 2.0f * phi[2]));
+  const sfloat sens1[3] = {s1.x, s1.y, s1.z}, sens2[3] = {s2.x, s2.y, s2.z};
+  sfloat F[3];
+  for (int c = 0; c < 3; ++c) {
+    const sfloat R123 = clamp(R12 * R23[c], 1e-5f, 0.9999f), r123 = sqrt(R123);
+    const sfloat Rs = T121 * T121 * R23[c] / (1.0f - R123);
+    const sfloat C1 = (Rs - T121) * r123, C2 = C1 * r123;
+    const sfloat I = R12 + Rs + C1 * 2.0f * sens1[c] + C2 * 2.0f * sens2[c];
+    F[c] = select(fmax(I, 0.0f), (sfloat)(1.0f), cos2sq < 0.0f);
+  }
+  return s3(F[0], F[1], F[2]);
+}
+
 /* D Vis of the anisotropic lobe for alpha = r^2, at the dot products of n, h, v and l given. */
 inline sfloat ggx_aniso_dv(const Anisotropy* A, sfloat alpha, sfloat3 h, sfloat3 v, sfloat3 l, sfloat nh, sfloat nv,
                            sfloat nl) {
@@ -89,9 +148,10 @@ inline sfloat ggx_aniso_dv(const Anisotropy* A, sfloat alpha, sfloat3 h, sfloat3
  * l (unit, toward the light). n and v are unit vectors; r is the clamped roughness; f0 and f90 the
  * Fresnel term's (pbr_f0); `transmission` (KHR_materials_transmission) the part of the diffuse lobe
  * that transmits instead (the environment's transmission term takes its place: cl/transmission.h);
- * `aniso` the anisotropic lobe where it is on (0: none). */
+ * `aniso` the anisotropic lobe where it is on (0: none), `irid` the thin film's Fresnel term (0: none). */
 inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat3 f0, sfloat f90, sfloat r, sfloat3 n,
-                                     sfloat3 v, sfloat3 l, sfloat transmission, const Anisotropy* aniso) {
+                                     sfloat3 v, sfloat3 l, sfloat transmission, const Anisotropy* aniso,
+                                     const Iridescence* irid) {
   const sfloat nl = clamp(s3_dot(n, l), 0.0f, 1.0f);
   const sfloat nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
   const sfloat3 hv = s3_add(l, v);
@@ -99,7 +159,8 @@ inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat3 f0, 
   const sfloat3 h = s3_select(n, s3_scale(hv, 1.0f / hl), hl > 0.0f);
   const sfloat nh = clamp(s3_dot(n, h), 0.0f, 1.0f), vh = clamp(s3_dot(v, h), 0.0f, 1.0f);
   const sfloat alpha = r * r, a2 = alpha * alpha;
-  const sfloat3 F = fresnel_schlick(f0, f90, vh);
+  sfloat3 F = fresnel_schlick(f0, f90, vh);
+  if (irid) F = s3_add(F, s3_scale(s3_sub(irid->F, F), irid->w));
   const sfloat diffuse = (1.0f - metallic) * (1.0f - transmission) * (1.0f / PMR_PI_F),
                iso = ggx_d(nh, a2) * smith_vis(nl, nv, a2);
   const sfloat spec = aniso ? select(iso, ggx_aniso_dv(aniso, alpha, h, v, l, nh, nv, nl), aniso->on) : iso;
@@ -111,8 +172,8 @@ inline sfloat3 brdf_cos_transmissive(sfloat3 base, sfloat metallic, sfloat3 f0, 
 
 /* The same for an opaque surface. */
 inline sfloat3 brdf_cos(sfloat3 base, sfloat metallic, sfloat3 f0, sfloat f90, sfloat r, sfloat3 n, sfloat3 v,
-                        sfloat3 l, const Anisotropy* aniso) {
-  return brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, (sfloat)(0.0f), aniso);
+                        sfloat3 l, const Anisotropy* aniso, const Iridescence* irid) {
+  return brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, (sfloat)(0.0f), aniso, irid);
 }
 
 /* KHR_materials_transmission's BTDF for a punctual light seen through the surface (as the Khronos

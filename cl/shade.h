@@ -106,6 +106,10 @@ typedef struct {
    * some lane is (strength 0 in the others). Their lanes count as textured: they read the tangent. */
   sint aniso;
   sfloat aniso_strength, aniso_cos, aniso_sin;
+  /* pbr, KHR_materials_iridescence: lanes `irid` (factor, film ior, thickness range in nm); set only
+   * when some lane is (factor 0 in the others) */
+  sint irid;
+  sfloat irid_factor, irid_ior, irid_min, irid_max;
   uint textured; /* bit l: lane l's material has a map the model reads (lambert: base colour) */
   uint tri[SW];  /* lane l's triangle, where textured                               */
 #if PMR_TRILINEAR
@@ -130,7 +134,7 @@ inline void lanes_clear(LaneWinners* L) {
   L->emissive = s3(zero, zero, zero);
   L->glass = (sint)(0);  /* the transmission inputs are set when the first glass lane comes */
   L->coated = (sint)(0); /* ... and the clear coat's when the first coated lane comes */
-  L->specular = L->aniso = (sint)(0);
+  L->specular = L->aniso = L->irid = (sint)(0);
   L->textured = 0u;
 #if PMR_TRILINEAR
   for (int k = 0; k < 3; ++k) vstore_s(zero, 0, L->ex[k]), vstore_s(zero, 0, L->ey[k]);
@@ -180,6 +184,16 @@ inline void lanes_add_anisotropy(LaneWinners* L, global const PmrMaterial* mat, 
   L->aniso_sin = blend(L->aniso_sin, mat->anisotropy[2], take);
 }
 
+/* The iridescence factors of material `mat` into lanes `take`. */
+inline void lanes_add_iridescence(LaneWinners* L, global const PmrMaterial* mat, sint take) {
+  if (!any(L->irid)) L->irid_factor = L->irid_min = L->irid_max = (sfloat)(0.0f), L->irid_ior = (sfloat)(1.3f);
+  L->irid |= take;
+  L->irid_factor = blend(L->irid_factor, mat->iridescence[0], take);
+  L->irid_ior = blend(L->irid_ior, mat->iridescence[1], take);
+  L->irid_min = blend(L->irid_min, mat->iridescence[2], take);
+  L->irid_max = blend(L->irid_max, mat->iridescence[3], take);
+}
+
 /* Lanes `take` (bits: the same as bits) are won by MTA m: its values blended into them (the edge
  * functions are set apart: lanes_gather in fine_core.h). */
 inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, sint take, uint bits, bool pbr) {
@@ -220,6 +234,7 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
     if (mat->clearcoat > 0.0f) lanes_add_coat(L, mat, take);
     if (mat->flags & PMR_MATERIAL_SPECULAR) lanes_add_specular(L, mat, take);
     if (mat->flags & PMR_MATERIAL_ANISOTROPY) lanes_add_anisotropy(L, mat, take);
+    if (mat->flags & PMR_MATERIAL_IRIDESCENCE) lanes_add_iridescence(L, mat, take);
     textured = (mat->flags & (PMR_MATERIAL_MAPS | PMR_MATERIAL_ANISOTROPY)) != 0;
   }
   if (textured) {
@@ -333,6 +348,7 @@ typedef struct {
   LaneNormalMap coat_normal;                  /* ... clearcoatNormalTexture (coated) */
   float spec_weight[SW], spec_color[3][SW];   /* KHR_materials_specular A, RGB (specular) */
   float aniso_dir[2][SW], aniso_strength[SW]; /* KHR_materials_anisotropy: 2 RG - 1, B (aniso) */
+  float irid_factor[SW], irid_thickness[SW];  /* KHR_materials_iridescence R, G (irid) */
 } LaneTextures;
 
 /* The screen-space derivatives of SW lanes' source barycentrics, per output pixel in x and in y. */
@@ -493,6 +509,14 @@ inline void sample_material_lanes(const ShadeInputs* in, global const PmrMateria
     sample_map_lanes(in, &mat->maps[PMR_MAP_SPECULAR_COLOR], L->tri, bits, take, b, g, true, C, c);
     for (int k = 0; k < 3; ++k) lanes_put(T->spec_color[k], c[k], take);
   }
+  if (mat->maps[PMR_MAP_IRIDESCENCE].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_IRIDESCENCE], L->tri, bits, take, b, g, false, C, c);
+    lanes_put(T->irid_factor, c[0], take);
+  }
+  if (mat->maps[PMR_MAP_IRIDESCENCE_THICKNESS].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_IRIDESCENCE_THICKNESS], L->tri, bits, take, b, g, false, C, c);
+    lanes_put(T->irid_thickness, c[1], take);
+  }
   if (mat->maps[PMR_MAP_ANISOTROPY].texture >= 0) {
     sample_map_lanes(in, &mat->maps[PMR_MAP_ANISOTROPY], L->tri, bits, take, b, g, false, C, c);
     lanes_put(T->aniso_dir[0], 2.0f * c[0] - 1.0f, take), lanes_put(T->aniso_dir[1], 2.0f * c[1] - 1.0f, take);
@@ -535,6 +559,8 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
       T->spec_weight[l] = T->spec_color[0][l] = T->spec_color[1][l] = T->spec_color[2][l] = 1.0f;
   if (any(L->aniso))
     for (int l = 0; l < SW; ++l) T->aniso_dir[0][l] = T->aniso_strength[l] = 1.0f, T->aniso_dir[1][l] = 0.0f;
+  if (any(L->irid)) /* without a thickness texture the film is the maximum thickness */
+    for (int l = 0; l < SW; ++l) T->irid_factor[l] = T->irid_thickness[l] = 1.0f;
   if (PMR_WITH_BLEND && any(L->blended))
     for (int l = 0; l < SW; ++l) T->base_alpha[l] = 1.0f;
   uint material[SW];
@@ -679,10 +705,18 @@ inline sfloat geometric_spread(const LaneWinners* L, const LaneBaryGrad* g, sflo
 
 #include "transmission.h" /* reads the inputs and lanes above */
 
-/* w (1 - (F0 A + F90 B)) c: the weight of the light through a transmissive surface (w = ao T (1 - metallic)). */
-inline sfloat3 btdf_weight(sfloat w, sfloat3 f0, sfloat f90, sfloat A, sfloat B, sfloat3 c) {
-  return s3(w * (1.0f - (f0.x * A + f90 * B)) * c.x, w * (1.0f - (f0.y * A + f90 * B)) * c.y,
-            w * (1.0f - (f0.z * A + f90 * B)) * c.z);
+/* w (1 - R) c: the weight of the light through a transmissive surface (w = ao T (1 - metallic)), R its
+ * environment reflectance (environment_reflectance). */
+inline sfloat3 btdf_weight(sfloat w, sfloat3 R, sfloat3 c) {
+  return s3(w * (1.0f - R.x) * c.x, w * (1.0f - R.y) * c.y, w * (1.0f - R.z) * c.z);
+}
+
+/* The split-sum reflectance F0 A + F90 B of the lanes' specular lobe, or with a thin film
+ * mix(F0 A + F90 B, F_iridescence (A + B), w): the film's Fresnel term is constant over the lobe. */
+inline sfloat3 environment_reflectance(sfloat3 f0, sfloat f90, sfloat A, sfloat B, const Iridescence* irid) {
+  const sfloat f90B = f90 * B;
+  const sfloat3 R = s3(f0.x * A + f90B, f0.y * A + f90B, f0.z * A + f90B);
+  return irid ? s3_add(R, s3_scale(s3_sub(s3_scale(irid->F, A + B), R), irid->w)) : R;
 }
 
 /* What the lobes read of each lane's surface, filled once per batch of lanes (pbr_surface): the one
@@ -697,6 +731,7 @@ typedef struct {
   sfloat coat, coat_r;            /* KHR_materials_clearcoat (coated lanes): intensity, roughness  */
   sfloat3 coat_n;                 /* ... the coat's unit normal (its own normal map, or the geometric one) */
   Anisotropy aniso;               /* KHR_materials_anisotropy (lanes aniso.on)                       */
+  Iridescence irid;               /* KHR_materials_iridescence (w 0 in lanes without)                */
 } Surface;
 
 /* The surface of the lanes seen from view `view`: n and coat_n are unit normals, flipped for back faces;
@@ -741,6 +776,14 @@ inline Surface pbr_surface(const ShadeInputs* in, const LaneWinners* L, const La
     S.aniso.t = aniso_t, S.aniso.b = s3_scale(ab, 1.0f / len);
     S.aniso.s = L->aniso_strength * vload_s(0, T->aniso_strength);
   }
+  if (any(L->irid)) { /* under a clear coat the film's outside is the coat (ior 1.5), else air */
+    const sfloat t = textured ? vload_s(0, T->irid_thickness) : (sfloat)(1.0f); /* no texture: the maximum */
+    const sfloat d = L->irid_min + (L->irid_max - L->irid_min) * t;
+    const sfloat outside = select((sfloat)(1.0f), (sfloat)(1.5f), L->coated & (S.coat > 0.0f));
+    const sfloat cos1 = clamp(s3_dot(n, S.v), 0.0f, 1.0f);
+    S.irid.F = thin_film_fresnel(outside, L->irid_ior, cos1, d, S.f0);
+    S.irid.w = textured ? L->irid_factor * vload_s(0, T->irid_factor) : L->irid_factor;
+  }
   return S;
 }
 
@@ -783,6 +826,7 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
   global const PmrParams* P = in->P;
   const bool glass = any(L->glass), coated = any(L->coated); /* their terms cost nothing to other lanes */
   const Anisotropy* aniso = any(L->aniso) ? &S->aniso : 0;
+  const Iridescence* irid = any(L->irid) ? &S->irid : 0;
   const sfloat3 n = S->n, v = S->v, base = S->base, f0 = S->f0;
   const sfloat f90 = S->f90;
   const sfloat metallic = S->metallic, r = S->r, transmission = S->transmission;
@@ -795,8 +839,8 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
     const sfloat3 E =
         light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
                          vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, S->p, &l);
-    const sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, transmission, aniso)
-                            : brdf_cos(base, metallic, f0, f90, r, n, v, l, aniso);
+    const sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, transmission, aniso, irid)
+                            : brdf_cos(base, metallic, f0, f90, r, n, v, l, aniso, irid);
     direct = s3_add(direct, s3_mul(f, E));
     if (glass) lights_through = s3_add(lights_through, s3_mul(btdf_light(f0, f90, r, L->ior, n, v, l), E));
     if (coated) coat_lights = s3_add(coat_lights, s3_scale(E, ggx_lobe_cos(S->coat_n, v, l, coat_a2)));
@@ -809,15 +853,15 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
   /* transmission replaces the diffuse lobe */
   const sfloat kd = glass ? (1.0f - metallic) * (1.0f - transmission) : 1.0f - metallic;
   const sfloat ao = S->ao;
-  const sfloat f90B = f90 * B;
-  sfloat3 ambient = s3(ao * (base.x * kd * irradiance.x + (f0.x * A + f90B) * prefiltered.x),
-                       ao * (base.y * kd * irradiance.y + (f0.y * A + f90B) * prefiltered.y),
-                       ao * (base.z * kd * irradiance.z + (f0.z * A + f90B) * prefiltered.z));
-  if (glass) { /* KHR_materials_transmission's BTDF: (1 - (F0 A + B)) c_diff x the light through */
+  const sfloat3 R = environment_reflectance(f0, f90, A, B, irid);
+  sfloat3 ambient = s3(ao * (base.x * kd * irradiance.x + R.x * prefiltered.x),
+                       ao * (base.y * kd * irradiance.y + R.y * prefiltered.y),
+                       ao * (base.z * kd * irradiance.z + R.z * prefiltered.z));
+  if (glass) { /* KHR_materials_transmission's BTDF: (1 - R) c_diff x the light through */
     const sfloat w = select((sfloat)(0.0f), transmission * (1.0f - metallic), L->glass);
     sfloat3 attenuation;
     const sfloat3 through = transmitted_lanes(in, L, S->p, n, v, r, S->thickness, view, &attenuation);
-    ambient = s3_add(ambient, s3_mul(btdf_weight(ao * w, f0, f90, A, B, base), through));
+    ambient = s3_add(ambient, s3_mul(btdf_weight(ao * w, R, base), through));
     direct = s3_add(direct, s3_mul(s3_scale(s3_mul(base, attenuation), w), lights_through));
   }
   sfloat3 lit = s3_add(s3_add(direct, ambient), S->emissive);

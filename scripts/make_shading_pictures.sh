@@ -22,6 +22,8 @@
 #                                       default materials | --variant midnight | beach | street
 #   docs/shading_clearcoat.png          the Khronos sample models ClearCoatTest (center view) and
 #                                       ClearCoatCarPaint (views 0 and N-1 of 9), the studio
+#   docs/shading_lobes.png              the Khronos sample models SpecularTest and IridescenceSuzanne,
+#                                       center views, the studio
 #
 # usage: scripts/make_shading_pictures.sh [GLTF_DIR]
 #   GLTF_DIR   folder of the Khronos sample models (GLTF_DIR/Suzanne/glTF/Suzanne.gltf, ...); default
@@ -142,6 +144,16 @@ if present "$COAT" "$OUT/shading_clearcoat.png" "$MODELS_HINT" &&
   render paint "$PAINT" --views 9 --view-size 498x279 --zoom 1.6
   $PICTURES strip "$OUT/shading_clearcoat.png" "$(views coat 4)" "$(views paint 0)" "$(views paint 8)" \
     --check-center "$(center coat)" - -
+fi
+
+echo "== SpecularTest and IridescenceSuzanne (KHR_materials_specular, KHR_materials_iridescence)"
+SPEC=$GLTF_DIR/SpecularTest/glTF/SpecularTest.gltf
+IRID=$GLTF_DIR/IridescenceSuzanne/glTF/IridescenceSuzanne.gltf
+if present "$SPEC" "$OUT/shading_lobes.png" "$MODELS_HINT" && present "$IRID" "$OUT/shading_lobes.png" "$MODELS_HINT"; then
+  render spec "$SPEC" --views 9 --view-size 664x372
+  render irid "$IRID" --views 9 --view-size 664x372 --zoom 1.4
+  $PICTURES strip "$OUT/shading_lobes.png" "$(views spec 4)" "$(views irid 4)" \
+    --check-center "$(center spec)" "$(center irid)"
 fi
 
 if [ ${#skipped[@]} -gt 0 ]; then

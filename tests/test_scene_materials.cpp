@@ -443,6 +443,58 @@ TEST_F(SceneMaterialsTest, AnisotropyIsReadAndGetsTangents) {
   EXPECT_EQ(s.structure.generated_tangent_primitives, 3u);
 }
 
+// KHR_materials_iridescence (DESIGN 4c): factor, film ior, thickness range and both textures read;
+// absent values are the extension's defaults (0, 1.3, 100 and 400 nm); bad ones replaced with a warning.
+TEST_F(SceneMaterialsTest, IridescenceIsRead) {
+  GltfFile g;
+  g.doc["extensionsUsed"] = {"KHR_materials_iridescence"};
+  const Quad q = quad(g);
+  g.add("images", {{"uri", png_uri(make_png(1, 1, 2, 8, {255, 128, 0}))}});
+  g.add("textures", {{"source", 0}});
+  g.add("materials", {{"name", "Film"},
+                      {"extensions",
+                       {{"KHR_materials_iridescence",
+                         {{"iridescenceFactor", 0.9},
+                          {"iridescenceIor", 1.8},
+                          {"iridescenceThicknessMinimum", 150},
+                          {"iridescenceThicknessMaximum", 700},
+                          {"iridescenceTexture", {{"index", 0}}},
+                          {"iridescenceThicknessTexture", {{"index", 0}}}}}}}});
+  g.add("materials", {{"name", "Defaults"}, {"extensions", {{"KHR_materials_iridescence", json::object()}}}});
+  g.add("materials",
+        {{"name", "Bad"},
+         {"extensions",
+          {{"KHR_materials_iridescence", {{"iridescenceIor", 0.5}, {"iridescenceThicknessMaximum", -1}}}}}});
+  json prims = json::array();
+  for (int m : {0, 1, 2})
+    prims.push_back(
+        {{"attributes", {{"POSITION", q.pos}, {"TEXCOORD_0", q.uv0}}}, {"indices", q.idx}, {"material", m}});
+  g.mesh(prims);
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  const Scene s = load_scene(g.write(dir_, "film"));
+  ASSERT_EQ(s.material_inputs.size(), 4u);
+  const SceneMaterialInputs &film = s.material_inputs[1], &defaults = s.material_inputs[2], &bad = s.material_inputs[3];
+  EXPECT_TRUE(film.has_iridescence);
+  EXPECT_FLOAT_EQ(film.iridescence, 0.9f);
+  EXPECT_FLOAT_EQ(film.iridescence_ior, 1.8f);
+  EXPECT_EQ(film.iridescence_thickness[0], 150.0f);
+  EXPECT_EQ(film.iridescence_thickness[1], 700.0f);
+  EXPECT_GE(film.slots[kSlotIridescence].texture, 0);
+  EXPECT_GE(film.slots[kSlotIridescenceThickness].texture, 0);
+  EXPECT_EQ(s.materials[1].iridescence[3], 700.0f) << "the kernels' copy";
+  EXPECT_EQ(defaults.iridescence, 0.0f);
+  EXPECT_FLOAT_EQ(defaults.iridescence_ior, 1.3f);
+  EXPECT_EQ(defaults.iridescence_thickness[0], 100.0f);
+  EXPECT_EQ(defaults.iridescence_thickness[1], 400.0f);
+  EXPECT_EQ(bad.iridescence_ior, 1.0f) << "clamped";
+  EXPECT_EQ(bad.iridescence_thickness[1], 0.0f) << "clamped";
+  EXPECT_EQ(warnings_with(s, "material 2 iridescenceIor is outside [1.0, inf]; clamped"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "material 2 iridescenceThicknessMaximum is outside [0.0, inf]; clamped"), 1u)
+      << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "drawn without"), 0u) << all_warnings(s);
+}
+
 TEST_F(SceneMaterialsTest, ATexCoordSetTheMeshLacksIsAnError) {
   GltfFile g;
   const Quad q = quad(g);

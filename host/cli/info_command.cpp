@@ -36,7 +36,7 @@ std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
       "occlusion",         "emissive",           "transmission",
       "thickness",         "clear coat",         "clear coat roughness",
       "clear coat normal", "specular",           "specular colour",
-      "anisotropy"};
+      "anisotropy",        "iridescence",        "iridescence thickness"};
   std::string t = std::string(short_names[kind]) + " (texture " + std::to_string(slot.texture);
   if (slot.texture >= 0 && size_t(slot.texture) < s.textures.size())
     t += " " + std::to_string(s.textures[size_t(slot.texture)].width) + "x" +
@@ -48,8 +48,8 @@ std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
   return t + ")";
 }
 
-// KHR_materials_transmission, _volume, _clearcoat, _specular and _anisotropy where the material has
-// them, and KHR_materials_ior's ior where it is not the default 1.5.
+// KHR_materials_transmission, _volume, _clearcoat, _specular, _anisotropy and _iridescence where the
+// material has them, and KHR_materials_ior's ior where it is not the default 1.5.
 std::string layer_text(const SceneMaterialInputs& in) {
   std::string t;
   if (in.has_transmission) t += ", transmission " + number(in.transmission);
@@ -68,6 +68,9 @@ std::string layer_text(const SceneMaterialInputs& in) {
          number(in.specular_color[1]) + ", " + number(in.specular_color[2]) + ")";
   if (in.has_anisotropy)
     t += ", anisotropy " + number(in.anisotropy_strength) + " rotation " + number(in.anisotropy_rotation);
+  if (in.has_iridescence)
+    t += ", iridescence " + number(in.iridescence) + " ior " + number(in.iridescence_ior) + " thickness " +
+         number(in.iridescence_thickness[0]) + "-" + number(in.iridescence_thickness[1]) + " nm";
   return t;
 }
 

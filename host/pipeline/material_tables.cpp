@@ -18,7 +18,8 @@ static_assert(PMR_MAP_BASE_COLOR == kSlotBaseColor && PMR_MAP_METALLIC_ROUGHNESS
                   PMR_MAP_CLEARCOAT_ROUGHNESS == kSlotClearcoatRoughness &&
                   PMR_MAP_CLEARCOAT_NORMAL == kSlotClearcoatNormal && PMR_MAP_SPECULAR == kSlotSpecular &&
                   PMR_MAP_SPECULAR_COLOR == kSlotSpecularColor && PMR_MAP_ANISOTROPY == kSlotAnisotropy &&
-                  PMR_MAPS == kTextureSlots,
+                  PMR_MAP_IRIDESCENCE == kSlotIridescence &&
+                  PMR_MAP_IRIDESCENCE_THICKNESS == kSlotIridescenceThickness && PMR_MAPS == kTextureSlots,
               "PMR_MAP_* follow SceneTextureSlotKind");
 
 void texture_transform_matrix(const SceneTextureSlot& slot, float out[6]) {
@@ -132,6 +133,7 @@ uint32_t material_flags(const PmrMaterial& m) {
       m.maps[PMR_MAP_SPECULAR_COLOR].texture >= 0)
     flags |= PMR_MATERIAL_SPECULAR;
   if (m.anisotropy[0] > 0.0f) flags |= PMR_MATERIAL_ANISOTROPY;
+  if (m.iridescence[0] > 0.0f) flags |= PMR_MATERIAL_IRIDESCENCE;
   return flags;
 }
 

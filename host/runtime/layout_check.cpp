@@ -20,7 +20,7 @@ static_assert(offsetof(PmrMta, bary) == 60 && offsetof(PmrMta, tri) == 84 && off
               "PmrMta layout");
 static_assert(sizeof(PmrVertexAttr) == 32 && offsetof(PmrVertexAttr, color) == 12, "PmrVertexAttr layout");
 static_assert(sizeof(PmrTriangle) == 32, "PmrTriangle layout");
-static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 84 && offsetof(PmrMaterial, maps) == 52 &&
+static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 100 && offsetof(PmrMaterial, maps) == 52 &&
                   offsetof(PmrMaterial, attenuation_color) == 52 + PMR_MAPS * 32 + 28 &&
                   offsetof(PmrMaterial, clearcoat) == 52 + PMR_MAPS * 32 + 40 &&
                   offsetof(PmrMaterial, specular_color) == 52 + PMR_MAPS * 32 + 56,

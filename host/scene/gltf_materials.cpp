@@ -278,6 +278,18 @@ void read_anisotropy(Loader& L, const tinygltf::Value& value, const std::string&
   m.anisotropy_rotation = extension_number(L, value, ext, "anisotropyRotation", 0.0, -inf, inf, name);
 }
 
+// KHR_materials_iridescence's factor (in [0, 1]), film ior (at least 1) and thickness range (nm, at
+// least 0), checked.
+void read_iridescence(Loader& L, const tinygltf::Value& value, const std::string& name, SceneMaterialInputs& m) {
+  const std::string ext = "KHR_materials_iridescence";
+  const double inf = std::numeric_limits<double>::infinity();
+  m.has_iridescence = true;
+  m.iridescence = extension_number(L, value, ext, "iridescenceFactor", 0.0, 0.0, 1.0, name);
+  m.iridescence_ior = extension_number(L, value, ext, "iridescenceIor", 1.3, 1.0, inf, name);
+  m.iridescence_thickness[0] = extension_number(L, value, ext, "iridescenceThicknessMinimum", 100.0, 0.0, inf, name);
+  m.iridescence_thickness[1] = extension_number(L, value, ext, "iridescenceThicknessMaximum", 400.0, 0.0, inf, name);
+}
+
 // KHR_materials_ior's ior: 0 or at least 1 (0: the extension's compatibility mode, a Fresnel term of 1).
 float read_ior(Loader& L, const tinygltf::Value& value, const std::string& name) {
   const float ior =
@@ -351,6 +363,8 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
       read_specular(L, value, name, m);
     } else if (ext == "KHR_materials_anisotropy") {
       read_anisotropy(L, value, name, m);
+    } else if (ext == "KHR_materials_iridescence") {
+      read_iridescence(L, value, name, m);
     } else if (material_extension_fallback(ext)) {
       m.unimplemented.push_back(ext);
     }

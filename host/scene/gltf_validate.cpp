@@ -55,7 +55,8 @@ bool extension_supported(const std::string& name) {
   return name == "KHR_mesh_quantization" || name == "KHR_texture_transform" || name == "KHR_lights_punctual" ||
          name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit" || name == "KHR_materials_ior" ||
          name == "KHR_materials_transmission" || name == "KHR_materials_volume" || name == "KHR_materials_variants" ||
-         name == "KHR_materials_clearcoat" || name == "KHR_materials_specular" || name == "KHR_materials_anisotropy";
+         name == "KHR_materials_clearcoat" || name == "KHR_materials_specular" || name == "KHR_materials_anisotropy" ||
+         name == "KHR_materials_iridescence";
 }
 
 uint32_t read_u32le(const unsigned char* p) {
@@ -503,7 +504,6 @@ std::string base_dir_of(const std::string& path) {
 const char* material_extension_fallback(const std::string& name) {
   static const std::pair<const char*, const char*> table[] = {
       {"KHR_materials_sheen", "drawn without sheen"},
-      {"KHR_materials_iridescence", "drawn without iridescence"},
       {"KHR_materials_pbrSpecularGlossiness",
        "drawn from their metallic-roughness properties (the defaults where absent), not specular-glossiness"},
   };

@@ -28,6 +28,7 @@ PmrMaterial default_material() {
   m.specular = 1.0f;
   for (float& c : m.specular_color) c = 1.0f;
   m.anisotropy[0] = 0.0f, m.anisotropy[1] = 1.0f, m.anisotropy[2] = 0.0f;  // isotropic
+  m.iridescence[0] = 0.0f, m.iridescence[1] = 1.3f, m.iridescence[2] = 100.0f, m.iridescence[3] = 400.0f;
   return m;
 }
 
@@ -46,6 +47,8 @@ void apply_material_inputs(const SceneMaterialInputs& in, PmrMaterial& m) {
   m.anisotropy[0] = in.anisotropy_strength;
   m.anisotropy[1] = float(std::cos(double(in.anisotropy_rotation)));
   m.anisotropy[2] = float(std::sin(double(in.anisotropy_rotation)));
+  m.iridescence[0] = in.iridescence, m.iridescence[1] = in.iridescence_ior;
+  m.iridescence[2] = in.iridescence_thickness[0], m.iridescence[3] = in.iridescence_thickness[1];
 }
 
 bool scene_transmissive(const Scene& scene) {
@@ -76,10 +79,11 @@ float dielectric_f0(double ior) {
 
 const char* texture_slot_name(int slot) {
   static const char* const names[kTextureSlots] = {
-      "baseColorTexture",          "metallicRoughnessTexture", "normalTexture",    "occlusionTexture",
-      "emissiveTexture",           "transmissionTexture",      "thicknessTexture", "clearcoatTexture",
-      "clearcoatRoughnessTexture", "clearcoatNormalTexture",   "specularTexture",  "specularColorTexture",
-      "anisotropyTexture"};
+      "baseColorTexture",       "metallicRoughnessTexture", "normalTexture",
+      "occlusionTexture",       "emissiveTexture",          "transmissionTexture",
+      "thicknessTexture",       "clearcoatTexture",         "clearcoatRoughnessTexture",
+      "clearcoatNormalTexture", "specularTexture",          "specularColorTexture",
+      "anisotropyTexture",      "iridescenceTexture",       "iridescenceThicknessTexture"};
   return slot >= 0 && slot < kTextureSlots ? names[slot] : "?";
 }
 
@@ -96,7 +100,9 @@ const char* texture_slot_extension(int slot) {
                                                         "KHR_materials_clearcoat",
                                                         "KHR_materials_specular",
                                                         "KHR_materials_specular",
-                                                        "KHR_materials_anisotropy"};
+                                                        "KHR_materials_anisotropy",
+                                                        "KHR_materials_iridescence",
+                                                        "KHR_materials_iridescence"};
   return slot >= 0 && slot < kTextureSlots ? extensions[slot] : nullptr;
 }
 

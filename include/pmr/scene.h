@@ -27,20 +27,22 @@ struct SceneTexture {
 
 // The texture slots of a glTF metallic-roughness material (DESIGN section 4b), in this order.
 enum SceneTextureSlotKind : int {
-  kSlotBaseColor = 0,           // RGBA, sRGB
-  kSlotMetallicRoughness = 1,   // B metallic, G roughness, linear
-  kSlotNormal = 2,              // RGB tangent-space normal, linear
-  kSlotOcclusion = 3,           // R occlusion, linear
-  kSlotEmissive = 4,            // RGB, sRGB
-  kSlotTransmission = 5,        // R transmission (KHR_materials_transmission), linear
-  kSlotThickness = 6,           // G thickness (KHR_materials_volume), linear
-  kSlotClearcoat = 7,           // R clear coat intensity (KHR_materials_clearcoat), linear
-  kSlotClearcoatRoughness = 8,  // G clear coat roughness, linear
-  kSlotClearcoatNormal = 9,     // RGB the clear coat's tangent-space normal, linear
-  kSlotSpecular = 10,           // A specular weight (KHR_materials_specular), linear
-  kSlotSpecularColor = 11,      // RGB specular colour, sRGB
-  kSlotAnisotropy = 12,         // RG direction, B strength (KHR_materials_anisotropy), linear
-  kTextureSlots = 13
+  kSlotBaseColor = 0,              // RGBA, sRGB
+  kSlotMetallicRoughness = 1,      // B metallic, G roughness, linear
+  kSlotNormal = 2,                 // RGB tangent-space normal, linear
+  kSlotOcclusion = 3,              // R occlusion, linear
+  kSlotEmissive = 4,               // RGB, sRGB
+  kSlotTransmission = 5,           // R transmission (KHR_materials_transmission), linear
+  kSlotThickness = 6,              // G thickness (KHR_materials_volume), linear
+  kSlotClearcoat = 7,              // R clear coat intensity (KHR_materials_clearcoat), linear
+  kSlotClearcoatRoughness = 8,     // G clear coat roughness, linear
+  kSlotClearcoatNormal = 9,        // RGB the clear coat's tangent-space normal, linear
+  kSlotSpecular = 10,              // A specular weight (KHR_materials_specular), linear
+  kSlotSpecularColor = 11,         // RGB specular colour, sRGB
+  kSlotAnisotropy = 12,            // RG direction, B strength (KHR_materials_anisotropy), linear
+  kSlotIridescence = 13,           // R iridescence factor (KHR_materials_iridescence), linear
+  kSlotIridescenceThickness = 14,  // G thin-film thickness, linear
+  kTextureSlots = 15
 };
 const char* texture_slot_name(int slot);  // "baseColorTexture", ... (the glTF property names)
 // The material extension whose object holds slot `slot`'s textureInfo; nullptr for the core slots.
@@ -92,8 +94,13 @@ struct SceneMaterialInputs {
   float specular_color[3] = {1.0f, 1.0f, 1.0f};  // specularColorFactor (linear, >= 0)
   // KHR_materials_anisotropy (pbr): GGX stretched along a direction of the tangent frame
   bool has_anisotropy = false;
-  float anisotropy_strength = 0.0f;                   // anisotropyStrength (validated to [0, 1])
-  float anisotropy_rotation = 0.0f;                   // anisotropyRotation, radians counter-clockwise from the tangent
+  float anisotropy_strength = 0.0f;  // anisotropyStrength (validated to [0, 1])
+  float anisotropy_rotation = 0.0f;  // anisotropyRotation, radians counter-clockwise from the tangent
+  // KHR_materials_iridescence (pbr): a thin film whose interference tints the Fresnel term
+  bool has_iridescence = false;
+  float iridescence = 0.0f;                           // iridescenceFactor (validated to [0, 1])
+  float iridescence_ior = 1.3f;                       // iridescenceIor (>= 1)
+  float iridescence_thickness[2] = {100.0f, 400.0f};  // iridescenceThicknessMinimum, ...Maximum (nm, >= 0)
   std::array<SceneTextureSlot, kTextureSlots> slots;  // indexed by SceneTextureSlotKind
   std::vector<std::string> unimplemented;  // material extensions present but not drawn (warned once per scene)
 };

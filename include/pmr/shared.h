@@ -96,6 +96,7 @@ typedef uint64_t pmr_u64;
 #define PMR_MATERIAL_MAPS 1u     /* some map (PMR_MAP_*) is sampled                                 */
 #define PMR_MATERIAL_SPECULAR 2u /* KHR_materials_specular changes the Fresnel term (a factor or a map) */
 #define PMR_MATERIAL_ANISOTROPY 4u /* KHR_materials_anisotropy with a strength above 0               */
+#define PMR_MATERIAL_IRIDESCENCE 8u /* KHR_materials_iridescence with a factor above 0               */
 
 /* Texture wrap modes (glTF sampler enums). */
 #define PMR_WRAP_REPEAT 10497
@@ -252,7 +253,9 @@ typedef struct {
 #define PMR_MAP_SPECULAR 10          /* A specular weight (KHR_materials_specular, linear)      */
 #define PMR_MAP_SPECULAR_COLOR 11    /* RGB specular colour (sRGB-encoded)                      */
 #define PMR_MAP_ANISOTROPY 12        /* RG direction, B strength (KHR_materials_anisotropy, linear) */
-#define PMR_MAPS 13
+#define PMR_MAP_IRIDESCENCE 13       /* R iridescence factor (KHR_materials_iridescence, linear) */
+#define PMR_MAP_IRIDESCENCE_THICKNESS 14 /* G thin-film thickness between the minimum and maximum    */
+#define PMR_MAPS 15
 
 /* One texture map of a material: which texture, sampled at which TEXCOORD set, through which
  * KHR_texture_transform (the identity without one). Producer: host/pipeline (from the scene's material
@@ -289,6 +292,7 @@ typedef struct {
   float specular_color[3];      /* ... specularColorFactor (linear; (1, 1, 1) without it)          */
   pmr_u32 flags;                /* PMR_MATERIAL_*, set with the maps (host/pipeline/material_tables.cpp) */
   float anisotropy[3];          /* KHR_materials_anisotropy: strength, cos and sin of the rotation */
+  float iridescence[4];         /* KHR_materials_iridescence: factor, ior, thickness min and max (nm) */
 } PmrMaterial;
 
 /* A texture and its mip chain: `levels` levels back to back from `offset`, level k of

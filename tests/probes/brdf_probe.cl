@@ -19,7 +19,7 @@ kernel void brdf_probe(global const float* in, global float* out, uint n) {
 #define LANES3(k) s3(LANES(k), LANES(k + 1), LANES(k + 2))
   const sfloat3 f0 = pbr_f0(LANES3(0), LANES(3), specular_f0((sfloat)(0.04f), LANES3(15), LANES(14)));
   const sfloat3 r = brdf_cos(LANES3(0), LANES(3), f0, pbr_f90(LANES(14), LANES(3)), pbr_roughness(LANES(4)), LANES3(5),
-                             LANES3(8), LANES3(11), 0);
+                             LANES3(8), LANES3(11), 0, 0);
   float o[3][SW];
   vstore_s(r.x, 0, o[0]), vstore_s(r.y, 0, o[1]), vstore_s(r.z, 0, o[2]);
   for (int l = 0; l < SW && first + (uint)l < n; ++l)

@@ -88,6 +88,12 @@ void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool bac
     if (sample_slot(scene, t, b, in.slots[kSlotTransmission], s)) sp.transmission *= s.x;
     const glm::dvec3 geometric = n;
     if (in.anisotropy_strength > 0.0f) anisotropy_at(scene, t, b, in, geometric, sp);
+    sp.iridescence = in.iridescence, sp.iridescence_ior = in.iridescence_ior;
+    sp.iridescence_thickness = in.iridescence_thickness[1];
+    if (sample_slot(scene, t, b, in.slots[kSlotIridescence], s)) sp.iridescence *= s.x;
+    if (sample_slot(scene, t, b, in.slots[kSlotIridescenceThickness], s))
+      sp.iridescence_thickness =
+          glm::mix(double(in.iridescence_thickness[0]), double(in.iridescence_thickness[1]), s.y);
     n = mapped_normal(scene, t, b, in.slots[kSlotNormal], in.normal_scale, geometric);
     sp.specular = in.specular;
     sp.specular_color = glm::dvec3(in.specular_color[0], in.specular_color[1], in.specular_color[2]);

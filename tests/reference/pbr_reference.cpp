@@ -25,7 +25,8 @@ double f90_of(double metallic, double specular) { return specular + (1.0 - specu
 
 glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
                     const glm::dvec3& l, double ior, double transmission, double specular,
-                    const glm::dvec3& specular_color, double anisotropy, const glm::dvec3& anisotropy_t) {
+                    const glm::dvec3& specular_color, double anisotropy, const glm::dvec3& anisotropy_t,
+                    double iridescence, const glm::dvec3& iridescence_F) {
   const double nl = clamp01(glm::dot(n, l));
   if (nl <= 0.0) return glm::dvec3(0.0);
   const double nv = clamp01(glm::dot(n, v));
@@ -34,7 +35,8 @@ glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm
   const double nh = clamp01(glm::dot(n, h)), vh = clamp01(glm::dot(v, h));
   const double alpha = r * r, a2 = alpha * alpha;
   const glm::dvec3 f0 = f0_of(base, metallic, ior, specular, specular_color);
-  const glm::dvec3 F = f0 + (f90_of(metallic, specular) - f0) * std::pow(1.0 - vh, 5.0);
+  const glm::dvec3 F =
+      glm::mix(f0 + (f90_of(metallic, specular) - f0) * std::pow(1.0 - vh, 5.0), iridescence_F, iridescence);
   const double dd = nh * nh * (a2 - 1.0) + 1.0;
   const double D = a2 / (kPi * dd * dd);
   const double s = nl * std::sqrt(nv * nv * (1.0 - a2) + a2) + nv * std::sqrt(nl * nl * (1.0 - a2) + a2);
@@ -78,6 +80,52 @@ double ggx_lobe_cos(double r, const glm::dvec3& n, const glm::dvec3& v, const gl
   return a2 / (kPi * dd * dd) * (s > 0.0 ? 0.5 / s : 0.0) * nl;
 }
 
+namespace {
+
+// The extension's evalSensitivity: the thin film's spectral term for optical path difference opd (nm)
+// and phase shifts `shift`, in Rec. 709.
+glm::dvec3 film_sensitivity(double opd, const glm::dvec3& shift) {
+  const double phase = 2.0 * kPi * opd * 1.0e-9, p2 = phase * phase;
+  const glm::dvec3 val(5.4856e-13, 4.4201e-13, 5.2481e-13), pos(1.6810e6, 1.7953e6, 2.2084e6),
+      var(4.3278e9, 9.3046e9, 6.6121e9);
+  glm::dvec3 xyz;
+  for (int c = 0; c < 3; ++c)
+    xyz[c] = val[c] * std::sqrt(2.0 * kPi * var[c]) * std::cos(pos[c] * phase + shift[c]) * std::exp(-p2 * var[c]);
+  xyz.x +=
+      9.7470e-14 * std::sqrt(2.0 * kPi * 4.5282e9) * std::cos(2.2399e6 * phase + shift[0]) * std::exp(-4.5282e9 * p2);
+  xyz /= 1.0685e-7;
+  const glm::dmat3 xyz_to_rec709(3.2404542, -0.9692660, 0.0556434, -1.5371385, 1.8760108, -0.2040259, -0.4985314,
+                                 0.0415560, 1.0572252);
+  return xyz_to_rec709 * xyz;
+}
+
+double schlick(double r0, double cos) { return r0 + (1.0 - r0) * std::pow(1.0 - cos, 5.0); }
+
+}  // namespace
+
+glm::dvec3 thin_film_fresnel(double outside, double film, double cos1, double d, const glm::dvec3& f0) {
+  const double t = std::clamp(d / 0.03, 0.0, 1.0), ior = outside + (film - outside) * t * t * (3.0 - 2.0 * t);
+  const double sin2sq = std::pow(outside / ior, 2.0) * (1.0 - cos1 * cos1), cos2sq = 1.0 - sin2sq;
+  if (cos2sq < 0.0) return glm::dvec3(1.0);  // total internal reflection
+  const double cos2 = std::sqrt(cos2sq);
+  const double R12 = schlick(std::pow((ior - outside) / (ior + outside), 2.0), cos1), T121 = 1.0 - R12;
+  const double phi21 = kPi - (ior < outside ? kPi : 0.0), opd = 2.0 * ior * d * cos2;
+  glm::dvec3 R23, phi;
+  for (int c = 0; c < 3; ++c) {
+    const double s0 = std::sqrt(std::clamp(f0[c], 0.0, 0.9999)), base = (1.0 + s0) / (1.0 - s0);
+    R23[c] = schlick(std::pow((base - ior) / (base + ior), 2.0), cos2);
+    phi[c] = phi21 + (base < ior ? kPi : 0.0);
+  }
+  const glm::dvec3 R123 = glm::clamp(R12 * R23, 1e-5, 0.9999), r123 = glm::sqrt(R123);
+  const glm::dvec3 Rs = T121 * T121 * R23 / (1.0 - R123);
+  glm::dvec3 I = R12 + Rs, Cm = Rs - T121;
+  for (int m = 1; m <= 2; ++m) {
+    Cm *= r123;
+    I += Cm * 2.0 * film_sensitivity(m * opd, double(m) * phi);
+  }
+  return glm::max(I, glm::dvec3(0.0));
+}
+
 glm::dvec3 light_irradiance(const PunctualLight& light, const glm::dvec3& p, glm::dvec3& l) {
   if (light.type == LightType::Directional) {
     l = -light.direction;
@@ -109,12 +157,16 @@ glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& li
   const glm::dvec3 v = glm::normalize(s.eye - s.p);
   const glm::dvec3 f0 = f0_of(s.base, s.metallic, s.ior, s.specular, s.specular_color);
   const double f90 = f90_of(s.metallic, s.specular);
+  glm::dvec3 film(0.0);  // under a clear coat the film's outside is the coat (ior 1.5)
+  if (s.iridescence > 0.0)
+    film = thin_film_fresnel(s.clearcoat > 0.0 ? 1.5 : 1.0, s.iridescence_ior, clamp01(glm::dot(s.n, v)),
+                             s.iridescence_thickness, f0);
   glm::dvec3 sum(0.0);
   for (const PunctualLight& light : lights) {
     glm::dvec3 l;
     const glm::dvec3 E = light_irradiance(light, s.p, l);
     sum += brdf_cos(s.base, s.metallic, r, s.n, v, l, s.ior, s.transmission, s.specular, s.specular_color, s.anisotropy,
-                    s.anisotropy_t) *
+                    s.anisotropy_t, s.iridescence, film) *
            E;
     if (s.transmission > 0.0)
       sum +=
@@ -129,7 +181,7 @@ glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& li
     const double bend = std::pow(1.0 - s.anisotropy * (1.0 - r), 4.0);
     reflected = glm::reflect(-v, glm::normalize(glm::mix(bent_to, s.n, bend)));
   }
-  const glm::dvec3 specular = f0 * ab.x + f90 * ab.y;
+  const glm::dvec3 specular = glm::mix(f0 * ab.x + f90 * ab.y, film * (ab.x + ab.y), s.iridescence);
   sum += s.ao * ((1.0 - s.transmission) * c_diff * env.irradiance(s.n) + specular * env.prefiltered(reflected, r));
   sum += s.ao * s.transmission * (1.0 - specular) * c_diff * s.through;
   glm::dvec3 color = sum + s.emissive;

@@ -19,7 +19,14 @@ namespace pmr::ref {
 glm::dvec3 brdf_cos(const glm::dvec3& base, double metallic, double r, const glm::dvec3& n, const glm::dvec3& v,
                     const glm::dvec3& l, double ior = 1.5, double transmission = 0.0, double specular = 1.0,
                     const glm::dvec3& specular_color = glm::dvec3(1.0), double anisotropy = 0.0,
-                    const glm::dvec3& anisotropy_t = glm::dvec3(1.0, 0.0, 0.0));
+                    const glm::dvec3& anisotropy_t = glm::dvec3(1.0, 0.0, 0.0), double iridescence = 0.0,
+                    const glm::dvec3& iridescence_F = glm::dvec3(0.0));
+
+// KHR_materials_iridescence's Fresnel term of a thin film (the extension's implementation notes): film
+// of ior `film` and thickness d nm between `outside` and a base of Fresnel F0 f0, seen at cos1 = n.v;
+// the film's ior eases to `outside` over the first 0.03 nm, as the Sample Viewer's. In the BRDF
+// F = mix(Schlick's F, this, iridescence).
+glm::dvec3 thin_film_fresnel(double outside, double film, double cos1, double d, const glm::dvec3& f0);
 
 // KHR_materials_transmission's BTDF for a light in direction l seen through the surface: (1 - F(v.h))
 // D(n.h) Vis(n.l', n.v), l' = l mirrored on the surface's plane, h = normalize(l' + v), GGX of roughness
@@ -63,6 +70,8 @@ struct SurfacePoint {
   glm::dvec3 specular_color{1.0};
   double anisotropy = 0.0;                 // KHR_materials_anisotropy: strength (factor x texture B) and
   glm::dvec3 anisotropy_t{1.0, 0.0, 0.0};  // the unit direction in world space (strength 0: isotropic)
+  double iridescence = 0.0;                // KHR_materials_iridescence: factor x texture R, film ior,
+  double iridescence_ior = 1.3, iridescence_thickness = 400.0;  // thickness in nm
 };
 
 // The environment's precomputed terms: I(n) (irradiance / pi), P(d, r) and the split-sum (A, B).

@@ -918,6 +918,17 @@ TEST_F(SceneMaterialsTest, InfoListsLightsAndMaterialFeatures) {
          {"emissiveFactor", {1, 0.5, 0.25}},
          {"extensions",
           {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}}, {"KHR_materials_unlit", json::object()}}}});
+  g.add("materials",
+        {{"name", "Layers"},
+         {"extensions",
+          {{"KHR_materials_transmission", {{"transmissionFactor", 0.5}, {"transmissionTexture", {{"index", 0}}}}},
+           {"KHR_materials_clearcoat",
+            {{"clearcoatFactor", 1},
+             {"clearcoatRoughnessFactor", 0.2},
+             {"clearcoatNormalTexture", {{"index", 0}, {"scale", 0.5}}}}},
+           {"KHR_materials_specular", {{"specularFactor", 0.5}, {"specularColorFactor", {1, 0.5, 0.25}}}},
+           {"KHR_materials_anisotropy", {{"anisotropyStrength", 0.3}, {"anisotropyRotation", 1}}},
+           {"KHR_materials_iridescence", {{"iridescenceFactor", 1}}}}}});
   g.doc["asset"]["generator"] = "Exporter\x1b[2J";
   const std::string path = g.write(dir_, "info");
   const test::CliRun r = test::run("info '" + path + "'");
@@ -930,7 +941,10 @@ TEST_F(SceneMaterialsTest, InfoListsLightsAndMaterialFeatures) {
         "1 'Shiny\\x1b[31m': alpha MASK (cutoff 0.5), double sided, unlit",
         "metallic 1, roughness 1, emissive (1, 0.5, 0.25) x strength 4",
         "metallic-roughness (texture 0 2x1, linear, set 1, transform offset (0.5, 0) rotation 0 scale (1, 1))",
-        "0 (default): alpha OPAQUE, single sided", "(generator: Exporter\\x1b[2J)"})
+        "0 (default): alpha OPAQUE, single sided", "(generator: Exporter\\x1b[2J)",
+        "transmission (texture 0 2x1, linear, set 0)", "clear coat 1 roughness 0.2 normal scale 0.5",
+        "clear coat normal (texture 0 2x1, linear, set 0)", "specular 0.5 colour (1, 0.5, 0.25)",
+        "anisotropy 0.3 rotation 1", "iridescence 1 ior 1.3 thickness 100-400 nm"})
     EXPECT_NE(r.output.find(part), std::string::npos) << part << "\n" << r.output;
   EXPECT_EQ(r.output.find('\x1b'), std::string::npos) << "names are printed sanitized";
 }

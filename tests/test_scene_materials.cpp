@@ -852,15 +852,20 @@ TEST_F(SceneMaterialsTest, OverflowingLightColourAndRangeAreErrors) {
 TEST_F(SceneMaterialsTest, OneWarningPerUnimplementedMaterialExtension) {
   GltfFile g;
   const Quad q = quad(g);
-  g.doc["extensionsUsed"] = {"KHR_materials_transmission",          "KHR_materials_volume", "KHR_materials_sheen",
-                             "KHR_materials_pbrSpecularGlossiness", "KHR_materials_foo",    "KHR_lights_punctual"};
-  g.doc["extensionsRequired"] = {"KHR_materials_transmission", "KHR_materials_pbrSpecularGlossiness"};
+  g.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_volume",
+                             "KHR_materials_sheen",        "KHR_materials_pbrSpecularGlossiness",
+                             "KHR_materials_foo",          "KHR_lights_punctual",
+                             "KHR_materials_dispersion"};
+  g.doc["extensionsRequired"] = {"KHR_materials_transmission", "KHR_materials_pbrSpecularGlossiness",
+                                 "KHR_materials_dispersion"};
   const json transmission = {{"KHR_materials_transmission", {{"transmissionFactor", 1}}}};
   g.add("materials", {{"extensions", transmission}});
   g.add("materials", {{"extensions", transmission}});
   g.add("materials",
         {{"extensions", {{"KHR_materials_transmission", json::object()}, {"KHR_materials_volume", json::object()}}}});
-  g.add("materials", {{"extensions", {{"KHR_materials_pbrSpecularGlossiness", {{"glossinessFactor", 0.5}}}}}});
+  g.add("materials", {{"extensions",
+                       {{"KHR_materials_pbrSpecularGlossiness", {{"glossinessFactor", 0.5}}},
+                        {"KHR_materials_dispersion", {{"dispersion", 0.1}}}}}});
   g.add("materials", {{"extensions", {{"KHR_materials_sheen", json::object()}}}});  // no primitive uses it
   json prims = json::array();
   for (int m = 0; m < 4; ++m)
@@ -875,6 +880,9 @@ TEST_F(SceneMaterialsTest, OneWarningPerUnimplementedMaterialExtension) {
             1u)
       << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "KHR_materials_sheen"), 0u) << "no drawn material uses it\n" << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "KHR_materials_dispersion (1 material): drawn without dispersion"), 1u)
+      << "drawn without it, even when required\n"
+      << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "extensions used but not implemented, ignored: KHR_materials_foo"), 1u) << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "KHR_lights_punctual"), 0u) << all_warnings(s);
   // An unknown required extension is still refused.

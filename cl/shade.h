@@ -586,22 +586,30 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
 }
 
 /* The tangent frame about the unit normals n (before any back-face flip): the interpolated tangent made
- * orthogonal to n and normalized (*t), the bitangent sign(w) * cross(n, t) (*b); returns the length of
- * the orthogonalized tangent (a lane without a tangent: 0, and t, b of no use). */
-inline sfloat tangent_frame(const LaneTextures* T, sfloat3 n, sfloat3* t, sfloat3* b) {
+ * orthogonal to n and normalized (t), the bitangent sign(w) * cross(n, t) (b), and the length of the
+ * orthogonalized tangent (a lane without a tangent: 0, and t, b of no use). Computed once per batch of
+ * textured lanes; every normal map and the anisotropy direction read it. */
+typedef struct {
+  sfloat3 t, b;
+  sfloat len;
+} TangentFrame;
+
+inline TangentFrame tangent_frame(const LaneTextures* T, sfloat3 n) {
   const sfloat3 tw = LANE3(T->tw);
   const sfloat3 o = s3_sub(tw, s3_scale(n, s3_dot(n, tw)));
-  const sfloat len = sqrt(s3_dot(o, o));
-  *t = s3_scale(o, 1.0f / len);
-  *b = s3_scale(s3_cross(n, *t), select((sfloat)(1.0f), (sfloat)(-1.0f), vload_s(0, T->tw[3]) < 0.0f));
-  return len;
+  TangentFrame F;
+  F.len = sqrt(s3_dot(o, o));
+  F.t = s3_scale(o, 1.0f / F.len);
+  F.b = s3_scale(s3_cross(n, F.t), select((sfloat)(1.0f), (sfloat)(-1.0f), vload_s(0, T->tw[3]) < 0.0f));
+  return F;
 }
 
-/* Normal map M applied to the unit normals n (before any back-face flip), in the lanes that have one:
- * m = (2 s - 1) * (scale, scale, 1) in the tangent frame. A lane without a tangent (zero) keeps n. */
-inline sfloat3 mapped_normal(const LaneTextures* T, const LaneNormalMap* M, sfloat3 n) {
-  sfloat3 tangent, bitangent;
-  const sfloat len = tangent_frame(T, n, &tangent, &bitangent);
+/* Normal map M applied to the unit normals n (before any back-face flip; F their tangent frame), in the
+ * lanes that have one: m = (2 s - 1) * (scale, scale, 1) in the frame. A lane without a tangent (zero)
+ * keeps n. */
+inline sfloat3 mapped_normal(const LaneNormalMap* M, const TangentFrame* F, sfloat3 n) {
+  const sfloat3 tangent = F->t, bitangent = F->b;
+  const sfloat len = F->len;
   const sfloat scale = vload_s(0, M->scale);
   const sfloat3 s = LANE3(M->s);
   const sfloat3 m = s3((2.0f * s.x - 1.0f) * scale, (2.0f * s.y - 1.0f) * scale, 2.0f * s.z - 1.0f);
@@ -611,12 +619,12 @@ inline sfloat3 mapped_normal(const LaneTextures* T, const LaneNormalMap* M, sflo
 }
 
 /* KHR_materials_anisotropy's direction in world space, for the lanes L->aniso: (cos, sin) of the
- * material's rotation applied to the texture's direction 2 RG - 1 (else (1, 0)), in the tangent frame
- * about the interpolated normal n (before any normal map or back-face flip), normalized; 0 where a lane
+ * material's rotation applied to the texture's direction 2 RG - 1 (else (1, 0)), in the tangent frame F
+ * about the interpolated normal (before any normal map or back-face flip), normalized; 0 where a lane
  * has no tangent (it is drawn isotropic). */
-inline sfloat3 anisotropy_direction(const LaneWinners* L, const LaneTextures* T, sfloat3 n) {
-  sfloat3 t, b;
-  const sfloat len = tangent_frame(T, n, &t, &b);
+inline sfloat3 anisotropy_direction(const LaneWinners* L, const LaneTextures* T, const TangentFrame* F) {
+  const sfloat3 t = F->t, b = F->b;
+  const sfloat len = F->len;
   const sfloat dx = vload_s(0, T->aniso_dir[0]), dy = vload_s(0, T->aniso_dir[1]);
   const sfloat rx = L->aniso_cos * dx - L->aniso_sin * dy, ry = L->aniso_sin * dx + L->aniso_cos * dy;
   const sfloat3 d = s3_add(s3_scale(t, rx), s3_scale(b, ry));
@@ -734,6 +742,43 @@ typedef struct {
   Iridescence irid;               /* KHR_materials_iridescence (w 0 in lanes without)                */
 } Surface;
 
+/* The Fresnel term's F0 and F90 of the surface S (base and metallic set): the dielectric's F0 from the
+ * ior, times KHR_materials_specular's colour and weight in its lanes. */
+inline void surface_fresnel(Surface* S, const LaneWinners* L, const LaneTextures* T, bool textured) {
+  if (!any(L->specular)) {
+    S->f0 = pbr_f0(S->base, S->metallic, s3(L->f0d, L->f0d, L->f0d));
+    S->f90 = 1.0f;
+    return;
+  }
+  sfloat weight = L->spec_weight;
+  sfloat3 color = L->spec_color;
+  if (textured) weight *= vload_s(0, T->spec_weight), color = s3_mul(color, LANE3(T->spec_color));
+  S->f0 = pbr_f0(S->base, S->metallic, specular_f0(L->f0d, color, weight));
+  S->f90 = pbr_f90(weight, S->metallic);
+}
+
+/* KHR_materials_anisotropy's frame of the surface S (n set), for the lanes that have it: the direction
+ * aniso_t and the bitangent from the shading normal, as the specification's implementation. */
+inline void surface_anisotropy(Surface* S, const LaneWinners* L, const LaneTextures* T, sfloat3 aniso_t) {
+  const sfloat3 ab = s3_cross(S->n, aniso_t);
+  const sfloat len = sqrt(s3_dot(ab, ab));
+  S->aniso.on = L->aniso & (len > 0.0f);
+  S->aniso.t = aniso_t, S->aniso.b = s3_scale(ab, 1.0f / len);
+  S->aniso.s = L->aniso_strength * vload_s(0, T->aniso_strength);
+}
+
+/* KHR_materials_iridescence's film over the surface S (n, v, F0 and the coat set): its Fresnel term at
+ * n.v and weight. Under a clear coat the film's outside is the coat (ior 1.5), else air; without a
+ * thickness texture the film has the maximum thickness. */
+inline void surface_iridescence(Surface* S, const LaneWinners* L, const LaneTextures* T, bool textured) {
+  const sfloat t = textured ? vload_s(0, T->irid_thickness) : (sfloat)(1.0f);
+  const sfloat d = L->irid_min + (L->irid_max - L->irid_min) * t;
+  const sfloat outside = select((sfloat)(1.0f), (sfloat)(1.5f), L->coated & (S->coat > 0.0f));
+  const sfloat cos1 = clamp(s3_dot(S->n, S->v), 0.0f, 1.0f);
+  S->irid.F = thin_film_fresnel(outside, L->irid_ior, cos1, d, S->f0);
+  S->irid.w = textured ? L->irid_factor * vload_s(0, T->irid_factor) : L->irid_factor;
+}
+
 /* The surface of the lanes seen from view `view`: n and coat_n are unit normals, flipped for back faces;
  * spread and coat_spread the specular antialiasing increments of the two lobes. */
 inline Surface pbr_surface(const ShadeInputs* in, const LaneWinners* L, const LaneTextures* T, bool textured, sfloat3 b,
@@ -757,33 +802,11 @@ inline Surface pbr_surface(const ShadeInputs* in, const LaneWinners* L, const La
   S.n = n, S.base = base, S.emissive = emissive;
   S.metallic = metallic, S.ao = ao, S.transmission = transmission, S.thickness = thickness;
   S.r = widened_roughness(pbr_roughness(roughness), spread);
-  if (any(L->specular)) { /* KHR_materials_specular */
-    sfloat weight = L->spec_weight;
-    sfloat3 color = L->spec_color;
-    if (textured) weight *= vload_s(0, T->spec_weight), color = s3_mul(color, LANE3(T->spec_color));
-    S.f0 = pbr_f0(base, metallic, specular_f0(L->f0d, color, weight));
-    S.f90 = pbr_f90(weight, metallic);
-  } else {
-    S.f0 = pbr_f0(base, metallic, s3(L->f0d, L->f0d, L->f0d));
-    S.f90 = 1.0f;
-  }
+  surface_fresnel(&S, L, T, textured);
   S.coat = coat, S.coat_n = coat_n;
   S.coat_r = coated ? widened_roughness(pbr_roughness(coat_roughness), coat_spread) : (sfloat)(1.0f);
-  if (any(L->aniso)) { /* the bitangent from the shading normal, as the specification's implementation */
-    const sfloat3 ab = s3_cross(n, aniso_t);
-    const sfloat len = sqrt(s3_dot(ab, ab));
-    S.aniso.on = L->aniso & (len > 0.0f);
-    S.aniso.t = aniso_t, S.aniso.b = s3_scale(ab, 1.0f / len);
-    S.aniso.s = L->aniso_strength * vload_s(0, T->aniso_strength);
-  }
-  if (any(L->irid)) { /* under a clear coat the film's outside is the coat (ior 1.5), else air */
-    const sfloat t = textured ? vload_s(0, T->irid_thickness) : (sfloat)(1.0f); /* no texture: the maximum */
-    const sfloat d = L->irid_min + (L->irid_max - L->irid_min) * t;
-    const sfloat outside = select((sfloat)(1.0f), (sfloat)(1.5f), L->coated & (S.coat > 0.0f));
-    const sfloat cos1 = clamp(s3_dot(n, S.v), 0.0f, 1.0f);
-    S.irid.F = thin_film_fresnel(outside, L->irid_ior, cos1, d, S.f0);
-    S.irid.w = textured ? L->irid_factor * vload_s(0, T->irid_factor) : L->irid_factor;
-  }
+  if (any(L->aniso)) surface_anisotropy(&S, L, T, aniso_t);
+  if (any(L->irid)) surface_iridescence(&S, L, T, textured);
   return S;
 }
 
@@ -921,14 +944,17 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
       if (textured && any(L->coated)) coat_spread += vload_s(0, T.coat_normal.toksvig);
     }
 #endif
-    const sfloat3 aniso_t = any(L->aniso) ? anisotropy_direction(L, &T, n) : s3_splat((float3)(0.0f));
+    /* anisotropic lanes count as textured: they have a tangent frame */
+    TangentFrame F;
+    if (textured) F = tangent_frame(&T, n);
+    const sfloat3 aniso_t = any(L->aniso) ? anisotropy_direction(L, &T, &F) : s3_splat((float3)(0.0f));
     /* the coat has its own normal map, or none: it follows the geometric normal */
     sfloat3 coat_n = n;
     if (any(L->coated)) {
-      if (textured) coat_n = mapped_normal(&T, &T.coat_normal, n);
+      if (textured) coat_n = mapped_normal(&T.coat_normal, &F, n);
       coat_n = s3_select(coat_n, s3_neg(coat_n), L->back);
     }
-    if (textured) n = mapped_normal(&T, &T.normal, n);
+    if (textured) n = mapped_normal(&T.normal, &F, n);
     n = s3_select(n, s3_neg(n), L->back); /* t, b and n together */
     const Surface S = pbr_surface(in, L, &T, textured, b, n, coat_n, aniso_t, base, spread, coat_spread, view);
     return s3_half_range(s3_scale(shade_pbr(in, L, &S, view), exposure));

@@ -179,4 +179,17 @@ inline sfloat3 env_prefiltered(global const PmrEnvironment* e, global const floa
   return s3(out[0], out[1], out[2]);
 }
 
+/* S(d, s) of KHR_materials_sheen for each lane's d at (u, v) and sheen roughness s (clamped to
+ * [PMR_SHEEN_MIN_ROUGHNESS, 1]): the linear blend of the two sheen levels around s in log(s). */
+inline sfloat3 env_sheen(global const PmrEnvironment* e, global const float4* data, sfloat u, sfloat v, sfloat s) {
+  /* the levels are evenly spaced in log(s) */
+  const float k = (PMR_SHEEN_LEVELS - 1) / -log2(PMR_SHEEN_MIN_ROUGHNESS);
+  const sfloat c = env_log2(clamp(s, PMR_SHEEN_MIN_ROUGHNESS, 1.0f) * (1.0f / PMR_SHEEN_MIN_ROUGHNESS)) * k;
+  const sint l0 = min(convert_int8(c), PMR_SHEEN_LEVELS - 2);
+  const sfloat f = c - convert_float8(l0);
+  const sint first = (sint)((int)e->sheen_first) + l0;
+  const sfloat3 a = env_fetch(data, env_level_taps(e, first, u, v)), b = env_fetch(data, env_level_taps(e, first + 1, u, v));
+  return s3_scale(s3_add(s3_scale(a, 1.0f - f), s3_scale(b, f)), (sfloat)(e->intensity));
+}
+
 #endif

@@ -85,6 +85,47 @@ std::vector<glm::dvec3> brute_force(const EnvironmentImage& m, glm::dvec3 d, con
   return num;
 }
 
+// KHR_materials_sheen's lobe D V n.l at v = d (n.v = 1) for a light at angle theta from d, as the
+// extension's implementation notes write it (alpha = s^2), V at most 1.
+double charlie_at_normal(double theta, double s) {
+  const double a = s * s, c = std::cos(theta);
+  if (c <= 0) return 0;
+  const double sin2h = std::sin(theta / 2) * std::sin(theta / 2);
+  const double D = (2 + 1 / a) * std::pow(sin2h, 0.5 / a) / (2 * kPi);
+  auto l = [a](double x) {
+    const double o = (1 - a) * (1 - a);
+    return (21.5473 + 3.7772 * o) / (1 + (3.82987 - 0.50552 * o) * std::pow(x, 0.19823 - 0.03022 * o)) +
+           (-1.97760 + 0.70367 * o) * x + (-4.32054 - 0.53913 * o);
+  };
+  auto lambda = [&](double x) { return x < 0.5 ? std::exp(l(x)) : std::exp(2 * l(0.5) - l(1 - x)); };
+  const double V = std::min(1.0, 1 / ((1 + lambda(1.0) + lambda(c)) * 4 * c));
+  return D * V * c;
+}
+
+// The sheen's S(d, s) for each s in ss, by quadrature over the hemisphere about d: theta = (pi / 2)
+// (1 - (1 - t)^2) (t uniform: dense near the horizon, where the lobe of a small s is a ring).
+std::vector<glm::dvec3> brute_force_sheen(const EnvironmentImage& m, glm::dvec3 d, const std::vector<double>& ss,
+                                          int n_theta = 600, int n_phi = 720) {
+  d = glm::normalize(d);
+  const glm::dvec3 a = std::abs(d.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0);
+  const glm::dvec3 t = glm::normalize(glm::cross(a, d)), b = glm::cross(d, t);
+  std::vector<glm::dvec3> num(ss.size(), glm::dvec3(0));
+  std::vector<double> den(ss.size(), 0.0);
+  for (int i = 0; i < n_theta; ++i) {
+    const double q = (i + 0.5) / n_theta, th = 0.5 * kPi * (1 - (1 - q) * (1 - q)), dth = kPi * (1 - q) / n_theta;
+    const double area = std::sin(th) * dth * (2 * kPi / n_phi);
+    std::vector<double> w(ss.size());
+    for (size_t k = 0; k < ss.size(); ++k) w[k] = charlie_at_normal(th, ss[k]) * area;
+    for (int j = 0; j < n_phi; ++j) {
+      const double ph = 2 * kPi * (j + 0.5) / n_phi;
+      const glm::dvec3 L = lookup(m, std::cos(th) * d + std::sin(th) * (std::cos(ph) * t + std::sin(ph) * b));
+      for (size_t k = 0; k < w.size(); ++k) num[k] += w[k] * L, den[k] += w[k];
+    }
+  }
+  for (size_t k = 0; k < num.size(); ++k) num[k] /= den[k];
+  return num;
+}
+
 double rel_err(const glm::dvec3& got, const glm::dvec3& want) {
   double e = 0;
   for (int c = 0; c < 3; ++c) e = std::max(e, std::abs(got[c] - want[c]) / std::max(std::abs(want[c]), 1e-12));
@@ -266,6 +307,15 @@ TEST(EnvironmentTables, LayoutIsConsistent) {
     }
     at += 4 * h.levels[k].width * (h.levels[k].height + 2);  // with the pole rows
   }
+  ASSERT_EQ(h.sheen_first, h.level_count);
+  for (uint32_t k = 0; k < PMR_SHEEN_LEVELS; ++k) {  // the sheen levels follow
+    const EnvLevel& l = h.levels[h.sheen_first + k];
+    EXPECT_EQ(l.offset, at);
+    EXPECT_EQ(l.width, 256u);
+    EXPECT_EQ(l.height, 128u);
+    EXPECT_NEAR(l.roughness, std::pow(0.07, 1.0 - double(k) / (PMR_SHEEN_LEVELS - 1)), 1e-6);
+    at += 4 * l.width * (l.height + 2);
+  }
   EXPECT_EQ(h.levels[1].width, 512u);  // r = 0.2
   EXPECT_EQ(h.levels[h.level_count - 1].width, 128u);
   EXPECT_EQ(h.roughness_offset, at);
@@ -284,7 +334,8 @@ TEST(EnvironmentTables, LayoutIsConsistent) {
   EXPECT_TRUE(std::equal(ab.begin(), ab.end(), e.tables().data.begin() + h.split_sum_offset));
   // Uniform: every level one texel.
   const Environment u = Environment::uniform(0.2);
-  for (uint32_t k = 0; k < u.tables().header.level_count; ++k) EXPECT_EQ(u.tables().header.levels[k].width, 1u);
+  for (uint32_t k = 0; k < u.tables().header.level_count + PMR_SHEEN_LEVELS; ++k)
+    EXPECT_EQ(u.tables().header.levels[k].width, 1u);
 }
 
 // ---- accuracy against brute force -----------------------------------------------------------------
@@ -329,17 +380,45 @@ void expect_within(const Errors& err) {
   for (size_t k = 0; k < kTestRoughness.size(); ++k) EXPECT_LT(err.p[k], 0.03) << "r = " << kTestRoughness[k];
 }
 
+// The sheen roughness values checked: levels (0.07, 0.113, 0.234, 0.615, 1) and between them.
+const std::vector<double> kTestSheen = {0.07, 0.08, 0.1, 0.113, 0.16, 0.234, 0.27, 0.35, 0.47, 0.615, 0.8, 1.0};
+
+// Max relative errors of S at each s in kTestSheen over the directions, printed; each within `bound`.
+void expect_sheen_within(const char* name, const Environment& e, const EnvironmentImage& img,
+                         const std::vector<glm::dvec3>& dirs, double bound) {
+  std::vector<std::vector<glm::dvec3>> ref(dirs.size());
+  std::vector<std::thread> pool;
+  const unsigned n = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
+  for (unsigned t = 0; t < n; ++t)
+    pool.emplace_back([&, t] {
+      for (size_t i = t; i < dirs.size(); i += n) ref[i] = brute_force_sheen(img, dirs[i], kTestSheen);
+    });
+  for (std::thread& t : pool) t.join();
+  std::vector<double> err(kTestSheen.size(), 0.0);
+  for (size_t i = 0; i < dirs.size(); ++i)
+    for (size_t k = 0; k < kTestSheen.size(); ++k)
+      err[k] = std::max(err[k], rel_err(e.sheen(dirs[i], kTestSheen[k]), ref[i][k]));
+  std::printf("[env] %s: sheen S max relative error:", name);
+  for (size_t k = 0; k < kTestSheen.size(); ++k) std::printf(" s=%.3f %.3f%%", kTestSheen[k], 100 * err[k]);
+  std::printf("\n");
+  for (size_t k = 0; k < kTestSheen.size(); ++k) EXPECT_LT(err[k], bound) << name << ": s = " << kTestSheen[k];
+}
+
 TEST(EnvironmentAccuracy, UniformMapGivesItsRadiance) {
   const EnvironmentImage img = make_map(64, 32, [](glm::dvec3) { return glm::dvec3(1.5, 0.5, 0.25); });
   const Environment e = Environment::from_image(img);
   for (const glm::dvec3& d : fibonacci(50)) {
     EXPECT_LT(rel_err(e.irradiance(d), {1.5, 0.5, 0.25}), 1e-5);
-    for (double r : {0.0, 0.03, 0.2, 0.27, 0.5, 0.8, 1.0})
+    for (double r : {0.0, 0.03, 0.2, 0.27, 0.5, 0.8, 1.0}) {
       EXPECT_LT(rel_err(e.prefiltered(d, r), {1.5, 0.5, 0.25}), 1e-5);
+      EXPECT_LT(rel_err(e.sheen(d, r), {1.5, 0.5, 0.25}), 1e-5);
+    }
   }
   // The brute-force reference agrees with itself on a uniform map.
   const std::vector<glm::dvec3> ref = brute_force(img, {0.2, 0.5, -1}, kTestRoughness, 100, 180);
   for (const glm::dvec3& v : ref) EXPECT_LT(rel_err(v, {1.5, 0.5, 0.25}), 1e-9);
+  for (const glm::dvec3& v : brute_force_sheen(img, {0.2, 0.5, -1}, kTestSheen, 100, 180))
+    EXPECT_LT(rel_err(v, {1.5, 0.5, 0.25}), 1e-9);
 }
 
 TEST(EnvironmentAccuracy, SunAndSkyAgainstBruteForce) {
@@ -353,6 +432,7 @@ TEST(EnvironmentAccuracy, SunAndSkyAgainstBruteForce) {
   const Errors err = measure(e, img, dirs);
   report("sun and sky 256x128", err, e.prefilter_seconds());
   expect_within(err);
+  expect_sheen_within("sun and sky 256x128", e, img, dirs, 0.15);
 }
 
 // A direction from the studio's angles (studio_environment.cpp): longitude phi from -Z toward +X,
@@ -374,6 +454,7 @@ TEST(EnvironmentAccuracy, StudioAgainstBruteForce) {
   const Errors err = measure(e, img, dirs);
   report("studio 512x256", err, 0.0);
   expect_within(err);
+  expect_sheen_within("studio 512x256", e, img, dirs, 0.06);
 }
 
 // What DESIGN 4b asks of the studio: grey walls of radiance about 0.15 to 0.3, soft boxes of 5 to 20
@@ -465,6 +546,7 @@ TEST(EnvironmentAccuracy, RealHdriAgainstBruteForce) {
   const Errors err = measure(e, img, dirs);
   report((fs::path(path).filename().string() + " at 256 wide").c_str(), err, e.prefilter_seconds());
   expect_within(err);
+  expect_sheen_within((fs::path(path).filename().string() + " at 256 wide").c_str(), e, img, dirs, 0.1);
 }
 
 TEST(EnvironmentAccuracy, PrefilterTime1024x512) {

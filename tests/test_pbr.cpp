@@ -529,8 +529,9 @@ Agreement compare_with_environment(const Scene& s, const Rig& rig, const test::R
 
 // The kernels' lookups (cl/environment.h: polynomial atan2, log2 and exp2 in float) against the host's
 // in double precision, directly: random directions, the axes, the poles and the u seam, every
-// roughness from 0 to 1, a turned map with a sun. Within 1e-4 relative plus 1e-6 absolute (float
-// texel coordinates, next to a sun texel 1000 times brighter than its neighbours).
+// roughness from 0 to 1 (for the GGX and the sheen levels), a turned map with a sun. Within 1e-4
+// relative plus 1e-6 absolute (float texel coordinates, next to a sun texel 1000 times brighter than
+// its neighbours).
 TEST(PbrEnvironment, KernelLookupsMatchTheHost) {
   const Environment e = *sky_environment(37.0, 1.7);
   std::mt19937 g(11);
@@ -548,7 +549,7 @@ TEST(PbrEnvironment, KernelLookupsMatchTheHost) {
   }
   const ClRuntime& rt = test::runtime();
   const ClProgram program = rt.build_program({"environment_probe.cl"}, "-cl-std=CL1.2", &test_kernel_sources());
-  std::vector<float> out(6 * dirs.size());
+  std::vector<float> out(9 * dirs.size());
   {
     ClKernel k(program, "environment_probe");
     const EnvironmentTables& t = e.tables();
@@ -563,12 +564,16 @@ TEST(PbrEnvironment, KernelLookupsMatchTheHost) {
   double worst = 0.0;
   for (size_t i = 0; i < dirs.size(); ++i) {
     const glm::dvec3 d = glm::dvec3(glm::vec3(dirs[i]));  // the float direction the kernel saw
-    const glm::dvec3 want[2] = {e.irradiance(d), e.prefiltered(d, double(float(rs[i])))};
-    for (int k = 0; k < 6; ++k) {
-      const double w = want[k / 3][k % 3], err = std::abs(double(out[6 * i + size_t(k)]) - w), tol = 1e-4 * w + 1e-6;
+    const double r = double(float(rs[i]));
+    const glm::dvec3 want[3] = {e.irradiance(d), e.prefiltered(d, r), e.sheen(d, r)};
+    for (int k = 0; k < 9; ++k) {
+      const double w = want[k / 3][k % 3], err = std::abs(double(out[9 * i + size_t(k)]) - w), tol = 1e-4 * w + 1e-6;
       worst = std::max(worst, err / tol);
       ASSERT_LE(err, tol) << "direction " << i << " (" << d.x << ", " << d.y << ", " << d.z << "), r " << rs[i]
-                          << (k < 3 ? ": I" : ": P") << " channel " << k % 3;
+                          << (k < 3   ? ": I"
+                              : k < 6 ? ": P"
+                                      : ": S")
+                          << " channel " << k % 3;
     }
   }
   std::printf("[ env look ] %zu directions, largest error %.3f of the bound\n", dirs.size(), worst);

@@ -79,17 +79,17 @@ Quad quad(GltfFile& g) {
 TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   GltfFile g;
   g.doc["extensionsUsed"] = {"KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_materials_unlit",
-                             "KHR_materials_sheen"};
+                             "KHR_materials_diffuse_transmission"};
   const Quad q = quad(g);
   const int uv1 = g.data<float>({0, 2, 2, 2, 2, 0, 0, 0}, kFloat, "VEC2");
   write_bytes(dir_ / "normal.png", make_png(1, 1, 2, 8, {128, 128, 255}));
-  write_bytes(dir_ / "sheen.png", make_png(1, 1, 0, 8, {7}));
+  write_bytes(dir_ / "diffuse.png", make_png(1, 1, 0, 8, {7}));
   g.add("images", {{"uri", png_uri(make_png(1, 1, 6, 8, {200, 100, 50, 255}))}});  // 0 base colour
   g.add("images", {{"uri", png_uri(make_png(1, 1, 2, 8, {255, 128, 64}))}});       // 1 ORM
   g.add("images", {{"uri", "normal.png"}});                                        // 2 normal (a file)
   g.add("images", {{"uri", png_uri(make_png(1, 1, 2, 8, {10, 20, 30}))}});         // 3 emissive
-  g.add("images", {{"uri", "sheen.png"}});                                         // 4 only sheen samples it
-  for (int i : {0, 1, 2, 3, 1, 4}) g.add("textures", {{"source", i}});             // texture 4 = image 1 again
+  g.add("images", {{"uri", "diffuse.png"}});  // 4 only KHR_materials_diffuse_transmission samples it
+  for (int i : {0, 1, 2, 3, 1, 4}) g.add("textures", {{"source", i}});  // texture 4 = image 1 again
   json mr_transform = {{"offset", {0.5, 0}}, {"rotation", 0.25}, {"scale", {2, 3}}};
   g.add("materials",
         {{"name", "Everything"},
@@ -105,7 +105,8 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
          {"emissiveFactor", {1, 0.5, 0.25}},
          {"extensions",
           {{"KHR_materials_emissive_strength", {{"emissiveStrength", 4}}},
-           {"KHR_materials_sheen", {{"sheenColorFactor", {1, 1, 1}}, {"sheenColorTexture", {{"index", 5}}}}}}}});
+           {"KHR_materials_diffuse_transmission",
+            {{"diffuseTransmissionFactor", 1}, {"diffuseTransmissionColorTexture", {{"index", 5}}}}}}}});
   g.add("materials", {{"name", "Flat"}, {"extensions", {{"KHR_materials_unlit", json::object()}}}});
   g.mesh(json::array(
       {{{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}, {"TEXCOORD_1", uv1}}},
@@ -127,7 +128,7 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   EXPECT_EQ(glm::vec3(m.emissive[0], m.emissive[1], m.emissive[2]), glm::vec3(1, 0.5f, 0.25f));
   EXPECT_EQ(m.emissive_strength, 4.0f);
   EXPECT_FALSE(m.unlit);
-  EXPECT_EQ(m.unimplemented, std::vector<std::string>{"KHR_materials_sheen"});
+  EXPECT_EQ(m.unimplemented, std::vector<std::string>{"KHR_materials_diffuse_transmission"});
   EXPECT_TRUE(s.material_inputs[2].unlit);
   EXPECT_EQ(s.material_inputs[2].slots[kSlotBaseColor].texture, -1);
   // defaults of the glTF default material
@@ -158,7 +159,7 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   EXPECT_EQ(sl[kSlotEmissive].scale[0], 1.0f);
 
   // Images: one texture per (image, wrap modes); the ORM image serves two textures and two slots; the
-  // sheen image is neither decoded nor read.
+  // diffuse transmission image is neither decoded nor read.
   ASSERT_EQ(s.textures.size(), 4u);
   EXPECT_EQ(sl[kSlotOcclusion].texture, sl[kSlotMetallicRoughness].texture);
   EXPECT_EQ(s.textures[size_t(sl[kSlotOcclusion].texture)].slots,
@@ -169,7 +170,7 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   std::vector<std::string> read;
   for (const SceneInputFile& f : s.input_files) read.push_back(f.path);
   EXPECT_EQ(read, (std::vector<std::string>{"materials.bin", "normal.png"}))
-      << "the normal map is a file read, the sheen image is not";
+      << "the normal map is a file read, the diffuse transmission image is not";
 
   // TEXCOORD_0 and _1 as stored, for every vertex; the second primitive has no TEXCOORD_1 (its material
   // samples none): zeros.
@@ -188,8 +189,9 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   for (int v = 4; v < 8; ++v) EXPECT_EQ(s.tangents[size_t(v)], glm::vec4(0, 0, 0, 0)) << v;
   EXPECT_EQ(s.structure.generated_tangent_primitives, 1u);
 
-  EXPECT_EQ(warnings_with(s, "KHR_materials_sheen"), 1u) << all_warnings(s);
-  EXPECT_EQ(warnings_with(s, "KHR_materials_sheen (1 material): drawn without sheen"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "KHR_materials_diffuse_transmission"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "KHR_materials_diffuse_transmission (1 material): drawn without diffuse transmission"), 1u)
+      << all_warnings(s);
 }
 
 TEST_F(SceneMaterialsTest, OutOfRangeFactorsAreClampedWithAWarning) {
@@ -852,9 +854,12 @@ TEST_F(SceneMaterialsTest, OverflowingLightColourAndRangeAreErrors) {
 TEST_F(SceneMaterialsTest, OneWarningPerUnimplementedMaterialExtension) {
   GltfFile g;
   const Quad q = quad(g);
-  g.doc["extensionsUsed"] = {"KHR_materials_transmission", "KHR_materials_volume",
-                             "KHR_materials_sheen",        "KHR_materials_pbrSpecularGlossiness",
-                             "KHR_materials_foo",          "KHR_lights_punctual",
+  g.doc["extensionsUsed"] = {"KHR_materials_transmission",
+                             "KHR_materials_volume",
+                             "KHR_materials_diffuse_transmission",
+                             "KHR_materials_pbrSpecularGlossiness",
+                             "KHR_materials_foo",
+                             "KHR_lights_punctual",
                              "KHR_materials_dispersion"};
   g.doc["extensionsRequired"] = {"KHR_materials_transmission", "KHR_materials_pbrSpecularGlossiness",
                                  "KHR_materials_dispersion"};
@@ -866,7 +871,8 @@ TEST_F(SceneMaterialsTest, OneWarningPerUnimplementedMaterialExtension) {
   g.add("materials", {{"extensions",
                        {{"KHR_materials_pbrSpecularGlossiness", {{"glossinessFactor", 0.5}}},
                         {"KHR_materials_dispersion", {{"dispersion", 0.1}}}}}});
-  g.add("materials", {{"extensions", {{"KHR_materials_sheen", json::object()}}}});  // no primitive uses it
+  g.add("materials", {{"extensions", {{"KHR_materials_diffuse_transmission", json::object()}}}});  // no primitive
+                                                                                                   // uses it
   json prims = json::array();
   for (int m = 0; m < 4; ++m)
     prims.push_back({{"attributes", {{"POSITION", q.pos}}}, {"indices", q.idx}, {"material", m}});
@@ -879,7 +885,8 @@ TEST_F(SceneMaterialsTest, OneWarningPerUnimplementedMaterialExtension) {
   EXPECT_EQ(warnings_with(s, "KHR_materials_pbrSpecularGlossiness (1 material): drawn from their metallic-roughness"),
             1u)
       << all_warnings(s);
-  EXPECT_EQ(warnings_with(s, "KHR_materials_sheen"), 0u) << "no drawn material uses it\n" << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "KHR_materials_diffuse_transmission"), 0u) << "no drawn material uses it\n"
+                                                                        << all_warnings(s);
   EXPECT_EQ(warnings_with(s, "KHR_materials_dispersion (1 material): drawn without dispersion"), 1u)
       << "drawn without it, even when required\n"
       << all_warnings(s);

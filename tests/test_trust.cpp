@@ -54,7 +54,8 @@ json sidecar(const std::string& path) { return json::parse(read_bytes(path)); }
 
 // A quad in the z = 0 plane, [-s, s]^2, facing +Z, written as dir/quad.gltf + dir/quad.bin. With
 // `textured` its material samples dir/tex.png as base colour; a second image (dir/unused.png) is
-// referenced only as a sheen texture (KHR_materials_sheen), which pmr never samples. With
+// referenced only as a diffuse transmission texture (KHR_materials_diffuse_transmission), which pmr
+// never samples. With
 // `embedded` the buffer is a data: URI.
 struct Quad {
   double r = 1, g = 0, b = 0, size = 1;
@@ -119,7 +120,8 @@ std::string write_quad(const std::string& dir, const Quad& q) {
   json material = {{"pbrMetallicRoughness", {{"baseColorFactor", {q.r, q.g, q.b, 1.0}}}}, {"doubleSided", true}};
   if (q.textured) {
     material["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
-    material["extensions"]["KHR_materials_sheen"] = {{"sheenColorTexture", {{"index", 1}}}};
+    material["extensions"]["KHR_materials_diffuse_transmission"] = {
+        {"diffuseTransmissionColorTexture", {{"index", 1}}}};
     doc["textures"] = {{{"source", 0}}, {{"source", 1}}};
     doc["images"] = {{{"uri", "tex.png"}}, {{"uri", "unused.png"}}};
     std::vector<uint16_t> px(4 * 4 * 4, 0x3c00);  // half 1.0: white

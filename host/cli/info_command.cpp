@@ -36,7 +36,8 @@ std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
       "occlusion",         "emissive",           "transmission",
       "thickness",         "clear coat",         "clear coat roughness",
       "clear coat normal", "specular",           "specular colour",
-      "anisotropy",        "iridescence",        "iridescence thickness"};
+      "anisotropy",        "iridescence",        "iridescence thickness",
+      "sheen colour",      "sheen roughness"};
   std::string t = std::string(short_names[kind]) + " (texture " + std::to_string(slot.texture);
   if (slot.texture >= 0 && size_t(slot.texture) < s.textures.size())
     t += " " + std::to_string(s.textures[size_t(slot.texture)].width) + "x" +
@@ -48,8 +49,8 @@ std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
   return t + ")";
 }
 
-// KHR_materials_transmission, _volume, _clearcoat, _specular, _anisotropy and _iridescence where the
-// material has them, and KHR_materials_ior's ior where it is not the default 1.5.
+// KHR_materials_transmission, _volume, _clearcoat, _specular, _anisotropy, _iridescence and _sheen where
+// the material has them, and KHR_materials_ior's ior where it is not the default 1.5.
 std::string layer_text(const SceneMaterialInputs& in) {
   std::string t;
   if (in.has_transmission) t += ", transmission " + number(in.transmission);
@@ -71,6 +72,9 @@ std::string layer_text(const SceneMaterialInputs& in) {
   if (in.has_iridescence)
     t += ", iridescence " + number(in.iridescence) + " ior " + number(in.iridescence_ior) + " thickness " +
          number(in.iridescence_thickness[0]) + "-" + number(in.iridescence_thickness[1]) + " nm";
+  if (in.has_sheen)
+    t += ", sheen (" + number(in.sheen_color[0]) + ", " + number(in.sheen_color[1]) + ", " + number(in.sheen_color[2]) +
+         ") roughness " + number(in.sheen_roughness);
   return t;
 }
 

@@ -19,7 +19,9 @@ static_assert(PMR_MAP_BASE_COLOR == kSlotBaseColor && PMR_MAP_METALLIC_ROUGHNESS
                   PMR_MAP_CLEARCOAT_NORMAL == kSlotClearcoatNormal && PMR_MAP_SPECULAR == kSlotSpecular &&
                   PMR_MAP_SPECULAR_COLOR == kSlotSpecularColor && PMR_MAP_ANISOTROPY == kSlotAnisotropy &&
                   PMR_MAP_IRIDESCENCE == kSlotIridescence &&
-                  PMR_MAP_IRIDESCENCE_THICKNESS == kSlotIridescenceThickness && PMR_MAPS == kTextureSlots,
+                  PMR_MAP_IRIDESCENCE_THICKNESS == kSlotIridescenceThickness &&
+                  PMR_MAP_SHEEN_COLOR == kSlotSheenColor && PMR_MAP_SHEEN_ROUGHNESS == kSlotSheenRoughness &&
+                  PMR_MAPS == kTextureSlots,
               "PMR_MAP_* follow SceneTextureSlotKind");
 
 void texture_transform_matrix(const SceneTextureSlot& slot, float out[6]) {
@@ -134,6 +136,8 @@ uint32_t material_flags(const PmrMaterial& m) {
     flags |= PMR_MATERIAL_SPECULAR;
   if (m.anisotropy[0] > 0.0f) flags |= PMR_MATERIAL_ANISOTROPY;
   if (m.iridescence[0] > 0.0f) flags |= PMR_MATERIAL_IRIDESCENCE;
+  // the specification: a sheen colour factor of 0 disables the whole layer
+  if (m.sheen[0] > 0.0f || m.sheen[1] > 0.0f || m.sheen[2] > 0.0f) flags |= PMR_MATERIAL_SHEEN;
   return flags;
 }
 

@@ -20,7 +20,7 @@ static_assert(offsetof(PmrMta, bary) == 60 && offsetof(PmrMta, tri) == 84 && off
               "PmrMta layout");
 static_assert(sizeof(PmrVertexAttr) == 32 && offsetof(PmrVertexAttr, color) == 12, "PmrVertexAttr layout");
 static_assert(sizeof(PmrTriangle) == 32, "PmrTriangle layout");
-static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 100 && offsetof(PmrMaterial, maps) == 52 &&
+static_assert(sizeof(PmrMaterial) == 52 + PMR_MAPS * 32 + 116 && offsetof(PmrMaterial, maps) == 52 &&
                   offsetof(PmrMaterial, attenuation_color) == 52 + PMR_MAPS * 32 + 28 &&
                   offsetof(PmrMaterial, clearcoat) == 52 + PMR_MAPS * 32 + 40 &&
                   offsetof(PmrMaterial, specular_color) == 52 + PMR_MAPS * 32 + 56,
@@ -33,8 +33,8 @@ static_assert(sizeof(PmrEncodeParams) == 48 && offsetof(PmrEncodeParams, display
 static_assert(sizeof(PmrEncodeColumn) == 16 && sizeof(PmrEncodeRow) == 16, "encoder table layout");
 static_assert(sizeof(PmrSampleChunk) == 32, "PmrSampleChunk layout");
 static_assert(sizeof(PmrEnvLevel) == 16 && offsetof(PmrEnvLevel, roughness) == 12, "PmrEnvLevel layout");
-static_assert(sizeof(PmrEnvironment) == 32 + 16 * PMR_ENV_MAX_LEVELS && offsetof(PmrEnvironment, intensity) == 20 &&
-                  offsetof(PmrEnvironment, levels) == 32,
+static_assert(sizeof(PmrEnvironment) == 36 + 16 * PMR_ENV_MAX_LEVELS && offsetof(PmrEnvironment, intensity) == 24 &&
+                  offsetof(PmrEnvironment, levels) == 36,
               "PmrEnvironment layout");
 static_assert(offsetof(PmrParams, num_lights) == 280, "PmrParams layout");
 static_assert(sizeof(PmrLight) == 64 && offsetof(PmrLight, type) == 12 && offsetof(PmrLight, range) == 28 &&

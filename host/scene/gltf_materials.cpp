@@ -290,6 +290,21 @@ void read_iridescence(Loader& L, const tinygltf::Value& value, const std::string
   m.iridescence_thickness[1] = extension_number(L, value, ext, "iridescenceThicknessMaximum", 400.0, 0.0, inf, name);
 }
 
+// KHR_materials_sheen's colour and roughness factors, checked: each in [0, 1].
+void read_sheen(Loader& L, const tinygltf::Value& value, const std::string& name, SceneMaterialInputs& m) {
+  const std::string ext = "KHR_materials_sheen";
+  m.has_sheen = true;
+  m.unimplemented.push_back(ext);  // until the kernels draw it
+  m.sheen_roughness = extension_number(L, value, ext, "sheenRoughnessFactor", 0.0, 0.0, 1.0, name);
+  if (!value.IsObject() || !value.Has("sheenColorFactor")) return;
+  double c[3];
+  if (!finite_numbers(value.Get("sheenColorFactor"), 3, c)) {
+    L.warn(name + " KHR_materials_sheen has no valid sheenColorFactor; using (0, 0, 0), no sheen");
+    return;
+  }
+  for (int k = 0; k < 3; ++k) m.sheen_color[k] = material_number(L, c[k], 0.0, 0.0, 1.0, name + " sheenColorFactor");
+}
+
 // KHR_materials_ior's ior: 0 or at least 1 (0: the extension's compatibility mode, a Fresnel term of 1).
 float read_ior(Loader& L, const tinygltf::Value& value, const std::string& name) {
   const float ior =
@@ -365,6 +380,8 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
       read_anisotropy(L, value, name, m);
     } else if (ext == "KHR_materials_iridescence") {
       read_iridescence(L, value, name, m);
+    } else if (ext == "KHR_materials_sheen") {
+      read_sheen(L, value, name, m);
     } else if (material_extension_fallback(ext)) {
       m.unimplemented.push_back(ext);
     }

@@ -56,7 +56,7 @@ bool extension_supported(const std::string& name) {
          name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit" || name == "KHR_materials_ior" ||
          name == "KHR_materials_transmission" || name == "KHR_materials_volume" || name == "KHR_materials_variants" ||
          name == "KHR_materials_clearcoat" || name == "KHR_materials_specular" || name == "KHR_materials_anisotropy" ||
-         name == "KHR_materials_iridescence";
+         name == "KHR_materials_iridescence" || name == "KHR_materials_sheen";
 }
 
 uint32_t read_u32le(const unsigned char* p) {

@@ -29,6 +29,7 @@ PmrMaterial default_material() {
   for (float& c : m.specular_color) c = 1.0f;
   m.anisotropy[0] = 0.0f, m.anisotropy[1] = 1.0f, m.anisotropy[2] = 0.0f;  // isotropic
   m.iridescence[0] = 0.0f, m.iridescence[1] = 1.3f, m.iridescence[2] = 100.0f, m.iridescence[3] = 400.0f;
+  for (float& c : m.sheen) c = 0.0f;  // no sheen
   return m;
 }
 
@@ -49,6 +50,8 @@ void apply_material_inputs(const SceneMaterialInputs& in, PmrMaterial& m) {
   m.anisotropy[2] = float(std::sin(double(in.anisotropy_rotation)));
   m.iridescence[0] = in.iridescence, m.iridescence[1] = in.iridescence_ior;
   m.iridescence[2] = in.iridescence_thickness[0], m.iridescence[3] = in.iridescence_thickness[1];
+  for (int c = 0; c < 3; ++c) m.sheen[c] = in.sheen_color[c];
+  m.sheen[3] = in.sheen_roughness;
 }
 
 bool scene_transmissive(const Scene& scene) {
@@ -83,7 +86,8 @@ const char* texture_slot_name(int slot) {
       "occlusionTexture",       "emissiveTexture",          "transmissionTexture",
       "thicknessTexture",       "clearcoatTexture",         "clearcoatRoughnessTexture",
       "clearcoatNormalTexture", "specularTexture",          "specularColorTexture",
-      "anisotropyTexture",      "iridescenceTexture",       "iridescenceThicknessTexture"};
+      "anisotropyTexture",      "iridescenceTexture",       "iridescenceThicknessTexture",
+      "sheenColorTexture",      "sheenRoughnessTexture"};
   return slot >= 0 && slot < kTextureSlots ? names[slot] : "?";
 }
 
@@ -102,14 +106,16 @@ const char* texture_slot_extension(int slot) {
                                                         "KHR_materials_specular",
                                                         "KHR_materials_anisotropy",
                                                         "KHR_materials_iridescence",
-                                                        "KHR_materials_iridescence"};
+                                                        "KHR_materials_iridescence",
+                                                        "KHR_materials_sheen",
+                                                        "KHR_materials_sheen"};
   return slot >= 0 && slot < kTextureSlots ? extensions[slot] : nullptr;
 }
 
 bool texture_slot_is_normal_map(int slot) { return slot == kSlotNormal || slot == kSlotClearcoatNormal; }
 
 bool texture_slot_is_srgb(int slot) {
-  return slot == kSlotBaseColor || slot == kSlotEmissive || slot == kSlotSpecularColor;
+  return slot == kSlotBaseColor || slot == kSlotEmissive || slot == kSlotSpecularColor || slot == kSlotSheenColor;
 }
 
 bool scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi) {

@@ -10,6 +10,7 @@
 #include "pmr/error.h"
 #include "pmr/printable.h"
 #include "shading/environment_prefilter.h"
+#include "shading/sheen.h"
 
 namespace pmr {
 namespace {
@@ -31,6 +32,24 @@ glm::dvec2 split_sum(double n_dot_v, double r) {
   const int i0 = std::min(int(x), N - 2), j0 = std::min(int(y), N - 2);
   const double fx = x - i0, fy = y - j0;
   auto at = [&](int i, int j) { return glm::dvec2(t[size_t(2 * (j * N + i))], t[size_t(2 * (j * N + i) + 1)]); };
+  return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i0 + 1, j0)) +
+         fy * ((1 - fx) * at(i0, j0 + 1) + fx * at(i0 + 1, j0 + 1));
+}
+
+const std::vector<float>& sheen_albedo_table() {
+  // computed at build time (pmr_brdf_tables_gen): a few seconds of CPU
+  static const std::vector<float> table(kSheenAlbedoTable, kSheenAlbedoTable + kSheenAlbedoSize * kSheenAlbedoSize);
+  return table;
+}
+
+double sheen_albedo(double nv, double r) {
+  const std::vector<float>& t = sheen_albedo_table();
+  const int N = kSheenAlbedoSize;
+  const double x = std::sqrt(std::clamp(std::isfinite(nv) ? nv : 0.0, 0.0, 1.0)) * (N - 1);
+  const double y = (sheen_roughness(r) - kSheenMinRoughness) / (1.0 - kSheenMinRoughness) * (N - 1);
+  const int i0 = std::min(int(x), N - 2), j0 = std::min(int(y), N - 2);
+  const double fx = x - i0, fy = y - j0;
+  auto at = [&](int i, int j) { return double(t[size_t(j * N + i)]); };
   return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i0 + 1, j0)) +
          fy * ((1 - fx) * at(i0, j0 + 1) + fx * at(i0 + 1, j0 + 1));
 }
@@ -140,7 +159,7 @@ void Environment::set_intensity(double k) { tables_.header.intensity = float(k);
 
 glm::dvec3 Environment::level_sample(int level, const glm::dvec3& dir) const {
   const EnvTablesHeader& h = tables_.header;
-  level = std::clamp(level, 0, int(h.level_count) - 1);
+  level = std::clamp(level, 0, int(h.sheen_first) + PMR_SHEEN_LEVELS - 1);
   const glm::dvec3 d = unit_or_up(dir);
   // The map turned by +angle reads the image at the direction turned by -angle.
   const double c = h.rotation_cos, s = h.rotation_sin;
@@ -170,6 +189,14 @@ glm::dvec3 Environment::prefiltered(const glm::dvec3& d, double r) const {
     p[ch] = l0 >= 1 && a[ch] > 0.0 && b[ch] > 0.0 ? a[ch] * std::pow(b[ch] / a[ch], f)  // geometric
                                                   : (1.0 - f) * a[ch] + f * b[ch];
   return p;
+}
+
+glm::dvec3 Environment::sheen(const glm::dvec3& d, double s) const {
+  const double c =
+      std::log(sheen_roughness(s) / kSheenMinRoughness) / std::log(1.0 / kSheenMinRoughness) * (PMR_SHEEN_LEVELS - 1);
+  const int l0 = std::min(int(c), PMR_SHEEN_LEVELS - 2), first = int(tables_.header.sheen_first);
+  const double f = c - l0;
+  return (1.0 - f) * level_sample(first + l0, d) + f * level_sample(first + l0 + 1, d);
 }
 
 }  // namespace pmr

@@ -28,6 +28,14 @@
 //   constant and P(n, 1) is exactly this mean, so I(n) is read from the last level (r = 1). (Order-2
 //   spherical harmonics were not used: for a point light they are 6% high facing it and 9% of its
 //   irradiance wrong at 90 degrees, far from the 1% we want with a sun in the map.)
+// - Sheen levels (KHR_materials_sheen), PMR_SHEEN_LEVELS (16) equirectangular RGB maps for the
+//   sheen roughness values s_k = 0.07^(1 - k / 15) (evenly spaced in log s from 0.07 to 1), the same
+//   integral with the Charlie lobe's integrand at v = d in place of D dot(d, l):
+//     S(d, s) = integral of L(l) f(d, l) dot(d, l) dl / integral of f(d, l) dot(d, l) dl,
+//   f = D_Charlie V_Charlie (sheen.h). All 256x128 texels; the lobe is integrated over each source
+//   texel (up to 8 x 8 points per texel: at s = 0.07 it is a ring about 2 degrees wide just above
+//   d's horizon). Between levels S is the linear blend of the two around s in log s (the sheen
+//   roughness clamped to [0.07, 1]). Errors against brute force: docs/SHADING.md ("Sheen").
 // - Between levels: a table of c(r), the fractional level coordinate, kEnvRoughnessNodes nodes at
 //   r = i / 100 (linear in between; each level's r is a node where c is the level's index).
 //   l = floor(c), f = c - l (l at most level_count - 2), P = the levels l and l + 1, each bilinear:
@@ -55,6 +63,7 @@
 //                where clamping would read the ring's texel at the direction's longitude, 1.4 degrees
 //                off the pole in a 128x64 level (2% of I at +Y under the studio).
 //   [roughness]  kEnvRoughnessNodes floats at roughness_offset: c(r) at r = i / (nodes - 1)
+//                The sheen levels follow the GGX levels (header sheen_first = level_count).
 //   [split sum]  kEnvSplitSumSize^2 nodes of 2 floats (A, B) at split_sum_offset, node (i, j) =
 //                (dot(n, v) = (i / (N - 1))^2, r = j / (N - 1)) at split_sum_offset + 2 * (j * N + i)
 // For a 1024x512 image: 4 x (1024 x 514 + 2 x 512 x 258 + 3 x 256 x 130 + 9 x 128 x 66) floats +
@@ -155,6 +164,7 @@ class Environment {
   glm::dvec3 radiance(const glm::dvec3& d) const;                 // the map: P(d, 0)
   glm::dvec3 irradiance(const glm::dvec3& n) const;               // I(n) = P(n, 1)
   glm::dvec3 prefiltered(const glm::dvec3& d, double r) const;    // P(d, r), r clamped to [0, 1]
+  glm::dvec3 sheen(const glm::dvec3& d, double s) const;           // S(d, s), s clamped to [0.07, 1]
   glm::dvec3 level_sample(int level, const glm::dvec3& d) const;  // one level, bilinear
 
   const EnvironmentTables& tables() const { return tables_; }
@@ -183,5 +193,7 @@ const std::vector<float>& split_sum_table();
 // The roughness of each prefiltered level after level 0, and c(r) (the fractional level coordinate).
 const std::vector<double>& environment_level_roughness();
 double environment_level_coordinate(double r);
+// The sheen roughness of each sheen level.
+const std::vector<double>& environment_sheen_roughness();
 
 }  // namespace pmr

@@ -17,9 +17,12 @@
 #include <atomic>
 #include <cmath>
 #include <complex>
+#include <functional>
+#include <memory>
 #include <thread>
 
 #include "pmr/error.h"
+#include "shading/sheen.h"
 #include "shading/split_sum_integral.h"
 
 namespace pmr {
@@ -53,7 +56,7 @@ using cd = std::complex<double>;
 // Roughness of the prefiltered levels after level 0, in hundredths (every one a node of c(r)).
 constexpr int kLevelHundredths[] = {20, 22, 25, 30, 35, 40, 45, 50, 55, 60, 70, 80, 90, 100};
 constexpr int kPrefilteredLevels = int(sizeof kLevelHundredths / sizeof kLevelHundredths[0]);
-static_assert(kPrefilteredLevels + 1 <= kEnvMaxLevels, "too many levels");
+static_assert(kPrefilteredLevels + 1 + PMR_SHEEN_LEVELS <= kEnvMaxLevels, "too many levels");
 
 template <class F>
 void parallel_for_index(int n, F&& f) {
@@ -152,18 +155,87 @@ inline double lobe(double c, double a2) {
   return a2 / (kPi * t * t) * c;
 }
 
-// P on a W x H grid (W a power of two, H = W / 2) from the resampled source (planar: [c][row][col]).
-// Writes 4 floats per texel into `out`.
-void prefilter_level(const std::vector<double>& src, int W, int H, double a2, float* out) {
+// The weights of source row k for output row i (whose direction is at column 0), one per azimuth
+// offset n = 0 .. W / 2 (dphi = 2 pi n / W): the lobe integrated over the source texel. Returns false
+// when they are all 0. The weights are even in n, so the row's circular kernel is real and even.
+using RowWeights = std::function<bool(int i, int k, double* w)>;
+
+// The rows' polar angles and the texels' solid angles of an equirectangular W x H grid.
+struct GridRows {
+  std::vector<double> ct, st, dom;  // cos and sin of each row's center, a texel's solid angle
+  GridRows(int W, int H) : ct(size_t(H)), st(size_t(H)), dom(size_t(H)) {
+    for (int k = 0; k < H; ++k) {
+      const double th = kPi * (k + 0.5) / H;
+      ct[size_t(k)] = std::cos(th), st[size_t(k)] = std::sin(th);
+      dom[size_t(k)] = 2.0 * kPi / W * (std::cos(kPi * k / H) - std::cos(kPi * (k + 1) / H));
+    }
+  }
+};
+
+// The GGX lobe of roughness alpha^2 = a2 at the source texels' centers.
+RowWeights ggx_weights(int W, int H, double a2) {
+  auto rows = std::make_shared<GridRows>(W, H);
+  auto cphi = std::make_shared<std::vector<double>>(size_t(W / 2 + 1));
+  for (int n = 0; n <= W / 2; ++n) (*cphi)[size_t(n)] = std::cos(2.0 * kPi * n / W);
+  return [=](int i, int k, double* w) {
+    const GridRows& g = *rows;
+    const double a = g.ct[size_t(i)] * g.ct[size_t(k)], b = g.st[size_t(i)] * g.st[size_t(k)];
+    if (a + b <= 0.0) return false;
+    for (int n = 0; n <= W / 2; ++n) w[n] = lobe(a + b * (*cphi)[size_t(n)], a2) * g.dom[size_t(k)];
+    return true;
+  };
+}
+
+// The Charlie lobe of sheen roughness r at v = n = d as a function of c = d.l, the weight D(d.h) V(1, c)
+// c of the sheen BRDF's integrand (sheen_lobe_cos), tabulated at kSheenKernelSteps + 1 points of c in
+// [0, 1] and integrated over each source texel by an s x s midpoint rule, s from the lobe's width: for
+// the smallest roughness the lobe is a ring about 0.03 rad wide just above the horizon of d, where a
+// 256x128 level's texels are 0.025 rad (s = 8 there, 1 from r = 0.2 on).
+constexpr int kSheenKernelSteps = 4096;
+constexpr int kSheenWidth = 256;
+
+RowWeights sheen_weights(int W, int H, double r) {
+  auto K = std::make_shared<std::vector<double>>(size_t(kSheenKernelSteps + 1));
+  for (int t = 0; t <= kSheenKernelSteps; ++t) {
+    const double c = double(t) / kSheenKernelSteps;
+    (*K)[size_t(t)] = sheen_lobe_cos(1.0, c, std::sqrt(0.5 * (1.0 + c)), r);
+  }
+  const int s = std::clamp(int(std::ceil(0.08 / (r * r) * 128.0 / W)), 1, 8);
+  // the sub-rows' polar angles and sub-texels' solid angles, the sub-columns' azimuth cosines
+  auto rows = std::make_shared<GridRows>(W, H);
+  auto sub = std::make_shared<GridRows>(W * s, H * s);
+  auto cphi = std::make_shared<std::vector<double>>(size_t((W / 2 + 1) * s));
+  for (int n = 0; n <= W / 2; ++n)
+    for (int b = 0; b < s; ++b) (*cphi)[size_t(n * s + b)] = std::cos(2.0 * kPi * (n + (b + 0.5) / s - 0.5) / W);
+  return [=](int i, int k, double* w) {
+    const std::vector<double>& kernel = *K;
+    bool any = false;
+    for (int n = 0; n <= W / 2; ++n) {
+      double sum = 0.0;
+      for (int a = 0; a < s; ++a) {
+        const size_t q = size_t(k * s + a);
+        const double A = rows->ct[size_t(i)] * sub->ct[q], B = rows->st[size_t(i)] * sub->st[q];
+        if (A + B <= 0.0) continue;
+        for (int b = 0; b < s; ++b) {
+          const double c = A + B * (*cphi)[size_t(n * s + b)];
+          if (c <= 0.0) continue;
+          const double x = std::min(c, 1.0) * kSheenKernelSteps;
+          const int t = std::min(int(x), kSheenKernelSteps - 1);
+          sum += (kernel[size_t(t)] + (x - t) * (kernel[size_t(t + 1)] - kernel[size_t(t)])) * sub->dom[q];
+        }
+      }
+      w[n] = sum;
+      any = any || sum > 0.0;
+    }
+    return any;
+  };
+}
+
+// P on a W x H grid (W a power of two, H = W / 2) from the resampled source (planar: [c][row][col]),
+// with the lobe `weights`. Writes 4 floats per texel into `out`.
+void prefilter_level(const std::vector<double>& src, int W, int H, const RowWeights& weights, float* out) {
   const int M = W / 2 + 1;
   const Fft fft(W);
-  std::vector<double> ct(static_cast<size_t>(H)), st(ct), dom(ct), cphi(static_cast<size_t>(M));
-  for (int k = 0; k < H; ++k) {
-    const double th = kPi * (k + 0.5) / H;
-    ct[size_t(k)] = std::cos(th), st[size_t(k)] = std::sin(th);
-    dom[size_t(k)] = 2.0 * kPi / W * (std::cos(kPi * k / H) - std::cos(kPi * (k + 1) / H));
-  }
-  for (int n = 0; n < M; ++n) cphi[size_t(n)] = std::cos(2.0 * kPi * n / W);
   // Row spectra of the source, bins 0..W/2 (the rest follow by symmetry).
   std::vector<cd> spec(size_t(3) * size_t(H) * size_t(M));
   parallel_for_index(3 * H, [&](int ck) {
@@ -177,16 +249,12 @@ void prefilter_level(const std::vector<double>& src, int W, int H, double a2, fl
     const int i2 = H - 1 - i;
     std::vector<cd> z(static_cast<size_t>(W)), acc(size_t(6) * size_t(M), cd(0.0));
     double den = 0.0;
+    std::vector<double> w0(static_cast<size_t>(M)), w1(static_cast<size_t>(M));
     for (int k = 0; k < H; k += 2) {
-      const bool on0 = ct[size_t(i)] * ct[size_t(k)] + st[size_t(i)] * st[size_t(k)] > 0.0;
-      const bool on1 = ct[size_t(i)] * ct[size_t(k + 1)] + st[size_t(i)] * st[size_t(k + 1)] > 0.0;
+      const bool on0 = weights(i, k, w0.data()), on1 = weights(i, k + 1, w1.data());
       if (!on0 && !on1) continue;
-      const double a0 = ct[size_t(i)] * ct[size_t(k)], b0 = st[size_t(i)] * st[size_t(k)];
-      const double a1 = ct[size_t(i)] * ct[size_t(k + 1)], b1 = st[size_t(i)] * st[size_t(k + 1)];
       for (int n = 0; n < M; ++n) {
-        const double w0 = on0 ? lobe(a0 + b0 * cphi[size_t(n)], a2) * dom[size_t(k)] : 0.0;
-        const double w1 = on1 ? lobe(a1 + b1 * cphi[size_t(n)], a2) * dom[size_t(k + 1)] : 0.0;
-        z[size_t(n)] = cd(w0, w1);
+        z[size_t(n)] = cd(on0 ? w0[size_t(n)] : 0.0, on1 ? w1[size_t(n)] : 0.0);
         if (n > 0 && n < W - n) z[size_t(W - n)] = z[size_t(n)];
       }
       fft.run(z.data(), false);
@@ -299,20 +367,24 @@ std::vector<float> with_pole_rows(const std::vector<float>& level, int W, int H,
   return out;
 }
 
-// Lays out levels (each 4 floats per texel, with pole rows), then c(r), then the split-sum table.
+// Lays out levels (each 4 floats per texel, with pole rows: the image's first, then the GGX levels,
+// then the PMR_SHEEN_LEVELS sheen levels), then c(r), then the split-sum table.
 EnvironmentTables assemble(const std::vector<std::pair<glm::ivec2, std::vector<float>>>& plain) {
   std::vector<std::pair<glm::ivec2, std::vector<float>>> levels;
   for (size_t k = 0; k < plain.size(); ++k)
     levels.push_back({plain[k].first, with_pole_rows(plain[k].second, plain[k].first.x, plain[k].first.y, k > 0)});
   EnvironmentTables t;
   EnvTablesHeader& h = t.header;
-  h.level_count = uint32_t(levels.size());
+  h.level_count = uint32_t(levels.size()) - PMR_SHEEN_LEVELS;
+  h.sheen_first = h.level_count;
   size_t at = 0;
   for (size_t k = 0; k < levels.size(); ++k) {
     h.levels[k].width = uint32_t(levels[k].first.x);
     h.levels[k].height = uint32_t(levels[k].first.y);
     h.levels[k].offset = uint32_t(at);
-    h.levels[k].roughness = k == 0 ? 0.0f : float(kLevelHundredths[k - 1] / 100.0);
+    h.levels[k].roughness = k == 0              ? 0.0f
+                            : k < h.sheen_first ? float(kLevelHundredths[k - 1] / 100.0)
+                                                : float(environment_sheen_roughness()[k - h.sheen_first]);
     at += levels[k].second.size();
   }
   h.roughness_nodes = kEnvRoughnessNodes;
@@ -334,7 +406,7 @@ EnvironmentTables assemble(const std::vector<std::pair<glm::ivec2, std::vector<f
 }  // namespace
 
 const std::vector<float>& split_sum_table() {
-  // computed at build time (compute_split_sum_table, by pmr_split_sum_gen): it would cost every pbr
+  // computed at build time (compute_split_sum_table, by pmr_brdf_tables_gen): it would cost every pbr
   // process about 0.3 s at start
   static const std::vector<float> table(kSplitSumTable, kSplitSumTable + 2 * kEnvSplitSumSize * kEnvSplitSumSize);
   return table;
@@ -344,6 +416,16 @@ const std::vector<double>& environment_level_roughness() {
   static const std::vector<double> r = [] {
     std::vector<double> v;
     for (int h : kLevelHundredths) v.push_back(h / 100.0);
+    return v;
+  }();
+  return r;
+}
+
+const std::vector<double>& environment_sheen_roughness() {
+  static const std::vector<double> r = [] {
+    std::vector<double> v;
+    for (int k = 0; k < PMR_SHEEN_LEVELS; ++k)
+      v.push_back(std::pow(kSheenMinRoughness, 1.0 - double(k) / (PMR_SHEEN_LEVELS - 1)));
     return v;
   }();
   return r;
@@ -384,15 +466,26 @@ EnvironmentTables prefilter_environment(const EnvironmentImage& image) {
     for (const Image3& p : pyramid)
       if (p.w >= W) src = &p;
     std::vector<float> out(size_t(W) * size_t(H) * 4);
-    prefilter_level(resample(*src, W, H), W, H, r * r * r * r, out.data());
+    prefilter_level(resample(*src, W, H), W, H, ggx_weights(W, H, r * r * r * r), out.data());
     levels.push_back({glm::ivec2(W, H), std::move(out)});
+  }
+  // the sheen levels, all kSheenWidth x kSheenWidth / 2 (see sheen_weights)
+  const Image3* sheen_src = &pyramid[0];
+  for (const Image3& p : pyramid)
+    if (p.w >= kSheenWidth) sheen_src = &p;
+  const std::vector<double> sheen_source = resample(*sheen_src, kSheenWidth, kSheenWidth / 2);
+  for (double r : environment_sheen_roughness()) {
+    std::vector<float> out(size_t(kSheenWidth) * (kSheenWidth / 2) * 4);
+    prefilter_level(sheen_source, kSheenWidth, kSheenWidth / 2, sheen_weights(kSheenWidth, kSheenWidth / 2, r),
+                    out.data());
+    levels.push_back({glm::ivec2(kSheenWidth, kSheenWidth / 2), std::move(out)});
   }
   return assemble(levels);
 }
 
 EnvironmentTables uniform_environment_tables(float radiance) {
   std::vector<std::pair<glm::ivec2, std::vector<float>>> levels;
-  for (int k = 0; k <= kPrefilteredLevels; ++k)
+  for (int k = 0; k <= kPrefilteredLevels + PMR_SHEEN_LEVELS; ++k)
     levels.push_back({glm::ivec2(1, 1), {radiance, radiance, radiance, 0.0f}});
   return assemble(levels);
 }

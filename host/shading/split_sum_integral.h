@@ -1,6 +1,6 @@
 // The split-sum terms (A, B) of DESIGN section 4b's BRDF (Karis 2013): the table the environment
 // lighting reads (split_sum_table, environment.h). The table is computed at build time by
-// pmr_split_sum_gen (tools/split_sum_gen.cpp) from compute_split_sum_table and compiled in as
+// pmr_brdf_tables_gen (tools/brdf_tables_gen.cpp) from compute_split_sum_table and compiled in as
 // kSplitSumTable; tests check the two agree bit for bit.
 #pragma once
 #include <vector>
@@ -17,7 +17,7 @@ glm::dvec2 split_sum_integral(double n_dot_v, double r);
 // dot(n, v) = (i / (N - 1))^2 and r = j / (N - 1).
 std::vector<float> compute_split_sum_table();
 
-// The build's copy of compute_split_sum_table() (generated/split_sum_table.cpp).
+// The build's copy of compute_split_sum_table() (generated/brdf_tables.cpp).
 extern const float kSplitSumTable[];
 
 }  // namespace pmr

@@ -42,14 +42,16 @@ enum SceneTextureSlotKind : int {
   kSlotAnisotropy = 12,            // RG direction, B strength (KHR_materials_anisotropy), linear
   kSlotIridescence = 13,           // R iridescence factor (KHR_materials_iridescence), linear
   kSlotIridescenceThickness = 14,  // G thin-film thickness, linear
-  kTextureSlots = 15
+  kSlotSheenColor = 15,            // RGB sheen colour (KHR_materials_sheen), sRGB
+  kSlotSheenRoughness = 16,        // A sheen roughness, linear
+  kTextureSlots = 17
 };
 const char* texture_slot_name(int slot);  // "baseColorTexture", ... (the glTF property names)
 // The material extension whose object holds slot `slot`'s textureInfo; nullptr for the core slots.
 const char* texture_slot_extension(int slot);
 // Whether the slot holds a tangent-space normal map (normalTexture, clearcoatNormalTexture).
 bool texture_slot_is_normal_map(int slot);
-// Whether the slot's texels are sRGB-encoded colours (base colour, emissive, specular colour).
+// Whether the slot's texels are sRGB-encoded colours (base colour, emissive, specular and sheen colour).
 bool texture_slot_is_srgb(int slot);
 
 // One textureInfo of a material. texcoord is the TEXCOORD_n set sampled (the KHR_texture_transform
@@ -101,6 +103,10 @@ struct SceneMaterialInputs {
   float iridescence = 0.0f;                           // iridescenceFactor (validated to [0, 1])
   float iridescence_ior = 1.3f;                       // iridescenceIor (>= 1)
   float iridescence_thickness[2] = {100.0f, 400.0f};  // iridescenceThicknessMinimum, ...Maximum (nm, >= 0)
+  // KHR_materials_sheen (pbr): a layer of fibres over the material (the Charlie lobe)
+  bool has_sheen = false;
+  float sheen_color[3] = {0.0f, 0.0f, 0.0f};  // sheenColorFactor (linear, validated to [0, 1])
+  float sheen_roughness = 0.0f;               // sheenRoughnessFactor (validated to [0, 1])
   std::array<SceneTextureSlot, kTextureSlots> slots;  // indexed by SceneTextureSlotKind
   std::vector<std::string> unimplemented;  // material extensions present but not drawn (warned once per scene)
 };

@@ -97,6 +97,7 @@ typedef uint64_t pmr_u64;
 #define PMR_MATERIAL_SPECULAR 2u /* KHR_materials_specular changes the Fresnel term (a factor or a map) */
 #define PMR_MATERIAL_ANISOTROPY 4u /* KHR_materials_anisotropy with a strength above 0               */
 #define PMR_MATERIAL_IRIDESCENCE 8u /* KHR_materials_iridescence with a factor above 0               */
+#define PMR_MATERIAL_SHEEN 16u      /* KHR_materials_sheen with a colour factor above 0              */
 
 /* Texture wrap modes (glTF sampler enums). */
 #define PMR_WRAP_REPEAT 10497
@@ -121,6 +122,13 @@ typedef uint64_t pmr_u64;
 /* The split-sum table of --shading pbr (host/shading/environment.h): (A, B) pairs, node (i, j) at
  * cos(n, v) = (i / (N - 1))^2 and roughness j / (N - 1), stored at j * N + i. */
 #define PMR_SPLIT_SUM_N 64
+
+/* KHR_materials_sheen (host/shading/sheen.h): the sheen roughness is clamped to
+ * [PMR_SHEEN_MIN_ROUGHNESS, 1]; the table of the Charlie lobe's directional albedo E has
+ * PMR_SHEEN_ALBEDO_N^2 nodes, node (i, j) at cos(n, v) = (i / (N - 1))^2 and roughness
+ * PMR_SHEEN_MIN_ROUGHNESS + (1 - PMR_SHEEN_MIN_ROUGHNESS) j / (N - 1), stored at j * N + i. */
+#define PMR_SHEEN_MIN_ROUGHNESS 0.07f
+#define PMR_SHEEN_ALBEDO_N 32
 
 /* PmrParams.texture_filter (--texture-filter): level 0 alone, bilinear (the textures have no mips);
  * or trilinear between the mip levels around the analytic level of detail (DESIGN section 3b). */
@@ -255,7 +263,9 @@ typedef struct {
 #define PMR_MAP_ANISOTROPY 12        /* RG direction, B strength (KHR_materials_anisotropy, linear) */
 #define PMR_MAP_IRIDESCENCE 13       /* R iridescence factor (KHR_materials_iridescence, linear) */
 #define PMR_MAP_IRIDESCENCE_THICKNESS 14 /* G thin-film thickness between the minimum and maximum    */
-#define PMR_MAPS 15
+#define PMR_MAP_SHEEN_COLOR 15       /* RGB sheen colour (KHR_materials_sheen, sRGB-encoded)     */
+#define PMR_MAP_SHEEN_ROUGHNESS 16   /* A sheen roughness (linear)                              */
+#define PMR_MAPS 17
 
 /* One texture map of a material: which texture, sampled at which TEXCOORD set, through which
  * KHR_texture_transform (the identity without one). Producer: host/pipeline (from the scene's material
@@ -293,6 +303,7 @@ typedef struct {
   pmr_u32 flags;                /* PMR_MATERIAL_*, set with the maps (host/pipeline/material_tables.cpp) */
   float anisotropy[3];          /* KHR_materials_anisotropy: strength, cos and sin of the rotation */
   float iridescence[4];         /* KHR_materials_iridescence: factor, ior, thickness min and max (nm) */
+  float sheen[4];               /* KHR_materials_sheen: colour factor (linear RGB), roughness factor */
 } PmrMaterial;
 
 /* A texture and its mip chain: `levels` levels back to back from `offset`, level k of
@@ -368,10 +379,14 @@ typedef struct {
 
 /* --shading pbr with an environment image (--environment): where the prefiltered tables lie in the
  * environment data buffer (host/shading/environment.h describes the tables, the mapping and how they
- * are sampled; its Environment::level_sample, irradiance and prefiltered are the kernels' lookups in
- * double precision). Producer: host/shading/environment.cpp; the pipeline uploads it and the float data.
- * level_count == 0 (no image) selects the uniform default environment, which reads no table. */
-#define PMR_ENV_MAX_LEVELS 16
+ * are sampled; its Environment::level_sample, irradiance, prefiltered and sheen are the kernels' lookups
+ * in double precision). Producer: host/shading/environment.cpp; the pipeline uploads it and the float
+ * data. level_count == 0 (no image) selects the uniform default environment, which reads no table.
+ * levels[0, level_count): the image and its GGX-prefiltered levels; levels[sheen_first + k],
+ * k < PMR_SHEEN_LEVELS: the Charlie-prefiltered levels (KHR_materials_sheen) of sheen roughness
+ * PMR_SHEEN_MIN_ROUGHNESS^(1 - k / (PMR_SHEEN_LEVELS - 1)), evenly spaced in log(roughness) up to 1. */
+#define PMR_ENV_MAX_LEVELS 32
+#define PMR_SHEEN_LEVELS 16
 typedef struct {
   pmr_u32 width, height; /* texels                                                          */
   pmr_u32 offset;        /* float offset of the level's first row, the north pole row: texel (j, i)
@@ -380,11 +395,12 @@ typedef struct {
 } PmrEnvLevel;
 
 typedef struct {
-  pmr_u32 level_count;              /* levels in use (level 0 = the image, the last r = 1); 0 = no image */
+  pmr_u32 level_count;              /* GGX levels (level 0 = the image, the last r = 1); 0 = no image */
   pmr_u32 roughness_nodes;          /* nodes of c(r), the fractional level coordinate, at r = i / (nodes - 1) */
   pmr_u32 roughness_offset;         /* float offset of c(r)                                        */
   pmr_u32 split_sum_size;           /* the split-sum table (PMR_SPLIT_SUM_N)                        */
   pmr_u32 split_sum_offset;         /* float offset of its (A, B) pairs                             */
+  pmr_u32 sheen_first;              /* the first Charlie-prefiltered level (= level_count)          */
   float intensity;                  /* multiplies every radiance read (0 = off)                     */
   float rotation_cos, rotation_sin; /* of the map's rotation (counter-clockwise seen from above) */
   PmrEnvLevel levels[PMR_ENV_MAX_LEVELS];

@@ -77,6 +77,38 @@ typedef struct {
   sfloat w;
 } Iridescence;
 
+/* KHR_materials_sheen's layer of fibres: its colour (0 in lanes without), the clamped sheen roughness
+ * r, max3 of the colour, Lambda(n.v) and E(n.v, r), the layer's albedo seen from v. */
+typedef struct {
+  sint on;
+  sfloat3 color;
+  sfloat r, m, lambda_v, e_v;
+} Sheen;
+
+/* Lambda of the Charlie visibility at cosine x (clamped to [0, 1]) for alpha = r^2: the extension's fit
+ * exp(l(x)) below x = 1/2, exp(2 l(1/2) - l(1 - x)) above. */
+inline sfloat sheen_lambda(sfloat x, sfloat alpha) {
+  const sfloat o = (1.0f - alpha) * (1.0f - alpha);
+  const sfloat a = 21.5473f + 3.7772f * o, b = 3.82987f - 0.50552f * o, c = 0.19823f - 0.03022f * o;
+  const sfloat d = -1.97760f + 0.70367f * o, e = -4.32054f - 0.53913f * o;
+  const sint low = x < 0.5f;
+  const sfloat y = select(1.0f - x, x, low);
+  const sfloat ly = a / (1.0f + b * pow(y, c)) + d * y + e;
+  const sfloat half_l = a / (1.0f + b * exp2(-c)) + 0.5f * d + e; /* l(1/2) */
+  return exp(select(2.0f * half_l - ly, ly, low));
+}
+
+/* D V n.l of the Charlie lobe (the extension's implementation notes): D = (2 + 1 / alpha) sin^(1 / alpha)
+ * (theta_h) / (2 pi), V = 1 / ((1 + Lambda(n.v) + Lambda(n.l)) 4 n.v n.l) at most 1 (as the Sample Viewer
+ * clamps it: bounded at grazing views), for the clamped cosines given; 0 where n.l = 0. */
+inline sfloat sheen_lobe_cos(const Sheen* s, sfloat nv, sfloat nl, sfloat nh) {
+  const sfloat alpha = s->r * s->r, inv = 1.0f / alpha;
+  const sfloat sin2h = fmax(1.0f - nh * nh, 0.0f);
+  const sfloat D = (2.0f + inv) * pow(sin2h, 0.5f * inv) * (0.5f / PMR_PI_F);
+  const sfloat q = (1.0f + s->lambda_v + sheen_lambda(nl, alpha)) * 4.0f * nv;
+  return select((sfloat)(0.0f), D * fmin(1.0f / q, nl), nl > 0.0f);
+}
+
 /* The spectral sensitivity term of the thin film's analytic spectral integration (the extension's
  * evalSensitivity: Gaussian fits of the CIE XYZ curves in Fourier space, then XYZ to Rec. 709) for
  * optical path difference opd (nm) and phase shift `shift` per channel. */

@@ -29,13 +29,14 @@
   global const PmrParams *P, global const PmrTriangle *tris, global const PmrVertexAttr *attrs,            \
       global const PmrMaterial *materials, global const PmrTexture *textures, global const uchar4 *texels, \
       global const float *srgb_lut, global const float *positions, global const float4 *eyes,              \
-      global const float2 *split_sum, global const float2 *texcoords, global const float4 *tangents,       \
-      global const PmrEnvironment *env, global const float4 *env_data, global const PmrLight *lights,      \
-      global const half *source, global const PmrSource *source_info, global uint *source_tiles
-#define PMR_SHADE_INPUTS                                                                                         \
-  {                                                                                                              \
-    tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, texcoords, tangents, env, \
-        env_data, lights, source, source_info, source_tiles                                                      \
+      global const float2 *split_sum, global const float *sheen_albedo, global const float2 *texcoords,    \
+      global const float4 *tangents, global const PmrEnvironment *env, global const float4 *env_data,      \
+      global const PmrLight *lights, global const half *source, global const PmrSource *source_info,       \
+      global uint *source_tiles
+#define PMR_SHADE_INPUTS                                                                                        \
+  {                                                                                                             \
+    tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, sheen_albedo, texcoords, \
+        tangents, env, env_data, lights, source, source_info, source_tiles                                      \
   }
 
 typedef struct {
@@ -49,6 +50,7 @@ typedef struct {
   global const float* positions;       /* world space, 3 floats per vertex: the surface point (pbr)  */
   global const float4* eyes;           /* each view's camera position, world space (pbr)            */
   global const float2* split_sum;      /* PMR_SPLIT_SUM_N^2 (A, B) (see PMR_SPLIT_SUM_N)             */
+  global const float* sheen_albedo;    /* PMR_SHEEN_ALBEDO_N^2 E (see PMR_SHEEN_ALBEDO_N)            */
   global const float2* texcoords;      /* TEXCOORD set k of vertex v at k * num_vertices + v (the maps) */
   global const float4* tangents;       /* world tangent per vertex (w: bitangent sign), pbr normal maps */
   global const PmrEnvironment* env;    /* pbr: the environment image's tables, level_count 0 = none */
@@ -110,6 +112,11 @@ typedef struct {
    * when some lane is (factor 0 in the others) */
   sint irid;
   sfloat irid_factor, irid_ior, irid_min, irid_max;
+  /* pbr, KHR_materials_sheen: lanes `sheen` (colour and roughness factors); set only when some lane
+   * is (colour 0 in the others) */
+  sint sheen;
+  sfloat3 sheen_color;
+  sfloat sheen_roughness;
   uint textured; /* bit l: lane l's material has a map the model reads (lambert: base colour) */
   uint tri[SW];  /* lane l's triangle, where textured                               */
 #if PMR_TRILINEAR
@@ -134,7 +141,7 @@ inline void lanes_clear(LaneWinners* L) {
   L->emissive = s3(zero, zero, zero);
   L->glass = (sint)(0);  /* the transmission inputs are set when the first glass lane comes */
   L->coated = (sint)(0); /* ... and the clear coat's when the first coated lane comes */
-  L->specular = L->aniso = L->irid = (sint)(0);
+  L->specular = L->aniso = L->irid = L->sheen = (sint)(0);
   L->textured = 0u;
 #if PMR_TRILINEAR
   for (int k = 0; k < 3; ++k) vstore_s(zero, 0, L->ex[k]), vstore_s(zero, 0, L->ey[k]);
@@ -194,6 +201,14 @@ inline void lanes_add_iridescence(LaneWinners* L, global const PmrMaterial* mat,
   L->irid_max = blend(L->irid_max, mat->iridescence[3], take);
 }
 
+/* The sheen factors of material `mat` into lanes `take`. */
+inline void lanes_add_sheen(LaneWinners* L, global const PmrMaterial* mat, sint take) {
+  if (!any(L->sheen)) L->sheen_color = s3_splat((float3)(0.0f)), L->sheen_roughness = (sfloat)(1.0f);
+  L->sheen |= take;
+  L->sheen_color = blend3(L->sheen_color, vload3(0, mat->sheen), take);
+  L->sheen_roughness = blend(L->sheen_roughness, mat->sheen[3], take);
+}
+
 /* Lanes `take` (bits: the same as bits) are won by MTA m: its values blended into them (the edge
  * functions are set apart: lanes_gather in fine_core.h). */
 inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, sint take, uint bits, bool pbr) {
@@ -235,6 +250,7 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
     if (mat->flags & PMR_MATERIAL_SPECULAR) lanes_add_specular(L, mat, take);
     if (mat->flags & PMR_MATERIAL_ANISOTROPY) lanes_add_anisotropy(L, mat, take);
     if (mat->flags & PMR_MATERIAL_IRIDESCENCE) lanes_add_iridescence(L, mat, take);
+    if (mat->flags & PMR_MATERIAL_SHEEN) lanes_add_sheen(L, mat, take);
     textured = (mat->flags & (PMR_MATERIAL_MAPS | PMR_MATERIAL_ANISOTROPY)) != 0;
   }
   if (textured) {
@@ -343,12 +359,13 @@ typedef struct {
   float base[3][SW], base_alpha[SW], metallic[SW], roughness[SW], ao[SW], emissive[3][SW];
   float tw[4][SW];
   LaneNormalMap normal;
-  float transmission[SW], thickness[SW];      /* KHR_materials_transmission R, KHR_materials_volume G (glass) */
-  float coat[SW], coat_roughness[SW];         /* KHR_materials_clearcoat R, G (coated) */
-  LaneNormalMap coat_normal;                  /* ... clearcoatNormalTexture (coated) */
-  float spec_weight[SW], spec_color[3][SW];   /* KHR_materials_specular A, RGB (specular) */
-  float aniso_dir[2][SW], aniso_strength[SW]; /* KHR_materials_anisotropy: 2 RG - 1, B (aniso) */
-  float irid_factor[SW], irid_thickness[SW];  /* KHR_materials_iridescence R, G (irid) */
+  float transmission[SW], thickness[SW];         /* KHR_materials_transmission R, KHR_materials_volume G (glass) */
+  float coat[SW], coat_roughness[SW];            /* KHR_materials_clearcoat R, G (coated) */
+  LaneNormalMap coat_normal;                     /* ... clearcoatNormalTexture (coated) */
+  float spec_weight[SW], spec_color[3][SW];      /* KHR_materials_specular A, RGB (specular) */
+  float aniso_dir[2][SW], aniso_strength[SW];    /* KHR_materials_anisotropy: 2 RG - 1, B (aniso) */
+  float irid_factor[SW], irid_thickness[SW];     /* KHR_materials_iridescence R, G (irid) */
+  float sheen_color[3][SW], sheen_roughness[SW]; /* KHR_materials_sheen RGB, A (sheen) */
 } LaneTextures;
 
 /* The screen-space derivatives of SW lanes' source barycentrics, per output pixel in x and in y. */
@@ -461,6 +478,20 @@ inline void sample_coat_lanes(const ShadeInputs* in, global const PmrMaterial* m
                             &T->coat_normal);
 }
 
+/* The sheen maps of material `mat` (KHR_materials_sheen) for its lanes `bits` (`take`). */
+inline void sample_sheen_lanes(const ShadeInputs* in, global const PmrMaterial* mat, const LaneWinners* L, uint bits,
+                               sint take, sfloat3 b, const LaneBaryGrad* g, LaneTexcoords* C, LaneTextures* T) {
+  sfloat c[4];
+  if (mat->maps[PMR_MAP_SHEEN_COLOR].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_SHEEN_COLOR], L->tri, bits, take, b, g, true, C, c);
+    for (int k = 0; k < 3; ++k) lanes_put(T->sheen_color[k], c[k], take);
+  }
+  if (mat->maps[PMR_MAP_SHEEN_ROUGHNESS].texture >= 0) {
+    sample_map_lanes(in, &mat->maps[PMR_MAP_SHEEN_ROUGHNESS], L->tri, bits, take, b, g, false, C, c);
+    lanes_put(T->sheen_roughness, c[3], take);
+  }
+}
+
 /* No normal map in any lane. */
 inline void normal_map_clear(LaneNormalMap* M) {
   for (int l = 0; l < SW; ++l) {
@@ -517,6 +548,7 @@ inline void sample_material_lanes(const ShadeInputs* in, global const PmrMateria
     sample_map_lanes(in, &mat->maps[PMR_MAP_IRIDESCENCE_THICKNESS], L->tri, bits, take, b, g, false, C, c);
     lanes_put(T->irid_thickness, c[1], take);
   }
+  if (mat->flags & PMR_MATERIAL_SHEEN) sample_sheen_lanes(in, mat, L, bits, take, b, g, C, T);
   if (mat->maps[PMR_MAP_ANISOTROPY].texture >= 0) {
     sample_map_lanes(in, &mat->maps[PMR_MAP_ANISOTROPY], L->tri, bits, take, b, g, false, C, c);
     lanes_put(T->aniso_dir[0], 2.0f * c[0] - 1.0f, take), lanes_put(T->aniso_dir[1], 2.0f * c[1] - 1.0f, take);
@@ -559,6 +591,9 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
       T->spec_weight[l] = T->spec_color[0][l] = T->spec_color[1][l] = T->spec_color[2][l] = 1.0f;
   if (any(L->aniso))
     for (int l = 0; l < SW; ++l) T->aniso_dir[0][l] = T->aniso_strength[l] = 1.0f, T->aniso_dir[1][l] = 0.0f;
+  if (any(L->sheen))
+    for (int l = 0; l < SW; ++l)
+      T->sheen_color[0][l] = T->sheen_color[1][l] = T->sheen_color[2][l] = T->sheen_roughness[l] = 1.0f;
   if (any(L->irid)) /* without a thickness texture the film is the maximum thickness */
     for (int l = 0; l < SW; ++l) T->irid_factor[l] = T->irid_thickness[l] = 1.0f;
   if (PMR_WITH_BLEND && any(L->blended))
@@ -690,6 +725,28 @@ inline void split_sum_lanes(global const float2* t, sfloat nv, sfloat r, sfloat*
   }
 }
 
+/* E(n.v, r) of the sheen's albedo table for every lane (host/shading/sheen.h: sheen_albedo), bilinear
+ * in (sqrt(n.v), r), r the clamped sheen roughness: the index arithmetic in vectors, the taps gathered
+ * lane by lane. */
+inline sfloat sheen_albedo_lanes(global const float* t, sfloat nv, sfloat r) {
+  const int n = PMR_SHEEN_ALBEDO_N;
+  const float span = 1.0f - PMR_SHEEN_MIN_ROUGHNESS;
+  const sfloat x = sqrt(clamp(nv, 0.0f, 1.0f)) * (float)(n - 1),
+               y = (clamp(r, PMR_SHEEN_MIN_ROUGHNESS, 1.0f) - PMR_SHEEN_MIN_ROUGHNESS) * ((float)(n - 1) / span);
+  const sint x0 = min(convert_int8(x), n - 2), y0 = min(convert_int8(y), n - 2);
+  const sfloat fx = x - convert_float8(x0), fy = y - convert_float8(y0);
+  int at[SW];
+  vstore_s(y0 * n + x0, 0, at);
+  float tap[4][SW];
+  for (int l = 0; l < SW; ++l) {
+    const float2 top = vload2(0, t + at[l]), bottom = vload2(0, t + at[l] + n);
+    tap[0][l] = top.x, tap[1][l] = top.y, tap[2][l] = bottom.x, tap[3][l] = bottom.y;
+  }
+  const sfloat a = vload_s(0, tap[0]), b = vload_s(0, tap[1]), c = vload_s(0, tap[2]), d = vload_s(0, tap[3]);
+  const sfloat top = a + (b - a) * fx, bottom = c + (d - c) * fx;
+  return top + (bottom - top) * fy;
+}
+
 /* Specular antialiasing (docs/DESIGN.md section 3b): roughness r widened so that alpha^2 = r^4 grows by
  * `spread` (at most to 1); lanes without spread keep r bit for bit. */
 inline sfloat widened_roughness(sfloat r, sfloat spread) {
@@ -740,6 +797,7 @@ typedef struct {
   sfloat3 coat_n;                 /* ... the coat's unit normal (its own normal map, or the geometric one) */
   Anisotropy aniso;               /* KHR_materials_anisotropy (lanes aniso.on)                       */
   Iridescence irid;               /* KHR_materials_iridescence (w 0 in lanes without)                */
+  Sheen sheen;                    /* KHR_materials_sheen (lanes sheen.on)                            */
 } Surface;
 
 /* The Fresnel term's F0 and F90 of the surface S (base and metallic set): the dielectric's F0 from the
@@ -779,6 +837,22 @@ inline void surface_iridescence(Surface* S, const LaneWinners* L, const LaneText
   S->irid.w = textured ? L->irid_factor * vload_s(0, T->irid_factor) : L->irid_factor;
 }
 
+/* KHR_materials_sheen's layer over the surface S (n and v set): colour and roughness times their maps,
+ * and what every light and the environment read of it at the view (Lambda(n.v), E(n.v)). */
+inline void surface_sheen(Surface* S, const ShadeInputs* in, const LaneWinners* L, const LaneTextures* T,
+                          bool textured) {
+  sfloat3 c = L->sheen_color;
+  sfloat r = L->sheen_roughness;
+  if (textured) c = s3_mul(c, LANE3(T->sheen_color)), r *= vload_s(0, T->sheen_roughness);
+  const sfloat nv = clamp(s3_dot(S->n, S->v), 0.0f, 1.0f);
+  S->sheen.on = L->sheen;
+  S->sheen.color = c;
+  S->sheen.r = clamp(r, PMR_SHEEN_MIN_ROUGHNESS, 1.0f);
+  S->sheen.m = fmax(fmax(c.x, c.y), c.z);
+  S->sheen.lambda_v = sheen_lambda(nv, S->sheen.r * S->sheen.r);
+  S->sheen.e_v = sheen_albedo_lanes(in->sheen_albedo, nv, S->sheen.r);
+}
+
 /* The surface of the lanes seen from view `view`: n and coat_n are unit normals, flipped for back faces;
  * spread and coat_spread the specular antialiasing increments of the two lobes. */
 inline Surface pbr_surface(const ShadeInputs* in, const LaneWinners* L, const LaneTextures* T, bool textured, sfloat3 b,
@@ -807,6 +881,7 @@ inline Surface pbr_surface(const ShadeInputs* in, const LaneWinners* L, const La
   S.coat_r = coated ? widened_roughness(pbr_roughness(coat_roughness), coat_spread) : (sfloat)(1.0f);
   if (any(L->aniso)) surface_anisotropy(&S, L, T, aniso_t);
   if (any(L->irid)) surface_iridescence(&S, L, T, textured);
+  if (any(L->sheen)) surface_sheen(&S, in, L, T, textured);
   return S;
 }
 
@@ -828,6 +903,44 @@ inline sfloat3 coated_lanes(const ShadeInputs* in, const LaneWinners* L, const S
   return s3_select(under, s3_add(s3_scale(under, 1.0f - w), s3_scale(coat, w)), L->coated);
 }
 
+/* KHR_materials_sheen over a light: f (the layers beneath, per unit irradiance, n.l included) scaled by
+ * the extension's albedo scaling min(1 - m E(n.v), 1 - m E(n.l)) (clamped to [0, 1]), plus the sheen
+ * lobe c D V n.l. Lanes without sheen keep f bit for bit. */
+inline sfloat3 sheen_over_light(const ShadeInputs* in, const Sheen* s, sfloat3 f, sfloat3 n, sfloat3 v, sfloat3 l) {
+  const sfloat nl = clamp(s3_dot(n, l), 0.0f, 1.0f), nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
+  const sfloat3 hv = s3_add(l, v);
+  const sfloat hl = sqrt(s3_dot(hv, hv));
+  const sfloat3 h = s3_select(n, s3_scale(hv, 1.0f / hl), hl > 0.0f);
+  const sfloat nh = clamp(s3_dot(n, h), 0.0f, 1.0f);
+  const sfloat e = fmax(s->e_v, sheen_albedo_lanes(in->sheen_albedo, nl, s->r));
+  const sfloat scale = clamp(1.0f - s->m * e, 0.0f, 1.0f);
+  const sfloat3 layered = s3_add(s3_scale(f, scale), s3_scale(s->color, sheen_lobe_cos(s, nv, nl, nh)));
+  return s3_select(f, layered, s->on);
+}
+
+/* What the sheen lets through from the view's side, x (1 - m E(n.v)) (clamped to [0, 1]), in its lanes. */
+inline sfloat3 sheen_view_scaled(const Sheen* s, sfloat3 x) {
+  return s3_select(x, s3_scale(x, clamp(1.0f - s->m * s->e_v, 0.0f, 1.0f)), s->on);
+}
+
+/* KHR_materials_sheen over the environment, in the lanes with sheen: `under` (the environment's, the
+ * transmission's and the emission's light through the layer) scaled as the view sees it
+ * (sheen_view_scaled), plus the sheen's environment term ao c E(n.v) S(reflect(-v, n), r) (the
+ * Charlie-prefiltered levels; the uniform default's radiance without an image). */
+inline sfloat3 sheen_over_environment(const ShadeInputs* in, const LaneWinners* L, const Surface* S, sfloat3 under) {
+  const Sheen* s = &S->sheen;
+  sfloat3 light = s3_splat((float3)(in->P->env_radiance));
+  if (in->env->level_count != 0) {
+    /* idle lanes look up +Y: their values are ignored, but their texel indices are read */
+    const sfloat3 up = s3((sfloat)(0.0f), (sfloat)(1.0f), (sfloat)(0.0f));
+    const sfloat3 d = s3_sub(s3_scale(S->n, 2.0f * s3_dot(S->n, S->v)), S->v);
+    sfloat u, v;
+    env_uv(in->env, s3_select(up, d, L->act & s->on), &u, &v);
+    light = env_sheen(in->env, in->env_data, u, v, s->r);
+  }
+  return s3_add(sheen_view_scaled(s, under), s3_scale(s3_mul(s->color, light), S->ao * s->e_v));
+}
+
 /* reflect(-v, n), or for anisotropic lanes about the Sample Viewer's bent normal: n bent toward the
  * normal of the plane through the anisotropy bitangent b and v, normalize(mix(cross(cross(b, v), b), n,
  * (1 - s (1 - r))^4)), s the strength and r the roughness. */
@@ -843,13 +956,14 @@ inline sfloat3 reflected_direction(const Surface* S, const LaneWinners* L, sfloa
 
 /* glTF metallic-roughness of the lanes' surfaces S seen from view `view`'s camera: the sum over the
  * light table of f E n.l (the file's punctual lights, or the default light, or none), the environment
- * times the occlusion, plus the emissive term, under the clear coat where there is one; an unlit material
- * is its base colour. */
+ * times the occlusion, plus the emissive term, under the sheen and then the clear coat where there are
+ * ones; an unlit material is its base colour. */
 inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surface* S, int view) {
   global const PmrParams* P = in->P;
   const bool glass = any(L->glass), coated = any(L->coated); /* their terms cost nothing to other lanes */
   const Anisotropy* aniso = any(L->aniso) ? &S->aniso : 0;
   const Iridescence* irid = any(L->irid) ? &S->irid : 0;
+  const Sheen* sheen = any(L->sheen) ? &S->sheen : 0;
   const sfloat3 n = S->n, v = S->v, base = S->base, f0 = S->f0;
   const sfloat f90 = S->f90;
   const sfloat metallic = S->metallic, r = S->r, transmission = S->transmission;
@@ -862,8 +976,9 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
     const sfloat3 E =
         light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
                          vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, S->p, &l);
-    const sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, transmission, aniso, irid)
-                            : brdf_cos(base, metallic, f0, f90, r, n, v, l, aniso, irid);
+    sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, transmission, aniso, irid)
+                      : brdf_cos(base, metallic, f0, f90, r, n, v, l, aniso, irid);
+    if (sheen) f = sheen_over_light(in, sheen, f, n, v, l);
     direct = s3_add(direct, s3_mul(f, E));
     if (glass) lights_through = s3_add(lights_through, s3_mul(btdf_light(f0, f90, r, L->ior, n, v, l), E));
     if (coated) coat_lights = s3_add(coat_lights, s3_scale(E, ggx_lobe_cos(S->coat_n, v, l, coat_a2)));
@@ -885,9 +1000,13 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
     sfloat3 attenuation;
     const sfloat3 through = transmitted_lanes(in, L, S->p, n, v, r, S->thickness, view, &attenuation);
     ambient = s3_add(ambient, s3_mul(btdf_weight(ao * w, R, base), through));
-    direct = s3_add(direct, s3_mul(s3_scale(s3_mul(base, attenuation), w), lights_through));
+    sfloat3 lights_in = s3_mul(s3_scale(s3_mul(base, attenuation), w), lights_through);
+    if (sheen) lights_in = sheen_view_scaled(sheen, lights_in);
+    direct = s3_add(direct, lights_in);
   }
   sfloat3 lit = s3_add(s3_add(direct, ambient), S->emissive);
+  if (sheen) /* the sheen between the view and the rest (the lights' layering is in f) */
+    lit = s3_select(lit, s3_add(direct, sheen_over_environment(in, L, S, s3_add(ambient, S->emissive))), sheen->on);
   if (coated) lit = coated_lanes(in, L, S, lit, coat_lights);
   return s3_select(lit, base, L->unlit);
 }

@@ -10,6 +10,7 @@
 #include "reference/material_reference.h"
 #include "reference/shade_reference.h"
 #include "shading/environment.h"
+#include "shading/sheen.h"
 
 namespace pmr::test {
 
@@ -53,6 +54,8 @@ ref::EnvironmentTerms uniform_environment(double radiance) {
   env.irradiance = [=](const glm::dvec3&) { return glm::dvec3(radiance); };
   env.prefiltered = [=](const glm::dvec3&, double) { return glm::dvec3(radiance); };
   env.split_sum = [](double nv, double r) { return split_sum(nv, r); };
+  env.sheen = [=](const glm::dvec3&, double) { return glm::dvec3(radiance); };
+  env.sheen_albedo = [](double nv, double s) { return sheen_albedo(nv, s); };
   return env;
 }
 
@@ -101,6 +104,8 @@ ref::EnvironmentTerms image_environment(const Environment& e) {
   env.irradiance = [&e](const glm::dvec3& n) { return e.irradiance(n); };
   env.prefiltered = [&e](const glm::dvec3& d, double r) { return e.prefiltered(d, r); };
   env.split_sum = [](double nv, double r) { return split_sum(nv, r); };
+  env.sheen = [&e](const glm::dvec3& d, double s) { return e.sheen(d, s); };
+  env.sheen_albedo = [](double nv, double s) { return sheen_albedo(nv, s); };
   return env;
 }
 
@@ -174,6 +179,18 @@ FeatureCheck check_feature(const VoxelReference& with, const VoxelReference& wit
       }
   }
   return r;
+}
+
+FeatureCheck check_feature_under(const Scene& lit, const Scene& without_feature,
+                                 const std::shared_ptr<const Environment>& env) {
+  Scene s = lit, plain = without_feature;
+  s.lights.clear(), plain.lights.clear();
+  const Rig rig = small_rig(5, 80, 40);
+  const Rendered out = render_pbr(s, rig, Method::Pmr, TextureFilter::Bilinear, env);
+  VoxelReference reference(s, rig, out), bare(plain, rig, out);
+  reference.lights.clear(), bare.lights.clear();
+  reference.env = bare.env = image_environment(*env);
+  return check_feature(reference, bare);
 }
 
 double expect_feature_matches_reference(const Scene& s, const Scene& without,

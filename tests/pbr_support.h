@@ -90,6 +90,9 @@ struct FeatureCheck {
   std::map<uint32_t, size_t> voxels, changed;
 };
 FeatureCheck check_feature(const VoxelReference& with, const VoxelReference& without);
+// The same for `s` lit by the environment image `env` alone (its lights and the default light off),
+// rendered at 5 views of 80 x 40; `without` is s without the feature.
+FeatureCheck check_feature_under(const Scene& s, const Scene& without, const std::shared_ptr<const Environment>& env);
 
 // Four quads side by side (x from -1.3 to 1.3) with curved normals, TEXCOORD_0 and tangents (w
 // alternating), the quad q drawn with material q + 1 of base colour bases[q] and the inputs `inputs(q,

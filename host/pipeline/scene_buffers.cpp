@@ -9,6 +9,7 @@
 #include "pmr/error.h"
 #include "shading/environment.h"
 #include "shading/lights.h"
+#include "shading/sheen.h"
 
 namespace pmr {
 
@@ -29,6 +30,8 @@ SceneBuffers::SceneBuffers(const ClRuntime& rt, const PipelineConfig& config)
   static_assert(kEnvSplitSumSize == PMR_SPLIT_SUM_N, "the kernels' split-sum table size");
   const std::vector<float> none(2, 0.0f);
   split_sum_ = rt.upload(config.shading == Shading::Pbr ? split_sum_table() : none, "split-sum table");
+  static_assert(kSheenAlbedoSize == PMR_SHEEN_ALBEDO_N, "the kernels' sheen albedo table size");
+  sheen_albedo_ = rt.upload(config.shading == Shading::Pbr ? sheen_albedo_table() : none, "sheen albedo table");
   upload_environment(config);
 }
 
@@ -96,9 +99,9 @@ void SceneBuffers::upload_frame(const FrameDescription& frame) {
 }
 
 cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params, const SourceBinding& source) const {
-  const ClBuffer* inputs[] = {&params, &tris_,      &attrs_,  &materials_, &textures_,  &texels_,
-                              &lut_,   &positions_, &eyes_,   &split_sum_, &texcoords_, &tangents_,
-                              &env_,   &env_data_,  &lights_, source.data, source.info, source.tiles};
+  const ClBuffer* inputs[] = {&params,     &tris_,   &attrs_,     &materials_,    &textures_,  &texels_,   &lut_,
+                              &positions_, &eyes_,   &split_sum_, &sheen_albedo_, &texcoords_, &tangents_, &env_,
+                              &env_data_,  &lights_, source.data, source.info,    source.tiles};
   cl_uint i = 0;
   for (const ClBuffer* b : inputs) k.arg(i++, *b);
   return i;
@@ -107,7 +110,7 @@ cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params, const So
 size_t SceneBuffers::device_bytes() const {
   size_t total = 0;
   for (const ClBuffer* b : {&positions_, &attrs_, &tris_, &materials_, &textures_, &texels_, &texcoords_, &tangents_,
-                            &lut_, &split_sum_, &env_, &env_data_, &lights_, &eyes_})
+                            &lut_, &split_sum_, &sheen_albedo_, &env_, &env_data_, &lights_, &eyes_})
     total += b->size();
   return total;
 }

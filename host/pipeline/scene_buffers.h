@@ -51,7 +51,7 @@ class SceneBuffers {
   bool has_tangents_ = false;
   std::vector<SceneLight> scene_lights_;
   ClBuffer positions_, attrs_, tris_, materials_, textures_, texels_, texcoords_, tangents_;
-  ClBuffer lut_, split_sum_, env_, env_data_;  // the run's tables
+  ClBuffer lut_, split_sum_, sheen_albedo_, env_, env_data_;  // the run's tables
   ClBuffer lights_, eyes_;                     // the frame's
 };
 

@@ -294,7 +294,6 @@ void read_iridescence(Loader& L, const tinygltf::Value& value, const std::string
 void read_sheen(Loader& L, const tinygltf::Value& value, const std::string& name, SceneMaterialInputs& m) {
   const std::string ext = "KHR_materials_sheen";
   m.has_sheen = true;
-  m.unimplemented.push_back(ext);  // until the kernels draw it
   m.sheen_roughness = extension_number(L, value, ext, "sheenRoughnessFactor", 0.0, 0.0, 1.0, name);
   if (!value.IsObject() || !value.Has("sheenColorFactor")) return;
   double c[3];

@@ -503,7 +503,6 @@ std::string base_dir_of(const std::string& path) {
 
 const char* material_extension_fallback(const std::string& name) {
   static const std::pair<const char*, const char*> table[] = {
-      {"KHR_materials_sheen", "drawn without sheen"},
       {"KHR_materials_dispersion", "drawn without dispersion (one ior for every wavelength)"},
       {"KHR_materials_diffuse_transmission", "drawn without diffuse transmission (opaque where not glass)"},
       {"KHR_materials_pbrSpecularGlossiness",

@@ -99,6 +99,10 @@ void material_at(const Scene& scene, uint32_t tri, const glm::dvec3& b, bool bac
     sp.specular_color = glm::dvec3(in.specular_color[0], in.specular_color[1], in.specular_color[2]);
     if (sample_slot(scene, t, b, in.slots[kSlotSpecular], s)) sp.specular *= s.w;
     if (sample_slot(scene, t, b, in.slots[kSlotSpecularColor], s)) sp.specular_color *= glm::dvec3(s);
+    sp.sheen_color = glm::dvec3(in.sheen_color[0], in.sheen_color[1], in.sheen_color[2]);
+    sp.sheen_roughness = in.sheen_roughness;
+    if (sample_slot(scene, t, b, in.slots[kSlotSheenColor], s)) sp.sheen_color *= glm::dvec3(s);
+    if (sample_slot(scene, t, b, in.slots[kSlotSheenRoughness], s)) sp.sheen_roughness *= s.w;
     sp.clearcoat = in.clearcoat, sp.clearcoat_roughness = in.clearcoat_roughness;
     if (in.clearcoat > 0.0f) {
       if (sample_slot(scene, t, b, in.slots[kSlotClearcoat], s)) sp.clearcoat *= s.x;

@@ -80,6 +80,26 @@ double ggx_lobe_cos(double r, const glm::dvec3& n, const glm::dvec3& v, const gl
   return a2 / (kPi * dd * dd) * (s > 0.0 ? 0.5 / s : 0.0) * nl;
 }
 
+double sheen_lobe_cos(double s, const glm::dvec3& n, const glm::dvec3& v, const glm::dvec3& l) {
+  const double nl = clamp01(glm::dot(n, l));
+  if (nl <= 0.0) return 0.0;
+  const double nv = clamp01(glm::dot(n, v)), a = s * s;
+  const glm::dvec3 hv = l + v;
+  const glm::dvec3 h = glm::length(hv) > 0.0 ? glm::normalize(hv) : n;
+  const double nh = clamp01(glm::dot(n, h)), sin_h = std::sqrt(std::max(0.0, 1.0 - nh * nh));
+  const double D = (2.0 + 1.0 / a) * std::pow(sin_h, 1.0 / a) / (2.0 * kPi);
+  auto fit = [a](double x) {
+    const double o = (1.0 - a) * (1.0 - a);
+    const double A = glm::mix(21.5473, 25.3245, o), B = glm::mix(3.82987, 3.32435, o),
+                 C = glm::mix(0.19823, 0.16801, o), Dd = glm::mix(-1.97760, -1.27393, o),
+                 E = glm::mix(-4.32054, -4.85967, o);
+    return A / (1.0 + B * std::pow(x, C)) + Dd * x + E;
+  };
+  auto lambda = [&](double x) { return x < 0.5 ? std::exp(fit(x)) : std::exp(2.0 * fit(0.5) - fit(1.0 - x)); };
+  const double V = std::min(1.0, 1.0 / ((1.0 + lambda(nv) + lambda(nl)) * 4.0 * nv * nl));
+  return D * V * nl;
+}
+
 namespace {
 
 // The extension's evalSensitivity: the thin film's spectral term for optical path difference opd (nm)
@@ -161,15 +181,23 @@ glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& li
   if (s.iridescence > 0.0)
     film = thin_film_fresnel(s.clearcoat > 0.0 ? 1.5 : 1.0, s.iridescence_ior, clamp01(glm::dot(s.n, v)),
                              s.iridescence_thickness, f0);
-  glm::dvec3 sum(0.0);
+  // the sheen's scalings of what lies beneath it, from the view and from a light (1 without sheen)
+  const double sheen_max = std::max({s.sheen_color.x, s.sheen_color.y, s.sheen_color.z});
+  const double rs = std::min(1.0, std::max(0.07, s.sheen_roughness)), nv0 = clamp01(glm::dot(s.n, v));
+  const double e_v = sheen_max > 0.0 ? env.sheen_albedo(nv0, rs) : 0.0, view_scale = clamp01(1.0 - sheen_max * e_v);
+  glm::dvec3 sum(0.0), under(0.0);  // the lights' reflection; what the view's scaling applies to
   for (const PunctualLight& light : lights) {
     glm::dvec3 l;
     const glm::dvec3 E = light_irradiance(light, s.p, l);
-    sum += brdf_cos(s.base, s.metallic, r, s.n, v, l, s.ior, s.transmission, s.specular, s.specular_color, s.anisotropy,
-                    s.anisotropy_t, s.iridescence, film) *
-           E;
+    glm::dvec3 f = brdf_cos(s.base, s.metallic, r, s.n, v, l, s.ior, s.transmission, s.specular, s.specular_color,
+                            s.anisotropy, s.anisotropy_t, s.iridescence, film);
+    if (sheen_max > 0.0) {
+      const double e_l = env.sheen_albedo(clamp01(glm::dot(s.n, l)), rs);
+      f = f * clamp01(1.0 - sheen_max * std::max(e_v, e_l)) + s.sheen_color * sheen_lobe_cos(rs, s.n, v, l);
+    }
+    sum += f * E;
     if (s.transmission > 0.0)
-      sum +=
+      under +=
           s.transmission * (s.base * (1.0 - s.metallic)) * s.attenuation * btdf_light(f0, f90, r, s.ior, s.n, v, l) * E;
   }
   const glm::dvec3 c_diff = s.base * (1.0 - s.metallic);
@@ -182,9 +210,10 @@ glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& li
     reflected = glm::reflect(-v, glm::normalize(glm::mix(bent_to, s.n, bend)));
   }
   const glm::dvec3 specular = glm::mix(f0 * ab.x + f90 * ab.y, film * (ab.x + ab.y), s.iridescence);
-  sum += s.ao * ((1.0 - s.transmission) * c_diff * env.irradiance(s.n) + specular * env.prefiltered(reflected, r));
-  sum += s.ao * s.transmission * (1.0 - specular) * c_diff * s.through;
-  glm::dvec3 color = sum + s.emissive;
+  under += s.ao * ((1.0 - s.transmission) * c_diff * env.irradiance(s.n) + specular * env.prefiltered(reflected, r));
+  under += s.ao * s.transmission * (1.0 - specular) * c_diff * s.through;
+  glm::dvec3 color = sum + (under + s.emissive) * view_scale;
+  if (sheen_max > 0.0) color += s.ao * s.sheen_color * e_v * env.sheen(glm::reflect(-v, s.n), rs);
   if (s.clearcoat > 0.0) {
     const double rc = std::min(1.0, std::max(0.03, s.clearcoat_roughness)), nv = glm::dot(s.clearcoat_n, v);
     glm::dvec3 coat(0.0);

@@ -72,13 +72,21 @@ struct SurfacePoint {
   glm::dvec3 anisotropy_t{1.0, 0.0, 0.0};  // the unit direction in world space (strength 0: isotropic)
   double iridescence = 0.0;                // KHR_materials_iridescence: factor x texture R, film ior,
   double iridescence_ior = 1.3, iridescence_thickness = 400.0;  // thickness in nm
+  glm::dvec3 sheen_color{0.0};   // KHR_materials_sheen: colour (factor x texture; 0: none) and roughness
+  double sheen_roughness = 0.0;  // (factor x texture A, before clamping to [0.07, 1])
 };
+
+// KHR_materials_sheen's lobe D V n.l (the extension's implementation notes: the Charlie distribution and
+// visibility, V at most 1) for the clamped sheen roughness s and unit n, v, l; 0 where n.l <= 0.
+double sheen_lobe_cos(double s, const glm::dvec3& n, const glm::dvec3& v, const glm::dvec3& l);
 
 // The environment's precomputed terms: I(n) (irradiance / pi), P(d, r) and the split-sum (A, B).
 struct EnvironmentTerms {
   std::function<glm::dvec3(const glm::dvec3&)> irradiance;
   std::function<glm::dvec3(const glm::dvec3&, double)> prefiltered;
-  std::function<glm::dvec2(double, double)> split_sum;  // (dot(n, v), r) -> (A, B)
+  std::function<glm::dvec2(double, double)> split_sum;         // (dot(n, v), r) -> (A, B)
+  std::function<glm::dvec3(const glm::dvec3&, double)> sheen;  // S(d, s): the Charlie-prefiltered levels
+  std::function<double(double, double)> sheen_albedo;          // (dot(n, v), s) -> E, the sheen's albedo
 };
 
 // exposure x (sum over lights of f E dot(n, l) + ao (c_diff I(n) + (F0 A + F90 B) P(reflect(-v, n), r)) + e);
@@ -95,6 +103,10 @@ double ggx_lobe_cos(double r, const glm::dvec3& n, const glm::dvec3& v, const gl
 // becomes C (1 - c Fc) + c Fc (sum over lights of ggx_lobe_cos(rc, nc) E + ao (A + B)(nc.v, rc)
 // P(reflect(-v, nc), rc)), Fc = 0.04 + 0.96 (1 - |nc.v|)^5, rc the clamped coat roughness, nc its
 // normal.
+// With a sheen of colour c (KHR_materials_sheen, m = max3(c), s the clamped sheen roughness), under the
+// coat: each light's f becomes f min(1 - m E(n.v), 1 - m E(n.l)) + c sheen_lobe_cos (the scalings
+// clamped to [0, 1]); the environment, transmission and emission terms are scaled by 1 - m E(n.v), and
+// ao c E(n.v) S(reflect(-v, n), s) is added.
 glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& lights, const EnvironmentTerms& env,
                      double exposure);
 

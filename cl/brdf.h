@@ -93,9 +93,9 @@ inline sfloat sheen_lambda(sfloat x, sfloat alpha) {
   const sfloat d = -1.97760f + 0.70367f * o, e = -4.32054f - 0.53913f * o;
   const sint low = x < 0.5f;
   const sfloat y = select(1.0f - x, x, low);
-  const sfloat ly = a / (1.0f + b * pow(y, c)) + d * y + e;
-  const sfloat half_l = a / (1.0f + b * exp2(-c)) + 0.5f * d + e; /* l(1/2) */
-  return exp(select(2.0f * half_l - ly, ly, low));
+  const sfloat ly = a / (1.0f + b * pow_lanes(y, c)) + d * y + e;
+  const sfloat half_l = a / (1.0f + b * exp2_lanes(-c)) + 0.5f * d + e; /* l(1/2) */
+  return exp2_lanes(select(2.0f * half_l - ly, ly, low) * 1.44269504089f);
 }
 
 /* D V n.l of the Charlie lobe (the extension's implementation notes): D = (2 + 1 / alpha) sin^(1 / alpha)
@@ -104,7 +104,7 @@ inline sfloat sheen_lambda(sfloat x, sfloat alpha) {
 inline sfloat sheen_lobe_cos(const Sheen* s, sfloat nv, sfloat nl, sfloat nh) {
   const sfloat alpha = s->r * s->r, inv = 1.0f / alpha;
   const sfloat sin2h = fmax(1.0f - nh * nh, 0.0f);
-  const sfloat D = (2.0f + inv) * pow(sin2h, 0.5f * inv) * (0.5f / PMR_PI_F);
+  const sfloat D = (2.0f + inv) * pow_lanes(sin2h, 0.5f * inv) * (0.5f / PMR_PI_F);
   const sfloat q = (1.0f + s->lambda_v + sheen_lambda(nl, alpha)) * 4.0f * nv;
   return select((sfloat)(0.0f), D * fmin(1.0f / q, nl), nl > 0.0f);
 }

@@ -43,42 +43,6 @@ inline void env_uv(global const PmrEnvironment* e, sfloat3 d, sfloat* u, sfloat*
   *v = env_atan2(sqrt(x * x + z * z), d.y) * PMR_INV_PI_F;
 }
 
-/* 2^x and log2(x) (x > 0, normal) for the geometric blend, to about 2e-7 relative (Cephes's exp2f and
- * logf polynomials), SW lanes at once. */
-inline sfloat env_exp2(sfloat x) {
-  x = clamp(x, -126.0f, 126.0f);
-  const sfloat k = rint(x), f = x - k; /* f in [-1/2, 1/2] */
-  sfloat p = (sfloat)(1.535336188319500e-4f);
-  p = p * f + 1.339887440266574e-3f;
-  p = p * f + 9.618437357674640e-3f;
-  p = p * f + 5.550332471162809e-2f;
-  p = p * f + 2.402264791363012e-1f;
-  p = p * f + 6.931472028550421e-1f;
-  const sfloat m = 1.0f + f * p;
-  return as_float8(as_int8(m) + (convert_int8(k) << 23));
-}
-
-inline sfloat env_log2(sfloat x) {
-  const sint bits = as_int8(x);
-  sint e = ((bits >> 23) & 0xff) - 127;
-  sfloat m = as_float8((bits & 0x007fffff) | 0x3f800000); /* [1, 2) */
-  const sint big = m > (sfloat)(1.41421356f);
-  m = select(m, m * 0.5f, big);
-  e -= big;                              /* -1 where true: e + 1 */
-  const sfloat z = m - 1.0f, z2 = z * z; /* z in [-0.29, 0.42): ln(1 + z) */
-  sfloat p = (sfloat)(7.0376836292e-2f);
-  p = p * z - 1.1514610310e-1f;
-  p = p * z + 1.1676998740e-1f;
-  p = p * z - 1.2420140846e-1f;
-  p = p * z + 1.4249322787e-1f;
-  p = p * z - 1.6668057665e-1f;
-  p = p * z + 2.0000714765e-1f;
-  p = p * z - 2.4999993993e-1f;
-  p = p * z + 3.3333331174e-1f;
-  const sfloat ln = z - 0.5f * z2 + z * z2 * p;
-  return ln * 1.44269504089f + convert_float8(e);
-}
-
 /* The four texels and weights of bilinear lookups at (u, v), one per lane, each lane on its own level
  * of W x H texels whose pole row starts at texel `first` of the data: texel centers at (j + 1/2) / W,
  * wrapping in u; v clamped half a texel beyond the outer rows' centers, between them and the pole rows
@@ -172,7 +136,7 @@ inline sfloat3 env_prefiltered(global const PmrEnvironment* e, global const floa
     /* a (b / a)^f interpolates a point light's peak exactly (environment.h); linear where a channel is 0 */
     const sfloat lin = ac[ch] + (bc[ch] - ac[ch]) * f;
     const sint geometric = !linear & (ac[ch] > 0.0f) & (bc[ch] > 0.0f);
-    sfloat p = select(lin, ac[ch] * env_exp2(f * env_log2(bc[ch] / ac[ch])), geometric);
+    sfloat p = select(lin, ac[ch] * exp2_lanes(f * log2_lanes(bc[ch] / ac[ch])), geometric);
     p = select(select(p, bc[ch], at_b), ac[ch], at_a);
     out[ch] = p * e->intensity;
   }
@@ -184,11 +148,15 @@ inline sfloat3 env_prefiltered(global const PmrEnvironment* e, global const floa
 inline sfloat3 env_sheen(global const PmrEnvironment* e, global const float4* data, sfloat u, sfloat v, sfloat s) {
   /* the levels are evenly spaced in log(s) */
   const float k = (PMR_SHEEN_LEVELS - 1) / -log2(PMR_SHEEN_MIN_ROUGHNESS);
-  const sfloat c = env_log2(clamp(s, PMR_SHEEN_MIN_ROUGHNESS, 1.0f) * (1.0f / PMR_SHEEN_MIN_ROUGHNESS)) * k;
+  const sfloat c = log2_lanes(clamp(s, PMR_SHEEN_MIN_ROUGHNESS, 1.0f) * (1.0f / PMR_SHEEN_MIN_ROUGHNESS)) * k;
   const sint l0 = min(convert_int8(c), PMR_SHEEN_LEVELS - 2);
   const sfloat f = c - convert_float8(l0);
-  const sint first = (sint)((int)e->sheen_first) + l0;
-  const sfloat3 a = env_fetch(data, env_level_taps(e, first, u, v)), b = env_fetch(data, env_level_taps(e, first + 1, u, v));
+  /* the sheen levels are all of one size and back to back: one set of taps, offset by whole levels */
+  global const PmrEnvLevel* L = &e->levels[e->sheen_first];
+  const int W = (int)L->width, H = (int)L->height, stride = W * (H + 2);
+  EnvTaps ta = env_taps((sint)(W), (sint)(H), (sint)((int)(L->offset / 4u)) + l0 * stride, u, v), tb = ta;
+  tb.i00 += stride, tb.i10 += stride, tb.i01 += stride, tb.i11 += stride;
+  const sfloat3 a = env_fetch(data, ta), b = env_fetch(data, tb);
   return s3_scale(s3_add(s3_scale(a, 1.0f - f), s3_scale(b, f)), (sfloat)(e->intensity));
 }
 

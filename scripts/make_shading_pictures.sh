@@ -24,6 +24,8 @@
 #                                       ClearCoatCarPaint (views 0 and N-1 of 9), the studio
 #   docs/shading_lobes.png              the Khronos sample models SpecularTest and IridescenceSuzanne,
 #                                       center views, the studio
+#   docs/shading_sheen.png              the Khronos sample model SheenCloth, views 0, N/2 and N-1 of 9,
+#                                       the studio
 #
 # usage: scripts/make_shading_pictures.sh [GLTF_DIR]
 #   GLTF_DIR   folder of the Khronos sample models (GLTF_DIR/Suzanne/glTF/Suzanne.gltf, ...); default
@@ -154,6 +156,14 @@ if present "$SPEC" "$OUT/shading_lobes.png" "$MODELS_HINT" && present "$IRID" "$
   render irid "$IRID" --views 9 --view-size 664x372 --zoom 1.4
   $PICTURES strip "$OUT/shading_lobes.png" "$(views spec 4)" "$(views irid 4)" \
     --check-center "$(center spec)" "$(center irid)"
+fi
+
+echo "== SheenCloth (KHR_materials_sheen)"
+SHEEN=$GLTF_DIR/SheenCloth/glTF/SheenCloth.gltf
+if present "$SHEEN" "$OUT/shading_sheen.png" "$MODELS_HINT"; then
+  render sheen "$SHEEN" --views 9 --view-size 498x279 --zoom 1.8
+  $PICTURES strip "$OUT/shading_sheen.png" "$(views sheen 0)" "$(views sheen 4)" "$(views sheen 8)" \
+    --check-center - "$(center sheen)" -
 fi
 
 if [ ${#skipped[@]} -gt 0 ]; then

@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "gltf_builder.h"
+#include "pipeline/material_tables.h"
 #include "pmr/error.h"
 #include "pmr/scene.h"
 #include "test_util.h"
@@ -497,6 +498,63 @@ TEST_F(SceneMaterialsTest, IridescenceIsRead) {
   EXPECT_EQ(warnings_with(s, "drawn without"), 0u) << all_warnings(s);
 }
 
+// KHR_materials_sheen (DESIGN 4c): colour and roughness factors and both textures read (the colour
+// sRGB, the roughness linear: the alpha of one packed texture); absent values are the extension's
+// defaults (colour 0: no sheen, roughness 0); bad ones replaced with a warning. The kernels' copy and
+// their feature flag (a colour of 0 turns the layer off).
+TEST_F(SceneMaterialsTest, SheenIsRead) {
+  GltfFile g;
+  g.doc["extensionsUsed"] = {"KHR_materials_sheen"};
+  const Quad q = quad(g);
+  g.add("images", {{"uri", png_uri(make_png(1, 1, 6, 8, {255, 128, 0, 200}))}});
+  g.add("textures", {{"source", 0}});
+  g.add("materials", {{"name", "Velvet"},
+                      {"extensions",
+                       {{"KHR_materials_sheen",
+                         {{"sheenColorFactor", {0.9, 0.5, 0.25}},
+                          {"sheenRoughnessFactor", 0.6},
+                          {"sheenColorTexture", {{"index", 0}}},
+                          {"sheenRoughnessTexture", {{"index", 0}}}}}}}});
+  g.add("materials", {{"name", "Defaults"}, {"extensions", {{"KHR_materials_sheen", json::object()}}}});
+  g.add("materials",
+        {{"name", "Bad"},
+         {"extensions", {{"KHR_materials_sheen", {{"sheenColorFactor", {2, 0.5}}, {"sheenRoughnessFactor", 3}}}}}});
+  json prims = json::array();
+  for (int m : {0, 1, 2})
+    prims.push_back(
+        {{"attributes", {{"POSITION", q.pos}, {"TEXCOORD_0", q.uv0}}}, {"indices", q.idx}, {"material", m}});
+  g.mesh(prims);
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+  const Scene s = load_scene(g.write(dir_, "sheen"));
+  ASSERT_EQ(s.material_inputs.size(), 4u);
+  const SceneMaterialInputs &velvet = s.material_inputs[1], &defaults = s.material_inputs[2],
+                            &bad = s.material_inputs[3];
+  EXPECT_TRUE(velvet.has_sheen);
+  EXPECT_EQ(glm::vec3(velvet.sheen_color[0], velvet.sheen_color[1], velvet.sheen_color[2]),
+            glm::vec3(0.9f, 0.5f, 0.25f));
+  EXPECT_FLOAT_EQ(velvet.sheen_roughness, 0.6f);
+  EXPECT_GE(velvet.slots[kSlotSheenColor].texture, 0);
+  EXPECT_TRUE(velvet.slots[kSlotSheenColor].srgb);
+  EXPECT_GE(velvet.slots[kSlotSheenRoughness].texture, 0);
+  EXPECT_FALSE(velvet.slots[kSlotSheenRoughness].srgb);
+  EXPECT_EQ(s.materials[1].sheen[3], 0.6f) << "the kernels' copy";
+  EXPECT_TRUE(defaults.has_sheen);
+  EXPECT_EQ(glm::vec3(defaults.sheen_color[0], defaults.sheen_color[1], defaults.sheen_color[2]), glm::vec3(0.0f));
+  EXPECT_EQ(defaults.sheen_roughness, 0.0f);
+  EXPECT_EQ(glm::vec3(bad.sheen_color[0], bad.sheen_color[1], bad.sheen_color[2]), glm::vec3(0.0f))
+      << "two numbers are no colour";
+  EXPECT_EQ(bad.sheen_roughness, 1.0f) << "clamped";
+  EXPECT_EQ(warnings_with(s, "material 2 KHR_materials_sheen has no valid sheenColorFactor"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "material 2 sheenRoughnessFactor is outside [0.0, 1.0]; clamped"), 1u) << all_warnings(s);
+  EXPECT_EQ(warnings_with(s, "drawn without"), 0u) << all_warnings(s);
+  const MaterialTables t = make_material_tables(s, true);
+  EXPECT_NE(t.materials[1].flags & PMR_MATERIAL_SHEEN, 0u);
+  EXPECT_EQ(t.materials[2].flags & PMR_MATERIAL_SHEEN, 0u) << "a colour of 0 turns the layer off";
+  EXPECT_EQ(t.materials[1].maps[PMR_MAP_SHEEN_ROUGHNESS].texture, t.materials[1].maps[PMR_MAP_SHEEN_COLOR].texture)
+      << "the packed roughness reads the colour's chain (the same alpha)";
+}
+
 TEST_F(SceneMaterialsTest, ATexCoordSetTheMeshLacksIsAnError) {
   GltfFile g;
   const Quad q = quad(g);
@@ -943,7 +1001,11 @@ TEST_F(SceneMaterialsTest, InfoListsLightsAndMaterialFeatures) {
              {"clearcoatNormalTexture", {{"index", 0}, {"scale", 0.5}}}}},
            {"KHR_materials_specular", {{"specularFactor", 0.5}, {"specularColorFactor", {1, 0.5, 0.25}}}},
            {"KHR_materials_anisotropy", {{"anisotropyStrength", 0.3}, {"anisotropyRotation", 1}}},
-           {"KHR_materials_iridescence", {{"iridescenceFactor", 1}}}}}});
+           {"KHR_materials_iridescence", {{"iridescenceFactor", 1}}},
+           {"KHR_materials_sheen",
+            {{"sheenColorFactor", {0.5, 0.25, 1}},
+             {"sheenRoughnessFactor", 0.7},
+             {"sheenRoughnessTexture", {{"index", 0}}}}}}}});
   g.doc["asset"]["generator"] = "Exporter\x1b[2J";
   const std::string path = g.write(dir_, "info");
   const test::CliRun r = test::run("info '" + path + "'");
@@ -959,7 +1021,8 @@ TEST_F(SceneMaterialsTest, InfoListsLightsAndMaterialFeatures) {
         "0 (default): alpha OPAQUE, single sided", "(generator: Exporter\\x1b[2J)",
         "transmission (texture 0 2x1, linear, set 0)", "clear coat 1 roughness 0.2 normal scale 0.5",
         "clear coat normal (texture 0 2x1, linear, set 0)", "specular 0.5 colour (1, 0.5, 0.25)",
-        "anisotropy 0.3 rotation 1", "iridescence 1 ior 1.3 thickness 100-400 nm"})
+        "anisotropy 0.3 rotation 1", "iridescence 1 ior 1.3 thickness 100-400 nm", "sheen (0.5, 0.25, 1) roughness 0.7",
+        "sheen roughness (texture 0 2x1, linear, set 0)"})
     EXPECT_NE(r.output.find(part), std::string::npos) << part << "\n" << r.output;
   EXPECT_EQ(r.output.find('\x1b'), std::string::npos) << "names are printed sanitized";
 }

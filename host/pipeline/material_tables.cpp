@@ -39,8 +39,15 @@ void texture_transform_matrix(const SceneTextureSlot& slot, float out[6]) {
 
 namespace {
 
-// The chain a texture slot samples: colour maps (sRGB), normal maps, or the other data maps.
-MipKind slot_kind(const SceneTextureSlot& slot, int k) {
+// The chain slot k of material `in` samples: colour maps (sRGB), normal maps, or the other data maps.
+// A slot read for its alpha alone (sheen roughness, specular weight) whose texture is also its colour
+// partner's (sheen colour, specular colour) samples the colour chain: both chains average alpha
+// linearly, so it reads the same values, and the kernels read the packed texture once.
+MipKind slot_kind(const SceneMaterialInputs& in, int k) {
+  const SceneTextureSlot& slot = in.slots[size_t(k)];
+  const int partner = k == kSlotSheenRoughness ? kSlotSheenColor : k == kSlotSpecular ? kSlotSpecularColor : -1;
+  if (partner >= 0 && in.slots[size_t(partner)].texture == slot.texture && in.slots[size_t(partner)].srgb)
+    return MipKind::Colour;
   return slot.srgb ? MipKind::Colour : texture_slot_is_normal_map(k) ? MipKind::Normal : MipKind::Data;
 }
 constexpr int kMipKinds = 3;
@@ -55,7 +62,7 @@ TextureUses texture_uses(const Scene& scene) {
     for (int k = 0; k < PMR_MAPS; ++k) {
       const SceneTextureSlot& slot = in.slots[size_t(k)];
       if (slot.texture >= 0 && size_t(slot.texture) < scene.textures.size())
-        u[size_t(slot_kind(slot, k))][size_t(slot.texture)] = true;
+        u[size_t(slot_kind(in, k))][size_t(slot.texture)] = true;
     }
   return u;
 }
@@ -174,7 +181,7 @@ MaterialTables make_material_tables(const Scene& scene, bool mips) {
                             " names a texture or TEXCOORD set the scene does not have");
       if (texture_slot_is_normal_map(k) && !has_tangents) continue;
       PmrTextureMap& map = m.maps[k];
-      map.texture = entry[size_t(slot_kind(slot, k))][size_t(slot.texture)];
+      map.texture = entry[size_t(slot_kind(in, k))][size_t(slot.texture)];
       map.texcoord = uint32_t(slot.texcoord);
       texture_transform_matrix(slot, map.uv_transform);
     }

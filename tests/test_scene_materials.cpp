@@ -75,6 +75,19 @@ Quad quad(GltfFile& g) {
   return q;
 }
 
+// The quad drawn once with each of glTF materials 0 .. n - 1 (POSITION, NORMAL, TEXCOORD_0), one node:
+// the file's mesh and scene.
+void quad_per_material(GltfFile& g, const Quad& q, int n) {
+  json prims = json::array();
+  for (int m = 0; m < n; ++m)
+    prims.push_back({{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}}},
+                     {"indices", q.idx},
+                     {"material", m}});
+  g.mesh(prims);
+  g.add("nodes", {{"mesh", 0}});
+  g.scene({0});
+}
+
 // ---- materials -------------------------------------------------------------------------------------------
 
 TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
@@ -418,14 +431,7 @@ TEST_F(SceneMaterialsTest, AnisotropyIsReadAndGetsTangents) {
   g.add("materials",
         {{"name", "Bad"},
          {"extensions", {{"KHR_materials_anisotropy", {{"anisotropyStrength", 3}, {"anisotropyRotation", "x"}}}}}});
-  json prims = json::array();
-  for (int m : {0, 1, 2})
-    prims.push_back({{"attributes", {{"POSITION", q.pos}, {"NORMAL", q.nrm}, {"TEXCOORD_0", q.uv0}}},
-                     {"indices", q.idx},
-                     {"material", m}});
-  g.mesh(prims);
-  g.add("nodes", {{"mesh", 0}});
-  g.scene({0});
+  quad_per_material(g, q, 3);
   const Scene s = load_scene(g.write(dir_, "aniso"));
   ASSERT_EQ(s.material_inputs.size(), 4u);
   EXPECT_TRUE(s.material_inputs[1].has_anisotropy);
@@ -468,13 +474,7 @@ TEST_F(SceneMaterialsTest, IridescenceIsRead) {
         {{"name", "Bad"},
          {"extensions",
           {{"KHR_materials_iridescence", {{"iridescenceIor", 0.5}, {"iridescenceThicknessMaximum", -1}}}}}});
-  json prims = json::array();
-  for (int m : {0, 1, 2})
-    prims.push_back(
-        {{"attributes", {{"POSITION", q.pos}, {"TEXCOORD_0", q.uv0}}}, {"indices", q.idx}, {"material", m}});
-  g.mesh(prims);
-  g.add("nodes", {{"mesh", 0}});
-  g.scene({0});
+  quad_per_material(g, q, 3);
   const Scene s = load_scene(g.write(dir_, "film"));
   ASSERT_EQ(s.material_inputs.size(), 4u);
   const SceneMaterialInputs &film = s.material_inputs[1], &defaults = s.material_inputs[2], &bad = s.material_inputs[3];
@@ -519,13 +519,7 @@ TEST_F(SceneMaterialsTest, SheenIsRead) {
   g.add("materials",
         {{"name", "Bad"},
          {"extensions", {{"KHR_materials_sheen", {{"sheenColorFactor", {2, 0.5}}, {"sheenRoughnessFactor", 3}}}}}});
-  json prims = json::array();
-  for (int m : {0, 1, 2})
-    prims.push_back(
-        {{"attributes", {{"POSITION", q.pos}, {"TEXCOORD_0", q.uv0}}}, {"indices", q.idx}, {"material", m}});
-  g.mesh(prims);
-  g.add("nodes", {{"mesh", 0}});
-  g.scene({0});
+  quad_per_material(g, q, 3);
   const Scene s = load_scene(g.write(dir_, "sheen"));
   ASSERT_EQ(s.material_inputs.size(), 4u);
   const SceneMaterialInputs &velvet = s.material_inputs[1], &defaults = s.material_inputs[2],

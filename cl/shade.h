@@ -399,22 +399,11 @@ inline LaneBaryGrad lane_bary_gradient(const LaneWinners* L) {
 }
 #endif
 
-/* The three vertices' TEXCOORD set of each lane's triangle (lanes `bits`, triangles tri[l]; others 0),
- * and the last map sampled for these lanes with its result: real materials pack several maps into one
- * texture (occlusion with metallic-roughness, sheen colour with its roughness), read once. */
+/* The three vertices' TEXCOORD set of each lane's triangle (lanes `bits`, triangles tri[l]; others 0). */
 typedef struct {
   uint set; /* which set (PMR_NO_KEY: none loaded yet) */
   sfloat u[3], v[3];
-  global const PmrTextureMap* last; /* 0: none yet */
-  bool last_srgb;
-  sfloat last_texel[4];
 } LaneTexcoords;
-
-/* Nothing loaded or sampled yet. */
-inline void texcoords_none(LaneTexcoords* C) {
-  C->set = PMR_NO_KEY;
-  C->last = 0;
-}
 
 /* Whether maps a and b read the same texels: texture, TEXCOORD set and transform. */
 inline bool same_texture_map(global const PmrTextureMap* a, global const PmrTextureMap* b) {
@@ -446,10 +435,6 @@ inline void lane_texcoords(const ShadeInputs* in, const uint* tri, uint bits, ui
  * of detail follows (trilinear); 0: level 0 (bilinear). out: RGBA, 4 vectors. */
 inline void sample_map_lanes(const ShadeInputs* in, global const PmrTextureMap* map, const uint* tri, uint bits,
                              sint act, sfloat3 b, const LaneBaryGrad* g, bool srgb, LaneTexcoords* C, sfloat* out) {
-  if (C->last && C->last_srgb == srgb && same_texture_map(C->last, map)) {
-    for (int k = 0; k < 4; ++k) out[k] = C->last_texel[k];
-    return;
-  }
   if (C->set != map->texcoord) lane_texcoords(in, tri, bits, map->texcoord, C);
   const sfloat uu = b.x * C->u[0] + b.y * C->u[1] + b.z * C->u[2], vv = b.x * C->v[0] + b.y * C->v[1] + b.z * C->v[2];
   global const float* m = map->uv_transform;
@@ -464,8 +449,16 @@ inline void sample_map_lanes(const ShadeInputs* in, global const PmrTextureMap* 
     lambda = texture_lod_lanes(m, &tex, dxu, dxv, dyu, dyv);
   }
   sample_texture_lanes(in->texels, in->srgb_lut, &tex, u, v, lambda, act, srgb, out);
-  C->last = map, C->last_srgb = srgb;
-  for (int k = 0; k < 4; ++k) C->last_texel[k] = out[k];
+}
+
+/* Map k of material `mat` into c, unless it reads the texels map `prev`, sampled into c just before
+ * (with the same decoding), read: real materials pack maps into one texture (occlusion with
+ * metallic-roughness, sheen roughness in the sheen colour's alpha), and c then already holds them. */
+inline void sample_map_after(const ShadeInputs* in, global const PmrMaterial* mat, int k, int prev,
+                             const LaneWinners* L, uint bits, sint take, sfloat3 b, const LaneBaryGrad* g, bool srgb,
+                             LaneTexcoords* C, sfloat* c) {
+  if (mat->maps[prev].texture >= 0 && same_texture_map(&mat->maps[prev], &mat->maps[k])) return;
+  sample_map_lanes(in, &mat->maps[k], L->tri, bits, take, b, g, srgb, C, c);
 }
 
 /* Where `take`, array x (SW floats) gets the lanes of value. */
@@ -504,7 +497,7 @@ inline void sample_coat_lanes(const ShadeInputs* in, global const PmrMaterial* m
 
 /* Whether map `alpha` (read for its alpha alone) is map `colour` (sRGB): then it is sampled decoded as
  * colour, its alpha being linear either way (the host gives both the colour chain: material_tables.cpp),
- * and the packed texture is read once (sample_map_lanes). */
+ * and the packed texture is read once (sample_map_after). */
 inline bool packed_alpha(global const PmrMaterial* mat, int alpha, int colour) {
   return mat->maps[colour].texture >= 0 && same_texture_map(&mat->maps[colour], &mat->maps[alpha]);
 }
@@ -518,8 +511,7 @@ inline void sample_sheen_lanes(const ShadeInputs* in, global const PmrMaterial* 
     for (int k = 0; k < 3; ++k) lanes_put(T->sheen_color[k], c[k], take);
   }
   if (mat->maps[PMR_MAP_SHEEN_ROUGHNESS].texture >= 0) {
-    sample_map_lanes(in, &mat->maps[PMR_MAP_SHEEN_ROUGHNESS], L->tri, bits, take, b, g,
-                     packed_alpha(mat, PMR_MAP_SHEEN_ROUGHNESS, PMR_MAP_SHEEN_COLOR), C, c);
+    sample_map_after(in, mat, PMR_MAP_SHEEN_ROUGHNESS, PMR_MAP_SHEEN_COLOR, L, bits, take, b, g, false, C, c);
     lanes_put(T->sheen_roughness, c[3], take);
   }
 }
@@ -548,7 +540,7 @@ inline void sample_material_lanes(const ShadeInputs* in, global const PmrMateria
     lanes_put(T->metallic, c[2], take), lanes_put(T->roughness, c[1], take);
   }
   if (mat->maps[PMR_MAP_OCCLUSION].texture >= 0) {
-    sample_map_lanes(in, &mat->maps[PMR_MAP_OCCLUSION], L->tri, bits, take, b, g, false, C, c);
+    sample_map_after(in, mat, PMR_MAP_OCCLUSION, PMR_MAP_METALLIC_ROUGHNESS, L, bits, take, b, g, false, C, c);
     lanes_put(T->ao, 1.0f + mat->occlusion_strength * (c[0] - 1.0f), take);
   }
   if (mat->maps[PMR_MAP_EMISSIVE].texture >= 0) {
@@ -570,7 +562,7 @@ inline void sample_material_lanes(const ShadeInputs* in, global const PmrMateria
     lanes_put(T->spec_weight, c[3], take);
   }
   if (mat->maps[PMR_MAP_SPECULAR_COLOR].texture >= 0) {
-    sample_map_lanes(in, &mat->maps[PMR_MAP_SPECULAR_COLOR], L->tri, bits, take, b, g, true, C, c);
+    sample_map_after(in, mat, PMR_MAP_SPECULAR_COLOR, PMR_MAP_SPECULAR, L, bits, take, b, g, true, C, c);
     for (int k = 0; k < 3; ++k) lanes_put(T->spec_color[k], c[k], take);
   }
   if (mat->maps[PMR_MAP_IRIDESCENCE].texture >= 0) {
@@ -648,7 +640,7 @@ inline void sample_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 b,
     todo &= ~bits;
     const sint take = ((sint)(bits) >> lane & 1) != 0;
     LaneTexcoords C;
-    texcoords_none(&C);
+    C.set = PMR_NO_KEY;
     sample_material_lanes(in, &in->materials[mat], L, bits, take, b, grad, pbr, &C, T);
   }
 }
@@ -723,10 +715,10 @@ inline sfloat3 environment_along(const ShadeInputs* in, sfloat3 d, sfloat r, sin
 }
 
 /* The environment's I(n) and P(d, r) per lane where `act` (cl/environment.h), d the reflected direction
- * (reflected_direction) at image coordinates (*du, *dv), or the uniform default of radiance L, for which
- * I(n) = P = L and no table is read. I is not needed (0) where metallic is 1 (c_diff = 0). */
+ * (reflected_direction), or the uniform default of radiance L, for which I(n) = P = L and no table is
+ * read. I is not needed (0) where metallic is 1 (c_diff = 0). */
 inline void environment_lanes(const ShadeInputs* in, sfloat3 n, sfloat3 d, sfloat metallic, sfloat r, sint act,
-                              sfloat3* irradiance, sfloat3* prefiltered, sfloat* du, sfloat* dv) {
+                              sfloat3* irradiance, sfloat3* prefiltered) {
   if (in->env->level_count == 0) {
     *irradiance = *prefiltered = s3_splat((float3)(in->P->env_radiance));
     return;
@@ -737,8 +729,7 @@ inline void environment_lanes(const ShadeInputs* in, sfloat3 n, sfloat3 d, sfloa
   const sint diffuse = act & (metallic < 1.0f);
   const sfloat3 zero = s3_splat((float3)(0.0f));
   *irradiance = any(diffuse) ? s3_select(zero, env_irradiance(in->env, in->env_data, un, vn), diffuse) : zero;
-  environment_uv(in, d, act, du, dv);
-  *prefiltered = environment_at(in, *du, *dv, r, act);
+  *prefiltered = environment_along(in, d, r, act);
 }
 
 /* The split-sum table's bilinear lookup for every lane, as pmr::split_sum (host/shading/environment.cpp)
@@ -970,19 +961,13 @@ inline sfloat3 sheen_view_scaled(const Sheen* s, sfloat3 x) {
 /* KHR_materials_sheen over the environment, in the lanes with sheen: `under` (the environment's, the
  * transmission's and the emission's light through the layer) scaled as the view sees it
  * (sheen_view_scaled), plus the sheen's environment term ao c E(n.v) S(reflect(-v, n), r) (the
- * Charlie-prefiltered levels; the uniform default's radiance without an image). (mu, mv): the image
- * coordinates of reflect(-v, n) where the caller has them (rows without anisotropy), else 0. */
-inline sfloat3 sheen_over_environment(const ShadeInputs* in, const LaneWinners* L, const Surface* S, sfloat3 under,
-                                      const sfloat* mu, const sfloat* mv) {
+ * Charlie-prefiltered levels; the uniform default's radiance without an image). */
+inline sfloat3 sheen_over_environment(const ShadeInputs* in, const LaneWinners* L, const Surface* S, sfloat3 under) {
   const Sheen* s = &S->sheen;
   sfloat3 light = s3_splat((float3)(in->P->env_radiance));
   if (in->env->level_count != 0) {
     sfloat u, v;
-    if (mu) {
-      u = *mu, v = *mv;
-    } else {
-      environment_uv(in, s3_sub(s3_scale(S->n, 2.0f * s3_dot(S->n, S->v)), S->v), L->act, &u, &v);
-    }
+    environment_uv(in, s3_sub(s3_scale(S->n, 2.0f * s3_dot(S->n, S->v)), S->v), L->act, &u, &v);
     light = env_sheen(in->env, in->env_data, u, v, s->r);
   }
   return s3_add(sheen_view_scaled(s, under), s3_scale(s3_mul(s->color, light), S->ao * s->e_v));
@@ -1034,8 +1019,7 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
   sfloat A, B;
   split_sum_lanes(in->split_sum, nv, r, &A, &B);
   sfloat3 irradiance, prefiltered;
-  sfloat du = 0.0f, dv = 0.0f; /* the image coordinates of the reflected direction */
-  environment_lanes(in, n, reflected_direction(S, L, nv), metallic, r, L->act, &irradiance, &prefiltered, &du, &dv);
+  environment_lanes(in, n, reflected_direction(S, L, nv), metallic, r, L->act, &irradiance, &prefiltered);
   /* transmission replaces the diffuse lobe */
   const sfloat kd = glass ? (1.0f - metallic) * (1.0f - transmission) : 1.0f - metallic;
   const sfloat ao = S->ao;
@@ -1054,10 +1038,7 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
   }
   sfloat3 lit = s3_add(s3_add(direct, ambient), S->emissive);
   if (sheen) /* the sheen between the view and the rest (the lights' layering is in f) */
-    lit = s3_select(lit,
-                    s3_add(direct, sheen_over_environment(in, L, S, s3_add(ambient, S->emissive), aniso ? 0 : &du,
-                                                          aniso ? 0 : &dv)),
-                    sheen->on);
+    lit = s3_select(lit, s3_add(direct, sheen_over_environment(in, L, S, s3_add(ambient, S->emissive))), sheen->on);
   if (coated) lit = coated_lanes(in, L, S, lit, coat_lights);
   return s3_select(lit, base, L->unlit);
 }
@@ -1176,7 +1157,7 @@ inline void mta_alpha_lanes(const ShadeInputs* in, const PmrMta* m, const long* 
                               s3_splat((float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1])));
     }
     LaneTexcoords C;
-    texcoords_none(&C);
+    C.set = PMR_NO_KEY;
     sfloat c[4];
     sample_map_lanes(in, &mat->maps[PMR_MAP_BASE_COLOR], tri, (1u << n) - 1u, vload_s(0, lane_index) < (sint)(n),
                      LANE3(b), trilinear ? &g : 0, true, &C, c);

@@ -699,19 +699,14 @@ inline void environment_uv(const ShadeInputs* in, sfloat3 d, sint act, sfloat* u
   env_uv(in->env, s3_select(up, d, act), u, v);
 }
 
-/* The environment image's P(d, r) per lane where `act` (0 elsewhere; idle lanes read roughness 1), d at
- * (u, v). */
-inline sfloat3 environment_at(const ShadeInputs* in, sfloat u, sfloat v, sfloat r, sint act) {
-  return s3_select(s3_splat((float3)(0.0f)),
-                   env_prefiltered(in->env, in->env_data, u, v, select((sfloat)(1.0f), r, act)), act);
-}
-
-/* The environment's P(d, r) per lane where `act` (0 elsewhere), or the uniform default's radiance. */
+/* The environment's P(d, r) per lane where `act` (0 elsewhere; idle lanes read roughness 1), or the
+ * uniform default's radiance. */
 inline sfloat3 environment_along(const ShadeInputs* in, sfloat3 d, sfloat r, sint act) {
   if (in->env->level_count == 0) return s3_splat((float3)(in->P->env_radiance));
   sfloat u, v;
   environment_uv(in, d, act, &u, &v);
-  return environment_at(in, u, v, r, act);
+  return s3_select(s3_splat((float3)(0.0f)),
+                   env_prefiltered(in->env, in->env_data, u, v, select((sfloat)(1.0f), r, act)), act);
 }
 
 /* The environment's I(n) and P(d, r) per lane where `act` (cl/environment.h), d the reflected direction

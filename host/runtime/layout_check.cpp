@@ -33,8 +33,8 @@ static_assert(sizeof(PmrEncodeParams) == 48 && offsetof(PmrEncodeParams, display
 static_assert(sizeof(PmrEncodeColumn) == 16 && sizeof(PmrEncodeRow) == 16, "encoder table layout");
 static_assert(sizeof(PmrSampleChunk) == 32, "PmrSampleChunk layout");
 static_assert(sizeof(PmrEnvLevel) == 16 && offsetof(PmrEnvLevel, roughness) == 12, "PmrEnvLevel layout");
-static_assert(sizeof(PmrEnvironment) == 36 + 16 * PMR_ENV_MAX_LEVELS && offsetof(PmrEnvironment, intensity) == 24 &&
-                  offsetof(PmrEnvironment, levels) == 36,
+static_assert(sizeof(PmrEnvironment) == 48 + 16 * PMR_ENV_MAX_LEVELS && offsetof(PmrEnvironment, intensity) == 24 &&
+                  offsetof(PmrEnvironment, levels) == 48,
               "PmrEnvironment layout");
 static_assert(offsetof(PmrParams, num_lights) == 280, "PmrParams layout");
 static_assert(sizeof(PmrLight) == 64 && offsetof(PmrLight, type) == 12 && offsetof(PmrLight, range) == 28 &&

@@ -403,6 +403,7 @@ typedef struct {
   pmr_u32 sheen_first;              /* the first Charlie-prefiltered level (= level_count)          */
   float intensity;                  /* multiplies every radiance read (0 = off)                     */
   float rotation_cos, rotation_sin; /* of the map's rotation (counter-clockwise seen from above) */
+  pmr_u32 pad[3];                   /* the levels 16-byte aligned: each lane's lookup reads its level's */
   PmrEnvLevel levels[PMR_ENV_MAX_LEVELS];
 } PmrEnvironment;
 

@@ -63,7 +63,7 @@ TEST(Sheen, AlbedoTableMatchesNumericalIntegration) {
 }
 
 // test::add_feature_quads:
-// 1. a grey dielectric under a white sheen of roughness 0.6;
+// 1. a dark grey dielectric under a white sheen of roughness 0.25;
 // 2. a red dielectric under a sheen colour texture (times (1, 0.6, 0.4)) and a roughness texture (A, 0.5
 //    to 1), roughness factor 0.9;
 // 3. a metal under a blue sheen of roughness 1 and a clear coat;
@@ -73,7 +73,7 @@ Scene sheen_quads() {
   const int color =
       test::add_texture16(s, [](int x, int y) { return glm::dvec4(0.5 + x / 30.0, 0.4 + y / 25.0, 1, 1); });
   const int rough = test::add_texture16(s, [](int x, int y) { return glm::dvec4(0, 0, 0, 0.5 + (x + y) / 60.0); });
-  test::add_feature_quads(s, {{{0.4f, 0.4f, 0.4f}, {0.6f, 0.1f, 0.1f}, {0.8f, 0.7f, 0.5f}, {0.4f, 0.4f, 0.4f}}},
+  test::add_feature_quads(s, {{{0.03f, 0.03f, 0.03f}, {0.6f, 0.1f, 0.1f}, {0.8f, 0.7f, 0.5f}, {0.03f, 0.03f, 0.03f}}},
                           [&](int q, SceneMaterialInputs& in) {
                             in.metallic = q == 2 ? 1.0f : 0.0f;
                             in.roughness = 0.4f + 0.1f * float(q % 3);
@@ -83,7 +83,7 @@ Scene sheen_quads() {
                                                 : q == 2 ? glm::vec3(0.3f, 0.4f, 1.0f)
                                                          : glm::vec3(0.0f);
                             for (int k = 0; k < 3; ++k) in.sheen_color[k] = c[k];
-                            in.sheen_roughness = q == 0 ? 0.6f : q == 1 ? 0.9f : 1.0f;
+                            in.sheen_roughness = q == 0 ? 0.25f : q == 1 ? 0.9f : 1.0f;
                             if (q == 1) {
                               in.slots[kSlotSheenColor].texture = color, in.slots[kSlotSheenColor].srgb = true;
                               in.slots[kSlotSheenRoughness].texture = rough;
@@ -101,11 +101,12 @@ Scene without_sheen(Scene s) {
 
 // Under a point light (and the uniform environment) every shaded voxel is within 1% + 1e-3 of the
 // reference, which evaluates the lobe and the layering from the scene's inputs itself; without the
-// sheen the reference leaves that bound on over a third of each sheen quad's voxels.
+// sheen the reference leaves that bound on over a sixth of each sheen quad's voxels (measured: 19% on
+// the sheen of roughness 0.25, which shows at grazing angles only).
 TEST(Sheen, EveryShadedVoxelMatchesTheReference) {
   const Scene s = sheen_quads();
   const double worst =
-      test::expect_feature_matches_reference(s, without_sheen(s), {test::reference_light(s.lights[0])}, 4, 3);
+      test::expect_feature_matches_reference(s, without_sheen(s), {test::reference_light(s.lights[0])}, 4, 6);
   std::printf("[ sheen    ] largest error %.3f of the bound\n", worst);
 }
 

@@ -100,7 +100,8 @@ inline sfloat sheen_lambda(sfloat x, sfloat alpha) {
 
 /* D V n.l of the Charlie lobe (the extension's implementation notes): D = (2 + 1 / alpha) sin^(1 / alpha)
  * (theta_h) / (2 pi), V = 1 / ((1 + Lambda(n.v) + Lambda(n.l)) 4 n.v n.l) at most 1 (as the Sample Viewer
- * clamps it: bounded at grazing views), for the clamped cosines given; 0 where n.l = 0. */
+ * clamps it: bounded at grazing views), for the clamped cosines given (n.v at least PMR_SHEEN_MIN_COS);
+ * 0 where n.l = 0. */
 inline sfloat sheen_lobe_cos(const Sheen* s, sfloat nv, sfloat nl, sfloat nh) {
   const sfloat alpha = s->r * s->r, inv = 1.0f / alpha;
   const sfloat sin2h = fmax(1.0f - nh * nh, 0.0f);

@@ -874,7 +874,7 @@ inline void surface_sheen(Surface* S, const ShadeInputs* in, const LaneWinners* 
   sfloat3 c = L->sheen_color;
   sfloat r = L->sheen_roughness;
   if (textured) c = s3_mul(c, LANE3(T->sheen_color)), r *= vload_s(0, T->sheen_roughness);
-  const sfloat nv = clamp(s3_dot(S->n, S->v), 0.0f, 1.0f);
+  const sfloat nv = clamp(s3_dot(S->n, S->v), PMR_SHEEN_MIN_COS, 1.0f);
   S->sheen.on = L->sheen;
   S->sheen.color = c;
   S->sheen.r = clamp(r, PMR_SHEEN_MIN_ROUGHNESS, 1.0f);
@@ -937,7 +937,7 @@ inline sfloat3 coated_lanes(const ShadeInputs* in, const LaneWinners* L, const S
  * the extension's albedo scaling min(1 - m E(n.v), 1 - m E(n.l)) (clamped to [0, 1]), plus the sheen
  * lobe c D V n.l. Lanes without sheen keep f bit for bit. */
 inline sfloat3 sheen_over_light(const ShadeInputs* in, const Sheen* s, sfloat3 f, sfloat3 n, sfloat3 v, sfloat3 l) {
-  const sfloat nl = clamp(s3_dot(n, l), 0.0f, 1.0f), nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
+  const sfloat nl = clamp(s3_dot(n, l), 0.0f, 1.0f), nv = clamp(s3_dot(n, v), PMR_SHEEN_MIN_COS, 1.0f);
   const sfloat3 hv = s3_add(l, v);
   const sfloat hl = sqrt(s3_dot(hv, hv));
   const sfloat3 h = s3_select(n, s3_scale(hv, 1.0f / hl), hl > 0.0f);

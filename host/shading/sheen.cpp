@@ -30,7 +30,8 @@ double sheen_lambda(double cos_theta, double alpha) {
 double sheen_roughness(double r) { return std::isfinite(r) ? std::clamp(r, kSheenMinRoughness, 1.0) : 1.0; }
 
 double sheen_lobe_cos(double nv, double nl, double nh, double r) {
-  if (nl <= 0.0 || nv < 0.0) return 0.0;
+  if (nl <= 0.0) return 0.0;
+  nv = std::max(nv, kSheenMinCos);
   const double alpha = r * r, sin2h = std::max(0.0, 1.0 - nh * nh);
   const double D = (2.0 + 1.0 / alpha) * std::pow(sin2h, 0.5 / alpha) / (2.0 * kPi);
   // V n.l with V at most 1 (as the Sample Viewer clamps it): bounded at grazing views
@@ -40,7 +41,7 @@ double sheen_lobe_cos(double nv, double nl, double nh, double r) {
 
 double sheen_albedo_integral(double nv, double r) {
   r = sheen_roughness(r);
-  nv = std::clamp(nv, 0.0, 1.0);
+  nv = std::clamp(nv, kSheenMinCos, 1.0);
   const double vx = std::sqrt(1.0 - nv * nv);
   // h = (sin t cos p, sin t sin p, cos t), p in [0, pi] (the integrand is even in p), l = 2 (v.h) h - v,
   // dl = 4 (v.h) dh, dh = sin t dt dp

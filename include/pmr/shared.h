@@ -129,6 +129,9 @@ typedef uint64_t pmr_u64;
  * PMR_SHEEN_MIN_ROUGHNESS + (1 - PMR_SHEEN_MIN_ROUGHNESS) j / (N - 1), stored at j * N + i. */
 #define PMR_SHEEN_MIN_ROUGHNESS 0.07f
 #define PMR_SHEEN_ALBEDO_N 32
+/* The sheen reads n.v at least this: at n.v = 0 exactly its visibility's clamp makes the lobe and its
+ * albedo jump to 1.2 to 2.4 times their values just above (host/shading/sheen.h). */
+#define PMR_SHEEN_MIN_COS 1e-4f
 
 /* PmrParams.texture_filter (--texture-filter): level 0 alone, bilinear (the textures have no mips);
  * or trilinear between the mip levels around the analytic level of detail (DESIGN section 3b). */

@@ -83,7 +83,7 @@ double ggx_lobe_cos(double r, const glm::dvec3& n, const glm::dvec3& v, const gl
 double sheen_lobe_cos(double s, const glm::dvec3& n, const glm::dvec3& v, const glm::dvec3& l) {
   const double nl = clamp01(glm::dot(n, l));
   if (nl <= 0.0) return 0.0;
-  const double nv = clamp01(glm::dot(n, v)), a = s * s;
+  const double nv = std::max(clamp01(glm::dot(n, v)), 1e-4), a = s * s;  // PMR_SHEEN_MIN_COS
   const glm::dvec3 hv = l + v;
   const glm::dvec3 h = glm::length(hv) > 0.0 ? glm::normalize(hv) : n;
   const double nh = clamp01(glm::dot(n, h)), sin_h = std::sqrt(std::max(0.0, 1.0 - nh * nh));

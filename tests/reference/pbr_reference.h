@@ -77,7 +77,8 @@ struct SurfacePoint {
 };
 
 // KHR_materials_sheen's lobe D V n.l (the extension's implementation notes: the Charlie distribution and
-// visibility, V at most 1) for the clamped sheen roughness s and unit n, v, l; 0 where n.l <= 0.
+// visibility, V at most 1) for the clamped sheen roughness s and unit n, v, l, n.v read at least 1e-4 (at
+// 0 exactly V's clamp makes the lobe jump); 0 where n.l <= 0.
 double sheen_lobe_cos(double s, const glm::dvec3& n, const glm::dvec3& v, const glm::dvec3& l);
 
 // The environment's precomputed terms: I(n) (irradiance / pi), P(d, r) and the split-sum (A, B).
@@ -105,7 +106,8 @@ double ggx_lobe_cos(double r, const glm::dvec3& n, const glm::dvec3& v, const gl
 // normal.
 // With a sheen of colour c (KHR_materials_sheen, m = max3(c), s the clamped sheen roughness), under the
 // coat: each light's f becomes f min(1 - m E(n.v), 1 - m E(n.l)) + c sheen_lobe_cos (the scalings
-// clamped to [0, 1]); the environment, transmission and emission terms are scaled by 1 - m E(n.v), and
+// clamped to [0, 1]; n.v at least 1e-4); the environment, transmission and emission terms are scaled by
+// 1 - m E(n.v), and
 // ao c E(n.v) S(reflect(-v, n), s) is added.
 glm::dvec3 pbr_color(const SurfacePoint& s, const std::vector<PunctualLight>& lights, const EnvironmentTerms& env,
                      double exposure);

@@ -25,7 +25,8 @@ using test::add_texture16;
 using test::render_pbr;
 
 // test::add_feature_quads, roughness 0.3 .. 0.5:
-// 1. a dark dielectric (where the specular term shows), specular weight 0.5 and colour (1, 0.6, 0.2);
+// 1. a dark dielectric (where the specular term shows), specular weight 0.5 and colour (1, 0.6, 0.2) times
+//    one texture holding both (sRGB colour, weight in alpha: the kernels read it once);
 // 2. a grey dielectric of ior 1.8 whose colour (3, 10, 30) clips F0 to 1 in green and blue;
 // 3. a half-metal with a specularTexture (A) and an sRGB specularColorTexture on TEXCOORD_0;
 // 4. material 1 without the extension.
@@ -34,12 +35,17 @@ Scene specular_quads() {
   const int weight =
       add_texture16(s, [](int x, int y) { return glm::dvec4(0.0, 0.0, 0.0, 0.1 + 0.05 * x + 0.01 * y); });
   const int colour = add_texture16(s, [](int x, int y) { return glm::dvec4(x / 15.0, 0.3 + 0.04 * y, 0.8, 1.0); });
+  const int packed =
+      add_texture16(s, [](int x, int y) { return glm::dvec4(0.6 + 0.02 * y, 1.0, 0.5 + x / 30.0, 0.5 + 0.03 * x); });
   test::add_feature_quads(s, {{{0.1f, 0.1f, 0.1f}, {0.4f, 0.4f, 0.4f}, {0.7f, 0.3f, 0.2f}, {0.1f, 0.1f, 0.1f}}},
                           [&](int q, SceneMaterialInputs& in) {
                             in.metallic = q == 2 ? 0.5f : 0.0f;
                             in.roughness = 0.3f + 0.1f * float(q % 3);
                             in.has_specular = q < 3;
-                            if (q == 0) in.specular = 0.5f, in.specular_color[1] = 0.6f, in.specular_color[2] = 0.2f;
+                            if (q == 0) {
+                              in.specular = 0.5f, in.specular_color[1] = 0.6f, in.specular_color[2] = 0.2f;
+                              in.slots[kSlotSpecular].texture = in.slots[kSlotSpecularColor].texture = packed;
+                            }
                             if (q == 1) {
                               in.ior = 1.8f;
                               in.specular_color[0] = 3.0f, in.specular_color[1] = 10.0f, in.specular_color[2] = 30.0f;

@@ -24,16 +24,34 @@ inline glm::dvec3 unit_or_up(const glm::dvec3& d) {
 
 }  // namespace
 
-glm::dvec2 split_sum(double n_dot_v, double r) {
-  const std::vector<float>& t = split_sum_table();
-  const int N = kEnvSplitSumSize;
-  const double x = std::sqrt(std::clamp(std::isfinite(n_dot_v) ? n_dot_v : 0.0, 0.0, 1.0)) * (N - 1);
-  const double y = std::clamp(std::isfinite(r) ? r : 1.0, 0.0, 1.0) * (N - 1);
+namespace {
+
+// Bilinear lookup of an N x N table of C-float nodes, node (i, j) at C (j N + i), at node coordinates
+// (x, y) in [0, N - 1]: the split-sum and sheen albedo tables, as the kernels read them.
+template <int C>
+glm::vec<C, double> node_bilinear(const std::vector<float>& t, int N, double x, double y) {
   const int i0 = std::min(int(x), N - 2), j0 = std::min(int(y), N - 2);
   const double fx = x - i0, fy = y - j0;
-  auto at = [&](int i, int j) { return glm::dvec2(t[size_t(2 * (j * N + i))], t[size_t(2 * (j * N + i) + 1)]); };
+  auto at = [&](int i, int j) {
+    glm::vec<C, double> v;
+    for (int c = 0; c < C; ++c) v[c] = t[size_t(C * (j * N + i) + c)];
+    return v;
+  };
   return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i0 + 1, j0)) +
          fy * ((1 - fx) * at(i0, j0 + 1) + fx * at(i0 + 1, j0 + 1));
+}
+
+// sqrt(n.v) in node units (non-finite: 0), the tables' first coordinate.
+double cosine_node(double n_dot_v, int N) {
+  return std::sqrt(std::clamp(std::isfinite(n_dot_v) ? n_dot_v : 0.0, 0.0, 1.0)) * (N - 1);
+}
+
+}  // namespace
+
+glm::dvec2 split_sum(double n_dot_v, double r) {
+  const int N = kEnvSplitSumSize;
+  const double y = std::clamp(std::isfinite(r) ? r : 1.0, 0.0, 1.0) * (N - 1);
+  return node_bilinear<2>(split_sum_table(), N, cosine_node(n_dot_v, N), y);
 }
 
 const std::vector<float>& sheen_albedo_table() {
@@ -43,15 +61,9 @@ const std::vector<float>& sheen_albedo_table() {
 }
 
 double sheen_albedo(double nv, double r) {
-  const std::vector<float>& t = sheen_albedo_table();
   const int N = kSheenAlbedoSize;
-  const double x = std::sqrt(std::clamp(std::isfinite(nv) ? nv : 0.0, 0.0, 1.0)) * (N - 1);
   const double y = (sheen_roughness(r) - kSheenMinRoughness) / (1.0 - kSheenMinRoughness) * (N - 1);
-  const int i0 = std::min(int(x), N - 2), j0 = std::min(int(y), N - 2);
-  const double fx = x - i0, fy = y - j0;
-  auto at = [&](int i, int j) { return double(t[size_t(j * N + i)]); };
-  return (1 - fy) * ((1 - fx) * at(i0, j0) + fx * at(i0 + 1, j0)) +
-         fy * ((1 - fx) * at(i0, j0 + 1) + fx * at(i0 + 1, j0 + 1));
+  return node_bilinear<1>(sheen_albedo_table(), N, cosine_node(nv, N), y).x;
 }
 
 Environment Environment::uniform(double radiance) {

@@ -27,7 +27,7 @@ using test::temp_dir;
 // A quad at the origin and five cameras, each on its own node:
 //   camera 0 'cam'   on node 'Front' at (0, 0, 5);
 //   camera 1 'Front' on node 'Side'  at (5, 0, 0), turned to look at the origin;
-//   cameras 2 and 3 on two nodes both named 'Twin';
+//   cameras 2 '1' and 3 'b' on two nodes both named 'Twin';
 //   camera 4 'Solo'  on an unnamed node at (0, 0, 3);
 //   camera 0 again on node 'Second' at (0, 0, 7): scene camera 5, its own pose (Blender exports camera
 //   objects that share their data so).
@@ -37,7 +37,7 @@ std::string cameras_file(const std::string& dir) {
   const int i = g.data<uint16_t>({0, 1, 2, 0, 2, 3}, test::kUShort, "SCALAR");
   g.mesh(json::array({{{"attributes", {{"POSITION", p}}}, {"indices", i}}}));
   g.add("nodes", {{"mesh", 0}});
-  for (const char* name : {"cam", "Front", "a", "b", "Solo"})
+  for (const char* name : {"cam", "Front", "1", "b", "Solo"})
     g.add("cameras", {{"name", name}, {"type", "perspective"}, {"perspective", {{"yfov", 0.6}, {"znear", 0.05}}}});
   const float s = std::sqrt(0.5f);  // yaw +90 degrees: -Z turns to -X
   g.add("nodes", {{"name", "Front"}, {"camera", 0}, {"translation", {0, 0, 5}}});
@@ -59,13 +59,14 @@ TEST(CameraChoice, ByIndexNodeNameOrCameraName) {
   EXPECT_EQ(scene.cameras[5].world_from_camera[3], glm::dvec4(0, 0, 7, 1));
   EXPECT_EQ(scene.cameras[0].world_from_camera[3], glm::dvec4(0, 0, 5, 1));
   EXPECT_EQ(find_camera(scene, "Second"), 5);
-  EXPECT_EQ(find_camera(scene, "0"), 0);
-  EXPECT_EQ(find_camera(scene, "4"), 4);
+  EXPECT_EQ(find_camera(scene, "#0"), 0);
+  EXPECT_EQ(find_camera(scene, "#4"), 4);
   EXPECT_EQ(find_camera(scene, "Side"), 1);
   EXPECT_EQ(find_camera(scene, "Front"), 0) << "a node's name comes before a camera's";
   EXPECT_EQ(find_camera(scene, "cam"), 0);
   EXPECT_EQ(find_camera(scene, "Solo"), 4);
   EXPECT_EQ(find_camera(scene, "b"), 3);
+  EXPECT_EQ(find_camera(scene, "1"), 2) << "a camera named 1 is chosen by its name, not taken for index 1";
   auto message = [&](const std::string& name) {
     try {
       find_camera(scene, name);
@@ -76,8 +77,13 @@ TEST(CameraChoice, ByIndexNodeNameOrCameraName) {
   };
   EXPECT_NE(message("Twin").find("ambiguous"), std::string::npos) << message("Twin");
   EXPECT_EQ(find_camera(scene, "cam"), 0) << "a camera's own name is the file's camera, not a further node's";
-  EXPECT_NE(message("6").find("the scene has 6 camera(s)"), std::string::npos) << message("6");
-  EXPECT_NE(message("99999999999999999999").find("6 camera(s)"), std::string::npos);
+  EXPECT_NE(message("#6").find("the scene has 6 camera(s)"), std::string::npos) << message("#6");
+  EXPECT_NE(message("#99999999999999999999").find("is not a number"), std::string::npos);
+  EXPECT_NE(message("#x").find("is not a number"), std::string::npos);
+  // a bare number is a name: none has it here, and the message shows how to write the index
+  EXPECT_NE(message("4").find("no camera node or camera of the scene has that name (an index is written #4"),
+            std::string::npos)
+      << message("4");
   EXPECT_NE(message("side").find("no camera node or camera"), std::string::npos) << "names are case-sensitive";
   EXPECT_NE(message("\x1b[2J").find("\\x1b"), std::string::npos) << "the name is made printable";
 }
@@ -112,8 +118,8 @@ TEST(CameraChoice, NamedCameraFromTheCommandLine) {
   EXPECT_FALSE(test::exists(dir + "/twin"));
   EXPECT_FALSE(test::exists(dir + "/nobody"));
   const std::string info = run("info " + file).output;
-  EXPECT_NE(info.find("placed by node 'Side' (--camera 1)"), std::string::npos) << info;
-  EXPECT_NE(info.find("placed by node 'Second', a further node of camera 0 (--camera 5)"), std::string::npos) << info;
+  EXPECT_NE(info.find("placed by node 'Side' (--camera '#1')"), std::string::npos) << info;
+  EXPECT_NE(info.find("placed by node 'Second', a further node of camera 0 (--camera '#5')"), std::string::npos) << info;
   // the further node drives the rig from its own pose
   ASSERT_EQ(run("render " + file + small + "--camera Second --out " + dir + "/second").status, 0);
   const json second = json::parse(test::read_file(dir + "/second/frame_0000.json"));

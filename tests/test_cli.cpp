@@ -107,7 +107,8 @@ TEST(Cli, BadInputsFailBeforeWritingAnything) {
   std::ofstream(bad + "/file") << "x";
   expect_one_error_line(run("render --view-size 32x16 --display 64x36 --out '" + bad + "/file/sub'"), "output folder");
   // --camera beyond the scene's cameras
-  expect_one_error_line(run("render --camera 3 --view-size 32x16 --display 64x36 --out " + out), "--camera 3");
+  expect_one_error_line(run("render --camera '#3' --view-size 32x16 --display 64x36 --out " + out),
+                        "--camera '#3': the scene has 0 camera(s)");
 }
 
 TEST(Cli, SmallRenderWritesReadableFiles) {

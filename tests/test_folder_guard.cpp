@@ -34,6 +34,7 @@ namespace fs = std::filesystem;
 using test::CliRun;
 using test::expect_one_error_line;
 using test::run;
+using test::start;
 using test::temp_dir;
 
 const std::string kSmall = " --turntable 360:8 --views 4 --view-size 64x32 --display 240x135 -q ";
@@ -76,16 +77,6 @@ std::string sidecar_of(const std::string& name, const std::string& args) {
   const std::string dir = temp_dir(name);
   EXPECT_EQ(run("render --frames 0" + args + "--out " + dir).status, 0);
   return test::read_file(dir + "/frame_0000.json");
-}
-
-pid_t start(const std::string& args) {
-  const pid_t pid = fork();
-  if (pid == 0) {
-    const std::string cmd = std::string(PMR_BINARY) + " " + args + " > /dev/null 2>&1";
-    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), (char*)nullptr);
-    _exit(127);
-  }
-  return pid;
 }
 
 int wait_exit(pid_t pid) {

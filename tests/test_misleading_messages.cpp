@@ -144,5 +144,40 @@ TEST(MisleadingMessages, RunningOutOfMemoryIsNotAnInvalidFile) {
   EXPECT_EQ(r.output.find("not a valid glTF file"), std::string::npos) << r.output;
 }
 
+// Each limit is named with the value the user gave: a glTF camera's tiny yfov (not "the view cone is
+// too wide"), an environment's side (not its texel count), and the memory an environment decodes to.
+TEST(MisleadingMessages, LimitsAreNamedWithTheValueGiven) {
+  const std::string dir = temp_dir("limit_messages");
+  std::filesystem::create_directories(dir);
+  // a Radiance header of 33554432 x 1 texels: 33554432 texels in all, but far wider than a side may be
+  std::ofstream(dir + "/wide.hdr") << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 33554432\n";
+  CliRun r = run("render --environment " + dir + "/wide.hdr --out " + dir + "/o1 --views 2 --view-size 32x16");
+  expect_one_error_line(r, "the image is too large (33554432x1); environments may be at most 16384 texels on a side");
+  // 8192 x 4096, run-length encoded (2 MB): decoding and prefiltering it needs about 1.5 GB
+  std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4096 +X 8192\n";
+  std::string row = {2, 2, char(0x20), 0};
+  for (int channel = 0; channel < 4; ++channel) {
+    for (int run = 0; run < 64; ++run) row += {char(128 + 127), char(channel == 3 ? 128 : 10)};
+    row += {char(128 + 64), char(channel == 3 ? 128 : 10)};
+  }
+  for (int y = 0; y < 4096; ++y) hdr += row;
+  std::ofstream(dir + "/big.hdr", std::ios::binary) << hdr;
+  r = run("render --environment " + dir + "/big.hdr --limit memory=256M --out " + dir + "/o2 --views 2 --view-size 32x16");
+  expect_one_error_line(r, "out of memory: decoding the 8192x4096 environment");
+  // a glTF camera with yfov 1e-7: the disparity leaves the fixed-point range; the message says why
+  const std::string gltf = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+    "nodes": [{"mesh": 0}, {"camera": 0, "translation": [0, 0, 5]}],
+    "cameras": [{"type": "perspective", "perspective": {"yfov": 1e-7, "znear": 0.1}}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                   "min": [-1, -1, 0], "max": [1, 1, 0]}],
+    "bufferViews": [{"buffer": 0, "byteLength": 36}],
+    "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,AACAvwAAgL8AAAAAAACAPwAAgL8AAAAAAAAAAAAAgD8AAAAA"}]})";
+  std::ofstream(dir + "/narrow.gltf") << gltf;
+  r = run("render " + dir + "/narrow.gltf --camera '#0' --out " + dir + "/o3 --views 4 --view-size 32x16");
+  expect_one_error_line(r, "a vertical field of view of 5.72958e-06 degrees (the glTF camera's yfov)");
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace pmr

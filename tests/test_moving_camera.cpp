@@ -155,7 +155,7 @@ TEST(MovingCamera, AFrameFacingAwayFailsAndTheOthersRender) {
   std::filesystem::create_directories(dir);
   const std::string file = dolly_file(dir);
   const std::string common =
-      " --camera 0 --views 8 --view-size 48x24 --display 96x54 --shading lambert --write encoded";
+      " --camera '#0' --views 8 --view-size 48x24 --display 96x54 --shading lambert --write encoded";
   const CliRun far_frame = run("render " + file + common + " --frames 24 --out " + dir + "/one");
   EXPECT_EQ(far_frame.status, 0) << far_frame.output;
   EXPECT_EQ(far_frame.output.find("nothing visible"), std::string::npos) << far_frame.output;

@@ -68,12 +68,17 @@ TEST(Names, FrameFieldsAndTheirStems) {
 TEST(Names, RefusedSpellingsShowAnAcceptedExample) {
   // space-padded, other conversions, two fields, folders, empty and hidden stems
   for (const char* bad : {"shot_%4d", "shot_%x", "shot_%s", "shot_%", "%-4d", "a_%d_%d", "a_##_%d", "a/%d", "", ".h_%d",
-                          "%%%5d", "f%0123d"}) {
+                          "%%%5d", "f%0123d",
+                          // what verify would refuse to read back: terminal controls, a backslash
+                          "a\nb_%d", "a\tb_%d", "a\\b_%d", "\x1b[31m_%d", "a\x7f_%d"}) {
     const std::string why = refusal(bad);
     EXPECT_NE(why.find("invalid --name"), std::string::npos) << bad << ": " << why;
     EXPECT_NE(why.find("e.g. --name shot_%04d"), std::string::npos) << bad << ": " << why;
     EXPECT_EQ(why.find('\n'), std::string::npos) << why;
+    EXPECT_EQ(why.find('\x1b'), std::string::npos) << "the name reaches the terminal sanitized: " << why;
   }
+  EXPECT_NE(refusal("a\\b_%d").find("cannot contain '\\'"), std::string::npos) << refusal("a\\b_%d");
+  EXPECT_NE(refusal("a\tb_%d").find("control characters"), std::string::npos) << refusal("a\tb_%d");
   EXPECT_NE(refusal("shot_%4d").find("use %04d"), std::string::npos) << refusal("shot_%4d");
   EXPECT_NE(refusal("a_%d_%d").find("more than one"), std::string::npos) << refusal("a_%d_%d");
   EXPECT_NO_THROW(check_name_covers_frames("duck", 1));

@@ -456,7 +456,7 @@ TEST_F(SceneLoaderTest, ACameraWithABadYfovSaysSo) {
   EXPECT_EQ(s.cameras[0].invalid, "its yfov must lie between 0 and pi radians");
   EXPECT_TRUE(any_warning(s, "camera 0 has invalid perspective parameters (its yfov must lie between 0 and pi"));
   const test::CliRun r =
-      test::run("render " + path + " --camera 0 --views 2 --view-size 16x8 --out " + (dir_ / "bad_yfov_out").string());
+      test::run("render " + path + " --camera '#0' --views 2 --view-size 16x8 --out " + (dir_ / "bad_yfov_out").string());
   test::expect_one_error_line(r, "--camera 0 has invalid perspective parameters: its yfov must lie between 0 and pi");
 }
 

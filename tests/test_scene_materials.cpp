@@ -151,10 +151,10 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
 
   const auto& sl = m.slots;
   EXPECT_GE(sl[kSlotBaseColor].texture, 0);
-  EXPECT_EQ(sl[kSlotBaseColor].texcoord, 0);
+  EXPECT_EQ(sl[kSlotBaseColor].texcoord_set, 0);
   EXPECT_TRUE(sl[kSlotBaseColor].srgb);
   EXPECT_FALSE(sl[kSlotBaseColor].transform);
-  EXPECT_EQ(sl[kSlotMetallicRoughness].texcoord, 1);
+  EXPECT_EQ(sl[kSlotMetallicRoughness].texcoord_set, 1);
   EXPECT_FALSE(sl[kSlotMetallicRoughness].srgb);
   EXPECT_TRUE(sl[kSlotMetallicRoughness].transform);
   EXPECT_EQ(sl[kSlotMetallicRoughness].offset[0], 0.5f);
@@ -162,12 +162,12 @@ TEST_F(SceneMaterialsTest, EveryMaterialInputWithItsOwnSetAndTransform) {
   EXPECT_EQ(sl[kSlotMetallicRoughness].rotation, 0.25f);
   EXPECT_EQ(sl[kSlotMetallicRoughness].scale[0], 2.0f);
   EXPECT_EQ(sl[kSlotMetallicRoughness].scale[1], 3.0f);
-  EXPECT_EQ(sl[kSlotNormal].texcoord, 1);
+  EXPECT_EQ(sl[kSlotNormal].texcoord_set, 1);
   EXPECT_FALSE(sl[kSlotNormal].srgb);
   EXPECT_FALSE(sl[kSlotNormal].transform);
-  EXPECT_EQ(sl[kSlotOcclusion].texcoord, 0);
+  EXPECT_EQ(sl[kSlotOcclusion].texcoord_set, 0);
   EXPECT_FALSE(sl[kSlotOcclusion].srgb);
-  EXPECT_EQ(sl[kSlotEmissive].texcoord, 1) << "the transform's texCoord overrides the textureInfo's";
+  EXPECT_EQ(sl[kSlotEmissive].texcoord_set, 1) << "the transform's texCoord overrides the textureInfo's";
   EXPECT_TRUE(sl[kSlotEmissive].srgb);
   EXPECT_TRUE(sl[kSlotEmissive].transform);
   EXPECT_EQ(sl[kSlotEmissive].scale[0], 1.0f);
@@ -339,7 +339,7 @@ TEST_F(SceneMaterialsTest, ClearcoatFactorsAndTexturesAreRead) {
   EXPECT_TRUE(sl[kSlotClearcoatRoughness].transform);
   EXPECT_EQ(sl[kSlotClearcoatRoughness].offset[0], 0.5f);
   EXPECT_FALSE(sl[kSlotClearcoat].transform);
-  EXPECT_EQ(sl[kSlotClearcoatNormal].texcoord, 1);
+  EXPECT_EQ(sl[kSlotClearcoatNormal].texcoord_set, 1);
   EXPECT_FALSE(sl[kSlotClearcoat].srgb || sl[kSlotClearcoatRoughness].srgb || sl[kSlotClearcoatNormal].srgb);
   EXPECT_EQ(s.textures[size_t(sl[kSlotClearcoatNormal].texture)].rgba, (std::vector<uint8_t>{128, 128, 255, 255}));
   EXPECT_EQ(s.materials[1].clearcoat, 0.75f) << "the kernels' copy";

@@ -131,13 +131,8 @@ TEST(Sequence, ResumeAfterInterruptRendersOnlyTheMissingFrames) {
   const std::string out = temp_dir("seq_resume");
   const std::string args =
       " --turntable 360:10 --frames 0:9 --views 32 --view-size 512x256 --display 1920x1080 --out " + out;
-  const pid_t pid = fork();
+  const pid_t pid = test::start("render" + args, out + ".log");
   ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    const std::string cmd = std::string(PMR_BINARY) + " render" + args + " > " + out + ".log 2>&1";
-    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), (char*)nullptr);
-    _exit(127);
-  }
   // wait for two finished frames, then interrupt
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   while (std::chrono::steady_clock::now() < deadline) {

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "output/checksum.h"
+#include "output/sidecar.h"
 #include "pmr/output.h"
 #include "pmr/version.h"
 #include "test_util.h"
@@ -130,8 +131,9 @@ std::string write_quad(const std::string& dir, const Quad& q) {
   }
   doc["materials"] = {material};
   if (!q.embedded) {
-    std::string file = q.bin;  // decoded as tinygltf does (%20 only, here)
+    std::string file = q.bin;  // decoded as tinygltf does (%20 and %FF only, here)
     for (size_t at; (at = file.find("%20")) != std::string::npos;) file.replace(at, 3, " ");
+    for (size_t at; (at = file.find("%FF")) != std::string::npos;) file.replace(at, 3, "\xff");
     fs::create_directories(fs::path(dir + "/" + file).parent_path());
     write_bytes(dir + "/" + file, bin);
   }
@@ -385,6 +387,130 @@ TEST(Trust, ResumeRendersFramesFromAnotherSceneAgain) {
   EXPECT_NE(r.output.find("1 frame(s) in"), std::string::npos) << r.output;
   EXPECT_EQ(sidecar(out + "/frame_0002.json")["program_version"], "0.15.0+gabcdef0");
   EXPECT_EQ(run("verify " + out + " --frames 0:7").status, 0);
+}
+
+// Names that are not UTF-8 (an output pattern, a buffer's file name) are recorded byte-exact beside
+// their readable text, so verify finds the files --resume keeps, and sees a changed buffer.
+TEST(Trust, NamesThatAreNotUtf8AreRecordedByteExact) {
+  const std::string dir = test::temp_dir("trust_bytes"), out = dir + "/out";
+  Quad q;
+  q.bin = "data%FF.bin";
+  const std::string scene = write_quad(dir + "/scene", q);
+  const std::string args = " --name \"$(printf '\\377\\376_%%04d')\" --frames 0:1 --turntable 360:4" + kSmall + "--out " + out;
+  ASSERT_EQ(run("render -q " + scene + args).status, 0);
+  const json j = sidecar(out + "/\xff\xfe_0000.json");
+  EXPECT_EQ(j["outputs_hex"]["encoded"], "fffe5f303030302e657872") << j.dump();
+  EXPECT_EQ(j["checksums"]["scene_files_hex"].size(), 1u) << j["checksums"].dump();
+  EXPECT_TRUE(j["checksums"]["scene_files_hex"].contains("64617461ff2e62696e")) << j["checksums"].dump();
+  const std::string name = " --name \"$(printf '\\377\\376_%%04d')\"";
+  test::CliRun v = run("verify " + out + name + " --frames 0:1");
+  EXPECT_EQ(v.status, 0) << v.output;
+  test::CliRun r = run("render " + scene + " --resume" + args);
+  EXPECT_NE(r.output.find("nothing to do"), std::string::npos) << r.output;
+  // the buffer changes: both see it
+  std::string bin = read_bytes(dir + "/scene/data\xff.bin");
+  bin[0] ^= 1;
+  write_bytes(dir + "/scene/data\xff.bin", bin);
+  v = run("verify " + out + name + " --frames 0:1");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("rendered from another version of the scene"), std::string::npos) << v.output;
+  r = run("render " + scene + " --resume" + args);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("2 frame(s) were rendered from a different scene"), std::string::npos) << r.output;
+}
+
+// verify hashes each scene file once, however many spellings of it the sidecars list: its reading is
+// bounded by the bytes on disk (it says how many it read).
+TEST(Trust, VerifyHashesEachSceneFileOnceWhateverItsSpelling) {
+  const std::string dir = test::temp_dir("trust_spellings"), out = dir + "/out";
+  const std::string scene = write_quad(dir + "/scene", {});
+  ASSERT_EQ(run("render -q " + scene + " --frames 0:1 --turntable 360:4" + kSmall + "--out " + out).status, 0);
+  const std::string sum = xxh3_of(dir + "/scene/quad.bin");
+  for (const char* frame : {"/frame_0000.json", "/frame_0001.json"}) {
+    json j = sidecar(out + frame);
+    std::string spelling = "quad.bin";
+    for (int k = 0; k < 500; ++k, spelling = "./" + spelling) j["checksums"]["scene_files"][spelling] = sum;
+    write_bytes(out + frame, j.dump());
+  }
+  const test::CliRun v = run("verify " + out + " --frames 0:1");
+  EXPECT_EQ(v.status, 0) << v.output;
+  const uint64_t bytes = fs::file_size(scene) + fs::file_size(dir + "/scene/quad.bin");
+  EXPECT_NE(v.output.find("read 2 scene file(s), " + std::to_string(bytes) + " bytes"), std::string::npos) << v.output;
+}
+
+// A sidecar nested 100,000 deep, or with 300,000 keys, neither crashes nor stalls verify and --resume:
+// the frame is unreadable (rendered again), and no lock is left.
+TEST(Trust, HostileSidecarsAreUnreadableFramesNotCrashes) {
+  const std::string dir = test::temp_dir("trust_hostile"), out = dir + "/out";
+  const std::string args = " --frames 0:1 --turntable 360:4" + kSmall + "--out " + out;
+  ASSERT_EQ(run("render -q" + args).status, 0);
+  write_bytes(out + "/frame_0000.json", std::string(100000, '[') + std::string(100000, ']'));
+  json j = sidecar(out + "/frame_0001.json");
+  for (int k = 0; k < 300000; ++k) j["extra"]["k" + std::to_string(k)] = k;
+  write_bytes(out + "/frame_0001.json", j.dump());
+  const auto start = std::chrono::steady_clock::now();
+  const test::CliRun v = run("verify " + out + " --frames 0:1");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frame 0: frame_0000.json is truncated or unreadable"), std::string::npos) << v.output;
+  EXPECT_EQ(v.output.find("frame 1:"), std::string::npos) << "extra keys are no damage: " << v.output;
+  const test::CliRun r = run("render --resume" + args);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_LT(seconds, 30.0) << "300,000 keys took verify 68 s to parse when lookups were linear";
+  for (const std::string& name : test::listing(out)) EXPECT_NE(name[0], '.') << "left behind: " << name;
+  // a sidecar of another frame nested 200,000 deep in "format" beside a plain render of frame 2
+  json k = sidecar(out + "/frame_0001.json");
+  k["frame"] = 3;
+  std::string text = k.dump();
+  text.replace(text.find("\"pmr-sidecar-1\""), 15, std::string(200000, '[') + std::string(200000, ']'));
+  write_bytes(out + "/frame_0003.json", text);
+  const test::CliRun plain = run("render --frames 2 --turntable 360:4" + kSmall + "--out " + out);
+  EXPECT_TRUE(plain.status == 0 || plain.status == 1) << "no crash: " << plain.status << " " << plain.output;
+}
+
+// A sidecar lists at most 256 lights (names cut to about 256 bytes) and a digest of all of them: 300
+// lights named with 4 kB each stay a readable sidecar, which --resume and verify agree on.
+TEST(Trust, SidecarsOfManyLongNamedLightsStayReadable) {
+  const std::string dir = test::temp_dir("trust_lights"), out = dir + "/out";
+  const std::string scene = write_quad(dir + "/scene", {});
+  json doc = json::parse(read_bytes(scene));
+  doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  for (int i = 0; i < 300; ++i) {
+    doc["extensions"]["KHR_lights_punctual"]["lights"].push_back(
+        {{"type", "point"}, {"name", std::string(4000, 'a') + std::to_string(i)}});
+    doc["nodes"].push_back({{"translation", {0, 0, 2}}, {"extensions", {{"KHR_lights_punctual", {{"light", i}}}}}});
+    doc["scenes"][0]["nodes"].push_back(i + 1);
+  }
+  write_bytes(scene, doc.dump());
+  const std::string args = " --frames 0:1 --turntable 360:4" + kSmall + "--out " + out;
+  ASSERT_EQ(run("render -q " + scene + args).status, 0);
+  const json j = sidecar(out + "/frame_0000.json");
+  ASSERT_EQ(j["shading"]["lights"].size(), 256u);
+  EXPECT_EQ(j["shading"]["lights_total"], 300);
+  EXPECT_LT(j["shading"]["lights"][0]["name"].get<std::string>().size(), 300u);
+  EXPECT_EQ(run("verify " + out + " --frames 0:1").status, 0);
+  EXPECT_NE(run("render " + scene + " --resume" + args).output.find("nothing to do"), std::string::npos);
+}
+
+// Beyond the lights a sidecar lists, their digest is compared: a change in the 300th light is a
+// difference of configuration, as one in the first is.
+TEST(Trust, TheLightsDigestComparesTheLightsNotListed) {
+  SidecarInfo a;
+  a.pipeline.shading = Shading::Pbr;
+  a.has_bounds = true;
+  for (int i = 0; i < 300; ++i) {
+    SceneLight l;
+    l.type = SceneLightType::Point;
+    l.name = "light " + std::to_string(i);
+    a.lights.push_back(l);
+  }
+  SidecarInfo b = a;
+  b.lights[299].intensity = 2.0f;
+  const Rig rig = test::sidecar_rig();
+  const std::string ta = sidecar_json(rig, Display(), a), tb = sidecar_json(rig, Display(), b);
+  EXPECT_EQ(sidecar_config_difference(ta, ta), "");
+  EXPECT_EQ(sidecar_config_difference(ta, tb), "shading");
+  EXPECT_EQ(json::parse(ta)["shading"]["lights"].size(), 256u);
 }
 
 }  // namespace pmr

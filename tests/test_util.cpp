@@ -196,6 +196,16 @@ namespace pmr::test {
 
 CliRun run(const std::string& args) { return run_env("", args); }
 
+pid_t start(const std::string& args, const std::string& log) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const std::string cmd = std::string(PMR_BINARY) + " " + args + " > '" + log + "' 2>&1";
+    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), (char*)nullptr);
+    _exit(127);
+  }
+  return pid;
+}
+
 CliRun run_env(const std::string& env, const std::string& args) {
   return run_wrapped(env.empty() ? "" : "env " + env, args);
 }

@@ -1,6 +1,8 @@
 // Shared helpers for the tests: one OpenCL runtime for the whole test binary, small rigs, and
 // procedural scenes with known properties.
 #pragma once
+#include <sys/types.h>
+
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -99,6 +101,8 @@ CliRun run(const std::string& args);
 CliRun run_env(const std::string& env, const std::string& args);
 // The same started through a wrapper command, e.g. "prlimit --as=1073741824" or "env X=1".
 CliRun run_wrapped(const std::string& wrapper, const std::string& args);
+// The pmr binary started in the background with `args` (its output to `log`); returns its pid.
+pid_t start(const std::string& args, const std::string& log = "/dev/null");
 // A fresh folder per test and process, so that two test runs on one machine cannot meet.
 std::string temp_dir(const std::string& name);
 bool exists(const std::string& path);

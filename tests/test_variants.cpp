@@ -72,7 +72,7 @@ TEST(Variants, EachPrimitiveTakesTheMaterialItsMappingNames) {
   EXPECT_EQ(none.variants, (std::vector<std::string>{"Green", "Blue"}));
   EXPECT_EQ(none.variant, -1);
   EXPECT_EQ(quad_colours(none), (Colours{kRed, kWhite}));
-  for (const std::string& green : {"Green", "0"}) {
+  for (const char* green : {"Green", "#0"}) {
     const Scene s = load_scene(file, InputLimits(), green);
     EXPECT_EQ(s.variant, 0);
     EXPECT_EQ(quad_colours(s), (Colours{kGreen, kWhite})) << "quad 1 does not map Green: its default material";
@@ -80,6 +80,18 @@ TEST(Variants, EachPrimitiveTakesTheMaterialItsMappingNames) {
   const Scene blue = load_scene(file, InputLimits(), "Blue");
   EXPECT_EQ(quad_colours(blue), (Colours{kBlue, kGreen}));
   for (const std::string& w : none.warnings) EXPECT_EQ(w.find("KHR_materials_variants"), std::string::npos) << w;
+}
+
+// Names come first: variants named "1" and "0" are chosen by those names, and "#K" is the index.
+TEST(Variants, NumbersAreNamesAndHashKIsTheIndex) {
+  const std::string dir = temp_dir("variants_numbers");
+  std::filesystem::create_directories(dir);
+  const std::string file = variants_file(
+      dir, [](json& d) { d["extensions"]["KHR_materials_variants"]["variants"] = {{{"name", "1"}}, {{"name", "0"}}}; });
+  EXPECT_EQ(load_scene(file, InputLimits(), "1").variant, 0);
+  EXPECT_EQ(load_scene(file, InputLimits(), "0").variant, 1);
+  EXPECT_EQ(load_scene(file, InputLimits(), "#1").variant, 1);
+  EXPECT_EQ(quad_colours(load_scene(file, InputLimits(), "1")), (Colours{kGreen, kWhite}));
 }
 
 TEST(Variants, BadChoicesAndMalformedMappingsAreOneLine) {
@@ -95,7 +107,8 @@ TEST(Variants, BadChoicesAndMalformedMappingsAreOneLine) {
     return std::string("(loaded)");
   };
   EXPECT_NE(error(file, "Red").find("--variant 'Red': no variant has that name"), std::string::npos);
-  EXPECT_NE(error(file, "2").find("the file has 2 variant(s)"), std::string::npos);
+  EXPECT_NE(error(file, "#2").find("has 2 variant(s)"), std::string::npos) << error(file, "#2");
+  EXPECT_NE(error(file, "2").find("an index is written #2"), std::string::npos) << error(file, "2");
   const std::vector<std::pair<std::function<void(json&)>, std::string>> broken = {
       {[](json& d) { d["extensions"]["KHR_materials_variants"]["variants"] = 3; }, "variants is not an array"},
       {[](json& d) { d["extensions"]["KHR_materials_variants"]["variants"][1].erase("name"); },

@@ -1,5 +1,6 @@
 """pmr's command line: the arguments for a render, and reading what pmr prints. No bpy here."""
 
+import json
 import re
 import shlex
 
@@ -35,27 +36,23 @@ def render_args(settings, scene_path, out_dir, camera, frames, fps, environment,
     args += environment
     # a folder is one configuration for pmr; re-rendering with changed settings is the normal case here
     args += ["--overwrite"]
-    args += shlex.split(settings.extra_args)
+    try:
+        args += shlex.split(settings.extra_args)
+    except ValueError as e:  # an unbalanced quote: a report, not a traceback
+        raise RuntimeError("Extra options: %s (%s)" % (settings.extra_args, e)) from None
     return args
 
 
-# --name's fields: %% (a percent sign), %q (the quilt's tag: nothing in the other files' names),
-# %d or %0Nd, a run of N '#'
-_NAME_TOKEN = re.compile(r"%%|%q|%(?:0(\d+))?d|#+")
-
-
-def frame_stem(pattern, frame):
-    """The file stem pmr writes for a frame's sidecar, from its --name pattern."""
-    def expand(m):
-        token = m.group(0)
-        if token == "%%":
-            return "%"
-        if token == "%q":
-            return ""
-        width = len(token) if token[0] == "#" else int(m.group(1) or 0)
-        return "%0*d" % (width, frame)
-
-    return _NAME_TOKEN.sub(expand, pattern)
+def planned_outputs(lines):
+    """{frame: sidecar file name} from the JSON lines of `pmr render ... --print-outputs`: pmr alone
+    expands --name, so the add-on finds exactly the files pmr writes."""
+    sidecars = {}
+    for line in lines:
+        line = line.strip()
+        if line.startswith("{"):
+            entry = json.loads(line)
+            sidecars[int(entry["frame"])] = entry["sidecar"]
+    return sidecars
 
 
 PROGRESS = re.compile(r"^pmr: frame (\d+) written \((\d+)/(\d+)\)")

@@ -23,7 +23,6 @@ class RenderJob:
         scene = context.scene
         settings = scene.pmr_lightfield
         self.settings = settings  # read during set-up only: undo may replace it while pmr runs
-        self.name = settings.name
         self.warnings = []
         self.program = runner.resolve_program(addon_prefs(context).pmr_path)
         if scene.camera is None:
@@ -37,13 +36,15 @@ class RenderJob:
         try:
             self.scene_path = self._export(context)
             self.environment, more = self._world(scene)
+            self.args = command.render_args(settings, self.scene_path, self.out_dir, self.camera,
+                                            self.frames, self.fps, self.environment,
+                                            export.has_animations(self.scene_path))
+            # the files each frame goes to, as pmr names them (the options are checked on the way)
+            self.sidecars = runner.print_outputs(self.program, self.args, cwd=self.out_dir)
         except Exception:
             self.cleanup()
             raise
         self.warnings += more
-        self.args = command.render_args(settings, self.scene_path, self.out_dir, self.camera,
-                                        self.frames, self.fps, self.environment,
-                                        export.has_animations(self.scene_path))
 
     def _export(self, context):
         """The glTF for pmr; notes every light it cannot carry in self.warnings."""
@@ -75,8 +76,8 @@ class RenderJob:
     def outputs(self):
         """The files pmr wrote, per frame: {frame: sidecar's outputs}, from the sidecars present."""
         found = {}
-        for frame in range(self.frames[0], self.frames[1] + 1):
-            sidecar = os.path.join(self.out_dir, command.frame_stem(self.name, frame) + ".json")
+        for frame, name in sorted(self.sidecars.items()):
+            sidecar = os.path.join(self.out_dir, name)
             if os.path.isfile(sidecar):
                 with open(sidecar, encoding="utf-8") as f:
                     found[frame] = json.load(f).get("outputs", {})
@@ -197,6 +198,8 @@ class PMR_OT_render(bpy.types.Operator):
         try:
             job = RenderJob(context)
         except (runner.PmrNotFound, RuntimeError, OSError) as e:
+            last_result.clear()
+            last_result.update(returncode=getattr(e, "returncode", None), errors=[str(e)])
             self.report({"ERROR"}, str(e))
             return None
         job.start()

@@ -13,6 +13,14 @@ class PmrNotFound(RuntimeError):
     pass
 
 
+class PmrRefused(RuntimeError):
+    """pmr refused the job before rendering (bad options, a bad scene): its error line, its status."""
+
+    def __init__(self, message, returncode):
+        super().__init__(message)
+        self.returncode = returncode
+
+
 def resolve_program(path):
     """The pmr executable from the preferences' path (a bare name is looked up on PATH)."""
     path = os.path.expanduser(path or "pmr")
@@ -22,6 +30,18 @@ def resolve_program(path):
             "pmr not found (%r): set its path in Edit > Preferences > Add-ons > pmr Light Field > "
             "pmr executable" % path)
     return found
+
+
+def print_outputs(program, args, cwd=None):
+    """{frame: sidecar file name} of the render `args` would run, from `pmr ... --print-outputs`
+    (which renders and creates nothing). Raises RuntimeError with pmr's error line when it refuses."""
+    run = subprocess.run([program] + list(args) + ["--print-outputs"], cwd=cwd, stdin=subprocess.DEVNULL,
+                         capture_output=True, text=True, errors="replace")
+    if run.returncode != 0:
+        errors = [value for kind, value in map(command.parse_line, run.stderr.splitlines()) if kind == "error"]
+        raise PmrRefused("pmr: " + (errors[0] if errors else "exited with status %d" % run.returncode),
+                         run.returncode)
+    return command.planned_outputs(run.stdout.splitlines())
 
 
 class PmrProcess:

@@ -1,6 +1,7 @@
 #include "cli/bench_command.h"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -199,13 +200,13 @@ int run_bench(const std::vector<std::string>& args) {
   if (!o.save_scene.empty()) {
     const Scene scene = generate(o.generator, o.triangle_counts[0]);
     save_glb(scene, o.save_scene);
-    std::printf("wrote %s: %zu triangles\n", o.save_scene.c_str(), scene.triangles.size());
+    std::printf("wrote %s: %zu triangles\n", printable_text(o.save_scene).c_str(), scene.triangles.size());
     return 0;
   }
   std::unique_ptr<std::ofstream> csv;
   if (!o.csv.empty()) {
     csv.reset(new std::ofstream(o.csv));
-    if (!*csv) throw Error("cannot write " + o.csv);
+    if (!*csv) throw Error("cannot write " + printable_text(o.csv) + ": " + write_failure(errno));
   }
   if (o.shading == Shading::Pbr) {  // made once, before the first point
     o.environment =
@@ -225,6 +226,8 @@ int run_bench(const std::vector<std::string>& args) {
   }
   for (size_t n : o.triangle_counts)
     bench_scene(o, rt, bw, generate(o.generator, n), o.generator + "-" + std::to_string(n), csv.get());
+  if (csv && !csv->flush())  // a full disk (or /dev/full) shows when the buffer is written
+    throw Error("cannot write " + printable_text(o.csv) + ": " + write_failure(errno));
   return 0;
 }
 

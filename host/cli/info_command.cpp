@@ -11,6 +11,8 @@
 #include "runtime/cl_runtime.h"
 #include "sequence/frame_files.h"
 #include "sequence/frame_renderer.h"
+#include "sequence/frame_work.h"
+#include "pipeline/pipeline_config.h"
 
 namespace pmr {
 
@@ -42,7 +44,7 @@ std::string slot_text(const Scene& s, const SceneTextureSlot& slot, int kind) {
   if (slot.texture >= 0 && size_t(slot.texture) < s.textures.size())
     t += " " + std::to_string(s.textures[size_t(slot.texture)].width) + "x" +
          std::to_string(s.textures[size_t(slot.texture)].height);
-  t += std::string(slot.srgb ? ", sRGB" : ", linear") + ", set " + std::to_string(slot.texcoord);
+  t += std::string(slot.srgb ? ", sRGB" : ", linear") + ", set " + std::to_string(slot.texcoord_set);
   if (slot.transform)
     t += ", transform offset (" + number(slot.offset[0]) + ", " + number(slot.offset[1]) + ") rotation " +
          number(slot.rotation) + " scale (" + number(slot.scale[0]) + ", " + number(slot.scale[1]) + ")";
@@ -138,7 +140,21 @@ std::string camera_use(const SceneCamera& c, size_t index) {
   if (!c.invalid.empty()) return "invalid: " + c.invalid;
   const std::string shared =
       c.shared_with >= 0 ? ", a further node of camera " + std::to_string(c.shared_with) : std::string();
-  return "placed by node " + quoted(c.node_name) + shared + " (--camera " + std::to_string(index) + ")";
+  return "placed by node " + quoted(c.node_name) + shared + " (--camera '#" + std::to_string(index) + "')";
+}
+
+// The frame-work estimate of a frame at the defaults (paper-8k: 96 views of 1024x512, 4 samples, pbr
+// shading under the studio, which adds no light to the file's, the rest pose framed): the light part
+// exact, the BLEND part an upper bound.
+void describe_default_frame_work(const Scene& s, const InputLimits& limits) {
+  glm::dvec3 lo(-1.0), hi(1.0);
+  scene_bounds(s, lo, hi);
+  PipelineConfig config;
+  config.samples = 4;
+  const Rig rig = make_rig(RigConfig(), Display(), lo, hi);
+  const FrameWork work = estimate_frame_work(s, rig, s.lights.size(), config);
+  std::printf("frame work at paper-8k: %s; the limit is %llu (--limit frame-work; docs/SECURITY.md)\n",
+              describe_frame_work(work).c_str(), (unsigned long long)limits.frame_work);
 }
 
 // What a user needs to pick --camera and --animation, and to see what the loader made of the file.
@@ -156,7 +172,7 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
               s.textures.size());
   describe_materials(s);
   if (!s.variants.empty()) {
-    std::printf("material variants: %zu (KHR_materials_variants; --variant NAME or K, default: none)\n",
+    std::printf("material variants: %zu (KHR_materials_variants; --variant NAME or #K, default: none)\n",
                 s.variants.size());
     for (size_t i = 0; i < s.variants.size(); ++i) std::printf("  %zu %s\n", i, quoted(s.variants[i]).c_str());
   }
@@ -205,6 +221,7 @@ void describe_scene(const std::string& path, const InputLimits& limits) {
                 lo.z, hi.x, hi.y, hi.z, 0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y), 0.5 * (lo.z + hi.z),
                 0.5 * glm::length(hi - lo));
   else std::printf("bounds: none (no triangles)\n");
+  describe_default_frame_work(s, limits);
   std::printf("warnings: %zu\n", s.warnings.size());
   for (const std::string& w : s.warnings) std::printf("  %s\n", terminal_text(w).c_str());
 }

@@ -271,6 +271,11 @@ const RenderSection kSequenceOptions = {
          "outside --frames (a warning counts them; without it the run refuses);\n"
          "with --resume: also re-render listed frames of another configuration",
          [](RenderOptions& o, const std::string&, const std::string&) { o.job.overwrite = true; }},
+        {"--print-outputs", nullptr, nullptr,
+         "print the files each frame of the job would be written to, one JSON\n"
+         "line a frame ({\"frame\", \"sidecar\", \"outputs\": {kind: file}}), and\n"
+         "exit without rendering or creating anything (for tools that drive pmr)",
+         [](RenderOptions& o, const std::string&, const std::string&) { o.job.print_outputs = true; }},
         {"--quiet", "-q", nullptr, "print only errors and warnings",
          [](RenderOptions& o, const std::string&, const std::string&) { o.job.quiet = true; }},
         {"--shard", nullptr, "K/N|auto",
@@ -332,10 +337,10 @@ const RenderSection kRigOptions = {
              throw Error("invalid --camera-spacing '" + v + "': expected linear or angular");
            o.job.rig.angular_spacing = v == "angular";
          }},
-        {"--camera", nullptr, "K|NAME",
+        {"--camera", nullptr, "NAME|#K",
          "use the scene's glTF camera (pose and field of view) instead of framing the\n"
-         "scene's bounding sphere: K its index, else NAME the name of the node that\n"
-         "places it (as Blender names the camera object), else the camera's own name;\n"
+         "scene's bounding sphere: NAME the name of the node that places it (as\n"
+         "Blender names the camera object), else the camera's own name; #K its index;\n"
          "a name several match is an error (pmr info lists the cameras)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
            if (v.empty()) throw Error("invalid " + name + ": expected a camera index or name");
@@ -459,8 +464,8 @@ const RenderSection kPipelineOptions = {
 const RenderSection kShadingOptions = {
     "shading (docs/SHADING.md):",
     {
-        {"--variant", nullptr, "NAME|K",
-         "draw the scene's material variant NAME (or index K; KHR_materials_variants,\n"
+        {"--variant", nullptr, "NAME|#K",
+         "draw the scene's material variant NAME (or #K, its index; KHR_materials_variants,\n"
          "pmr info lists them) instead of its default materials",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
            if (v.empty()) throw Error("invalid " + name + ": expected a variant's name or index");

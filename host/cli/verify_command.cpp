@@ -6,6 +6,10 @@
 // missing or broken.
 #include "cli/verify_command.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -17,9 +21,11 @@
 
 #include "cli/options.h"
 #include "pmr/error.h"
+#include "pmr/json_text.h"
 #include "pmr/memory_budget.h"
 #include "output/checksum.h"
 #include "output/sidecar.h"
+#include "output/sidecar_names.h"
 #include "pmr/output.h"
 #include "sequence/folder_guard.h"
 #include "sequence/frame_files.h"
@@ -76,11 +82,7 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) continue;
     const std::string text = read_sidecar_text(path);
-    try {
-      if (!nlohmann::json::parse(text).is_object()) continue;
-    } catch (const std::exception&) {
-      continue;
-    }
+    if (!parse_json_text(text).is_object()) continue;
     const SidecarProvenance p = sidecar_provenance(text);
     ++seen.try_emplace(p.scene, 0, f).first->second.first;
     const std::string v = p.version.empty() ? "unrecorded" : p.version;
@@ -99,21 +101,38 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
   return folder;
 }
 
-// The scene files as they are now, read once each: the scene the sidecars name and the files they list
-// beside it. Only regular files are read, listed files only inside the scene's folder.
+// The scene files as they are now, each distinct file hashed once however many spellings and frames
+// name it (distinct: the (st_dev, st_ino) of the opened file, so "x.bin", "./x.bin" and hard links are
+// one file), so verify's reading is bounded by the bytes on disk, not by the sidecars' entries: the
+// scene the sidecars name and the files they list beside it. Only regular files are read, listed files
+// only inside the scene's folder.
 struct SceneNow {
-  std::map<std::string, std::string> sums;  // path -> XXH3-64, "" when it cannot be read
-  bool scene_unreadable = false;            // a sidecar's scene cannot be read: the folder's majority decides
+  std::map<std::string, std::string> by_path;                  // as named -> XXH3-64, "" when unreadable
+  std::map<std::pair<dev_t, ino_t>, std::string> by_file;      // each opened file's
+  uint64_t files_hashed = 0, bytes_hashed = 0;                 // what `sum` read, for the summary
+  bool scene_unreadable = false;  // a sidecar's scene cannot be read: the folder's majority decides
 
   std::string sum(const std::string& path) {
-    auto it = sums.find(path);
-    if (it != sums.end()) return it->second;
+    if (const auto it = by_path.find(path); it != by_path.end()) return it->second;
     std::string s;
-    std::error_code ec;
-    if (fs::is_regular_file(path, ec)) try {
-        s = checksum_file(path);
-      } catch (const std::exception&) {}
-    return sums[path] = s;
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    struct stat st {};
+    if (fd >= 0 && ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) {
+      const auto file = by_file.find({st.st_dev, st.st_ino});
+      if (file != by_file.end()) {
+        s = file->second;
+      } else {
+        uint64_t bytes = 0;
+        try {
+          s = checksum_descriptor(fd, path, &bytes);
+        } catch (const Error&) {
+        }
+        ++files_hashed, bytes_hashed += bytes;
+        by_file[{st.st_dev, st.st_ino}] = s;
+      }
+    }
+    if (fd >= 0) ::close(fd);
+    return by_path[path] = s;
   }
 };
 
@@ -132,16 +151,24 @@ std::string changed_scene_file(const nlohmann::json& j, SceneNow& now) {
   if (c == j.end() || !c->is_object() || c->value("algorithm", "") != "XXH3-64" || !j.contains("scene") ||
       !j["scene"].is_string())
     return "";
-  const std::string scene = j["scene"].get<std::string>();
+  const std::string scene = recorded_name(&j["scene"], j.contains("scene_hex") ? &j["scene_hex"] : nullptr);
   const std::string sum = now.sum(scene);
   if (sum.empty()) return now.scene_unreadable = true, "";
   if (c->value("scene", "") != sum) return fs::path(scene).filename().string();
   const auto files = c->find("scene_files");
   if (files == c->end() || !files->is_object()) return "";
-  for (auto it = files->begin(); it != files->end(); ++it)
-    if (!inside_folder(it.key()) || !it.value().is_string() ||
-        now.sum((fs::path(scene).parent_path() / it.key()).string()) != it.value().get<std::string>())
-      return it.key();
+  std::vector<std::pair<std::string, const nlohmann::json*>> listed;  // (name, checksum)
+  for (auto it = files->begin(); it != files->end(); ++it) listed.push_back({it.key(), &it.value()});
+  const auto files_hex = c->find("scene_files_hex");  // the names that are not UTF-8, byte-exact
+  if (files_hex != c->end() && files_hex->is_object())
+    for (auto it = files_hex->begin(); it != files_hex->end(); ++it) {
+      const nlohmann::json hex = it.key();
+      listed.push_back({recorded_name(nullptr, &hex), &it.value()});
+    }
+  for (const auto& [name, sum] : listed)
+    if (!inside_folder(name) || !sum->is_string() ||
+        now.sum((fs::path(scene).parent_path() / name).string()) != sum->get<std::string>())
+      return name;
   return "";
 }
 
@@ -154,12 +181,8 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
   std::error_code ec;
   if (!fs::is_regular_file(sidecar, ec)) return stem + ".json is missing";
   const std::string text = read_sidecar_text(sidecar);
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const std::exception&) {
-    return stem + ".json is truncated or unreadable";
-  }
+  const nlohmann::json j = parse_json_text(text);
+  if (j.is_discarded()) return stem + ".json is truncated or unreadable";
   if (!j.is_object() || !j.contains("frame") || j["frame"] != f)
     return stem + ".json does not describe frame " + std::to_string(f);
   if (!j.contains("fps") || !j.contains("time") || !j["fps"].is_number() || !j["time"].is_number() ||
@@ -200,6 +223,10 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
     if (!outputs || outputs->empty()) return stem + ".json lists no outputs";
     for (auto it = outputs->begin(); it != outputs->end(); ++it) listed.push_back({it.key(), it.value()});
   }
+  // names that are not UTF-8 are recorded byte-exact beside them
+  const nlohmann::json* hex = j.contains("outputs_hex") && j["outputs_hex"].is_object() ? &j["outputs_hex"] : nullptr;
+  for (auto& [kind, value] : listed)
+    if (hex && hex->contains(kind) && value.is_string()) value = recorded_name(&value, &(*hex)[kind]);
   std::vector<std::string> images;  // each file once, however many kinds list it: the work is bounded by the files
   std::set<std::string> seen;
   for (const auto& [kind, value] : listed) {
@@ -208,6 +235,7 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
     if (!plain_file_name(name))
       return stem + ".json lists " + printable_text(kind) + " output '" + printable_text(name) +
              "', which is not a plain file name in the folder";
+    if (!seen.insert(name).second) continue;  // looked at already
     const fs::path path = fs::path(dir) / name;
     const fs::file_status st = fs::symlink_status(path, ec);
     if (st.type() == fs::file_type::not_found) return printable_text(name) + " is missing";
@@ -217,7 +245,7 @@ std::string check_frame(const std::string& dir, const RenderOptions& o, bool exp
               : st.type() == fs::file_type::directory ? "a folder"
                                                       : "a special file") +
              ")";
-    if (seen.insert(path.string()).second) images.push_back(path.string());
+    images.push_back(path.string());
   }
   // frame_problem names the files by their (plain, but maybe not ASCII) names
   return printable_text(frame_problem(sidecar, images, deep), std::string::npos);
@@ -327,6 +355,9 @@ int run_verify(const std::vector<std::string>& args) {
     std::fprintf(stderr, "pmr verify: frame %ld: %s\n", f, problem.c_str());
   }
   note_leftover_temporaries(dir);
+  if (now.files_hashed > 0)
+    std::fprintf(stderr, "pmr verify: read %llu scene file(s), %llu bytes, to compare with the sidecars' checksums\n",
+                 (unsigned long long)now.files_hashed, (unsigned long long)now.bytes_hashed);
   if (now.scene_unreadable)
     std::fprintf(stderr,
                  "pmr verify: note: the scene the sidecars name cannot be read from here: frames are compared with "

@@ -39,6 +39,10 @@ const LimitKey kLimitKeys[] = {
      "                         target; docs/SECURITY.md, \"Posing\")"},
     {"framing-work", &InputLimits::framing_work, "work of all the poses that frame an animation (same units)"},
     {"tile-queue", &InputLimits::tile_queue, "tile-queue entries of one frame"},
+    {"frame-work", &InputLimits::frame_work,
+     "work of rendering one frame: light evaluations and BLEND\n"
+     "                         fragments, about a nanosecond a unit (docs/SECURITY.md,\n"
+     "                         \"Frame work\")"},
     {"memory", &InputLimits::memory, "bytes of memory for the large host and device allocations"},
 };
 

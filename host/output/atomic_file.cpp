@@ -1,5 +1,6 @@
 // Atomic file creation (temporary name + rename) and the output-folder check.
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <signal.h>
@@ -18,6 +19,7 @@
 #include "output/interrupt.h"
 #include "pmr/error.h"
 #include "pmr/output.h"
+#include "pmr/printable.h"
 
 namespace pmr {
 namespace {
@@ -97,9 +99,29 @@ size_t remove_dead_temporaries(const std::string& dir) {
   return removed;
 }
 
+namespace {
+
+// What a file pmr writes may replace: nothing, or a regular file. A device, a FIFO, a socket, a folder
+// or a symbolic link at the path is somebody else's and is refused (a rename would replace it: as
+// root, /dev/full became a regular file).
+void check_replaceable(const std::string& path) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return;
+  const char* kind = S_ISLNK(st.st_mode)    ? "a symbolic link"
+                     : S_ISDIR(st.st_mode)  ? "a folder"
+                     : S_ISFIFO(st.st_mode) ? "a FIFO"
+                     : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+                                                                  : "a special file";
+  throw Error("cannot write " + printable_text(path) + ": it exists and is " + kind +
+              ", not a regular file (pmr replaces only regular files)");
+}
+
+}  // namespace
+
 AtomicFile::AtomicFile(std::string final_path) : final_path_(std::move(final_path)) {
   const fs::path p(final_path_);
   if (final_path_.empty() || !p.has_filename()) throw Error("cannot write '" + final_path_ + "': not a file name");
+  check_replaceable(final_path_);
   int err = 0;
   for (int attempt = 0; attempt < 100; ++attempt) {
     temp_path_ = temporary_name(final_path_);

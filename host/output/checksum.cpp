@@ -1,5 +1,6 @@
 #include "output/checksum.h"
 
+#include <unistd.h>
 #include <xxhash.h>
 
 #include <cerrno>
@@ -23,17 +24,44 @@ std::string checksum_hex(uint64_t h) {
 
 std::string checksum_hex(const void* data, size_t size) { return checksum_hex(checksum64(data, size)); }
 
+namespace {
+
+using XxhState = std::unique_ptr<XXH3_state_t, XXH_errorcode (*)(XXH3_state_t*)>;
+
+XxhState new_state(const std::string& name) {
+  XxhState state(XXH3_createState(), XXH3_freeState);
+  if (!state || XXH3_64bits_reset(state.get()) != XXH_OK) throw Error("cannot checksum " + name + ": out of memory");
+  return state;
+}
+
+}  // namespace
+
 std::string checksum_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot read " + path + ": " + std::strerror(errno));
-  const std::unique_ptr<XXH3_state_t, XXH_errorcode (*)(XXH3_state_t*)> state(XXH3_createState(), XXH3_freeState);
-  if (!state || XXH3_64bits_reset(state.get()) != XXH_OK) throw Error("cannot checksum " + path + ": out of memory");
+  const XxhState state = new_state(path);
   std::vector<char> piece(size_t(1) << 20);
   while (in) {
     in.read(piece.data(), std::streamsize(piece.size()));
     if (in.gcount() > 0) XXH3_64bits_update(state.get(), piece.data(), size_t(in.gcount()));
   }
   if (!in.eof()) throw Error("cannot read " + path + ": read error");
+  return checksum_hex(XXH3_64bits_digest(state.get()));
+}
+
+std::string checksum_descriptor(int fd, const std::string& name, uint64_t* bytes) {
+  const XxhState state = new_state(name);
+  std::vector<char> piece(size_t(1) << 20);
+  uint64_t total = 0;
+  for (;;) {
+    const ssize_t n = ::read(fd, piece.data(), piece.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw Error("cannot read " + name + ": " + std::strerror(errno));
+    if (n == 0) break;
+    XXH3_64bits_update(state.get(), piece.data(), size_t(n));
+    total += uint64_t(n);
+  }
+  if (bytes) *bytes = total;
   return checksum_hex(XXH3_64bits_digest(state.get()));
 }
 

@@ -25,4 +25,8 @@ std::string checksum_hex(const void* data, size_t size);
 // cannot be read.
 std::string checksum_file(const std::string& path);
 
+// The same of what is left to read from an open descriptor (`name` for messages); `bytes` gets how many
+// bytes were hashed.
+std::string checksum_descriptor(int fd, const std::string& name, uint64_t* bytes = nullptr);
+
 }  // namespace pmr

@@ -1,8 +1,10 @@
 // Clean interruption of long jobs (SIGINT, SIGTERM, SIGHUP: a closed terminal or SSH session, SIGALRM). The first signal sets a flag that the frame loop
-// and the writer poll: the frame in flight is abandoned, finished files stay. A second signal exits at
-// once, after unlinking every temporary file still open (AtomicFile registers them here), so no partial
-// file is left either way. Everything the handler touches is async-signal-safe: fixed slots, atomics,
-// unlink, write and _exit.
+// and the writer poll: the frame in flight is abandoned, finished files stay. A second signal, or 1.5 s
+// after the first when the run has not ended by then (a long frame's kernels do not poll), exits at
+// once, after unlinking every temporary file still open (AtomicFile registers them here) and releasing
+// the folder's lock (FolderGuard registers it), so no partial file and no stale lock is left either
+// way. Everything the handler and the watchdog touch is async-signal-safe: fixed slots, atomics,
+// sem_post, flock, stat, unlink, write and _exit.
 #pragma once
 #include <string>
 
@@ -24,5 +26,9 @@ const char* interrupt_signal_name(int sig);
 // then only cleaned up by its destructor).
 int register_temp_file(const std::string& path);
 void unregister_temp_file(int slot);
+
+// The run's folder lock (one per process): an exit by signal removes it as FolderGuard::release does.
+void register_lock_file(int fd, const std::string& path);
+void unregister_lock_file();
 
 }  // namespace pmr

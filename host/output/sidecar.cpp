@@ -8,7 +8,9 @@
 #include "output/sidecar.h"
 
 #include "output/checksum.h"
+#include "output/sidecar_names.h"
 #include "pmr/error.h"
+#include "pmr/json_text.h"
 #include "pmr/output.h"
 #include "pmr/printable.h"
 #include "pmr/version.h"
@@ -19,6 +21,9 @@ namespace {
 
 // Insertion order kept, so "format" comes first and related fields stay together.
 using json = nlohmann::ordered_json;
+
+// What a sidecar lists in full: beyond these a count (and, for lights, a digest) stands for the rest.
+constexpr size_t kSidecarLights = 256, kSidecarWarnings = 64;
 
 std::string scalar_text(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
 
@@ -76,7 +81,7 @@ const char* light_type_name(SceneLightType t) {
 // for point and spot lights, the cone angles (radians) for spots.
 json light_json(const SceneLight& l) {
   const bool is_default = is_default_light(l);
-  json j = {{"name", l.name}, {"source", is_default ? "default" : "file"}};
+  json j = {{"name", bounded_text(l.name)}, {"source", is_default ? "default" : "file"}};
   if (!is_default) j["light"] = l.light, j["node"] = l.node;
   j["type"] = light_type_name(l.type);
   j["color"] = {double(l.color[0]), double(l.color[1]), double(l.color[2])};
@@ -93,6 +98,26 @@ json light_json(const SceneLight& l) {
 // have none: they were lambert at exposure 0. Lambert's one light is the top-level light_dir_*. An
 // environment image is recorded by its file (as given), the checksum of its bytes, rotation and
 // intensity, so --resume renders again when any of them changes.
+// The first kSidecarLights lights (a file may hold 100,000: the sidecar stays readable); with more,
+// the whole list is compared through lights_total and lights_digest.
+json lights_json(const std::vector<SceneLight>& lights) {
+  json list = json::array();
+  for (size_t i = 0; i < lights.size() && i < kSidecarLights; ++i) list.push_back(light_json(lights[i]));
+  return list;
+}
+
+// XXH3 of every light as recorded, without what follows the frame (position, direction): equal for two
+// frames of one configuration, as the comparison of other frames' listed lights is.
+std::string lights_digest(const std::vector<SceneLight>& lights) {
+  std::string all;
+  for (const SceneLight& l : lights) {
+    json j = light_json(l);
+    j.erase("position"), j.erase("direction");
+    all += scalar_text(j) + "\n";
+  }
+  return checksum_hex(all.data(), all.size());
+}
+
 json shading_json(const SidecarInfo& info) {
   const PipelineConfig& p = info.pipeline;
   json s = {{"model", to_string(p.shading)}, {"exposure_ev", p.exposure_ev}};
@@ -111,9 +136,13 @@ json shading_json(const SidecarInfo& info) {
                         {"checksum_algorithm", kChecksumAlgorithm},
                         {"rotation_deg", info.environment_rotation_deg},
                         {"intensity", p.environment_intensity}};
-  json lights = json::array();
-  for (const SceneLight& l : info.lights) lights.push_back(light_json(l));
-  s["lights"] = lights;
+  if (kind == EnvironmentSource::Kind::File && !is_utf8(info.environment.file))
+    s["environment"]["file_hex"] = to_hex(info.environment.file);
+  s["lights"] = lights_json(info.lights);
+  if (info.lights.size() > kSidecarLights) {
+    s["lights_total"] = info.lights.size();
+    s["lights_digest"] = lights_digest(info.lights);
+  }
   return s;
 }
 
@@ -131,8 +160,10 @@ json checksums_json(const SidecarInfo& info) {
   if (!info.scene_checksum.empty()) {
     c["scene"] = info.scene_checksum;
     json files = json::object();
-    for (const auto& [file, sum] : info.scene_files) files[file] = sum;
+    json files_hex = json::object();  // the names that are not UTF-8, byte-exact
+    for (const auto& [file, sum] : info.scene_files) (is_utf8(file) ? files[file] : files_hex[to_hex(file)]) = sum;
     c["scene_files"] = files;
+    if (!files_hex.empty()) c["scene_files_hex"] = files_hex;
   }
   if (!display_config_checksum(info).empty()) c["display_config"] = display_config_checksum(info);
   return c;
@@ -140,8 +171,17 @@ json checksums_json(const SidecarInfo& info) {
 
 json output_checksums_json(const SidecarInfo& info) {
   json files = json::object();
-  for (const OutputChecksum& o : info.output_checksums) files[o.file] = {{"bytes", o.bytes}, {"checksum", o.checksum}};
+  for (const OutputChecksum& o : info.output_checksums) {
+    files[o.file] = {{"bytes", o.bytes}, {"checksum", o.checksum}};
+    if (!is_utf8(o.file)) files[o.file]["name_hex"] = to_hex(o.file);
+  }
   return {{"algorithm", kChecksumAlgorithm}, {"files", files}};
+}
+
+json warnings_json(const std::vector<std::string>& warnings) {
+  json list = json::array();
+  for (size_t i = 0; i < warnings.size() && i < kSidecarWarnings; ++i) list.push_back(bounded_text(warnings[i], 1024));
+  return list;
 }
 
 json quilt_json(const Rig& rig, const SidecarInfo& info) {
@@ -155,7 +195,7 @@ json quilt_json(const Rig& rig, const SidecarInfo& info) {
 // both keys.
 json animation_json(const SidecarInfo& info) {
   if (info.sequence.animation == kNoAnimation) return nullptr;
-  return {{"index", info.sequence.animation}, {"name", info.sequence.animation_label}};
+  return {{"index", info.sequence.animation}, {"name", bounded_text(info.sequence.animation_label)}};
 }
 
 json turntable_json(const SidecarInfo& info) {
@@ -293,6 +333,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["format"] = "pmr-sidecar-1";
   j["program_version"] = program_version();
   j["scene"] = info.scene;
+  if (!is_utf8(info.scene)) j["scene_hex"] = to_hex(info.scene);
   if (!info.scene_checksum.empty() || !display_config_checksum(info).empty()) j["checksums"] = checksums_json(info);
   j["frame"] = info.frame;
   j["method"] = to_string(info.pipeline.method);
@@ -302,13 +343,17 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["shading"] = shading_json(info);
   j["tile"] = {{"x", info.pipeline.tile_x}, {"y", info.pipeline.tile_y}, {"v", info.pipeline.tile_v}};
   j["camera"] = info.rig_config.camera;
-  if (info.rig_config.camera >= 0) j["camera_name"] = info.camera_name;
-  if (info.variant) j["variant"] = *info.variant;
+  if (info.rig_config.camera >= 0) j["camera_name"] = bounded_text(info.camera_name);
+  if (info.variant) j["variant"] = bounded_text(*info.variant), j["variant_index"] = info.variant_index;
   if (info.has_bounds) j["scene_bounds"] = {{"min", vec3_json(info.bounds_lo)}, {"max", vec3_json(info.bounds_hi)}};
   if (info.compression) j["compression"] = to_string(*info.compression);
-  json outputs = json::object();
-  for (const auto& [kind, file] : info.outputs) outputs[kind] = file;
+  json outputs = json::object(), outputs_hex = json::object();
+  for (const auto& [kind, file] : info.outputs) {
+    outputs[kind] = file;
+    if (!is_utf8(file)) outputs_hex[kind] = to_hex(file);
+  }
   j["outputs"] = outputs;
+  if (!outputs_hex.empty()) j["outputs_hex"] = outputs_hex;
   const Background& bg = info.background;
   if (!bg.transparent()) j["background"] = {bg.r, bg.g, bg.b, bg.a};
   if (!info.output_checksums.empty()) j["output_checksums"] = output_checksums_json(info);
@@ -317,7 +362,8 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["depth_channel"] = info.depth;
   // the scene's files were read without confinement to its folder (docs/SECURITY.md)
   if (info.input_limits.allow_outside_scene_folder) j["allow_outside_scene_folder"] = true;
-  j["warnings"] = info.warnings;
+  j["warnings"] = warnings_json(info.warnings);
+  if (info.warnings.size() > kSidecarWarnings) j["warnings_total"] = info.warnings.size();
   j["time"] = info.time;
   j["fps"] = info.sequence.fps;
   j["animation"] = animation_json(info);
@@ -365,7 +411,7 @@ std::string config_difference_text(const std::string& existing, const std::strin
                                    const std::string& existing_label, const std::string& expected_label) {
   const std::string plain = key + " differs";
   try {
-    const nlohmann::json a = nlohmann::json::parse(existing), b = nlohmann::json::parse(expected);
+    const nlohmann::json a = parse_json_text(existing), b = parse_json_text(expected);
     if (!a.is_object() || !b.is_object() || !a.contains(key) || !b.contains(key)) return plain;
     nlohmann::json x = a[key], y = b[key];
     for (nlohmann::json* t : {&x, &y})  // the frame's own angle is no difference (sidecar_config_difference)
@@ -385,18 +431,16 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   // sidecar rewritten by another tool compares as before)
   using json = nlohmann::json;
   const json b = json::parse(expected);
-  json a;
-  try {
-    a = json::parse(existing);
-  } catch (const std::exception&) {
-    return "unreadable";
-  }
+  const json a = parse_json_text(existing);
   if (!a.is_object() || !b.is_object()) return "unreadable";
   // a member of either side, null when absent (so a damaged sidecar compares unequal, never crashes)
   auto get = [](const json& o, const char* key) { return o.is_object() && o.contains(key) ? o[key] : json(); };
   for (const char* key : {"format", "scene", "method", "tile", "camera", "display", "fps", "depth_channel"})
     if (!a.contains(key) || get(a, key) != get(b, key)) return key;
   if (get(a, "variant") != get(b, "variant")) return "variant";  // absent: the default materials
+  // the selection by index as well as by name (recorded since names come first; absent in older sidecars)
+  for (const char* key : {"variant_index", "camera_name"})
+    if (a.contains(key) && b.contains(key) && get(a, key) != get(b, key)) return key;
   // the animation (its name comes from the scene file)
   auto anim = [&](json t) {
     if (ignore_scene_derived && t.is_object()) t.erase("name");
@@ -476,12 +520,8 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
 
 SidecarProvenance sidecar_provenance(const std::string& sidecar_text) {
   SidecarProvenance p;
-  json j;
-  try {
-    j = json::parse(sidecar_text);
-  } catch (const std::exception&) {
-    return p;
-  }
+  using json = nlohmann::json;  // sorted keys: linear-time lookups made ordered_json quadratic here
+  const json j = parse_json_text(sidecar_text);
   if (!j.is_object()) return p;
   if (const auto v = j.find("program_version"); v != j.end() && v->is_string()) p.version = v->get<std::string>();
   const auto c = j.find("checksums");
@@ -496,6 +536,11 @@ SidecarProvenance sidecar_provenance(const std::string& sidecar_text) {
     if (!it.value().is_string()) return p;
     sorted[it.key()] = it.value().get<std::string>();
   }
+  if (const auto hex = c->find("scene_files_hex"); hex != c->end() && hex->is_object())
+    for (auto it = hex->begin(); it != hex->end(); ++it) {  // names that are not UTF-8, by their bytes
+      if (!it.value().is_string()) return p;
+      sorted["hex:" + it.key()] = it.value().get<std::string>();
+    }
   json identity = json::array({*algorithm, *scene});
   for (const auto& [file, sum] : sorted) identity.push_back(json::array({file, sum}));
   p.scene = identity.dump(-1, ' ', false, json::error_handler_t::replace);
@@ -511,7 +556,15 @@ void write_sidecar(const std::string& path, const Rig& rig, const Display& displ
   } catch (const std::exception& e) {  // e.g. nlohmann::json::type_error on a name that is not UTF-8
     throw Error("cannot write " + path + ": " + write_failure(e.what()));
   }
+  check_sidecar_size(text.size());
   write_text_atomic(path, text);
+}
+
+void check_sidecar_size(uint64_t bytes) {
+  if (bytes <= kMaxSidecarBytes) return;
+  throw Error("a frame's sidecar would hold " + std::to_string(bytes) + " bytes, more than the " +
+              std::to_string(kMaxSidecarBytes) +
+              " pmr reads back (the scene reads too many files, or files with very long names)");
 }
 
 }  // namespace pmr

@@ -33,8 +33,9 @@ struct SidecarInfo {
   // the job's configuration
   std::string scene;                          // the scene file as given (empty = the bundled default scene)
   RigConfig rig_config;                       // its glTF camera (the rig itself is recorded as resolved)
-  std::string camera_name;                    // that camera's node name (informational; "" = none)
+  std::string camera_name;                    // that camera's node name ("" = none)
   std::optional<std::string> variant;         // the material variant drawn (none: the default materials)
+  int variant_index = -1;                     // its index in the file
   PipelineConfig pipeline;                    // method, sampling, shading and exposure, tile
   DisplaySource display_source;               // the display's source and its calibration's values
   SequenceSpec sequence;                      // fps, animation, turntable
@@ -69,6 +70,10 @@ struct SidecarInfo {
   bool depth = false;                            // Z channels in the views / quilt files
 };
 
+// The largest sidecar pmr reads back. Everything a sidecar lists from the scene is bounded (names cut,
+// lights and warnings counted beyond the first few), and write_sidecar refuses to write a larger one.
+constexpr uint64_t kMaxSidecarBytes = uint64_t(16) << 20;
+
 // The sidecar's JSON text (pretty printed, doubles with round-trip precision).
 std::string sidecar_json(const Rig& rig, const Display& display, const SidecarInfo& info);
 // Compares the configuration that decides a frame's pixels (scene, method, tile, camera, display, rig,
@@ -96,6 +101,11 @@ struct SidecarProvenance {
   std::string version;  // program_version, "" when absent
 };
 SidecarProvenance sidecar_provenance(const std::string& sidecar_text);
+
+// Throws pmr::Error when a sidecar of `bytes` is larger than pmr reads back (kMaxSidecarBytes): a job
+// is refused before its first frame renders (SequenceRun), so no frame is left that verify and
+// --resume could not read.
+void check_sidecar_size(uint64_t bytes);
 
 // Writes the JSON sidecar (DESIGN section 6) atomically. Matrices are 16 numbers, column-major.
 void write_sidecar(const std::string& path, const Rig& rig, const Display& display, const SidecarInfo& info);

@@ -174,8 +174,8 @@ MaterialTables make_material_tables(const Scene& scene, bool mips) {
     apply_material_inputs(in, m);  // the factors as the loader checked them (a scene's copies may be stale)
     for (int k = 0; k < PMR_MAPS; ++k) {
       const SceneTextureSlot& slot = in.slots[size_t(k)];  // PMR_MAP_* is the slot's kind
-      if (slot.texture < 0) continue;
-      if (size_t(slot.texture) >= scene.textures.size() || slot.texcoord < 0 ||
+      if (slot.texture < 0 || slot.texcoord < 0) continue;  // no map, or no drawn primitive samples it
+      if (size_t(slot.texture) >= scene.textures.size() ||
           size_t(slot.texcoord) >= scene.texcoords.size())
         throw InternalError("material " + std::to_string(i) + "'s " + texture_slot_name(k) +
                             " names a texture or TEXCOORD set the scene does not have");

@@ -13,6 +13,7 @@
 #include "output/checksum.h"
 #include "pmr/display_presets.h"
 #include "pmr/error.h"
+#include "pmr/json_text.h"
 #include "pmr/limits.h"
 
 namespace pmr {
@@ -60,6 +61,9 @@ LookingGlassCalibration read_looking_glass_calibration(const std::string& path, 
                 " bytes; a Looking Glass calibration file has a few thousand (at most 1 MiB is read)");
   const std::vector<unsigned char> file = read_user_file(path, std::min(max_bytes, kMaxCalibrationBytes));
   const std::string text(file.begin(), file.end());
+  if (json_depth(text) > kMaxJsonDepth)
+    throw Error(path + ": not a JSON calibration file (nested more than " + std::to_string(kMaxJsonDepth) +
+                " levels deep)");
   json doc;
   try {
     doc = json::parse(text);

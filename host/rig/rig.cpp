@@ -2,6 +2,7 @@
 #include "pmr/rig.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <cstdint>
 
@@ -179,9 +180,16 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
   if (rig.views > 1) {
     const double k_ndc = std::tan(rig.cone / 2.0) / (rig.aspect * tan_half);
     const double room = (guard_ndc(rig.view_w) - 1.0) / (2.0 * k_ndc);
-    if (!(room > 1.0))
-      throw Error("the view cone is too wide for a " + std::to_string(rig.view_w) +
-                  "-pixel view: disparity would leave the fixed-point guard band");
+    if (!(room > 1.0)) {
+      // the disparity grows with tan(cone / 2) / tan(yfov / 2): name both as the user gave them
+      const bool from_camera = camera_pose && camera_yfov > 0.0 && !(config.yfov_deg > 0.0);
+      char values[160];
+      std::snprintf(values, sizeof values, "a %g degree view cone and a vertical field of view of %g degrees%s",
+                    glm::degrees(rig.cone), glm::degrees(rig.yfov), from_camera ? " (the glTF camera's yfov)" : "");
+      throw Error(std::string("the views' disparity would leave the fixed-point guard band with ") + values +
+                  " in a " + std::to_string(rig.view_w) +
+                  "-pixel view: widen the field of view (--yfov) or narrow the cone (--cone)");
+    }
     const double w_min = rig.focal / (1.0 + room);
     if (w_min > rig.near_eff) {
       if (warnings)

@@ -237,7 +237,9 @@ size_t walk_count(const Loader& L, const std::vector<int>& roots) {
 struct Decoded {
   std::shared_ptr<DeformSource> geo;     // positions, normals, morph targets, joints and weights
   std::vector<float> col;                // COLOR_0, empty when absent
-  std::vector<std::vector<float>> sets;  // TEXCOORD_k as stored, for the sets its material samples (else empty)
+  // TEXCOORD_k as stored, by k: the sets its material samples, and TEXCOORD_0 for an anisotropic
+  // material's tangents
+  std::map<int, std::vector<float>> sets;
   std::vector<uint32_t> tris;            // 3 local vertex indices per triangle, as authored (CCW front)
   uint32_t material = 0;                 // Scene::materials index
 };
@@ -316,14 +318,13 @@ void read_skin_influences(const PrimitiveAttributes& attrs, DeformSource& geo) {
 int read_texcoord_sets(const PrimitiveAttributes& attrs, int mesh, int index, Decoded& d) {
   Loader& L = attrs.L;
   const tinygltf::Primitive& p = attrs.p;
-  d.sets.resize(size_t(L.texcoord_sets));
   if (p.material < 0) return -1;
   const std::array<int, kTextureSlots>& sets = L.slot_sets[size_t(p.material)];
   for (int slot = 0; slot < kTextureSlots; ++slot) {
     const int k = sets[size_t(slot)];
-    if (k < 0 || !d.sets[size_t(k)].empty()) continue;
-    d.sets[size_t(k)] = attrs.read("TEXCOORD_" + std::to_string(k), Semantic::Texcoord);
-    if (d.sets[size_t(k)].empty()) {
+    if (k < 0 || d.sets.count(k)) continue;
+    std::vector<float>& values = d.sets[k] = attrs.read("TEXCOORD_" + std::to_string(k), Semantic::Texcoord);
+    if (values.empty()) {
       const std::string& mesh_name = L.model.meshes[size_t(mesh)].name;
       const std::string& mat_name = L.model.materials[size_t(p.material)].name;
       fail(L.file, "material " + std::to_string(p.material) +
@@ -336,7 +337,7 @@ int read_texcoord_sets(const PrimitiveAttributes& attrs, int mesh, int index, De
   for (int slot : {kSlotNormal, kSlotClearcoatNormal, kSlotAnisotropy})
     if (sets[size_t(slot)] >= 0) return sets[size_t(slot)];
   if (L.scene.material_inputs[size_t(p.material) + 1].anisotropy_strength <= 0.0f) return -1;
-  if (d.sets[0].empty()) d.sets[0] = attrs.read("TEXCOORD_0", Semantic::Texcoord);
+  if (!d.sets.count(0)) d.sets[0] = attrs.read("TEXCOORD_0", Semantic::Texcoord);
   return d.sets[0].empty() ? -1 : 0;
 }
 
@@ -380,7 +381,7 @@ void read_tangents(const PrimitiveAttributes& attrs, Decoded& d, int normal_set)
   if (!geo.tan.empty()) {
     for (size_t k = 0; k < attrs.p.targets.size(); ++k) geo.target_tan.push_back(attrs.read_target(k, "TANGENT"));
   } else {
-    geo.tan = generate_tangents(geo.pos, geo.nrm, d.sets[size_t(normal_set)], d.tris);
+    geo.tan = generate_tangents(geo.pos, geo.nrm, d.sets.at(normal_set), d.tris);
     ++attrs.L.generated_tangents;
   }
 }
@@ -452,13 +453,14 @@ void emit(Loader& L, const Decoded& d, const Instance& inst) {
   deform(geo, L.motion->nodes[size_t(inst.node)].weights, skin >= 0 ? L.rest_joints[size_t(skin)].data() : nullptr,
          world, &s.positions[base], &s.attributes[base], bad_position.data(), bad_normal.data(),
          geo.tan.empty() ? nullptr : &s.tangents[base]);
-  s.texcoords.resize(size_t(L.texcoord_sets));
-  for (size_t k = 0; k < s.texcoords.size(); ++k) {
-    std::vector<glm::vec2>& set = s.texcoords[k];
-    set.resize(s.positions.size(), glm::vec2(0.0f));
-    if (k >= d.sets.size() || d.sets[k].empty()) continue;
+  s.texcoords.resize(L.texcoord_index.size());
+  for (std::vector<glm::vec2>& set : s.texcoords) set.resize(s.positions.size(), glm::vec2(0.0f));
+  for (const auto& [k, values] : d.sets) {
+    const auto index = L.texcoord_index.find(k);
+    if (values.empty() || index == L.texcoord_index.end()) continue;  // read for tangents only
+    std::vector<glm::vec2>& set = s.texcoords[size_t(index->second)];
     for (size_t v = 0; v < geo.vertices; ++v) {
-      glm::vec2 t(d.sets[k][2 * v], d.sets[k][2 * v + 1]);
+      glm::vec2 t(values[2 * v], values[2 * v + 1]);
       if (!std::isfinite(t.x) || !std::isfinite(t.y)) t = glm::vec2(0.0f), ++L.nonfinite_attributes;
       set[base + v] = t;
     }
@@ -536,6 +538,26 @@ uint64_t primitive_data_bytes(const Loader& L, int mesh, int index, uint64_t tri
 
 // Sums the whole scene before anything is decoded: a small file instancing a big mesh many times must
 // fail here, not after allocating gigabytes. The vertex cap is what the triangle cap can reference.
+// The TEXCOORD sets the drawn primitives' materials sample, numbered in increasing set order
+// (L.texcoord_index), and every material slot pointed at its set's number (-1: no drawn primitive
+// samples it). Returns how many there are: each costs 8 bytes per vertex of the scene.
+uint64_t assign_texcoord_sets(Loader& L, const std::vector<Instance>& instances) {
+  std::set<int> meshes, sets;
+  for (const Instance& inst : instances) meshes.insert(inst.mesh);
+  for (int mesh : meshes)
+    for (const tinygltf::Primitive& p : L.model.meshes[size_t(mesh)].primitives)
+      if (p.material >= 0)
+        for (int k : L.slot_sets[size_t(p.material)])
+          if (k >= 0) sets.insert(k);
+  for (int k : sets) L.texcoord_index.emplace(k, int(L.texcoord_index.size()));
+  for (size_t m = 1; m < L.scene.material_inputs.size(); ++m)
+    for (SceneTextureSlot& slot : L.scene.material_inputs[m].slots) {
+      const auto index = L.texcoord_index.find(slot.texcoord_set);
+      slot.texcoord = slot.texture >= 0 && index != L.texcoord_index.end() ? index->second : -1;
+    }
+  return sets.size();
+}
+
 void check_totals(Loader& L, const std::vector<Instance>& instances) {
   struct Size {
     uint64_t triangles = 0, vertices = 0, data = 0;  // data: primitive_data_bytes
@@ -566,12 +588,18 @@ void check_totals(Loader& L, const std::vector<Instance>& instances) {
                      " bytes of vertex data (every instance and "
                      "morph target counted), more than the vertex-data limit of " +
                      std::to_string(L.limits->vertex_data) + " (raise it with --limit vertex-data=N)");
-  // What the flattened scene holds per vertex and triangle (positions, attributes, two texture
-  // coordinate sets, tangents; triangles), on top of the decoded data.
-  const uint64_t per_vertex = sizeof(glm::vec3) + sizeof(PmrVertexAttr) + 2 * sizeof(glm::vec2) + sizeof(glm::vec4);
-  uint64_t scene_bytes = data;
-  if (vertices < (uint64_t(1) << 40)) add(scene_bytes, vertices * per_vertex + triangles * sizeof(PmrTriangle));
-  else scene_bytes = UINT64_MAX;
+  // What the flattened scene holds per vertex and triangle (positions, attributes, the texture
+  // coordinate sets drawn materials sample, tangents; triangles), on top of the decoded data.
+  const uint64_t sets = assign_texcoord_sets(L, instances);
+  const uint64_t per_vertex =
+      sizeof(glm::vec3) + sizeof(PmrVertexAttr) + sets * sizeof(glm::vec2) + sizeof(glm::vec4);
+  uint64_t scene_bytes = data, flattened = 0;
+  if (vertices < (uint64_t(1) << 40) && !__builtin_mul_overflow(vertices, per_vertex, &flattened)) {
+    add(scene_bytes, flattened);
+    add(scene_bytes, triangles * sizeof(PmrTriangle));
+  } else {
+    scene_bytes = UINT64_MAX;
+  }
   const uint64_t max_triangles = PMR_MAX_TRIANGLES - 1, max_vertices = 3 * max_triangles;
   if (triangles > max_triangles)
     fail(L.file, "the scene has " + std::to_string(triangles) + " triangles; the renderer supports at most " +

@@ -413,7 +413,7 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
     // the base colour slot's messages name no slot (they predate the other slots)
     const MaterialUv uv =
         material_uv(L, info.texcoord, *info.extensions, i, slot == kSlotBaseColor ? "" : texture_slot_name(slot));
-    out.texcoord = uv.set;
+    out.texcoord_set = uv.set;  // Scene::texcoords index: set by the loader (texcoord_sets_used)
     out.transform = uv.transform;
     if (out.transform) {
       out.offset[0] = uv.offset[0], out.offset[1] = uv.offset[1];
@@ -422,10 +422,8 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
     }
     out.texture = scene_texture(L, info.index, slot);
     sets[size_t(slot)] = uv.set;
-    L.texcoord_sets = std::max(L.texcoord_sets, uv.set + 1);
   }
   L.slot_sets.push_back(sets);
-  if (m.anisotropy_strength > 0.0f) L.texcoord_sets = std::max(L.texcoord_sets, 1);  // its tangents' set
   return m;
 }
 

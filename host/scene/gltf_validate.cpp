@@ -10,6 +10,7 @@
 
 #include "output/checksum.h"
 #include "pmr/error.h"
+#include "pmr/json_text.h"
 #include "pmr/memory_budget.h"
 #include "pmr/printable.h"
 #include "pmr/scene.h"
@@ -43,8 +44,7 @@ std::string one_line(const std::string& text, bool ascii_only) {
 namespace {
 
 // tinygltf's extras/extensions parser recurses once per nesting level, so a hostile file nested a
-// million levels deep would overflow the stack. Real glTF nests less than ten levels.
-constexpr int kMaxJsonDepth = 128;
+// million levels deep would overflow the stack: kMaxJsonDepth (pmr/json_text.h) bounds it.
 // Memory per JSON value once parsed by both parsers (see read_source).
 constexpr uint64_t kJsonBytesPerValue = 200;
 
@@ -113,31 +113,6 @@ std::string glb_json(const std::string& path, std::vector<unsigned char>& bytes,
     if (read_u32le(&bytes[size_t(next) + 4]) == 0x004E4942u) bin_length = int64_t(chunk_length);
   }
   return std::string(reinterpret_cast<const char*>(&bytes[20]), size_t(json_length));
-}
-
-// Nesting depth of JSON text, counting brackets outside strings (cheap, no recursion), and an upper
-// bound of its values (separators and openings outside strings, plus one).
-int json_depth(const std::string& text, uint64_t& values) {
-  int depth = 0, max_depth = 0;
-  values = 1;
-  bool in_string = false, escaped = false;
-  for (char c : text) {
-    if (in_string) {
-      if (escaped) escaped = false;
-      else if (c == '\\') escaped = true;
-      else if (c == '"') in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      max_depth = std::max(max_depth, ++depth);
-      ++values;
-    } else if (c == ']' || c == '}') {
-      --depth;
-    } else if (c == ',' || c == ':') {
-      ++values;
-    }
-  }
-  return max_depth;
 }
 
 // An index-like JSON value (non-negative integer); -1 when absent or of another type.
@@ -562,7 +537,7 @@ SourceFile read_source(const std::string& path, const InputLimits& limits, const
                    " bytes, more than the json-bytes limit of " + std::to_string(limits.json_bytes) +
                    " (raise it with --limit json-bytes=N)");
   uint64_t values = 0;
-  const int depth = json_depth(text, values);
+  const int depth = json_depth(text, &values);
   // Parsed, the JSON is held twice (here and by tinygltf, whose values for extras are larger still):
   // about 200 bytes a value where the text has two, as measured on a 40 MB array of numbers.
   check_memory(values * kJsonBytesPerValue + 2 * uint64_t(text.size()),

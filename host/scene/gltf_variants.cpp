@@ -28,20 +28,19 @@ std::vector<std::string> variant_names(const std::string& path, const json& doc)
   return names;
 }
 
-// The variant `choice` names: its index (digits), else the one variant of that name.
+// The variant `choice` names: the one variant of that name, or "#K" its index.
 int chosen_variant(const std::string& path, const std::vector<std::string>& names, const std::string& choice) {
   const std::string shown = "--variant '" + one_line(choice) + "'";
   if (names.empty()) fail(path, shown + ": the file has no material variants (KHR_materials_variants)");
-  if (choice.find_first_not_of("0123456789") == std::string::npos) {
-    if (choice.size() > 9 || std::stoul(choice) >= names.size())
-      fail(path, shown + ": the file has " + std::to_string(names.size()) + " variant(s)");
-    return int(std::stoul(choice));
-  }
   const auto count = std::count(names.begin(), names.end(), choice);
-  if (count > 1) fail(path, shown + " is ambiguous: " + std::to_string(count) + " variants have that name");
+  if (count > 1)
+    fail(path, shown + " is ambiguous: " + std::to_string(count) + " variants have that name (give its index, #K)");
   const auto it = std::find(names.begin(), names.end(), choice);
-  if (it == names.end()) fail(path, shown + ": no variant has that name (pmr info lists them)");
-  return int(it - names.begin());
+  if (it != names.end()) return int(it - names.begin());
+  const IndexChoice index = parse_index_choice(choice, names.size(), "variant(s)");
+  if (!index.is_index) fail(path, shown + ": no variant has that name" + unnamed_choice_hint(choice, "pmr info"));
+  if (!index.problem.empty()) fail(path, shown + ": " + index.problem);
+  return index.index;
 }
 
 // The material `variant` maps primitive `p` to (-1: none of its mappings names it), every mapping

@@ -148,22 +148,42 @@ std::vector<int> cameras_named(const Scene& scene, const std::string& name, bool
 
 }  // namespace
 
+IndexChoice parse_index_choice(const std::string& choice, size_t count, const std::string& things) {
+  IndexChoice c;
+  if (choice.empty() || choice[0] != '#') return c;
+  c.is_index = true;
+  const std::string digits = choice.substr(1);
+  if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
+    c.problem = "'#' starts an index (#0, #1, ...), and '" + printable_text(digits, 12) + "' is not a number";
+  else if (std::stoul(digits) >= count)
+    c.problem = "the scene has " + std::to_string(count) + " " + things;
+  else
+    c.index = int(std::stoul(digits));
+  return c;
+}
+
+std::string unnamed_choice_hint(const std::string& choice, const std::string& lister) {
+  if (!choice.empty() && choice.size() <= 9 && choice.find_first_not_of("0123456789") == std::string::npos)
+    return " (an index is written #" + choice + "; " + lister + " lists them)";
+  return " (" + lister + " lists them)";
+}
+
 int find_camera(const Scene& scene, const std::string& name) {
   const std::string shown = "--camera '" + printable_text(name, 60) + "'";
-  if (!name.empty() && name.find_first_not_of("0123456789") == std::string::npos) {
-    if (name.size() > 9 || std::stol(name) >= long(scene.cameras.size()))
-      throw Error("--camera " + printable_text(name, 12) + ": the scene has " + std::to_string(scene.cameras.size()) +
-                  " camera(s)");
-    return int(std::stol(name));
-  }
   for (bool node : {true, false}) {
     const std::vector<int> found = cameras_named(scene, name, node);
     if (found.size() == 1) return found[0];
     if (found.size() > 1)
       throw Error(shown + " is ambiguous: " + std::to_string(found.size()) + (node ? " camera nodes" : " cameras") +
-                  " have that name (give the camera's index; pmr info lists them)");
+                  " have that name (give the camera's index, #K; pmr info lists them)");
   }
-  throw Error(shown + ": no camera node or camera of the scene has that name (pmr info lists them)");
+  const IndexChoice index = parse_index_choice(name, scene.cameras.size(), "camera(s)");
+  if (index.is_index) {
+    if (!index.problem.empty()) throw Error(shown + ": " + index.problem);
+    return index.index;
+  }
+  throw Error(shown + ": no camera node or camera of the scene has that name" +
+              unnamed_choice_hint(name, "pmr info"));
 }
 
 }  // namespace pmr

@@ -17,6 +17,7 @@
 #include <utility>
 
 #include "sequence/frame_names.h"
+#include "output/interrupt.h"
 #include "pmr/error.h"
 #include "output/sidecar.h"
 #include "pmr/output.h"
@@ -313,6 +314,7 @@ FolderGuard::FolderGuard(const std::string& dir, const std::string& pattern, con
   lock_path_ = (fs::path(dir) / own_name).string();
   fd_ = take_own_lock(dir, own_name, expected, lock_path_);
   release_at_exit(this);
+  if (fd_ >= 0) register_lock_file(fd_, lock_path_);
   try {
     const FolderContents found = scan_folder(dir, pattern, job_frames, own_name);
     refuse_running_configurations(dir, found.locks, difference);
@@ -344,6 +346,7 @@ void FolderGuard::release() {
     live_ = nullptr;
   }
   if (fd_ < 0) return;
+  unregister_lock_file();
   // the last process of this configuration removes the file (exclusive = nobody else holds it)
   if (::flock(fd_, LOCK_EX | LOCK_NB) == 0 && same_file(fd_, lock_path_)) ::unlink(lock_path_.c_str());
   ::close(fd_);

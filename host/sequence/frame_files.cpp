@@ -12,6 +12,9 @@
 
 #include "output/checksum.h"
 #include "pmr/error.h"
+#include "output/sidecar_names.h"
+#include "pmr/json_text.h"
+#include "pmr/printable.h"
 #include "pmr/memory_budget.h"
 #include "output/sidecar.h"
 #include "pmr/output.h"
@@ -85,7 +88,9 @@ std::map<std::string, OutputChecksum> recorded_outputs(const nlohmann::json& sid
     if (!v.is_object() || !v.contains("bytes") || !v["bytes"].is_number_unsigned() || !v.contains("checksum") ||
         !v["checksum"].is_string())
       continue;
-    out[it.key()] = {it.key(), v["bytes"].get<uint64_t>(), v["checksum"].get<std::string>()};
+    const json key = it.key();  // a name that is not UTF-8 is recorded byte-exact in name_hex
+    const std::string name = recorded_name(&key, v.contains("name_hex") ? &v["name_hex"] : nullptr);
+    out[name] = {name, v["bytes"].get<uint64_t>(), v["checksum"].get<std::string>()};
   }
   return out;
 }
@@ -117,12 +122,11 @@ std::string frame_problem(const std::string& sidecar, const std::vector<std::str
     if (!fs::is_regular_file(p, ec)) return name(p) + " is missing";
   json j;
   try {
-    j = json::parse(read_sidecar_text(sidecar));
-  } catch (const std::bad_alloc&) {
-    throw;
-  } catch (const std::exception&) {
+    j = parse_json_text(read_sidecar_text(sidecar));
+  } catch (const Error&) {  // beyond the memory budget: a frame to render again, not the job's end
     return name(sidecar) + " is truncated or unreadable";
   }
+  if (j.is_discarded()) return name(sidecar) + " is truncated or unreadable";
   if (!j.is_object()) return name(sidecar) + " is not a sidecar";
   const std::map<std::string, OutputChecksum> recorded = recorded_outputs(j);
   for (const std::string& p : images) {
@@ -168,7 +172,7 @@ void check_frame_file_names(const FrameProducts& o, const std::vector<long>& fra
     if (const std::string n = fs::path(file).filename().string(); n.size() > name.size()) name = n;
   const size_t limit = max_output_file_name();
   if (name.size() > limit)
-    throw UsageError("invalid --name '" + o.name + "': it makes the file name " + name + " of " +
+    throw UsageError("invalid --name '" + printable_text(o.name) + "': it makes the file name " + name + " of " +
                      std::to_string(name.size()) + " bytes, and pmr can write at most " + std::to_string(limit) +
                      " (the file system's 255, less what the temporary name it writes first adds)");
 }

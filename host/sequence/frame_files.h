@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "output/sidecar.h"
 #include "pmr/printable.h"  // printable_text, for names read from sidecars
 #include "pmr/quilt.h"
 
@@ -36,8 +37,8 @@ FramePaths frame_paths(const FrameProducts& o, long frame, const QuiltLayout& qu
 // pixel is decoded as well.
 std::string frame_problem(const std::string& sidecar, const std::vector<std::string>& images, bool deep = false);
 
-// A sidecar is a few kB; a larger file is not read (read_sidecar_text returns "").
-constexpr uint64_t kMaxSidecarBytes = uint64_t(16) << 20;
+// A sidecar is a few kB; one larger than kMaxSidecarBytes (output/sidecar.h: pmr writes none) is not
+// read (read_sidecar_text returns "").
 std::string read_sidecar_text(const std::string& path);
 
 // Throws a UsageError naming --name when a file of these frames would have a name longer than the file

@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "pmr/error.h"
+#include "pmr/printable.h"
 
 namespace pmr {
 
@@ -18,7 +19,7 @@ const char* const kNameExample = "e.g. --name shot_%04d or shot_#### (frame 7: s
 NamePattern parse_name_pattern(const std::string& p) {
   NamePattern n;
   auto refuse = [&](const std::string& why) -> Error {
-    return Error("invalid --name '" + p + "': " + why + "; " + kNameExample);
+    return Error("invalid --name '" + printable_text(p) + "': " + why + "; " + kNameExample);
   };
   auto field = [&](int width) {
     if (n.has_field) throw refuse("more than one frame number field");
@@ -28,6 +29,9 @@ NamePattern parse_name_pattern(const std::string& p) {
   for (size_t i = 0; i < p.size(); ++i) {
     std::string& out = n.has_field ? n.suffix : n.prefix;
     if (p[i] == '/') throw refuse("a file stem cannot contain '/' (--out names the folder)");
+    // names pmr verify and other tools read back: no terminal controls, no Windows separator
+    if (p[i] == '\\') throw refuse("a file stem cannot contain '\\'");
+    if ((unsigned char)p[i] < 0x20 || p[i] == 0x7f) throw refuse("a file stem cannot contain control characters");
     if (p[i] == '#') {  // Blender: a run of N '#' is the frame zero-padded to N digits
       size_t j = i;
       while (j < p.size() && p[j] == '#') ++j;
@@ -72,7 +76,7 @@ NamePattern parse_name_pattern(const std::string& p) {
 void check_name_pattern(const std::string& p) {
   const std::string stem = frame_stem(p, 0);
   if (stem.empty() || stem[0] == '.')
-    throw Error("invalid --name '" + p + "': the file stem would be empty or hidden; " + kNameExample);
+    throw Error("invalid --name '" + printable_text(p) + "': the file stem would be empty or hidden; " + kNameExample);
 }
 
 namespace {

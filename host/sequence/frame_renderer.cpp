@@ -7,6 +7,7 @@
 #include "pmr/error.h"
 #include "pmr/printable.h"
 #include "scene/motion.h"
+#include "sequence/frame_work.h"
 
 namespace pmr {
 
@@ -52,6 +53,7 @@ SequenceSpec resolve_sequence(const Scene& scene, const SequenceChoice& choice, 
   SequenceSpec spec;
   spec.framing_work = limits.framing_work;
   spec.pose_work = limits.pose_work;
+  spec.frame_work = limits.frame_work;
   select_animation(scene, choice.animation, spec);
   spec.fps = choice.fps;
   spec.turntable = choice.turntable;
@@ -252,6 +254,8 @@ FrameRenderer::Frame FrameRenderer::render(long frame) {
   // the lights every frame: an animation may move a light and no geometry
   const FrameDescription d = describe_posed(moves_ ? posed_ : rest_, pipeline_->config());
   out.rig = d.rig, out.lights = d.lights;
+  check_frame_work(estimate_frame_work(moves_ ? posed_ : rest_, d.rig, d.lights.size(), pipeline_->config()),
+                   spec_.frame_work);
   out.times = pipeline_->render(d);
   out.visible = out.times.mtas > 0;
   return out;

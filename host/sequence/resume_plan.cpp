@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pmr/error.h"
+#include "pmr/json_text.h"
 #include "output/sidecar.h"
 #include "pmr/output.h"
 #include "pmr/version.h"
@@ -25,7 +26,7 @@ std::string first_few(const std::vector<std::string>& names) {
 
 // The sidecar says it holds frame f (frame_problem has checked that it parses as an object).
 bool records_frame(const std::string& sidecar, long f) {
-  const nlohmann::json j = nlohmann::json::parse(sidecar, nullptr, false);
+  const nlohmann::json j = parse_json_text(sidecar);
   return j.is_object() && j.contains("frame") && j["frame"].is_number_integer() && j["frame"].get<long>() == f;
 }
 

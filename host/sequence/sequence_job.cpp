@@ -13,6 +13,8 @@
 #include <filesystem>
 #include <memory>
 
+#include <nlohmann/json.hpp>
+
 #include "output/checksum.h"
 #include "output/interrupt.h"
 #include "pipeline/transmission_stage.h"
@@ -75,6 +77,7 @@ class SequenceRun {
   }
   FramePaths paths(long f) const { return frame_paths(products_, f, quilt_, renderer_->rig().aspect); }
   void print_header() const;
+  int print_outputs() const;
   int render_frames();
   void finish_writing(FrameWriter& writer, Progress& progress);
   FrameFiles frame_files(long f, const FrameRenderer::Frame& fr, Pipeline& pipeline, FrameWriter& writer) const;
@@ -211,7 +214,7 @@ void SequenceRun::prepare_frames() {
   info.scene = job_.scene;
   info.rig_config = rig_config_;
   if (rig_config_.camera >= 0) info.camera_name = scene_.cameras[size_t(rig_config_.camera)].node_name;
-  if (scene_.variant >= 0) info.variant = scene_.variants[size_t(scene_.variant)];
+  if (scene_.variant >= 0) info.variant = scene_.variants[size_t(scene_.variant)], info.variant_index = scene_.variant;
   info.pipeline = job_.pipeline;
   info.display_source = job_.display_source;
   info.sequence = spec_;
@@ -252,6 +255,18 @@ SidecarInfo SequenceRun::frame_info(long frame, const FramePaths& p, double angl
   return i;
 }
 
+// --print-outputs: the files of each frame of the job, one JSON line a frame on stdout, so that a tool
+// driving pmr (the Blender add-on) never expands --name itself. Nothing is rendered or created.
+int SequenceRun::print_outputs() const {
+  for (long f : frames_) {
+    const FramePaths p = paths(f);
+    nlohmann::json line = {{"frame", f}, {"sidecar", base_name(p.sidecar)}, {"outputs", nlohmann::json::object()}};
+    for (const auto& [kind, file] : frame_info(f, p, 0.0, {}).outputs) line["outputs"][kind] = file;
+    std::printf("%s\n", line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+  }
+  return 0;
+}
+
 void SequenceRun::print_header() const {
   if (job_.quiet) return;
   const Rig& rig = renderer_->rig();
@@ -267,6 +282,9 @@ int SequenceRun::run() {
   load_inputs();
   choose_frames();
   prepare_frames();
+  // before anything is written: the first frame's sidecar, and room for its outputs' checksums
+  check_sidecar_size(expected_sidecar(0, paths(0)).size() + (uint64_t(64) << 10));
+  if (job_.print_outputs) return print_outputs();
   // A run refused before it wrote anything (a budget met in the first frame) leaves no folder it made.
   const bool created = prepare_output_dir(products_.out_dir);
   try {

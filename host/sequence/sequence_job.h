@@ -41,6 +41,7 @@ struct SequenceJob {
   long shard_count = 0, shard_first = 0;
   bool resume = false, overwrite = false;
   bool quiet = false, verbose = false;
+  bool print_outputs = false;  // --print-outputs: list each frame's files (JSON lines) and render nothing
   std::vector<std::string> warnings;  // printed before the work starts (e.g. from the options)
   Background background;              // behind every output (output/background.h)
   bool quilt_preview_opaque = false;  // the quilt PNG over opaque black when no background is given

@@ -31,6 +31,9 @@ struct SequenceSpec {
   // FrameRenderer before it poses anything.
   uint64_t pose_work = InputLimits().pose_work;
   uint64_t framing_work = InputLimits().framing_work;
+  // --limit frame-work: the estimated work of one frame (sequence/frame_work.h), checked by
+  // FrameRenderer before each frame renders.
+  uint64_t frame_work = InputLimits().frame_work;
 };
 
 }  // namespace pmr

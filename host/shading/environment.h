@@ -91,6 +91,10 @@ constexpr int kEnvMaxBaseWidth = 4096;  // level 0 is box-downsampled by 2 until
 // Memory budget for an image: at most kEnvMaxTexels texels (8192x4096; decoding needs at most
 // 16 bytes per texel, 512 MiB) and, for .hdr, a file of at most kEnvMaxFileBytes.
 constexpr uint64_t kEnvMaxTexels = uint64_t(1) << 25;
+constexpr uint64_t kEnvMaxSide = uint64_t(1) << 14;  // texels on a side (an image 2:1 wide reaches the total first)
+// Peak host memory of decoding and prefiltering an image, per texel of the image (an 8192x4096 .hdr
+// peaked at 1.46 GB: 44 bytes a texel), counted against the memory budget before decoding.
+constexpr uint64_t kEnvBytesPerTexel = 48;
 constexpr uint64_t kEnvMaxFileBytes = uint64_t(1) << 28;
 
 // The description of EnvironmentTables::data, shared with the kernels (include/pmr/shared.h).

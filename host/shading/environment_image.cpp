@@ -22,6 +22,7 @@
 #include <fstream>
 
 #include "pmr/error.h"
+#include "pmr/memory_budget.h"
 #include "pmr/printable.h"
 #include "shading/environment.h"
 
@@ -54,11 +55,23 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
+// What is wrong with an image of w x h texels as an environment, "" when nothing: the size the file
+// gave and the limits it exceeds.
+std::string size_problem(uint64_t w, uint64_t h) {
+  const std::string size = std::to_string(w) + "x" + std::to_string(h);
+  if (w == 0 || h == 0) return "the image is empty (" + size + ")";
+  if (w > kEnvMaxSide || h > kEnvMaxSide || w * h > kEnvMaxTexels)
+    return "the image is too large (" + size + "); environments may be at most " + std::to_string(kEnvMaxSide) +
+           " texels on a side and " + std::to_string(kEnvMaxTexels) + " texels in all (8192x4096)";
+  return "";
+}
+
+// The size limits, then the memory decoding and prefiltering the image take (kEnvBytesPerTexel),
+// against the memory budget before any pixel is decoded.
 void check_size(const std::string& path, uint64_t w, uint64_t h) {
-  if (w == 0 || h == 0) fail(path, "the image is empty (" + std::to_string(w) + "x" + std::to_string(h) + ")");
-  if (w > kEnvMaxTexels || h > kEnvMaxTexels || w * h > kEnvMaxTexels)
-    fail(path, "the image is too large (" + std::to_string(w) + "x" + std::to_string(h) +
-                   "); environments may have at most " + std::to_string(kEnvMaxTexels) + " texels (8192x4096)");
+  if (const std::string why = size_problem(w, h); !why.empty()) fail(path, why);
+  check_memory(w * h * kEnvBytesPerTexel, "decoding the " + std::to_string(w) + "x" + std::to_string(h) +
+                                              " environment " + printable(path));
 }
 
 // ---- Radiance .hdr --------------------------------------------------------------------------------
@@ -94,9 +107,7 @@ std::string check_hdr_data(const std::vector<unsigned char>& b, int& width, int&
   if (std::sscanf(t.c_str(), "-Y %ld +X %ld%c", &h, &w, &tail) != 2)
     return "unsupported resolution line '" + t.substr(0, 40) + "' (only -Y H +X W, rows top to bottom)";
   if (w <= 0 || h <= 0) return "the image is empty (" + std::to_string(w) + "x" + std::to_string(h) + ")";
-  if (uint64_t(w) * uint64_t(h) > kEnvMaxTexels || w > (1 << 24) || h > (1 << 24))
-    return "the image is too large (" + std::to_string(w) + "x" + std::to_string(h) +
-           "); environments may have at most " + std::to_string(kEnvMaxTexels) + " texels (8192x4096)";
+  if (const std::string why = size_problem(uint64_t(w), uint64_t(h)); !why.empty()) return why;
   width = int(w), height = int(h);
   const uint64_t flat_bytes = uint64_t(w) * uint64_t(h) * 4;
   auto truncated = [&](long row) {

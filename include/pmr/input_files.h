@@ -22,6 +22,7 @@ struct InputLimits {
   uint64_t pose_work = uint64_t(1) << 28;         // "pose-work": work units of posing one frame
   uint64_t framing_work = uint64_t(1) << 34;      // "framing-work": work units of all the framing's poses
   uint64_t tile_queue = uint64_t(1) << 30;        // "tile-queue": tile-queue entries of one frame
+  uint64_t frame_work = uint64_t(600000000000);  // "frame-work": work units of one frame (about ns: 10 min)
   uint64_t memory = 0;                            // "memory": bytes; 0 = automatic (memory_budget.h)
 };
 

@@ -53,7 +53,9 @@ size_t remove_dead_temporaries(const std::string& dir);
 // A file written under a temporary name in the same folder as `final_path` and renamed into place by
 // commit(). The constructor creates the (empty) temporary file, so an unwritable or missing folder
 // fails early with pmr::Error. The destructor removes the temporary if commit() was not reached.
-// commit() replaces an existing file at final_path atomically (POSIX rename); it does not fsync.
+// commit() replaces an existing file at final_path atomically (POSIX rename); it does not fsync. Only
+// a regular file is replaced: the constructor refuses a path holding a symbolic link, a folder, a FIFO
+// or a device.
 class AtomicFile {
  public:
   explicit AtomicFile(std::string final_path);

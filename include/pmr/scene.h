@@ -59,7 +59,8 @@ bool texture_slot_is_srgb(int slot);
 // u' = sx cos(r) u + sy sin(r) v + ox, v' = -sx sin(r) u + sy cos(r) v + oy.
 struct SceneTextureSlot {
   int texture = -1;        // index into Scene::textures; -1 = none (absent, or its image is unusable)
-  int texcoord = 0;        // index into Scene::texcoords
+  int texcoord = 0;        // index into Scene::texcoords; -1: no drawn primitive samples it (load_scene)
+  int texcoord_set = 0;    // the file's TEXCOORD_n (what pmr info names)
   bool srgb = false;       // true for base colour and emissive
   bool transform = false;  // KHR_texture_transform present (else the identity)
   float offset[2] = {0.0f, 0.0f};
@@ -178,10 +179,11 @@ struct Scene {
                                           // (load_scene: 0 is the default, glTF material i is i + 1)
   std::vector<SceneTexture> textures;     // referenced by SceneTextureSlot::texture
   // Texture slots and physically based inputs (DESIGN 4b). material_inputs is parallel to materials
-  // (same index), or empty (generated scenes: every material has the defaults, no textures). texcoords[k] is TEXCOORD_k for every
-  // vertex, as stored in the file (no KHR_texture_transform applied: each slot has its own), for each
-  // set k some material slot samples ((0, 0) for vertices of meshes without it, whose materials do not
-  // sample it). tangents is empty or one per vertex: world-space unit xyz, and w = the file's
+  // (same index), or empty (generated scenes: every material has the defaults, no textures). texcoords holds, for every
+  // vertex, each TEXCOORD set that some drawn primitive's material samples, in increasing set number
+  // (SceneTextureSlot::texcoord indexes it, texcoord_set names the file's set), as stored in the file
+  // (no KHR_texture_transform applied: each slot has its own); (0, 0) for vertices of meshes without
+  // it, whose materials do not sample it. tangents is empty or one per vertex: world-space unit xyz, and w = the file's
   // handedness times sign(det) of the matrix that placed the vertex (the node's world matrix or the
   // blended joint matrix), so the world bitangent is w * cross(n, t); xyz = 0 where the vertex has
   // no tangent (its material has no normal texture). Tangents are the file's, or generated for
@@ -267,8 +269,19 @@ Scene load_scene(const std::string& path, const InputLimits& limits, const std::
 // untouched) when there are none.
 bool scene_bounds(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi);
 
-// The glTF camera `--camera` names: an index (digits only), else the camera whose node has that name,
-// else the one whose camera object has it. Throws pmr::Error when none or several match.
+// --camera and --variant take a name first; "#K", when nothing has that name, selects the K-th (from 0),
+// so that a camera or variant named "1" is never mistaken for an index.
+struct IndexChoice {
+  bool is_index = false;  // the choice is "#..."
+  int index = -1;         // K, when it is an index of one of the `count` things
+  std::string problem;    // why "#..." selects none ("" when it does)
+};
+IndexChoice parse_index_choice(const std::string& choice, size_t count, const std::string& things);
+// The end of the message for a choice that names nothing: a hint when it is a bare number.
+std::string unnamed_choice_hint(const std::string& choice, const std::string& lister);
+
+// The glTF camera `--camera` names: the camera whose node has that name, else the one whose camera
+// object has it, else "#K" its index. Throws pmr::Error when none or several match.
 int find_camera(const Scene& scene, const std::string& name);
 
 }  // namespace pmr

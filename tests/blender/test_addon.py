@@ -361,6 +361,42 @@ def check_errors(scene, ops_module, work):
     check(ops_module.last_result["returncode"] == 2, "pmr's usage error did not exit 2")
 
 
+def check_names(scene, ops_module, work):
+    """pmr alone names the files: a camera named "1" is that camera (not index 1), a file name pattern
+    shot_%0d gives the files the add-on then finds, and an unbalanced quote in the extra options is a
+    report, not a traceback."""
+    cam = bpy.data.objects.new("1", bpy.data.cameras.new("One"))
+    scene.collection.objects.link(cam)
+    cam.location = (-4.0, -3.5, 2.5)
+    look_at(cam, (0, 0, 0))
+    bpy.context.view_layer.update()
+    shot = scene.camera
+    scene.camera = cam
+    out = os.path.join(work, "names")
+    s = settings_for(scene, out, "STILL", SEQ_VIEW)
+    s.name = "shot_%0d"
+    r = run_operator(ops_module)
+    s.name = ""
+    scene.camera = shot
+    check(r["argv"][r["argv"].index("--camera") + 1] == "1", "pmr was not given --camera 1: %s" % r["argv"])
+    frame = scene.frame_current
+    check(list(r["outputs"]) == [frame], "the add-on found no outputs for shot_%%0d: %s" % r["outputs"])
+    path = os.path.join(out, "shot_%d.json" % frame)
+    check(os.path.isfile(path), "pmr did not write %s" % path)
+    with open(path, encoding="utf-8") as f:
+        sidecar = json.load(f)
+    check(sidecar.get("camera_name") == "1", "the sidecar's camera is %r, not '1'" % sidecar.get("camera_name"))
+    check_camera(sidecar, cam)
+    s.extra_args = "--background '0,0,0"
+    try:
+        bpy.ops.pmr.render_lightfield()
+        fail("an unbalanced quote in the extra options did not raise an error report")
+    except RuntimeError as e:
+        check("Extra options" in str(e), "the extra options' error does not say so: %s" % e)
+    s.extra_args = ""
+    bpy.data.objects.remove(cam)
+
+
 def check_fps_base(scene, ops_module, work):
     """With fps 30 / 1.001 the kept export's key times are frame / 29.97 (the exporter alone writes
     frame / 30) and pmr gets --fps 29.97: pmr's frame F is Blender's frame F."""
@@ -443,6 +479,9 @@ def main():
 
     check_errors(scene, ops_module, work)
     log("a missing pmr names its preference; pmr's error lines become error reports")
+
+    check_names(scene, ops_module, work)
+    log("a camera named 1, the pattern shot_%0d and a bad quote in the extra options")
 
     check_fps_base(scene, ops_module, work)
     log("fps 30 / 1.001: pmr --fps 29.97, the exported key times frame / 29.97")

@@ -34,7 +34,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   pmr::fuzz::write_file(path, data, size);
   const pmr::InputLimits limits = pmr::fuzz::small_limits();
   try {
-    const pmr::Scene scene = pmr::load_scene(path, limits);
+    // the material variant by name or by index, as --variant takes it (the input's first byte picks)
+    const char* variants[] = {"", "#0", "#1", "Blue", "1"};
+    const pmr::Scene scene = pmr::load_scene(path, limits, size ? variants[data[0] % 5] : "");
     glm::dvec3 lo, hi;
     pmr::scene_bounds(scene, lo, hi);
   } catch (const pmr::Error&) {

@@ -11,6 +11,7 @@
 #include "fuzz/fuzz_util.h"
 #include "fuzz/sidecar_reference.h"
 #include "pmr/error.h"
+#include "pmr/json_text.h"
 #include "output/sidecar.h"
 #include "pmr/output.h"
 #include "sequence/folder_guard.h"
@@ -34,7 +35,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   pmr::sidecar_provenance(text);
   pmr::sidecar_config_difference(pmr::without_view_matrices(text), pmr::without_view_matrices(reference));
   // pmr verify compares the other frames with the folder's reference frame, a sidecar that parsed
-  if (nlohmann::json::parse(text, nullptr, false).is_object()) {
+  if (pmr::parse_json_text(text).is_object()) {
     pmr::sidecar_config_difference(reference, text);
     pmr::sidecar_config_difference(text, text, /*ignore_scene_derived=*/true);
   }

@@ -253,6 +253,14 @@ void sidecar_seeds(const fs::path& out) {
   save(out / "output_parent.json", with("\"frame_0000.exr\"", "\"../frame_0000.exr\""));
   save(out / "fps_0.json", with("\"fps\": 24", "\"fps\": 0"));
   save(out / "frame_huge.json", with("\"frame\": 0", "\"frame\": 1e308"));
+  // what once crashed or stalled the readers (issue 48): a value nested 100,000 deep, an object of
+  // 200,000 keys (the target runs with -max_len=4M), names recorded byte-exact in hex
+  save(out / "deep.json", with("\"pmr-sidecar-1\"", std::string(100000, '[') + std::string(100000, ']')));
+  std::string keys = "{";
+  for (int k = 0; k < 200000; ++k) keys += (k ? ",\"" : "\"") + std::to_string(k) + "\":0";
+  save(out / "many_keys.json", with("\"frame\": 0", "\"frame\": 0, \"extra\": " + keys + "}"));
+  save(out / "outputs_hex.json", with("\"outputs\": {", "\"outputs_hex\": {\"encoded\": \"fffe2e657872\"}, \"outputs\": {"));
+  save(out / "scene_hex.json", with("\"scene\": ", "\"scene_hex\": \"2e2e2f6574632f706173737764\", \"scene\": "));
 }
 
 // A lock file's text is a sidecar: this run's configuration, another one's, and text that is none.

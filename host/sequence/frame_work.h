@@ -1,0 +1,45 @@
+// The frame-work budget (docs/SECURITY.md, "Frame work"): what one frame will cost, estimated from
+// the scene, the rig and the configuration before the frame renders, so that a small file cannot
+// hold a job for hours (1000 point lights, hundreds of stacked BLEND layers). Two parts, weighted so
+// that a unit is about a nanosecond of the 2-core development machine (measured with pmr bench):
+// - light evaluations: every view pixel and every BLEND fragment is shaded once per light (shading is
+//   once per pixel, not per sample: 100 lights cost the same at 1, 4 and 16 samples within 10%);
+// - BLEND fragments: each BLEND triangle's fragments, sorted into the nearest layers once per fragment
+//   and composited per sample; bounded by the voxels of the 3D tiles its screen bounding box covers
+//   in every view (an upper bound of its tile-queue entries times the tile's voxels).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pmr/rig.h"
+#include "pmr/scene.h"
+
+namespace pmr {
+
+struct PipelineConfig;
+
+struct FrameWork {
+  uint64_t pixels = 0;             // views x W x H
+  uint64_t lights = 0;             // lights the frame is shaded with
+  uint64_t blend_fragments = 0;    // upper bound of the BLEND triangles' voxels
+  uint64_t samples = 1;            // per pixel
+  uint64_t light_evaluations = 0;  // (pixels + blend_fragments) x lights
+  uint64_t units = 0;              // the weighted sum the budget limits
+};
+
+// Weights: units per light evaluation, per BLEND fragment, and per BLEND fragment and sample.
+constexpr uint64_t kUnitsPerLightEvaluation = 4;
+constexpr uint64_t kUnitsPerBlendFragment = 14;
+constexpr uint64_t kUnitsPerBlendSample = 2;
+
+// The estimate for one frame of `placed` (posed) seen by `rig`, shaded with `lights` lights.
+FrameWork estimate_frame_work(const Scene& placed, const Rig& rig, size_t lights, const PipelineConfig& config);
+
+// Throws pmr::Error naming --limit frame-work when the estimate exceeds `limit`.
+void check_frame_work(const FrameWork& work, uint64_t limit);
+
+// The estimate in words, for pmr info.
+std::string describe_frame_work(const FrameWork& work);
+
+}  // namespace pmr

@@ -199,4 +199,30 @@ TEST(Names, QuietPrintsOnlyErrorsAndWarnings) {
   EXPECT_NE(r.output.find("triangles"), std::string::npos) << r.output;
 }
 
+// --print-outputs: the files of every frame as pmr names them (here shot_%0d, which a tool expanding
+// patterns itself got wrong), one JSON line a frame, and nothing rendered or created; the files then
+// rendered are those.
+TEST(Names, PrintOutputsListsTheFilesOfEveryFrameAndRendersNothing) {
+  const std::string out = temp_dir("names_print");
+  const std::string args = "render --name shot_%0d --frames 9:10 --turntable 360:12 --write encoded,quilt" + kSmall + "--out " + out;
+  const CliRun r = run(args + " --print-outputs");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_FALSE(test::exists(out)) << "nothing is created";
+  std::istringstream lines(r.output);
+  std::vector<nlohmann::json> frames;
+  for (std::string line; std::getline(lines, line);)
+    if (!line.empty() && line[0] == '{') frames.push_back(nlohmann::json::parse(line));
+  ASSERT_EQ(frames.size(), 2u) << r.output;
+  EXPECT_EQ(frames[0]["frame"], 9);
+  EXPECT_EQ(frames[0]["sidecar"], "shot_9.json");
+  EXPECT_EQ(frames[1]["sidecar"], "shot_10.json");
+  EXPECT_EQ(frames[1]["outputs"]["encoded"], "shot_10.exr");
+  ASSERT_EQ(run(args + " -q").status, 0);
+  for (const nlohmann::json& f : frames) {
+    EXPECT_TRUE(test::exists(out + "/" + f["sidecar"].get<std::string>())) << f.dump();
+    for (const auto& [kind, file] : f["outputs"].items())
+      EXPECT_TRUE(test::exists(out + "/" + file.get<std::string>())) << kind;
+  }
+}
+
 }  // namespace pmr

@@ -536,8 +536,6 @@ uint64_t primitive_data_bytes(const Loader& L, int mesh, int index, uint64_t tri
   return bytes;
 }
 
-// Sums the whole scene before anything is decoded: a small file instancing a big mesh many times must
-// fail here, not after allocating gigabytes. The vertex cap is what the triangle cap can reference.
 // The TEXCOORD sets the drawn primitives' materials sample, numbered in increasing set order
 // (L.texcoord_index), and every material slot pointed at its set's number (-1: no drawn primitive
 // samples it). Returns how many there are: each costs 8 bytes per vertex of the scene.
@@ -558,6 +556,8 @@ uint64_t assign_texcoord_sets(Loader& L, const std::vector<Instance>& instances)
   return sets.size();
 }
 
+// Sums the whole scene before anything is decoded: a small file instancing a big mesh many times must
+// fail here, not after allocating gigabytes. The vertex cap is what the triangle cap can reference.
 void check_totals(Loader& L, const std::vector<Instance>& instances) {
   struct Size {
     uint64_t triangles = 0, vertices = 0, data = 0;  // data: primitive_data_bytes

@@ -36,7 +36,7 @@ struct Loader {
   std::set<std::string> seen;
   std::vector<std::array<int, kTextureSlots>> slot_sets;  // per glTF material and slot: TEXCOORD set, -1 = no texture
   // glTF TEXCOORD set -> Scene::texcoords index, for the sets that drawn primitives' materials sample
-  // (texcoord_sets_used), so that a set number a file names costs nothing but its own vertices
+  // (assign_texcoord_sets), so that a set number a file names costs nothing but its own vertices
   std::map<int, int> texcoord_index;
   std::map<int, int> scene_texture_of;                    // glTF texture -> Scene::textures index (-1: unusable)
   std::map<std::array<int, 3>, int> scene_texture_of_image;  // (image, wrap s, wrap t) -> Scene::textures

@@ -413,7 +413,7 @@ SceneMaterialInputs material_inputs(Loader& L, const tinygltf::Material& g, int 
     // the base colour slot's messages name no slot (they predate the other slots)
     const MaterialUv uv =
         material_uv(L, info.texcoord, *info.extensions, i, slot == kSlotBaseColor ? "" : texture_slot_name(slot));
-    out.texcoord_set = uv.set;  // Scene::texcoords index: set by the loader (texcoord_sets_used)
+    out.texcoord_set = uv.set;  // Scene::texcoords index: set by the loader (assign_texcoord_sets)
     out.transform = uv.transform;
     if (out.transform) {
       out.offset[0] = uv.offset[0], out.offset[1] = uv.offset[1];

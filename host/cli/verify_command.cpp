@@ -155,17 +155,7 @@ std::string changed_scene_file(const nlohmann::json& j, SceneNow& now) {
   const std::string sum = now.sum(scene);
   if (sum.empty()) return now.scene_unreadable = true, "";
   if (c->value("scene", "") != sum) return fs::path(scene).filename().string();
-  const auto files = c->find("scene_files");
-  if (files == c->end() || !files->is_object()) return "";
-  std::vector<std::pair<std::string, const nlohmann::json*>> listed;  // (name, checksum)
-  for (auto it = files->begin(); it != files->end(); ++it) listed.push_back({it.key(), &it.value()});
-  const auto files_hex = c->find("scene_files_hex");  // the names that are not UTF-8, byte-exact
-  if (files_hex != c->end() && files_hex->is_object())
-    for (auto it = files_hex->begin(); it != files_hex->end(); ++it) {
-      const nlohmann::json hex = it.key();
-      listed.push_back({recorded_name(nullptr, &hex), &it.value()});
-    }
-  for (const auto& [name, sum] : listed)
+  for (const auto& [name, sum] : recorded_scene_files(*c))
     if (!inside_folder(name) || !sum->is_string() ||
         now.sum((fs::path(scene).parent_path() / name).string()) != sum->get<std::string>())
       return name;

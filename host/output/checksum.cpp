@@ -1,11 +1,11 @@
 #include "output/checksum.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 #include <xxhash.h>
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <memory>
 #include <vector>
 
@@ -36,19 +36,6 @@ XxhState new_state(const std::string& name) {
 
 }  // namespace
 
-std::string checksum_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot read " + path + ": " + std::strerror(errno));
-  const XxhState state = new_state(path);
-  std::vector<char> piece(size_t(1) << 20);
-  while (in) {
-    in.read(piece.data(), std::streamsize(piece.size()));
-    if (in.gcount() > 0) XXH3_64bits_update(state.get(), piece.data(), size_t(in.gcount()));
-  }
-  if (!in.eof()) throw Error("cannot read " + path + ": read error");
-  return checksum_hex(XXH3_64bits_digest(state.get()));
-}
-
 std::string checksum_descriptor(int fd, const std::string& name, uint64_t* bytes) {
   const XxhState state = new_state(name);
   std::vector<char> piece(size_t(1) << 20);
@@ -63,6 +50,19 @@ std::string checksum_descriptor(int fd, const std::string& name, uint64_t* bytes
   }
   if (bytes) *bytes = total;
   return checksum_hex(XXH3_64bits_digest(state.get()));
+}
+
+std::string checksum_file(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw Error("cannot read " + path + ": " + std::strerror(errno));
+  try {
+    std::string sum = checksum_descriptor(fd, path);
+    ::close(fd);
+    return sum;
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
 }
 
 }  // namespace pmr

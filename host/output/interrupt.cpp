@@ -25,14 +25,9 @@ sem_t g_deadline;                 // posted by the first signal: the watchdog's 
 std::atomic<int> g_lock_fd{-1};   // the run's folder lock (register_lock_file), -1 when none
 char g_lock_path[kPathMax];
 
-// Removes the folder lock as FolderGuard::release does, when no other process of the job holds it.
 void release_lock() {
   const int fd = g_lock_fd.exchange(-1);
-  if (fd < 0) return;
-  struct stat held {}, named {};
-  if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && ::fstat(fd, &held) == 0 && ::stat(g_lock_path, &named) == 0 &&
-      held.st_dev == named.st_dev && held.st_ino == named.st_ino)
-    ::unlink(g_lock_path);
+  if (fd >= 0) remove_lock_if_last(fd, g_lock_path);
 }
 
 // The second signal's exit (and the watchdog's): async-signal-safe calls only.
@@ -84,6 +79,13 @@ void install_interrupt_handlers() {
   sigemptyset(&sa.sa_mask);
   // what schedulers send before a kill: SGE's -notify (USR1, USR2), Slurm's --signal, a CPU-time limit (XCPU)
   for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGALRM, SIGXCPU, SIGUSR1, SIGUSR2}) sigaction(sig, &sa, nullptr);
+}
+
+void remove_lock_if_last(int fd, const char* path) {
+  struct stat held {}, named {};
+  if (::flock(fd, LOCK_EX | LOCK_NB) == 0 && ::fstat(fd, &held) == 0 && ::stat(path, &named) == 0 &&
+      held.st_dev == named.st_dev && held.st_ino == named.st_ino)
+    ::unlink(path);
 }
 
 void register_lock_file(int fd, const std::string& path) {

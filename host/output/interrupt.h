@@ -27,7 +27,11 @@ const char* interrupt_signal_name(int sig);
 int register_temp_file(const std::string& path);
 void unregister_temp_file(int slot);
 
-// The run's folder lock (one per process): an exit by signal removes it as FolderGuard::release does.
+// Removes the lock file `path` that `fd` holds when no other process holds it (an exclusive flock
+// succeeds) and the name is still that file. Async-signal-safe: FolderGuard::release and the exit by
+// signal both call it.
+void remove_lock_if_last(int fd, const char* path);
+// The run's folder lock (one per process): an exit by signal releases it with remove_lock_if_last.
 void register_lock_file(int fd, const std::string& path);
 void unregister_lock_file();
 

@@ -530,17 +530,12 @@ SidecarProvenance sidecar_provenance(const std::string& sidecar_text) {
   if (algorithm == c->end() || !algorithm->is_string() || scene == c->end() || !scene->is_string() ||
       files == c->end() || !files->is_object())
     return p;
-  // canonical: files sorted by path, every value a string
+  // canonical: files sorted by path (a name that is not UTF-8 by its bytes in hex), every value a string
   std::map<std::string, std::string> sorted;
-  for (auto it = files->begin(); it != files->end(); ++it) {
-    if (!it.value().is_string()) return p;
-    sorted[it.key()] = it.value().get<std::string>();
+  for (const auto& [name, sum] : recorded_scene_files(*c)) {
+    if (!sum->is_string()) return p;
+    sorted[is_utf8(name) ? name : "hex:" + to_hex(name)] = sum->get<std::string>();
   }
-  if (const auto hex = c->find("scene_files_hex"); hex != c->end() && hex->is_object())
-    for (auto it = hex->begin(); it != hex->end(); ++it) {  // names that are not UTF-8, by their bytes
-      if (!it.value().is_string()) return p;
-      sorted["hex:" + it.key()] = it.value().get<std::string>();
-    }
   json identity = json::array({*algorithm, *scene});
   for (const auto& [file, sum] : sorted) identity.push_back(json::array({file, sum}));
   p.scene = identity.dump(-1, ' ', false, json::error_handler_t::replace);

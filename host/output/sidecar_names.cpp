@@ -63,6 +63,19 @@ std::string recorded_name(const nlohmann::json* text, const nlohmann::json* hex)
   return text && text->is_string() ? text->get<std::string>() : std::string();
 }
 
+std::vector<std::pair<std::string, const nlohmann::json*>> recorded_scene_files(const nlohmann::json& checksums) {
+  std::vector<std::pair<std::string, const nlohmann::json*>> files;
+  if (!checksums.is_object()) return files;
+  if (const auto plain = checksums.find("scene_files"); plain != checksums.end() && plain->is_object())
+    for (auto it = plain->begin(); it != plain->end(); ++it) files.push_back({it.key(), &it.value()});
+  if (const auto hex = checksums.find("scene_files_hex"); hex != checksums.end() && hex->is_object())
+    for (auto it = hex->begin(); it != hex->end(); ++it) {
+      const nlohmann::json key = it.key();
+      files.push_back({recorded_name(nullptr, &key), &it.value()});
+    }
+  return files;
+}
+
 std::string bounded_text(const std::string& text, size_t limit) {
   if (text.size() <= limit) return text;
   size_t cut = 0;  // whole characters (a stray byte counts as one)

@@ -348,7 +348,7 @@ void FolderGuard::release() {
   if (fd_ < 0) return;
   unregister_lock_file();
   // the last process of this configuration removes the file (exclusive = nobody else holds it)
-  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0 && same_file(fd_, lock_path_)) ::unlink(lock_path_.c_str());
+  remove_lock_if_last(fd_, lock_path_.c_str());
   ::close(fd_);
   fd_ = -1;
 }

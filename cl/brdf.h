@@ -1,6 +1,6 @@
 /* The glTF 2.0 metallic-roughness BRDF of --shading pbr (docs/SHADING.md): Schlick's Fresnel, the GGX
- * (Trowbridge-Reitz) distribution and the height-correlated Smith visibility, for one light, plus the
- * punctual lights of KHR_lights_punctual, each for SW lanes at once (cl/lanes.h). Every dot product
+ * (Trowbridge-Reitz) distribution and the height-correlated Smith visibility, for one light direction,
+ * and the layers' lobes, each for SW lanes at once (cl/lanes.h). Every dot product
  * with n is clamped to [0, 1]. The C++ reference (tests/reference/pbr_reference.cpp) computes the same
  * in double precision. */
 #ifndef PMR_CL_BRDF_H
@@ -225,37 +225,6 @@ inline sfloat3 btdf_light(sfloat3 f0, sfloat f90, sfloat r, sfloat ior, sfloat3 
   const sfloat3 F = fresnel_schlick(f0, f90, vh);
   const sfloat s = ggx_d(nh, a2) * smith_vis(nl, nv, a2);
   return s3((1.0f - F.x) * s, (1.0f - F.y) * s, (1.0f - F.z) * s);
-}
-
-/* KHR_lights_punctual at the surface points p: the unit directions toward the light (*l) and the
- * irradiance E it delivers on a surface facing it. Directional: colour x intensity (lux), travelling
- * along `direction` (the node's -Z). Point and spot: colour x intensity (candela) / d^2, times the range
- * window clamp(1 - (d / range)^4, 0, 1) when range > 0; a spot also times
- * clamp((cos_angle - cos_outer) / max(0.001, cos_inner - cos_outer), 0, 1)^2 with cos_angle between
- * its direction and -l. type is PMR_LIGHT_* (include/pmr/shared.h, with the light table's PmrLight).
- * A point at the light itself receives nothing (l = 0). */
-inline sfloat3 light_irradiance(int type, float3 color_intensity, float3 position, float3 direction, float range,
-                                float cos_inner, float cos_outer, sfloat3 p, sfloat3* l) {
-  if (type == PMR_LIGHT_DIRECTIONAL) {
-    *l = s3_splat(-direction);
-    return s3_splat(color_intensity);
-  }
-  const sfloat3 d = s3_sub(s3_splat(position), p);
-  const sfloat d2 = s3_dot(d, d);
-  const sint lit = d2 > 0.0f;
-  const sfloat dist = sqrt(d2);
-  *l = s3_select(s3_splat((float3)(0.0f)), s3_scale(d, 1.0f / dist), lit);
-  sfloat w = select((sfloat)(0.0f), 1.0f / d2, lit);
-  if (range > 0.0f) {
-    const sfloat q = dist / range, q2 = q * q;
-    w *= clamp(1.0f - q2 * q2, 0.0f, 1.0f);
-  }
-  if (type == PMR_LIGHT_SPOT) {
-    const sfloat c = -s3_dot(s3_splat(direction), *l);
-    const sfloat s = clamp((c - cos_outer) / max(0.001f, cos_inner - cos_outer), 0.0f, 1.0f);
-    w *= s * s;
-  }
-  return s3_scale(s3_splat(color_intensity), w);
 }
 
 #endif

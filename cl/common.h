@@ -6,9 +6,18 @@
 
 #include "pmr/shared.h"
 
-/* The C++ references round exactly like this code only if no multiply-add is fused. */
+/* The C++ references round exactly like this code only if no multiply-add is fused. A function defined
+ * before this line would be contracted: every header includes common.h (or lanes.h) first. */
 #pragma OPENCL FP_CONTRACT OFF
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
+
+/* The kernels are built for one filter (-DPMR_TRILINEAR, the host's --texture-filter), as for one
+ * sample count: built with 0 they carry no per-lane derivatives and no level-of-detail code, so
+ * bilinear filtering costs what it did before mips. A build without the define serves both filters,
+ * chosen by PmrParams.texture_filter (cl/texture.h). Defined here, before any header tests it. */
+#ifndef PMR_TRILINEAR
+#define PMR_TRILINEAR 1
+#endif
 
 /* This work-item's item in a launch over N items (ClRuntime::launch). The host folds long launches
  * into rows of fewer than 65535 work-items, so no grid dimension reaches PoCL's "small grid" limit and

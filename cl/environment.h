@@ -5,6 +5,7 @@
  * time (cl/lanes.h): the arithmetic in vectors, the texels gathered lane by lane. */
 #ifndef PMR_CL_ENVIRONMENT_H
 #define PMR_CL_ENVIRONMENT_H
+#include "common.h"
 #include "lanes.h"
 
 #define PMR_INV_2PI_F 0.159154943091895f

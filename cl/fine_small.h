@@ -1,7 +1,9 @@
 #ifndef PMR_CL_FINE_SMALL_H
 #define PMR_CL_FINE_SMALL_H
-/* The small-triangle path of the pixel-center fine raster (included by fine_raster.h before the queue
- * walk that chooses it).
+
+#include "fine_chunk.h"
+
+/* The small-triangle path of the pixel-center fine raster (fine_raster.h's queue walk chooses it).
  *
  * Why. At a million triangles most MTAs cover one or two pixel centers in a view, or none: the general
  * path's unit of work, a row chunk of VW pixels in one view, is mostly empty lanes, and it is spent

@@ -5,6 +5,8 @@
 #ifndef PMR_CL_LANES_H
 #define PMR_CL_LANES_H
 
+#include "common.h" /* first: its FP_CONTRACT pragma must precede every function */
+
 #define SW 8 /* one AVX2 register of floats; wider machines split it in halves less often than they gain */
 typedef float8 sfloat;
 typedef int8 sint;

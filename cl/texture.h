@@ -1,6 +1,6 @@
 /* Texture filtering (docs/DESIGN.md section 3b, "Filtered textures"): texels of a mip level, the
  * bilinear sample of one level with the glTF sampler's wrap modes, the trilinear sample between two,
- * and the level of detail from the analytic screen-space derivatives of the texture coordinates. cl/shade.h's
+ * and the level of detail from the analytic screen-space derivatives of the texture coordinates. cl/material_maps.h's
  * sample_map_lanes is the one caller: every path and every map samples through it. */
 #ifndef PMR_CL_TEXTURE_H
 #define PMR_CL_TEXTURE_H
@@ -8,13 +8,6 @@
 #include "common.h"
 #include "lanes.h"
 
-/* The kernels are built for one filter (-DPMR_TRILINEAR, the host's --texture-filter), as for one
- * sample count: built with 0 they carry no per-lane derivatives and no level-of-detail code, so
- * bilinear filtering costs what it did before mips. A build without the define serves both filters,
- * chosen by PmrParams.texture_filter. */
-#ifndef PMR_TRILINEAR
-#define PMR_TRILINEAR 1
-#endif
 #define PMR_USE_TRILINEAR(P) (PMR_TRILINEAR && (P)->texture_filter == PMR_FILTER_TRILINEAR)
 
 /* The sampling below runs for SW lanes at once (cl/lanes.h), each lane with its own coordinates and

@@ -8,6 +8,9 @@
 #ifndef PMR_CL_TRANSMISSION_H
 #define PMR_CL_TRANSMISSION_H
 
+#include "environment_light.h"
+#include "lane_winners.h"
+
 /* Texel (x, y) of level k (w x h texels a view) of view slice `slice`, premultiplied RGBA. */
 inline float4 source_texel(global const half* src, global const PmrSource* S, int k, size_t slice, int w, int h, int x,
                            int y) {

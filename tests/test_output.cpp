@@ -426,7 +426,7 @@ TEST(Output, SidecarMatricesReproduceTheRig) {
   SidecarInfo info;
   info.scene = "scene.glb";
   info.frame = 7;
-  info.pipeline.tile_x = 8;
+  info.render.tile_x = 8;
   info.outputs = {{"encoded", "frame_0007.exr"}, {"views", "frame_0007.views.exr"}};
   info.warnings = {"near plane raised"};
   const std::string path = dir / "frame_0007.json";

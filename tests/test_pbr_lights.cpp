@@ -43,7 +43,7 @@ SceneLight file_light(SceneLightType type, int index, const glm::dvec3& position
 std::string pbr_sidecar(const Rig& rig, int frame, const std::vector<SceneLight>& lights) {
   SidecarInfo info;
   info.scene = "scene.gltf";
-  info.pipeline.shading = Shading::Pbr;
+  info.render.shading = Shading::Pbr;
   info.frame = frame;
   info.has_bounds = true;
   info.lights = lights;
@@ -86,7 +86,7 @@ TEST(PbrLightsSidecar, RecordsEachLightAsUsed) {
     EXPECT_EQ(d.at("direction").at(c).get<double>(), -j.at("light_dir_world").at(c).get<double>());
   // lambert records no lights (its one light is light_dir_*)
   SidecarInfo lambert;
-  lambert.pipeline.shading = Shading::Lambert;
+  lambert.render.shading = Shading::Lambert;
   lambert.lights = lights;
   EXPECT_FALSE(json::parse(sidecar_json(rig, Display{}, lambert)).at("shading").contains("lights"));
 }
@@ -143,7 +143,7 @@ TEST(PbrLightsSidecar, OlderSidecarsCompareAsBefore) {
   EXPECT_EQ(sidecar_config_difference(old_image.dump(), lit.dump()), "shading");
   // before --shading: lambert at exposure 0
   SidecarInfo lambert;
-  lambert.pipeline.shading = Shading::Lambert;
+  lambert.render.shading = Shading::Lambert;
   lambert.has_bounds = true;
   json older = json::parse(sidecar_json(rig, Display{}, lambert));
   older.erase("shading");

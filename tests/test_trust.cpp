@@ -496,7 +496,7 @@ TEST(Trust, SidecarsOfManyLongNamedLightsStayReadable) {
 // difference of configuration, as one in the first is.
 TEST(Trust, TheLightsDigestComparesTheLightsNotListed) {
   SidecarInfo a;
-  a.pipeline.shading = Shading::Pbr;
+  a.render.shading = Shading::Pbr;
   a.has_bounds = true;
   for (int i = 0; i < 300; ++i) {
     SceneLight l;

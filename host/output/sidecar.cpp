@@ -119,7 +119,7 @@ std::string lights_digest(const std::vector<SceneLight>& lights) {
 }
 
 json shading_json(const SidecarInfo& info) {
-  const PipelineConfig& p = info.pipeline;
+  const RenderSettings& p = info.render;
   json s = {{"model", to_string(p.shading)}, {"exposure_ev", p.exposure_ev}};
   if (p.shading != Shading::Pbr) return s;
   const EnvironmentSource::Kind kind = info.environment.kind;
@@ -336,12 +336,12 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   if (!is_utf8(info.scene)) j["scene_hex"] = to_hex(info.scene);
   if (!info.scene_checksum.empty() || !display_config_checksum(info).empty()) j["checksums"] = checksums_json(info);
   j["frame"] = info.frame;
-  j["method"] = to_string(info.pipeline.method);
-  j["sampling"] = to_string(info.pipeline.sampling);
-  j["samples_per_pixel"] = info.pipeline.samples;
-  j["texture_filter"] = to_string(info.pipeline.texture_filter);
+  j["method"] = to_string(info.render.method);
+  j["sampling"] = to_string(info.render.sampling);
+  j["samples_per_pixel"] = info.render.samples;
+  j["texture_filter"] = to_string(info.render.texture_filter);
   j["shading"] = shading_json(info);
-  j["tile"] = {{"x", info.pipeline.tile_x}, {"y", info.pipeline.tile_y}, {"v", info.pipeline.tile_v}};
+  j["tile"] = {{"x", info.render.tile_x}, {"y", info.render.tile_y}, {"v", info.render.tile_v}};
   j["camera"] = info.rig_config.camera;
   if (info.rig_config.camera >= 0) j["camera_name"] = bounded_text(info.camera_name);
   if (info.variant) j["variant"] = bounded_text(*info.variant), j["variant_index"] = info.variant_index;

@@ -27,6 +27,21 @@ struct OutputChecksum {
   std::string checksum;
 };
 
+// The render settings that decide a frame's pixels, as the sidecar records them: plain values, so that
+// what writes and compares sidecars does not depend on the pipeline's own configuration (which also
+// holds the prefiltered environment, callbacks and budgets). render_settings (sequence/sequence_job.h)
+// takes them from a PipelineConfig.
+struct RenderSettings {
+  Method method = Method::Pmr;
+  Sampling sampling = Sampling::View;
+  int samples = 1;  // per pixel
+  TextureFilter texture_filter = TextureFilter::Bilinear;
+  Shading shading = Shading::Pbr;
+  double exposure_ev = 0.0;
+  double environment_intensity = 1.0;  // pbr
+  int tile_x = 16, tile_y = 2, tile_v = 16;
+};
+
 // What the sidecar records besides the rig and the display: the job's configuration, whole, as the
 // job holds it; what the run read and framed; and the frame's own values.
 struct SidecarInfo {
@@ -36,14 +51,14 @@ struct SidecarInfo {
   std::string camera_name;                    // that camera's node name ("" = none)
   std::optional<std::string> variant;         // the material variant drawn (none: the default materials)
   int variant_index = -1;                     // its index in the file
-  PipelineConfig pipeline;                    // method, sampling, shading and exposure, tile
+  RenderSettings render;                      // method, sampling, shading and exposure, tile
   DisplaySource display_source;               // the display's source and its calibration's values
   SequenceSpec sequence;                      // fps, animation, turntable
   std::optional<ExrCompression> compression;  // of the images (none: not recorded)
   Background background;                      // transparent: not recorded
   InputLimits input_limits;                   // allow_outside_scene_folder: recorded only when given
   // pbr: the environment (--environment: the studio, the uniform one or an image file as given), an
-  // image's checksum, the rotation (its intensity is pipeline.environment_intensity)
+  // image's checksum, the rotation (its intensity is render.environment_intensity)
   EnvironmentSource environment;
   std::string environment_checksum;
   double environment_rotation_deg = 0.0;

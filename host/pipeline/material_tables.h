@@ -14,7 +14,7 @@ namespace pmr {
 struct MaterialTables {
   std::vector<PmrMaterial> materials;  // Scene::materials, the maps and pbr fields from Scene::material_inputs
   // Scene::textures in order, then (with mips) further entries of those sampled through more than one
-  // kind of chain (colour, data, normal: MipKind), whose chains differ (cl/shade.h reads map.texture)
+  // kind of chain (colour, data, normal: MipKind), whose chains differ (cl/material_maps.h reads map.texture)
   std::vector<PmrTexture> textures;
   std::vector<uint8_t> texels;       // RGBA8 as stored, each texture's levels back to back (PmrTexture)
   std::vector<glm::vec2> texcoords;  // TEXCOORD set k of vertex v at k * vertices + v (at least one entry)

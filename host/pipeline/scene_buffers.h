@@ -1,7 +1,7 @@
 // The scene on the device, and everything shading reads: geometry and materials (set_scene), the posed
 // geometry of a frame (update_geometry), the frame's lights and camera positions (upload_frame), and the
 // run's tables (sRGB decoding, the split-sum table, the environment image). Shading kernels take these
-// as their leading arguments in one order (cl/shade.h, PMR_SHADE_PARAMS), bound by bind_shading alone.
+// as their leading arguments in one order (cl/shade_inputs.h, PMR_SHADE_PARAMS), bound by bind_shading alone.
 #pragma once
 #include <cstdint>
 #include <vector>

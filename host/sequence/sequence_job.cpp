@@ -207,6 +207,15 @@ void SequenceRun::check_frame_memory() const {
           (glass ? ", and a " + std::to_string(glass >> 20) + " MiB transmission source for the glass" : "") + ")");
 }
 
+// The settings of the pipeline configuration `p` that the sidecar records.
+static RenderSettings render_settings(const PipelineConfig& p) {
+  RenderSettings r;
+  r.method = p.method, r.sampling = p.sampling, r.samples = p.samples, r.texture_filter = p.texture_filter;
+  r.shading = p.shading, r.exposure_ev = p.exposure_ev, r.environment_intensity = p.environment_intensity;
+  r.tile_x = p.tile_x, r.tile_y = p.tile_y, r.tile_v = p.tile_v;
+  return r;
+}
+
 // What every frame's sidecar shares: the job's configuration, the sequence as resolved, what the run
 // read and how it framed the scene.
 void SequenceRun::prepare_frames() {
@@ -215,7 +224,7 @@ void SequenceRun::prepare_frames() {
   info.rig_config = rig_config_;
   if (rig_config_.camera >= 0) info.camera_name = scene_.cameras[size_t(rig_config_.camera)].node_name;
   if (scene_.variant >= 0) info.variant = scene_.variants[size_t(scene_.variant)], info.variant_index = scene_.variant;
-  info.pipeline = job_.pipeline;
+  info.render = render_settings(job_.pipeline);
   info.display_source = job_.display_source;
   info.sequence = spec_;
   info.compression = job_.compression;

@@ -21,7 +21,7 @@ inline std::string reference_sidecar(int frame) {
   SidecarInfo info;
   info.scene = "scene.glb";
   info.frame = frame;
-  info.pipeline.shading = Shading::Lambert;
+  info.render.shading = Shading::Lambert;
   info.time = frame / info.sequence.fps;
   info.has_bounds = true;
   info.bounds_lo = glm::dvec3(-1.0);

@@ -3,6 +3,7 @@
  * per work-item, one per lane (past n, lanes repeat the last case); work-items past n / SW return. */
 #include "common.h"
 #include "brdf.h"
+#include "lights.h"
 
 /* Case (first + l) of lane l, as a lane's index into the inputs. */
 inline int probe_case(uint first, int l, uint n) { return (int)min(first + (uint)l, n - 1u); }

@@ -1,6 +1,7 @@
 /* The lights (part of the one shading module, cl/shade.h): what a light delivers at the lanes' surface
- * points, independent of the view: the direction toward it and its irradiance on a surface facing it.
- * The lobes (cl/brdf.h) turn that into what each view sees. */
+ * points, independent of the view: the direction toward it, its irradiance on a surface facing it, and
+ * the fraction of it that arrives past the casters (shadow_visibility: DESIGN section 4d). The lobes
+ * (cl/brdf.h) turn that into what each view sees. */
 #ifndef PMR_CL_LIGHTS_H
 #define PMR_CL_LIGHTS_H
 
@@ -36,6 +37,72 @@ inline sfloat3 light_irradiance(int type, float3 color_intensity, float3 positio
     w *= s * s;
   }
   return s3_scale(s3_splat(color_intensity), w);
+}
+
+/* Shadow lookups (DESIGN section 4d). Every offset is in texels of the map at the receiver, so it is
+ * fixed in world space and a shadow's edge stays on its surface from view to view:
+ * - the receiver moves PMR_SHADOW_NORMAL_OFFSET texels along its face normal, turned toward the light;
+ * - its depth is compared less PMR_SHADOW_BIAS + PMR_SHADOW_SLOPE_BIAS x min(tan theta, 50) texels,
+ *   theta between the face normal and the light.
+ * A tap at lateral distance r from the receiver sees the receiver's own plane at most r tan theta
+ * nearer: with r up to sqrt(2) texels (the 2 x 2 taps), offset / cos theta + slope bias x tan theta
+ * exceeds it at every angle, so flat and curved receivers facing the light have no acne. */
+#define PMR_SHADOW_NORMAL_OFFSET 1.0f
+#define PMR_SHADOW_BIAS 0.2f
+#define PMR_SHADOW_SLOPE_BIAS 0.5f
+
+/* Whether the caster depths of map m's texel (x, y) lie beyond `ref` (lit: 1), outside the map: 1. */
+inline float shadow_tap(global const PmrShadowMap* m, global const uint* depth, int x, int y, float ref) {
+  if (x < 0 || y < 0 || x >= m->size || y >= m->size) return 1.0f;
+  return ref <= as_float(depth[m->offset + (size_t)y * (size_t)m->size + (size_t)x]) ? 1.0f : 0.0f;
+}
+
+/* The visibility of light `light` at world point p of face normal ng (unit, either side): its shadow
+ * map's depth comparisons at the 4 texels around p, bilinearly weighted (filtered over one texel, the
+ * same in every view). A cube (6 maps) reads the face of p's major axis from the light. 1: unshadowed. */
+inline float shadow_visibility(global const PmrShadowMap* maps, global const uint* depth, global const PmrLight* light,
+                               float3 p, float3 ng) {
+  int k = light->shadow;
+  if (light->shadow_maps == 6) {
+    const float3 d = p - vload3(0, light->position), a = fabs(d);
+    const int axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+    k += 2 * axis + ((axis == 0 ? d.x : axis == 1 ? d.y : d.z) < 0.0f ? 1 : 0);
+  }
+  global const PmrShadowMap* m = &maps[k];
+  const float3 origin = vload3(0, m->origin), axis = vload3(0, m->axis);
+  const float z_p = dot(p - origin, axis);
+  if (m->perspective && z_p <= m->near_z) return 1.0f;
+  const float texel = m->perspective ? m->texel * z_p : m->texel;
+  const float3 to_light = m->perspective ? normalize(origin - p) : -axis;
+  const float cos_l = dot(ng, to_light);
+  const float3 side = cos_l < 0.0f ? -ng : ng;
+  const float c = fmax(fabs(cos_l), 1e-4f), tan_l = fmin(sqrt(fmax(1.0f - c * c, 0.0f)) / c, 50.0f);
+  const float3 d = p + side * (PMR_SHADOW_NORMAL_OFFSET * texel) - origin;
+  const float z = dot(d, axis);
+  if (m->perspective && z <= m->near_z) return 1.0f;
+  const float w = m->perspective ? 1.0f / z : 1.0f, half_size = 0.5f * (float)m->size;
+  const float x = (dot(d, vload3(0, m->right)) * w + 1.0f) * half_size - 0.5f;
+  const float y = (dot(d, vload3(0, m->up)) * w + 1.0f) * half_size - 0.5f;
+  const float ref = z - (PMR_SHADOW_BIAS + PMR_SHADOW_SLOPE_BIAS * tan_l) * texel;
+  const float fx0 = floor(x), fy0 = floor(y), fx = x - fx0, fy = y - fy0;
+  const int x0 = (int)fx0, y0 = (int)fy0;
+  const float top = mix(shadow_tap(m, depth, x0, y0, ref), shadow_tap(m, depth, x0 + 1, y0, ref), fx);
+  const float bottom = mix(shadow_tap(m, depth, x0, y0 + 1, ref), shadow_tap(m, depth, x0 + 1, y0 + 1, ref), fx);
+  return mix(top, bottom, fy);
+}
+
+/* shadow_visibility of the lanes `act` (1 elsewhere) at their points p, face normals ng. */
+inline sfloat shadow_visibility_lanes(global const PmrShadowMap* maps, global const uint* depth,
+                                      global const PmrLight* light, sfloat3 p, sfloat3 ng, sint act) {
+  float px[SW], py[SW], pz[SW], nx[SW], ny[SW], nz[SW], v[SW];
+  s3_store(p, px, py, pz);
+  s3_store(ng, nx, ny, nz);
+  int on[SW];
+  vstore_s(act, 0, on);
+  for (int l = 0; l < SW; ++l)
+    v[l] = on[l] ? shadow_visibility(maps, depth, light, (float3)(px[l], py[l], pz[l]), (float3)(nx[l], ny[l], nz[l]))
+                 : 1.0f;
+  return vload_s(0, v);
 }
 
 #endif

@@ -43,8 +43,8 @@ inline sfloat3 reflected_direction(const Surface* S, const LaneWinners* L, sfloa
 }
 
 /* What the light table's lights (the file's punctual lights, or the default light, or none) send toward
- * the view through the lanes' surfaces S, each light's irradiance E (lights.h: the same in every view)
- * times the view's lobes: `direct` the sum of f E n.l (the sheen's layering in f), `through` the
+ * the view through the lanes' surfaces S, each light's irradiance E times its visibility (lights.h: the
+ * same in every view) times the view's lobes: `direct` the sum of f E n.l (the sheen's layering in f), `through` the
  * transmissive lanes' BTDF times E (before their weights), `coat` the clear coat's GGX lobe times E. */
 typedef struct {
   sfloat3 direct, through, coat;
@@ -63,9 +63,11 @@ inline LightSums light_table_lanes(const ShadeInputs* in, const LaneWinners* L, 
   for (uint i = 0; i < num_lights; ++i) {
     global const PmrLight* light = &in->lights[i];
     sfloat3 l;
-    const sfloat3 E =
+    sfloat3 E =
         light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
                          vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, S->p, &l);
+    if (light->shadow >= 0) /* (--shadows off: E as before, bit for bit) */
+      E = s3_scale(E, shadow_visibility_lanes(in->shadow_maps, in->shadow_depth, light, S->p, L->face, L->act));
     sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, transmission, aniso, irid)
                       : brdf_cos(base, metallic, f0, f90, r, n, v, l, aniso, irid);
     if (sheen) f = sheen_over_light(in, sheen, f, n, v, l);

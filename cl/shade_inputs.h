@@ -15,12 +15,12 @@
       global const float *srgb_lut, global const float *positions, global const float4 *eyes,              \
       global const float2 *split_sum, global const float *sheen_albedo, global const float2 *texcoords,    \
       global const float4 *tangents, global const PmrEnvironment *env, global const float4 *env_data,      \
-      global const PmrLight *lights, global const half *source, global const PmrSource *source_info,       \
-      global uint *source_tiles
+      global const PmrLight *lights, global const PmrShadowMap *shadow_maps, global const uint *shadow_depth, \
+      global const half *source, global const PmrSource *source_info, global uint *source_tiles
 #define PMR_SHADE_INPUTS                                                                                        \
   {                                                                                                             \
     tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, sheen_albedo, texcoords, \
-        tangents, env, env_data, lights, source, source_info, source_tiles                                      \
+        tangents, env, env_data, lights, shadow_maps, shadow_depth, source, source_info, source_tiles           \
   }
 
 typedef struct {
@@ -40,6 +40,8 @@ typedef struct {
   global const PmrEnvironment* env;    /* pbr: the environment image's tables, level_count 0 = none */
   global const float4* env_data;       /* ... their data (cl/environment.h)                        */
   global const PmrLight* lights;       /* P->num_lights punctual lights, world space (pbr)           */
+  global const PmrShadowMap* shadow_maps; /* the lights' shadow maps (PmrLight.shadow), and their  */
+  global const uint* shadow_depth;        /* ... depths (cl/shadow.cl), this frame's               */
   global const half* source;           /* pbr: the transmission source (cl/transmission.h)           */
   global const PmrSource* source_info; /* ... its levels, and whether this is the opaque pass       */
   global uint* source_tiles;           /* ... per 3D tile: 1 if the opaque pass left a transmissive MTA out  */

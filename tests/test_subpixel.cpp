@@ -488,13 +488,7 @@ TEST(SubpixelSampling, EqualsViewSamplingWhereSamplesArePixelCenters) {
     test::texcoord(scene, 0, v) = glm::vec2(u, uv(rng));
   }
   Display d;
-  d.width = 64, d.height = 40;
-  d.lens_pitch = parse_rational("7.3125", "L");
-  d.tan_slant = parse_rational("-0.15", "T");
-  RigConfig rc;
-  rc.views = 10, rc.view_w = 3 * d.width, rc.view_h = d.height;
-  d.offset = default_offset(d.lens_pitch, rc.views);
-  const Rig rig = make_rig(rc, d, glm::dvec3(-1.0), glm::dvec3(1.0));
+  const Rig rig = test::subpixel_display_rig(d);
   auto render = [&](Sampling sampling) {
     PipelineConfig pc;
     pc.sampling = sampling;

@@ -267,6 +267,17 @@ void expect_one_error_line(const CliRun& r, const std::string& fragment, int sta
   EXPECT_NE(line.find(fragment), std::string::npos) << "expected '" << fragment << "' in: " << line;
 }
 
+Rig subpixel_display_rig(Display& d) {
+  d = Display{};
+  d.width = 64, d.height = 40;
+  d.lens_pitch = parse_rational("7.3125", "L");
+  d.tan_slant = parse_rational("-0.15", "T");
+  RigConfig rc;
+  rc.views = 10, rc.view_w = 3 * d.width, rc.view_h = d.height;
+  d.offset = default_offset(d.lens_pitch, rc.views);
+  return make_rig(rc, d, glm::dvec3(-1.0), glm::dvec3(1.0));
+}
+
 void expect_resume_compares(const std::string& options, const std::string& recorded, const std::string& key) {
   const std::string out = temp_dir("resume_" + key);
   const std::string small = " --views 4 --view-size 48x24 --display 160x90 --out " + out;

@@ -77,6 +77,10 @@ EncodedRender render_encoded(const Scene& scene, const Rig& rig, const Display& 
 // encoder directly with a volume of the test's own (Pipeline::encode_volume).
 std::unique_ptr<Pipeline> encoder_pipeline(const Display& display, int views, int vw, int vh);
 
+// A 64 x 40 display (lens pitch 7.3125, slant -0.15) into `d`, and a rig of 10 views of 3 x 64 by 40
+// framing [-1, 1]^3: every subpixel's sample is a view pixel center, so subpixel sampling gives view
+// sampling's image (but for depth ties).
+Rig subpixel_display_rig(Display& d);
 // Path of the shared glTF corpus (PMR_SOURCE_DIR/../shared/gltf), empty if absent.
 std::string corpus_dir();
 

@@ -70,8 +70,11 @@ const BenchSection kSweepOptions = {
 // Not listed one by one: the heading names them.
 const BenchSection kShadingOptions = {
     "  --shading S, --exposure EV, --environment E, --environment-rotation DEG,\n"
-    "  --environment-intensity X   as for pmr render (default pbr, studio)",
+    "  --environment-intensity X, --shadows on|off   as for pmr render (default pbr, studio,\n"
+    "  shadows on)",
     {
+        {"--shadows", nullptr, "on|off", "",
+         [](BenchOptions& o, const std::string& v, const std::string&) { o.shadows = parse_shadows(v); }},
         {"--shading", nullptr, "S", "",
          [](BenchOptions& o, const std::string& v, const std::string&) { o.shading = parse_shading(v); }},
         {"--exposure", nullptr, "EV", "",

@@ -480,6 +480,11 @@ const RenderSection kShadingOptions = {
          "lambert: base colour x (0.2 + 0.8 max(0, n.l)), the same in every view,\n"
          "one fixed light (faster)",
          [](RenderOptions& o, const std::string& v, const std::string&) { o.job.pipeline.shading = parse_shading(v); }},
+        {"--shadows", nullptr, "on|off",
+         "pbr: every light casts shadows, from maps rendered once per frame and\n"
+         "shared by every view (default on); off: no shadows, the images of pmr\n"
+         "before 0.26 bit for bit (docs/SHADING.md, \"Shadows\")",
+         [](RenderOptions& o, const std::string& v, const std::string&) { o.job.pipeline.shadows = parse_shadows(v); }},
         {"--exposure", nullptr, "EV", "the colour times 2^EV, either model (default 0)",
          [](RenderOptions& o, const std::string& v, const std::string&) {
            o.job.pipeline.exposure_ev = parse_exposure(v);
@@ -568,6 +573,7 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
   // are; the library's PipelineConfig keeps the point-sampled images its tests compare bit for bit
   o.job.pipeline.samples = 4;
   o.job.pipeline.texture_filter = TextureFilter::Trilinear;
+  o.job.pipeline.shadows = true;
   apply_display_source(o, args);  // a bad --display-config file is bad input (exit 1), not a usage error
   as_usage([&] { parse_arguments(o, args); });
   return o;

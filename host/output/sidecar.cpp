@@ -139,6 +139,8 @@ json shading_json(const SidecarInfo& info) {
   if (kind == EnvironmentSource::Kind::File && !is_utf8(info.environment.file))
     s["environment"]["file_hex"] = to_hex(info.environment.file);
   s["lights"] = lights_json(info.lights);
+  if (info.render.shadows)  // absent: off, as every sidecar before shadows
+    s["shadows"] = {{"map_size", info.render.shadow_sizes.directional}, {"local_map_size", info.render.shadow_sizes.local}};
   if (info.lights.size() > kSidecarLights) {
     s["lights_total"] = info.lights.size();
     s["lights_digest"] = lights_digest(info.lights);

@@ -39,6 +39,8 @@ struct RenderSettings {
   Shading shading = Shading::Pbr;
   double exposure_ev = 0.0;
   double environment_intensity = 1.0;  // pbr
+  bool shadows = false;                // pbr: --shadows (recorded only when on: an older sidecar is off)
+  ShadowSizes shadow_sizes;
   int tile_x = 16, tile_y = 2, tile_v = 16;
 };
 

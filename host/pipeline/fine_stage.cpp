@@ -100,18 +100,18 @@ void FineStage::configure_subpixel(int views, EncodeStage& encode) {
 }
 
 void FineStage::run_volume(const SceneBuffers& scene, const GeometryStage& geometry, uint64_t num_tiles,
-                           const SourceBinding& source, FrameEvents& ev, const ClBuffer* out) {
-  const cl_uint next = scene.bind_shading(fine_, geometry.params(), source);
+                           const ShadowBinding& shadows, const SourceBinding& source, FrameEvents& ev, const ClBuffer* out) {
+  const cl_uint next = scene.bind_shading(fine_, geometry.params(), shadows, source);
   fine_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(), out ? *out : volume_, dbg_key_,
                   dbg_depth_, dbg_count_, blend_overflow_);
   ev.add(kFine, launcher_.launch(fine_, size_t(num_tiles), kFineGroup));
 }
 
 void FineStage::run_fused(const SceneBuffers& scene, const GeometryStage& geometry, size_t screen_tiles,
-                          EncodeStage& encode, const SourceBinding& source, FrameEvents& ev) {
+                          EncodeStage& encode, const ShadowBinding& shadows, const SourceBinding& source, FrameEvents& ev) {
   // the fused program is compiled without BLEND compositing (cl/fine_encode.cl)
   if (scene.blended()) throw InternalError("a scene with alphaMode BLEND on the fused path");
-  const cl_uint next = scene.bind_shading(fine_encode_, geometry.params(), source);
+  const cl_uint next = scene.bind_shading(fine_encode_, geometry.params(), shadows, source);
   fine_encode_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(), encode.params_buffer(),
                          column_soa_, encode.rows_buffer(), column_start_, row_start_, encode.display(),
                          encode.sub_alpha());
@@ -120,8 +120,8 @@ void FineStage::run_fused(const SceneBuffers& scene, const GeometryStage& geomet
 }
 
 void FineStage::run_subpixel(const SceneBuffers& scene, const GeometryStage& geometry, EncodeStage& encode,
-                             const SourceBinding& source, FrameEvents& ev) {
-  const cl_uint next = scene.bind_shading(fine_subpixel_, geometry.params(), source);
+                             const ShadowBinding& shadows, const SourceBinding& source, FrameEvents& ev) {
+  const cl_uint next = scene.bind_shading(fine_subpixel_, geometry.params(), shadows, source);
   const bool debug = paths_.debug && !paths_.volume;  // per display subpixel
   fine_subpixel_.args_from(next, geometry.mtas(), geometry.tile_offsets(), geometry.tile_queue(),
                            encode.params_buffer(), column_a_, column_b_, encode.rows_buffer(), sample_x_, sample_y_,

@@ -36,12 +36,12 @@ class FineStage {
   // The view volume's 3D tiles (num_tiles of them: the volume form and the multipass passes), into the
   // view volume, or into `out` (the transmission source's opaque pass).
   void run_volume(const SceneBuffers& scene, const GeometryStage& geometry, uint64_t num_tiles,
-                  const SourceBinding& source, FrameEvents& ev, const ClBuffer* out = nullptr);
+                  const ShadowBinding& shadows, const SourceBinding& source, FrameEvents& ev, const ClBuffer* out = nullptr);
   // The fused form: one work-item per screen tile.
   void run_fused(const SceneBuffers& scene, const GeometryStage& geometry, size_t screen_tiles, EncodeStage& encode,
-                 const SourceBinding& source, FrameEvents& ev);
+                 const ShadowBinding& shadows, const SourceBinding& source, FrameEvents& ev);
   void run_subpixel(const SceneBuffers& scene, const GeometryStage& geometry, EncodeStage& encode,
-                    const SourceBinding& source, FrameEvents& ev);
+                    const ShadowBinding& shadows, const SourceBinding& source, FrameEvents& ev);
 
   const ClBuffer& volume() const { return volume_; }
   size_t volume_bytes() const { return volume_bytes_; }

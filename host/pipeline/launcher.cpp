@@ -28,6 +28,7 @@ void FrameEvents::collect(StageTimes& t) const {
   double ms[kStages] = {};
   for (const auto& se : all_) ms[se.first] += event_ms(se.second);
   t.vertex = ms[kVertex], t.setup = ms[kSetup], t.bin = ms[kBin], t.fine = ms[kFine], t.encode = ms[kEncode];
+  t.shadow = ms[kShadow];
   if (!all_.empty()) t.device_total = event_span_ms(all_.front().second, all_.back().second);
 }
 

@@ -15,7 +15,7 @@ namespace pmr {
 
 struct StageTimes;
 
-enum Stage { kVertex, kSetup, kBin, kFine, kEncode, kStages };
+enum Stage { kVertex, kSetup, kBin, kFine, kEncode, kShadow, kStages };
 
 // The profiling events of one frame, each tagged with its stage; released with the frame.
 class FrameEvents {

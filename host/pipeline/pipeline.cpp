@@ -13,6 +13,7 @@
 #include "pipeline/geometry_stage.h"
 #include "pipeline/launcher.h"
 #include "pipeline/scene_buffers.h"
+#include "pipeline/shadow_stage.h"
 #include "pmr/error.h"
 #include "pmr/limits.h"
 #include "shading/lights.h"
@@ -67,13 +68,15 @@ struct Pipeline::Impl {
         launcher(rt),
         options(build_options(tile, config)),
         program(launcher.build(
-            {"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl", "straddle_alpha.cl", "source_mips.cl"},
+            {"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl", "straddle_alpha.cl", "source_mips.cl",
+             "shadow.cl"},
             options)),
         scene(rt, config),
         geometry(launcher, program, config.tile_queue_limit),
         encode(launcher, program),
         fine(launcher, program, options, tile),
-        transmission(launcher, program) {}
+        transmission(launcher, program),
+        shadows(launcher, program, config.shadow_sizes) {}
 
   int tile[3];
   Launcher launcher;
@@ -84,6 +87,7 @@ struct Pipeline::Impl {
   EncodeStage encode;
   FineStage fine;
   TransmissionStage transmission;
+  ShadowStage shadows;
   FinePaths paths;
   int views = 0, view_w = 0, view_h = 0;  // as configured
   Rig rig;                                // ... the rig and display of the last configure()
@@ -183,6 +187,11 @@ void Pipeline::configure(const Rig& rig, const Display* display) {
 double Pipeline::kernel_build_seconds() const { return impl_->launcher.build_seconds(); }
 const std::vector<std::string>& Pipeline::kernel_variants() const { return impl_->launcher.variants(); }
 
+void Pipeline::read_shadow_maps(std::vector<PmrShadowMap>& maps, std::vector<float>& depth) const {
+  maps = impl_->shadows.maps();
+  depth = impl_->shadows.read_depth();
+}
+
 void Pipeline::set_mta_capacity(uint32_t capacity) { impl_->geometry.set_mta_capacity(capacity); }
 
 StageTimes Pipeline::render(const Rig& rig) {
@@ -229,8 +238,10 @@ StageTimes Pipeline::render_frame(const FrameDescription& frame, bool empty) {
   StageTimes times;
   FrameEvents ev;
   PmrParams P = frame_params(frame, empty);
-  m.scene.upload_frame(frame);
+  m.shadows.place(config_.shadows && config_.shading == Shading::Pbr, frame.lights, m.scene);
+  m.scene.upload_frame(frame, m.shadows.slots());
   m.fine.begin_frame();
+  if (config_.shadows && config_.shading == Shading::Pbr) m.shadows.render(m.scene, ev, empty);
   if (config_.method == Method::Multipass) {
     m.render_multipass(frame.rig, P, config_.multipass_snapped, ev, times);
   } else {
@@ -252,13 +263,14 @@ StageTimes Pipeline::render_frame(const FrameDescription& frame, bool empty) {
 // configuration's paths, which read it.
 void Pipeline::Impl::render_fine(FrameEvents& ev, int screen_tiles) {
   if (transmission.active()) {
-    fine.run_volume(scene, geometry, num_tiles, transmission.opaque_pass(), ev, &transmission.source());
+    fine.run_volume(scene, geometry, num_tiles, shadows.binding(), transmission.opaque_pass(), ev,
+                    &transmission.source());
     transmission.mip(0, views, ev);
   }
   const SourceBinding source = transmission.full_pass();
-  if (paths.fused) fine.run_fused(scene, geometry, size_t(screen_tiles), encode, source, ev);
-  if (paths.volume) fine.run_volume(scene, geometry, num_tiles, source, ev);
-  if (paths.subpixel) fine.run_subpixel(scene, geometry, encode, source, ev);
+  if (paths.fused) fine.run_fused(scene, geometry, size_t(screen_tiles), encode, shadows.binding(), source, ev);
+  if (paths.volume) fine.run_volume(scene, geometry, num_tiles, shadows.binding(), source, ev);
+  if (paths.subpixel) fine.run_subpixel(scene, geometry, encode, shadows.binding(), source, ev);
 }
 
 // The multipass baseline: one conventional pass per view with view i's own view matrix and off-axis
@@ -284,10 +296,11 @@ void Pipeline::Impl::render_multipass(const Rig& rig, const PmrParams& P, bool s
     else geometry.transform(Q, scene, ev);
     geometry.setup_and_bin(Q, scene, ev, t);
     if (transmission.active()) {  // as a conventional renderer: the view's opaque pass, then its own
-      fine.run_volume(scene, geometry, num_tiles, transmission.opaque_pass(), ev, &transmission.source());
+      fine.run_volume(scene, geometry, num_tiles, shadows.binding(), transmission.opaque_pass(), ev,
+                    &transmission.source());
       transmission.mip(i, 1, ev);
     }
-    fine.run_volume(scene, geometry, num_tiles, transmission.full_pass(), ev);
+    fine.run_volume(scene, geometry, num_tiles, shadows.binding(), transmission.full_pass(), ev);
   }
   if (snapped) geometry.swap_snapped();
 }

@@ -25,6 +25,7 @@ struct FinePaths;
 
 struct StageTimes {  // milliseconds
   double vertex = 0, setup = 0, bin = 0, fine = 0, encode = 0;
+  double shadow = 0;          // the frame's shadow maps (DESIGN section 4d)
   double device_total = 0;    // first kernel start to last kernel end (includes host work in between)
   double wall = 0;            // host wall-clock time of render()
   int retries = 0;            // frames redone because a queue was full
@@ -83,6 +84,9 @@ class Pipeline {
   // Requires debug_outputs: per voxel the window depth of its nearest covered sample, +infinity where
   // none (the Z channel: DESIGN section 3b; not averaged).
   void read_depth(std::vector<float>& depth) const;
+  // The last frame's shadow maps (DESIGN section 4d) and their depths, texel (x, y) of map m at
+  // m.offset + y m.size + x (+infinity: no caster); none with shadows off.
+  void read_shadow_maps(std::vector<PmrShadowMap>& maps, std::vector<float>& depth) const;
   // The MTAs of the last frame, in queue order (arbitrary), and the tile queues (offsets has one entry
   // per tile plus one; queue[offsets[t] .. offsets[t+1]) are MTA indices).
   std::vector<PmrMta> read_mtas() const;

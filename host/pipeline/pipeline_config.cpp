@@ -41,6 +41,12 @@ Shading parse_shading(const std::string& name) {
 
 const char* to_string(Shading s) { return s == Shading::Pbr ? "pbr" : "lambert"; }
 
+bool parse_shadows(const std::string& name) {
+  if (name == "on") return true;
+  if (name == "off") return false;
+  throw Error("unknown --shadows '" + name + "' (expected on or off)");
+}
+
 TextureFilter parse_texture_filter(const std::string& name) {
   if (name == "bilinear") return TextureFilter::Bilinear;
   if (name == "trilinear") return TextureFilter::Trilinear;

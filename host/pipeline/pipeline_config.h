@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "pipeline/shadow_sizes.h"
 #include "pmr/input_files.h"
 #include "pmr/rig.h"
 
@@ -47,6 +48,7 @@ enum class Shading {
   Pbr,      // glTF metallic-roughness seen from each view's camera
 };
 Shading parse_shading(const std::string& name);  // "lambert", "pbr"
+bool parse_shadows(const std::string& name);     // "on", "off"
 const char* to_string(Shading s);
 
 // How textures are filtered (DESIGN section 3b, --texture-filter).
@@ -82,6 +84,11 @@ struct PipelineConfig {
   // the command line's default is trilinear (cli/options.cpp).
   TextureFilter texture_filter = TextureFilter::Bilinear;
   double environment_intensity = 1.0;  // pbr: scales the uniform default environment (radiance 0.2)
+  // pbr: every light's term times its visibility from the frame's shadow maps (DESIGN section 4d).
+  // Off here (the library's images stay those of the tests that pin them); the command line's default
+  // is on. Off: every visibility 1, the images bit for bit those before shadows.
+  bool shadows = false;
+  ShadowSizes shadow_sizes;
   // pbr: an environment image, prefiltered once (Environment::make) and shared by every pipeline of
   // a process; its rotation and intensity are its own (the intensity must equal environment_intensity).
   // It replaces the uniform default and turns the default light off (host/shading/lights.h; the file's

@@ -66,6 +66,7 @@ void SceneBuffers::set_scene(const Scene& scene) {
   blended_ = scene_blended(scene, pbr_);
   const std::vector<glm::vec4> no_tangents(1, glm::vec4(0.0f));
   scene_lights_ = scene.lights;
+  set_bounds(scene.positions);
   positions_ = rt_.upload(scene.positions, "vertex positions");
   attrs_ = rt_.upload(scene.attributes, "vertex attributes");
   tris_ = rt_.upload(scene.triangles, "triangles");
@@ -81,15 +82,27 @@ void SceneBuffers::update_geometry(const Scene& posed) {
       posed.attributes.size() != posed.positions.size())
     throw InternalError("update_geometry: the posed scene does not match the scene given to set_scene");
   if (posed.triangles.empty()) return;
+  set_bounds(posed.positions);
   rt_.write(positions_, posed.positions);
   rt_.write(attrs_, posed.attributes);
   rt_.write(tris_, posed.triangles);
   if (has_tangents_ && posed.tangents.size() == posed.positions.size()) rt_.write(tangents_, posed.tangents);
 }
 
-void SceneBuffers::upload_frame(const FrameDescription& frame) {
+void SceneBuffers::set_bounds(const std::vector<glm::vec3>& positions) {
+  glm::vec3 lo(0.0f), hi(0.0f);
+  if (!positions.empty()) lo = hi = positions[0];
+  for (const glm::vec3& p : positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  bounds_lo_ = glm::dvec3(lo), bounds_hi_ = glm::dvec3(hi);
+}
+
+void SceneBuffers::upload_frame(const FrameDescription& frame, const std::vector<ShadowSlot>& slots) {
   std::vector<PmrLight> table;
-  for (const SceneLight& l : frame.lights) table.push_back(device_light(l));
+  for (size_t i = 0; i < frame.lights.size(); ++i) {
+    PmrLight d = device_light(frame.lights[i]);
+    if (i < slots.size() && slots[i].count > 0) d.shadow = slots[i].first, d.shadow_maps = slots[i].count;
+    table.push_back(d);
+  }
   table.resize(std::max<size_t>(table.size(), 1));  // no empty buffers
   rt_.rewrite(lights_, table, "lights");
   const Rig& rig = frame.rig;
@@ -98,10 +111,12 @@ void SceneBuffers::upload_frame(const FrameDescription& frame) {
   rt_.rewrite(eyes_, eyes, "camera positions");
 }
 
-cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params, const SourceBinding& source) const {
-  const ClBuffer* inputs[] = {&params,     &tris_,   &attrs_,     &materials_,    &textures_,  &texels_,   &lut_,
-                              &positions_, &eyes_,   &split_sum_, &sheen_albedo_, &texcoords_, &tangents_, &env_,
-                              &env_data_,  &lights_, source.data, source.info,    source.tiles};
+cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params, const ShadowBinding& shadows,
+                                   const SourceBinding& source) const {
+  const ClBuffer* inputs[] = {&params,     &tris_,       &attrs_,        &materials_,  &textures_,  &texels_,
+                              &lut_,       &positions_,  &eyes_,         &split_sum_,  &sheen_albedo_,
+                              &texcoords_, &tangents_,   &env_,          &env_data_,   &lights_,
+                              shadows.maps, shadows.depth, source.data,  source.info,  source.tiles};
   cl_uint i = 0;
   for (const ClBuffer* b : inputs) k.arg(i++, *b);
   return i;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "pipeline/frame_description.h"
+#include "pipeline/shadow_stage.h"
 #include "pipeline/transmission_stage.h"
 #include "pmr/scene.h"
 #include "runtime/cl_runtime.h"
@@ -22,11 +23,17 @@ class SceneBuffers {
   void set_scene(const Scene& scene);
   // The posed geometry of a frame of the scene given to set_scene (same counts): copied, not reallocated.
   void update_geometry(const Scene& posed);
-  // The frame's light table and each view's camera position in world space (the view vector of pbr).
-  void upload_frame(const FrameDescription& frame);
-  // Binds the frame parameters `params`, the shading inputs and the pass's transmission source as
-  // arguments 0 .. of `k` (the order of PMR_SHADE_PARAMS); returns the index of the kernel's next argument.
-  cl_uint bind_shading(ClKernel& k, const ClBuffer& params, const SourceBinding& source) const;
+  // The frame's light table (light i with its shadow maps slots[i]: ShadowStage::slots) and each view's
+  // camera position in world space (the view vector of pbr).
+  void upload_frame(const FrameDescription& frame, const std::vector<ShadowSlot>& slots);
+  // Binds the frame parameters `params`, the shading inputs, the frame's shadow maps and the pass's
+  // transmission source as arguments 0 .. of `k` (the order of PMR_SHADE_PARAMS); returns the index of
+  // the kernel's next argument.
+  cl_uint bind_shading(ClKernel& k, const ClBuffer& params, const ShadowBinding& shadows,
+                       const SourceBinding& source) const;
+  // The world box of the posed geometry (set_scene, update_geometry): where shadow maps are placed.
+  const glm::dvec3& bounds_lo() const { return bounds_lo_; }
+  const glm::dvec3& bounds_hi() const { return bounds_hi_; }
 
   uint32_t num_vertices() const { return num_vertices_; }
   // pbr and a triangle with a transmissive material: frames need the transmission source
@@ -50,6 +57,8 @@ class SceneBuffers {
   uint32_t num_vertices_ = 0, num_triangles_ = 0;
   bool has_tangents_ = false;
   std::vector<SceneLight> scene_lights_;
+  glm::dvec3 bounds_lo_{0.0}, bounds_hi_{0.0};
+  void set_bounds(const std::vector<glm::vec3>& positions);
   ClBuffer positions_, attrs_, tris_, materials_, textures_, texels_, texcoords_, tangents_;
   ClBuffer lut_, split_sum_, sheen_albedo_, env_, env_data_;  // the run's tables
   ClBuffer lights_, eyes_;                     // the frame's

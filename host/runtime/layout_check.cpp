@@ -40,3 +40,7 @@ static_assert(offsetof(PmrParams, num_lights) == 280, "PmrParams layout");
 static_assert(sizeof(PmrLight) == 64 && offsetof(PmrLight, type) == 12 && offsetof(PmrLight, range) == 28 &&
                   offsetof(PmrLight, direction) == 32 && offsetof(PmrLight, cos_outer) == 48,
               "PmrLight layout");
+static_assert(sizeof(PmrShadowMap) == 80 && offsetof(PmrShadowMap, offset) == 12 && offsetof(PmrShadowMap, size) == 28 &&
+                  offsetof(PmrShadowMap, perspective) == 44 && offsetof(PmrShadowMap, texel) == 60 &&
+                  offsetof(PmrShadowMap, near_z) == 64,
+              "PmrShadowMap layout");

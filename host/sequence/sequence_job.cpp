@@ -212,6 +212,7 @@ static RenderSettings render_settings(const PipelineConfig& p) {
   RenderSettings r;
   r.method = p.method, r.sampling = p.sampling, r.samples = p.samples, r.texture_filter = p.texture_filter;
   r.shading = p.shading, r.exposure_ev = p.exposure_ev, r.environment_intensity = p.environment_intensity;
+  r.shadows = p.shadows, r.shadow_sizes = p.shadow_sizes;
   r.tile_x = p.tile_x, r.tile_y = p.tile_y, r.tile_v = p.tile_v;
   return r;
 }

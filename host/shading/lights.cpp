@@ -41,6 +41,7 @@ PmrLight device_light(const SceneLight& light) {
   // the loader guarantees 0 <= inner < outer <= pi / 2; unused for other types
   d.cos_inner = float(std::cos(double(light.inner_cone)));
   d.cos_outer = float(std::cos(double(light.outer_cone)));
+  d.shadow = -1;  // unshadowed until shadow maps are placed (ShadowStage)
   return d;
 }
 

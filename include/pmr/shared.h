@@ -332,8 +332,29 @@ typedef struct {
                              toward a directional light is -direction (directional, spot)      */
   float cos_inner;    /* spot: cos(innerConeAngle)                                         */
   float cos_outer;    /* spot: cos(outerConeAngle)                                         */
-  pmr_u32 pad0, pad1, pad2;
+  pmr_i32 shadow;     /* its first shadow map (PmrShadowMap), -1: unshadowed (--shadows off) */
+  pmr_i32 shadow_maps; /* 1, or 6 for a cube about a point light (the face of the major axis) */
+  pmr_u32 pad2;
 } PmrLight;
+
+/* One shadow map (DESIGN section 4d), rendered once per frame and read by every view: depth along
+ * `axis` from `origin` of the nearest caster over size x size texels of float depth (as uint bits), at
+ * `offset` in the depth buffer. A point q maps to d = q - origin, z = axis . d, and
+ * (s, t) = (right . d, up . d) / (perspective ? z : 1), in [-1, 1] over the map (right and up are
+ * scaled: 1 / half extent, or 1 / tan(half angle)). texel: a texel's world size, at z = 1 when
+ * perspective. Producer: host/pipeline/shadow_stage.cpp, every frame. */
+typedef struct {
+  float origin[3];
+  pmr_u32 offset;
+  float right[3];
+  pmr_i32 size;
+  float up[3];
+  pmr_u32 perspective;
+  float axis[3];
+  float texel;
+  float near_z; /* perspective: casters nearer than this are clipped */
+  pmr_u32 pad0, pad1, pad2;
+} PmrShadowMap;
 
 /* Encoder parameters (DESIGN section 5): sizes and flags. The subpixel-to-view map itself is in the
  * tables below, computed exactly by the host (host/rig/display.cpp). */

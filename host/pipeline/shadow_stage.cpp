@@ -1,0 +1,168 @@
+#include "pipeline/shadow_stage.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pipeline/scene_buffers.h"
+#include "pmr/error.h"
+
+namespace pmr {
+
+namespace {
+
+// A unit vector orthogonal to unit `a`, and the third of a right-handed frame (x, y, a).
+void frame_about(const glm::dvec3& a, glm::dvec3& x, glm::dvec3& y) {
+  const glm::dvec3 helper = std::abs(a.y) < 0.9 ? glm::dvec3(0.0, 1.0, 0.0) : glm::dvec3(1.0, 0.0, 0.0);
+  x = glm::normalize(glm::cross(helper, a));
+  y = glm::cross(a, x);
+}
+
+void set3(float* out, const glm::dvec3& v) { out[0] = float(v.x), out[1] = float(v.y), out[2] = float(v.z); }
+
+std::vector<glm::dvec3> corners(const glm::dvec3& lo, const glm::dvec3& hi) {
+  std::vector<glm::dvec3> c;
+  for (int k = 0; k < 8; ++k) c.push_back(glm::dvec3(k & 1 ? hi.x : lo.x, k & 2 ? hi.y : lo.y, k & 4 ? hi.z : lo.z));
+  return c;
+}
+
+// An orthographic map along `axis` over the box: square texels, half a texel's margin beyond the box
+// on each side, the origin on the box's near face (every depth >= 0).
+PmrShadowMap orthographic_map(const glm::dvec3& axis, const glm::dvec3& lo, const glm::dvec3& hi, int size) {
+  glm::dvec3 x, y;
+  frame_about(axis, x, y);
+  glm::dvec3 mn(1e300), mx(-1e300);
+  for (const glm::dvec3& c : corners(lo, hi)) {
+    const glm::dvec3 q(glm::dot(c, x), glm::dot(c, y), glm::dot(c, axis));
+    mn = glm::min(mn, q), mx = glm::max(mx, q);
+  }
+  const double half = std::max({0.5 * (mx.x - mn.x), 0.5 * (mx.y - mn.y), 1e-6}) * (1.0 + 2.0 / size);
+  const glm::dvec3 origin = x * (0.5 * (mn.x + mx.x)) + y * (0.5 * (mn.y + mx.y)) + axis * (mn.z - 1e-3 * half);
+  PmrShadowMap m{};
+  set3(m.origin, origin), set3(m.right, x / half), set3(m.up, y / half), set3(m.axis, axis);
+  m.size = size, m.perspective = 0, m.texel = float(2.0 * half / size);
+  return m;
+}
+
+// A perspective map from `origin` along `axis`, tan(half angle) = t.
+PmrShadowMap perspective_map(const glm::dvec3& origin, const glm::dvec3& axis, const glm::dvec3& x, double t,
+                             double near_z, int size) {
+  const glm::dvec3 y = glm::cross(axis, x);
+  PmrShadowMap m{};
+  set3(m.origin, origin), set3(m.right, x / t), set3(m.up, y / t), set3(m.axis, axis);
+  m.size = size, m.perspective = 1, m.texel = float(2.0 * t / size), m.near_z = float(near_z);
+  return m;
+}
+
+// The maps of a point or spot light at `position` (spot: along `direction`, outer cone angle `outer`).
+void local_maps(const SceneLight& l, const glm::dvec3& lo, const glm::dvec3& hi, int size,
+                std::vector<PmrShadowMap>& maps) {
+  double far = 0.0;
+  for (const glm::dvec3& c : corners(lo, hi)) far = std::max(far, glm::length(c - l.position));
+  const double near_z = std::max(far, 1e-6) * 1e-4;
+  if (l.type == SceneLightType::Spot && l.outer_cone <= kSpotSingleMapAngle) {
+    glm::dvec3 x, y;
+    frame_about(l.direction, x, y);
+    // two texels' margin beyond the cone, for the filter's taps at its edge
+    const double t = std::tan(double(l.outer_cone)) * (1.0 + 4.0 / size);
+    maps.push_back(perspective_map(l.position, l.direction, x, t, near_z, size));
+    return;
+  }
+  // a cube: +X, -X, +Y, -Y, +Z, -Z (cl/lights.h picks the face of the major axis)
+  const glm::dvec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  const glm::dvec3 rights[6] = {{0, 0, -1}, {0, 0, 1}, {1, 0, 0}, {1, 0, 0}, {1, 0, 0}, {-1, 0, 0}};
+  for (int f = 0; f < 6; ++f) maps.push_back(perspective_map(l.position, axes[f], rights[f], 1.0 + 4.0 / size, near_z, size));
+}
+
+// The texels of the maps of `lights` (the first kMaxShadowedLights) at `sizes`.
+uint64_t texels_needed(const std::vector<SceneLight>& lights, const ShadowSizes& sizes) {
+  uint64_t n = 0;
+  for (size_t i = 0; i < lights.size() && i < size_t(kMaxShadowedLights); ++i) {
+    const SceneLight& l = lights[i];
+    const uint64_t d = uint64_t(sizes.directional), f = uint64_t(sizes.local);
+    n += l.type == SceneLightType::Directional                                     ? d * d
+         : l.type == SceneLightType::Spot && l.outer_cone <= kSpotSingleMapAngle ? f * f
+                                                                                   : 6 * f * f;
+  }
+  return n;
+}
+
+}  // namespace
+
+std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& lights, const glm::dvec3& lo,
+                                            const glm::dvec3& hi, const ShadowSizes& wanted,
+                                            std::vector<ShadowSlot>& slots) {
+  ShadowSizes sizes = wanted;
+  while (texels_needed(lights, sizes) > kShadowTexelBudget &&
+         std::max(sizes.directional, sizes.local) > kMinShadowSize) {
+    sizes.directional = std::max(kMinShadowSize, sizes.directional / 2);
+    sizes.local = std::max(kMinShadowSize, sizes.local / 2);
+  }
+  std::vector<PmrShadowMap> maps;
+  slots.assign(lights.size(), ShadowSlot{});
+  for (size_t i = 0; i < lights.size() && i < size_t(kMaxShadowedLights); ++i) {
+    const SceneLight& l = lights[i];
+    slots[i].first = int(maps.size());
+    if (l.type == SceneLightType::Directional) maps.push_back(orthographic_map(l.direction, lo, hi, sizes.directional));
+    else local_maps(l, lo, hi, sizes.local, maps);
+    slots[i].count = int(maps.size()) - slots[i].first;
+  }
+  uint64_t offset = 0;
+  for (PmrShadowMap& m : maps) {
+    m.offset = uint32_t(offset);
+    offset += uint64_t(m.size) * uint64_t(m.size);
+  }
+  return maps;
+}
+
+uint64_t shadow_texels(const std::vector<PmrShadowMap>& maps) {
+  uint64_t n = 0;
+  for (const PmrShadowMap& m : maps) n += uint64_t(m.size) * uint64_t(m.size);
+  return n;
+}
+
+std::vector<float> ShadowStage::read_depth() const {
+  std::vector<float> out(size_t(shadow_texels(maps_)));
+  if (!out.empty()) rt_.read(depth_, out.data(), out.size() * sizeof(float));
+  return out;
+}
+
+ShadowStage::ShadowStage(Launcher& launcher, const ClProgram& program, const ShadowSizes& sizes)
+    : launcher_(launcher),
+      rt_(launcher.runtime()),
+      sizes_(sizes),
+      clear_(program, "shadow_clear"),
+      raster_(program, "shadow_raster") {
+  maps_buffer_ = rt_.buffer(sizeof(PmrShadowMap), "shadow maps");
+  depth_ = rt_.buffer(16, "shadow depths");
+}
+
+void ShadowStage::place(bool on, const std::vector<SceneLight>& lights, const SceneBuffers& scene) {
+  maps_.clear();
+  slots_.assign(lights.size(), ShadowSlot{});
+  if (!on || scene.num_triangles() == 0) return;
+  maps_ = place_shadow_maps(lights, scene.bounds_lo(), scene.bounds_hi(), sizes_, slots_);
+  const uint64_t texels = shadow_texels(maps_);
+  if (texels >= (uint64_t(1) << 32)) throw Error("the lights' shadow maps need more than 2^32 texels");
+  if (depth_.size() < texels * 4) depth_ = ClBuffer(), depth_ = rt_.buffer(size_t(texels * 4), "shadow depths");
+  rt_.rewrite(maps_buffer_, maps_, "shadow maps");
+}
+
+void ShadowStage::render(const SceneBuffers& scene, FrameEvents& ev, bool warm) {
+  if (warm) {  // one launch of each kernel, so that frames compile nothing
+    clear_.args(depth_, cl_uint(0), cl_uint(0));
+    ev.add(kShadow, launcher_.launch(clear_, 1, 64));
+    raster_.args(scene.positions(), scene.triangles(), scene.materials(), cl_uint(0), maps_buffer_, cl_uint(0), depth_);
+    ev.add(kShadow, launcher_.launch(raster_, 1, 64));
+    return;
+  }
+  for (size_t k = 0; k < maps_.size(); ++k) {
+    const uint32_t texels = uint32_t(maps_[k].size) * uint32_t(maps_[k].size);
+    clear_.args(depth_, cl_uint(maps_[k].offset), cl_uint(texels));
+    ev.add(kShadow, launcher_.launch(clear_, texels, 64));
+    raster_.args(scene.positions(), scene.triangles(), scene.materials(), cl_uint(scene.num_triangles()),
+                 maps_buffer_, cl_uint(k), depth_);
+    ev.add(kShadow, launcher_.launch(raster_, scene.num_triangles(), 64));
+  }
+}
+
+}  // namespace pmr

@@ -1,0 +1,71 @@
+// The frame's shadow maps (DESIGN section 4d): each light's maps placed over the box of the scene's
+// posed geometry, rendered once per frame before any fine raster (cl/shadow.cl), and read by the shading
+// of every view, every path and every product (cl/lights.h, shadow_visibility), so a shadow costs one
+// pass per light whatever the number of views. This stage owns the maps and their depths.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "pipeline/launcher.h"
+#include "pipeline/shadow_sizes.h"
+#include "pmr/scene.h"
+#include "pmr/shared.h"
+#include "runtime/cl_runtime.h"
+
+namespace pmr {
+
+class SceneBuffers;
+
+// What a shading kernel binds for the shadows: the maps and their depths.
+struct ShadowBinding {
+  const ClBuffer* maps;
+  const ClBuffer* depth;
+};
+
+// A light's maps in the frame's table: the first, and how many (0: none, 1, or 6 for a cube).
+struct ShadowSlot {
+  int first = -1;
+  int count = 0;
+};
+
+// The maps of `lights` (world space, posed) over the world box [lo, hi] of every caster and receiver:
+// a directional light's orthographic map covers the box seen along its direction; a point light's
+// cube and a spot light's map look from its position, their near plane 1e-4 of the farthest corner's
+// distance. slots[i]: light i's maps (none after the first kMaxShadowedLights). Sizes are halved
+// until all fit kShadowTexelBudget (not below kMinShadowSize). Depth offsets are packed in order.
+std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& lights, const glm::dvec3& lo,
+                                            const glm::dvec3& hi, const ShadowSizes& sizes,
+                                            std::vector<ShadowSlot>& slots);
+// Texels of all of `maps`.
+uint64_t shadow_texels(const std::vector<PmrShadowMap>& maps);
+
+class ShadowStage {
+ public:
+  // `program`: the main program (shadow.cl).
+  ShadowStage(Launcher& launcher, const ClProgram& program, const ShadowSizes& sizes);
+  // Places the maps of the frame's lights over the scene's posed box (none when `on` is false or the
+  // scene is empty): slots() then says which light has which maps.
+  void place(bool on, const std::vector<SceneLight>& lights, const SceneBuffers& scene);
+  // Renders the placed maps from the scene's posed triangles. `warm`: the warm-up frame, which
+  // launches each kernel once whatever was placed.
+  void render(const SceneBuffers& scene, FrameEvents& ev, bool warm);
+  const std::vector<ShadowSlot>& slots() const { return slots_; }
+  const std::vector<PmrShadowMap>& maps() const { return maps_; }
+  // The placed maps' depths as floats (after the frame).
+  std::vector<float> read_depth() const;
+  ShadowBinding binding() const { return {&maps_buffer_, &depth_}; }
+  size_t device_bytes() const { return maps_buffer_.size() + depth_.size(); }
+
+ private:
+  Launcher& launcher_;
+  const ClRuntime& rt_;
+  ShadowSizes sizes_;
+  ClKernel clear_, raster_;
+  std::vector<PmrShadowMap> maps_;
+  std::vector<ShadowSlot> slots_;
+  ClBuffer maps_buffer_, depth_;
+};
+
+}  // namespace pmr

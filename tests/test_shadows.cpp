@@ -1,0 +1,384 @@
+// Shadows (DESIGN section 4d): the frame's shadow maps against a plain C++ rasterization, and the
+// visibility the kernels shade with against exact visibility, ray-cast in double precision
+// (tests/reference/visibility_reference.h).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "pbr_support.h"
+#include "pipeline/shadow_stage.h"
+#include "reference/shade_reference.h"
+#include "reference/visibility_reference.h"
+#include "shading/lights.h"
+#include "test_util.h"
+
+namespace pmr {
+namespace {
+
+// A quad of two triangles with corners a, b, c, d (counter-clockwise seen from the front).
+void add_quad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
+  test::add_triangle(s, a, b, c);
+  test::add_triangle(s, a, c, d);
+}
+
+// The box [lo, hi], its faces outward.
+void add_box(Scene& s, glm::vec3 lo, glm::vec3 hi) {
+  const glm::vec3 p[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
+                          {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
+  add_quad(s, p[4], p[5], p[6], p[7]);  // +z
+  add_quad(s, p[1], p[0], p[3], p[2]);  // -z
+  add_quad(s, p[5], p[1], p[2], p[6]);  // +x
+  add_quad(s, p[0], p[4], p[7], p[3]);  // -x
+  add_quad(s, p[3], p[7], p[6], p[2]);  // +y
+  add_quad(s, p[0], p[1], p[5], p[4]);  // -y
+}
+
+// A ground plane at y = -0.5 and a box standing on it.
+Scene box_on_plane() {
+  Scene s = test::empty_scene(false);
+  add_quad(s, {-1.5f, -0.5f, 1.5f}, {1.5f, -0.5f, 1.5f}, {1.5f, -0.5f, -1.5f}, {-1.5f, -0.5f, -1.5f});
+  add_box(s, {-0.25f, -0.5f, -0.25f}, {0.25f, 0.1f, 0.25f});
+  return s;
+}
+
+// The same turned 60 degrees about +X (+Y toward +Z), so that the rigs of test::small_rig, which look
+// down -Z, see the plane nearly face on; vertex and face normals turned with it.
+Scene box_on_plane_facing_the_camera() {
+  Scene s = box_on_plane();
+  const double c = 0.5, sn = std::sqrt(0.75);
+  auto turn = [&](float* v) {
+    const double y = v[1], z = v[2];
+    v[1] = float(c * y - sn * z), v[2] = float(sn * y + c * z);
+  };
+  for (glm::vec3& p : s.positions) turn(&p.x);
+  for (PmrVertexAttr& a : s.attributes) turn(a.normal);
+  for (PmrTriangle& t : s.triangles) turn(t.face_normal);
+  return s;
+}
+
+SceneLight sun(glm::dvec3 travel) {
+  SceneLight l;
+  l.type = SceneLightType::Directional;
+  l.intensity = 3.0f;
+  l.direction = glm::normalize(travel);
+  return l;
+}
+
+// A sphere of radius r about c, `rings` x 2 `rings` facets, outward.
+void add_sphere(Scene& s, glm::vec3 c, float r, int rings) {
+  auto at = [&](int i, int j) {
+    const double th = M_PI * i / rings, ph = M_PI * j / rings;
+    return c + r * glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), -std::sin(th) * std::sin(ph));
+  };
+  for (int i = 0; i < rings; ++i)
+    for (int j = 0; j < 2 * rings; ++j) {
+      if (i > 0) test::add_triangle(s, at(i, j), at(i + 1, j), at(i, j + 1));
+      if (i + 1 < rings) test::add_triangle(s, at(i, j + 1), at(i + 1, j), at(i + 1, j + 1));
+    }
+}
+
+// The frame's shadow maps of scene `s` (its lights) as the pipeline renders them.
+struct ShadowMaps {
+  std::vector<PmrShadowMap> maps;
+  std::vector<float> depth;
+};
+
+ShadowMaps render_maps(const Scene& s) {
+  PipelineConfig pc;
+  pc.shading = Shading::Pbr;
+  pc.shadows = true;
+  Pipeline p(test::runtime(), pc);
+  p.set_scene(s);
+  const Rig rig = test::small_rig(2, 32, 16);
+  p.configure(rig, nullptr);
+  p.render(rig);
+  ShadowMaps out;
+  p.read_shadow_maps(out.maps, out.depth);
+  return out;
+}
+
+// A receiver: a point on a surface and that surface's unit normal.
+struct Receiver {
+  glm::dvec3 p, n;
+};
+
+// cl/lights.h's shadow_visibility of the scene's one light at each receiver (tests/probes/shadow_probe.cl).
+std::vector<float> probe(const ShadowMaps& m, const SceneLight& light, const std::vector<Receiver>& at) {
+  const ClRuntime& rt = test::runtime();
+  const ClProgram program = rt.build_program({"shadow_probe.cl"}, "-cl-std=CL1.2", &test_kernel_sources());
+  PmrLight d = device_light(light);
+  d.shadow = 0, d.shadow_maps = int(m.maps.size());
+  std::vector<float> in;
+  for (const Receiver& r : at)
+    for (const glm::dvec3& v : {r.p, r.n}) in.insert(in.end(), {float(v.x), float(v.y), float(v.z)});
+  std::vector<uint32_t> bits(m.depth.size());
+  std::memcpy(bits.data(), m.depth.data(), bits.size() * 4);
+  std::vector<float> out(at.size());
+  ClKernel k(program, "shadow_probe");
+  ClBuffer maps = rt.upload(m.maps, "maps"), depth = rt.upload(bits, "depth"), l = rt.upload(std::vector<PmrLight>{d}, "light");
+  ClBuffer a = rt.upload(in, "probe in"), b = rt.buffer(out.size() * 4, "probe out");
+  k.args(maps, depth, l, a, b, cl_uint(at.size()));
+  clReleaseEvent(rt.launch(k, at.size(), 64));
+  rt.read(b, out.data(), out.size() * 4);
+  return out;
+}
+
+// The world size of a texel of the light's map at p (the face of p's major axis for a cube).
+double texel_at(const ShadowMaps& m, const SceneLight& light, const glm::dvec3& p) {
+  size_t k = 0;
+  if (m.maps.size() == 6) {
+    const glm::dvec3 d = p - light.position, a = glm::abs(d);
+    const int axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+    k = size_t(2 * axis + (d[axis] < 0.0 ? 1 : 0));
+  }
+  const PmrShadowMap& s = m.maps[k];
+  if (!s.perspective) return s.texel;
+  return s.texel * glm::dot(p - glm::dvec3(s.origin[0], s.origin[1], s.origin[2]),
+                            glm::dvec3(s.axis[0], s.axis[1], s.axis[2]));
+}
+
+// Whether the exact visibility of `exact` changes within distance h across the light (unit l toward
+// it) around receiver r: at 8 points h from r.p across l, each slid along l back onto r's plane (for h
+// a texel, the texel's footprint on the receiver).
+bool near_shadow_edge(const Scene& s, const ref::PunctualLight& exact, const Receiver& r, const glm::dvec3& l,
+                      double h) {
+  const double e = ref::ray_visibility(s, r.p, exact);
+  const glm::dvec3 t = glm::normalize(glm::cross(l, std::abs(l.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
+  const glm::dvec3 b = glm::cross(l, t);
+  for (int k = 0; k < 8; ++k) {
+    const double a = k * M_PI / 4.0;
+    const glm::dvec3 step = h * (std::cos(a) * t + std::sin(a) * b);
+    if (ref::ray_visibility(s, r.p + step - l * (glm::dot(step, r.n) / glm::dot(l, r.n)), exact) != e) return true;
+  }
+  return false;
+}
+
+// DESIGN 4d's bound on the receivers that a point-like light reaches (facing it, inside a spot's cone):
+// the mean |V - V_exact| at most 0.02, and where V is on the wrong side of 1/2 the exact edge lies
+// within one texel of the map (V_exact differs at a point of the receiver's plane one texel away as
+// the map sees it). Returns the count of receivers compared with V_exact = 0.
+size_t expect_hard_shadow(const Scene& s, const SceneLight& light, const std::vector<Receiver>& at) {
+  const ShadowMaps m = render_maps(s);
+  const std::vector<float> v = probe(m, light, at);
+  const ref::PunctualLight exact = test::reference_light(light);
+  double sum = 0.0;
+  size_t shadowed = 0, displaced = 0;
+  size_t compared = 0;
+  for (size_t i = 0; i < at.size(); ++i) {
+    glm::dvec3 l;
+    if (!(ref::light_irradiance(exact, at[i].p, l).x > 0.0) || glm::dot(l, at[i].n) <= 0.0) continue;
+    ++compared;
+    const double e = ref::ray_visibility(s, at[i].p, exact);
+    sum += std::abs(v[i] - e);
+    shadowed += e == 0.0;
+    if (std::abs(v[i] - e) <= 0.5) continue;
+    const double h = texel_at(m, light, at[i].p);
+    if (!near_shadow_edge(s, exact, at[i], l, h) && ++displaced <= 5)
+      ADD_FAILURE() << "V " << v[i] << " at (" << at[i].p.x << ", " << at[i].p.y << ", " << at[i].p.z
+                    << "), exactly " << e << " within a texel (" << h << ") around";
+  }
+  const double mean = sum / double(compared);
+  EXPECT_LE(mean, 0.02);
+  EXPECT_EQ(displaced, 0u);
+  std::printf("[ shadows  ] %zu receivers lit (%zu shadowed), mean |V error| %.4f\n", compared, shadowed, mean);
+  return shadowed;
+}
+
+// Receivers on the ground plane y = -0.5 (step apart) and on the box's faces.
+std::vector<Receiver> box_receivers(double step) {
+  std::vector<Receiver> at;
+  for (double x = -1.45; x <= 1.45; x += step)
+    for (double z = -1.45; z <= 1.45; z += step)
+      if (std::abs(x) > 0.25 || std::abs(z) > 0.25) at.push_back({{x, -0.5, z}, {0, 1, 0}});
+  for (double u = -0.24; u <= 0.24; u += step)
+    for (double w = -0.49; w <= 0.09; w += step) {
+      at.push_back({{0.25, w, u}, {1, 0, 0}}), at.push_back({{-0.25, w, u}, {-1, 0, 0}});
+      at.push_back({{u, w, 0.25}, {0, 0, 1}}), at.push_back({{u, w, -0.25}, {0, 0, -1}});
+    }
+  return at;
+}
+
+TEST(Shadows, DirectionalLightMatchesRayCasting) {
+  for (const glm::dvec3 travel : {glm::dvec3(0.3, -1.0, -0.2), glm::dvec3(1.0, -0.27, 0.4)}) {  // steep, grazing
+    Scene s = box_on_plane();
+    s.lights = {sun(travel)};
+    EXPECT_GT(expect_hard_shadow(s, s.lights[0], box_receivers(0.013)), 500u);
+  }
+}
+
+TEST(Shadows, SpotLightMatchesRayCasting) {
+  Scene s = box_on_plane();
+  s.lights = {test::make_light(SceneLightType::Spot, {1.1, 0.6, 0.7}, {-1.1, -1.0, -0.7}, 20.0f, 0.0f)};
+  s.lights[0].outer_cone = 0.7f;
+  EXPECT_GT(expect_hard_shadow(s, s.lights[0], box_receivers(0.013)), 500u);
+}
+
+// A point light inside a room of six walls, a small box between it and each wall: every cube face
+// holds a shadow.
+TEST(Shadows, PointLightMatchesRayCastingOnEveryCubeFace) {
+  Scene s = test::empty_scene(false);
+  const float w = 1.2f;
+  add_box(s, {-w, -w, -w}, {w, w, w});  // outward faces; both sides receive (the kernel flips toward the light)
+  const glm::vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const glm::vec3& a : axes) add_box(s, a * 0.5f - glm::vec3(0.1f), a * 0.5f + glm::vec3(0.1f));
+  s.lights = {test::make_light(SceneLightType::Point, {0.05, 0.03, -0.02}, {0, 0, -1}, 20.0f, 0.0f)};
+  std::vector<Receiver> at;
+  for (const glm::vec3& a : axes)
+    for (double u = -1.15; u <= 1.15; u += 0.02)
+      for (double v = -1.15; v <= 1.15; v += 0.02) {
+        glm::dvec3 p = glm::dvec3(a) * double(w);
+        const int i = a.x != 0 ? 0 : a.y != 0 ? 1 : 2;
+        p[(i + 1) % 3] = u, p[(i + 2) % 3] = v;
+        at.push_back({p, -glm::dvec3(a)});
+      }
+  EXPECT_GT(expect_hard_shadow(s, s.lights[0], at), 6u * 200u);
+}
+
+// A convex receiver facing the light shadows nothing of itself.
+TEST(Shadows, NoAcneOnACurvedReceiverFacingTheLight) {
+  Scene s = test::empty_scene(false);
+  add_sphere(s, {0.0f, 0.0f, 0.0f}, 0.8f, 48);
+  s.lights = {sun({0.4, -0.7, -0.6})};
+  const ShadowMaps m = render_maps(s);
+  std::vector<Receiver> at;
+  const glm::dvec3 l = -glm::normalize(s.lights[0].direction);
+  for (const PmrTriangle& t : s.triangles) {
+    const glm::dvec3 a(s.positions[t.v[0]]), b(s.positions[t.v[1]]), c(s.positions[t.v[2]]);
+    const glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+    for (const glm::dvec3 w : {glm::dvec3(1, 1, 1) / 3.0, glm::dvec3(0.7, 0.2, 0.1), glm::dvec3(0.1, 0.1, 0.8)})
+      if (glm::dot(n, l) > 0.05) at.push_back({w.x * a + w.y * b + w.z * c, n});
+  }
+  const std::vector<float> v = probe(m, s.lights[0], at);
+  size_t acne = 0;
+  for (size_t i = 0; i < v.size(); ++i)
+    if (v[i] < 0.999f && ++acne <= 5)
+      ADD_FAILURE() << "V " << v[i] << " at n.l " << glm::dot(at[i].n, l) << " (" << at[i].p.x << ", " << at[i].p.y
+                    << ", " << at[i].p.z << ")";
+  EXPECT_EQ(acne, 0u) << "of " << at.size() << " receivers facing the light";
+  EXPECT_GT(at.size(), 5000u);
+}
+
+// Where a box stands on the plane the shadow starts at the box: receivers just beyond its base, in its
+// shadow, are shadowed from one texel on (the light at 20 degrees above the horizon).
+TEST(Shadows, NoGapAtContact) {
+  Scene s = box_on_plane();
+  s.lights = {sun({1.0, -0.36, 0.0})};
+  const ShadowMaps m = render_maps(s);
+  const double texel = m.maps[0].texel;
+  std::vector<Receiver> at;
+  for (double d = 1.0; d <= 6.0; d += 0.25)
+    for (double z = -0.2; z <= 0.2; z += 0.05) at.push_back({{0.25 + d * texel, -0.5, z}, {0, 1, 0}});
+  const std::vector<float> v = probe(m, s.lights[0], at);
+  for (size_t i = 0; i < at.size(); ++i) EXPECT_LT(v[i], 0.5f) << "at x = 0.25 + " << (at[i].p.x - 0.25) / texel << " texels";
+}
+
+// The shaded result: every covered voxel of the box on the plane under a sun equals the reference's
+// colour with the sun's term times the ray-cast visibility at the voxel's surface point (1% + 1e-3 per
+// channel), except within a texel of a shadow's edge.
+TEST(Shadows, ShadedVoxelsMatchTheReferenceWithRayCastVisibility) {
+  Scene s = box_on_plane_facing_the_camera();
+  s.lights = {sun({0.5, -1.0, -0.3})};
+  const Rig rig = test::small_rig(5, 96, 64);
+  PipelineConfig pc = test::pbr_config(Method::Pmr, TextureFilter::Bilinear, nullptr);
+  pc.shadows = true;
+  const test::Rendered out = test::render_with(s, rig, pc);
+  test::VoxelReference lit(s, rig, out), ambient(s, rig, out);
+  lit.lights = {test::reference_light(s.lights[0])};
+  ambient.lights.clear();
+  const ref::PunctualLight exact = lit.lights[0];
+  const double texel = render_maps(s).maps[0].texel;
+  const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
+  test::BoundCheck check;
+  size_t compared = 0, shadowed = 0;
+  for (size_t v = 0; v < out.key.size(); ++v) {
+    if (out.key[v] == PMR_NO_KEY) continue;
+    const PmrMta* m = lit.mta(v);
+    ASSERT_NE(m, nullptr);
+    const int view = int(v / (W * H));
+    const glm::dvec3 b = ref::source_barycentrics(*m, int(v % W), int((v / W) % H), view);
+    const glm::dvec3 p = test::surface_at(s, rig, m->tri, b, (m->flags & PMR_MTA_BACK) != 0, view).p;
+    const double e = ref::ray_visibility(s, p, exact);
+    const float* fn = s.triangles[m->tri].face_normal;
+    if (near_shadow_edge(s, exact, {p, glm::dvec3(fn[0], fn[1], fn[2])}, -exact.direction, 1.5 * texel)) continue;
+    const glm::dvec3 a = ambient.colour(v, *m);
+    check.voxel(out, v, a + e * (lit.colour(v, *m) - a), "shadowed voxel");
+    ++compared, shadowed += e == 0.0;
+  }
+  EXPECT_EQ(check.bad, 0u);
+  EXPECT_GT(compared, 5000u);
+  EXPECT_GT(shadowed, 500u);
+  size_t covered = 0;
+  for (uint32_t k : out.key) covered += k != PMR_NO_KEY;
+  std::printf("[ shadows  ] %zu of %zu covered voxels compared, %zu of them shadowed\n", compared, covered, shadowed);
+}
+
+// Every path gives the same shadows: the fused display image equals the encoded view volume bit for
+// bit, subpixel sampling on a raster of 3 W_d x H_d equals view sampling but for depth ties, and the
+// duplicate and multipass baselines shade each voxel they share with PMR (same winner) alike: the same
+// bits (duplicate), within 1e-3 (multipass, whose per-view passes round the surface point apart).
+TEST(Shadows, EveryPathGivesTheSameShadows) {
+  Scene s = box_on_plane_facing_the_camera();
+  s.lights = {sun({0.5, -1.0, -0.3})};
+  Display d;
+  const Rig rig = test::subpixel_display_rig(d);
+  auto encoded = [&](Sampling sampling, bool fuse, bool shadows) {
+    PipelineConfig pc;
+    pc.shading = Shading::Pbr, pc.sampling = sampling, pc.fuse_encode = fuse, pc.shadows = shadows;
+    return test::render_encoded(s, rig, d, pc);
+  };
+  const test::EncodedRender unfused = encoded(Sampling::View, false, true), fused = encoded(Sampling::View, true, true),
+                            subpixel = encoded(Sampling::Subpixel, true, true),
+                            unshadowed = encoded(Sampling::View, true, false);
+  ASSERT_TRUE(fused.fused);
+  EXPECT_EQ(fused.image, unfused.image);
+  size_t differ = 0, darker = 0;
+  for (size_t i = 0; i < unfused.image.size(); i += 4) {
+    differ += !std::equal(&subpixel.image[i], &subpixel.image[i] + 4, &unfused.image[i]);
+    darker += test::half_value(fused.image[i + 1]) < 0.9f * test::half_value(unshadowed.image[i + 1]);
+  }
+  EXPECT_LE(differ, unfused.image.size() / 4 / 1000);
+  EXPECT_GT(darker, 25u) << "the box's shadow should darken the plane (of " << unfused.image.size() / 4 << " pixels)";
+  const Rig small = test::small_rig(5, 64, 48);
+  std::vector<test::Rendered> methods;
+  for (Method m : {Method::Pmr, Method::Duplicate, Method::Multipass}) {
+    PipelineConfig pc = test::pbr_config(m, TextureFilter::Bilinear, nullptr);
+    pc.shadows = true;
+    methods.push_back(test::render_with(s, small, pc));
+  }
+  for (size_t k = 1; k < methods.size(); ++k) {
+    size_t same = 0, covered = 0;
+    for (size_t v = 0; v < methods[0].key.size(); ++v) {
+      covered += methods[0].key[v] != PMR_NO_KEY;
+      if (methods[0].key[v] == PMR_NO_KEY || methods[0].key[v] != methods[k].key[v]) continue;
+      for (int c = 0; c < 3; ++c) {
+        const float a = test::half_value(methods[0].volume[v * 4 + size_t(c)]);
+        const float b = test::half_value(methods[k].volume[v * 4 + size_t(c)]);
+        if (k == 1) ASSERT_EQ(a, b) << "duplicate, voxel " << v;
+        else ASSERT_NEAR(a, b, 1e-3) << "multipass, voxel " << v;
+      }
+      ++same;
+    }
+    EXPECT_GT(same, covered * 9 / 10) << k;
+  }
+}
+
+// The sidecar records the shadows when they are on (their map sizes), and nothing when off, so that a
+// sidecar of an older pmr reads as off; --resume compares them.
+TEST(Shadows, TheSidecarRecordsThemAndResumeCompares) {
+  const std::string out = test::temp_dir("shadows_resume");
+  const std::string small = " --views 4 --view-size 48x24 --display 160x90 --environment uniform --out " + out;
+  ASSERT_EQ(test::run("render --shadows off" + small).status, 0);
+  EXPECT_EQ(test::read_file(out + "/frame_0000.json").find("\"shadows\""), std::string::npos);
+  EXPECT_EQ(test::run("render --shadows off --resume" + small).status, 0);
+  test::expect_one_error_line(test::run("render --resume" + small), "shading differs");
+  ASSERT_EQ(test::run("render --overwrite" + small).status, 0);
+  const std::string on = test::read_file(out + "/frame_0000.json");
+  EXPECT_NE(on.find("\"map_size\": 2048"), std::string::npos) << on;
+  EXPECT_NE(on.find("\"local_map_size\": 1024"), std::string::npos);
+  EXPECT_EQ(test::run("render --resume" + small).status, 0);
+  test::expect_usage_error(test::run("render --shadows maybe" + small), "--shadows");
+}
+
+}  // namespace
+}  // namespace pmr

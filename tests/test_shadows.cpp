@@ -363,6 +363,35 @@ TEST(Shadows, EveryPathGivesTheSameShadows) {
   }
 }
 
+// A still frame renders its maps once: a second frame of the same lights and triangles renders none
+// and draws the same image; a moved light, or moved triangles, render them again.
+TEST(Shadows, MapsAreRenderedAgainOnlyWhenSomethingMoved) {
+  Scene s = box_on_plane_facing_the_camera();
+  s.lights = {sun({0.5, -1.0, -0.3})};
+  const Rig rig = test::small_rig(3, 64, 48);
+  PipelineConfig pc = test::pbr_config(Method::Pmr, TextureFilter::Bilinear, nullptr);
+  pc.shadows = true;
+  Pipeline p(test::runtime(), pc);
+  p.set_scene(s);
+  p.configure(rig, nullptr);
+  std::vector<uint16_t> first, again, moved;
+  auto frame = [&](const std::vector<SceneLight>& lights, std::vector<uint16_t>& image) {
+    FrameDescription f = describe_frame(rig, lights, pc);
+    const StageTimes t = p.render(f);
+    p.read_volume(image);
+    return t.shadow;
+  };
+  EXPECT_GT(frame(s.lights, first), 0.0);
+  EXPECT_EQ(frame(s.lights, again), 0.0) << "nothing moved: no shadow pass";
+  EXPECT_EQ(first, again);
+  EXPECT_GT(frame({sun({-0.5, -1.0, -0.3})}, moved), 0.0) << "the light moved";
+  EXPECT_NE(first, moved);
+  Scene posed = s;
+  for (glm::vec3& q : posed.positions) q.x += 0.1f;
+  p.update_geometry(posed);
+  EXPECT_GT(frame(s.lights, moved), 0.0) << "the triangles moved";
+}
+
 // The sidecar records the shadows when they are on (their map sizes), and nothing when off, so that a
 // sidecar of an older pmr reads as off; --resume compares them.
 TEST(Shadows, TheSidecarRecordsThemAndResumeCompares) {

@@ -90,6 +90,7 @@ void SceneBuffers::update_geometry(const Scene& posed) {
 }
 
 void SceneBuffers::set_bounds(const std::vector<glm::vec3>& positions) {
+  ++geometry_generation_;
   glm::vec3 lo(0.0f), hi(0.0f);
   if (!positions.empty()) lo = hi = positions[0];
   for (const glm::vec3& p : positions) lo = glm::min(lo, p), hi = glm::max(hi, p);

@@ -34,6 +34,8 @@ class SceneBuffers {
   // The world box of the posed geometry (set_scene, update_geometry): where shadow maps are placed.
   const glm::dvec3& bounds_lo() const { return bounds_lo_; }
   const glm::dvec3& bounds_hi() const { return bounds_hi_; }
+  // Counts set_scene and update_geometry calls: unchanged, the device holds the same triangles.
+  uint64_t geometry_generation() const { return geometry_generation_; }
 
   uint32_t num_vertices() const { return num_vertices_; }
   // pbr and a triangle with a transmissive material: frames need the transmission source
@@ -58,6 +60,7 @@ class SceneBuffers {
   bool has_tangents_ = false;
   std::vector<SceneLight> scene_lights_;
   glm::dvec3 bounds_lo_{0.0}, bounds_hi_{0.0};
+  uint64_t geometry_generation_ = 0;
   void set_bounds(const std::vector<glm::vec3>& positions);
   ClBuffer positions_, attrs_, tris_, materials_, textures_, texels_, texcoords_, tangents_;
   ClBuffer lut_, split_sum_, sheen_albedo_, env_, env_data_;  // the run's tables

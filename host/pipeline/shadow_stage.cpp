@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "pipeline/scene_buffers.h"
 #include "pmr/error.h"
@@ -143,7 +144,10 @@ void ShadowStage::place(bool on, const std::vector<SceneLight>& lights, const Sc
   maps_ = place_shadow_maps(lights, scene.bounds_lo(), scene.bounds_hi(), sizes_, slots_);
   const uint64_t texels = shadow_texels(maps_);
   if (texels >= (uint64_t(1) << 32)) throw Error("the lights' shadow maps need more than 2^32 texels");
-  if (depth_.size() < texels * 4) depth_ = ClBuffer(), depth_ = rt_.buffer(size_t(texels * 4), "shadow depths");
+  if (depth_.size() < texels * 4) {
+    rendered_.clear();
+    depth_ = ClBuffer(), depth_ = rt_.buffer(size_t(texels * 4), "shadow depths");
+  }
   rt_.rewrite(maps_buffer_, maps_, "shadow maps");
 }
 
@@ -155,6 +159,10 @@ void ShadowStage::render(const SceneBuffers& scene, FrameEvents& ev, bool warm) 
     ev.add(kShadow, launcher_.launch(raster_, 1, 64));
     return;
   }
+  const bool same = maps_.size() == rendered_.size() && rendered_generation_ == scene.geometry_generation() &&
+                    std::memcmp(maps_.data(), rendered_.data(), maps_.size() * sizeof(PmrShadowMap)) == 0;
+  if (same) return;
+  rendered_ = maps_, rendered_generation_ = scene.geometry_generation();
   for (size_t k = 0; k < maps_.size(); ++k) {
     const uint32_t texels = uint32_t(maps_[k].size) * uint32_t(maps_[k].size);
     clear_.args(depth_, cl_uint(maps_[k].offset), cl_uint(texels));

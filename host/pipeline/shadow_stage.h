@@ -48,8 +48,9 @@ class ShadowStage {
   // Places the maps of the frame's lights over the scene's posed box (none when `on` is false or the
   // scene is empty): slots() then says which light has which maps.
   void place(bool on, const std::vector<SceneLight>& lights, const SceneBuffers& scene);
-  // Renders the placed maps from the scene's posed triangles. `warm`: the warm-up frame, which
-  // launches each kernel once whatever was placed.
+  // Renders the placed maps from the scene's posed triangles, unless the maps and the triangles are
+  // those of the last frame rendered (a still scene renders its maps once). `warm`: the warm-up
+  // frame, which launches each kernel once whatever was placed.
   void render(const SceneBuffers& scene, FrameEvents& ev, bool warm);
   const std::vector<ShadowSlot>& slots() const { return slots_; }
   const std::vector<PmrShadowMap>& maps() const { return maps_; }
@@ -65,6 +66,9 @@ class ShadowStage {
   ClKernel clear_, raster_;
   std::vector<PmrShadowMap> maps_;
   std::vector<ShadowSlot> slots_;
+  // what the depths hold: the maps and the geometry generation they were rendered from
+  std::vector<PmrShadowMap> rendered_;
+  uint64_t rendered_generation_ = 0;
   ClBuffer maps_buffer_, depth_;
 };
 

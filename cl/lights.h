@@ -51,10 +51,16 @@ inline sfloat3 light_irradiance(int type, float3 color_intensity, float3 positio
 #define PMR_SHADOW_BIAS 0.2f
 #define PMR_SHADOW_SLOPE_BIAS 0.5f
 
-/* Whether the caster depths of map m's texel (x, y) lie beyond `ref` (lit: 1), outside the map: 1. */
+/* The light passing map m's texel (x, y) to depth `ref`: 0 behind its nearest opaque caster, else the
+ * transmittance exp(-optical depth) of its translucent casters when ref lies beyond the nearest of
+ * them, else 1; outside the map 1. */
 inline float shadow_tap(global const PmrShadowMap* m, global const uint* depth, int x, int y, float ref) {
   if (x < 0 || y < 0 || x >= m->size || y >= m->size) return 1.0f;
-  return ref <= as_float(depth[m->offset + (size_t)y * (size_t)m->size + (size_t)x]) ? 1.0f : 0.0f;
+  const size_t texel = (size_t)y * (size_t)m->size + (size_t)x;
+  if (ref > as_float(depth[m->offset + texel])) return 0.0f;
+  if (m->translucent == PMR_NO_TRANSLUCENT) return 1.0f;
+  global const uint* pair = depth + m->translucent + 2 * texel;
+  return ref > as_float(pair[0]) ? exp(-(float)pair[1] * (1.0f / PMR_SHADOW_OPTICAL_ONE)) : 1.0f;
 }
 
 /* The visibility of light `light` at world point p of face normal ng (unit, either side): its shadow

@@ -179,22 +179,38 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
   return s3_half_range(s3(base.x * lambert * exposure, base.y * lambert * exposure, base.z * lambert * exposure));
 }
 
+/* The base colour alpha (baseColorFactor alpha x COLOR_0 alpha x the base colour map's alpha) of
+ * triangle `tri` at source barycentrics b[.][j] of lanes j < n (lanes from n on: copies of lane 0,
+ * finite, unused), the map trilinear with the barycentrics' derivatives g, or at level 0 (g = 0). Each
+ * lane is one lane of sample_map_lanes, so how lanes are batched changes no value. */
+inline void triangle_alpha_lanes(const ShadeInputs* in, uint tri, float b[3][SW], int n, const LaneBaryGrad* g,
+                                 float* alpha) {
+  const PmrTriangle t = in->tris[tri];
+  global const PmrMaterial* mat = &in->materials[t.material];
+  const float ca[3] = {in->attrs[t.v[0]].color[3], in->attrs[t.v[1]].color[3], in->attrs[t.v[2]].color[3]};
+  for (int j = 0; j < SW; ++j) alpha[j] = mat->base_color[3] * (b[0][j] * ca[0] + b[1][j] * ca[1] + b[2][j] * ca[2]);
+  if (mat->maps[PMR_MAP_BASE_COLOR].texture < 0) return;
+  uint tris[SW];
+  for (int j = 0; j < SW; ++j) tris[j] = tri;
+  LaneTexcoords C;
+  C.set = PMR_NO_KEY;
+  sfloat c[4];
+  sample_map_lanes(in, &mat->maps[PMR_MAP_BASE_COLOR], tris, (1u << n) - 1u, vload_s(0, lane_index) < (sint)(n),
+                   LANE3(b), g, true, &C, c);
+  float a[SW];
+  vstore_s(c[3], 0, a);
+  for (int j = 0; j < n; ++j) alpha[j] *= a[j];
+}
+
 /* alphaMode MASK: whether the base colour alpha of MTA m at raster points (X[j], Y[j]), j < n <= SW, of
- * view `view` passes the cutoff (pass[j]). Each point is one lane of the lanes' base colour (the factor,
- * COLOR_0 and the base colour map through sample_map_lanes; lanes are independent), so how the raster
- * batches its candidate voxels changes no outcome. Lanes from n on copy lane 0 (finite, unused). */
+ * view `view` passes the cutoff (pass[j]): the alpha of triangle_alpha_lanes at the points' source
+ * barycentrics, the map trilinear at the view's level of detail. */
 inline void mta_alpha_lanes(const ShadeInputs* in, const PmrMta* m, const long* X, const long* Y, int n, int view,
                             float cutoff, int* pass) {
   const long f = view_coord(in->P, view);
-  const PmrTriangle t = in->tris[m->tri];
-  global const PmrMaterial* mat = &in->materials[t.material];
-  const float ca[3] = {in->attrs[t.v[0]].color[3], in->attrs[t.v[1]].color[3], in->attrs[t.v[2]].color[3]};
   float alpha[SW], b[3][SW], e[3][SW];
-  uint tri[SW];
   for (int j = 0; j < SW; ++j) {
-    tri[j] = m->tri;
     if (j >= n) { /* idle: a copy of lane 0, evaluated once */
-      alpha[j] = alpha[0];
       for (int i = 0; i < 3; ++i) b[i][j] = b[i][0], e[i][j] = e[i][0];
       continue;
     }
@@ -206,30 +222,50 @@ inline void mta_alpha_lanes(const ShadeInputs* in, const PmrMta* m, const long* 
     const float b1 = la * m->bary[0][0] + lb * m->bary[1][0] + lc * m->bary[2][0];
     const float b2 = la * m->bary[0][1] + lb * m->bary[1][1] + lc * m->bary[2][1];
     b[0][j] = 1.0f - b1 - b2, b[1][j] = b1, b[2][j] = b2;
-    alpha[j] = mat->base_color[3] * (b[0][j] * ca[0] + b[1][j] * ca[1] + b[2][j] * ca[2]);
     for (int i = 0; i < 3; ++i) e[i][j] = (float)ej[i];
   }
-  if (mat->maps[PMR_MAP_BASE_COLOR].texture >= 0) {
-    LaneBaryGrad g;
-    const bool trilinear = PMR_USE_TRILINEAR(in->P);
-    if (trilinear) {
-      float3 ex, ey;
-      mta_edge_derivatives(in->P, m, f, &ex, &ey);
-      g = bary_gradient_lanes(LANE3(e), s3_splat(ex), s3_splat(ey),
-                              s3_splat((float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2])),
-                              s3_splat((float3)(m->bary[0][0], m->bary[1][0], m->bary[2][0])),
-                              s3_splat((float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1])));
-    }
-    LaneTexcoords C;
-    C.set = PMR_NO_KEY;
-    sfloat c[4];
-    sample_map_lanes(in, &mat->maps[PMR_MAP_BASE_COLOR], tri, (1u << n) - 1u, vload_s(0, lane_index) < (sint)(n),
-                     LANE3(b), trilinear ? &g : 0, true, &C, c);
-    float a[SW];
-    vstore_s(c[3], 0, a);
-    for (int j = 0; j < n; ++j) alpha[j] *= a[j];
+  LaneBaryGrad g;
+  const bool trilinear = PMR_USE_TRILINEAR(in->P);
+  if (trilinear && in->materials[in->tris[m->tri].material].maps[PMR_MAP_BASE_COLOR].texture >= 0) {
+    float3 ex, ey;
+    mta_edge_derivatives(in->P, m, f, &ex, &ey);
+    g = bary_gradient_lanes(LANE3(e), s3_splat(ex), s3_splat(ey), s3_splat((float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2])),
+                            s3_splat((float3)(m->bary[0][0], m->bary[1][0], m->bary[2][0])),
+                            s3_splat((float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1])));
   }
+  triangle_alpha_lanes(in, m->tri, b, n, trilinear ? &g : 0, alpha);
   for (int j = 0; j < n; ++j) pass[j] = alpha[j] >= cutoff;
+}
+
+/* How much of a light triangle `tri` blocks at source barycentrics b[.][j], j < n (DESIGN section 4d):
+ * alphaMode MASK 1 or 0 by its cutoff, BLEND its alpha (clamped to [0, 1]), a transmissive material
+ * 1 - transmission (factor x the map's R; colourless), others 1. Maps at level 0. */
+inline void caster_opacity_lanes(const ShadeInputs* in, uint tri, float b[3][SW], int n, float* opacity) {
+  global const PmrMaterial* mat = &in->materials[in->tris[tri].material];
+  if (mat->transmission > 0.0f) {
+    float t[SW];
+    for (int j = 0; j < SW; ++j) t[j] = mat->transmission;
+    if (mat->maps[PMR_MAP_TRANSMISSION].texture >= 0) {
+      uint tris[SW];
+      for (int j = 0; j < SW; ++j) tris[j] = tri;
+      LaneTexcoords C;
+      C.set = PMR_NO_KEY;
+      sfloat c[4];
+      sample_map_lanes(in, &mat->maps[PMR_MAP_TRANSMISSION], tris, (1u << n) - 1u,
+                       vload_s(0, lane_index) < (sint)(n), LANE3(b), 0, false, &C, c);
+      vstore_s(vload_s(0, t) * c[0], 0, t);
+    }
+    for (int j = 0; j < n; ++j) opacity[j] = clamp(1.0f - t[j], 0.0f, 1.0f);
+    return;
+  }
+  if (mat->alpha_mode == PMR_ALPHA_OPAQUE) {
+    for (int j = 0; j < n; ++j) opacity[j] = 1.0f;
+    return;
+  }
+  triangle_alpha_lanes(in, tri, b, n, 0, opacity);
+  for (int j = 0; j < n; ++j)
+    opacity[j] = mat->alpha_mode == PMR_ALPHA_MASK ? (opacity[j] >= mat->alpha_cutoff ? 1.0f : 0.0f)
+                                                   : clamp(opacity[j], 0.0f, 1.0f);
 }
 
 /* The MTA loaded last for shading: neighbouring voxels and samples mostly share their winner, and an

@@ -1,30 +1,40 @@
 /* Shadow maps (DESIGN section 4d): the frame's posed triangles rasterized into one map of a light
- * (PmrShadowMap), each texel keeping the nearest caster's depth along the map's axis. Depths are
- * non-negative floats, whose bits order as the floats do, so the nearest is an atomic minimum of the
- * bits and the map does not depend on the order in which triangles arrive. Rendered once per frame,
- * before any fine raster, and read by the shading of every view (cl/lights.h, shadow_visibility). */
-#include "common.h"
+ * (PmrShadowMap), each texel keeping the nearest opaque caster's depth along the map's axis. Depths
+ * are non-negative floats, whose bits order as the floats do, so the nearest is an atomic minimum of
+ * the bits. Translucent casters (alphaMode BLEND, transmissive materials) add -ln(1 - opacity) to the
+ * texel's optical depth in fixed point (an integer sum) and their depth to its nearest translucent
+ * depth. So a map does not depend on the order in which triangles arrive. MASK casters are
+ * alpha-tested at each texel. Rendered once per frame, before any fine raster, and read by the shading
+ * of every view (cl/lights.h, shadow_visibility). */
+#include "shade.h"
 
 #define PMR_SHADOW_EMPTY 0x7f800000u /* +infinity: no caster */
 
-kernel void shadow_clear(global uint* depth, uint first, uint count) {
+/* Clears texels [first, first + count): depths to empty, or (pairs) depth empty and optical depth 0. */
+kernel void shadow_clear(global uint* depth, uint first, uint count, uint pairs) {
   const uint i = pmr_item_id();
-  if (i < count) depth[first + i] = PMR_SHADOW_EMPTY;
+  if (i >= count) return;
+  if (pairs) depth[first + 2 * i] = PMR_SHADOW_EMPTY, depth[first + 2 * i + 1] = 0u;
+  else depth[first + i] = PMR_SHADOW_EMPTY;
 }
 
-/* World point q in the map's space: (right . d, up . d, axis . d), d = q - origin (unscaled by z). */
-inline float3 shadow_space(global const PmrShadowMap* m, float3 q) {
-  const float3 d = q - vload3(0, m->origin);
-  return (float3)(dot(vload3(0, m->right), d), dot(vload3(0, m->up), d), dot(vload3(0, m->axis), d));
-}
+/* A corner of a triangle in map space: (right . d, up . d, axis . d), d = q - origin, and its source
+ * barycentrics (a vertex's, or interpolated where the near plane clips). */
+typedef struct {
+  float3 c, b;
+} ShadowCorner;
 
-/* The polygon of a triangle in map space clipped to z >= near (perspective maps; up to 4 corners). */
-inline int clip_near(const float3* c, float near_z, float3* out) {
+/* The corners of a triangle clipped to z >= near_z (perspective maps; up to 4). */
+inline int clip_near(const ShadowCorner* c, float near_z, ShadowCorner* out) {
   int n = 0;
   for (int k = 0; k < 3; ++k) {
-    const float3 a = c[k], b = c[(k + 1) % 3];
-    if (a.z >= near_z) out[n++] = a;
-    if ((a.z >= near_z) != (b.z >= near_z)) out[n++] = mix(a, b, (near_z - a.z) / (b.z - a.z));
+    const ShadowCorner a = c[k], b = c[(k + 1) % 3];
+    if (a.c.z >= near_z) out[n++] = a;
+    if ((a.c.z >= near_z) != (b.c.z >= near_z)) {
+      const float t = (near_z - a.c.z) / (b.c.z - a.c.z);
+      out[n].c = mix(a.c, b.c, t), out[n].b = mix(a.b, b.b, t);
+      ++n;
+    }
   }
   return n;
 }
@@ -37,9 +47,40 @@ inline float3 shadow_texel(global const PmrShadowMap* m, float3 c) {
   return (float3)((c.x * w + 1.0f) * half_size, (c.y * w + 1.0f) * half_size, m->perspective ? w : c.z);
 }
 
-/* Rasterizes the triangle of texel-space corners a, b, c: every texel whose center it covers (edges
- * included) takes the depth at the center if nearer. Perspective maps interpolate 1/z linearly. */
-inline void shadow_triangle(global const PmrShadowMap* m, global uint* depth, float3 a, float3 b, float3 c) {
+/* Up to SW covered texels of a translucent or MASK caster, whose opacity is evaluated together. */
+typedef struct {
+  int n;
+  uint texel[SW];
+  float z[SW], b[3][SW];
+} ShadowBatch;
+
+/* The batch's texels take the caster: opaque ones (opacity 1) its depth if nearer, partial ones its
+ * optical depth and nearest translucent depth. */
+inline void shadow_flush(const ShadeInputs* in, global const PmrShadowMap* m, uint tri, global uint* depth,
+                         ShadowBatch* B) {
+  if (B->n == 0) return;
+  for (int j = B->n; j < SW; ++j) B->b[0][j] = B->b[0][0], B->b[1][j] = B->b[1][0], B->b[2][j] = B->b[2][0];
+  float opacity[SW];
+  caster_opacity_lanes(in, tri, B->b, B->n, opacity);
+  for (int j = 0; j < B->n; ++j) {
+    const float a = opacity[j];
+    if (a >= 1.0f) {
+      atomic_min(depth + m->offset + B->texel[j], as_uint(B->z[j]));
+    } else if (a > 0.0f && m->translucent != PMR_NO_TRANSLUCENT) {
+      global uint* pair = depth + m->translucent + 2 * B->texel[j];
+      atomic_min(pair, as_uint(B->z[j]));
+      atomic_add(pair + 1, (uint)(fmin(-log1p(-a), 40.0f) * PMR_SHADOW_OPTICAL_ONE + 0.5f));
+    }
+  }
+  B->n = 0;
+}
+
+/* Rasterizes the clipped triangle of texel-space corners t[.] (source barycentrics s[.]): every texel
+ * whose center it covers (edges included) takes the depth at the center. `opaque`: the caster is
+ * opaque everywhere (its depth goes straight to the map), else texels gather in batches. */
+inline void shadow_triangle(const ShadeInputs* in, global const PmrShadowMap* m, uint tri, bool opaque,
+                            global uint* depth, const float3* t, const float3* s) {
+  const float3 a = t[0], b = t[1], c = t[2];
   const float area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
   if (!(fabs(area) > 0.0f)) return;
   const float inv = 1.0f / area;
@@ -48,7 +89,8 @@ inline void shadow_triangle(global const PmrShadowMap* m, global uint* depth, fl
             x1 = min(size - 1, (int)ceil(fmax(fmax(a.x, b.x), c.x) - 0.5f));
   const int y0 = max(0, (int)floor(fmin(fmin(a.y, b.y), c.y) - 0.5f)),
             y1 = min(size - 1, (int)ceil(fmax(fmax(a.y, b.y), c.y) - 0.5f));
-  global uint* map = depth + m->offset;
+  ShadowBatch B;
+  B.n = 0;
   for (int y = y0; y <= y1; ++y) {
     const float py = (float)y + 0.5f;
     for (int x = x0; x <= x1; ++x) {
@@ -59,30 +101,45 @@ inline void shadow_triangle(global const PmrShadowMap* m, global uint* depth, fl
       if (wa < 0.0f || wb < 0.0f || wc < 0.0f) continue;
       const float q = wa * a.z + wb * b.z + wc * c.z;
       const float z = fmax(m->perspective ? 1.0f / q : q, 0.0f);
-      atomic_min(map + (size_t)y * (size_t)size + (size_t)x, as_uint(z));
+      const uint texel = (uint)y * (uint)size + (uint)x;
+      if (opaque) {
+        atomic_min(depth + m->offset + texel, as_uint(z));
+        continue;
+      }
+      /* perspective-correct weights of the corners (1/z is linear in the map), then source barycentrics */
+      const float3 w = m->perspective ? (float3)(wa * a.z, wb * b.z, wc * c.z) / q : (float3)(wa, wb, wc);
+      const float3 sb = w.x * s[0] + w.y * s[1] + w.z * s[2];
+      B.texel[B.n] = texel, B.z[B.n] = z, B.b[0][B.n] = sb.x, B.b[1][B.n] = sb.y, B.b[2][B.n] = sb.z;
+      if (++B.n == SW) shadow_flush(in, m, tri, depth, &B);
     }
   }
+  shadow_flush(in, m, tri, depth, &B);
 }
 
-/* One work-item per triangle of the frame's posed scene (positions: world space, 3 floats a vertex),
- * into map `map`. Casters: every triangle but alphaMode BLEND and transmissive ones (they cast nothing
- * yet), MASK ones whole. */
-kernel void shadow_raster(global const float* positions, global const PmrTriangle* tris,
-                          global const PmrMaterial* materials, uint num_triangles,
-                          global const PmrShadowMap* maps, uint map, global uint* depth) {
+/* One work-item per triangle of the frame's posed scene (the shading inputs' positions: world space)
+ * into map `map` of the shading inputs' shadow maps, writing `depth` (the shadow_depth they read). */
+kernel void shadow_raster(PMR_SHADE_PARAMS, uint map, global uint* depth) {
+  const ShadeInputs inputs = PMR_SHADE_INPUTS;
+  const ShadeInputs* in = &inputs;
   const uint t = pmr_item_id();
-  if (t >= num_triangles) return;
+  if (t >= P->num_triangles) return;
   const PmrTriangle tri = tris[t];
   global const PmrMaterial* mat = &materials[tri.material];
-  if (mat->alpha_mode == PMR_ALPHA_BLEND || mat->transmission > 0.0f) return;
-  global const PmrShadowMap* m = &maps[map];
-  float3 c[3];
-  for (int k = 0; k < 3; ++k) c[k] = shadow_space(m, vload3(tri.v[k], positions));
-  float3 poly[4];
+  const bool opaque = mat->alpha_mode == PMR_ALPHA_OPAQUE && !(mat->transmission > 0.0f);
+  global const PmrShadowMap* m = &shadow_maps[map];
+  const float3 origin = vload3(0, m->origin);
+  ShadowCorner c[3], poly[4];
+  for (int k = 0; k < 3; ++k) {
+    const float3 d = vload3(tri.v[k], positions) - origin;
+    c[k].c = (float3)(dot(vload3(0, m->right), d), dot(vload3(0, m->up), d), dot(vload3(0, m->axis), d));
+    c[k].b = (float3)(k == 0, k == 1, k == 2);
+  }
   int n = 3;
   if (m->perspective) n = clip_near(c, m->near_z, poly);
   else poly[0] = c[0], poly[1] = c[1], poly[2] = c[2];
-  if (n < 3) return;
-  const float3 a = shadow_texel(m, poly[0]);
-  for (int k = 1; k + 1 < n; ++k) shadow_triangle(m, depth, a, shadow_texel(m, poly[k]), shadow_texel(m, poly[k + 1]));
+  for (int k = 1; k + 1 < n; ++k) {
+    const float3 texel[3] = {shadow_texel(m, poly[0].c), shadow_texel(m, poly[k].c), shadow_texel(m, poly[k + 1].c)};
+    const float3 source[3] = {poly[0].b, poly[k].b, poly[k + 1].b};
+    shadow_triangle(in, m, t, opaque, depth, texel, source);
+  }
 }

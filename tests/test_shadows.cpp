@@ -235,6 +235,48 @@ TEST(Shadows, PointLightMatchesRayCastingOnEveryCubeFace) {
   EXPECT_GT(expect_hard_shadow(s, s.lights[0], at), 6u * 200u);
 }
 
+// Casters by material (DESIGN 4d): a MASK quad alpha-tested (a checker of alpha 0 and 1), a BLEND quad
+// of alpha 0.5 and a glass quad of transmission 0.7 over a plane: the light through each is what
+// ray casting with the casters' opacities gives (0 or 1, 0.5, 0.7).
+TEST(Shadows, MaskBlendAndGlassCastWhatTheyBlock) {
+  Scene s = test::empty_scene(false);
+  add_quad(s, {-1.5f, -0.5f, 1.5f}, {1.5f, -0.5f, 1.5f}, {1.5f, -0.5f, -1.5f}, {-1.5f, -0.5f, -1.5f});
+  PmrMaterial mask = s.materials[0], blend = s.materials[0], glass = s.materials[0];
+  mask.alpha_mode = PMR_ALPHA_MASK, mask.alpha_cutoff = 0.5f;
+  blend.alpha_mode = PMR_ALPHA_BLEND, blend.base_color[3] = 0.5f;
+  glass.transmission = 0.7f;
+  s.materials.insert(s.materials.end(), {mask, blend, glass});
+  const int checker = test::add_texture16(s, [](int x, int y) { return glm::dvec4(1, 1, 1, ((x / 4 + y / 4) % 2) ? 1.0 : 0.0); });
+  test::base_colour_texture(s, 1, checker);
+  s.material_inputs[3].has_transmission = true, s.material_inputs[3].transmission = 0.7f;  // the factors drawn
+  const float x0[3] = {-1.2f, -0.3f, 0.5f};
+  for (uint32_t q = 0; q < 3; ++q) {
+    const float a = x0[q], b = a + 0.7f;
+    test::add_triangle(s, {a, 0.0f, 0.4f}, {b, 0.0f, 0.4f}, {b, 0.0f, -0.4f}, q + 1);
+    test::add_triangle(s, {a, 0.0f, 0.4f}, {b, 0.0f, -0.4f}, {a, 0.0f, -0.4f}, q + 1);
+  }
+  for (size_t v = 0; v < s.positions.size(); ++v)
+    test::texcoord(s, 0, v) = glm::vec2((s.positions[v].x + 1.2f) / 0.7f, (s.positions[v].z + 0.4f) / 0.8f);
+  s.lights = {sun({0.1, -1.0, 0.05})};
+  std::vector<Receiver> at;
+  for (double x = -1.45; x <= 1.45; x += 0.01)
+    for (double z = -0.6; z <= 0.6; z += 0.01) at.push_back({{x, -0.5, z}, {0, 1, 0}});
+  expect_hard_shadow(s, s.lights[0], at);
+  const ShadowMaps m = render_maps(s);
+  const std::vector<float> v = probe(m, s.lights[0], at);
+  const ref::PunctualLight exact = test::reference_light(s.lights[0]);
+  size_t half = 0, glassy = 0, holes = 0;
+  for (size_t i = 0; i < at.size(); ++i) {
+    const double e = ref::ray_visibility(s, at[i].p, exact);
+    if (std::abs(e - 0.5) < 1e-9 && std::abs(v[i] - 0.5) < 0.02) ++half;
+    if (std::abs(e - 0.7) < 1e-6 && std::abs(v[i] - 0.7) < 0.02) ++glassy;
+    if (e == 1.0 && at[i].p.x < -0.5 && at[i].p.x > -1.15 && std::abs(at[i].p.z) < 0.35 && v[i] > 0.98f) ++holes;
+  }
+  EXPECT_GT(half, 2000u) << "under the BLEND quad";
+  EXPECT_GT(glassy, 2000u) << "under the glass";
+  EXPECT_GT(holes, 1000u) << "through the MASK quad's holes";
+}
+
 // A convex receiver facing the light shadows nothing of itself.
 TEST(Shadows, NoAcneOnACurvedReceiverFacingTheLight) {
   Scene s = test::empty_scene(false);

@@ -241,7 +241,8 @@ StageTimes Pipeline::render_frame(const FrameDescription& frame, bool empty) {
   m.shadows.place(config_.shadows && config_.shading == Shading::Pbr, frame.lights, m.scene);
   m.scene.upload_frame(frame, m.shadows.slots());
   m.fine.begin_frame();
-  if (config_.shadows && config_.shading == Shading::Pbr) m.shadows.render(m.scene, ev, empty);
+  if (config_.shadows && config_.shading == Shading::Pbr)
+    m.shadows.render(m.scene, P, m.transmission.full_pass(), ev, empty);
   if (config_.method == Method::Multipass) {
     m.render_multipass(frame.rig, P, config_.multipass_snapped, ev, times);
   } else {

@@ -63,6 +63,7 @@ void SceneBuffers::set_scene(const Scene& scene) {
   const MaterialTables tables = make_material_tables(scene, mips_);
   has_tangents_ = scene.tangents.size() == scene.positions.size() && !scene.positions.empty();
   transmissive_ = pbr_ && scene_transmissive(scene);
+  translucent_casters_ = scene_transmissive(scene);
   blended_ = scene_blended(scene, pbr_);
   const std::vector<glm::vec4> no_tangents(1, glm::vec4(0.0f));
   scene_lights_ = scene.lights;

@@ -42,6 +42,8 @@ class SceneBuffers {
   bool transmissive() const { return transmissive_; }
   // a triangle with an alphaMode BLEND material (scene_blended): frames composite BLEND layers
   bool blended() const { return blended_; }
+  // a triangle with a transmissive material, whatever the shading: casts a partial shadow
+  bool translucent_casters() const { return translucent_casters_; }
   uint32_t num_triangles() const { return num_triangles_; }
   const ClBuffer& positions() const { return positions_; }
   const ClBuffer& triangles() const { return tris_; }
@@ -55,7 +57,7 @@ class SceneBuffers {
   const ClRuntime& rt_;
   bool mips_;  // --texture-filter trilinear: the textures' mip chains are built and uploaded
   bool pbr_;
-  bool transmissive_ = false, blended_ = false;
+  bool transmissive_ = false, blended_ = false, translucent_casters_ = false;
   uint32_t num_vertices_ = 0, num_triangles_ = 0;
   bool has_tangents_ = false;
   std::vector<SceneLight> scene_lights_;

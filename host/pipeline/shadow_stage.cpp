@@ -41,6 +41,7 @@ PmrShadowMap orthographic_map(const glm::dvec3& axis, const glm::dvec3& lo, cons
   PmrShadowMap m{};
   set3(m.origin, origin), set3(m.right, x / half), set3(m.up, y / half), set3(m.axis, axis);
   m.size = size, m.perspective = 0, m.texel = float(2.0 * half / size);
+  m.translucent = PMR_NO_TRANSLUCENT;
   return m;
 }
 
@@ -51,6 +52,7 @@ PmrShadowMap perspective_map(const glm::dvec3& origin, const glm::dvec3& axis, c
   PmrShadowMap m{};
   set3(m.origin, origin), set3(m.right, x / t), set3(m.up, y / t), set3(m.axis, axis);
   m.size = size, m.perspective = 1, m.texel = float(2.0 * t / size), m.near_z = float(near_z);
+  m.translucent = PMR_NO_TRANSLUCENT;
   return m;
 }
 
@@ -90,10 +92,10 @@ uint64_t texels_needed(const std::vector<SceneLight>& lights, const ShadowSizes&
 }  // namespace
 
 std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& lights, const glm::dvec3& lo,
-                                            const glm::dvec3& hi, const ShadowSizes& wanted,
+                                            const glm::dvec3& hi, const ShadowSizes& wanted, bool translucent,
                                             std::vector<ShadowSlot>& slots) {
   ShadowSizes sizes = wanted;
-  while (texels_needed(lights, sizes) > kShadowTexelBudget &&
+  while (texels_needed(lights, sizes) * (translucent ? 3 : 1) > kShadowTexelBudget &&
          std::max(sizes.directional, sizes.local) > kMinShadowSize) {
     sizes.directional = std::max(kMinShadowSize, sizes.directional / 2);
     sizes.local = std::max(kMinShadowSize, sizes.local / 2);
@@ -112,12 +114,23 @@ std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& light
     m.offset = uint32_t(offset);
     offset += uint64_t(m.size) * uint64_t(m.size);
   }
+  if (translucent) add_translucent_layers(maps);
   return maps;
+}
+
+void add_translucent_layers(std::vector<PmrShadowMap>& maps) {
+  uint64_t offset = 0;
+  for (const PmrShadowMap& m : maps) offset += uint64_t(m.size) * uint64_t(m.size);
+  for (PmrShadowMap& m : maps) {
+    m.translucent = uint32_t(offset);
+    offset += 2 * uint64_t(m.size) * uint64_t(m.size);
+  }
 }
 
 uint64_t shadow_texels(const std::vector<PmrShadowMap>& maps) {
   uint64_t n = 0;
-  for (const PmrShadowMap& m : maps) n += uint64_t(m.size) * uint64_t(m.size);
+  for (const PmrShadowMap& m : maps)
+    n += uint64_t(m.size) * uint64_t(m.size) * (m.translucent == PMR_NO_TRANSLUCENT ? 1 : 3);
   return n;
 }
 
@@ -134,6 +147,7 @@ ShadowStage::ShadowStage(Launcher& launcher, const ClProgram& program, const Sha
       clear_(program, "shadow_clear"),
       raster_(program, "shadow_raster") {
   maps_buffer_ = rt_.buffer(sizeof(PmrShadowMap), "shadow maps");
+  params_ = rt_.buffer(sizeof(PmrParams), "shadow pass parameters", CL_MEM_READ_ONLY);
   depth_ = rt_.buffer(16, "shadow depths");
 }
 
@@ -141,7 +155,8 @@ void ShadowStage::place(bool on, const std::vector<SceneLight>& lights, const Sc
   maps_.clear();
   slots_.assign(lights.size(), ShadowSlot{});
   if (!on || scene.num_triangles() == 0) return;
-  maps_ = place_shadow_maps(lights, scene.bounds_lo(), scene.bounds_hi(), sizes_, slots_);
+  maps_ = place_shadow_maps(lights, scene.bounds_lo(), scene.bounds_hi(), sizes_,
+                            scene.blended() || scene.translucent_casters(), slots_);
   const uint64_t texels = shadow_texels(maps_);
   if (texels >= (uint64_t(1) << 32)) throw Error("the lights' shadow maps need more than 2^32 texels");
   if (depth_.size() < texels * 4) {
@@ -151,11 +166,14 @@ void ShadowStage::place(bool on, const std::vector<SceneLight>& lights, const Sc
   rt_.rewrite(maps_buffer_, maps_, "shadow maps");
 }
 
-void ShadowStage::render(const SceneBuffers& scene, FrameEvents& ev, bool warm) {
+void ShadowStage::render(const SceneBuffers& scene, const PmrParams& P, const SourceBinding& source,
+                         FrameEvents& ev, bool warm) {
+  rt_.write(params_, &P, sizeof P);
+  const cl_uint next = scene.bind_shading(raster_, params_, binding(), source);
   if (warm) {  // one launch of each kernel, so that frames compile nothing
-    clear_.args(depth_, cl_uint(0), cl_uint(0));
+    clear_.args(depth_, cl_uint(0), cl_uint(0), cl_uint(0));
     ev.add(kShadow, launcher_.launch(clear_, 1, 64));
-    raster_.args(scene.positions(), scene.triangles(), scene.materials(), cl_uint(0), maps_buffer_, cl_uint(0), depth_);
+    raster_.args_from(next, cl_uint(0), depth_);
     ev.add(kShadow, launcher_.launch(raster_, 1, 64));
     return;
   }
@@ -164,11 +182,15 @@ void ShadowStage::render(const SceneBuffers& scene, FrameEvents& ev, bool warm) 
   if (same) return;
   rendered_ = maps_, rendered_generation_ = scene.geometry_generation();
   for (size_t k = 0; k < maps_.size(); ++k) {
-    const uint32_t texels = uint32_t(maps_[k].size) * uint32_t(maps_[k].size);
-    clear_.args(depth_, cl_uint(maps_[k].offset), cl_uint(texels));
+    const PmrShadowMap& m = maps_[k];
+    const uint32_t texels = uint32_t(m.size) * uint32_t(m.size);
+    clear_.args(depth_, cl_uint(m.offset), cl_uint(texels), cl_uint(0));
     ev.add(kShadow, launcher_.launch(clear_, texels, 64));
-    raster_.args(scene.positions(), scene.triangles(), scene.materials(), cl_uint(scene.num_triangles()),
-                 maps_buffer_, cl_uint(k), depth_);
+    if (m.translucent != PMR_NO_TRANSLUCENT) {
+      clear_.args(depth_, cl_uint(m.translucent), cl_uint(texels), cl_uint(1));
+      ev.add(kShadow, launcher_.launch(clear_, texels, 64));
+    }
+    raster_.args_from(next, cl_uint(k), depth_);
     ev.add(kShadow, launcher_.launch(raster_, scene.num_triangles(), 64));
   }
 }

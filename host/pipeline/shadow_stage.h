@@ -10,6 +10,7 @@
 
 #include "pipeline/launcher.h"
 #include "pipeline/shadow_sizes.h"
+#include "pipeline/transmission_stage.h"
 #include "pmr/scene.h"
 #include "pmr/shared.h"
 #include "runtime/cl_runtime.h"
@@ -35,10 +36,13 @@ struct ShadowSlot {
 // cube and a spot light's map look from its position, their near plane 1e-4 of the farthest corner's
 // distance. slots[i]: light i's maps (none after the first kMaxShadowedLights). Sizes are halved
 // until all fit kShadowTexelBudget (not below kMinShadowSize). Depth offsets are packed in order.
+// `translucent`: every map gets a translucent layer (add_translucent_layers), counted in the budget.
 std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& lights, const glm::dvec3& lo,
-                                            const glm::dvec3& hi, const ShadowSizes& sizes,
+                                            const glm::dvec3& hi, const ShadowSizes& sizes, bool translucent,
                                             std::vector<ShadowSlot>& slots);
-// Texels of all of `maps`.
+// Gives every map a translucent layer (two values a texel) after the depths of all maps.
+void add_translucent_layers(std::vector<PmrShadowMap>& maps);
+// Values (4 bytes each) of all of `maps`: depths, and the translucent layers' pairs.
 uint64_t shadow_texels(const std::vector<PmrShadowMap>& maps);
 
 class ShadowStage {
@@ -46,12 +50,15 @@ class ShadowStage {
   // `program`: the main program (shadow.cl).
   ShadowStage(Launcher& launcher, const ClProgram& program, const ShadowSizes& sizes);
   // Places the maps of the frame's lights over the scene's posed box (none when `on` is false or the
-  // scene is empty): slots() then says which light has which maps.
+  // scene is empty), with translucent layers when the scene has BLEND or transmissive materials:
+  // slots() then says which light has which maps.
   void place(bool on, const std::vector<SceneLight>& lights, const SceneBuffers& scene);
-  // Renders the placed maps from the scene's posed triangles, unless the maps and the triangles are
-  // those of the last frame rendered (a still scene renders its maps once). `warm`: the warm-up
-  // frame, which launches each kernel once whatever was placed.
-  void render(const SceneBuffers& scene, FrameEvents& ev, bool warm);
+  // Renders the placed maps from the scene's posed triangles (the shading kernels' inputs: frame
+  // parameters P, any pass's transmission source), unless the maps and the triangles are those of the
+  // last frame rendered (a still scene renders its maps once). `warm`: the warm-up frame, which
+  // launches each kernel once whatever was placed.
+  void render(const SceneBuffers& scene, const PmrParams& P, const SourceBinding& source, FrameEvents& ev,
+              bool warm);
   const std::vector<ShadowSlot>& slots() const { return slots_; }
   const std::vector<PmrShadowMap>& maps() const { return maps_; }
   // The placed maps' depths as floats (after the frame).
@@ -69,7 +76,7 @@ class ShadowStage {
   // what the depths hold: the maps and the geometry generation they were rendered from
   std::vector<PmrShadowMap> rendered_;
   uint64_t rendered_generation_ = 0;
-  ClBuffer maps_buffer_, depth_;
+  ClBuffer maps_buffer_, depth_, params_;
 };
 
 }  // namespace pmr

@@ -352,9 +352,14 @@ typedef struct {
   pmr_u32 perspective;
   float axis[3];
   float texel;
-  float near_z; /* perspective: casters nearer than this are clipped */
-  pmr_u32 pad0, pad1, pad2;
+  float near_z;        /* perspective: casters nearer than this are clipped */
+  pmr_u32 translucent; /* PMR_NO_TRANSLUCENT, or where its translucent casters' pairs start in the depth
+                          buffer: per texel the nearest one's depth and the sum of -ln(1 - opacity) of
+                          all, in units of 1 / PMR_SHADOW_OPTICAL_ONE */
+  pmr_u32 pad1, pad2;
 } PmrShadowMap;
+#define PMR_NO_TRANSLUCENT 0xffffffffu
+#define PMR_SHADOW_OPTICAL_ONE 4096.0f /* -ln(1 - a) per caster at most 40: 26,000 layers fit 32 bits */
 
 /* Encoder parameters (DESIGN section 5): sizes and flags. The subpixel-to-view map itself is in the
  * tables below, computed exactly by the host (host/rig/display.cpp). */

@@ -9,13 +9,18 @@
 
 namespace pmr::ref {
 
-// Whether the segment from p toward the light reaches it past every caster of `scene` (its triangles as
-// given, world space): 1 or 0. Casters: every triangle but alphaMode BLEND and transmissive ones. The
-// segment starts `start` along its direction from p (above the receiver's own surface); a directional
-// light's is unbounded, a point or spot light's ends at the light.
+// The fraction of the light that travels from p to the light past the casters of `scene` (its
+// triangles as given, world space): the product over every caster the segment crosses of 1 - its
+// opacity (caster_opacity). The segment starts `start` along its direction from p (above the
+// receiver's own surface); a directional light's is unbounded, a point or spot light's ends at it.
 double ray_visibility(const Scene& scene, const glm::dvec3& p, const PunctualLight& light, double start = 1e-7);
 
-// The nearest intersection of the ray o + t d (t > t_min) with a caster, t; infinity where none.
-double nearest_caster(const Scene& scene, const glm::dvec3& o, const glm::dvec3& d, double t_min);
+// How much of the light triangle `tri` blocks at barycentrics b (DESIGN section 4d): a transmissive
+// material 1 - transmissionFactor, alphaMode MASK 1 or 0 by the cutoff, BLEND its base colour alpha
+// (tests/reference/shade_reference.h, base_color), others 1.
+double caster_opacity(const Scene& scene, uint32_t tri, const glm::dvec3& b);
+
+// The product of 1 - opacity over the casters the ray o + t d crosses at t_min < t < t_max.
+double transmittance(const Scene& scene, const glm::dvec3& o, const glm::dvec3& d, double t_min, double t_max);
 
 }  // namespace pmr::ref

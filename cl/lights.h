@@ -63,18 +63,10 @@ inline float shadow_tap(global const PmrShadowMap* m, global const uint* depth, 
   return ref > as_float(pair[0]) ? exp(-(float)pair[1] * (1.0f / PMR_SHADOW_OPTICAL_ONE)) : 1.0f;
 }
 
-/* The visibility of light `light` at world point p of face normal ng (unit, either side): its shadow
- * map's depth comparisons at the 4 texels around p, bilinearly weighted (filtered over one texel, the
- * same in every view). A cube (6 maps) reads the face of p's major axis from the light. 1: unshadowed. */
-inline float shadow_visibility(global const PmrShadowMap* maps, global const uint* depth, global const PmrLight* light,
-                               float3 p, float3 ng) {
-  int k = light->shadow;
-  if (light->shadow_maps == 6) {
-    const float3 d = p - vload3(0, light->position), a = fabs(d);
-    const int axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
-    k += 2 * axis + ((axis == 0 ? d.x : axis == 1 ? d.y : d.z) < 0.0f ? 1 : 0);
-  }
-  global const PmrShadowMap* m = &maps[k];
+/* The visibility from map m at world point p of face normal ng (unit, either side): the depth
+ * comparisons (shadow_tap) at the 4 texels around p, bilinearly weighted (filtered over one texel, the
+ * same in every view). */
+inline float shadow_map_visibility(global const PmrShadowMap* m, global const uint* depth, float3 p, float3 ng) {
   const float3 origin = vload3(0, m->origin), axis = vload3(0, m->axis);
   const float z_p = dot(p - origin, axis);
   if (m->perspective && z_p <= m->near_z) return 1.0f;
@@ -95,6 +87,25 @@ inline float shadow_visibility(global const PmrShadowMap* maps, global const uin
   const float top = mix(shadow_tap(m, depth, x0, y0, ref), shadow_tap(m, depth, x0 + 1, y0, ref), fx);
   const float bottom = mix(shadow_tap(m, depth, x0, y0 + 1, ref), shadow_tap(m, depth, x0 + 1, y0 + 1, ref), fx);
   return mix(top, bottom, fy);
+}
+
+/* The visibility of light `light` at world point p of face normal ng: the mean over the light's
+ * samples (1 for a point-like light; points or directions of its size) of their maps' visibility, a
+ * cube's read at the face of p's major axis from the sample's point. 1: unshadowed. */
+inline float shadow_visibility(global const PmrShadowMap* maps, global const uint* depth, global const PmrLight* light,
+                               float3 p, float3 ng) {
+  const int samples = light->shadow_samples, faces = light->shadow_maps / samples;
+  float sum = 0.0f;
+  for (int s = 0; s < samples; ++s) {
+    int k = light->shadow + s * faces;
+    if (faces == 6) {
+      const float3 d = p - vload3(0, maps[k].origin), a = fabs(d);
+      const int axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+      k += 2 * axis + ((axis == 0 ? d.x : axis == 1 ? d.y : d.z) < 0.0f ? 1 : 0);
+    }
+    sum += shadow_map_visibility(&maps[k], depth, p, ng);
+  }
+  return samples == 1 ? sum : sum * (1.0f / (float)samples);
 }
 
 /* shadow_visibility of the lanes `act` (1 elsewhere) at their points p, face normals ng. */

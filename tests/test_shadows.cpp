@@ -5,7 +5,9 @@
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 
+#include "gltf_builder.h"
 #include "pbr_support.h"
 #include "pipeline/shadow_stage.h"
 #include "reference/shade_reference.h"
@@ -108,7 +110,8 @@ std::vector<float> probe(const ShadowMaps& m, const SceneLight& light, const std
   const ClRuntime& rt = test::runtime();
   const ClProgram program = rt.build_program({"shadow_probe.cl"}, "-cl-std=CL1.2", &test_kernel_sources());
   PmrLight d = device_light(light);
-  d.shadow = 0, d.shadow_maps = int(m.maps.size());
+  const bool sized = light.type == SceneLightType::Directional ? light.angle > 0.0f : light.radius > 0.0f;
+  d.shadow = 0, d.shadow_maps = int(m.maps.size()), d.shadow_samples = sized ? kShadowSamples : 1;
   std::vector<float> in;
   for (const Receiver& r : at)
     for (const glm::dvec3& v : {r.p, r.n}) in.insert(in.end(), {float(v.x), float(v.y), float(v.z)});
@@ -277,6 +280,72 @@ TEST(Shadows, MaskBlendAndGlassCastWhatTheyBlock) {
   EXPECT_GT(holes, 1000u) << "through the MASK quad's holes";
 }
 
+// The exact visibility of a light with a size at p: the unoccluded fraction of n x n stratified points
+// on the disk it shows to p (a sphere light: its great disk facing p; a sun of apparent diameter
+// `angle`: directions within the cone), ray-cast.
+double exact_soft_visibility(const Scene& s, const SceneLight& light, const glm::dvec3& p, int n) {
+  const bool sun = light.type == SceneLightType::Directional;
+  const glm::dvec3 axis = sun ? -light.direction : glm::normalize(light.position - p);
+  const glm::dvec3 x = glm::normalize(glm::cross(axis, std::abs(axis.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
+  const glm::dvec3 y = glm::cross(axis, x);
+  const double r = sun ? std::tan(0.5 * light.angle) : double(light.radius);
+  auto lit = [&](double u, double v) {
+    const glm::dvec3 d = r * (u * x + v * y);
+    return sun ? ref::transmittance(s, p, glm::normalize(axis + d), 1e-7, 1e300) > 0.5
+               : ref::transmittance(s, p, glm::normalize(light.position + d - p), 1e-7,
+                                    glm::length(light.position + d - p)) > 0.5;
+  };
+  // the center and the rim agreeing: fully lit or fully shadowed (the occluders here are large)
+  const bool center = lit(0.0, 0.0);
+  bool same = true;
+  for (int k = 0; k < 8 && same; ++k) same = lit(std::cos(k * M_PI / 4), std::sin(k * M_PI / 4)) == center;
+  if (same) return center ? 1.0 : 0.0;
+  size_t on = 0, all = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double u = 2.0 * (i + 0.5) / n - 1.0, v = 2.0 * (j + 0.5) / n - 1.0;
+      if (u * u + v * v > 1.0) continue;
+      ++all, on += lit(u, v);
+    }
+  return double(on) / double(all);
+}
+
+// A ball resting on a plane and two overlapping occluders at two heights above it (where estimating
+// one blocker depth per receiver fails), lit by a sphere light and by a sun with an apparent size:
+// over the receivers in a penumbra (0 < V_exact < 1) the mean |V - V_exact| is at most 0.03, and the
+// penumbra widens away from the caster (a contact region stays dark).
+TEST(Shadows, SoftShadowsMatchTheExactFraction) {
+  Scene base = test::empty_scene(false);
+  add_quad(base, {-1.5f, -0.5f, 1.5f}, {1.5f, -0.5f, 1.5f}, {1.5f, -0.5f, -1.5f}, {-1.5f, -0.5f, -1.5f});
+  add_sphere(base, {-0.5f, -0.2f, 0.3f}, 0.3f, 12);
+  add_quad(base, {0.1f, 0.4f, 0.4f}, {0.9f, 0.4f, 0.4f}, {0.9f, 0.4f, -0.2f}, {0.1f, 0.4f, -0.2f});
+  add_quad(base, {0.4f, -0.1f, 0.1f}, {1.1f, -0.1f, 0.1f}, {1.1f, -0.1f, -0.6f}, {0.4f, -0.1f, -0.6f});
+  SceneLight sphere = test::make_light(SceneLightType::Point, {0.1, 1.6, 0.1}, {0, -1, 0}, 30.0f, 0.0f);
+  sphere.radius = 0.25f;
+  SceneLight wide_sun = sun({0.1, -1.0, 0.05});
+  wide_sun.angle = 0.12f;
+  for (const SceneLight& light : {sphere, wide_sun}) {
+    SCOPED_TRACE(light.type == SceneLightType::Directional ? "sun" : "sphere");
+    Scene s = base;
+    s.lights = {light};
+    const ShadowMaps m = render_maps(s);
+    std::vector<Receiver> at;
+    std::vector<double> exact;
+    for (double x = -1.2; x <= 1.4; x += 0.025)
+      for (double z = -1.0; z <= 1.0; z += 0.025) {
+        const double e = exact_soft_visibility(s, light, {x, -0.5, z}, 20);
+        if (e > 0.0 && e < 1.0) at.push_back({{x, -0.5, z}, {0, 1, 0}}), exact.push_back(e);
+      }
+    const std::vector<float> v = probe(m, light, at);
+    double sum = 0.0;
+    for (size_t i = 0; i < at.size(); ++i) sum += std::abs(v[i] - exact[i]);
+    const double mean = sum / double(at.size());
+    EXPECT_LE(mean, 0.03);
+    EXPECT_GT(at.size(), 300u);
+    std::printf("[ shadows  ] %zu penumbra receivers, mean |V error| %.4f\n", at.size(), mean);
+  }
+}
+
 // A convex receiver facing the light shadows nothing of itself.
 TEST(Shadows, NoAcneOnACurvedReceiverFacingTheLight) {
   Scene s = test::empty_scene(false);
@@ -432,6 +501,39 @@ TEST(Shadows, MapsAreRenderedAgainOnlyWhenSomethingMoved) {
   for (glm::vec3& q : posed.positions) q.x += 0.1f;
   p.update_geometry(posed);
   EXPECT_GT(frame(s.lights, moved), 0.0) << "the triangles moved";
+}
+
+// A light's size comes from its extras (Blender's light radius and sun angle): pmr info names it, the
+// sidecar records it, and a value out of range is one error line.
+TEST(Shadows, LightSizesAreReadFromTheLightsExtras) {
+  using namespace test::gltf_builder_detail;
+  const std::string dir = test::temp_dir("light_sizes");
+  std::filesystem::create_directories(dir);
+  auto file = [&](const nlohmann::json& radius, const std::string& name) {
+    GltfFile g;
+    const int p = g.data<float>({-1, -1, 0, 1, -1, 0, 0, 1, 0}, kFloat, "VEC3");
+    g.mesh(nlohmann::json::array({{{"attributes", {{"POSITION", p}}}}}));
+    std::vector<int> roots = {g.add("nodes", {{"mesh", 0}})};
+    for (int i = 0; i < 2; ++i)
+      roots.push_back(g.add("nodes", {{"translation", {0, 0, 2}}, {"extensions", {{"KHR_lights_punctual", {{"light", i}}}}}}));
+    g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {
+        {{"type", "point"}, {"intensity", 5.0}, {"extras", {{"pmr_radius", radius}}}},
+        {{"type", "directional"}, {"extras", {{"pmr_angle", 0.02}}}}};
+    g.scene(roots);
+    return g.write(dir, name);
+  };
+  const test::CliRun info = test::run("info " + file(0.1, "sized"));
+  EXPECT_NE(info.output.find("radius 0.1 m (soft shadows)"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("angle 1.14592 deg (soft shadows)"), std::string::npos) << info.output;
+  const std::string out = dir + "/out";
+  ASSERT_EQ(test::run("render " + file(0.1, "sized") + " -q --views 2 --view-size 32x16 --display 64x36 --out " + out).status, 0);
+  const std::string sidecar = test::read_file(out + "/frame_0000.json");
+  EXPECT_NE(sidecar.find("\"radius\": 0.1"), std::string::npos);
+  EXPECT_NE(sidecar.find("\"angle\": 0.0199999"), std::string::npos) << sidecar;  // 0.02 in single precision
+  test::expect_one_error_line(test::run("info " + file(-1.0, "negative")), "extras.pmr_radius must be a number");
+  test::expect_one_error_line(test::run("info " + file("big", "text")), "extras.pmr_radius must be a number");
+  std::filesystem::remove_all(dir);
 }
 
 // The sidecar records the shadows when they are on (their map sizes), and nothing when off, so that a

@@ -130,6 +130,8 @@ void describe_lights(const Scene& s) {
       line += ", at (" + number(l.position.x) + ", " + number(l.position.y) + ", " + number(l.position.z) + ")";
     if (l.type != SceneLightType::Point)
       line += ", toward (" + number(l.direction.x) + ", " + number(l.direction.y) + ", " + number(l.direction.z) + ")";
+    if (l.radius > 0.0f) line += ", radius " + number(l.radius) + " m (soft shadows)";
+    if (l.angle > 0.0f) line += ", angle " + number(l.angle * 180.0 / 3.14159265358979323846) + " deg (soft shadows)";
     std::printf("%s\n", line.c_str());
   }
 }

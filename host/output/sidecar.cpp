@@ -91,6 +91,8 @@ json light_json(const SceneLight& l) {
   if (l.type != SceneLightType::Directional) j["range"] = l.range > 0.0f ? json(double(l.range)) : json();
   if (l.type == SceneLightType::Spot)
     j["inner_cone_angle"] = double(l.inner_cone), j["outer_cone_angle"] = double(l.outer_cone);
+  if (l.radius > 0.0f) j["radius"] = double(l.radius);  // absent: point-like, as every older sidecar
+  if (l.angle > 0.0f) j["angle"] = double(l.angle);
   return j;
 }
 
@@ -140,7 +142,9 @@ json shading_json(const SidecarInfo& info) {
     s["environment"]["file_hex"] = to_hex(info.environment.file);
   s["lights"] = lights_json(info.lights);
   if (info.render.shadows)  // absent: off, as every sidecar before shadows
-    s["shadows"] = {{"map_size", info.render.shadow_sizes.directional}, {"local_map_size", info.render.shadow_sizes.local}};
+    s["shadows"] = {{"map_size", info.render.shadow_sizes.directional},
+                    {"local_map_size", info.render.shadow_sizes.local},
+                    {"light_samples", kShadowSamples}};
   if (info.lights.size() > kSidecarLights) {
     s["lights_total"] = info.lights.size();
     s["lights_digest"] = lights_digest(info.lights);

@@ -102,7 +102,8 @@ void SceneBuffers::upload_frame(const FrameDescription& frame, const std::vector
   std::vector<PmrLight> table;
   for (size_t i = 0; i < frame.lights.size(); ++i) {
     PmrLight d = device_light(frame.lights[i]);
-    if (i < slots.size() && slots[i].count > 0) d.shadow = slots[i].first, d.shadow_maps = slots[i].count;
+    if (i < slots.size() && slots[i].count > 0)
+      d.shadow = slots[i].first, d.shadow_maps = slots[i].count, d.shadow_samples = slots[i].samples;
     table.push_back(d);
   }
   table.resize(std::max<size_t>(table.size(), 1));  // no empty buffers

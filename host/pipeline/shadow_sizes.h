@@ -18,5 +18,11 @@ constexpr double kSpotSingleMapAngle = 0.8726646259971648;  // 50 degrees
 constexpr unsigned long long kShadowTexelBudget = 1ull << 26;
 constexpr int kMinShadowSize = 256;
 constexpr int kMaxShadowedLights = 64;
+// A light with a size is sampled at this many points (or directions) of it, each with its maps (at a
+// quarter of the sizes above, not below kMinShadowSize / 2): its shadow is the mean of their hard
+// shadows. Measured on a sphere light and a wide sun over occluders at two heights
+// (Shadows.SoftShadowsMatchTheExactFraction), mean |V error| over the penumbra: 16 samples at half
+// size 0.031 and 0.030, 32 at half size 0.022 and 0.021, 32 at a quarter 0.024 and 0.025.
+constexpr int kShadowSamples = 32;
 
 }  // namespace pmr

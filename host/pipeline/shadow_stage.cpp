@@ -56,35 +56,80 @@ PmrShadowMap perspective_map(const glm::dvec3& origin, const glm::dvec3& axis, c
   return m;
 }
 
-// The maps of a point or spot light at `position` (spot: along `direction`, outer cone angle `outer`).
-void local_maps(const SceneLight& l, const glm::dvec3& lo, const glm::dvec3& hi, int size,
+// The maps of a point or spot light seen from `origin` (spot: along `direction`, outer cone angle
+// `outer`): one perspective map over a cone of at most kSpotSingleMapAngle, else a cube.
+void local_maps(const SceneLight& l, const glm::dvec3& origin, const glm::dvec3& lo, const glm::dvec3& hi, int size,
                 std::vector<PmrShadowMap>& maps) {
   double far = 0.0;
-  for (const glm::dvec3& c : corners(lo, hi)) far = std::max(far, glm::length(c - l.position));
+  for (const glm::dvec3& c : corners(lo, hi)) far = std::max(far, glm::length(c - origin));
   const double near_z = std::max(far, 1e-6) * 1e-4;
   if (l.type == SceneLightType::Spot && l.outer_cone <= kSpotSingleMapAngle) {
     glm::dvec3 x, y;
     frame_about(l.direction, x, y);
     // two texels' margin beyond the cone, for the filter's taps at its edge
     const double t = std::tan(double(l.outer_cone)) * (1.0 + 4.0 / size);
-    maps.push_back(perspective_map(l.position, l.direction, x, t, near_z, size));
+    maps.push_back(perspective_map(origin, l.direction, x, t, near_z, size));
     return;
   }
   // a cube: +X, -X, +Y, -Y, +Z, -Z (cl/lights.h picks the face of the major axis)
   const glm::dvec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   const glm::dvec3 rights[6] = {{0, 0, -1}, {0, 0, 1}, {1, 0, 0}, {1, 0, 0}, {1, 0, 0}, {-1, 0, 0}};
-  for (int f = 0; f < 6; ++f) maps.push_back(perspective_map(l.position, axes[f], rights[f], 1.0 + 4.0 / size, near_z, size));
+  for (int f = 0; f < 6; ++f) maps.push_back(perspective_map(origin, axes[f], rights[f], 1.0 + 4.0 / size, near_z, size));
+}
+
+// Sample i of k on the unit disk, uniform in area (Vogel's spiral: radius sqrt((i + 1/2) / k), turned
+// by the golden angle).
+glm::dvec2 disk_sample(int i, int k) {
+  const double r = std::sqrt((i + 0.5) / k), a = i * 2.399963229728653;
+  return {r * std::cos(a), r * std::sin(a)};
+}
+
+// Sample i of k in the unit ball with density proportional to 1 / sqrt(1 - r^2): its projection onto
+// any plane is uniform on the unit disk (the integral of the density along every chord at distance
+// rho from the center is pi), so from every receiver the samples spread uniformly over the disk a
+// sphere light shows. r = sin(phi), phi of density sin^2 phi on [0, pi/2] (by bisection of its
+// distribution (phi - sin phi cos phi) / (pi / 2)); directions on a Fibonacci sphere, radii in another
+// order (the golden ratio's), so the two are not correlated.
+glm::dvec3 ball_sample(int i, int k) {
+  const double u = std::fmod((i + 0.5) * 0.6180339887498949, 1.0);
+  double lo = 0.0, hi = 1.5707963267948966;
+  for (int it = 0; it < 60; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    ((mid - std::sin(mid) * std::cos(mid)) / 1.5707963267948966 < u ? lo : hi) = mid;
+  }
+  const double z = 1.0 - (2.0 * i + 1.0) / k, ring = std::sqrt(std::max(0.0, 1.0 - z * z)), a = i * 2.399963229728653;
+  return std::sin(0.5 * (lo + hi)) * glm::dvec3(ring * std::cos(a), ring * std::sin(a), z);
+}
+
+// The maps of light l: one per sample of its size (kShadowSamples for a light with a size, at a quarter of
+// the point-like sizes), each a directional light's map along a direction of its apparent disk, or a
+// point or spot light's from a point of its sphere.
+void light_maps(const SceneLight& l, const glm::dvec3& lo, const glm::dvec3& hi, const ShadowSizes& sizes,
+                std::vector<PmrShadowMap>& maps) {
+  const bool directional = l.type == SceneLightType::Directional;
+  const bool sized = directional ? l.angle > 0.0f : l.radius > 0.0f;
+  const int samples = sized ? kShadowSamples : 1;
+  const int size = std::max(kMinShadowSize / 2, (directional ? sizes.directional : sizes.local) / (sized ? 4 : 1));
+  glm::dvec3 x, y;
+  frame_about(l.direction, x, y);
+  for (int i = 0; i < samples; ++i) {
+    if (directional) {
+      const glm::dvec2 d = sized ? disk_sample(i, samples) * std::tan(0.5 * double(l.angle)) : glm::dvec2(0.0);
+      maps.push_back(orthographic_map(glm::normalize(l.direction + d.x * x + d.y * y), lo, hi, size));
+    } else {
+      local_maps(l, l.position + (sized ? double(l.radius) * ball_sample(i, samples) : glm::dvec3(0.0)), lo, hi, size,
+                 maps);
+    }
+  }
 }
 
 // The texels of the maps of `lights` (the first kMaxShadowedLights) at `sizes`.
 uint64_t texels_needed(const std::vector<SceneLight>& lights, const ShadowSizes& sizes) {
   uint64_t n = 0;
   for (size_t i = 0; i < lights.size() && i < size_t(kMaxShadowedLights); ++i) {
-    const SceneLight& l = lights[i];
-    const uint64_t d = uint64_t(sizes.directional), f = uint64_t(sizes.local);
-    n += l.type == SceneLightType::Directional                                     ? d * d
-         : l.type == SceneLightType::Spot && l.outer_cone <= kSpotSingleMapAngle ? f * f
-                                                                                   : 6 * f * f;
+    std::vector<PmrShadowMap> maps;
+    light_maps(lights[i], glm::dvec3(-1.0), glm::dvec3(1.0), sizes, maps);
+    n += shadow_texels(maps);
   }
   return n;
 }
@@ -105,9 +150,9 @@ std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& light
   for (size_t i = 0; i < lights.size() && i < size_t(kMaxShadowedLights); ++i) {
     const SceneLight& l = lights[i];
     slots[i].first = int(maps.size());
-    if (l.type == SceneLightType::Directional) maps.push_back(orthographic_map(l.direction, lo, hi, sizes.directional));
-    else local_maps(l, lo, hi, sizes.local, maps);
+    light_maps(l, lo, hi, sizes, maps);
     slots[i].count = int(maps.size()) - slots[i].first;
+    slots[i].samples = (l.type == SceneLightType::Directional ? l.angle > 0.0f : l.radius > 0.0f) ? kShadowSamples : 1;
   }
   uint64_t offset = 0;
   for (PmrShadowMap& m : maps) {

@@ -29,6 +29,7 @@ struct ShadowBinding {
 struct ShadowSlot {
   int first = -1;
   int count = 0;
+  int samples = 1;  // groups of count / samples maps, one per sample of a light's size
 };
 
 // The maps of `lights` (world space, posed) over the world box [lo, hi] of every caster and receiver:

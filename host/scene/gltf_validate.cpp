@@ -149,6 +149,22 @@ void check_extensions(const std::string& path, const json& doc, SourceFile& src)
   }
 }
 
+// A light's size from its extras (DESIGN section 4d): pmr_radius (metres, point and spot lights, at
+// most 1e6) and pmr_angle (radians, directional lights, below pi / 2); absent: point-like.
+void read_light_size(const std::string& path, const std::string& where, const json& light, SceneLight& out) {
+  const json* extras = member(light, "extras");
+  if (!extras || !extras->is_object()) return;
+  const bool directional = out.type == SceneLightType::Directional;
+  const char* key = directional ? "pmr_angle" : "pmr_radius";
+  const json* v = member(*extras, key);
+  if (!v) return;
+  const double limit = directional ? 1.5707963267948966 : 1e6;
+  if (!v->is_number() || !(v->get<double>() >= 0.0 && v->get<double>() < limit))
+    fail(path, where + " extras." + key + " must be a number from 0 to " + (directional ? "pi/2" : "1e6") + " (is " +
+                   one_line(v->dump(), true) + ")");
+  (directional ? out.angle : out.radius) = float(v->get<double>());
+}
+
 // KHR_lights_punctual on the raw JSON: tinygltf reads an absent range as 0 and coerces odd values, so
 // the checks that matter for lighting (DESIGN 4b) are made here, each a one-line error.
 void read_lights(const std::string& path, const json& doc, SourceFile& src) {
@@ -218,6 +234,7 @@ void read_lights(const std::string& path, const json& doc, SourceFile& src) {
                          std::to_string(inner) + ", outer " + std::to_string(outer) + ")");
         out.inner_cone = float(inner), out.outer_cone = float(outer);
       }
+      read_light_size(path, where, l, out);
       src.lights.push_back(out);
     }
   }

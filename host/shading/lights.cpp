@@ -42,6 +42,7 @@ PmrLight device_light(const SceneLight& light) {
   d.cos_inner = float(std::cos(double(light.inner_cone)));
   d.cos_outer = float(std::cos(double(light.outer_cone)));
   d.shadow = -1;  // unshadowed until shadow maps are placed (ShadowStage)
+  d.shadow_samples = 1;
   return d;
 }
 

@@ -128,6 +128,10 @@ struct SceneLight {
   float inner_cone = 0.0f, outer_cone = 0.7853981634f;  // spot: radians, 0 <= inner < outer <= pi / 2
   glm::dvec3 position{0.0};                             // the node's origin
   glm::dvec3 direction{0.0, 0.0, -1.0};                 // unit, the node's -Z: where the light shines
+  // Its size (DESIGN section 4d), which shapes its shadows only: a point or spot light's radius (the
+  // light's extras.pmr_radius, metres: a sphere, Blender's light radius) and a directional light's
+  // apparent diameter (extras.pmr_angle, radians: Blender's sun angle). 0: point-like.
+  float radius = 0.0f, angle = 0.0f;
 };
 
 // A glTF camera, placed by the first node (in scene traversal order) that uses it. Cameras that no

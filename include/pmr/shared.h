@@ -333,8 +333,9 @@ typedef struct {
   float cos_inner;    /* spot: cos(innerConeAngle)                                         */
   float cos_outer;    /* spot: cos(outerConeAngle)                                         */
   pmr_i32 shadow;     /* its first shadow map (PmrShadowMap), -1: unshadowed (--shadows off) */
-  pmr_i32 shadow_maps; /* 1, or 6 for a cube about a point light (the face of the major axis) */
-  pmr_u32 pad2;
+  pmr_i32 shadow_maps; /* its maps: shadow_samples groups of 1, or of 6 (a cube: the face of the major axis) */
+  pmr_i32 shadow_samples; /* a light with a size: the points (or directions) sampled on it, whose hard
+                             visibilities are averaged; 1 for a point-like light */
 } PmrLight;
 
 /* One shadow map (DESIGN section 4d), rendered once per frame and read by every view: depth along

@@ -6,6 +6,8 @@
 #
 #   docs/shading_default_scene.png      data/default_scene.glb, center view, --shading lambert | pbr
 #                                       (under the studio, the default environment)
+#   docs/shading_shadows.png            data/default_scene.glb, center view, --environment uniform (the
+#                                       default light), --shadows off | on
 #   docs/shading_suzanne.png            the Khronos sample model Suzanne, center view, lambert | pbr
 #   docs/shading_highlight_views.png    a glossy gold sphere (made here by shading_pictures.py sphere),
 #                                       views 0, N/2 and N-1 of the default 96, under the default light
@@ -81,6 +83,12 @@ pair() {  # pair OUT SCENE VIEW_SIZE: the center view under lambert and pbr
 
 echo "== default scene, lambert | pbr"
 pair "$OUT/shading_default_scene.png" data/default_scene.glb 996x558
+
+echo "== default scene under the uniform environment and the default light: --shadows off | on"
+render noshadow data/default_scene.glb --views 9 --view-size 996x558 --environment uniform --shadows off
+render shadow data/default_scene.glb --views 9 --view-size 996x558 --environment uniform
+$PICTURES strip "$OUT/shading_shadows.png" "$(views noshadow 4)" "$(views shadow 4)" \
+  --check-center "$(center noshadow)" "$(center shadow)"
 
 echo "== Suzanne, lambert | pbr"
 SUZANNE=$GLTF_DIR/Suzanne/glTF/Suzanne.gltf

@@ -117,3 +117,33 @@ TEST(FrameWork, ACommandLineRenderIsRefusedBeforeItStarts) {
 
 }  // namespace
 }  // namespace pmr
+
+namespace pmr {
+namespace {
+
+// Shadows count (DESIGN section 4d): every shaded point reads one map per sample of each shadowed
+// light, and each map is a pass over every triangle.
+TEST(FrameWork, ShadowsCountTheirMapReadsAndPasses) {
+  SceneLight sun, bulb, soft_sun;
+  bulb.type = SceneLightType::Point;
+  soft_sun.angle = 0.05f;
+  const ShadowSizes sizes;
+  const ShadowCost hard = shadow_cost({sun, bulb}, sizes), soft = shadow_cost({soft_sun}, sizes);
+  EXPECT_EQ(hard.maps, 1u + 6u);
+  EXPECT_EQ(hard.lookups_per_point, 2u);
+  EXPECT_EQ(hard.texels, 2048u * 2048u + 6u * 1024u * 1024u);
+  EXPECT_EQ(soft.maps, uint64_t(kShadowSamples));
+  EXPECT_EQ(soft.lookups_per_point, uint64_t(kShadowSamples));
+  Scene s = test::empty_scene(false);
+  test::add_triangle(s, {-1, -1, 0}, {1, -1, 0}, {0, 1, 0});
+  const Rig rig = test::small_rig(4, 32, 16);
+  PipelineConfig config;
+  const FrameWork none = estimate_frame_work(s, rig, 1, config), with = estimate_frame_work(s, rig, 1, config, soft);
+  EXPECT_EQ(with.shadow_reads, 4u * 32u * 16u * uint64_t(kShadowSamples));
+  EXPECT_EQ(with.shadow_map_triangles, uint64_t(kShadowSamples));
+  EXPECT_EQ(with.units - none.units, with.shadow_reads * kUnitsPerShadowRead +
+                                         with.shadow_map_triangles * kUnitsPerShadowTriangle + soft.texels);
+}
+
+}  // namespace
+}  // namespace pmr

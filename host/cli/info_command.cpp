@@ -154,7 +154,7 @@ void describe_default_frame_work(const Scene& s, const InputLimits& limits) {
   PipelineConfig config;
   config.samples = 4;
   const Rig rig = make_rig(RigConfig(), Display(), lo, hi);
-  const FrameWork work = estimate_frame_work(s, rig, s.lights.size(), config);
+  const FrameWork work = estimate_frame_work(s, rig, s.lights.size(), config, shadow_cost(s.lights, config.shadow_sizes));
   std::printf("frame work at paper-8k: %s; the limit is %llu (--limit frame-work; docs/SECURITY.md)\n",
               describe_frame_work(work).c_str(), (unsigned long long)limits.frame_work);
 }

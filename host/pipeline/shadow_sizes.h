@@ -1,6 +1,10 @@
 // The shadow maps' sizes (DESIGN section 4d), apart from the shadow stage so that a configuration needs
 // no OpenCL.
 #pragma once
+#include <cstdint>
+#include <vector>
+
+#include "pmr/scene.h"
 
 namespace pmr {
 
@@ -24,5 +28,13 @@ constexpr int kMaxShadowedLights = 64;
 // (Shadows.SoftShadowsMatchTheExactFraction), mean |V error| over the penumbra: 16 samples at half
 // size 0.031 and 0.030, 32 at half size 0.022 and 0.021, 32 at a quarter 0.024 and 0.025.
 constexpr int kShadowSamples = 32;
+
+// What the shadows of `lights` cost a frame (as placed with `sizes`, before any halving): the map
+// passes (each over every triangle), their texels, and the maps one shaded point reads (one per
+// sample of each shadowed light).
+struct ShadowCost {
+  uint64_t maps = 0, texels = 0, lookups_per_point = 0;
+};
+ShadowCost shadow_cost(const std::vector<SceneLight>& lights, const ShadowSizes& sizes);
 
 }  // namespace pmr

@@ -163,6 +163,17 @@ std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& light
   return maps;
 }
 
+ShadowCost shadow_cost(const std::vector<SceneLight>& lights, const ShadowSizes& sizes) {
+  ShadowCost c;
+  for (size_t i = 0; i < lights.size() && i < size_t(kMaxShadowedLights); ++i) {
+    std::vector<PmrShadowMap> maps;
+    light_maps(lights[i], glm::dvec3(-1.0), glm::dvec3(1.0), sizes, maps);
+    const bool sized = lights[i].type == SceneLightType::Directional ? lights[i].angle > 0.0f : lights[i].radius > 0.0f;
+    c.maps += maps.size(), c.texels += shadow_texels(maps), c.lookups_per_point += sized ? kShadowSamples : 1;
+  }
+  return c;
+}
+
 void add_translucent_layers(std::vector<PmrShadowMap>& maps) {
   uint64_t offset = 0;
   for (const PmrShadowMap& m : maps) offset += uint64_t(m.size) * uint64_t(m.size);

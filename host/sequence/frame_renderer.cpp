@@ -254,7 +254,10 @@ FrameRenderer::Frame FrameRenderer::render(long frame) {
   // the lights every frame: an animation may move a light and no geometry
   const FrameDescription d = describe_posed(moves_ ? posed_ : rest_, pipeline_->config());
   out.rig = d.rig, out.lights = d.lights;
-  check_frame_work(estimate_frame_work(moves_ ? posed_ : rest_, d.rig, d.lights.size(), pipeline_->config()),
+  const PipelineConfig& config = pipeline_->config();
+  const bool shadows = config.shadows && config.shading == Shading::Pbr;
+  check_frame_work(estimate_frame_work(moves_ ? posed_ : rest_, d.rig, d.lights.size(), config,
+                                       shadows ? shadow_cost(d.lights, config.shadow_sizes) : ShadowCost{}),
                    spec_.frame_work);
   out.times = pipeline_->render(d);
   out.visible = out.times.mtas > 0;

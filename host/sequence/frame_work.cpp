@@ -44,7 +44,8 @@ uint64_t blend_voxel_bound(const glm::dvec3 (&p)[3], const Rig& rig, const glm::
 
 }  // namespace
 
-FrameWork estimate_frame_work(const Scene& placed, const Rig& rig, size_t lights, const PipelineConfig& config) {
+FrameWork estimate_frame_work(const Scene& placed, const Rig& rig, size_t lights, const PipelineConfig& config,
+                              const ShadowCost& shadows) {
   FrameWork f;
   f.pixels = uint64_t(rig.views) * uint64_t(rig.view_w) * uint64_t(rig.view_h);
   f.lights = lights;
@@ -60,6 +61,12 @@ FrameWork estimate_frame_work(const Scene& placed, const Rig& rig, size_t lights
   f.light_evaluations = mul_sat(add_sat(f.pixels, f.blend_fragments), f.lights);
   const uint64_t per_fragment = kUnitsPerBlendFragment + f.samples * kUnitsPerBlendSample;
   f.units = add_sat(mul_sat(f.light_evaluations, kUnitsPerLightEvaluation), mul_sat(f.blend_fragments, per_fragment));
+  f.shadow_reads = mul_sat(add_sat(f.pixels, f.blend_fragments), shadows.lookups_per_point);
+  f.shadow_map_triangles = mul_sat(shadows.maps, placed.triangles.size());
+  f.shadow_texels = shadows.texels;
+  f.units = add_sat(f.units, mul_sat(f.shadow_reads, kUnitsPerShadowRead));
+  f.units = add_sat(f.units, add_sat(mul_sat(f.shadow_map_triangles, kUnitsPerShadowTriangle),
+                                     mul_sat(f.shadow_texels, kUnitsPerShadowTexel)));
   return f;
 }
 
@@ -67,7 +74,11 @@ std::string describe_frame_work(const FrameWork& f) {
   return std::to_string(f.units) + " units: " + std::to_string(f.light_evaluations) + " light evaluations ((" +
          std::to_string(f.pixels) + " view pixels + BLEND fragments) x " + std::to_string(f.lights) +
          " light(s)) and at most " + std::to_string(f.blend_fragments) + " BLEND fragments x " +
-         std::to_string(f.samples) + " sample(s)";
+         std::to_string(f.samples) + " sample(s)" +
+         (f.shadow_reads + f.shadow_map_triangles > 0
+              ? ", " + std::to_string(f.shadow_reads) + " shadow map reads and " + std::to_string(f.shadow_map_triangles) +
+                    " shadow map triangles"
+              : std::string());
 }
 
 void check_frame_work(const FrameWork& f, uint64_t limit) {

@@ -5,6 +5,9 @@
 // - light evaluations: every view pixel and every BLEND fragment is shaded once per light (shading is
 //   once per pixel, not per sample: 100 lights add 392, 406 and 410 ms to a 16-view frame at 1, 4
 //   and 16 samples);
+// - shadows (DESIGN section 4d): every shaded point reads one map per sample of each shadowed light
+//   (2.2 ns a read: a sun of 32 samples added 3.5 s to a 96-view frame of 50M pixels), and every map
+//   is cleared and rasterized from every triangle once;
 // - BLEND fragments: each BLEND triangle's fragments, sorted into the nearest layers once per fragment
 //   and composited per sample; bounded by the voxels of the 3D tiles its screen bounding box covers
 //   in every view (an upper bound of its tile-queue entries times the tile's voxels).
@@ -13,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/shadow_sizes.h"
 #include "pmr/rig.h"
 #include "pmr/scene.h"
 
@@ -26,6 +30,8 @@ struct FrameWork {
   uint64_t blend_fragments = 0;    // upper bound of the BLEND triangles' voxels
   uint64_t samples = 1;            // per pixel
   uint64_t light_evaluations = 0;  // (pixels + blend_fragments) x lights
+  uint64_t shadow_reads = 0;       // (pixels + blend_fragments) x maps read per point
+  uint64_t shadow_map_triangles = 0, shadow_texels = 0;  // map passes x triangles; texels cleared
   uint64_t units = 0;              // the weighted sum the budget limits
 };
 
@@ -33,9 +39,15 @@ struct FrameWork {
 constexpr uint64_t kUnitsPerLightEvaluation = 4;
 constexpr uint64_t kUnitsPerBlendFragment = 14;
 constexpr uint64_t kUnitsPerBlendSample = 2;
+// ... per shadow map read, per triangle of a map pass, per map texel
+constexpr uint64_t kUnitsPerShadowRead = 2;
+constexpr uint64_t kUnitsPerShadowTriangle = 20;
+constexpr uint64_t kUnitsPerShadowTexel = 1;
 
-// The estimate for one frame of `placed` (posed) seen by `rig`, shaded with `lights` lights.
-FrameWork estimate_frame_work(const Scene& placed, const Rig& rig, size_t lights, const PipelineConfig& config);
+// The estimate for one frame of `placed` (posed) seen by `rig`, shaded with `lights` lights whose
+// shadows cost `shadows` (none: shadow_cost of no lights).
+FrameWork estimate_frame_work(const Scene& placed, const Rig& rig, size_t lights, const PipelineConfig& config,
+                              const ShadowCost& shadows = {});
 
 // Throws pmr::Error naming --limit frame-work when the estimate exceeds `limit`.
 void check_frame_work(const FrameWork& work, uint64_t limit);

@@ -387,12 +387,13 @@ void SequenceRun::print_frame_stages(long f, const FrameRenderer::Frame& fr, con
   // the fused path and --sampling subpixel write the display image from the fine raster's tiles
   const bool subpixel = pc_.sampling == Sampling::Subpixel, tiled_encode = pipeline.fused() || subpixel;
   const char* encode_label = subpixel ? " + subpixel samples" : " + encode (fused)";
-  char line[320];
+  char line[360];
   std::snprintf(
       line, sizeof line,
-      "pmr: frame %ld: pose %.2f ms, upload %.2f ms; stage times (ms): vertex %.2f, setup %.2f, tile raster %.2f, "
-      "fine raster%s %.2f, %s %.2f; %u MTAs, %llu tile-queue entries, %d queue regrowth(s)",
-      f, fr.pose_ms, fr.upload_ms, fr.times.vertex, fr.times.setup, fr.times.bin, tiled_encode ? encode_label : "",
+      "pmr: frame %ld: pose %.2f ms, upload %.2f ms; stage times (ms): shadow maps %.2f, vertex %.2f, setup %.2f, "
+      "tile raster %.2f, fine raster%s %.2f, %s %.2f; %u MTAs, %llu tile-queue entries, %d queue regrowth(s)",
+      f, fr.pose_ms, fr.upload_ms, fr.times.shadow, fr.times.vertex, fr.times.setup, fr.times.bin,
+      tiled_encode ? encode_label : "",
       fr.times.fine, tiled_encode ? "straddling alpha" : "encode", fr.times.encode, fr.times.mtas,
       (unsigned long long)fr.times.bin_entries, fr.times.retries);
   progress.message(line);

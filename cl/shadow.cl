@@ -75,11 +75,12 @@ inline void shadow_flush(const ShadeInputs* in, global const PmrShadowMap* m, ui
   B->n = 0;
 }
 
-/* Rasterizes the clipped triangle of texel-space corners t[.] (source barycentrics s[.]): every texel
- * whose center it covers (edges included) takes the depth at the center. `opaque`: the caster is
- * opaque everywhere (its depth goes straight to the map), else texels gather in batches. */
+/* Rasterizes the clipped triangle of texel-space corners t[.] (source barycentrics s[.]), the rows
+ * `row`, row + rows, ... of its bounding box: every texel whose center it covers (edges included) takes
+ * the depth at the center. `opaque`: the caster is opaque everywhere (its depth goes straight to the
+ * map), else texels gather in batches. */
 inline void shadow_triangle(const ShadeInputs* in, global const PmrShadowMap* m, uint tri, bool opaque,
-                            global uint* depth, const float3* t, const float3* s) {
+                            global uint* depth, const float3* t, const float3* s, int row, int rows) {
   const float3 a = t[0], b = t[1], c = t[2];
   const float area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
   if (!(fabs(area) > 0.0f)) return;
@@ -91,7 +92,7 @@ inline void shadow_triangle(const ShadeInputs* in, global const PmrShadowMap* m,
             y1 = min(size - 1, (int)ceil(fmax(fmax(a.y, b.y), c.y) - 0.5f));
   ShadowBatch B;
   B.n = 0;
-  for (int y = y0; y <= y1; ++y) {
+  for (int y = y0 + row; y <= y1; y += rows) {
     const float py = (float)y + 0.5f;
     for (int x = x0; x <= x1; ++x) {
       const float px = (float)x + 0.5f;
@@ -116,30 +117,77 @@ inline void shadow_triangle(const ShadeInputs* in, global const PmrShadowMap* m,
   shadow_flush(in, m, tri, depth, &B);
 }
 
-/* One work-item per triangle of the frame's posed scene (the shading inputs' positions: world space)
- * into map `map` of the shading inputs' shadow maps, writing `depth` (the shadow_depth they read). */
-kernel void shadow_raster(PMR_SHADE_PARAMS, uint map, global uint* depth) {
-  const ShadeInputs inputs = PMR_SHADE_INPUTS;
-  const ShadeInputs* in = &inputs;
-  const uint t = pmr_item_id();
-  if (t >= P->num_triangles) return;
-  const PmrTriangle tri = tris[t];
-  global const PmrMaterial* mat = &materials[tri.material];
-  const bool opaque = mat->alpha_mode == PMR_ALPHA_OPAQUE && !(mat->transmission > 0.0f);
-  global const PmrShadowMap* m = &shadow_maps[map];
+/* Triangle t's corners in map m clipped to its near plane (poly, n of them), and whether it is opaque. */
+inline int shadow_corners(const ShadeInputs* in, global const PmrShadowMap* m, uint t, ShadowCorner* poly,
+                          bool* opaque) {
+  const PmrTriangle tri = in->tris[t];
+  global const PmrMaterial* mat = &in->materials[tri.material];
+  *opaque = mat->alpha_mode == PMR_ALPHA_OPAQUE && !(mat->transmission > 0.0f);
   const float3 origin = vload3(0, m->origin);
-  ShadowCorner c[3], poly[4];
+  ShadowCorner c[3];
   for (int k = 0; k < 3; ++k) {
-    const float3 d = vload3(tri.v[k], positions) - origin;
+    const float3 d = vload3(tri.v[k], in->positions) - origin;
     c[k].c = (float3)(dot(vload3(0, m->right), d), dot(vload3(0, m->up), d), dot(vload3(0, m->axis), d));
     c[k].b = (float3)(k == 0, k == 1, k == 2);
   }
-  int n = 3;
-  if (m->perspective) n = clip_near(c, m->near_z, poly);
-  else poly[0] = c[0], poly[1] = c[1], poly[2] = c[2];
+  if (m->perspective) return clip_near(c, m->near_z, poly);
+  poly[0] = c[0], poly[1] = c[1], poly[2] = c[2];
+  return 3;
+}
+
+/* Rows `row`, row + rows, ... of triangle t's clipped polygon (a fan) in map m. */
+inline void shadow_rows(const ShadeInputs* in, global const PmrShadowMap* m, uint t, const ShadowCorner* poly, int n,
+                        bool opaque, global uint* depth, int row, int rows) {
   for (int k = 1; k + 1 < n; ++k) {
     const float3 texel[3] = {shadow_texel(m, poly[0].c), shadow_texel(m, poly[k].c), shadow_texel(m, poly[k + 1].c)};
     const float3 source[3] = {poly[0].b, poly[k].b, poly[k + 1].b};
-    shadow_triangle(in, m, t, opaque, depth, texel, source);
+    shadow_triangle(in, m, t, opaque, depth, texel, source, row, rows);
+  }
+}
+
+/* Texels of the bounding box of a clipped polygon in map m (0 when nothing is left). */
+inline float shadow_box_texels(global const PmrShadowMap* m, const ShadowCorner* poly, int n) {
+  if (n < 3) return 0.0f;
+  float2 lo = (float2)(INFINITY), hi = (float2)(-INFINITY);
+  for (int k = 0; k < n; ++k) {
+    const float3 t = shadow_texel(m, poly[k].c);
+    lo = fmin(lo, t.xy), hi = fmax(hi, t.xy);
+  }
+  const float size = (float)m->size;
+  const float2 span = clamp(hi, 0.0f, size) - clamp(lo, 0.0f, size);
+  return (span.x + 1.0f) * (span.y + 1.0f);
+}
+
+/* A caster whose bounding box holds more texels than this is rasterized by its whole work-group, row
+ * by row: one work-item alone would hold the pass while the others wait (a ground plane covers most
+ * of a map). */
+#define PMR_SHADOW_SHARED_TEXELS 1024.0f
+#define PMR_SHADOW_GROUP 64
+
+/* One work-item per triangle of the frame's posed scene (the shading inputs' positions: world space)
+ * into map `map` of the shading inputs' shadow maps, writing `depth` (the shadow_depth they read).
+ * Work-groups of PMR_SHADOW_GROUP: small casters are rasterized by their own work-item, large ones by
+ * the whole group together. */
+kernel void shadow_raster(PMR_SHADE_PARAMS, uint map, global uint* depth) {
+  const ShadeInputs inputs = PMR_SHADE_INPUTS;
+  const ShadeInputs* in = &inputs;
+  local uint shared[PMR_SHADOW_GROUP];
+  local uint shared_count;
+  const int lid = (int)get_local_id(0);
+  if (lid == 0) shared_count = 0u;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  const uint t = pmr_item_id();
+  global const PmrShadowMap* m = &shadow_maps[map];
+  ShadowCorner poly[4];
+  bool opaque = true;
+  const int n = t < P->num_triangles ? shadow_corners(in, m, t, poly, &opaque) : 0;
+  if (shadow_box_texels(m, poly, n) > PMR_SHADOW_SHARED_TEXELS) shared[atomic_inc(&shared_count)] = t;
+  else if (n >= 3) shadow_rows(in, m, t, poly, n, opaque, depth, 0, 1);
+  barrier(CLK_LOCAL_MEM_FENCE);
+  const uint count = shared_count;
+  for (uint k = 0; k < count; ++k) {
+    const uint big = shared[k];
+    const int bn = shadow_corners(in, m, big, poly, &opaque);
+    shadow_rows(in, m, big, poly, bn, opaque, depth, lid, PMR_SHADOW_GROUP);
   }
 }

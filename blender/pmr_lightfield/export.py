@@ -37,6 +37,7 @@ def export_gltf(folder):
         raise RuntimeError("the glTF export failed (see the console)")
     if not has_mode:
         _edit_json(path, _rewrite_light_intensities)
+    _edit_json(path, _add_light_sizes)
     return path
 
 
@@ -57,6 +58,23 @@ def _rewrite_light_intensities(doc):
         if data is not None:
             light["intensity"] = data.energy / (1.0 if data.type == "SUN" else 4.0 * math.pi)
     return bool(lights)
+
+
+def _add_light_sizes(doc):
+    """Each light's size as pmr reads it (docs/SHADING.md, "Shadows"): a point or spot light's
+    radius as extras.pmr_radius, a sun's angle as extras.pmr_angle; they soften its shadows as in
+    Cycles. glTF's KHR_lights_punctual has neither. The lights are found by name, as above."""
+    lights = doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
+    changed = False
+    for light in lights:
+        data = bpy.data.lights.get(light.get("name", ""))
+        if data is None:
+            continue
+        size = data.angle if data.type == "SUN" else getattr(data, "shadow_soft_size", 0.0)
+        if size > 0.0 and data.type in ("SUN", "POINT", "SPOT"):
+            light.setdefault("extras", {})["pmr_angle" if data.type == "SUN" else "pmr_radius"] = float(size)
+            changed = True
+    return changed
 
 
 def has_animations(path):

@@ -468,6 +468,12 @@ def main():
           "the first and last quilts are identical: the animation did not play")
     log("3 quilts + sidecars, layout %(columns)dx%(rows)d of %(tile_width)dx%(tile_height)d, "
         "animation plays" % sidecars[FRAMES[0]]["quilt"])
+    sun_data = bpy.data.lights["Sun"]
+    recorded = [l for l in sidecars[FRAMES[0]]["shading"]["lights"] if l["type"] == "directional"]
+    check(len(recorded) == 1 and abs(recorded[0].get("angle", 0.0) - sun_data.angle) < 1e-6,
+          "the sun's angle (%g rad) does not reach pmr: %s" % (sun_data.angle, recorded))
+    check(sidecars[FRAMES[0]]["shading"].get("shadows") is not None, "pmr rendered without shadows")
+    log("the sun's angle reaches pmr (%g rad: soft shadows)" % sun_data.angle)
     err = check_camera(sidecars[FRAMES[0]], scene.camera)
     log("center view = the active camera (max error %.2g)" % err)
 

@@ -22,10 +22,12 @@
  *   material_maps.h      the material's textures at the lanes' points
  *   surface.h            the material inputs read once: view-independent, then seen from the view
  *   brdf.h, lights.h     the lobes; what each light delivers at a point
+ *   area_lights.h        an area light's lobes integrated over its shape
  *   environment_light.h  the environment's irradiance and prefiltered radiance, the split-sum tables
  *   layering.h           clear coat and sheen layers; transmission (transmission.h)
  * and here: the lights and the environment summed through the lobes (shade_pbr), Lambert, the entry
  * point shade_lanes, and the MASK alpha test. */
+#include "area_lights.h"
 #include "layering.h"
 #include "lights.h"
 
@@ -62,18 +64,31 @@ inline LightSums light_table_lanes(const ShadeInputs* in, const LaneWinners* L, 
   const uint num_lights = in->P->num_lights;
   for (uint i = 0; i < num_lights; ++i) {
     global const PmrLight* light = &in->lights[i];
-    sfloat3 l;
-    sfloat3 E =
-        light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
-                         vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, S->p, &l);
+    const bool area = light->type == PMR_LIGHT_RECT || light->type == PMR_LIGHT_DISK;
+    sfloat3 l, E;
+    AreaLanes A;
+    if (area) { /* E: on a surface facing the shape's vector irradiance l */
+      A = area_light_lanes(in->ltc, light, S->p, S->n, S->v, S->r, S->coat_n, S->coat_r, L->act, L->coated);
+      l = A.l, E = s3_scale(s3_splat(vload3(0, light->color)), A.e);
+    } else {
+      E = light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
+                           vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, S->p, &l);
+    }
     if (light->shadow >= 0) /* (--shadows off: E as before, bit for bit) */
       E = s3_scale(E, shadow_visibility_lanes(in->shadow_maps, in->shadow_depth, light, S->p, L->face, L->act));
     sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, transmission, aniso, irid)
                       : brdf_cos(base, metallic, f0, f90, r, n, v, l, aniso, irid);
+    if (area) { /* integrated over the shape, but for anisotropic lanes (as if a point at l) */
+      const sfloat3 fa = area_brdf(S, &A, transmission, irid);
+      f = aniso ? s3_select(fa, f, aniso->on) : fa;
+    }
     if (sheen) f = sheen_over_light(in, sheen, f, n, v, l);
     direct = s3_add(direct, s3_mul(f, E));
     if (glass) lights_through = s3_add(lights_through, s3_mul(btdf_light(f0, f90, r, L->ior, n, v, l), E));
-    if (coated) coat_lights = s3_add(coat_lights, s3_scale(E, ggx_lobe_cos(S->coat_n, v, l, coat_a2)));
+    if (coated) {
+      const sfloat coat = area ? select((sfloat)(0.0f), A.coat / A.e, A.e > 0.0f) : ggx_lobe_cos(S->coat_n, v, l, coat_a2);
+      coat_lights = s3_add(coat_lights, s3_scale(E, coat));
+    }
   }
   const LightSums sums = {direct, lights_through, coat_lights};
   return sums;

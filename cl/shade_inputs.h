@@ -13,13 +13,13 @@
   global const PmrParams *P, global const PmrTriangle *tris, global const PmrVertexAttr *attrs,            \
       global const PmrMaterial *materials, global const PmrTexture *textures, global const uchar4 *texels, \
       global const float *srgb_lut, global const float *positions, global const float4 *eyes,              \
-      global const float2 *split_sum, global const float *sheen_albedo, global const float2 *texcoords,    \
+      global const float2 *split_sum, global const float *ltc, global const float *sheen_albedo, global const float2 *texcoords,    \
       global const float4 *tangents, global const PmrEnvironment *env, global const float4 *env_data,      \
       global const PmrLight *lights, global const PmrShadowMap *shadow_maps, global const uint *shadow_depth, \
       global const half *source, global const PmrSource *source_info, global uint *source_tiles
 #define PMR_SHADE_INPUTS                                                                                        \
   {                                                                                                             \
-    tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, sheen_albedo, texcoords, \
+    tris, attrs, materials, textures, texels, srgb_lut, P, positions, eyes, split_sum, ltc, sheen_albedo, texcoords, \
         tangents, env, env_data, lights, shadow_maps, shadow_depth, source, source_info, source_tiles           \
   }
 
@@ -34,6 +34,7 @@ typedef struct {
   global const float* positions;       /* world space, 3 floats per vertex: the surface point (pbr)  */
   global const float4* eyes;           /* each view's camera position, world space (pbr)            */
   global const float2* split_sum;      /* PMR_SPLIT_SUM_N^2 (A, B) (see PMR_SPLIT_SUM_N)             */
+  global const float* ltc;             /* the area lights' LTC fit, PMR_LTC_N^2 nodes (cl/area_lights.h) */
   global const float* sheen_albedo;    /* PMR_SHEEN_ALBEDO_N^2 E (see PMR_SHEEN_ALBEDO_N)            */
   global const float2* texcoords;      /* TEXCOORD set k of vertex v at k * num_vertices + v (the maps) */
   global const float4* tangents;       /* world tangent per vertex (w: bitangent sign), pbr normal maps */

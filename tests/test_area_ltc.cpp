@@ -1,7 +1,7 @@
-// Rectangle and disk lights by linearly transformed cosines (host/shading/ltc.h) against the
-// double-precision reference (tests/reference/area_light_reference.h): the table is the build's fit bit
-// for bit, its amplitudes are the hemispherical integrals, the float polygon integrals are Lambert's
-// exact formula, and the specular radiance over a fixed set of lights is within stated RMS errors.
+// Rectangle and disk lights by linearly transformed cosines (host/shading/ltc.h, cl/area_lights.h) against
+// the double-precision reference (tests/reference/area_light_reference.h): the table is the build's fit
+// bit for bit, its amplitudes are the hemispherical integrals, and the kernels' specular radiance over a
+// fixed set of lights (tests/area_light_probe.h) is within stated RMS errors.
 //
 // Relative error, as measured here: for each (n.v, r) and material, over the lights of the set whose
 // reference is at least a fraction T of the largest reference of that (n.v, r) and material,
@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "area_light_probe.h"
 #include "reference/area_light_reference.h"
 #include "shading/ltc.h"
 #include "shading/split_sum_integral.h"
@@ -48,6 +49,7 @@ struct Case {
   double nv, r;
   ref::AreaLight light;
   glm::dvec2 reference{0.0};  // (integral of D Vis n.l, of its Fresnel-weighted part) over the light
+  glm::dvec2 kernel{0.0};     // the same by the kernels' LTCs (compute_kernels)
 };
 
 // The lights for one (n.v, r): 14 centers (the normal; 35 and 70 degrees from it at 4 azimuths; the
@@ -100,31 +102,26 @@ void compute_references(std::vector<Case>& cases) {
   other.join();
 }
 
-// The LTC's (lobe, Fresnel part) for a case, a disk as a polygon of `sides`: F0 = 1, F90 = 0 gives
-// norm S_lobe - fresnel S_fresnel, F0 = 0, F90 = 1 gives fresnel S_fresnel. With `one_shape`, the
-// lobe's LTC stands for both parts (what a single LTC per node gives).
-glm::dvec2 ltc_case(const Case& c, int sides, bool one_shape) {
-  const glm::vec3 n(rotate(glm::dvec3(0.0, 0.0, 1.0)));
-  const glm::vec3 v(rotate(glm::dvec3(std::sqrt(1.0 - c.nv * c.nv), 0.0, c.nv)));
-  const glm::vec3 center(c.light.center), u(c.light.u), w(c.light.v);
-  glm::vec3 poly[kLtcMaxVertices];
-  const int count =
-      c.light.disk ? disk_light_polygon(center, u, w, sides, poly) : rect_light_polygon(center, u, w, poly);
-  const float r = float(c.r);
-  if (one_shape) {
-    const glm::vec3 tv = v - n * glm::dot(n, v);  // at n.v = 1 any tangent does: the node is isotropic
-    const glm::vec3 t = glm::dot(tv, tv) > 1e-12f ? glm::normalize(tv) : glm::vec3(rotate(glm::dvec3(1.0, 0.0, 0.0)));
-    const glm::vec3 b = glm::cross(n, t);
-    float x[kLtcMaxVertices], y[kLtcMaxVertices], z[kLtcMaxVertices];
-    for (int k = 0; k < count; ++k)
-      x[k] = glm::dot(t, poly[k]), y[k] = glm::dot(b, poly[k]), z[k] = glm::dot(n, poly[k]);
-    const LtcCoefficients k = ltc_lookup(glm::dot(n, v), r);
-    const double share = std::max(0.0f, ltc_polygon_integral(k.lobe, x, y, z, count));
-    return {share * k.norm, share * k.fresnel};
+// The kernels' (lobe, Fresnel part) for every case (cl/area_lights.h through tests/area_light_probe.h):
+// the integrals over the light of D Vis n.l and of (1 - v.h)^5 D Vis n.l by the two LTCs.
+void compute_kernels(std::vector<Case>& cases) {
+  const glm::dvec3 n = rotate(glm::dvec3(0.0, 0.0, 1.0));
+  std::vector<PmrLight> lights;
+  std::vector<test::AreaProbePoint> at;
+  for (const Case& c : cases) {
+    PmrLight l{};
+    l.type = c.light.disk ? PMR_LIGHT_DISK : PMR_LIGHT_RECT;
+    const glm::dvec3 toward = glm::normalize(glm::cross(c.light.u, c.light.v));  // where it emits
+    for (int k = 0; k < 3; ++k)
+      l.position[k] = float(c.light.center[k]), l.direction[k] = float(toward[k]), l.half_width[k] = float(c.light.u[k]),
+      l.half_height[k] = float(c.light.v[k]);
+    l.color[0] = l.color[1] = l.color[2] = 1.0f;
+    at.push_back({int(lights.size()), glm::dvec3(0.0), n, rotate(glm::dvec3(std::sqrt(1.0 - c.nv * c.nv), 0.0, c.nv)),
+                  c.r});
+    lights.push_back(l);
   }
-  const double a = ltc_specular(n, v, poly, count, r, glm::vec3(1.0f), 0.0f).x;
-  const double b = ltc_specular(n, v, poly, count, r, glm::vec3(0.0f), 1.0f).x;
-  return {a + b, b};
+  const std::vector<test::AreaProbeResult> got = test::probe_area_lights(lights, at);
+  for (size_t k = 0; k < cases.size(); ++k) cases[k].kernel = {got[k].lobe, got[k].schlick};
 }
 
 // RMS relative errors, overall and per band of n.v and of r.
@@ -137,8 +134,7 @@ struct Errors {
 // The errors of a set of cases, over rectangles, disks or both (`shapes`: 1, 2, 3).
 struct Report {
   std::vector<double> nv_bands, r_bands;  // lower edges
-  int sides = 16, shapes = 3;
-  bool one_shape = false;
+  int shapes = 3;
   Errors all[2][2];  // [metal, dielectric][T = 10%, 1%]
   std::vector<Errors> band[2][2];
 
@@ -157,7 +153,7 @@ struct Report {
       for (const Case& c : group) {
         if (!(shapes & (c.light.disk ? 2 : 1))) continue;
         const double want = f0 * (c.reference.x - c.reference.y) + c.reference.y;
-        const glm::dvec2 got = ltc_case(c, sides, one_shape);
+        const glm::dvec2 got = c.kernel;
         const double e = (f0 * (got.x - got.y) + got.y - want) / want;
         const size_t cell = size_t(band_of(nv_bands, c.nv)) * r_bands.size() + size_t(band_of(r_bands, c.r));
         for (int t = 0; t < 2; ++t) {
@@ -192,12 +188,13 @@ std::vector<Case> cases_for(const std::vector<double>& nvs, const std::vector<do
       cases.insert(cases.end(), group.begin(), group.end());
     }
   compute_references(cases);
+  compute_kernels(cases);
   return cases;
 }
 
 Report report_of(const std::vector<Case>& cases, std::vector<double> nv_bands, std::vector<double> r_bands,
-                 int sides = 16, int shapes = 3, bool one_shape = false) {
-  Report report{std::move(nv_bands), std::move(r_bands), sides, shapes, one_shape, {}, {}};
+                 int shapes = 3) {
+  Report report{std::move(nv_bands), std::move(r_bands), shapes, {}, {}};
   const size_t per_group = light_set(0.5, 0.5).size();
   for (size_t g = 0; g < cases.size(); g += per_group)
     report.add(std::vector<Case>(cases.begin() + long(g), cases.begin() + long(g + per_group)));
@@ -269,114 +266,6 @@ TEST(AreaLtc, AmplitudesAreTheHemisphericalIntegrals) {
               worst_grazing);
 }
 
-// ---- the polygon integrals --------------------------------------------------------------------------------
-
-// The rational acos(d) / sin(acos(d)): relative error below 1e-6 on [-0.9, 1] in float (the fit's 5.6e-7
-// plus float rounding); toward d = -1 (edges near 180 degrees) pi / sqrt(1 - d^2) loses 1 - d^2's digits.
-TEST(AreaLtc, ThetaOverSin) {
-  double worst = 0.0;
-  for (int k = 0; k <= 19000; ++k) {
-    const double d = -0.9 + k * 1e-4;
-    const double want = d >= 1.0 ? 1.0 : std::acos(d) / std::sqrt(1.0 - d * d);
-    worst = std::max(worst, std::abs(double(ltc_theta_over_sin(float(d))) - want) / want);
-  }
-  std::printf("[ ltc      ] theta / sin theta: worst relative error %.2g on [-0.9, 1]\n", worst);
-  EXPECT_LE(worst, 1e-6);
-  EXPECT_NEAR(ltc_theta_over_sin(-0.999f), std::acos(-0.999) / std::sqrt(1.0 - 0.999 * 0.999), 1e-4 * 70.0);
-}
-
-std::vector<glm::vec3> to_float(const std::vector<glm::dvec3>& p) {
-  std::vector<glm::vec3> out;
-  for (const glm::dvec3& x : p) out.push_back(glm::vec3(x));
-  return out;
-}
-
-// Diffuse: polygon_irradiance (float) against the exact form factor in double and against the cubature
-// of n.l over the light, within 1% of the largest; rectangles in front, straddling the horizon, seen
-// from behind (0) and below the horizon (0).
-TEST(AreaLtc, PolygonIrradianceIsTheFormFactor) {
-  const glm::dvec3 n = rotate(glm::dvec3(0.0, 0.0, 1.0));
-  std::vector<ref::AreaLight> lights;
-  for (double theta : {0.0, 40.0, 80.0, 95.0, 120.0})
-    for (double phi : {0.0, 130.0}) {
-      const glm::dvec3 d = direction(theta, phi);
-      const glm::dvec3 a = glm::normalize(glm::cross(d, theta == 0.0 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 0, 1)));
-      for (double extent : {0.2, 1.5}) {  // the 1.5 one at 80 and 95 degrees straddles the horizon
-        ref::AreaLight l;
-        l.center = rotate(2.0 * d), l.u = rotate(extent * a), l.v = rotate(0.7 * extent * glm::cross(a, d));
-        lights.push_back(l);
-      }
-    }
-  double peak = 0.0, worst = 0.0;
-  std::vector<double> want, got;
-  for (const ref::AreaLight& l : lights) {
-    const std::vector<glm::dvec3> poly = ref::area_light_polygon(l, glm::dvec3(0.0));
-    want.push_back(ref::polygon_form_factor(poly, n));
-    EXPECT_NEAR(want.back(), ref::area_form_factor(l, glm::dvec3(0.0), n), 1e-6);
-    const std::vector<glm::vec3> fp = to_float(poly);
-    got.push_back(polygon_irradiance(glm::vec3(n), fp.data(), 4));
-    peak = std::max(peak, want.back());
-  }
-  for (size_t k = 0; k < want.size(); ++k) {
-    worst = std::max(worst, std::abs(got[k] - want[k]) / peak);
-    EXPECT_LE(std::abs(got[k] - want[k]), 0.01 * peak) << "light " << k << ": " << got[k] << " vs " << want[k];
-  }
-  std::printf("[ ltc      ] polygon irradiance: worst error %.2g of the largest\n", worst);
-  const size_t straddling = (2 * 2 + 0) * 2 + 1;  // theta 80, phi 0, extent 1.5: crosses the horizon
-  EXPECT_GT(want[straddling], 0.0);
-  double lowest = 1.0, highest = -1.0;
-  for (const glm::dvec3& p : ref::area_light_polygon(lights[straddling], glm::dvec3(0.0)))
-    lowest = std::min(lowest, glm::dot(n, p)), highest = std::max(highest, glm::dot(n, p));
-  EXPECT_LT(lowest, 0.0);
-  EXPECT_GT(highest, 0.0);
-  // seen from behind: the same rectangle with its normal turned away, and one wholly below the horizon
-  ref::AreaLight behind = lights[3];
-  behind.v = -behind.v;
-  const std::vector<glm::vec3> bp = to_float(ref::area_light_polygon(behind, glm::dvec3(0.0)));
-  EXPECT_EQ(polygon_irradiance(glm::vec3(n), bp.data(), 4), 0.0f);
-  EXPECT_EQ(ref::polygon_form_factor(ref::area_light_polygon(lights[16], glm::dvec3(0.0)), n), 0.0);
-  const std::vector<glm::vec3> below = to_float(ref::area_light_polygon(lights[16], glm::dvec3(0.0)));
-  EXPECT_EQ(polygon_irradiance(glm::vec3(n), below.data(), 4), 0.0f);
-}
-
-// A disk as 16-gon: against the exact disk (cubature of n.l over the disk itself), the equal-area 16-gon
-// is within 0.5% of the largest irradiance and 1.5% of each; the inscribed one (radius / 1.0130) reads
-// up to 2.5% low.
-TEST(AreaLtc, DiskAsSixteenGon) {
-  const glm::dvec3 n(0.0, 0.0, 1.0);
-  double worst_equal = 0.0, worst_inscribed = 0.0, peak = 0.0;
-  std::vector<double> want, equal, inscribed;
-  for (double theta : {0.0, 30.0, 60.0, 85.0})
-    for (double radius : {0.1, 0.6, 1.5})
-      for (double tilt : {0.0, 0.8}) {
-        const glm::dvec3 d = direction(theta, 30.0);
-        glm::dvec3 a = glm::normalize(glm::cross(d, theta == 0.0 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 0, 1)));
-        const glm::dvec3 b = glm::cross(a, d);
-        a = turn(a, b, tilt);
-        ref::AreaLight disk;
-        disk.disk = true, disk.center = 2.0 * d, disk.u = radius * a,
-        disk.v = radius * glm::normalize(glm::cross(glm::cross(a, b), a));
-        if (glm::dot(glm::cross(disk.u, disk.v), disk.center) > 0.0) disk.v = -disk.v;
-        want.push_back(ref::area_form_factor(disk, glm::dvec3(0.0), n, 1e-9));
-        glm::vec3 poly[16];
-        disk_light_polygon(glm::vec3(disk.center), glm::vec3(disk.u), glm::vec3(disk.v), 16, poly);
-        equal.push_back(polygon_irradiance(glm::vec3(n), poly, 16));
-        disk_light_polygon(glm::vec3(disk.center), glm::vec3(disk.u / 1.0130015), glm::vec3(disk.v / 1.0130015), 16,
-                           poly);
-        inscribed.push_back(polygon_irradiance(glm::vec3(n), poly, 16));
-        peak = std::max(peak, want.back());
-      }
-  for (size_t k = 0; k < want.size(); ++k) {
-    worst_equal = std::max(worst_equal, std::abs(equal[k] - want[k]) / peak);
-    worst_inscribed = std::max(worst_inscribed, std::abs(inscribed[k] - want[k]) / peak);
-    EXPECT_LE(std::abs(equal[k] - want[k]), std::max(0.015 * want[k], 1e-4 * peak)) << "disk " << k;
-  }
-  std::printf(
-      "[ ltc      ] disk as 16-gon: worst irradiance error %.2g (equal area) and %.2g (inscribed) of the largest\n",
-      worst_equal, worst_inscribed);
-  EXPECT_LE(worst_equal, 0.005);
-}
-
 // ---- the specular radiance --------------------------------------------------------------------------------
 
 // 64 (n.v, r) with n.v in [0.1, 1] and r in [0.1, 1], off the table's nodes, 84 lights each (light_set).
@@ -389,41 +278,43 @@ TEST(AreaLtc, SpecularAgainstBruteForce) {
   EXPECT_LE(report.all[1][0].rms(), 0.08);  // dielectric
   EXPECT_LE(report.all[0][1].rms(), 0.35);  // T = 1%
   EXPECT_LE(report.all[1][1].rms(), 0.25);
-  report_of(cases, {0.1}, {0.1}, 16, 1).print("rectangles only");
-  report_of(cases, {0.1}, {0.1, 0.3, 0.6}, 16, 2).print("disks only, as 16-gons");
-  report_of(cases, {0.1}, {0.1, 0.3, 0.6}, 32, 2).print("disks only, as 32-gons");
-  // one LTC per node for both parts: the dielectric's Fresnel part is shaped differently
-  const Report one = report_of(cases, {0.1}, {0.1}, 16, 3, true);
-  one.print("the lobe's LTC for the Fresnel part too");
-  EXPECT_GT(one.all[1][0].rms(), 2.0 * report.all[1][0].rms());
+  report_of(cases, {0.1}, {0.1}, 1).print("rectangles only");
+  report_of(cases, {0.1}, {0.1, 0.3, 0.6}, 2).print("disks only, as 16-gons");
 }
 
 // Below r = 0.1 (the materials' floor is 0.03): the highlight is smaller than most lights, and where it
 // falls on a disk's rim the polygon's outline shows.
 TEST(AreaLtc, SpecularLowRoughness) {
   const std::vector<Case> cases = cases_for({0.1, 0.2, 0.3, 0.45, 0.6, 0.75, 0.9, 1.0}, {0.03, 0.05, 0.07});
-  const Report rects = report_of(cases, {0.1, 0.3, 0.6, 0.9}, {0.03}, 16, 1);
-  const Report disks16 = report_of(cases, {0.1}, {0.03}, 16, 2), disks32 = report_of(cases, {0.1}, {0.03}, 32, 2);
+  const Report rects = report_of(cases, {0.1, 0.3, 0.6, 0.9}, {0.03}, 1), disks = report_of(cases, {0.1}, {0.03}, 2);
   rects.print("n.v in [0.1, 1], r in [0.03, 0.07], rectangles");
-  disks16.print("disks as 16-gons");
-  disks32.print("disks as 32-gons");
+  disks.print("disks as 16-gons");
   EXPECT_LE(rects.all[0][0].rms(), 0.05);
   EXPECT_LE(rects.all[1][0].rms(), 0.05);
-  EXPECT_LE(disks16.all[0][0].rms(), 0.35);
-  EXPECT_LE(disks32.all[0][0].rms(), 0.25);
+  EXPECT_LE(disks.all[0][0].rms(), 0.35);
 }
 
 // A light seen from behind gives no specular; one across the whole sky (all but the last 0.06 degrees
 // above the horizon) gives the lobe's amplitude, less the LTC's little share below the horizon.
 TEST(AreaLtc, SpecularLimits) {
-  const glm::vec3 n(0.0f, 0.0f, 1.0f), v(0.6f, 0.0f, 0.8f);
-  glm::vec3 poly[16];
-  rect_light_polygon(glm::vec3(-0.6f, 0.0f, 0.8f), glm::vec3(0.3f, 0.0f, 0.0f), glm::vec3(0.0f, 0.3f, 0.0f), poly);
-  EXPECT_EQ(ltc_specular(n, v, poly, 4, 0.4f, glm::vec3(1.0f), 1.0f), glm::vec3(0.0f));  // emits upward
-  rect_light_polygon(glm::vec3(0.0f, 0.0f, 1.0f), glm::vec3(0.0f, 1e3f, 0.0f), glm::vec3(1e3f, 0.0f, 0.0f), poly);
+  const glm::dvec3 n(0.0, 0.0, 1.0), v(0.6, 0.0, 0.8);
+  auto rect = [](glm::vec3 center, glm::vec3 u, glm::vec3 w) {
+    PmrLight l{};
+    l.type = PMR_LIGHT_RECT;
+    const glm::vec3 toward = glm::normalize(glm::cross(u, w));
+    for (int k = 0; k < 3; ++k)
+      l.position[k] = center[k], l.direction[k] = toward[k], l.half_width[k] = u[k], l.half_height[k] = w[k];
+    return l;
+  };
+  const std::vector<PmrLight> lights = {rect({-0.6f, 0.0f, 0.8f}, {0.3f, 0.0f, 0.0f}, {0.0f, 0.3f, 0.0f}),  // emits upward
+                                        rect({0.0f, 0.0f, 1.0f}, {0.0f, 1e3f, 0.0f}, {1e3f, 0.0f, 0.0f})};
+  const std::vector<test::AreaProbeResult> got =
+      test::probe_area_lights(lights, {{0, glm::dvec3(0.0), n, v, 0.4}, {1, glm::dvec3(0.0), n, v, 0.4}});
+  EXPECT_EQ(got[0].lobe, 0.0);
+  EXPECT_EQ(got[0].cosine, 0.0);
   const LtcCoefficients c = ltc_lookup(0.8f, 0.4f);
-  const glm::vec3 s = ltc_specular(n, v, poly, 4, 0.4f, glm::vec3(1.0f), 1.0f);
-  EXPECT_NEAR(s.x, c.norm, 0.01 * c.norm);
+  EXPECT_NEAR(got[1].lobe, c.norm, 0.01 * c.norm);
+  EXPECT_NEAR(got[1].cosine, 3.14159265358979, 0.01);  // the whole hemisphere: pi
 }
 
 }  // namespace

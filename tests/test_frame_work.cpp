@@ -106,7 +106,7 @@ TEST(FrameWork, ACommandLineRenderIsRefusedBeforeItStarts) {
   const std::string file = g.write(dir, "lights");
   const test::CliRun r = test::run("render " + file + " --out " + dir + "/out");
   test::expect_one_error_line(r, "more than the frame-work limit");
-  EXPECT_NE(r.output.find("x 5000 light(s)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("x 5000 light evaluation(s) a point)"), std::string::npos) << r.output;
   EXPECT_FALSE(test::exists(dir + "/out/frame_0000.exr"));
   const test::CliRun small = test::run("render " + file + " -q --views 2 --view-size 32x16 --display 64x36 --out " + dir + "/small");
   EXPECT_EQ(small.status, 0) << small.output;
@@ -143,6 +143,16 @@ TEST(FrameWork, ShadowsCountTheirMapReadsAndPasses) {
   EXPECT_EQ(with.shadow_map_triangles, uint64_t(kShadowSamples));
   EXPECT_EQ(with.units - none.units, with.shadow_reads * kUnitsPerShadowRead +
                                          with.shadow_map_triangles * kUnitsPerShadowTriangle + soft.texels);
+}
+
+// An area light weighs as the point-like lights its shading costs, and its shadow is sampled like any
+// light with a size.
+TEST(FrameWork, AreaLightsWeighTheirShading) {
+  SceneLight sun, rect, disk;
+  rect.type = SceneLightType::Rect, disk.type = SceneLightType::Disk;
+  EXPECT_EQ(light_evaluations_per_point({sun, rect, disk}), 1u + kRectLightEvaluations + kDiskLightEvaluations);
+  EXPECT_EQ(shadow_cost({rect}, ShadowSizes()).lookups_per_point, uint64_t(kShadowSamples));
+  EXPECT_EQ(shadow_cost({rect}, ShadowSizes()).maps, 6u * uint64_t(kShadowSamples));
 }
 
 }  // namespace

@@ -66,6 +66,9 @@ TEST(Layout, DeviceStructsMatchHost) {
   EXPECT_EQ(got[48], offsetof(PmrMaterial, attenuation_color));
   EXPECT_EQ(got[49], sizeof(PmrSource));
   EXPECT_EQ(got[50], offsetof(PmrSource, opaque_only));
+  // an area light's extents (probes 51, 52)
+  EXPECT_EQ(got[51], offsetof(PmrLight, half_width));
+  EXPECT_EQ(got[52], offsetof(PmrLight, half_height));
 }
 
 }  // namespace

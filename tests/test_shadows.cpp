@@ -110,7 +110,7 @@ std::vector<float> probe(const ShadowMaps& m, const SceneLight& light, const std
   const ClRuntime& rt = test::runtime();
   const ClProgram program = rt.build_program({"shadow_probe.cl"}, "-cl-std=CL1.2", &test_kernel_sources());
   PmrLight d = device_light(light);
-  const bool sized = light.type == SceneLightType::Directional ? light.angle > 0.0f : light.radius > 0.0f;
+  const bool sized = has_size(light);
   d.shadow = 0, d.shadow_maps = int(m.maps.size()), d.shadow_samples = sized ? kShadowSamples : 1;
   std::vector<float> in;
   for (const Receiver& r : at)
@@ -283,7 +283,36 @@ TEST(Shadows, MaskBlendAndGlassCastWhatTheyBlock) {
 // The exact visibility of a light with a size at p: the unoccluded fraction of n x n stratified points
 // on the disk it shows to p (a sphere light: its great disk facing p; a sun of apparent diameter
 // `angle`: directions within the cone), ray-cast.
+double exact_soft_visibility(const Scene& s, const SceneLight& light, const glm::dvec3& p, int n);
+
+// The same for an area light and a receiver of normal up: the fraction of its irradiance (the points of
+// an n x n grid on its shape weighted by cos_light cos_receiver / d^2) that arrives unoccluded.
+double exact_area_visibility(const Scene& s, const SceneLight& light, const glm::dvec3& p, int n) {
+  double on = 0.0, all = 0.0;
+  auto add = [&](double u, double v) {
+    const glm::dvec3 q = light.position + 0.5 * u * light.width * light.right + 0.5 * v * light.height * light.up;
+    const glm::dvec3 d = q - p;
+    const double len = glm::length(d);
+    const double w = std::max(0.0, -glm::dot(d, light.direction) / len) * std::max(0.0, d.y / len) / (len * len);
+    all += w;
+    if (w > 0.0 && ref::transmittance(s, p, d / len, 1e-7, len) > 0.5) on += w;
+  };
+  // the center and the rim agreeing: fully lit or fully shadowed (the occluders here are large)
+  for (int k = 0; k < 8; ++k) add(std::cos(k * M_PI / 4), std::sin(k * M_PI / 4));
+  add(0.0, 0.0);
+  if (on == 0.0 || on == all) return on == 0.0 ? 0.0 : 1.0;
+  on = all = 0.0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double u = 2.0 * (i + 0.5) / n - 1.0, v = 2.0 * (j + 0.5) / n - 1.0;
+      if (light.type == SceneLightType::Disk && u * u + v * v > 1.0) continue;
+      add(u, v);
+    }
+  return on / all;
+}
+
 double exact_soft_visibility(const Scene& s, const SceneLight& light, const glm::dvec3& p, int n) {
+  if (is_area_light(light)) return exact_area_visibility(s, light, p, n);
   const bool sun = light.type == SceneLightType::Directional;
   const glm::dvec3 axis = sun ? -light.direction : glm::normalize(light.position - p);
   const glm::dvec3 x = glm::normalize(glm::cross(axis, std::abs(axis.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
@@ -324,8 +353,14 @@ TEST(Shadows, SoftShadowsMatchTheExactFraction) {
   sphere.radius = 0.25f;
   SceneLight wide_sun = sun({0.1, -1.0, 0.05});
   wide_sun.angle = 0.12f;
-  for (const SceneLight& light : {sphere, wide_sun}) {
-    SCOPED_TRACE(light.type == SceneLightType::Directional ? "sun" : "sphere");
+  // a disk of the sphere's silhouette, and a rect of the same area, facing down
+  SceneLight disk = sphere;
+  disk.type = SceneLightType::Disk, disk.right = {1, 0, 0}, disk.up = {0, 0, -1};
+  disk.width = disk.height = 2.0 * sphere.radius;
+  SceneLight rect = disk;
+  rect.type = SceneLightType::Rect, rect.width = rect.height = std::sqrt(M_PI) * sphere.radius;
+  for (const SceneLight& light : {sphere, wide_sun, disk, rect}) {
+    SCOPED_TRACE(light_type_name(light.type));
     Scene s = base;
     s.lights = {light};
     const ShadowMaps m = render_maps(s);
@@ -342,7 +377,8 @@ TEST(Shadows, SoftShadowsMatchTheExactFraction) {
     const double mean = sum / double(at.size());
     EXPECT_LE(mean, 0.03);
     EXPECT_GT(at.size(), 300u);
-    std::printf("[ shadows  ] %zu penumbra receivers, mean |V error| %.4f\n", at.size(), mean);
+    std::printf("[ shadows  ] %s: %zu penumbra receivers, mean |V error| %.4f\n", light_type_name(light.type),
+                at.size(), mean);
   }
 }
 

@@ -41,6 +41,96 @@ def export_gltf(folder):
     return path
 
 
+# Blender is Z-up, glTF Y-up: glTF (x, y, z) = Blender (x, z, -y), a rotation.
+_TO_GLTF = ((1.0, 0.0, 0.0), (0.0, 0.0, 1.0), (0.0, -1.0, 0.0))
+
+
+def _to_gltf(v):
+    return [sum(_TO_GLTF[r][c] * v[c] for c in range(3)) for r in range(3)]
+
+
+def area_light_entry(obj):
+    """EXT_lights_area's light and node for a Blender area light object at the current frame, and the
+    warnings it needs: (light, node, warnings). The node carries the object's world position and
+    rotation turned to glTF's Y-up (a light's -Z shines along Blender's -Z, as in glTF), and no scale:
+    the object's scale is multiplied into the size. Luminance L = P / (pi A) for power P (W) over the
+    area A, the same units convention as the point lights (W / (4 pi) as candela)."""
+    data, warnings = obj.data, []
+    loc, rot, scale = obj.matrix_world.decompose()
+    height = data.size_y if data.shape in ("RECTANGLE", "ELLIPSE") else data.size
+    sx, sy = abs(data.size * scale.x), abs(height * scale.y)
+    shape = data.shape
+    if shape == "DISK" and abs(sx - sy) > 1e-6 * max(sx, sy):
+        shape = "ELLIPSE"  # a disk under non-uniform scale
+    if shape == "ELLIPSE":
+        # the rect of the same area and aspect
+        warnings.append("light %s: an ellipse is exported as the rect of its area and aspect" % obj.name)
+        sx, sy = sx * math.sqrt(math.pi) / 2.0, sy * math.sqrt(math.pi) / 2.0
+        shape = "RECTANGLE"
+    if getattr(data, "spread", math.pi) < math.pi - 1e-6:
+        warnings.append("light %s: a spread of %.0f degrees is not carried (pmr's area lights emit over "
+                        "the whole half space)" % (obj.name, math.degrees(data.spread)))
+    disk = shape == "DISK"
+    area = math.pi * sx * sx / 4.0 if disk else sx * sy
+    if not area > 0.0:
+        return None, None, ["light %s has no area: not exported" % obj.name]
+    light = {"name": obj.name, "type": "disk" if disk else "rect", "color": list(data.color),
+             "intensity": max(data.energy, 0.0) / (math.pi * area), "size": sx if disk else sy}
+    if not disk:
+        light["rect"] = {"aspect": sx / sy}
+    # C R: the light's local axes in glTF's world (its node's local frame stays Blender's local one)
+    m = rot.to_matrix()
+    g = [[sum(_TO_GLTF[r][k] * m[k][c] for k in range(3)) for c in range(3)] for r in range(3)]
+    node = {"name": obj.name, "translation": _to_gltf(loc), "rotation": _quaternion(g)}
+    return light, node, warnings
+
+
+def _quaternion(m):
+    """The unit quaternion [x, y, z, w] of the rotation matrix m (rows)."""
+    t = m[0][0] + m[1][1] + m[2][2]
+    if t > 0.0:
+        s = 2.0 * math.sqrt(t + 1.0)
+        return [(m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s, 0.25 * s]
+    i = max(range(3), key=lambda k: m[k][k])
+    j, k = (i + 1) % 3, (i + 2) % 3
+    s = 2.0 * math.sqrt(max(1.0 + m[i][i] - m[j][j] - m[k][k], 1e-30))
+    q = [0.0, 0.0, 0.0, 0.0]
+    q[i] = 0.25 * s
+    q[j] = (m[j][i] + m[i][j]) / s
+    q[k] = (m[k][i] + m[i][k]) / s
+    q[3] = (m[k][j] - m[j][k]) / s
+    return q
+
+
+def add_area_lights(path, scene, view_layer):
+    """Writes the rendered area lights into the exported .gltf as EXT_lights_area lights on nodes of
+    their own (Blender 3.4's exporter has no such extension); returns the warnings."""
+    objs = [o for o in scene.objects if o.type == "LIGHT" and o.data.type == "AREA" and not o.hide_render
+            and o.name in view_layer.objects]
+    if not objs:
+        return []
+    warnings = []
+
+    def edit(doc):
+        ext = doc.setdefault("extensions", {}).setdefault("EXT_lights_area", {"lights": []})
+        for obj in objs:
+            light, node, more = area_light_entry(obj)
+            warnings.extend(more)
+            if light is None:
+                continue
+            node["extensions"] = {"EXT_lights_area": {"light": len(ext["lights"])}}
+            ext["lights"].append(light)
+            doc.setdefault("nodes", []).append(node)
+            doc["scenes"][doc.get("scene", 0)].setdefault("nodes", []).append(len(doc["nodes"]) - 1)
+        used = doc.setdefault("extensionsUsed", [])
+        if "EXT_lights_area" not in used:
+            used.append("EXT_lights_area")
+        return True
+
+    _edit_json(path, edit)
+    return warnings
+
+
 def _edit_json(path, edit):
     """Applies edit(doc) to the .gltf; rewrites the file when edit returns True."""
     with open(path, encoding="utf-8") as f:
@@ -106,17 +196,6 @@ def retime_animations(path, factor):
         acc["min"], acc["max"] = [min(times)], [max(times)]
     with open(path, "w", encoding="utf-8") as f:
         json.dump(doc, f)
-
-
-def dropped_lights(scene, view_layer):
-    """Names of the rendered lights glTF cannot carry (KHR_lights_punctual has no area lights)."""
-    names = []
-    for obj in scene.objects:
-        if obj.type != "LIGHT" or obj.hide_render or obj.name not in view_layer.objects:
-            continue
-        if obj.data.type not in ("POINT", "SPOT", "SUN"):
-            names.append("%s (%s)" % (obj.name, obj.data.type.lower()))
-    return names
 
 
 # ---- the world ----------------------------------------------------------------------------------

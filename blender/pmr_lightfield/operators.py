@@ -47,14 +47,12 @@ class RenderJob:
         self.warnings += more
 
     def _export(self, context):
-        """The glTF for pmr; notes every light it cannot carry in self.warnings."""
+        """The glTF for pmr, area lights included; notes what a light loses on the way in self.warnings."""
         scene = context.scene
         path = export.export_gltf(self.export_dir)
         if scene.render.fps_base != 1.0:
             export.retime_animations(path, scene.render.fps_base)
-        for name in export.dropped_lights(scene, context.view_layer):
-            self.warnings.append("light %s is not exported: glTF has only point, spot and sun "
-                                 "lights" % name)
+        self.warnings += export.add_area_lights(path, scene, context.view_layer)
         return path
 
     def _world(self, scene):

@@ -112,17 +112,17 @@ void describe_materials(const Scene& s) {
 
 void describe_lights(const Scene& s) {
   std::printf("lights: %zu%s\n", s.lights.size(),
-              s.lights.empty() ? "" : " (KHR_lights_punctual, rest pose, world space)");
+              s.lights.empty() ? "" : " (KHR_lights_punctual, EXT_lights_area; rest pose, world space)");
   for (size_t i = 0; i < s.lights.size(); ++i) {
     const SceneLight& l = s.lights[i];
-    const char* type = l.type == SceneLightType::Directional ? "directional"
-                       : l.type == SceneLightType::Point     ? "point"
-                                                             : "spot";
+    const char* type = light_type_name(l.type);
+    const bool area = is_area_light(l);
     std::string line = "  " + std::to_string(i) + " " + quoted(l.name) + " (light " + std::to_string(l.light) +
                        "): " + type + ", node " + std::to_string(l.node) + " " + quoted(l.node_name) + ", color (" +
                        number(l.color[0]) + ", " + number(l.color[1]) + ", " + number(l.color[2]) + "), intensity " +
-                       number(l.intensity) + (l.type == SceneLightType::Directional ? " lux" : " cd");
-    if (l.type != SceneLightType::Directional) line += l.range > 0 ? ", range " + number(l.range) : ", no range";
+                       number(l.intensity) +
+                       (l.type == SceneLightType::Directional ? " lux" : area ? " nits" : " cd");
+    if (l.type != SceneLightType::Directional && !area) line += l.range > 0 ? ", range " + number(l.range) : ", no range";
     if (l.type == SceneLightType::Spot)
       line += ", cones inner " + number(l.inner_cone * 180.0 / 3.14159265358979323846) + " deg outer " +
               number(l.outer_cone * 180.0 / 3.14159265358979323846) + " deg";
@@ -132,6 +132,8 @@ void describe_lights(const Scene& s) {
       line += ", toward (" + number(l.direction.x) + ", " + number(l.direction.y) + ", " + number(l.direction.z) + ")";
     if (l.radius > 0.0f) line += ", radius " + number(l.radius) + " m (soft shadows)";
     if (l.angle > 0.0f) line += ", angle " + number(l.angle * 180.0 / 3.14159265358979323846) + " deg (soft shadows)";
+    if (l.type == SceneLightType::Rect) line += ", " + number(l.width) + " x " + number(l.height) + " m";
+    if (l.type == SceneLightType::Disk) line += ", diameter " + number(l.width) + " m";
     std::printf("%s\n", line.c_str());
   }
 }
@@ -154,7 +156,7 @@ void describe_default_frame_work(const Scene& s, const InputLimits& limits) {
   PipelineConfig config;
   config.samples = 4;
   const Rig rig = make_rig(RigConfig(), Display(), lo, hi);
-  const FrameWork work = estimate_frame_work(s, rig, s.lights.size(), config, shadow_cost(s.lights, config.shadow_sizes));
+  const FrameWork work = estimate_frame_work(s, rig, light_evaluations_per_point(s.lights), config, shadow_cost(s.lights, config.shadow_sizes));
   std::printf("frame work at paper-8k: %s; the limit is %llu (--limit frame-work; docs/SECURITY.md)\n",
               describe_frame_work(work).c_str(), (unsigned long long)limits.frame_work);
 }

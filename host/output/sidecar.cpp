@@ -72,13 +72,10 @@ json matrix_json(const glm::dmat4& m) {
 
 json vec3_json(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }
 
-const char* light_type_name(SceneLightType t) {
-  return t == SceneLightType::Point ? "point" : t == SceneLightType::Spot ? "spot" : "directional";
-}
-
-// One light as pbr used it, world space, with what its type reads: a position for point and spot
-// lights, a direction (where the light travels) for directional and spot lights, a range (null: none)
-// for point and spot lights, the cone angles (radians) for spots.
+// One light as pbr used it, world space, with what its type reads: a position for point, spot and area
+// lights, a direction (where the light travels) for all but point lights, a range (null: none) for
+// point and spot lights, the cone angles (radians) for spots, an area light's axes (right, up: its
+// width and height run along them) and world width and height (a disk's: its diameter).
 json light_json(const SceneLight& l) {
   const bool is_default = is_default_light(l);
   json j = {{"name", bounded_text(l.name)}, {"source", is_default ? "default" : "file"}};
@@ -88,11 +85,16 @@ json light_json(const SceneLight& l) {
   j["intensity"] = double(l.intensity);
   if (l.type != SceneLightType::Directional) j["position"] = vec3_json(l.position);
   if (l.type != SceneLightType::Point) j["direction"] = vec3_json(l.direction);
-  if (l.type != SceneLightType::Directional) j["range"] = l.range > 0.0f ? json(double(l.range)) : json();
+  const bool area = is_area_light(l);
+  if (l.type != SceneLightType::Directional && !area) j["range"] = l.range > 0.0f ? json(double(l.range)) : json();
   if (l.type == SceneLightType::Spot)
     j["inner_cone_angle"] = double(l.inner_cone), j["outer_cone_angle"] = double(l.outer_cone);
   if (l.radius > 0.0f) j["radius"] = double(l.radius);  // absent: point-like, as every older sidecar
   if (l.angle > 0.0f) j["angle"] = double(l.angle);
+  if (area) {  // as placed: the plane's axes and the world size
+    j["right"] = vec3_json(l.right), j["up"] = vec3_json(l.up);
+    j["width"] = l.width, j["height"] = l.height;
+  }
   return j;
 }
 

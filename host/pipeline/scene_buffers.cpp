@@ -9,6 +9,7 @@
 #include "pmr/error.h"
 #include "shading/environment.h"
 #include "shading/lights.h"
+#include "shading/ltc.h"
 #include "shading/sheen.h"
 
 namespace pmr {
@@ -32,6 +33,8 @@ SceneBuffers::SceneBuffers(const ClRuntime& rt, const PipelineConfig& config)
   split_sum_ = rt.upload(config.shading == Shading::Pbr ? split_sum_table() : none, "split-sum table");
   static_assert(kSheenAlbedoSize == PMR_SHEEN_ALBEDO_N, "the kernels' sheen albedo table size");
   sheen_albedo_ = rt.upload(config.shading == Shading::Pbr ? sheen_albedo_table() : none, "sheen albedo table");
+  static_assert(kLtcSize == PMR_LTC_N && kLtcNodeFloats == PMR_LTC_NODE_FLOATS, "the kernels' LTC table size");
+  ltc_ = rt.upload(config.shading == Shading::Pbr ? ltc_table() : none, "area lights' LTC table");
   upload_environment(config);
 }
 
@@ -117,7 +120,7 @@ void SceneBuffers::upload_frame(const FrameDescription& frame, const std::vector
 cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params, const ShadowBinding& shadows,
                                    const SourceBinding& source) const {
   const ClBuffer* inputs[] = {&params,     &tris_,       &attrs_,        &materials_,  &textures_,  &texels_,
-                              &lut_,       &positions_,  &eyes_,         &split_sum_,  &sheen_albedo_,
+                              &lut_,       &positions_,  &eyes_,         &split_sum_,  &ltc_,         &sheen_albedo_,
                               &texcoords_, &tangents_,   &env_,          &env_data_,   &lights_,
                               shadows.maps, shadows.depth, source.data,  source.info,  source.tiles};
   cl_uint i = 0;
@@ -128,7 +131,7 @@ cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params, const Sh
 size_t SceneBuffers::device_bytes() const {
   size_t total = 0;
   for (const ClBuffer* b : {&positions_, &attrs_, &tris_, &materials_, &textures_, &texels_, &texcoords_, &tangents_,
-                            &lut_, &split_sum_, &sheen_albedo_, &env_, &env_data_, &lights_, &eyes_})
+                            &lut_, &split_sum_, &ltc_, &sheen_albedo_, &env_, &env_data_, &lights_, &eyes_})
     total += b->size();
   return total;
 }

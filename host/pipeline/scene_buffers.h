@@ -65,7 +65,7 @@ class SceneBuffers {
   uint64_t geometry_generation_ = 0;
   void set_bounds(const std::vector<glm::vec3>& positions);
   ClBuffer positions_, attrs_, tris_, materials_, textures_, texels_, texcoords_, tangents_;
-  ClBuffer lut_, split_sum_, sheen_albedo_, env_, env_data_;  // the run's tables
+  ClBuffer lut_, split_sum_, ltc_, sheen_albedo_, env_, env_data_;  // the run's tables
   ClBuffer lights_, eyes_;                     // the frame's
 };
 

@@ -101,13 +101,34 @@ glm::dvec3 ball_sample(int i, int k) {
   return std::sin(0.5 * (lo + hi)) * glm::dvec3(ring * std::cos(a), ring * std::sin(a), z);
 }
 
+// A point of the unit disk taken to the square [-1, 1]^2 by the inverse of Shirley and Chiu's concentric
+// map, which preserves area: Vogel's disk samples stay as evenly spread over the square.
+glm::dvec2 disk_to_square(const glm::dvec2& d) {
+  const double r = glm::length(d), quarter = 4.0 / 3.14159265358979323846;
+  if (r == 0.0) return d;
+  if (std::abs(d.x) >= std::abs(d.y)) {
+    const double a = std::copysign(r, d.x);
+    return {a, a * std::atan2(d.y / a, d.x / a) * quarter};
+  }
+  const double b = std::copysign(r, d.y);
+  return {b * (2.0 - std::atan2(d.y / b, d.x / b) * quarter), b};
+}
+
+// Sample point i of k on light l's shape: a point of its sphere (point, spot), of its rect or disk.
+glm::dvec3 light_point(const SceneLight& l, int i, int k) {
+  if (!is_area_light(l)) return l.position + double(l.radius) * ball_sample(i, k);
+  const glm::dvec2 s = l.type == SceneLightType::Rect ? disk_to_square(disk_sample(i, k)) : disk_sample(i, k);
+  return l.position + (0.5 * s.x * l.width) * l.right + (0.5 * s.y * l.height) * l.up;
+}
+
 // The maps of light l: one per sample of its size (kShadowSamples for a light with a size, at a quarter of
 // the point-like sizes), each a directional light's map along a direction of its apparent disk, or a
-// point or spot light's from a point of its sphere.
+// point or spot light's from a point of its sphere, or an area light's (a cube) from a point of its
+// shape.
 void light_maps(const SceneLight& l, const glm::dvec3& lo, const glm::dvec3& hi, const ShadowSizes& sizes,
                 std::vector<PmrShadowMap>& maps) {
   const bool directional = l.type == SceneLightType::Directional;
-  const bool sized = directional ? l.angle > 0.0f : l.radius > 0.0f;
+  const bool sized = has_size(l);
   const int samples = sized ? kShadowSamples : 1;
   const int size = std::max(kMinShadowSize / 2, (directional ? sizes.directional : sizes.local) / (sized ? 4 : 1));
   glm::dvec3 x, y;
@@ -117,8 +138,7 @@ void light_maps(const SceneLight& l, const glm::dvec3& lo, const glm::dvec3& hi,
       const glm::dvec2 d = sized ? disk_sample(i, samples) * std::tan(0.5 * double(l.angle)) : glm::dvec2(0.0);
       maps.push_back(orthographic_map(glm::normalize(l.direction + d.x * x + d.y * y), lo, hi, size));
     } else {
-      local_maps(l, l.position + (sized ? double(l.radius) * ball_sample(i, samples) : glm::dvec3(0.0)), lo, hi, size,
-                 maps);
+      local_maps(l, sized ? light_point(l, i, samples) : l.position, lo, hi, size, maps);
     }
   }
 }
@@ -152,7 +172,7 @@ std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& light
     slots[i].first = int(maps.size());
     light_maps(l, lo, hi, sizes, maps);
     slots[i].count = int(maps.size()) - slots[i].first;
-    slots[i].samples = (l.type == SceneLightType::Directional ? l.angle > 0.0f : l.radius > 0.0f) ? kShadowSamples : 1;
+    slots[i].samples = has_size(l) ? kShadowSamples : 1;
   }
   uint64_t offset = 0;
   for (PmrShadowMap& m : maps) {
@@ -168,8 +188,7 @@ ShadowCost shadow_cost(const std::vector<SceneLight>& lights, const ShadowSizes&
   for (size_t i = 0; i < lights.size() && i < size_t(kMaxShadowedLights); ++i) {
     std::vector<PmrShadowMap> maps;
     light_maps(lights[i], glm::dvec3(-1.0), glm::dvec3(1.0), sizes, maps);
-    const bool sized = lights[i].type == SceneLightType::Directional ? lights[i].angle > 0.0f : lights[i].radius > 0.0f;
-    c.maps += maps.size(), c.texels += shadow_texels(maps), c.lookups_per_point += sized ? kShadowSamples : 1;
+    c.maps += maps.size(), c.texels += shadow_texels(maps), c.lookups_per_point += has_size(lights[i]) ? kShadowSamples : 1;
   }
   return c;
 }

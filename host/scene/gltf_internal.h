@@ -9,6 +9,7 @@
 // Everything read from the model therefore goes through the checks here first, in 64-bit arithmetic,
 // and every failure is a pmr::Error naming the file and the offending element.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <map>
 #include <set>
@@ -51,10 +52,11 @@ struct SourceFile {
   std::set<std::string> unused_image_files;
   std::vector<std::string> ignored_extensions;  // in extensionsUsed, not implemented (the material
                                                 // extensions of material_extension_fallback excepted)
-  // KHR_lights_punctual, validated: the file's lights (position and direction unset) and per node
-  // the light it places (-1 = none).
+  // KHR_lights_punctual and EXT_lights_area, validated: the file's lights (the punctual ones, then the
+  // area lights; unplaced) and per node the lights it places: [0] a punctual one, [1] an area light
+  // (indices into `lights`, -1 = none).
   std::vector<SceneLight> lights;
-  std::vector<int> node_light;
+  std::vector<std::array<int, 2>> node_light;
   // The external files tinygltf will ask for (buffers, sampled images), read and checked here: inside
   // the scene's folder (unless allowed outside), regular, within the file-bytes budget. Keyed by the
   // path tinygltf asks for (resolve_uri); `uses` counts the buffers and images that name the file.

@@ -201,15 +201,12 @@ std::vector<Instance> walk(Loader& L, const std::vector<int>& roots) {
         if (!std::isfinite(world[c][r]))
           fail(L.file, "node " + std::to_string(index) + " has a world matrix that overflows");
     if (node.mesh >= 0) instances.push_back({node.mesh, index});
-    if (const int light = (*L.node_light)[size_t(index)]; light >= 0) {
+    for (const int light : (*L.node_light)[size_t(index)]) {
+      if (light < 0) continue;
       SceneLight l = (*L.light_defs)[size_t(light)];
       l.node = index;
       l.node_name = node.name;
-      l.position = glm::dvec3(world[3]);
-      const glm::dvec3 dir = -glm::dvec3(world[2]);
-      const double len = glm::length(dir);
-      if (len > 0.0 && std::isfinite(len)) l.direction = dir / len;
-      else
+      if (!place_light(l, world))
         L.warn("node " + std::to_string(index) +
                " places a light with a degenerate matrix (zero scale?): shining along -Z");
       L.scene.lights.push_back(l);

@@ -41,7 +41,7 @@ struct Loader {
   std::map<int, int> scene_texture_of;                    // glTF texture -> Scene::textures index (-1: unusable)
   std::map<std::array<int, 3>, int> scene_texture_of_image;  // (image, wrap s, wrap t) -> Scene::textures
   const std::vector<SceneLight>* light_defs = nullptr;       // SourceFile::lights
-  const std::vector<int>* node_light = nullptr;              // SourceFile::node_light
+  const std::vector<std::array<int, 2>>* node_light = nullptr;  // SourceFile::node_light
   std::set<int> used_materials;                              // glTF materials of emitted primitives
   size_t point_line_primitives = 0, skipped_triangles = 0, nonfinite_attributes = 0, leftover_indices = 0;
   size_t generated_tangents = 0;                     // primitives

@@ -52,7 +52,7 @@ constexpr uint64_t kJsonBytesPerValue = 200;
 // reader already accepts; KHR_texture_transform is applied per texture slot; the material and light
 // extensions are read into the scene (DESIGN 4b, 4c).
 bool extension_supported(const std::string& name) {
-  return name == "KHR_mesh_quantization" || name == "KHR_texture_transform" || name == "KHR_lights_punctual" ||
+  return name == "KHR_mesh_quantization" || name == "KHR_texture_transform" || name == "KHR_lights_punctual" || name == "EXT_lights_area" ||
          name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit" || name == "KHR_materials_ior" ||
          name == "KHR_materials_transmission" || name == "KHR_materials_volume" || name == "KHR_materials_variants" ||
          name == "KHR_materials_clearcoat" || name == "KHR_materials_specular" || name == "KHR_materials_anisotropy" ||
@@ -165,12 +165,108 @@ void read_light_size(const std::string& path, const std::string& where, const js
   (directional ? out.angle : out.radius) = float(v->get<double>());
 }
 
+// The nodes' references to the lights of extension `name` (KHR_lights_punctual: slot 0, EXT_lights_area:
+// slot 1 of SourceFile::node_light), whose definitions are src.lights[first, end).
+void read_node_lights(const std::string& path, const json& doc, const char* name, int slot, size_t first,
+                      SourceFile& src) {
+  const json* nodes = member(doc, "nodes");
+  const size_t count = src.lights.size() - first;
+  for (size_t n = 0; n < src.node_light.size(); ++n) {
+    const json* next = member((*nodes)[n], "extensions");
+    const json* use = next ? member(*next, name) : nullptr;
+    if (!use) continue;
+    const std::string where = "node " + std::to_string(n) + " " + name;
+    const json* light = use->is_object() ? member(*use, "light") : nullptr;
+    if (!light || !light->is_number_integer()) fail(path, where + " has no integer light index");
+    const int64_t index = json_index(light);
+    if (index < 0 || size_t(index) >= count)
+      fail(path, where + " refers to light " + light->dump() + ", which does not exist (the file has " +
+                     std::to_string(count) + ")");
+    src.node_light[n][size_t(slot)] = int(first + size_t(index));
+  }
+}
+
+// A light's name, and how messages name it ("EXT_lights_area light 2 'Key'").
+std::string read_light_name(const char* extension, size_t i, const json& l, SceneLight& out) {
+  const json* name = l.is_object() ? member(l, "name") : nullptr;
+  if (name && name->is_string()) out.name = name->get<std::string>();
+  return std::string(extension) + " light " + std::to_string(i) +
+         (out.name.empty() ? std::string() : " '" + one_line(out.name, true) + "'");
+}
+
+// A light's colour: 3 finite, non-negative numbers (absent: white).
+void read_light_color(const std::string& path, const std::string& where, const json& l, SceneLight& out) {
+  const json* color = member(l, "color");
+  if (!color) return;
+  if (!color->is_array() || color->size() != 3) fail(path, where + " color is not an array of 3 numbers");
+  for (size_t c = 0; c < 3; ++c) {
+    const json& v = (*color)[c];
+    if (!v.is_number() || !std::isfinite(v.get<double>()))
+      fail(path, where + " color has a non-finite or non-numeric value");
+    if (v.get<double>() < 0.0) fail(path, where + " color has a negative value (" + v.dump() + ")");
+    out.color[c] = float(v.get<double>());
+  }
+}
+
+// A positive, finite number at most `limit` (absent: `fallback`).
+double area_number(const std::string& path, const std::string& where, const json& parent, const char* key,
+                   double fallback, double limit) {
+  const json* v = member(parent, key);
+  if (!v) return fallback;
+  if (!v->is_number() || !(v->get<double>() > 0.0 && v->get<double>() <= limit))
+    fail(path, where + " " + key + " must be a number above 0 and at most " + one_line(json(limit).dump()) +
+                   " (is " + one_line(v->dump(), true) + ")");
+  return v->get<double>();
+}
+
+// EXT_lights_area (DESIGN section 4d; a draft Khronos vendor extension): rect and disk lights, appended
+// to src.lights, with their nodes in slot 1 of src.node_light. intensity is the surface's luminance in
+// nits (default 1000), size the rect's height or the disk's diameter (default 1 m), rect.aspect its
+// width over its height (default 1).
+void read_area_lights(const std::string& path, const json& doc, SourceFile& src) {
+  const json* ext = member(doc, "extensions");
+  const json* area = ext ? member(*ext, "EXT_lights_area") : nullptr;
+  const json* lights = area && area->is_object() ? member(*area, "lights") : nullptr;
+  if (area && (!area->is_object() || (lights && !lights->is_array())))
+    fail(path, "EXT_lights_area: lights is not an array");
+  const size_t first = src.lights.size();
+  for (size_t i = 0; lights && i < lights->size(); ++i) {
+    const json& l = (*lights)[i];
+    SceneLight out;
+    out.light = int(i);
+    const std::string where = read_light_name("EXT_lights_area", i, l, out);
+    if (!l.is_object()) fail(path, where + " is not an object");
+    const json* type = member(l, "type");
+    const std::string t = type && type->is_string() ? type->get<std::string>() : std::string();
+    if (t == "rect") out.type = SceneLightType::Rect;
+    else if (t == "disk") out.type = SceneLightType::Disk;
+    else
+      fail(path, where + (type ? " has unknown type " + (type->is_string() ? "'" + one_line(t, true) + "'"
+                                                                             : std::string("(not a string)")) +
+                                     " (rect or disk expected)"
+                               : std::string(" has no type")));
+    read_light_color(path, where, l, out);
+    const json* intensity = member(l, "intensity");
+    if (intensity && !(intensity->is_number() && intensity->get<double>() >= 0.0 &&
+                       std::isfinite(intensity->get<double>())))
+      fail(path, where + " intensity must be a finite number >= 0 (is " + one_line(intensity->dump(), true) + ")");
+    out.intensity = float(intensity ? intensity->get<double>() : 1000.0);
+    out.size = float(area_number(path, where, l, "size", 1.0, 1e6));
+    const json* rect = out.type == SceneLightType::Rect ? member(l, "rect") : nullptr;
+    if (rect && !rect->is_object()) fail(path, where + " rect is not an object");
+    if (rect) out.aspect = float(area_number(path, where, *rect, "aspect", 1.0, 1e6));
+    if (out.aspect < 1e-6f) fail(path, where + " rect.aspect must be at least 1e-6");
+    src.lights.push_back(out);
+  }
+  read_node_lights(path, doc, "EXT_lights_area", 1, first, src);
+}
+
 // KHR_lights_punctual on the raw JSON: tinygltf reads an absent range as 0 and coerces odd values, so
 // the checks that matter for lighting (DESIGN 4b) are made here, each a one-line error.
 void read_lights(const std::string& path, const json& doc, SourceFile& src) {
   const json* nodes = member(doc, "nodes");
   const size_t node_count = nodes && nodes->is_array() ? nodes->size() : 0;
-  src.node_light.assign(node_count, -1);
+  src.node_light.assign(node_count, {-1, -1});
   const json* ext = member(doc, "extensions");
   const json* khr = ext ? member(*ext, "KHR_lights_punctual") : nullptr;
   const json* lights = khr ? member(*khr, "lights") : nullptr;
@@ -182,10 +278,7 @@ void read_lights(const std::string& path, const json& doc, SourceFile& src) {
       const json& l = (*lights)[i];
       SceneLight out;
       out.light = int(i);
-      const json* name = member(l, "name");
-      if (name && name->is_string()) out.name = name->get<std::string>();
-      const std::string where = "KHR_lights_punctual light " + std::to_string(i) +
-                                (out.name.empty() ? std::string() : " '" + one_line(out.name, true) + "'");
+      const std::string where = read_light_name("KHR_lights_punctual", i, l, out);
       if (!l.is_object()) fail(path, where + " is not an object");
       auto number = [&](const json& parent, const char* key, double fallback) {
         const json* v = member(parent, key);
@@ -205,16 +298,7 @@ void read_lights(const std::string& path, const json& doc, SourceFile& src) {
         fail(path, where + " has unknown type " +
                        (type->is_string() ? "'" + one_line(t, true) + "'" : std::string("(not a string)")) +
                        " (directional, point or spot expected)");
-      if (const json* color = member(l, "color")) {
-        if (!color->is_array() || color->size() != 3) fail(path, where + " color is not an array of 3 numbers");
-        for (size_t c = 0; c < 3; ++c) {
-          const json& v = (*color)[c];
-          if (!v.is_number() || !std::isfinite(v.get<double>()))
-            fail(path, where + " color has a non-finite or non-numeric value");
-          if (v.get<double>() < 0.0) fail(path, where + " color has a negative value (" + v.dump() + ")");
-          out.color[c] = float(v.get<double>());
-        }
-      }
+      read_light_color(path, where, l, out);
       const double intensity = number(l, "intensity", 1.0);
       if (intensity < 0.0) fail(path, where + " has a negative intensity (" + member(l, "intensity")->dump() + ")");
       out.intensity = float(intensity);
@@ -238,19 +322,8 @@ void read_lights(const std::string& path, const json& doc, SourceFile& src) {
       src.lights.push_back(out);
     }
   }
-  for (size_t n = 0; n < node_count; ++n) {
-    const json* next = member((*nodes)[n], "extensions");
-    const json* use = next ? member(*next, "KHR_lights_punctual") : nullptr;
-    if (!use) continue;
-    const std::string where = "node " + std::to_string(n) + " KHR_lights_punctual";
-    const json* light = member(*use, "light");
-    if (!light || !light->is_number_integer()) fail(path, where + " has no integer light index");
-    const int64_t index = json_index(light);
-    if (index < 0 || size_t(index) >= src.lights.size())
-      fail(path, where + " refers to light " + light->dump() + ", which does not exist (the file has " +
-                     std::to_string(src.lights.size()) + ")");
-    src.node_light[n] = int(index);
-  }
+  read_node_lights(path, doc, "KHR_lights_punctual", 0, 0, src);
+  read_area_lights(path, doc, src);
 }
 
 // Reads an external file the scene names into src.external (once, however many buffers and images

@@ -61,14 +61,10 @@ void place_cameras_and_lights(const SceneMotion& m, const std::vector<glm::dmat4
   for (size_t c = 0; c < out.cameras.size() && c < m.camera_node.size(); ++c)
     if (m.camera_node[c] >= 0 && out.cameras[c].placed)
       out.cameras[c].world_from_camera = world[size_t(m.camera_node[c])];
-  // Lights: the node's origin and -Z (a degenerate matrix keeps the rest direction).
-  for (size_t l = 0; l < out.lights.size() && l < m.light_node.size(); ++l) {
-    const glm::dmat4& w = world[size_t(m.light_node[l])];
-    out.lights[l].position = glm::dvec3(w[3]);
-    const glm::dvec3 dir = -glm::dvec3(w[2]);
-    const double len = glm::length(dir);
-    if (len > 0.0 && std::isfinite(len)) out.lights[l].direction = dir / len;
-  }
+  // Lights: the node's origin and -Z (a degenerate matrix keeps the rest direction), an area light's
+  // plane and size.
+  for (size_t l = 0; l < out.lights.size() && l < m.light_node.size(); ++l)
+    place_light(out.lights[l], world[size_t(m.light_node[l])]);
 }
 
 // The world matrices of every node at the request's time, and their morph weights.
@@ -126,6 +122,7 @@ void turn_lights(const PoseRequest& r, std::vector<SceneLight>& lights) {
   for (SceneLight& l : lights) {
     l.position = R * l.position + shift;
     l.direction = R * l.direction;
+    l.right = R * l.right, l.up = R * l.up;
   }
 }
 

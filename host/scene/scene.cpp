@@ -1,4 +1,5 @@
 // Scene-wide helpers shared by the loader, the synthetic scenes and the renderer.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -184,6 +185,49 @@ int find_camera(const Scene& scene, const std::string& name) {
   }
   throw Error(shown + ": no camera node or camera of the scene has that name" +
               unnamed_choice_hint(name, "pmr info"));
+}
+
+const char* light_type_name(SceneLightType type) {
+  switch (type) {
+    case SceneLightType::Directional: return "directional";
+    case SceneLightType::Point: return "point";
+    case SceneLightType::Spot: return "spot";
+    case SceneLightType::Rect: return "rect";
+    case SceneLightType::Disk: return "disk";
+  }
+  return "unknown";
+}
+
+bool is_area_light(const SceneLight& light) {
+  return light.type == SceneLightType::Rect || light.type == SceneLightType::Disk;
+}
+
+bool has_size(const SceneLight& light) {
+  if (is_area_light(light)) return true;
+  return light.type == SceneLightType::Directional ? light.angle > 0.0f : light.radius > 0.0f;
+}
+
+bool place_light(SceneLight& light, const glm::dmat4& world) {
+  light.position = glm::dvec3(world[3]);
+  const glm::dvec3 dir = -glm::dvec3(world[2]);
+  const double len = glm::length(dir);
+  if (!(len > 0.0 && std::isfinite(len))) return false;
+  light.direction = dir / len;
+  if (!is_area_light(light)) return true;
+  // The plane's axes: the node's X, made orthogonal to the direction (a sheared matrix), then Y from the
+  // right-handed frame; a degenerate X takes any axis of the plane.
+  const glm::dvec3 x = glm::dvec3(world[0]), y = glm::dvec3(world[1]);
+  glm::dvec3 right = x - glm::dot(x, light.direction) * light.direction;
+  if (!(glm::length(right) > 1e-9 * len)) {
+    right = glm::cross(light.direction, std::fabs(light.direction.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0));
+  }
+  light.right = glm::normalize(right);
+  light.up = glm::cross(-light.direction, light.right);
+  const double scale = std::max({glm::length(x), glm::length(y), len});
+  // (at most 1e9 m: a node's scale can be anything finite, and the kernels take floats)
+  light.height = std::min(scale * double(light.size), 1e9);
+  light.width = light.type == SceneLightType::Rect ? std::min(light.height * double(light.aspect), 1e9) : light.height;
+  return true;
 }
 
 }  // namespace pmr

@@ -44,7 +44,14 @@ uint64_t blend_voxel_bound(const glm::dvec3 (&p)[3], const Rig& rig, const glm::
 
 }  // namespace
 
-FrameWork estimate_frame_work(const Scene& placed, const Rig& rig, size_t lights, const PipelineConfig& config,
+uint64_t light_evaluations_per_point(const std::vector<SceneLight>& lights) {
+  uint64_t n = 0;
+  for (const SceneLight& l : lights)
+    n += l.type == SceneLightType::Rect ? kRectLightEvaluations : l.type == SceneLightType::Disk ? kDiskLightEvaluations : 1;
+  return n;
+}
+
+FrameWork estimate_frame_work(const Scene& placed, const Rig& rig, uint64_t lights, const PipelineConfig& config,
                               const ShadowCost& shadows) {
   FrameWork f;
   f.pixels = uint64_t(rig.views) * uint64_t(rig.view_w) * uint64_t(rig.view_h);
@@ -73,7 +80,7 @@ FrameWork estimate_frame_work(const Scene& placed, const Rig& rig, size_t lights
 std::string describe_frame_work(const FrameWork& f) {
   return std::to_string(f.units) + " units: " + std::to_string(f.light_evaluations) + " light evaluations ((" +
          std::to_string(f.pixels) + " view pixels + BLEND fragments) x " + std::to_string(f.lights) +
-         " light(s)) and at most " + std::to_string(f.blend_fragments) + " BLEND fragments x " +
+         " light evaluation(s) a point) and at most " + std::to_string(f.blend_fragments) + " BLEND fragments x " +
          std::to_string(f.samples) + " sample(s)" +
          (f.shadow_reads + f.shadow_map_triangles > 0
               ? ", " + std::to_string(f.shadow_reads) + " shadow map reads and " + std::to_string(f.shadow_map_triangles) +

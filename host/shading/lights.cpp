@@ -29,13 +29,19 @@ std::vector<SceneLight> resolve_lights(const std::vector<SceneLight>& scene_ligh
 
 PmrLight device_light(const SceneLight& light) {
   PmrLight d{};
-  d.type = light.type == SceneLightType::Point  ? PMR_LIGHT_POINT
-           : light.type == SceneLightType::Spot ? PMR_LIGHT_SPOT
-                                                : PMR_LIGHT_DIRECTIONAL;
+  switch (light.type) {
+    case SceneLightType::Directional: d.type = PMR_LIGHT_DIRECTIONAL; break;
+    case SceneLightType::Point: d.type = PMR_LIGHT_POINT; break;
+    case SceneLightType::Spot: d.type = PMR_LIGHT_SPOT; break;
+    case SceneLightType::Rect: d.type = PMR_LIGHT_RECT; break;
+    case SceneLightType::Disk: d.type = PMR_LIGHT_DISK; break;
+  }
   for (int c = 0; c < 3; ++c) {
     d.color[c] = float(double(light.color[c]) * double(light.intensity));
     d.position[c] = float(light.position[c]);
     d.direction[c] = float(light.direction[c]);
+    d.half_width[c] = float(0.5 * light.width * light.right[c]);
+    d.half_height[c] = float(0.5 * light.height * light.up[c]);
   }
   d.range = light.range;
   // the loader guarantees 0 <= inner < outer <= pi / 2; unused for other types

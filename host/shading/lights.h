@@ -1,5 +1,5 @@
-// The punctual lights --shading pbr renders a frame with (docs/SHADING.md, "Lights"): the scene's
-// KHR_lights_punctual lights as posed for the frame (world space) when it has any; otherwise the
+// The lights --shading pbr renders a frame with (docs/SHADING.md, "Lights"): the scene's
+// KHR_lights_punctual and EXT_lights_area lights as posed for the frame (world space) when it has any; otherwise the
 // default light, unless an environment image lights the scene instead. Lambert keeps its one fixed
 // light (Rig::light_world) and reads none of these.
 #pragma once
@@ -23,7 +23,7 @@ bool is_default_light(const SceneLight& light);
 std::vector<SceneLight> resolve_lights(const std::vector<SceneLight>& scene_lights, const Rig& rig, bool use_default);
 
 // The kernels' light table entry of a resolved light (colour x intensity, cosines of the cone angles,
-// single precision).
+// an area light's half extents, single precision).
 PmrLight device_light(const SceneLight& light);
 
 }  // namespace pmr

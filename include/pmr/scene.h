@@ -115,15 +115,16 @@ struct SceneMaterialInputs {
 // A KHR_lights_punctual light placed by one node of the rendered scene (a light used by two nodes is
 // two SceneLights). position and direction are world space; pose_scene moves them with the node's
 // animation and the turntable.
-enum class SceneLightType { Directional, Point, Spot };
+// KHR_lights_punctual's three kinds, and EXT_lights_area's rect and disk (DESIGN section 4d).
+enum class SceneLightType { Directional, Point, Spot, Rect, Disk };
 struct SceneLight {
   std::string name;       // the light's name in the file
-  int light = 0;          // index into the file's KHR_lights_punctual lights
+  int light = 0;          // index into the file's KHR_lights_punctual lights (area lights: EXT_lights_area's)
   int node = 0;           // the node that places it
   std::string node_name;  // that node's name in the file
   SceneLightType type = SceneLightType::Directional;
   float color[3] = {1.0f, 1.0f, 1.0f};                  // linear
-  float intensity = 1.0f;                               // directional: lux; point and spot: candela
+  float intensity = 1.0f;  // directional: lux; point and spot: candela; rect and disk: nits (cd/m^2)
   float range = 0.0f;                                   // 0 = not given (no window); point and spot only
   float inner_cone = 0.0f, outer_cone = 0.7853981634f;  // spot: radians, 0 <= inner < outer <= pi / 2
   glm::dvec3 position{0.0};                             // the node's origin
@@ -132,7 +133,27 @@ struct SceneLight {
   // light's extras.pmr_radius, metres: a sphere, Blender's light radius) and a directional light's
   // apparent diameter (extras.pmr_angle, radians: Blender's sun angle). 0: point-like.
   float radius = 0.0f, angle = 0.0f;
+  // An area light (EXT_lights_area, one-sided, emitting along `direction`): its `size` and `aspect` as
+  // the file gives them, and as placed by its node (place_light): the unit axes of its plane (the
+  // node's X and Y, `right` x `up` = -direction) and its world width (along right) and height (along
+  // up): width = s size aspect, height = s size (a disk: its diameter s size), s the largest of the
+  // node's world scales.
+  float size = 1.0f, aspect = 1.0f;
+  glm::dvec3 right{1.0, 0.0, 0.0}, up{0.0, 1.0, 0.0};
+  double width = 1.0, height = 1.0;
 };
+
+// The light type's name as glTF spells it ("directional", "point", "spot", "rect", "disk").
+const char* light_type_name(SceneLightType type);
+
+// Whether a light is an area light (rect or disk), and whether its shadows are soft (it has a size:
+// an area, a radius or an angle).
+bool is_area_light(const SceneLight& light);
+bool has_size(const SceneLight& light);
+
+// Places `light` by its node's world matrix: the origin, the -Z direction (a degenerate matrix keeps the
+// one it had: returns false), and for an area light its axes and world size.
+bool place_light(SceneLight& light, const glm::dmat4& world);
 
 // A glTF camera, placed by the first node (in scene traversal order) that uses it. Cameras that no
 // node of the rendered scene uses, or whose perspective parameters are invalid, keep placed = false.

@@ -122,6 +122,9 @@ typedef uint64_t pmr_u64;
 /* The split-sum table of --shading pbr (host/shading/environment.h): (A, B) pairs, node (i, j) at
  * cos(n, v) = (i / (N - 1))^2 and roughness j / (N - 1), stored at j * N + i. */
 #define PMR_SPLIT_SUM_N 64
+/* The area lights' LTC table (cl/area_lights.h): PMR_LTC_N^2 nodes of PMR_LTC_NODE_FLOATS floats. */
+#define PMR_LTC_N 64
+#define PMR_LTC_NODE_FLOATS 10
 
 /* KHR_materials_sheen (host/shading/sheen.h): the sheen roughness is clamped to
  * [PMR_SHEEN_MIN_ROUGHNESS, 1]; the table of the Charlie lobe's directional albedo E has
@@ -159,10 +162,12 @@ typedef uint64_t pmr_u64;
 #define PMR_SAMPLE_PATTERN_16 \
   { 1, 1, -1, -3, -3, 2, 4, -1, -5, -2, 2, 5, 5, 3, 3, -5, -2, 6, 0, -7, -4, -6, -6, 4, -8, 0, 7, -4, 6, 7, -7, -8 }
 
-/* PmrLight.type: KHR_lights_punctual's three kinds. */
+/* PmrLight.type: KHR_lights_punctual's three kinds, and EXT_lights_area's two (DESIGN section 4d). */
 #define PMR_LIGHT_DIRECTIONAL 0
 #define PMR_LIGHT_POINT 1
 #define PMR_LIGHT_SPOT 2
+#define PMR_LIGHT_RECT 3
+#define PMR_LIGHT_DISK 4
 
 /* Frame parameters, one copy per frame, read by every stage. Producer: host/pipeline. */
 typedef struct {
@@ -324,7 +329,8 @@ typedef struct {
  * KHR_lights_punctual lights, posed, or the default light; host/shading/lights.h). Producer: host, every
  * frame. cl/brdf.h light_irradiance() evaluates it. */
 typedef struct {
-  float color[3];     /* colour x intensity, linear: lux (directional) or candela (point, spot) */
+  float color[3];     /* colour x intensity, linear: lux (directional), candela (point, spot) or nits
+                         (rect, disk: the luminance of the emitting side) */
   pmr_u32 type;       /* PMR_LIGHT_*                                                      */
   float position[3];  /* the light's origin (point, spot)                                  */
   float range;        /* point, spot: the distance window's range; 0 = none                */
@@ -336,6 +342,10 @@ typedef struct {
   pmr_i32 shadow_maps; /* its maps: shadow_samples groups of 1, or of 6 (a cube: the face of the major axis) */
   pmr_i32 shadow_samples; /* a light with a size: the points (or directions) sampled on it, whose hard
                              visibilities are averaged; 1 for a point-like light */
+  float half_width[3];    /* rect, disk: the half extents of the emitting shape along its plane's axes */
+  pmr_u32 pad0;           /* (world space; a disk's are equal: its radius), centred on `position`, */
+  float half_height[3];   /* emitting along `direction` (= half_height x half_width, normalized)   */
+  pmr_u32 pad1;
 } PmrLight;
 
 /* One shadow map (DESIGN section 4d), rendered once per frame and read by every view: depth along

@@ -126,9 +126,12 @@ def build_scene():
     point.data.shadow_soft_size = 0.0  # a true point light, as glTF's
     point.location = (0, 0, 3)
     scene.collection.objects.link(point)
-    # glTF has no area lights: the add-on must say that this one is left out
+    # an area light (2 m x 1 m, facing down and tilted toward the origin): EXT_lights_area
     panel = bpy.data.objects.new("Panel", bpy.data.lights.new("Panel", "AREA"))
-    panel.location = (0, 2, 3)
+    panel.data.shape, panel.data.size, panel.data.size_y = "RECTANGLE", 2.0, 1.0
+    panel.data.energy = 300.0
+    panel.location = (0, 1, 3)
+    panel.rotation_euler = (math.radians(-20), 0, 0)
     scene.collection.objects.link(panel)
     scene.frame_set(FRAMES[0])
     return scene
@@ -240,6 +243,44 @@ def cycles_render(scene, path):
     return bpy.data.images.load(path)
 
 
+def compare_center_view(scene, sidecar, out, work, what):
+    """pmr's center view of `out` against Cycles' render of the camera: brightness ratios of three
+    patches, each within LIGHT_TOLERANCE."""
+    q = sidecar["quilt"]
+    quilt = bpy.data.images.load(os.path.join(out, sidecar["outputs"]["quilt"]))
+    center = VIEWS // 2
+    col, row = center % q["columns"], center // q["columns"]  # view 0 bottom-left, rows upward
+    tw, th = q["tile_width"], q["tile_height"]
+    ref = cycles_render(scene, os.path.join(work, "cycles_%s.exr" % what.replace(" ", "_")))
+    ratios = []
+    for cx, cy in ((0.5, 0.5), (0.35, 0.6), (0.65, 0.4)):
+        a = patch_mean(quilt, col * tw, row * th, tw, th, cx, cy)
+        b = patch_mean(ref, 0, 0, *LIGHT_VIEW, cx, cy)
+        check(b > 0.01, "Cycles' patch at %s is black (%g)" % ((cx, cy), b))
+        ratios.append(a / b)
+        log("%s patch at (%.2f, %.2f): pmr %.4f, Cycles %.4f, ratio %.4f" % (what, cx, cy, a, b, a / b))
+    worst = max(abs(r - 1) for r in ratios)
+    check(worst <= LIGHT_TOLERANCE, "%s: pmr / Cycles brightness ratios %s: off by %.1f%% (> %.0f%%)"
+          % (what, ["%.4f" % r for r in ratios], 100 * worst, 100 * LIGHT_TOLERANCE))
+    return ratios
+
+
+def check_area_light(scene, ops_module, work):
+    """The grey plane lit only by the area light (no shadow falls in the patches): pmr's center view
+    against Cycles, seen from above as check_point_light."""
+    for name in ("Mover", "Sun", "Bulb"):
+        scene.objects[name].hide_render = True
+    scene.objects["Panel"].hide_render = False
+    out = os.path.join(work, "area")
+    settings_for(scene, out, "STILL", LIGHT_VIEW)
+    scene.frame_set(FRAMES[0])
+    run_operator(ops_module)
+    sidecar = read_sidecar(out, FRAMES[0])
+    check([l["type"] for l in sidecar["shading"]["lights"]] == ["rect"],
+          "expected only the area light, the sidecar lists %s" % sidecar["shading"]["lights"])
+    return compare_center_view(scene, sidecar, out, work, "area light")
+
+
 def check_point_light(scene, ops_module, work):
     """A grey plane lit only by the point light: pmr's center view against Cycles."""
     for name in ("Mover", "Sun", "Panel"):
@@ -264,23 +305,7 @@ def check_point_light(scene, ops_module, work):
     want_cd = 500.0 / (4 * math.pi)
     check(abs(lights[0]["intensity"] - want_cd) < 1e-3 * want_cd,
           "point light intensity %s cd, expected 500 W / 4 pi = %.4f" % (lights[0]["intensity"], want_cd))
-    q = sidecar["quilt"]
-    quilt = bpy.data.images.load(os.path.join(out, sidecar["outputs"]["quilt"]))
-    center = VIEWS // 2
-    col, row = center % q["columns"], center // q["columns"]  # view 0 bottom-left, rows upward
-    tw, th = q["tile_width"], q["tile_height"]
-    ref = cycles_render(scene, os.path.join(work, "cycles_point.exr"))
-    ratios = []
-    for cx, cy in ((0.5, 0.5), (0.35, 0.6), (0.65, 0.4)):
-        a = patch_mean(quilt, col * tw, row * th, tw, th, cx, cy)
-        b = patch_mean(ref, 0, 0, *LIGHT_VIEW, cx, cy)
-        check(b > 0.01, "Cycles' patch at %s is black (%g)" % ((cx, cy), b))
-        ratios.append(a / b)
-        log("point light patch at (%.2f, %.2f): pmr %.4f, Cycles %.4f, ratio %.4f" % (cx, cy, a, b, a / b))
-    worst = max(abs(r - 1) for r in ratios)
-    check(worst <= LIGHT_TOLERANCE, "pmr / Cycles brightness ratios %s: off by %.1f%% (> %.0f%%)"
-          % (["%.4f" % r for r in ratios], 100 * worst, 100 * LIGHT_TOLERANCE))
-    return ratios
+    return compare_center_view(scene, sidecar, out, work, "point light")
 
 
 def environment_image(path):
@@ -460,8 +485,7 @@ def main():
     log("sequence of %d frames rendered through the add-on in %.1f s" % (len(r["outputs"]), r["elapsed"]))
     check("--camera" in r["argv"] and r["argv"][r["argv"].index("--camera") + 1] == "ShotCam",
           "pmr was not given --camera ShotCam: %s" % r["argv"])
-    check(any("Panel (area)" in w for w in r["warnings"]), "no warning for the area light: %s"
-          % r["warnings"])
+    check(not r["warnings"], "warnings for an exportable scene: %s" % r["warnings"])
     sidecars = {f: read_sidecar(out, f) for f in range(FRAMES[0], FRAMES[1] + 1)}
     quilts = [check_quilt(out, f, sc) for f, sc in sidecars.items()]
     check(list(quilts[0].pixels) != list(quilts[-1].pixels),
@@ -473,12 +497,22 @@ def main():
     check(len(recorded) == 1 and abs(recorded[0].get("angle", 0.0) - sun_data.angle) < 1e-6,
           "the sun's angle (%g rad) does not reach pmr: %s" % (sun_data.angle, recorded))
     check(sidecars[FRAMES[0]]["shading"].get("shadows") is not None, "pmr rendered without shadows")
+    areas = [l for l in sidecars[FRAMES[0]]["shading"]["lights"] if l["type"] == "rect"]
+    check(len(areas) == 1 and abs(areas[0]["width"] - 2.0) < 1e-6 and abs(areas[0]["height"] - 1.0) < 1e-6,
+          "the 2 m x 1 m area light does not reach pmr as a rect: %s" % areas)
+    want = 300.0 / (math.pi * 2.0)
+    check(abs(areas[0]["intensity"] - want) < 1e-3 * want, "area light luminance %s, expected P / (pi A) = %g"
+          % (areas[0]["intensity"], want))
+    log("the area light reaches pmr as EXT_lights_area (2 m x 1 m, %g nits)" % want)
     log("the sun's angle reaches pmr (%g rad: soft shadows)" % sun_data.angle)
     err = check_camera(sidecars[FRAMES[0]], scene.camera)
     log("center view = the active camera (max error %.2g)" % err)
 
     check_point_light(scene, ops_module, work)
     log("point light matches Cycles within %.0f%%" % (100 * LIGHT_TOLERANCE))
+
+    check_area_light(scene, ops_module, work)
+    log("area light matches Cycles within %.0f%%" % (100 * LIGHT_TOLERANCE))
 
     check_environment(scene, ops_module, work)
     log("the world's HDRI lights the cube from the side Blender shows it")

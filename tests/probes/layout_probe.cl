@@ -48,4 +48,6 @@ kernel void layout_probe(global uint* out) {
   PROBE(50, PmrSource, opaque_only);
   PROBE(46, PmrParams, lod_scale_x);
   PROBE(47, PmrTexture, levels);
+  PROBE(51, PmrLight, half_width);
+  PROBE(52, PmrLight, half_height);
 }

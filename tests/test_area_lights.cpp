@@ -3,11 +3,17 @@
 // precision; and EXT_lights_area as the loader reads it.
 #include <gtest/gtest.h>
 
+#include <Imath/half.h>
+
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
 #include "area_light_probe.h"
 #include "gltf_builder.h"
+#include "pbr_support.h"
+#include "reference/area_light_reference.h"
+#include "reference/shade_reference.h"
 #include "shading/lights.h"
 #include "test_util.h"
 
@@ -95,6 +101,60 @@ TEST(AreaLights, ASmallFarLightIsAPointAtItsCenter) {
   EXPECT_GT(glm::dot(got[0].l, d / len), 0.99999);
   EXPECT_EQ(got[1].e, 0.0);
   EXPECT_EQ(got[1].cosine, 0.0);
+}
+
+// The rendered voxels of a rough metal quad facing the camera under a rect light (shadows off): the
+// environment's term (the reference without lights) plus L times the integral of D Vis n.l over the
+// light in double precision (ref::area_specular; F0 = F90 = 1). Over the voxels whose light term is at
+// least 10% of the largest, the RMS relative error is within the LTC's (tests/test_area_ltc.cpp), and
+// every voxel is within 30% of its term plus 1% of the largest.
+TEST(AreaLights, ShadedVoxelsMatchTheIntegralOverTheLight) {
+  Scene s = test::empty_scene(false);
+  test::add_triangle(s, {-1, -1, 0}, {1, -1, 0}, {1, 1, 0});
+  test::add_triangle(s, {-1, -1, 0}, {1, 1, 0}, {-1, 1, 0});
+  s.materials[0].metallic = 1.0f, s.materials[0].roughness = 0.5f;
+  const SceneLight light = area_light(SceneLightType::Rect, {0.3, 0.2, 1.2}, {-0.1, 0.0, -1.0}, {1, 0, 0}, 1.0, 0.6);
+  SceneLight placed = light;
+  placed.intensity = 2.0f;
+  s.lights = {placed};
+  const Rig rig = test::small_rig(5, 96, 64);
+  PipelineConfig pc = test::pbr_config(Method::Pmr, TextureFilter::Bilinear, nullptr);
+  const test::Rendered out = test::render_with(s, rig, pc);
+  test::VoxelReference ambient(s, rig, out);
+  ambient.lights.clear();
+  ref::AreaLight shape;
+  shape.center = light.position, shape.u = 0.5 * light.width * light.right, shape.v = 0.5 * light.height * light.up;
+  if (glm::dot(glm::cross(shape.u, shape.v), light.direction) < 0.0) shape.v = -shape.v;  // emits toward u x v
+  const size_t W = size_t(rig.view_w), H = size_t(rig.view_h);
+  std::vector<double> want, got;
+  for (size_t v = 0; v < out.key.size(); v += 3) {
+    if (out.key[v] == PMR_NO_KEY) continue;
+    const PmrMta* m = ambient.mta(v);
+    ASSERT_NE(m, nullptr);
+    const int view = int(v / (W * H));
+    const glm::dvec3 b = ref::source_barycentrics(*m, int(v % W), int((v / W) % H), view);
+    const ref::SurfacePoint q = test::surface_at(s, rig, m->tri, b, (m->flags & PMR_MTA_BACK) != 0, view);
+    const double term = 2.0 * ref::area_specular(shape, q.p, q.n, glm::normalize(q.eye - q.p), 0.5, 1e-4).x;
+    want.push_back(term);
+    half green;
+    green.setBits(out.volume[4 * v + 1]);
+    got.push_back(double(float(green)) - ambient.colour(v, *m).y);
+  }
+  ASSERT_GT(want.size(), 1000u);
+  const double peak = *std::max_element(want.begin(), want.end());
+  double sum2 = 0.0, n = 0.0;
+  size_t bad = 0;
+  for (size_t k = 0; k < want.size(); ++k) {
+    if (want[k] >= 0.1 * peak) sum2 += std::pow((got[k] - want[k]) / want[k], 2.0), n += 1.0;
+    if (std::abs(got[k] - want[k]) > 0.3 * want[k] + 0.01 * peak && ++bad <= 5)
+      ADD_FAILURE() << "voxel " << k << ": " << got[k] << " for " << want[k] << " (peak " << peak << ")";
+  }
+  const double rms = std::sqrt(sum2 / n);
+  EXPECT_EQ(bad, 0u);
+  EXPECT_LE(rms, 0.08);
+  EXPECT_GT(n, 500.0);
+  std::printf("[ area     ] shaded: %zu voxels, RMS relative error %.4f over the %.0f of at least 10%% of the peak\n",
+              want.size(), rms, n);
 }
 
 // EXT_lights_area as a file gives it: types, sizes by the node's largest scale, axes, luminance (pmr

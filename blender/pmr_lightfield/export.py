@@ -53,8 +53,10 @@ def area_light_entry(obj):
     """EXT_lights_area's light and node for a Blender area light object at the current frame, and the
     warnings it needs: (light, node, warnings). The node carries the object's world position and
     rotation turned to glTF's Y-up (a light's -Z shines along Blender's -Z, as in glTF), and no scale:
-    the object's scale is multiplied into the size. Luminance L = P / (pi A) for power P (W) over the
-    area A, the same units convention as the point lights (W / (4 pi) as candela)."""
+    the object's scale is multiplied into the size. Luminance L = P / (4 A) for power P (W) over the
+    area A: the radiance Cycles gives an area light (P / (pi A) rendered 4 / pi = 1.27 times brighter
+    than Cycles in tests/blender/test_addon.py), in the units convention of the point lights (W / (4 pi)
+    as candela: what Cycles shows)."""
     data, warnings = obj.data, []
     loc, rot, scale = obj.matrix_world.decompose()
     height = data.size_y if data.shape in ("RECTANGLE", "ELLIPSE") else data.size
@@ -75,7 +77,7 @@ def area_light_entry(obj):
     if not area > 0.0:
         return None, None, ["light %s has no area: not exported" % obj.name]
     light = {"name": obj.name, "type": "disk" if disk else "rect", "color": list(data.color),
-             "intensity": max(data.energy, 0.0) / (math.pi * area), "size": sx if disk else sy}
+             "intensity": max(data.energy, 0.0) / (4.0 * area), "size": sx if disk else sy}
     if not disk:
         light["rect"] = {"aspect": sx / sy}
     # C R: the light's local axes in glTF's world (its node's local frame stays Blender's local one)

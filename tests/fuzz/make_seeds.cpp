@@ -148,7 +148,7 @@ void gltf_seeds(const fs::path& out) {
     d["nodes"][0]["mesh"] = uint64_t(1) << 32;
     save(out / "index_2_32.gltf", d.dump());
   }
-  {  // a skinned, animated node with a camera and a light
+  {  // a skinned, animated node with a camera, a spot light with a radius and a rect light
     GltfFile g;
     const int pos = g.data<float>({0, 0, 0, 1, 0, 0, 0, 1, 0}, kFloat, "VEC3");
     const int joints = g.data<uint16_t>({0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}, kUShort, "VEC4");
@@ -158,12 +158,16 @@ void gltf_seeds(const fs::path& out) {
         nlohmann::json::array({{{"attributes", {{"POSITION", pos}, {"JOINTS_0", joints}, {"WEIGHTS_0", weights}}}}}));
     g.add("nodes", {{"mesh", 0}, {"skin", 0}});
     g.add("nodes", {{"name", "joint"}, {"rotation", {0, 0, 0, 1}}});
-    g.add("nodes",
-          {{"camera", 0}, {"translation", {0, 0, 3}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    g.add("nodes", {{"camera", 0},
+                    {"translation", {0, 0, 3}},
+                    {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}, {"EXT_lights_area", {{"light", 0}}}}}});
     g.add("skins", {{"joints", {1}}, {"inverseBindMatrices", ibm}});
     g.add("cameras", {{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}});
-    g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
-    g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "spot"}, {"intensity", 2}}};
+    g.doc["extensionsUsed"] = {"KHR_lights_punctual", "EXT_lights_area"};
+    g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {
+        {{"type", "spot"}, {"intensity", 2}, {"extras", {{"pmr_radius", 0.1}}}}};
+    g.doc["extensions"]["EXT_lights_area"]["lights"] = {
+        {{"type", "rect"}, {"intensity", 20}, {"size", 0.5}, {"rect", {{"aspect", 2}}}}};
     const int times = g.data<float>({0, 1}, kFloat, "SCALAR");
     const int rot = g.data<float>({0, 0, 0, 1, 0, 1, 0, 0}, kFloat, "VEC4");
     g.add("animations", {{"samplers", {{{"input", times}, {"output", rot}, {"interpolation", "LINEAR"}}}},

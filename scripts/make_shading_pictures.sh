@@ -8,6 +8,10 @@
 #                                       (under the studio, the default environment)
 #   docs/shading_shadows.png            data/default_scene.glb, center view, --environment uniform (the
 #                                       default light), --shadows off | on
+#   docs/shading_area_light.png         a floor under a rect area light (made here by shading_pictures.py
+#                                       arealight), center view of 9: roughness 0.6 | 0.12
+#   docs/shading_penumbra_views.png     the rough one's views 0, N/2 and N-1 of the default 96: the soft
+#                                       shadows stay on the floor as the views change
 #   docs/shading_suzanne.png            the Khronos sample model Suzanne, center view, lambert | pbr
 #   docs/shading_highlight_views.png    a glossy gold sphere (made here by shading_pictures.py sphere),
 #                                       views 0, N/2 and N-1 of the default 96, under the default light
@@ -89,6 +93,17 @@ render noshadow data/default_scene.glb --views 9 --view-size 996x558 --environme
 render shadow data/default_scene.glb --views 9 --view-size 996x558 --environment uniform
 $PICTURES strip "$OUT/shading_shadows.png" "$(views noshadow 4)" "$(views shadow 4)" \
   --check-center "$(center noshadow)" "$(center shadow)"
+
+echo "== an area light over a rough and a polished floor; the rough one's soft shadows in views 0, 48 and 95 of 96"
+$PICTURES arealight "$WORK/rough.glb" 0.6
+$PICTURES arealight "$WORK/polished.glb" 0.12
+render rough "$WORK/rough.glb" --camera Cam --views 9 --view-size 664x372 --environment uniform
+render polished "$WORK/polished.glb" --camera Cam --views 9 --view-size 664x372 --environment uniform
+$PICTURES strip "$OUT/shading_area_light.png" "$(views rough 4)" "$(views polished 4)" \
+  --check-center "$(center rough)" "$(center polished)"
+render penumbra "$WORK/rough.glb" --camera Cam --views 96 --view-size 498x279 --environment uniform
+$PICTURES strip "$OUT/shading_penumbra_views.png" "$(views penumbra 0)" "$(views penumbra 48)" "$(views penumbra 95)" \
+  --check-center - "$(center penumbra)" -
 
 echo "== Suzanne, lambert | pbr"
 SUZANNE=$GLTF_DIR/Suzanne/glTF/Suzanne.gltf

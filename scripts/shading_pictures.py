@@ -19,6 +19,11 @@ Driven by scripts/make_shading_pictures.sh; Python standard library only (struct
       A unit sphere of a glossy gold metal (the default scene's Gold, base (0.95, 0.58, 0.1),
       metallic 1, roughness 0.2 instead of 0.3), 128 x 64 segments, for the highlight picture.
 
+  shading_pictures.py arealight OUT.glb ROUGHNESS
+      A grey floor of that roughness with a ball and a pole on it, lit only by a rect area light
+      (EXT_lights_area) behind them, turned toward the camera: its highlight on the floor and the
+      soft shadows, for the area light pictures.
+
 Reads scanline EXR files, single- or multi-part, uncompressed or ZIP/ZIPS, with half R, G, B, A
 channels (what `pmr render` writes); anything else stops with one line.
 """
@@ -331,12 +336,10 @@ def strip(out_path, panels, mark, checks):
     print(f"wrote {out_path}: {total_w}x{ch} (panels of {cw}x{ch} from ({x0}, {y0}) of the {width}x{height} views)")
 
 
-def sphere(out_path, base, metallic, roughness):
-    """A unit UV sphere (128 x 64 segments, smooth normals) of one material, as a .glb."""
-    import json
+def _uv_sphere(seg_u=128, seg_v=64):
+    """A unit UV sphere: its positions (= normals) and triangle indices."""
     import math
 
-    seg_u, seg_v = 128, 64
     positions, indices = [], []
     for j in range(seg_v + 1):
         theta = math.pi * j / seg_v
@@ -350,31 +353,97 @@ def sphere(out_path, base, metallic, roughness):
                 indices += [a, b, a + 1]
             if j < seg_v - 1:
                 indices += [a + 1, b, b + 1]
-    vertex_bytes = b"".join(struct.pack("<3f", *p) for p in positions)  # on a unit sphere, normal = position
-    index_bytes = struct.pack(f"<{len(indices)}H", *indices)
-    binary = vertex_bytes + index_bytes
-    gltf = {
-        "asset": {"version": "2.0", "generator": "pmr scripts/shading_pictures.py"},
-        "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
-        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 0}, "indices": 1, "material": 0}]}],
-        "materials": [{"name": "GlossyMetal", "pbrMetallicRoughness": {
-            "baseColorFactor": list(base) + [1.0], "metallicFactor": metallic, "roughnessFactor": roughness}}],
-        "buffers": [{"byteLength": len(binary)}],
-        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": len(vertex_bytes), "target": 34962},
-                        {"buffer": 0, "byteOffset": len(vertex_bytes), "byteLength": len(index_bytes), "target": 34963}],
-        "accessors": [{"bufferView": 0, "componentType": 5126, "count": len(positions), "type": "VEC3",
-                       "min": [-1.0, -1.0, -1.0], "max": [1.0, 1.0, 1.0]},
-                      {"bufferView": 1, "componentType": 5123, "count": len(indices), "type": "SCALAR"}],
-    }
+    return positions, indices
+
+
+def _write_glb(out_path, gltf, meshes):
+    """Writes gltf as a .glb whose buffer holds `meshes` [(positions, normals, indices)], adding their
+    buffer views and accessors (POSITION, NORMAL, indices: 3 a mesh, in order) and primitives' attributes."""
+    import json
+
+    binary, views, accessors = b"", [], []
+    for k, (positions, normals, indices) in enumerate(meshes):
+        for data, kind in ((positions, "POSITION"), (normals, "NORMAL"), (indices, "indices")):
+            index = kind == "indices"
+            raw = struct.pack(f"<{len(data)}H", *data) if index else b"".join(struct.pack("<3f", *p) for p in data)
+            views.append({"buffer": 0, "byteOffset": len(binary), "byteLength": len(raw),
+                          "target": 34963 if index else 34962})
+            acc = {"bufferView": len(views) - 1, "componentType": 5123 if index else 5126, "count": len(data),
+                   "type": "SCALAR" if index else "VEC3"}
+            if kind == "POSITION":  # required by glTF
+                acc["min"] = [float(min(p[c] for p in data)) for c in range(3)]
+                acc["max"] = [float(max(p[c] for p in data)) for c in range(3)]
+            accessors.append(acc)
+            binary += raw + b"\0" * (-len(raw) % 4)
+        gltf["meshes"][k]["primitives"][0].update(
+            {"attributes": {"POSITION": 3 * k, "NORMAL": 3 * k + 1}, "indices": 3 * k + 2})
+    gltf.update({"buffers": [{"byteLength": len(binary)}], "bufferViews": views, "accessors": accessors})
     text = json.dumps(gltf, separators=(",", ":")).encode()
     text += b" " * (-len(text) % 4)
-    binary += b"\0" * (-len(binary) % 4)
     body = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(binary), 0x004E4942) + binary
     with open(out_path, "wb") as f:
         f.write(struct.pack("<III", 0x46546C67, 2, 12 + len(body)) + body)
 
 
+def sphere(out_path, base, metallic, roughness):
+    """A unit UV sphere (128 x 64 segments, smooth normals) of one material, as a .glb."""
+    positions, indices = _uv_sphere()
+    gltf = {
+        "asset": {"version": "2.0", "generator": "pmr scripts/shading_pictures.py"},
+        "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"material": 0}]}],
+        "materials": [{"name": "GlossyMetal", "pbrMetallicRoughness": {
+            "baseColorFactor": list(base) + [1.0], "metallicFactor": metallic, "roughnessFactor": roughness}}],
+    }
+    _write_glb(out_path, gltf, [(positions, positions, indices)])  # on a unit sphere, normal = position
+
+
+def _light_rotation(tilt):
+    """The quaternion [x, y, z, w] turning -Z half a turn about Y (toward +Z), then by `tilt` about X."""
+    import math
+
+    h = 0.5 * tilt
+    # (0, 1, 0, 0) * (sin h, 0, 0, cos h)
+    return [0.0, math.cos(h), -math.sin(h), 0.0]
+
+
+def area_light_floor(out_path, roughness):
+    """A 6 m x 6 m grey dielectric floor of `roughness` with a ball of 0.4 m and a pole on it, lit only by
+    an EXT_lights_area rect light of 1.6 m x 0.8 m behind them, 1.6 m up and turned toward the camera
+    Cam (on +Z, 2.2 m up, looking down at them), whose reflection on the floor lies by the ball, as a
+    .glb."""
+    import math
+
+    floor = ([(-3, 0, -3), (3, 0, -3), (3, 0, 3), (-3, 0, 3)], [(0, 1, 0)] * 4, [0, 2, 1, 0, 3, 2])
+    ball_p, ball_i = _uv_sphere(64, 32)
+    tilt = math.radians(-60.0)  # -Z (its light) turned from the horizon toward the floor and the camera
+    pitch = math.atan2(2.2 - 0.3, 4.2 + 0.2)  # the camera Cam looks down at (0, 0.3, -0.2)
+    gltf = {
+        "asset": {"version": "2.0", "generator": "pmr scripts/shading_pictures.py"},
+        "extensionsUsed": ["EXT_lights_area"],
+        "extensions": {"EXT_lights_area": {"lights": [
+            {"name": "Panel", "type": "rect", "intensity": 6.0, "size": 0.8, "rect": {"aspect": 2.0}}]}},
+        "scene": 0, "scenes": [{"nodes": [0, 1, 2, 3, 4]}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.55, "znear": 0.1}}],
+        "nodes": [{"mesh": 0}, {"mesh": 1, "translation": [-0.5, 0.4, 0.3], "scale": [0.4, 0.4, 0.4]},
+                  {"mesh": 1, "translation": [0.7, 0.7, 0.2], "scale": [0.06, 0.7, 0.06]},
+                  {"name": "Panel", "translation": [0.0, 1.6, -2.2], "rotation": _light_rotation(tilt),
+                   "extensions": {"EXT_lights_area": {"light": 0}}},
+                  {"name": "Cam", "camera": 0, "translation": [0.0, 2.2, 4.2],
+                   "rotation": [math.sin(-0.5 * pitch), 0.0, 0.0, math.cos(0.5 * pitch)]}],
+        "meshes": [{"primitives": [{"material": 0}]}, {"primitives": [{"material": 1}]}],
+        "materials": [{"name": "Floor", "pbrMetallicRoughness": {
+                           "baseColorFactor": [0.5, 0.5, 0.5, 1.0], "metallicFactor": 0.0, "roughnessFactor": roughness}},
+                      {"name": "Clay", "pbrMetallicRoughness": {
+                           "baseColorFactor": [0.8, 0.35, 0.1, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.6}}],
+    }
+    _write_glb(out_path, gltf, [floor, (ball_p, ball_p, ball_i)])
+
+
 def main(argv):
+    if len(argv) == 3 and argv[0] == "arealight":
+        area_light_floor(argv[1], float(argv[2]))
+        return
     if len(argv) == 2 and argv[0] == "sphere":
         # the metal of the default scene's Gold, smoother: a highlight of a few pixels
         sphere(argv[1], (0.95, 0.58, 0.1), 1.0, 0.2)

@@ -464,9 +464,30 @@ TEST(Shadows, ShadedVoxelsMatchTheReferenceWithRayCastVisibility) {
 // bit, subpixel sampling on a raster of 3 W_d x H_d equals view sampling but for depth ties, and the
 // duplicate and multipass baselines shade each voxel they share with PMR (same winner) alike: the same
 // bits (duplicate), within 1e-3 (multipass, whose per-view passes round the surface point apart).
+void every_path_gives_the_same_shadows(const SceneLight& light);
+
+// A rect area light of 0.6 m x 0.4 m, 1.6 m over the plane of box_on_plane_facing_the_camera and off to
+// the side of the box, facing the plane.
+SceneLight rect_over_the_turned_plane() {
+  auto turn = [](glm::dvec3 v) { return glm::dvec3(v.x, 0.5 * v.y - std::sqrt(0.75) * v.z, std::sqrt(0.75) * v.y + 0.5 * v.z); };
+  SceneLight l;
+  l.type = SceneLightType::Rect, l.intensity = 30.0f;
+  l.position = turn({0.3, 1.1, 0.1}), l.direction = glm::normalize(turn({-0.2, -1.0, 0.0}));
+  l.right = glm::normalize(glm::dvec3(1, 0, 0) - l.direction.x * l.direction), l.up = glm::cross(-l.direction, l.right);
+  l.width = 0.6, l.height = 0.4;
+  return l;
+}
+
 TEST(Shadows, EveryPathGivesTheSameShadows) {
+  for (const SceneLight& light : {sun({0.5, -1.0, -0.3}), rect_over_the_turned_plane()}) {
+    SCOPED_TRACE(light_type_name(light.type));
+    every_path_gives_the_same_shadows(light);
+  }
+}
+
+void every_path_gives_the_same_shadows(const SceneLight& light) {
   Scene s = box_on_plane_facing_the_camera();
-  s.lights = {sun({0.5, -1.0, -0.3})};
+  s.lights = {light};
   Display d;
   const Rig rig = test::subpixel_display_rig(d);
   auto encoded = [&](Sampling sampling, bool fuse, bool shadows) {

@@ -25,6 +25,9 @@ import bpy
 import numpy
 from mathutils import Matrix, Vector
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cycles_common import plain_cycles  # noqa: E402 (after its folder is on the path)
+
 # Blender 3.4's glTF importer names numpy.bool, which newer numpy (Debian's) no longer has: the alias it meant.
 if "bool" not in numpy.__dict__:
     numpy.bool = bool
@@ -62,20 +65,12 @@ def setup_scene(scene_path, sidecar, width, height, samples, bounces):
     radiance = env.get("radiance", 0.2) * env.get("intensity", 1.0) if uniform else 0.0
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (radiance, radiance, radiance, 1.0)
     scene.world = world
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = samples
-    scene.cycles.use_denoising = False
+    plain_cycles(scene, samples)
     scene.cycles.max_bounces = bounces  # 0: direct light only, what pmr computes
     scene.cycles.sample_clamp_direct = 0.0
     scene.render.film_transparent = True
     scene.render.dither_intensity = 0.0
     scene.render.resolution_x, scene.render.resolution_y = width, height
-    scene.render.resolution_percentage = 100
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
-    scene.view_settings.exposure = 0.0
-    scene.view_settings.gamma = 1.0
     scene.render.image_settings.file_format = "PNG"
     scene.render.image_settings.color_mode = "RGBA"
     scene.render.image_settings.color_depth = "8"

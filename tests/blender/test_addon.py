@@ -21,6 +21,8 @@ import bpy
 from mathutils import Matrix, Vector
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+from cycles_common import plain_cycles  # noqa: E402 (after its folder is on the path)
 ADDON_SRC = os.path.join(HERE, "..", "..", "blender", "pmr_lightfield")
 ADDON = "pmr_lightfield"
 
@@ -227,15 +229,7 @@ def patch_mean(img, x0, y0, w, h, cx, cy, frac=0.12):
 
 def cycles_render(scene, path):
     """The camera's view with Cycles: linear EXR, Standard view transform, no denoiser."""
-    scene.render.engine = "CYCLES"
-    scene.cycles.device = "CPU"
-    scene.cycles.samples = 64
-    scene.cycles.use_denoising = False
-    scene.render.resolution_percentage = 100
-    scene.view_settings.view_transform = "Standard"
-    scene.view_settings.look = "None"
-    scene.view_settings.exposure = 0.0
-    scene.view_settings.gamma = 1.0
+    plain_cycles(scene, 64)
     scene.render.image_settings.file_format = "OPEN_EXR"
     scene.render.image_settings.color_depth = "32"
     scene.render.filepath = path

@@ -27,11 +27,11 @@
 /* theta / sin(theta) for cos(theta) = x in (-1, 1]: at y = |x| the degree-6 polynomial (interpolated at
  * Chebyshev nodes of [0, 1], relative error below 3e-6) of acos(y) / sqrt(1 - y^2); for x < 0,
  * theta = pi - acos(y) gives pi / sin(theta) less it. The same expression for one lane and for SW. */
-#define PMR_THETA_OVER_SIN(x, y, poly)                                                                     \
-  ((poly) = 1.5707917f +                                                                                   \
-            (y) * (-0.999542399f +                                                                         \
-                   (y) * (0.777722417f +                                                                   \
-                          (y) * (-0.616057222f + (y) * (0.417915612f + (y) * (-0.192474865f + (y) * 0.0416471676f))))), \
+#define PMR_THETA_OVER_SIN(x, y, poly)                                                                                \
+  ((poly) = 1.5707917f +                                                                                              \
+            (y) * (-0.999542399f +                                                                                    \
+                   (y) * (0.777722417f +                                                                              \
+                          (y) * (-0.616057222f + (y) * (0.417915612f + (y) * (-0.192474865f + (y)*0.0416471676f))))), \
    select(PMR_PI_F * rsqrt(fmax(1.0f - (x) * (x), 1e-7f)) - (poly), (poly), (x) >= 0.0f))
 
 /* theta n / sin(theta) for unit a, b, n = a x b, theta the angle between them: an edge's term of
@@ -166,8 +166,8 @@ inline void ltc_lobe_lanes(global const float* ltc, const sfloat3* q, int count,
   /* x along v's part in the tangent plane (any tangent where v = n) */
   const sfloat3 t = s3_sub(v, s3_scale(n, nv));
   const sfloat len = sqrt(s3_dot(t, t));
-  const sfloat3 other = s3_select(s3_splat((float3)(1.0f, 0.0f, 0.0f)), s3_splat((float3)(0.0f, 1.0f, 0.0f)),
-                                  fabs(n.x) >= 0.9f);
+  const sfloat3 other =
+      s3_select(s3_splat((float3)(1.0f, 0.0f, 0.0f)), s3_splat((float3)(0.0f, 1.0f, 0.0f)), fabs(n.x) >= 0.9f);
   const sfloat3 side = s3_cross(n, other);
   const sfloat3 t1 = s3_select(s3_scale(side, rsqrt(s3_dot(side, side))), s3_scale(t, 1.0f / len), len > 1e-6f);
   const sfloat3 t2 = s3_cross(n, t1);
@@ -179,9 +179,9 @@ inline void ltc_lobe_lanes(global const float* ltc, const sfloat3* q, int count,
 
 /* What an area light sends to the lanes' points, per unit luminance (area_light_lanes). */
 typedef struct {
-  sfloat3 l;           /* the direction of the shape's vector irradiance (0: nothing arrives) */
-  sfloat e;            /* |that vector|: the irradiance on a surface facing l                */
-  sfloat cosine;       /* the cosine-weighted solid angle over n's horizon (the diffuse lobe) */
+  sfloat3 l;            /* the direction of the shape's vector irradiance (0: nothing arrives) */
+  sfloat e;             /* |that vector|: the irradiance on a surface facing l                */
+  sfloat cosine;        /* the cosine-weighted solid angle over n's horizon (the diffuse lobe) */
   sfloat lobe, schlick; /* the GGX lobe's D Vis n.l and (1 - v.h)^5 D Vis n.l over the shape  */
   sfloat coat;          /* the clear coat's D Vis n.l over the shape                         */
 } AreaLanes;
@@ -223,11 +223,11 @@ inline sfloat3 area_brdf(const Surface* S, const AreaLanes* A, sfloat transmissi
   if (irid) F = s3_add(F, s3_scale(s3_sub(irid->F, F), irid->w));
   const sfloat kd = (1.0f - S->metallic) * (1.0f - transmission) * (1.0f / PMR_PI_F) * A->cosine;
   const sfloat plain = A->lobe - A->schlick, schlick = A->schlick;
-  sfloat3 G = s3(S->f0.x * plain + S->f90 * schlick, S->f0.y * plain + S->f90 * schlick,
-                 S->f0.z * plain + S->f90 * schlick);
+  sfloat3 G =
+      s3(S->f0.x * plain + S->f90 * schlick, S->f0.y * plain + S->f90 * schlick, S->f0.z * plain + S->f90 * schlick);
   if (irid) G = s3_add(G, s3_scale(s3_sub(s3_scale(irid->F, A->lobe), G), irid->w));
-  const sfloat3 f = s3((1.0f - F.x) * S->base.x * kd + G.x, (1.0f - F.y) * S->base.y * kd + G.y,
-                       (1.0f - F.z) * S->base.z * kd + G.z);
+  const sfloat3 f =
+      s3((1.0f - F.x) * S->base.x * kd + G.x, (1.0f - F.y) * S->base.y * kd + G.y, (1.0f - F.z) * S->base.z * kd + G.z);
   return s3_scale(f, select((sfloat)(0.0f), 1.0f / A->e, A->e > 0.0f));
 }
 

@@ -76,17 +76,20 @@ inline LightSums light_table_lanes(const ShadeInputs* in, const LaneWinners* L, 
     }
     if (light->shadow >= 0) /* (--shadows off: E as before, bit for bit) */
       E = s3_scale(E, shadow_visibility_lanes(in->shadow_maps, in->shadow_depth, light, S->p, L->face, L->act));
-    sfloat3 f = glass ? brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, transmission, aniso, irid)
-                      : brdf_cos(base, metallic, f0, f90, r, n, v, l, aniso, irid);
-    if (area) { /* integrated over the shape, but for anisotropic lanes (as if a point at l) */
-      const sfloat3 fa = area_brdf(S, &A, transmission, irid);
-      f = aniso ? s3_select(fa, f, aniso->on) : fa;
+    /* an area light's lobes are integrated over its shape, but for anisotropic lanes (a point at l) */
+    sfloat3 f = area ? area_brdf(S, &A, transmission, irid) : s3_splat((float3)(0.0f));
+    if (!area || aniso) {
+      const sfloat3 point = glass
+                                ? brdf_cos_transmissive(base, metallic, f0, f90, r, n, v, l, transmission, aniso, irid)
+                                : brdf_cos(base, metallic, f0, f90, r, n, v, l, aniso, irid);
+      f = !area ? point : s3_select(f, point, aniso->on);
     }
     if (sheen) f = sheen_over_light(in, sheen, f, n, v, l);
     direct = s3_add(direct, s3_mul(f, E));
     if (glass) lights_through = s3_add(lights_through, s3_mul(btdf_light(f0, f90, r, L->ior, n, v, l), E));
     if (coated) {
-      const sfloat coat = area ? select((sfloat)(0.0f), A.coat / A.e, A.e > 0.0f) : ggx_lobe_cos(S->coat_n, v, l, coat_a2);
+      const sfloat coat =
+          area ? select((sfloat)(0.0f), A.coat / A.e, A.e > 0.0f) : ggx_lobe_cos(S->coat_n, v, l, coat_a2);
       coat_lights = s3_add(coat_lights, s3_scale(E, coat));
     }
   }
@@ -244,7 +247,8 @@ inline void mta_alpha_lanes(const ShadeInputs* in, const PmrMta* m, const long* 
   if (trilinear && in->materials[in->tris[m->tri].material].maps[PMR_MAP_BASE_COLOR].texture >= 0) {
     float3 ex, ey;
     mta_edge_derivatives(in->P, m, f, &ex, &ey);
-    g = bary_gradient_lanes(LANE3(e), s3_splat(ex), s3_splat(ey), s3_splat((float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2])),
+    g = bary_gradient_lanes(LANE3(e), s3_splat(ex), s3_splat(ey),
+                            s3_splat((float3)(m->inv_w[0], m->inv_w[1], m->inv_w[2])),
                             s3_splat((float3)(m->bary[0][0], m->bary[1][0], m->bary[2][0])),
                             s3_splat((float3)(m->bary[0][1], m->bary[1][1], m->bary[2][1])));
   }
@@ -266,8 +270,8 @@ inline void caster_opacity_lanes(const ShadeInputs* in, uint tri, float b[3][SW]
       LaneTexcoords C;
       C.set = PMR_NO_KEY;
       sfloat c[4];
-      sample_map_lanes(in, &mat->maps[PMR_MAP_TRANSMISSION], tris, (1u << n) - 1u,
-                       vload_s(0, lane_index) < (sint)(n), LANE3(b), 0, false, &C, c);
+      sample_map_lanes(in, &mat->maps[PMR_MAP_TRANSMISSION], tris, (1u << n) - 1u, vload_s(0, lane_index) < (sint)(n),
+                       LANE3(b), 0, false, &C, c);
       vstore_s(vload_s(0, t) * c[0], 0, t);
     }
     for (int j = 0; j < n; ++j) opacity[j] = clamp(1.0f - t[j], 0.0f, 1.0f);

@@ -10,10 +10,10 @@
 namespace pmr::test {
 
 struct AreaProbePoint {
-  int light = 0;          // index into the lights
-  glm::dvec3 p, n, v;     // the point, its unit shading normal, the unit direction toward the view
-  double r = 0.5;         // roughness (clamped)
-  double coat_r = -1.0;   // the clear coat's roughness about n; < 0: no coat
+  int light = 0;         // index into the lights
+  glm::dvec3 p, n, v;    // the point, its unit shading normal, the unit direction toward the view
+  double r = 0.5;        // roughness (clamped)
+  double coat_r = -1.0;  // the clear coat's roughness about n; < 0: no coat
 };
 
 // Per unit luminance (AreaLanes): the vector irradiance's direction l and size e, the diffuse lobe's

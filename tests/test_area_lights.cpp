@@ -173,7 +173,8 @@ TEST(AreaLights, TheLoaderPlacesThemByTheirNodes) {
                                     {"rotation", {-0.7071067811865476, 0, 0, 0.7071067811865476}},
                                     {"scale", {2, 1, 0.5}},
                                     {"extensions", {{"EXT_lights_area", {{"light", 0}}}}}}));
-    roots.push_back(g.add("nodes", {{"translation", {0, 0, 2}}, {"extensions", {{"EXT_lights_area", {{"light", 1}}}}}}));
+    roots.push_back(
+        g.add("nodes", {{"translation", {0, 0, 2}}, {"extensions", {{"EXT_lights_area", {{"light", 1}}}}}}));
     g.doc["extensionsUsed"] = {"EXT_lights_area"};
     g.doc["extensions"]["EXT_lights_area"]["lights"] = {first, {{"type", "disk"}, {"size", 2.0}}};
     g.scene(roots);
@@ -181,12 +182,15 @@ TEST(AreaLights, TheLoaderPlacesThemByTheirNodes) {
   };
   const nlohmann::json key = {{"type", "rect"}, {"intensity", 250.0}, {"size", 0.5}, {"rect", {{"aspect", 3.0}}}};
   const test::CliRun info = test::run("info " + file(key, "area"));
-  EXPECT_NE(info.output.find("rect, node 1 (unnamed), color (1, 1, 1), intensity 250 nits"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("rect, node 1 (unnamed), color (1, 1, 1), intensity 250 nits"), std::string::npos)
+      << info.output;
   EXPECT_NE(info.output.find("toward (0, -1, 0), 3 x 1 m"), std::string::npos) << info.output;
   EXPECT_NE(info.output.find("disk, node 2 (unnamed), color (1, 1, 1), intensity 1000 nits"), std::string::npos);
   EXPECT_NE(info.output.find("diameter 2 m"), std::string::npos) << info.output;
   const std::string out = dir + "/out";
-  ASSERT_EQ(test::run("render " + file(key, "area") + " -q --views 2 --view-size 32x16 --display 64x36 --out " + out).status, 0);
+  ASSERT_EQ(
+      test::run("render " + file(key, "area") + " -q --views 2 --view-size 32x16 --display 64x36 --out " + out).status,
+      0);
   const std::string sidecar = test::read_file(out + "/frame_0000.json");
   EXPECT_NE(sidecar.find("\"type\": \"rect\""), std::string::npos) << sidecar;
   EXPECT_NE(sidecar.find("\"width\": 3.0"), std::string::npos) << sidecar;
@@ -197,7 +201,8 @@ TEST(AreaLights, TheLoaderPlacesThemByTheirNodes) {
       {{{"type", "disk"}, {"intensity", -1}}, "intensity must be a finite number >= 0"},
       {{{"type", "rect"}, {"rect", {{"aspect", "wide"}}}}, "aspect must be a number above 0"}};
   for (const auto& [light, message] : bad)
-    test::expect_one_error_line(test::run("info " + file(light, "bad")), std::string("EXT_lights_area light 0 ") + message);
+    test::expect_one_error_line(test::run("info " + file(light, "bad")),
+                                std::string("EXT_lights_area light 0 ") + message);
   std::filesystem::remove_all(dir);
 }
 

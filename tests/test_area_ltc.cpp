@@ -113,11 +113,11 @@ void compute_kernels(std::vector<Case>& cases) {
     l.type = c.light.disk ? PMR_LIGHT_DISK : PMR_LIGHT_RECT;
     const glm::dvec3 toward = glm::normalize(glm::cross(c.light.u, c.light.v));  // where it emits
     for (int k = 0; k < 3; ++k)
-      l.position[k] = float(c.light.center[k]), l.direction[k] = float(toward[k]), l.half_width[k] = float(c.light.u[k]),
-      l.half_height[k] = float(c.light.v[k]);
+      l.position[k] = float(c.light.center[k]), l.direction[k] = float(toward[k]),
+      l.half_width[k] = float(c.light.u[k]), l.half_height[k] = float(c.light.v[k]);
     l.color[0] = l.color[1] = l.color[2] = 1.0f;
-    at.push_back({int(lights.size()), glm::dvec3(0.0), n, rotate(glm::dvec3(std::sqrt(1.0 - c.nv * c.nv), 0.0, c.nv)),
-                  c.r});
+    at.push_back(
+        {int(lights.size()), glm::dvec3(0.0), n, rotate(glm::dvec3(std::sqrt(1.0 - c.nv * c.nv), 0.0, c.nv)), c.r});
     lights.push_back(l);
   }
   const std::vector<test::AreaProbeResult> got = test::probe_area_lights(lights, at);
@@ -306,8 +306,9 @@ TEST(AreaLtc, SpecularLimits) {
       l.position[k] = center[k], l.direction[k] = toward[k], l.half_width[k] = u[k], l.half_height[k] = w[k];
     return l;
   };
-  const std::vector<PmrLight> lights = {rect({-0.6f, 0.0f, 0.8f}, {0.3f, 0.0f, 0.0f}, {0.0f, 0.3f, 0.0f}),  // emits upward
-                                        rect({0.0f, 0.0f, 1.0f}, {0.0f, 1e3f, 0.0f}, {1e3f, 0.0f, 0.0f})};
+  const std::vector<PmrLight> lights = {
+      rect({-0.6f, 0.0f, 0.8f}, {0.3f, 0.0f, 0.0f}, {0.0f, 0.3f, 0.0f}),  // emits upward
+      rect({0.0f, 0.0f, 1.0f}, {0.0f, 1e3f, 0.0f}, {1e3f, 0.0f, 0.0f})};
   const std::vector<test::AreaProbeResult> got =
       test::probe_area_lights(lights, {{0, glm::dvec3(0.0), n, v, 0.4}, {1, glm::dvec3(0.0), n, v, 0.4}});
   EXPECT_EQ(got[0].lobe, 0.0);

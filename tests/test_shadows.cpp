@@ -119,7 +119,8 @@ std::vector<float> probe(const ShadowMaps& m, const SceneLight& light, const std
   std::memcpy(bits.data(), m.depth.data(), bits.size() * 4);
   std::vector<float> out(at.size());
   ClKernel k(program, "shadow_probe");
-  ClBuffer maps = rt.upload(m.maps, "maps"), depth = rt.upload(bits, "depth"), l = rt.upload(std::vector<PmrLight>{d}, "light");
+  ClBuffer maps = rt.upload(m.maps, "maps"), depth = rt.upload(bits, "depth"),
+           l = rt.upload(std::vector<PmrLight>{d}, "light");
   ClBuffer a = rt.upload(in, "probe in"), b = rt.buffer(out.size() * 4, "probe out");
   k.args(maps, depth, l, a, b, cl_uint(at.size()));
   clReleaseEvent(rt.launch(k, at.size(), 64));
@@ -137,8 +138,8 @@ double texel_at(const ShadowMaps& m, const SceneLight& light, const glm::dvec3& 
   }
   const PmrShadowMap& s = m.maps[k];
   if (!s.perspective) return s.texel;
-  return s.texel * glm::dot(p - glm::dvec3(s.origin[0], s.origin[1], s.origin[2]),
-                            glm::dvec3(s.axis[0], s.axis[1], s.axis[2]));
+  return s.texel *
+         glm::dot(p - glm::dvec3(s.origin[0], s.origin[1], s.origin[2]), glm::dvec3(s.axis[0], s.axis[1], s.axis[2]));
 }
 
 // Whether the exact visibility of `exact` changes within distance h across the light (unit l toward
@@ -178,8 +179,8 @@ size_t expect_hard_shadow(const Scene& s, const SceneLight& light, const std::ve
     if (std::abs(v[i] - e) <= 0.5) continue;
     const double h = texel_at(m, light, at[i].p);
     if (!near_shadow_edge(s, exact, at[i], l, h) && ++displaced <= 5)
-      ADD_FAILURE() << "V " << v[i] << " at (" << at[i].p.x << ", " << at[i].p.y << ", " << at[i].p.z
-                    << "), exactly " << e << " within a texel (" << h << ") around";
+      ADD_FAILURE() << "V " << v[i] << " at (" << at[i].p.x << ", " << at[i].p.y << ", " << at[i].p.z << "), exactly "
+                    << e << " within a texel (" << h << ") around";
   }
   const double mean = sum / double(compared);
   EXPECT_LE(mean, 0.02);
@@ -249,7 +250,8 @@ TEST(Shadows, MaskBlendAndGlassCastWhatTheyBlock) {
   blend.alpha_mode = PMR_ALPHA_BLEND, blend.base_color[3] = 0.5f;
   glass.transmission = 0.7f;
   s.materials.insert(s.materials.end(), {mask, blend, glass});
-  const int checker = test::add_texture16(s, [](int x, int y) { return glm::dvec4(1, 1, 1, ((x / 4 + y / 4) % 2) ? 1.0 : 0.0); });
+  const int checker =
+      test::add_texture16(s, [](int x, int y) { return glm::dvec4(1, 1, 1, ((x / 4 + y / 4) % 2) ? 1.0 : 0.0); });
   test::base_colour_texture(s, 1, checker);
   s.material_inputs[3].has_transmission = true, s.material_inputs[3].transmission = 0.7f;  // the factors drawn
   const float x0[3] = {-1.2f, -0.3f, 0.5f};
@@ -315,7 +317,8 @@ double exact_soft_visibility(const Scene& s, const SceneLight& light, const glm:
   if (is_area_light(light)) return exact_area_visibility(s, light, p, n);
   const bool sun = light.type == SceneLightType::Directional;
   const glm::dvec3 axis = sun ? -light.direction : glm::normalize(light.position - p);
-  const glm::dvec3 x = glm::normalize(glm::cross(axis, std::abs(axis.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
+  const glm::dvec3 x =
+      glm::normalize(glm::cross(axis, std::abs(axis.y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0)));
   const glm::dvec3 y = glm::cross(axis, x);
   const double r = sun ? std::tan(0.5 * light.angle) : double(light.radius);
   auto lit = [&](double u, double v) {
@@ -417,7 +420,8 @@ TEST(Shadows, NoGapAtContact) {
   for (double d = 1.0; d <= 6.0; d += 0.25)
     for (double z = -0.2; z <= 0.2; z += 0.05) at.push_back({{0.25 + d * texel, -0.5, z}, {0, 1, 0}});
   const std::vector<float> v = probe(m, s.lights[0], at);
-  for (size_t i = 0; i < at.size(); ++i) EXPECT_LT(v[i], 0.5f) << "at x = 0.25 + " << (at[i].p.x - 0.25) / texel << " texels";
+  for (size_t i = 0; i < at.size(); ++i)
+    EXPECT_LT(v[i], 0.5f) << "at x = 0.25 + " << (at[i].p.x - 0.25) / texel << " texels";
 }
 
 // The shaded result: every covered voxel of the box on the plane under a sun equals the reference's
@@ -469,7 +473,9 @@ void every_path_gives_the_same_shadows(const SceneLight& light);
 // A rect area light of 0.6 m x 0.4 m, 1.6 m over the plane of box_on_plane_facing_the_camera and off to
 // the side of the box, facing the plane.
 SceneLight rect_over_the_turned_plane() {
-  auto turn = [](glm::dvec3 v) { return glm::dvec3(v.x, 0.5 * v.y - std::sqrt(0.75) * v.z, std::sqrt(0.75) * v.y + 0.5 * v.z); };
+  auto turn = [](glm::dvec3 v) {
+    return glm::dvec3(v.x, 0.5 * v.y - std::sqrt(0.75) * v.z, std::sqrt(0.75) * v.y + 0.5 * v.z);
+  };
   SceneLight l;
   l.type = SceneLightType::Rect, l.intensity = 30.0f;
   l.position = turn({0.3, 1.1, 0.1}), l.direction = glm::normalize(turn({-0.2, -1.0, 0.0}));
@@ -572,7 +578,8 @@ TEST(Shadows, LightSizesAreReadFromTheLightsExtras) {
     g.mesh(nlohmann::json::array({{{"attributes", {{"POSITION", p}}}}}));
     std::vector<int> roots = {g.add("nodes", {{"mesh", 0}})};
     for (int i = 0; i < 2; ++i)
-      roots.push_back(g.add("nodes", {{"translation", {0, 0, 2}}, {"extensions", {{"KHR_lights_punctual", {{"light", i}}}}}}));
+      roots.push_back(
+          g.add("nodes", {{"translation", {0, 0, 2}}, {"extensions", {{"KHR_lights_punctual", {{"light", i}}}}}}));
     g.doc["extensionsUsed"] = {"KHR_lights_punctual"};
     g.doc["extensions"]["KHR_lights_punctual"]["lights"] = {
         {{"type", "point"}, {"intensity", 5.0}, {"extras", {{"pmr_radius", radius}}}},
@@ -584,7 +591,9 @@ TEST(Shadows, LightSizesAreReadFromTheLightsExtras) {
   EXPECT_NE(info.output.find("radius 0.1 m (soft shadows)"), std::string::npos) << info.output;
   EXPECT_NE(info.output.find("angle 1.14592 deg (soft shadows)"), std::string::npos) << info.output;
   const std::string out = dir + "/out";
-  ASSERT_EQ(test::run("render " + file(0.1, "sized") + " -q --views 2 --view-size 32x16 --display 64x36 --out " + out).status, 0);
+  ASSERT_EQ(
+      test::run("render " + file(0.1, "sized") + " -q --views 2 --view-size 32x16 --display 64x36 --out " + out).status,
+      0);
   const std::string sidecar = test::read_file(out + "/frame_0000.json");
   EXPECT_NE(sidecar.find("\"radius\": 0.1"), std::string::npos);
   EXPECT_NE(sidecar.find("\"angle\": 0.0199999"), std::string::npos) << sidecar;  // 0.02 in single precision

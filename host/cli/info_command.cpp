@@ -121,8 +121,11 @@ void describe_lights(const Scene& s) {
                        "): " + type + ", node " + std::to_string(l.node) + " " + quoted(l.node_name) + ", color (" +
                        number(l.color[0]) + ", " + number(l.color[1]) + ", " + number(l.color[2]) + "), intensity " +
                        number(l.intensity) +
-                       (l.type == SceneLightType::Directional ? " lux" : area ? " nits" : " cd");
-    if (l.type != SceneLightType::Directional && !area) line += l.range > 0 ? ", range " + number(l.range) : ", no range";
+                       (l.type == SceneLightType::Directional ? " lux"
+                        : area                                ? " nits"
+                                                              : " cd");
+    if (l.type != SceneLightType::Directional && !area)
+      line += l.range > 0 ? ", range " + number(l.range) : ", no range";
     if (l.type == SceneLightType::Spot)
       line += ", cones inner " + number(l.inner_cone * 180.0 / 3.14159265358979323846) + " deg outer " +
               number(l.outer_cone * 180.0 / 3.14159265358979323846) + " deg";
@@ -156,7 +159,8 @@ void describe_default_frame_work(const Scene& s, const InputLimits& limits) {
   PipelineConfig config;
   config.samples = 4;
   const Rig rig = make_rig(RigConfig(), Display(), lo, hi);
-  const FrameWork work = estimate_frame_work(s, rig, light_evaluations_per_point(s.lights), config, shadow_cost(s.lights, config.shadow_sizes));
+  const FrameWork work = estimate_frame_work(s, rig, light_evaluations_per_point(s.lights), config,
+                                             shadow_cost(s.lights, config.shadow_sizes));
   std::printf("frame work at paper-8k: %s; the limit is %llu (--limit frame-work; docs/SECURITY.md)\n",
               describe_frame_work(work).c_str(), (unsigned long long)limits.frame_work);
 }

@@ -119,10 +119,10 @@ void SceneBuffers::upload_frame(const FrameDescription& frame, const std::vector
 
 cl_uint SceneBuffers::bind_shading(ClKernel& k, const ClBuffer& params, const ShadowBinding& shadows,
                                    const SourceBinding& source) const {
-  const ClBuffer* inputs[] = {&params,     &tris_,       &attrs_,        &materials_,  &textures_,  &texels_,
-                              &lut_,       &positions_,  &eyes_,         &split_sum_,  &ltc_,         &sheen_albedo_,
-                              &texcoords_, &tangents_,   &env_,          &env_data_,   &lights_,
-                              shadows.maps, shadows.depth, source.data,  source.info,  source.tiles};
+  const ClBuffer* inputs[] = {&params,       &tris_,      &attrs_,     &materials_, &textures_, &texels_,
+                              &lut_,         &positions_, &eyes_,      &split_sum_, &ltc_,      &sheen_albedo_,
+                              &texcoords_,   &tangents_,  &env_,       &env_data_,  &lights_,   shadows.maps,
+                              shadows.depth, source.data, source.info, source.tiles};
   cl_uint i = 0;
   for (const ClBuffer* b : inputs) k.arg(i++, *b);
   return i;

@@ -74,7 +74,8 @@ void local_maps(const SceneLight& l, const glm::dvec3& origin, const glm::dvec3&
   // a cube: +X, -X, +Y, -Y, +Z, -Z (cl/lights.h picks the face of the major axis)
   const glm::dvec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   const glm::dvec3 rights[6] = {{0, 0, -1}, {0, 0, 1}, {1, 0, 0}, {1, 0, 0}, {1, 0, 0}, {-1, 0, 0}};
-  for (int f = 0; f < 6; ++f) maps.push_back(perspective_map(origin, axes[f], rights[f], 1.0 + 4.0 / size, near_z, size));
+  for (int f = 0; f < 6; ++f)
+    maps.push_back(perspective_map(origin, axes[f], rights[f], 1.0 + 4.0 / size, near_z, size));
 }
 
 // Sample i of k on the unit disk, uniform in area (Vogel's spiral: radius sqrt((i + 1/2) / k), turned
@@ -188,7 +189,8 @@ ShadowCost shadow_cost(const std::vector<SceneLight>& lights, const ShadowSizes&
   for (size_t i = 0; i < lights.size() && i < size_t(kMaxShadowedLights); ++i) {
     std::vector<PmrShadowMap> maps;
     light_maps(lights[i], glm::dvec3(-1.0), glm::dvec3(1.0), sizes, maps);
-    c.maps += maps.size(), c.texels += shadow_texels(maps), c.lookups_per_point += has_size(lights[i]) ? kShadowSamples : 1;
+    c.maps += maps.size(), c.texels += shadow_texels(maps),
+        c.lookups_per_point += has_size(lights[i]) ? kShadowSamples : 1;
   }
   return c;
 }
@@ -241,8 +243,8 @@ void ShadowStage::place(bool on, const std::vector<SceneLight>& lights, const Sc
   rt_.rewrite(maps_buffer_, maps_, "shadow maps");
 }
 
-void ShadowStage::render(const SceneBuffers& scene, const PmrParams& P, const SourceBinding& source,
-                         FrameEvents& ev, bool warm) {
+void ShadowStage::render(const SceneBuffers& scene, const PmrParams& P, const SourceBinding& source, FrameEvents& ev,
+                         bool warm) {
   rt_.write(params_, &P, sizeof P);
   const cl_uint next = scene.bind_shading(raster_, params_, binding(), source);
   if (warm) {  // one launch of each kernel, so that frames compile nothing

@@ -37,10 +37,11 @@ static_assert(sizeof(PmrEnvironment) == 48 + 16 * PMR_ENV_MAX_LEVELS && offsetof
                   offsetof(PmrEnvironment, levels) == 48,
               "PmrEnvironment layout");
 static_assert(offsetof(PmrParams, num_lights) == 280, "PmrParams layout");
-static_assert(sizeof(PmrLight) == 96 && offsetof(PmrLight, half_width) == 64 && offsetof(PmrLight, half_height) == 80 && offsetof(PmrLight, type) == 12 && offsetof(PmrLight, range) == 28 &&
+static_assert(sizeof(PmrLight) == 96 && offsetof(PmrLight, half_width) == 64 && offsetof(PmrLight, half_height) == 80 &&
+                  offsetof(PmrLight, type) == 12 && offsetof(PmrLight, range) == 28 &&
                   offsetof(PmrLight, direction) == 32 && offsetof(PmrLight, cos_outer) == 48,
               "PmrLight layout");
-static_assert(sizeof(PmrShadowMap) == 80 && offsetof(PmrShadowMap, offset) == 12 && offsetof(PmrShadowMap, size) == 28 &&
-                  offsetof(PmrShadowMap, perspective) == 44 && offsetof(PmrShadowMap, texel) == 60 &&
-                  offsetof(PmrShadowMap, near_z) == 64,
+static_assert(sizeof(PmrShadowMap) == 80 && offsetof(PmrShadowMap, offset) == 12 &&
+                  offsetof(PmrShadowMap, size) == 28 && offsetof(PmrShadowMap, perspective) == 44 &&
+                  offsetof(PmrShadowMap, texel) == 60 && offsetof(PmrShadowMap, near_z) == 64,
               "PmrShadowMap layout");

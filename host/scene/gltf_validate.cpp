@@ -52,11 +52,11 @@ constexpr uint64_t kJsonBytesPerValue = 200;
 // reader already accepts; KHR_texture_transform is applied per texture slot; the material and light
 // extensions are read into the scene (DESIGN 4b, 4c).
 bool extension_supported(const std::string& name) {
-  return name == "KHR_mesh_quantization" || name == "KHR_texture_transform" || name == "KHR_lights_punctual" || name == "EXT_lights_area" ||
-         name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit" || name == "KHR_materials_ior" ||
-         name == "KHR_materials_transmission" || name == "KHR_materials_volume" || name == "KHR_materials_variants" ||
-         name == "KHR_materials_clearcoat" || name == "KHR_materials_specular" || name == "KHR_materials_anisotropy" ||
-         name == "KHR_materials_iridescence" || name == "KHR_materials_sheen";
+  return name == "KHR_mesh_quantization" || name == "KHR_texture_transform" || name == "KHR_lights_punctual" ||
+         name == "EXT_lights_area" || name == "KHR_materials_emissive_strength" || name == "KHR_materials_unlit" ||
+         name == "KHR_materials_ior" || name == "KHR_materials_transmission" || name == "KHR_materials_volume" ||
+         name == "KHR_materials_variants" || name == "KHR_materials_clearcoat" || name == "KHR_materials_specular" ||
+         name == "KHR_materials_anisotropy" || name == "KHR_materials_iridescence" || name == "KHR_materials_sheen";
 }
 
 uint32_t read_u32le(const unsigned char* p) {
@@ -214,8 +214,8 @@ double area_number(const std::string& path, const std::string& where, const json
   const json* v = member(parent, key);
   if (!v) return fallback;
   if (!v->is_number() || !(v->get<double>() > 0.0 && v->get<double>() <= limit))
-    fail(path, where + " " + key + " must be a number above 0 and at most " + one_line(json(limit).dump()) +
-                   " (is " + one_line(v->dump(), true) + ")");
+    fail(path, where + " " + key + " must be a number above 0 and at most " + one_line(json(limit).dump()) + " (is " +
+                   one_line(v->dump(), true) + ")");
   return v->get<double>();
 }
 
@@ -241,14 +241,15 @@ void read_area_lights(const std::string& path, const json& doc, SourceFile& src)
     if (t == "rect") out.type = SceneLightType::Rect;
     else if (t == "disk") out.type = SceneLightType::Disk;
     else
-      fail(path, where + (type ? " has unknown type " + (type->is_string() ? "'" + one_line(t, true) + "'"
-                                                                             : std::string("(not a string)")) +
-                                     " (rect or disk expected)"
-                               : std::string(" has no type")));
+      fail(path,
+           where + (type ? " has unknown type " +
+                               (type->is_string() ? "'" + one_line(t, true) + "'" : std::string("(not a string)")) +
+                               " (rect or disk expected)"
+                         : std::string(" has no type")));
     read_light_color(path, where, l, out);
     const json* intensity = member(l, "intensity");
-    if (intensity && !(intensity->is_number() && intensity->get<double>() >= 0.0 &&
-                       std::isfinite(intensity->get<double>())))
+    if (intensity &&
+        !(intensity->is_number() && intensity->get<double>() >= 0.0 && std::isfinite(intensity->get<double>())))
       fail(path, where + " intensity must be a finite number >= 0 (is " + one_line(intensity->dump(), true) + ")");
     out.intensity = float(intensity ? intensity->get<double>() : 1000.0);
     out.size = float(area_number(path, where, l, "size", 1.0, 1e6));

@@ -156,10 +156,8 @@ IndexChoice parse_index_choice(const std::string& choice, size_t count, const st
   const std::string digits = choice.substr(1);
   if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos)
     c.problem = "'#' starts an index (#0, #1, ...), and '" + printable_text(digits, 12) + "' is not a number";
-  else if (std::stoul(digits) >= count)
-    c.problem = "the scene has " + std::to_string(count) + " " + things;
-  else
-    c.index = int(std::stoul(digits));
+  else if (std::stoul(digits) >= count) c.problem = "the scene has " + std::to_string(count) + " " + things;
+  else c.index = int(std::stoul(digits));
   return c;
 }
 
@@ -183,17 +181,21 @@ int find_camera(const Scene& scene, const std::string& name) {
     if (!index.problem.empty()) throw Error(shown + ": " + index.problem);
     return index.index;
   }
-  throw Error(shown + ": no camera node or camera of the scene has that name" +
-              unnamed_choice_hint(name, "pmr info"));
+  throw Error(shown + ": no camera node or camera of the scene has that name" + unnamed_choice_hint(name, "pmr info"));
 }
 
 const char* light_type_name(SceneLightType type) {
   switch (type) {
-    case SceneLightType::Directional: return "directional";
-    case SceneLightType::Point: return "point";
-    case SceneLightType::Spot: return "spot";
-    case SceneLightType::Rect: return "rect";
-    case SceneLightType::Disk: return "disk";
+    case SceneLightType::Directional:
+      return "directional";
+    case SceneLightType::Point:
+      return "point";
+    case SceneLightType::Spot:
+      return "spot";
+    case SceneLightType::Rect:
+      return "rect";
+    case SceneLightType::Disk:
+      return "disk";
   }
   return "unknown";
 }

@@ -47,7 +47,9 @@ uint64_t blend_voxel_bound(const glm::dvec3 (&p)[3], const Rig& rig, const glm::
 uint64_t light_evaluations_per_point(const std::vector<SceneLight>& lights) {
   uint64_t n = 0;
   for (const SceneLight& l : lights)
-    n += l.type == SceneLightType::Rect ? kRectLightEvaluations : l.type == SceneLightType::Disk ? kDiskLightEvaluations : 1;
+    n += l.type == SceneLightType::Rect   ? kRectLightEvaluations
+         : l.type == SceneLightType::Disk ? kDiskLightEvaluations
+                                          : 1;
   return n;
 }
 
@@ -83,8 +85,8 @@ std::string describe_frame_work(const FrameWork& f) {
          " light evaluation(s) a point) and at most " + std::to_string(f.blend_fragments) + " BLEND fragments x " +
          std::to_string(f.samples) + " sample(s)" +
          (f.shadow_reads + f.shadow_map_triangles > 0
-              ? ", " + std::to_string(f.shadow_reads) + " shadow map reads and " + std::to_string(f.shadow_map_triangles) +
-                    " shadow map triangles"
+              ? ", " + std::to_string(f.shadow_reads) + " shadow map reads and " +
+                    std::to_string(f.shadow_map_triangles) + " shadow map triangles"
               : std::string());
 }
 

@@ -32,7 +32,7 @@ struct FrameWork {
   uint64_t light_evaluations = 0;  // (pixels + blend_fragments) x lights
   uint64_t shadow_reads = 0;       // (pixels + blend_fragments) x maps read per point
   uint64_t shadow_map_triangles = 0, shadow_texels = 0;  // map passes x triangles; texels cleared
-  uint64_t units = 0;              // the weighted sum the budget limits
+  uint64_t units = 0;                                    // the weighted sum the budget limits
 };
 
 // An area light costs a point's shading as much as this many point-like lights (its polygon integrated

@@ -62,9 +62,11 @@ inline float clipped_cosine_integral(const float3* q, int count, float3 n) {
 
 /* The light's shape about the lanes' points p: its vertices minus p in q (the rect's 4; a disk's
  * PMR_DISK_SIDES on the circle of radius r sqrt(2 pi / (n sin(2 pi / n))), the polygon of the disk's
- * area), counted, and the lanes in front of its emitting side (*front). */
+ * area; a distant light's vertices as they are, the same for every p), counted, and the lanes in front
+ * of its emitting side (*front). */
 inline int area_polygon_lanes(global const PmrLight* light, sfloat3 p, sfloat3* q, sint* front) {
-  const sfloat3 c = s3_sub(s3_splat(vload3(0, light->position)), p);
+  /* a distant light's shape lies at distance 1 toward `position` from every point alike */
+  const sfloat3 at = s3_splat(vload3(0, light->position)), c = light->distant ? at : s3_sub(at, p);
   const float3 u = vload3(0, light->half_width), w = vload3(0, light->half_height);
   *front = s3_dot(c, s3_splat(vload3(0, light->direction))) < 0.0f;
   if (light->type == PMR_LIGHT_RECT) {

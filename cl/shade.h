@@ -75,7 +75,7 @@ inline LightSums light_table_lanes(const ShadeInputs* in, const LaneWinners* L, 
                            vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, S->p, &l);
     }
     if (light->shadow >= 0) /* (--shadows off: E as before, bit for bit) */
-      E = s3_scale(E, shadow_visibility_lanes(in->shadow_maps, in->shadow_depth, light, S->p, L->face, L->act));
+      E = s3_scale(E, shadow_visibility_lanes(in->shadow_maps, in->shadow_depth, light, S->p, L->face, S->n, L->act));
     /* an area light's lobes are integrated over its shape, but for anisotropic lanes (a point at l) */
     sfloat3 f = area ? area_brdf(S, &A, transmission, irid) : s3_splat((float3)(0.0f));
     if (!area || aniso) {

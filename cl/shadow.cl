@@ -5,7 +5,7 @@
  * texel's optical depth in fixed point (an integer sum) and their depth to its nearest translucent
  * depth. So a map does not depend on the order in which triangles arrive. MASK casters are
  * alpha-tested at each texel. Rendered once per frame, before any fine raster, and read by the shading
- * of every view (cl/lights.h, shadow_visibility). */
+ * of every view (cl/lights.h, shadow_visibility_lanes). */
 #include "shade.h"
 
 #define PMR_SHADOW_EMPTY 0x7f800000u /* +infinity: no caster */

@@ -116,6 +116,15 @@ std::shared_ptr<Environment> sky_environment(double rotation_deg, double intensi
   return e;
 }
 
+Scene white_rough_square() {
+  Scene s = empty_scene(true);
+  s.materials[0].metallic = 0.0f, s.materials[0].roughness = 1.0f;
+  for (float& c : s.materials[0].base_color) c = 1.0f;
+  add_triangle(s, {-1.0f, -1.0f, 0.0f}, {1.0f, -1.0f, 0.0f}, {1.0f, 1.0f, 0.0f});
+  add_triangle(s, {-1.0f, -1.0f, 0.0f}, {1.0f, 1.0f, 0.0f}, {-1.0f, 1.0f, 0.0f});
+  return s;
+}
+
 int add_texture16(Scene& s, const std::function<glm::dvec4(int, int)>& f) {
   SceneTexture t;
   t.width = t.height = 16;

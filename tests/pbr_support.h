@@ -78,6 +78,8 @@ ref::EnvironmentTerms image_environment(const Environment& e);
 // A 64x32 sky: a gradient, a darker ground and one sun texel about 1000 times brighter (tests/
 // environment_maps.h), seen in reflection by the default rig's camera on +Z.
 std::shared_ptr<Environment> sky_environment(double rotation_deg, double intensity);
+// A white rough dielectric (roughness 1, double-sided) square of side 2 at z = 0, facing the camera.
+Scene white_rough_square();
 
 // Appends a 16 x 16 texture whose texel (x, y) is f(x, y) (RGBA in [0, 1], rounded to 8 bits); its index.
 int add_texture16(Scene& s, const std::function<glm::dvec4(int, int)>& f);

@@ -2,6 +2,7 @@
 // line and write nothing, the sidecar records the environment, and --resume notices when it changes.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -105,7 +106,15 @@ TEST(EnvironmentCli, StudioByDefaultUniformByNameAndFilesByPath) {
   EXPECT_EQ(s["environment"]["kind"], "studio");
   EXPECT_EQ(s["environment"]["rotation_deg"], 20.0);
   EXPECT_EQ(s["environment"]["intensity"], 1.0);
-  EXPECT_EQ(s["lights"], nlohmann::json::array()) << "the studio lights the default scene alone";
+  // the studio lights the default scene alone: its four boxes drawn as lights (shadows on), turned with
+  // it (counter-clockwise seen from above: the key box, at -X 15 degrees above the horizon, toward +Z)
+  ASSERT_EQ(s["lights"].size(), 4u) << "the studio lights the default scene alone";
+  const double a = 20.0 * M_PI / 180.0, e = 15.0 * M_PI / 180.0;
+  const nlohmann::json key = s["lights"][1];
+  EXPECT_EQ(key["name"], "studio key");
+  EXPECT_NEAR(key["position"][0].get<double>(), -std::cos(a) * std::cos(e), 1e-6);
+  EXPECT_NEAR(key["position"][1].get<double>(), std::sin(e), 1e-6);
+  EXPECT_NEAR(key["position"][2].get<double>(), std::sin(a) * std::cos(e), 1e-6);
   expect_one_error_line(run("render" + kSmall + " --environment uniform --resume --out '" + out + "'"),
                         "shading differs");
 

@@ -660,11 +660,7 @@ TEST(PbrEnvironment, IntensityScalesAndZeroTurnsOff) {
 // studio alone: no default light comes with it.
 TEST(PbrEnvironment, TheStudioLightsAWhiteRoughDielectricFacingTheCameraAt08To1) {
   const Rig rig = test::small_rig(5, 40, 24);
-  Scene s = test::empty_scene(true);
-  s.materials[0].metallic = 0.0f, s.materials[0].roughness = 1.0f;
-  for (float& c : s.materials[0].base_color) c = 1.0f;
-  test::add_triangle(s, {-1.0f, -1.0f, 0.0f}, {1.0f, -1.0f, 0.0f}, {1.0f, 1.0f, 0.0f});
-  test::add_triangle(s, {-1.0f, -1.0f, 0.0f}, {1.0f, 1.0f, 0.0f}, {-1.0f, 1.0f, 0.0f});
+  const Scene s = test::white_rough_square();
   const auto studio = std::make_shared<const Environment>(Environment::studio());
   const test::Rendered out = render_environment(s, rig, studio);
   size_t covered = 0;

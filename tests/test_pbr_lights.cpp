@@ -188,7 +188,8 @@ TEST(PbrLightsSidecar, ResumeComparesTheLightsOfEachFrame) {
   const std::string out = test::temp_dir("pbr_lights_resume"), in = test::temp_dir("pbr_lights_resume_scene");
   fs::create_directories(in);
   const std::string scene = lights_scene(in, 2.0);
-  const std::string args = " '" + scene + "' --shading pbr --fps 1" + kSmall + "--out " + out;
+  // (shadows off: with them the studio's boxes follow the file's lights, TheDefaultLightAndLambert)
+  const std::string args = " '" + scene + "' --shading pbr --shadows off --fps 1" + kSmall + "--out " + out;
   CliRun r = run("render --frames 0:1" + args);
   ASSERT_EQ(r.status, 0) << r.output;
   for (int f : {0, 1}) {
@@ -223,11 +224,24 @@ TEST(PbrLightsSidecar, ResumeComparesTheLightsOfEachFrame) {
 }
 
 // Without lights in the file, pbr records the default light (toward light_dir_world) with the uniform
-// environment, and none with the studio (the default) or an image; the file's lights stay with an
+// environment; with the studio (the default) the four soft boxes it draws as distant lights with
+// shadows on, and none with shadows off or an image without a sun; the file's lights stay with an
 // image; lambert records none.
 TEST(PbrLightsSidecar, TheDefaultLightAndLambert) {
   const std::string out = test::temp_dir("pbr_lights_default");
   CliRun r = run("render --shading pbr" + kSmall + "--out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const json boxes = sidecar_at(out + "/frame_0000.json").at("shading").at("lights");
+  ASSERT_EQ(boxes.size(), 4u);
+  for (const json& b : boxes) {
+    EXPECT_EQ(b.at("source"), "environment");
+    EXPECT_EQ(b.at("distant"), true);
+    EXPECT_FALSE(b.contains("node"));
+  }
+  EXPECT_EQ(boxes[0].at("name"), "studio ceiling");
+  EXPECT_EQ(boxes[0].at("type"), "disk");
+  EXPECT_EQ(boxes[0].at("position"), json({0.0, 1.0, 0.0}));
+  r = run("render --shading pbr --shadows off --overwrite" + kSmall + "--out " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(sidecar_at(out + "/frame_0000.json").at("shading").at("lights"), json::array());
   r = run("render --shading pbr --environment uniform --overwrite" + kSmall + "--out " + out);
@@ -242,15 +256,23 @@ TEST(PbrLightsSidecar, TheDefaultLightAndLambert) {
   fs::create_directories(in);
   const std::string sky = in + "/sky.exr";
   test::write_exr(sky, test::make_map(64, 32, test::sun_sky));
+  // the sky's sun is taken out as a light with shadows on (test_environment_lights.cpp), not with them off
   r = run("render --shading pbr --environment '" + sky + "'" + kSmall + "--out " + out);
+  ASSERT_EQ(r.status, 0) << r.output;
+  const json sun = sidecar_at(out + "/frame_0000.json").at("shading").at("lights");
+  ASSERT_EQ(sun.size(), 1u);
+  EXPECT_EQ(sun[0].at("source"), "environment");
+  EXPECT_EQ(sun[0].at("name"), "environment light 1");
+  r = run("render --shading pbr --shadows off --environment '" + sky + "'" + kSmall + "--overwrite --out " + out);
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_EQ(sidecar_at(out + "/frame_0000.json").at("shading").at("lights"), json::array());
   r = run("render '" + lights_scene(in, 2.0) + "' --shading pbr --environment '" + sky + "' --frames 1 --fps 1" +
           kSmall + "--out " + out + "_image");
   ASSERT_EQ(r.status, 0) << r.output;
   const json file_lights = sidecar_at(out + "_image/frame_0001.json").at("shading").at("lights");
-  ASSERT_EQ(file_lights.size(), 2u);
+  ASSERT_EQ(file_lights.size(), 3u);
   EXPECT_EQ(file_lights[0].at("position"), json({1.0, 0.0, 1.0}));
+  EXPECT_EQ(file_lights[2].at("source"), "environment");
   r = run("render '" + lights_scene(in, 2.0) + "' --shading pbr --environment '" + sky +
           "' --frames 1 --fps 1 --resume" + kSmall + "--out " + out + "_image");
   EXPECT_NE(r.output.find("nothing to do"), std::string::npos) << r.output;

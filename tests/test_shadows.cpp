@@ -13,6 +13,7 @@
 #include "reference/shade_reference.h"
 #include "reference/visibility_reference.h"
 #include "shading/lights.h"
+#include "shading/studio_environment.h"
 #include "test_util.h"
 
 namespace pmr {
@@ -105,13 +106,12 @@ struct Receiver {
   glm::dvec3 p, n;
 };
 
-// cl/lights.h's shadow_visibility of the scene's one light at each receiver (tests/probes/shadow_probe.cl).
+// cl/lights.h's shadow_visibility_lanes of the scene's one light at each receiver (tests/probes/shadow_probe.cl).
 std::vector<float> probe(const ShadowMaps& m, const SceneLight& light, const std::vector<Receiver>& at) {
   const ClRuntime& rt = test::runtime();
   const ClProgram program = rt.build_program({"shadow_probe.cl"}, "-cl-std=CL1.2", &test_kernel_sources());
   PmrLight d = device_light(light);
-  const bool sized = has_size(light);
-  d.shadow = 0, d.shadow_maps = int(m.maps.size()), d.shadow_samples = sized ? kShadowSamples : 1;
+  d.shadow = 0, d.shadow_maps = int(m.maps.size()), d.shadow_samples = shadow_samples(light);
   std::vector<float> in;
   for (const Receiver& r : at)
     for (const glm::dvec3& v : {r.p, r.n}) in.insert(in.end(), {float(v.x), float(v.y), float(v.z)});
@@ -293,11 +293,12 @@ double exact_area_visibility(const Scene& s, const SceneLight& light, const glm:
   double on = 0.0, all = 0.0;
   auto add = [&](double u, double v) {
     const glm::dvec3 q = light.position + 0.5 * u * light.width * light.right + 0.5 * v * light.height * light.up;
-    const glm::dvec3 d = q - p;
-    const double len = glm::length(d);
+    // a distant light's shape lies at distance 1 in every direction from p: a ray to infinity
+    const glm::dvec3 d = light.distant ? q : q - p;
+    const double len = glm::length(d), far = light.distant ? 1e300 : len;
     const double w = std::max(0.0, -glm::dot(d, light.direction) / len) * std::max(0.0, d.y / len) / (len * len);
     all += w;
-    if (w > 0.0 && ref::transmittance(s, p, d / len, 1e-7, len) > 0.5) on += w;
+    if (w > 0.0 && ref::transmittance(s, p, d / len, 1e-7, far) > 0.5) on += w;
   };
   // the center and the rim agreeing: fully lit or fully shadowed (the occluders here are large)
   for (int k = 0; k < 8; ++k) add(std::cos(k * M_PI / 4), std::sin(k * M_PI / 4));
@@ -362,8 +363,10 @@ TEST(Shadows, SoftShadowsMatchTheExactFraction) {
   disk.width = disk.height = 2.0 * sphere.radius;
   SceneLight rect = disk;
   rect.type = SceneLightType::Rect, rect.width = rect.height = std::sqrt(M_PI) * sphere.radius;
-  for (const SceneLight& light : {sphere, wide_sun, disk, rect}) {
-    SCOPED_TRACE(light_type_name(light.type));
+  // the studio's ceiling (a distant disk) and its key box (a distant rect, 15 degrees above the horizon)
+  const std::vector<SceneLight> boxes = studio_box_lights();
+  for (const SceneLight& light : {sphere, wide_sun, disk, rect, boxes[0], boxes[1]}) {
+    SCOPED_TRACE(light.distant ? light.name : light_type_name(light.type));
     Scene s = base;
     s.lights = {light};
     const ShadowMaps m = render_maps(s);
@@ -380,8 +383,8 @@ TEST(Shadows, SoftShadowsMatchTheExactFraction) {
     const double mean = sum / double(at.size());
     EXPECT_LE(mean, 0.03);
     EXPECT_GT(at.size(), 300u);
-    std::printf("[ shadows  ] %s: %zu penumbra receivers, mean |V error| %.4f\n", light_type_name(light.type),
-                at.size(), mean);
+    std::printf("[ shadows  ] %s: %zu penumbra receivers, mean |V error| %.4f\n",
+                light.distant ? light.name.c_str() : light_type_name(light.type), at.size(), mean);
   }
 }
 

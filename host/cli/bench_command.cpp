@@ -210,8 +210,8 @@ int run_bench(const std::vector<std::string>& args) {
     if (!*csv) throw Error("cannot write " + printable_text(o.csv) + ": " + write_failure(errno));
   }
   if (o.shading == Shading::Pbr) {  // made once, before the first point
-    o.environment =
-        make_pipeline_environment({o.environment_source, o.environment_rotation_deg, o.environment_intensity});
+    o.environment = make_pipeline_environment(
+        {o.environment_source, o.environment_rotation_deg, o.environment_intensity, o.shadows});
     std::printf("# environment %s\n", environment_summary(o.environment_source, o.environment.get()).c_str());
   }
   set_memory_budget(o.limits.memory);

@@ -39,8 +39,9 @@ int run_samples_quality(const std::vector<int>& samples, const std::vector<std::
   RenderOptions o = parse_render_options(rest);
   finalize_render_options(o);
   if (o.job.pipeline.shading == Shading::Pbr)
-    o.job.pipeline.environment = make_pipeline_environment(
-        {o.job.environment, o.job.environment_rotation_deg, o.job.pipeline.environment_intensity});
+    o.job.pipeline.environment =
+        make_pipeline_environment({o.job.environment, o.job.environment_rotation_deg,
+                                   o.job.pipeline.environment_intensity, o.job.pipeline.shadows});
   if (o.job.scene.empty()) o.job.scene = default_scene_path();
   const Scene scene = load_scene(o.job.scene);
   ClRuntime rt;

@@ -77,9 +77,10 @@ json vec3_json(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }
 // point and spot lights, the cone angles (radians) for spots, an area light's axes (right, up: its
 // width and height run along them) and world width and height (a disk's: its diameter).
 json light_json(const SceneLight& l) {
-  const bool is_default = is_default_light(l);
-  json j = {{"name", bounded_text(l.name)}, {"source", is_default ? "default" : "file"}};
-  if (!is_default) j["light"] = l.light, j["node"] = l.node;
+  const bool is_default = is_default_light(l), from_file = !is_default && !l.distant;
+  json j = {{"name", bounded_text(l.name)}, {"source", is_default ? "default" : from_file ? "file" : "environment"}};
+  if (from_file) j["light"] = l.light, j["node"] = l.node;
+  if (l.distant) j["distant"] = true;  // position: the unit direction toward it; its shape at distance 1
   j["type"] = light_type_name(l.type);
   j["color"] = {double(l.color[0]), double(l.color[1]), double(l.color[2])};
   j["intensity"] = double(l.intensity);

@@ -126,7 +126,7 @@ FrameDescription describe_frame(const Rig& rig, const std::vector<SceneLight>& s
                                 const PipelineConfig& config) {
   FrameDescription f;
   f.rig = rig;
-  if (config.shading == Shading::Pbr) f.lights = resolve_lights(scene_lights, rig, !config.environment);
+  if (config.shading == Shading::Pbr) f.lights = resolve_lights(scene_lights, rig, config.environment.get());
   return f;
 }
 

@@ -28,6 +28,10 @@ constexpr int kMaxShadowedLights = 64;
 // (Shadows.SoftShadowsMatchTheExactFraction), mean |V error| over the penumbra: 16 samples at half
 // size 0.031 and 0.030, 32 at half size 0.022 and 0.021, 32 at a quarter 0.024 and 0.025.
 constexpr int kShadowSamples = 32;
+// The samples light l's shadows take: 1 for a point-like light. The studio's boxes, 20 to 28 degrees
+// wide, take kShadowSamples too: with 16 the key box's mean |V error| is 0.038 (at a quarter of the
+// sizes) and 0.041 (at an eighth); with 32 at an eighth 0.029.
+inline int shadow_samples(const SceneLight& l) { return has_size(l) ? kShadowSamples : 1; }
 
 // What the shadows of `lights` cost a frame (as placed with `sizes`, before any halving): the map
 // passes (each over every triangle), their texels, and the maps one shaded point reads (one per

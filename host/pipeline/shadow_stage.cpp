@@ -115,7 +115,8 @@ glm::dvec2 disk_to_square(const glm::dvec2& d) {
   return {b * (2.0 - std::atan2(d.y / b, d.x / b) * quarter), b};
 }
 
-// Sample point i of k on light l's shape: a point of its sphere (point, spot), of its rect or disk.
+// Sample point i of k on light l's shape: a point of its sphere (point, spot), of its rect or disk (a
+// distant light's: on its shape at distance 1, so the direction toward that point of it).
 glm::dvec3 light_point(const SceneLight& l, int i, int k) {
   if (!is_area_light(l)) return l.position + double(l.radius) * ball_sample(i, k);
   const glm::dvec2 s = l.type == SceneLightType::Rect ? disk_to_square(disk_sample(i, k)) : disk_sample(i, k);
@@ -123,19 +124,22 @@ glm::dvec3 light_point(const SceneLight& l, int i, int k) {
 }
 
 // The maps of light l: one per sample of its size (kShadowSamples for a light with a size, at a quarter of
-// the point-like sizes), each a directional light's map along a direction of its apparent disk, or a
+// the point-like sizes), each a directional light's map along a direction of its apparent disk (a
+// distant area light's: toward a point of its shape at distance 1), or a
 // point or spot light's from a point of its sphere, or an area light's (a cube) from a point of its
 // shape.
 void light_maps(const SceneLight& l, const glm::dvec3& lo, const glm::dvec3& hi, const ShadowSizes& sizes,
                 std::vector<PmrShadowMap>& maps) {
-  const bool directional = l.type == SceneLightType::Directional;
+  const bool directional = l.type == SceneLightType::Directional || l.distant;
   const bool sized = has_size(l);
-  const int samples = sized ? kShadowSamples : 1;
+  const int samples = shadow_samples(l);
   const int size = std::max(kMinShadowSize / 2, (directional ? sizes.directional : sizes.local) / (sized ? 4 : 1));
   glm::dvec3 x, y;
   frame_about(l.direction, x, y);
   for (int i = 0; i < samples; ++i) {
-    if (directional) {
+    if (l.distant) {
+      maps.push_back(orthographic_map(-glm::normalize(light_point(l, i, samples)), lo, hi, size));
+    } else if (directional) {
       const glm::dvec2 d = sized ? disk_sample(i, samples) * std::tan(0.5 * double(l.angle)) : glm::dvec2(0.0);
       maps.push_back(orthographic_map(glm::normalize(l.direction + d.x * x + d.y * y), lo, hi, size));
     } else {
@@ -173,7 +177,7 @@ std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& light
     slots[i].first = int(maps.size());
     light_maps(l, lo, hi, sizes, maps);
     slots[i].count = int(maps.size()) - slots[i].first;
-    slots[i].samples = has_size(l) ? kShadowSamples : 1;
+    slots[i].samples = shadow_samples(l);
   }
   uint64_t offset = 0;
   for (PmrShadowMap& m : maps) {
@@ -189,8 +193,7 @@ ShadowCost shadow_cost(const std::vector<SceneLight>& lights, const ShadowSizes&
   for (size_t i = 0; i < lights.size() && i < size_t(kMaxShadowedLights); ++i) {
     std::vector<PmrShadowMap> maps;
     light_maps(lights[i], glm::dvec3(-1.0), glm::dvec3(1.0), sizes, maps);
-    c.maps += maps.size(), c.texels += shadow_texels(maps),
-        c.lookups_per_point += has_size(lights[i]) ? kShadowSamples : 1;
+    c.maps += maps.size(), c.texels += shadow_texels(maps), c.lookups_per_point += uint64_t(shadow_samples(lights[i]));
   }
   return c;
 }

@@ -1,6 +1,6 @@
 // The frame's shadow maps (DESIGN section 4d): each light's maps placed over the box of the scene's
 // posed geometry, rendered once per frame before any fine raster (cl/shadow.cl), and read by the shading
-// of every view, every path and every product (cl/lights.h, shadow_visibility), so a shadow costs one
+// of every view, every path and every product (cl/lights.h, shadow_visibility_lanes), so a shadow costs one
 // pass per light whatever the number of views. This stage owns the maps and their depths.
 #pragma once
 #include <cstdint>

@@ -136,8 +136,8 @@ void SequenceRun::load_inputs() {
     };
   if (job_.pipeline.shading == Shading::Pbr) {
     const EnvironmentSource& source = job_.environment;
-    pc_.environment =
-        make_pipeline_environment({source, job_.environment_rotation_deg, job_.pipeline.environment_intensity});
+    pc_.environment = make_pipeline_environment(
+        {source, job_.environment_rotation_deg, job_.pipeline.environment_intensity, job_.pipeline.shadows});
     if (source.kind == EnvironmentSource::Kind::File) environment_checksum_ = checksum_file(source.file);
     if (job_.verbose)
       std::fprintf(stderr, "pmr: environment %s\n", environment_summary(source, pc_.environment.get()).c_str());
@@ -393,9 +393,8 @@ void SequenceRun::print_frame_stages(long f, const FrameRenderer::Frame& fr, con
       "pmr: frame %ld: pose %.2f ms, upload %.2f ms; stage times (ms): shadow maps %.2f, vertex %.2f, setup %.2f, "
       "tile raster %.2f, fine raster%s %.2f, %s %.2f; %u MTAs, %llu tile-queue entries, %d queue regrowth(s)",
       f, fr.pose_ms, fr.upload_ms, fr.times.shadow, fr.times.vertex, fr.times.setup, fr.times.bin,
-      tiled_encode ? encode_label : "",
-      fr.times.fine, tiled_encode ? "straddling alpha" : "encode", fr.times.encode, fr.times.mtas,
-      (unsigned long long)fr.times.bin_entries, fr.times.retries);
+      tiled_encode ? encode_label : "", fr.times.fine, tiled_encode ? "straddling alpha" : "encode", fr.times.encode,
+      fr.times.mtas, (unsigned long long)fr.times.bin_entries, fr.times.retries);
   progress.message(line);
 }
 

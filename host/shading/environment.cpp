@@ -9,8 +9,10 @@
 
 #include "pmr/error.h"
 #include "pmr/printable.h"
+#include "shading/environment_lights.h"
 #include "shading/environment_prefilter.h"
 #include "shading/sheen.h"
+#include "shading/studio_environment.h"
 
 namespace pmr {
 namespace {
@@ -100,6 +102,33 @@ Environment Environment::studio() {
   return e;
 }
 
+Environment Environment::studio_walls() {
+  Environment e = from_image(studio_walls_image(), "studio walls");
+  e.distant_ = studio_box_lights();
+  return e;
+}
+
+Environment Environment::with_lights_taken_out(EnvironmentImage image, const std::string& name) {
+  check_environment_image(image, name);
+  std::vector<SceneLight> lights = take_out_bright_regions(image);
+  Environment e = from_image(image, name);
+  e.distant_ = std::move(lights);
+  return e;
+}
+
+std::vector<SceneLight> Environment::distant_lights() const {
+  const double c = tables_.header.rotation_cos, s = tables_.header.rotation_sin;
+  // the map turned by +angle shows at d what the image holds at d turned by -angle (level_sample): a
+  // box at b is seen at b turned by +angle
+  const auto turn = [c, s](const glm::dvec3& b) { return glm::dvec3(c * b.x + s * b.z, b.y, c * b.z - s * b.x); };
+  std::vector<SceneLight> out = distant_;
+  for (SceneLight& l : out) {
+    l.position = turn(l.position), l.direction = turn(l.direction), l.right = turn(l.right), l.up = turn(l.up);
+    l.intensity = float(double(l.intensity) * double(tables_.header.intensity));
+  }
+  return out;
+}
+
 EnvironmentSource EnvironmentSource::parse(const std::string& text) {
   if (text.empty()) throw Error("invalid --environment '': expected studio, uniform or a .hdr or .exr file");
   if (text == "studio") return {Kind::Studio, ""};
@@ -124,9 +153,10 @@ void check_rotation_and_intensity(const EnvironmentOptions& o) {
 Environment Environment::make(const EnvironmentOptions& o) {
   check_rotation_and_intensity(o);
   const EnvironmentSource& s = o.source;
-  Environment e = s.kind == EnvironmentSource::Kind::Studio    ? studio()
+  Environment e = s.kind == EnvironmentSource::Kind::Studio    ? (o.take_out_lights ? studio_walls() : studio())
                   : s.kind == EnvironmentSource::Kind::Uniform ? uniform(o.uniform_radiance)
-                                                               : from_image(load_environment_image(s.file), s.file);
+                  : o.take_out_lights ? with_lights_taken_out(load_environment_image(s.file), s.file)
+                                      : from_image(load_environment_image(s.file), s.file);
   e.set_rotation(o.rotation_deg);
   e.set_intensity(o.intensity);
   return e;
@@ -145,7 +175,11 @@ std::string environment_summary(const EnvironmentSource& source, const Environme
   const EnvTablesHeader& h = e->tables().header;
   char line[160];
   const double mb = double(e->tables().data.size() * sizeof(float)) / 1e6;
-  if (source.kind == EnvironmentSource::Kind::Studio)
+  if (source.kind == EnvironmentSource::Kind::Studio && !e->distant_lights().empty())
+    std::snprintf(line, sizeof line,
+                  ": walls %ux%u, prefiltered in %.3f s (%.1f MB of tables), and %zu boxes as lights",
+                  h.levels[0].width, h.levels[0].height, e->prefilter_seconds(), mb, e->distant_lights().size());
+  else if (source.kind == EnvironmentSource::Kind::Studio)
     std::snprintf(line, sizeof line, ": %ux%u, prefiltered when pmr was built (%.1f MB of tables)", h.levels[0].width,
                   h.levels[0].height, mb);
   else

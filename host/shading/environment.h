@@ -80,6 +80,7 @@
 
 #include <glm/glm.hpp>
 
+#include "pmr/scene.h"
 #include "pmr/shared.h"
 
 namespace pmr {
@@ -142,8 +143,12 @@ struct EnvironmentSource {
 
 struct EnvironmentOptions {
   EnvironmentSource source;
-  double rotation_deg = 0.0;      // counter-clockwise seen from above
-  double intensity = 1.0;         // >= 0; 0 turns the environment off
+  double rotation_deg = 0.0;  // counter-clockwise seen from above
+  double intensity = 1.0;     // >= 0; 0 turns the environment off
+  // With shadows on (DESIGN 4d) the studio's boxes (Environment::studio_walls) and an image's
+  // brightest regions (take_out_bright_regions) are taken out and drawn as shadowed distant lights;
+  // off keeps them in the image.
+  bool take_out_lights = false;
   double uniform_radiance = 0.2;  // the radiance of the uniform environment (DESIGN 4b: 0.2)
 };
 
@@ -156,6 +161,12 @@ class Environment {
   // The built-in studio (studio_environment.h), prefiltered at build time: from_image of
   // studio_environment_image(), bit for bit, without the wait.
   static Environment studio();
+  // The studio's walls alone (studio_walls_image, prefiltered here: a 128 x 64 image takes a few ms),
+  // with its boxes as distant_lights(): what the studio is with shadows on.
+  static Environment studio_walls();
+  // An image (checked here) with its brightest regions taken out as distant_lights()
+  // (take_out_bright_regions, shading/environment_lights.h), the rest prefiltered.
+  static Environment with_lights_taken_out(EnvironmentImage image, const std::string& name);
   // studio(), uniform() or load_environment_image + from_image as the source says; then the rotation
   // and intensity (which must be finite, intensity >= 0).
   static Environment make(const EnvironmentOptions& options);
@@ -168,8 +179,12 @@ class Environment {
   glm::dvec3 radiance(const glm::dvec3& d) const;                 // the map: P(d, 0)
   glm::dvec3 irradiance(const glm::dvec3& n) const;               // I(n) = P(n, 1)
   glm::dvec3 prefiltered(const glm::dvec3& d, double r) const;    // P(d, r), r clamped to [0, 1]
-  glm::dvec3 sheen(const glm::dvec3& d, double s) const;           // S(d, s), s clamped to [0.07, 1]
+  glm::dvec3 sheen(const glm::dvec3& d, double s) const;          // S(d, s), s clamped to [0.07, 1]
   glm::dvec3 level_sample(int level, const glm::dvec3& d) const;  // one level, bilinear
+
+  // The lights taken out of the environment (studio_walls' boxes, an image's bright regions; none
+  // otherwise), world space: turned by the rotation and scaled by the intensity as the tables are.
+  std::vector<SceneLight> distant_lights() const;
 
   const EnvironmentTables& tables() const { return tables_; }
   double prefilter_seconds() const { return prefilter_seconds_; }  // wall time of from_image
@@ -177,6 +192,7 @@ class Environment {
  private:
   EnvironmentTables tables_;
   double prefilter_seconds_ = 0.0;
+  std::vector<SceneLight> distant_;  // unrotated, at intensity 1
 };
 
 // The environment a run's pipelines share (PipelineConfig::environment), made once: null for the

@@ -19,12 +19,15 @@ SceneLight default_light(const glm::dvec3& toward) {
   return l;
 }
 
-bool is_default_light(const SceneLight& light) { return light.light < 0 && light.node < 0; }
+bool is_default_light(const SceneLight& light) { return light.light < 0 && light.node < 0 && !light.distant; }
 
-std::vector<SceneLight> resolve_lights(const std::vector<SceneLight>& scene_lights, const Rig& rig, bool use_default) {
-  if (!scene_lights.empty()) return scene_lights;
-  if (use_default) return {default_light(rig.light_world())};
-  return {};
+std::vector<SceneLight> resolve_lights(const std::vector<SceneLight>& scene_lights, const Rig& rig,
+                                       const Environment* environment) {
+  std::vector<SceneLight> out = scene_lights;
+  if (out.empty() && !environment) out.push_back(default_light(rig.light_world()));
+  if (environment)
+    for (SceneLight& l : environment->distant_lights()) out.push_back(std::move(l));
+  return out;
 }
 
 PmrLight device_light(const SceneLight& light) {
@@ -47,6 +50,7 @@ PmrLight device_light(const SceneLight& light) {
   // the loader guarantees 0 <= inner < outer <= pi / 2; unused for other types
   d.cos_inner = float(std::cos(double(light.inner_cone)));
   d.cos_outer = float(std::cos(double(light.outer_cone)));
+  d.distant = light.distant ? 1u : 0u;
   d.shadow = -1;  // unshadowed until shadow maps are placed (ShadowStage)
   d.shadow_samples = 1;
   return d;

@@ -8,6 +8,7 @@
 #include "pmr/rig.h"
 #include "pmr/scene.h"
 #include "pmr/shared.h"
+#include "shading/environment.h"
 
 namespace pmr {
 
@@ -17,10 +18,11 @@ namespace pmr {
 SceneLight default_light(const glm::dvec3& toward);
 bool is_default_light(const SceneLight& light);
 
-// The lights of a frame: `scene_lights` (posed, world space) when there are any; else the default light
-// when `use_default` (false when an environment image is given: that image lights the scene); else
-// none.
-std::vector<SceneLight> resolve_lights(const std::vector<SceneLight>& scene_lights, const Rig& rig, bool use_default);
+// The lights of a frame: `scene_lights` (posed, world space), or the default light when there are
+// none and no environment image lights the scene (`environment` null: the uniform one); then the
+// environment's distant lights (the studio's boxes with shadows on).
+std::vector<SceneLight> resolve_lights(const std::vector<SceneLight>& scene_lights, const Rig& rig,
+                                       const Environment* environment);
 
 // The kernels' light table entry of a resolved light (colour x intensity, cosines of the cone angles,
 // an area light's half extents, single precision).

@@ -106,8 +106,8 @@ struct SceneMaterialInputs {
   float iridescence_thickness[2] = {100.0f, 400.0f};  // iridescenceThicknessMinimum, ...Maximum (nm, >= 0)
   // KHR_materials_sheen (pbr): a layer of fibres over the material (the Charlie lobe)
   bool has_sheen = false;
-  float sheen_color[3] = {0.0f, 0.0f, 0.0f};  // sheenColorFactor (linear, validated to [0, 1])
-  float sheen_roughness = 0.0f;               // sheenRoughnessFactor (validated to [0, 1])
+  float sheen_color[3] = {0.0f, 0.0f, 0.0f};          // sheenColorFactor (linear, validated to [0, 1])
+  float sheen_roughness = 0.0f;                       // sheenRoughnessFactor (validated to [0, 1])
   std::array<SceneTextureSlot, kTextureSlots> slots;  // indexed by SceneTextureSlotKind
   std::vector<std::string> unimplemented;  // material extensions present but not drawn (warned once per scene)
 };
@@ -123,9 +123,9 @@ struct SceneLight {
   int node = 0;           // the node that places it
   std::string node_name;  // that node's name in the file
   SceneLightType type = SceneLightType::Directional;
-  float color[3] = {1.0f, 1.0f, 1.0f};                  // linear
-  float intensity = 1.0f;  // directional: lux; point and spot: candela; rect and disk: nits (cd/m^2)
-  float range = 0.0f;                                   // 0 = not given (no window); point and spot only
+  float color[3] = {1.0f, 1.0f, 1.0f};  // linear
+  float intensity = 1.0f;               // directional: lux; point and spot: candela; rect and disk: nits (cd/m^2)
+  float range = 0.0f;                   // 0 = not given (no window); point and spot only
   float inner_cone = 0.0f, outer_cone = 0.7853981634f;  // spot: radians, 0 <= inner < outer <= pi / 2
   glm::dvec3 position{0.0};                             // the node's origin
   glm::dvec3 direction{0.0, 0.0, -1.0};                 // unit, the node's -Z: where the light shines
@@ -141,6 +141,11 @@ struct SceneLight {
   float size = 1.0f, aspect = 1.0f;
   glm::dvec3 right{1.0, 0.0, 0.0}, up{0.0, 1.0, 0.0};
   double width = 1.0, height = 1.0;
+  // A distant area light (a patch of directions at infinity taken out of the environment, such as the
+  // studio's soft boxes; DESIGN 4d): its shape lies on the plane tangent to the unit sphere at
+  // `position`, the unit direction toward its centre (direction = -position), and is seen from every
+  // point alike. Shadowed as a directional light of that size. light = node = -1.
+  bool distant = false;
 };
 
 // The light type's name as glTF spells it ("directional", "point", "spot", "rect", "disk").

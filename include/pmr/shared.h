@@ -343,9 +343,12 @@ typedef struct {
   pmr_i32 shadow_samples; /* a light with a size: the points (or directions) sampled on it, whose hard
                              visibilities are averaged; 1 for a point-like light */
   float half_width[3];    /* rect, disk: the half extents of the emitting shape along its plane's axes */
-  pmr_u32 pad0;           /* (world space; a disk's are equal: its radius), centred on `position`, */
+  pmr_u32 distant;        /* (world space; a disk's are equal: its radius), centred on `position`, */
   float half_height[3];   /* emitting along `direction` (= half_height x half_width, normalized)   */
   pmr_u32 pad1;
+  /* distant (1): a patch of directions at infinity (SceneLight::distant): `position` is the unit
+     direction toward its centre, the shape lies on the plane tangent to the unit sphere there and
+     is seen alike from every point */
 } PmrLight;
 
 /* One shadow map (DESIGN section 4d), rendered once per frame and read by every view: depth along

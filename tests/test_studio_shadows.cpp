@@ -94,6 +94,10 @@ TEST(StudioShadows, BoxLightsTurnAndScaleWithTheStudio) {
       EXPECT_LT(glm::length(glm::cross(turned[i].right, turned[i].up) - turned[i].position), 1e-6);
     }
   }
+  // turned off (Blender's black world), it brings no lights to shade or to shadow
+  Environment off = Environment::studio_walls();
+  off.set_intensity(0.0);
+  EXPECT_TRUE(off.distant_lights().empty());
 }
 
 // V = 1 gives the studio: the walls' irradiance plus the boxes' (integrated numerically over each box

@@ -117,6 +117,9 @@ Environment Environment::with_lights_taken_out(EnvironmentImage image, const std
 }
 
 std::vector<SceneLight> Environment::distant_lights() const {
+  // an environment turned off (intensity 0, e.g. Blender's black world) brings no lights: nothing to
+  // shade, and no shadow maps to render
+  if (tables_.header.intensity == 0.0f) return {};
   const double c = tables_.header.rotation_cos, s = tables_.header.rotation_sin;
   // the map turned by +angle shows at d what the image holds at d turned by -angle (level_sample): a
   // box at b is seen at b turned by +angle

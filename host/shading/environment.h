@@ -183,7 +183,8 @@ class Environment {
   glm::dvec3 level_sample(int level, const glm::dvec3& d) const;  // one level, bilinear
 
   // The lights taken out of the environment (studio_walls' boxes, an image's bright regions; none
-  // otherwise), world space: turned by the rotation and scaled by the intensity as the tables are.
+  // otherwise), world space: turned by the rotation and scaled by the intensity as the tables are;
+  // none at intensity 0.
   std::vector<SceneLight> distant_lights() const;
 
   const EnvironmentTables& tables() const { return tables_; }

@@ -13,6 +13,7 @@
 #include "sequence/frame_renderer.h"
 #include "sequence/frame_work.h"
 #include "pipeline/pipeline_config.h"
+#include "shading/studio_environment.h"
 
 namespace pmr {
 
@@ -151,16 +152,18 @@ std::string camera_use(const SceneCamera& c, size_t index) {
 }
 
 // The frame-work estimate of a frame at the defaults (paper-8k: 96 views of 1024x512, 4 samples, pbr
-// shading under the studio, which adds no light to the file's, the rest pose framed): the light part
-// exact, the BLEND part an upper bound.
+// shading under the studio with shadows on, whose soft boxes are lights besides the file's, the rest
+// pose framed): the light part exact, the BLEND part an upper bound.
 void describe_default_frame_work(const Scene& s, const InputLimits& limits) {
   glm::dvec3 lo(-1.0), hi(1.0);
   scene_bounds(s, lo, hi);
   PipelineConfig config;
   config.samples = 4;
   const Rig rig = make_rig(RigConfig(), Display(), lo, hi);
-  const FrameWork work = estimate_frame_work(s, rig, light_evaluations_per_point(s.lights), config,
-                                             shadow_cost(s.lights, config.shadow_sizes));
+  std::vector<SceneLight> lights = s.lights;
+  for (SceneLight& box : studio_box_lights()) lights.push_back(std::move(box));
+  const FrameWork work = estimate_frame_work(s, rig, light_evaluations_per_point(lights), config,
+                                             shadow_cost(lights, config.shadow_sizes));
   std::printf("frame work at paper-8k: %s; the limit is %llu (--limit frame-work; docs/SECURITY.md)\n",
               describe_frame_work(work).c_str(), (unsigned long long)limits.frame_work);
 }

@@ -40,7 +40,7 @@ double over_shape(const SceneLight& l, int n, F f) {
 // a 2048 x 1024 image within 35 degrees of the box's centre counts with the fraction f of it the box
 // covers (the image is antialiased: texel = f box + (1 - f) walls, the walls image giving the second).
 double image_solid_angle(const SceneLight& l) {
-  const EnvironmentImage img = studio_environment_image(2048), walls = studio_walls_image(2048);
+  static const EnvironmentImage img = studio_environment_image(2048), walls = studio_walls_image(2048);
   double sum = 0.0;
   for (int j = 0; j < img.height; ++j)
     for (int i = 0; i < img.width; ++i) {

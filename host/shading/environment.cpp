@@ -178,16 +178,17 @@ std::string environment_summary(const EnvironmentSource& source, const Environme
   const EnvTablesHeader& h = e->tables().header;
   char line[160];
   const double mb = double(e->tables().data.size() * sizeof(float)) / 1e6;
-  if (source.kind == EnvironmentSource::Kind::Studio && !e->distant_lights().empty())
-    std::snprintf(line, sizeof line,
-                  ": walls %ux%u, prefiltered in %.3f s (%.1f MB of tables), and %zu boxes as lights",
-                  h.levels[0].width, h.levels[0].height, e->prefilter_seconds(), mb, e->distant_lights().size());
-  else if (source.kind == EnvironmentSource::Kind::Studio)
+  // the built-in studio's tables come with pmr; its walls (shadows on) and images are prefiltered here
+  if (e->prefilter_seconds() == 0.0)
     std::snprintf(line, sizeof line, ": %ux%u, prefiltered when pmr was built (%.1f MB of tables)", h.levels[0].width,
                   h.levels[0].height, mb);
   else
     std::snprintf(line, sizeof line, ": %ux%u, prefiltered in %.2f s (%.1f MB of tables)", h.levels[0].width,
                   h.levels[0].height, e->prefilter_seconds(), mb);
+  const size_t lights = e->distant_lights().size();
+  if (lights > 0)
+    return printable_text(source.name()) + line + ", " + std::to_string(lights) +
+           " region(s) taken out as shadowed lights";
   return printable_text(source.name()) + line;
 }
 

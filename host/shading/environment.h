@@ -161,7 +161,7 @@ class Environment {
   // The built-in studio (studio_environment.h), prefiltered at build time: from_image of
   // studio_environment_image(), bit for bit, without the wait.
   static Environment studio();
-  // The studio's walls alone (studio_walls_image, prefiltered here: a 128 x 64 image takes a few ms),
+  // The studio's walls alone (studio_walls_image, prefiltered here: 0.27-0.31 s on 2 cores),
   // with its boxes as distant_lights(): what the studio is with shadows on.
   static Environment studio_walls();
   // An image (checked here) with its brightest regions taken out as distant_lights()
@@ -188,7 +188,7 @@ class Environment {
   std::vector<SceneLight> distant_lights() const;
 
   const EnvironmentTables& tables() const { return tables_; }
-  double prefilter_seconds() const { return prefilter_seconds_; }  // wall time of from_image
+  double prefilter_seconds() const { return prefilter_seconds_; }  // wall time of from_image; 0: studio()'s
 
  private:
   EnvironmentTables tables_;

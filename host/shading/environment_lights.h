@@ -25,9 +25,11 @@ constexpr double kMaxRegionSolidAngle = 0.1;  // sr: a cap of 10 degrees' radius
 constexpr double kMinRegionShare = 0.05;
 constexpr int kMaxEnvironmentLights = 4;
 
-// Takes the regions of `image` (checked: finite, non-negative) out by the rule above, in place (the
-// image's decoding budget covers it; the rule needs 2 bytes a texel more), and returns them as distant
-// disks (SceneLight::distant), unrotated, at intensity 1.
+// Takes the regions of `image` (checked: finite, non-negative) out by the rule above, in place, and
+// returns them as distant disks (SceneLight::distant), unrotated, at intensity 1. Memory: two bytes a
+// texel (the bright and seen maps) and the bright texels' indices (at most 5% of the texels), beside
+// the decoded image's 12: within the kEnvBytesPerTexel charged before decoding, whose peak is the
+// prefilter's, later.
 std::vector<SceneLight> take_out_bright_regions(EnvironmentImage& image);
 
 }  // namespace pmr

@@ -25,10 +25,10 @@ inline sfloat3 environment_reflectance(sfloat3 f0, sfloat f90, sfloat A, sfloat 
 /* KHR_materials_clearcoat's layering (its specification's fresnel_coat): the material's colour `under`
  * seen through a coat of intensity c and ior 1.5, mix(under, coat lobe, c Fc), Fc = 0.04 + 0.96
  * (1 - |coat_n . v|)^5; the coat lobe is `lights` (the GGX lobe about coat_n of roughness coat_r with no
- * Fresnel of its own, summed over the lights) plus ao (A + B) P(reflect(-v, coat_n), coat_r). Lanes
- * without a coat keep `under` bit for bit. */
+ * Fresnel of its own, summed over the lights) plus ao V (A + B) P(reflect(-v, coat_n), coat_r), V the
+ * environment's visibility env_v (1 without shadows). Lanes without a coat keep `under` bit for bit. */
 inline sfloat3 coated_lanes(const ShadeInputs* in, const LaneWinners* L, const Surface* S, sfloat3 under,
-                            sfloat3 lights) {
+                            sfloat3 lights, sfloat env_v) {
   const sfloat nv = s3_dot(S->coat_n, S->v);
   const sfloat k = 1.0f - fmin(fabs(nv), 1.0f), k2 = k * k;
   const sfloat w = S->coat * (0.04f + 0.96f * (k2 * k2 * k));
@@ -36,7 +36,7 @@ inline sfloat3 coated_lanes(const ShadeInputs* in, const LaneWinners* L, const S
   split_sum_lanes(in->split_sum, nv, S->coat_r, &A, &B);
   const sint act = L->act & L->coated;
   const sfloat3 env = environment_along(in, s3_sub(s3_scale(S->coat_n, 2.0f * nv), S->v), S->coat_r, act);
-  const sfloat3 coat = s3_add(lights, s3_scale(env, S->ao * (A + B)));
+  const sfloat3 coat = s3_add(lights, s3_scale(env, S->ao * env_v * (A + B)));
   return s3_select(under, s3_add(s3_scale(under, 1.0f - w), s3_scale(coat, w)), L->coated);
 }
 
@@ -62,9 +62,11 @@ inline sfloat3 sheen_view_scaled(const Sheen* s, sfloat3 x) {
 
 /* KHR_materials_sheen over the environment, in the lanes with sheen: `under` (the environment's, the
  * transmission's and the emission's light through the layer) scaled as the view sees it
- * (sheen_view_scaled), plus the sheen's environment term ao c E(n.v) S(reflect(-v, n), r) (the
- * Charlie-prefiltered levels; the uniform default's radiance without an image). */
-inline sfloat3 sheen_over_environment(const ShadeInputs* in, const LaneWinners* L, const Surface* S, sfloat3 under) {
+ * (sheen_view_scaled), plus the sheen's environment term ao V c E(n.v) S(reflect(-v, n), r) (the
+ * Charlie-prefiltered levels; the uniform default's radiance without an image), V the environment's
+ * diffuse visibility env_v (1 without shadows). */
+inline sfloat3 sheen_over_environment(const ShadeInputs* in, const LaneWinners* L, const Surface* S, sfloat3 under,
+                                      sfloat env_v) {
   const Sheen* s = &S->sheen;
   sfloat3 light = s3_splat((float3)(in->P->env_radiance));
   if (in->env->level_count != 0) {
@@ -72,7 +74,7 @@ inline sfloat3 sheen_over_environment(const ShadeInputs* in, const LaneWinners* 
     environment_uv(in, s3_sub(s3_scale(S->n, 2.0f * s3_dot(S->n, S->v)), S->v), L->act, &u, &v);
     light = env_sheen(in->env, in->env_data, u, v, s->r);
   }
-  return s3_add(sheen_view_scaled(s, under), s3_scale(s3_mul(s->color, light), S->ao * s->e_v));
+  return s3_add(sheen_view_scaled(s, under), s3_scale(s3_mul(s->color, light), S->ao * env_v * s->e_v));
 }
 
 #endif

@@ -158,4 +158,31 @@ inline sfloat shadow_visibility_lanes(global const PmrShadowMap* maps, global co
   return select(select(sum / weight, first, none), (sfloat)(1.0f), ~act);
 }
 
+/* The environment's occlusion (DESIGN section 4d; host/shading/environment_occlusion.h) at the lanes'
+ * points p of face normals ng, seen on the side of shading normals n (`act`; 1 elsewhere), from the
+ * light table's entry `occ`: one orthographic map along each of its directions d toward the environment,
+ * of weight w (the environment's radiance about d). *diffuse: the directions' visibilities weighted by
+ * w max(n.d, 0); *specular: weighted by that times exp(sharpness (r.d - 1)), a lobe about the reflected
+ * direction r (unit). Directions below the face's horizon are not read; where no direction weighs
+ * anything the visibility is 1. The maps' lookups are the same in every view; r and the lobe are the
+ * view's. */
+inline void environment_visibility_lanes(global const PmrShadowMap* maps, global const uint* depth,
+                                         global const PmrLight* occ, sfloat3 p, sfloat3 ng, sfloat3 n, sfloat3 r,
+                                         sfloat sharpness, sint act, sfloat* diffuse, sfloat* specular) {
+  const sfloat3 rn = s3_select(ng, s3_neg(ng), s3_dot(ng, n) < 0.0f);
+  sfloat vd = 0.0f, wd = 0.0f, vs = 0.0f, ws = 0.0f;
+  for (int k = 0; k < occ->shadow_samples; ++k) {
+    global const PmrShadowMap* m = &maps[occ->shadow + k];
+    const sfloat3 d = s3_splat(-vload3(0, m->axis));
+    const sfloat c = fmax(s3_dot(n, d), 0.0f);
+    const sint on = act & (s3_dot(rn, d) > 0.0f) & (c > 0.0f);
+    if (!any(on)) continue;
+    const sfloat v = shadow_map_visibility_lanes(m, depth, p, ng, on);
+    const sfloat w = select((sfloat)(0.0f), m->weight * c, on), g = w * exp(sharpness * (s3_dot(r, d) - 1.0f));
+    vd += w * v, wd += w, vs += g * v, ws += g;
+  }
+  *diffuse = select((sfloat)(1.0f), vd / wd, act & (wd > 0.0f));
+  *specular = select((sfloat)(1.0f), vs / ws, act & (ws > 0.0f));
+}
+
 #endif

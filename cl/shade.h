@@ -44,6 +44,21 @@ inline sfloat3 reflected_direction(const Surface* S, const LaneWinners* L, sfloa
   return s3_select(mirror, s3_sub(s3_scale(bent, 2.0f * s3_dot(bent, S->v)), S->v), S->aniso.on);
 }
 
+/* The environment's occlusion at the lanes' surfaces S (lights.h, environment_visibility_lanes, with the
+ * entry after the light table's lights): *vd for the diffuse term, *vs for the specular lobes about
+ * `reflected`, whose width follows the roughness as a spherical Gaussian of GGX's lobe (sharpness
+ * 1 / (2 alpha^2) about the reflected direction) but is never narrower than the directions' spacing
+ * allows (sharpness at most K / 4 for K directions, a lobe about 20 degrees wide for 64): a glossy
+ * surface's occlusion is that of a blurred lobe (docs/SHADING.md gives the error). */
+inline void environment_occlusion_lanes(const ShadeInputs* in, const LaneWinners* L, const Surface* S,
+                                        sfloat3 reflected, sfloat* vd, sfloat* vs) {
+  global const PmrLight* occ = &in->lights[in->P->num_lights];
+  const sfloat a = S->r * S->r;
+  const sfloat sharpness = fmin(0.5f / fmax(a * a, 1e-6f), 0.25f * (float)occ->shadow_samples);
+  environment_visibility_lanes(in->shadow_maps, in->shadow_depth, occ, S->p, L->face, S->n, reflected, sharpness,
+                               L->act, vd, vs);
+}
+
 /* What the light table's lights (the file's punctual lights, or the default light, or none) send toward
  * the view through the lanes' surfaces S, each light's irradiance E times its visibility (lights.h: the
  * same in every view) times the view's lobes: `direct` the sum of f E n.l (the sheen's layering in f), `through` the
@@ -115,7 +130,13 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
   sfloat A, B;
   split_sum_lanes(in->split_sum, nv, r, &A, &B);
   sfloat3 irradiance, prefiltered;
-  environment_lanes(in, n, reflected_direction(S, L, nv), metallic, r, L->act, &irradiance, &prefiltered);
+  const sfloat3 reflected = reflected_direction(S, L, nv);
+  environment_lanes(in, n, reflected, metallic, r, L->act, &irradiance, &prefiltered);
+  sfloat vd = 1.0f, vs = 1.0f; /* the environment's occlusion, with shadows on */
+  if (in->P->env_occlusion) {
+    environment_occlusion_lanes(in, L, S, reflected, &vd, &vs);
+    irradiance = s3_scale(irradiance, vd), prefiltered = s3_scale(prefiltered, vs);
+  }
   /* transmission replaces the diffuse lobe */
   const sfloat kd = glass ? (1.0f - metallic) * (1.0f - transmission) : 1.0f - metallic;
   const sfloat ao = S->ao;
@@ -134,8 +155,8 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
   }
   sfloat3 lit = s3_add(s3_add(direct, ambient), S->emissive);
   if (sheen) /* the sheen between the view and the rest (the lights' layering is in f) */
-    lit = s3_select(lit, s3_add(direct, sheen_over_environment(in, L, S, s3_add(ambient, S->emissive))), sheen->on);
-  if (coated) lit = coated_lanes(in, L, S, lit, coat_lights);
+    lit = s3_select(lit, s3_add(direct, sheen_over_environment(in, L, S, s3_add(ambient, S->emissive), vd)), sheen->on);
+  if (coated) lit = coated_lanes(in, L, S, lit, coat_lights, vs);
   return s3_select(lit, base, L->unlit);
 }
 

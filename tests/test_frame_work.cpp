@@ -131,10 +131,15 @@ TEST(FrameWork, ShadowsCountTheirMapReadsAndPasses) {
   bulb.type = SceneLightType::Point;
   soft_sun.angle = 0.05f;
   const ShadowSizes sizes;
-  const ShadowCost hard = shadow_cost({sun, bulb}, sizes), soft = shadow_cost({soft_sun}, sizes);
+  const ShadowCost hard = shadow_cost({sun, bulb}, 0, sizes), soft = shadow_cost({soft_sun}, 0, sizes);
   EXPECT_EQ(hard.maps, 1u + 6u);
   EXPECT_EQ(hard.lookups_per_point, 2u);
   EXPECT_EQ(hard.texels, 2048u * 2048u + 6u * 1024u * 1024u);
+  // the environment's occlusion: one map of 256 x 256 and one read per direction
+  const ShadowCost occluded = shadow_cost({sun, bulb}, 32, sizes);
+  EXPECT_EQ(occluded.maps, hard.maps + 32u);
+  EXPECT_EQ(occluded.lookups_per_point, hard.lookups_per_point + 32u);
+  EXPECT_EQ(occluded.texels, hard.texels + 32u * 256u * 256u);
   EXPECT_EQ(soft.maps, uint64_t(kShadowSamples));
   EXPECT_EQ(soft.lookups_per_point, uint64_t(kShadowSamples));
   Scene s = test::empty_scene(false);
@@ -154,8 +159,8 @@ TEST(FrameWork, AreaLightsWeighTheirShading) {
   SceneLight sun, rect, disk;
   rect.type = SceneLightType::Rect, disk.type = SceneLightType::Disk;
   EXPECT_EQ(light_evaluations_per_point({sun, rect, disk}), 1u + kRectLightEvaluations + kDiskLightEvaluations);
-  EXPECT_EQ(shadow_cost({rect}, ShadowSizes()).lookups_per_point, uint64_t(kShadowSamples));
-  EXPECT_EQ(shadow_cost({rect}, ShadowSizes()).maps, 6u * uint64_t(kShadowSamples));
+  EXPECT_EQ(shadow_cost({rect}, 0, ShadowSizes()).lookups_per_point, uint64_t(kShadowSamples));
+  EXPECT_EQ(shadow_cost({rect}, 0, ShadowSizes()).maps, 6u * uint64_t(kShadowSamples));
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "pipeline/shadow_stage.h"
 #include "reference/shade_reference.h"
 #include "reference/visibility_reference.h"
+#include "shadow_support.h"
 #include "shading/lights.h"
 #include "shading/studio_environment.h"
 #include "test_util.h"
@@ -19,23 +20,13 @@
 namespace pmr {
 namespace {
 
-// A quad of two triangles with corners a, b, c, d (counter-clockwise seen from the front).
-void add_quad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
-  test::add_triangle(s, a, b, c);
-  test::add_triangle(s, a, c, d);
-}
-
-// The box [lo, hi], its faces outward.
-void add_box(Scene& s, glm::vec3 lo, glm::vec3 hi) {
-  const glm::vec3 p[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z}, {lo.x, hi.y, lo.z},
-                          {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z}, {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
-  add_quad(s, p[4], p[5], p[6], p[7]);  // +z
-  add_quad(s, p[1], p[0], p[3], p[2]);  // -z
-  add_quad(s, p[5], p[1], p[2], p[6]);  // +x
-  add_quad(s, p[0], p[4], p[7], p[3]);  // -x
-  add_quad(s, p[3], p[7], p[6], p[2]);  // +y
-  add_quad(s, p[0], p[1], p[5], p[4]);  // -y
-}
+using test::add_box;
+using test::add_quad;
+using test::add_sphere;
+using test::probe;
+using test::Receiver;
+using test::render_maps;
+using test::ShadowMaps;
 
 // A ground plane at y = -0.5 and a box standing on it.
 Scene box_on_plane() {
@@ -66,66 +57,6 @@ SceneLight sun(glm::dvec3 travel) {
   l.intensity = 3.0f;
   l.direction = glm::normalize(travel);
   return l;
-}
-
-// A sphere of radius r about c, `rings` x 2 `rings` facets, outward.
-void add_sphere(Scene& s, glm::vec3 c, float r, int rings) {
-  auto at = [&](int i, int j) {
-    const double th = M_PI * i / rings, ph = M_PI * j / rings;
-    return c + r * glm::vec3(std::sin(th) * std::cos(ph), std::cos(th), -std::sin(th) * std::sin(ph));
-  };
-  for (int i = 0; i < rings; ++i)
-    for (int j = 0; j < 2 * rings; ++j) {
-      if (i > 0) test::add_triangle(s, at(i, j), at(i + 1, j), at(i, j + 1));
-      if (i + 1 < rings) test::add_triangle(s, at(i, j + 1), at(i + 1, j), at(i + 1, j + 1));
-    }
-}
-
-// The frame's shadow maps of scene `s` (its lights) as the pipeline renders them.
-struct ShadowMaps {
-  std::vector<PmrShadowMap> maps;
-  std::vector<float> depth;
-};
-
-ShadowMaps render_maps(const Scene& s) {
-  PipelineConfig pc;
-  pc.shading = Shading::Pbr;
-  pc.shadows = true;
-  Pipeline p(test::runtime(), pc);
-  p.set_scene(s);
-  const Rig rig = test::small_rig(2, 32, 16);
-  p.configure(rig, nullptr);
-  p.render(rig);
-  ShadowMaps out;
-  p.read_shadow_maps(out.maps, out.depth);
-  return out;
-}
-
-// A receiver: a point on a surface and that surface's unit normal.
-struct Receiver {
-  glm::dvec3 p, n;
-};
-
-// cl/lights.h's shadow_visibility_lanes of the scene's one light at each receiver (tests/probes/shadow_probe.cl).
-std::vector<float> probe(const ShadowMaps& m, const SceneLight& light, const std::vector<Receiver>& at) {
-  const ClRuntime& rt = test::runtime();
-  const ClProgram program = rt.build_program({"shadow_probe.cl"}, "-cl-std=CL1.2", &test_kernel_sources());
-  PmrLight d = device_light(light);
-  d.shadow = 0, d.shadow_maps = int(m.maps.size()), d.shadow_samples = shadow_samples(light);
-  std::vector<float> in;
-  for (const Receiver& r : at)
-    for (const glm::dvec3& v : {r.p, r.n}) in.insert(in.end(), {float(v.x), float(v.y), float(v.z)});
-  std::vector<uint32_t> bits(m.depth.size());
-  std::memcpy(bits.data(), m.depth.data(), bits.size() * 4);
-  std::vector<float> out(at.size());
-  ClKernel k(program, "shadow_probe");
-  ClBuffer maps = rt.upload(m.maps, "maps"), depth = rt.upload(bits, "depth"),
-           l = rt.upload(std::vector<PmrLight>{d}, "light");
-  ClBuffer a = rt.upload(in, "probe in"), b = rt.buffer(out.size() * 4, "probe out");
-  k.args(maps, depth, l, a, b, cl_uint(at.size()));
-  clReleaseEvent(rt.launch(k, at.size(), 64));
-  rt.read(b, out.data(), out.size() * 4);
-  return out;
 }
 
 // The world size of a texel of the light's map at p (the face of p's major axis for a cube).
@@ -427,8 +358,8 @@ TEST(Shadows, NoGapAtContact) {
     EXPECT_LT(v[i], 0.5f) << "at x = 0.25 + " << (at[i].p.x - 0.25) / texel << " texels";
 }
 
-// The shaded result: every covered voxel of the box on the plane under a sun equals the reference's
-// colour with the sun's term times the ray-cast visibility at the voxel's surface point (1% + 1e-3 per
+// The shaded result: every covered voxel of the box on the plane under a sun (in a black environment)
+// equals the reference's colour with the sun's term times the ray-cast visibility at the voxel's surface point (1% + 1e-3 per
 // channel), except within a texel of a shadow's edge.
 TEST(Shadows, ShadedVoxelsMatchTheReferenceWithRayCastVisibility) {
   Scene s = box_on_plane_facing_the_camera();
@@ -436,9 +367,11 @@ TEST(Shadows, ShadedVoxelsMatchTheReferenceWithRayCastVisibility) {
   const Rig rig = test::small_rig(5, 96, 64);
   PipelineConfig pc = test::pbr_config(Method::Pmr, TextureFilter::Bilinear, nullptr);
   pc.shadows = true;
+  pc.environment_intensity = 0.0;  // the sun alone: the environment's occlusion is tested on its own
   const test::Rendered out = test::render_with(s, rig, pc);
   test::VoxelReference lit(s, rig, out), ambient(s, rig, out);
   lit.lights = {test::reference_light(s.lights[0])};
+  lit.env = ambient.env = test::uniform_environment(0.0);
   ambient.lights.clear();
   const ref::PunctualLight exact = lit.lights[0];
   const double texel = render_maps(s).maps[0].texel;

@@ -158,10 +158,10 @@ TEST(StudioShadows, AnUnoccludedWhiteDielectricReadsAsUnderTheImage) {
 }
 
 // A slab held over a floor under the studio with shadows on: the floor under it loses the ceiling's
-// light, about a quarter of the floor's irradiance (the boxes low on the walls still reach it, and the
-// walls are not occluded). At least 30 voxels of view 1 read below 0.85 of what they read with
-// shadows off, at 0.65 or more on average (the ceiling's share and no more), while most voxels read as
-// before (the median ratio within 3% of 1).
+// light and the walls' above the slab's edges (the environment's occlusion), but the boxes low on the
+// walls and the walls' lower parts still reach it. At least 30 voxels of view 1 read below 0.85 of
+// what they read with shadows off, at 0.4 or more on average, while most voxels read nearly as before
+// (the median ratio within 5% of 1: the slab hides a little of every floor point's sky).
 TEST(StudioShadows, ASlabShadowsTheFloorUnderIt) {
   const Rig rig = test::small_rig(3, 96, 64);
   Scene s = test::empty_scene(true);
@@ -192,8 +192,8 @@ TEST(StudioShadows, ASlabShadowsTheFloorUnderIt) {
       "ratio %.3f\n",
       dark, ratio.size(), dark ? dark_sum / double(dark) : 0.0, median);
   EXPECT_GE(dark, size_t(30));
-  EXPECT_GE(dark_sum, 0.65 * double(dark));
-  EXPECT_NEAR(median, 1.0, 0.03);
+  EXPECT_GE(dark_sum, 0.4 * double(dark));
+  EXPECT_NEAR(median, 1.0, 0.05);
 }
 
 }  // namespace

@@ -163,7 +163,7 @@ void describe_default_frame_work(const Scene& s, const InputLimits& limits) {
   std::vector<SceneLight> lights = s.lights;
   for (SceneLight& box : studio_box_lights()) lights.push_back(std::move(box));
   const FrameWork work = estimate_frame_work(s, rig, light_evaluations_per_point(lights), config,
-                                             shadow_cost(lights, config.shadow_sizes));
+                                             shadow_cost(lights, kOcclusionDirections, config.shadow_sizes));
   std::printf("frame work at paper-8k: %s; the limit is %llu (--limit frame-work; docs/SECURITY.md)\n",
               describe_frame_work(work).c_str(), (unsigned long long)limits.frame_work);
 }

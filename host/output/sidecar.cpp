@@ -15,6 +15,7 @@
 #include "pmr/printable.h"
 #include "pmr/version.h"
 #include "shading/lights.h"
+#include "shading/environment_occlusion.h"
 
 namespace pmr {
 namespace {
@@ -147,7 +148,8 @@ json shading_json(const SidecarInfo& info) {
   if (info.render.shadows)  // absent: off, as every sidecar before shadows
     s["shadows"] = {{"map_size", info.render.shadow_sizes.directional},
                     {"local_map_size", info.render.shadow_sizes.local},
-                    {"light_samples", kShadowSamples}};
+                    {"light_samples", kShadowSamples},
+                    {"environment_occlusion", {{"directions", kOcclusionDirections}, {"map_size", kOcclusionSize}}}};
   if (info.lights.size() > kSidecarLights) {
     s["lights_total"] = info.lights.size();
     s["lights_digest"] = lights_digest(info.lights);

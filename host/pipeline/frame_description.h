@@ -7,6 +7,7 @@
 
 #include "pmr/rig.h"
 #include "pmr/scene.h"
+#include "shading/environment_occlusion.h"
 
 namespace pmr {
 
@@ -20,6 +21,9 @@ struct FrameDescription {
   // (resolve_lights: the scene's lights, else the default light unless an environment image lights the
   // scene). Empty under lambert, whose one fixed light is the rig's.
   std::vector<SceneLight> lights;
+  // --shading pbr with shadows on: the directions of the environment's occlusion
+  // (occlusion_directions); empty when the environment is off.
+  std::vector<OcclusionDirection> occlusion;
 };
 
 // The frame of `rig` lit by `scene_lights` (posed, world space) under `config`'s shading.

@@ -67,10 +67,9 @@ struct Pipeline::Impl {
       : tile{tile_in[0], tile_in[1], tile_in[2]},
         launcher(rt),
         options(build_options(tile, config)),
-        program(launcher.build(
-            {"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl", "straddle_alpha.cl", "source_mips.cl",
-             "shadow.cl"},
-            options)),
+        program(launcher.build({"vertex.cl", "setup.cl", "bin.cl", "fine.cl", "encode.cl", "straddle_alpha.cl",
+                                "source_mips.cl", "shadow.cl"},
+                               options)),
         scene(rt, config),
         geometry(launcher, program, config.tile_queue_limit),
         encode(launcher, program),
@@ -126,7 +125,9 @@ FrameDescription describe_frame(const Rig& rig, const std::vector<SceneLight>& s
                                 const PipelineConfig& config) {
   FrameDescription f;
   f.rig = rig;
-  if (config.shading == Shading::Pbr) f.lights = resolve_lights(scene_lights, rig, config.environment.get());
+  if (config.shading != Shading::Pbr) return f;
+  f.lights = resolve_lights(scene_lights, rig, config.environment.get());
+  if (config.shadows) f.occlusion = occlusion_directions(config.environment.get(), config.environment_intensity);
   return f;
 }
 
@@ -238,8 +239,9 @@ StageTimes Pipeline::render_frame(const FrameDescription& frame, bool empty) {
   StageTimes times;
   FrameEvents ev;
   PmrParams P = frame_params(frame, empty);
-  m.shadows.place(config_.shadows && config_.shading == Shading::Pbr, frame.lights, m.scene);
-  m.scene.upload_frame(frame, m.shadows.slots());
+  m.shadows.place(config_.shadows && config_.shading == Shading::Pbr, frame.lights, frame.occlusion, m.scene);
+  m.scene.upload_frame(frame, m.shadows.placement());
+  P.env_occlusion = m.shadows.placement().occlusion.count > 0 ? 1u : 0u;
   m.fine.begin_frame();
   if (config_.shadows && config_.shading == Shading::Pbr)
     m.shadows.render(m.scene, P, m.transmission.full_pass(), ev, empty);
@@ -298,7 +300,7 @@ void Pipeline::Impl::render_multipass(const Rig& rig, const PmrParams& P, bool s
     geometry.setup_and_bin(Q, scene, ev, t);
     if (transmission.active()) {  // as a conventional renderer: the view's opaque pass, then its own
       fine.run_volume(scene, geometry, num_tiles, shadows.binding(), transmission.opaque_pass(), ev,
-                    &transmission.source());
+                      &transmission.source());
       transmission.mip(i, 1, ev);
     }
     fine.run_volume(scene, geometry, num_tiles, shadows.binding(), transmission.full_pass(), ev);

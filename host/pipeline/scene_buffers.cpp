@@ -101,13 +101,20 @@ void SceneBuffers::set_bounds(const std::vector<glm::vec3>& positions) {
   bounds_lo_ = glm::dvec3(lo), bounds_hi_ = glm::dvec3(hi);
 }
 
-void SceneBuffers::upload_frame(const FrameDescription& frame, const std::vector<ShadowSlot>& slots) {
+void SceneBuffers::upload_frame(const FrameDescription& frame, const ShadowPlacement& shadows) {
   std::vector<PmrLight> table;
-  for (size_t i = 0; i < frame.lights.size(); ++i) {
-    PmrLight d = device_light(frame.lights[i]);
-    if (i < slots.size() && slots[i].count > 0)
-      d.shadow = slots[i].first, d.shadow_maps = slots[i].count, d.shadow_samples = slots[i].samples;
-    table.push_back(d);
+  auto with_maps = [](PmrLight d, const ShadowSlot& slot) {
+    if (slot.count > 0) d.shadow = slot.first, d.shadow_maps = slot.count, d.shadow_samples = slot.samples;
+    return d;
+  };
+  for (size_t i = 0; i < frame.lights.size(); ++i)
+    table.push_back(
+        with_maps(device_light(frame.lights[i]), i < shadows.slots.size() ? shadows.slots[i] : ShadowSlot{}));
+  // the environment's occlusion: an entry after the lights (PmrParams.env_occlusion), its maps alone
+  if (shadows.occlusion.count > 0) {
+    PmrLight occlusion{};
+    occlusion.shadow = -1;
+    table.push_back(with_maps(occlusion, shadows.occlusion));
   }
   table.resize(std::max<size_t>(table.size(), 1));  // no empty buffers
   rt_.rewrite(lights_, table, "lights");

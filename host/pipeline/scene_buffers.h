@@ -23,9 +23,10 @@ class SceneBuffers {
   void set_scene(const Scene& scene);
   // The posed geometry of a frame of the scene given to set_scene (same counts): copied, not reallocated.
   void update_geometry(const Scene& posed);
-  // The frame's light table (light i with its shadow maps slots[i]: ShadowStage::slots) and each view's
-  // camera position in world space (the view vector of pbr).
-  void upload_frame(const FrameDescription& frame, const std::vector<ShadowSlot>& slots);
+  // The frame's light table (light i with its shadow maps shadows.slots[i], then an entry with the
+  // environment's occlusion maps when there are any) and each view's camera position in world space
+  // (the view vector of pbr).
+  void upload_frame(const FrameDescription& frame, const ShadowPlacement& shadows);
   // Binds the frame parameters `params`, the shading inputs, the frame's shadow maps and the pass's
   // transmission source as arguments 0 .. of `k` (the order of PMR_SHADE_PARAMS); returns the index of
   // the kernel's next argument.
@@ -66,7 +67,7 @@ class SceneBuffers {
   void set_bounds(const std::vector<glm::vec3>& positions);
   ClBuffer positions_, attrs_, tris_, materials_, textures_, texels_, texcoords_, tangents_;
   ClBuffer lut_, split_sum_, ltc_, sheen_albedo_, env_, env_data_;  // the run's tables
-  ClBuffer lights_, eyes_;                     // the frame's
+  ClBuffer lights_, eyes_;                                          // the frame's
 };
 
 }  // namespace pmr

@@ -33,12 +33,17 @@ constexpr int kShadowSamples = 32;
 // sizes) and 0.041 (at an eighth); with 32 at an eighth 0.029.
 inline int shadow_samples(const SceneLight& l) { return has_size(l) ? kShadowSamples : 1; }
 
-// What the shadows of `lights` cost a frame (as placed with `sizes`, before any halving): the map
-// passes (each over every triangle), their texels, and the maps one shaded point reads (one per
-// sample of each shadowed light).
+// The environment's occlusion maps (shading/environment_occlusion.h) are this many texels a side: the
+// occlusion is an integral over many directions, smooth where one light's shadow is sharp.
+constexpr int kOcclusionSize = 256;
+
+// What the shadows of `lights` and of `occlusion_directions` of the environment's occlusion cost a
+// frame (as placed with `sizes`, before any halving): the map passes (each over every triangle), their
+// texels, and the maps one shaded point reads (one per sample of each shadowed light, one per
+// occlusion direction).
 struct ShadowCost {
   uint64_t maps = 0, texels = 0, lookups_per_point = 0;
 };
-ShadowCost shadow_cost(const std::vector<SceneLight>& lights, const ShadowSizes& sizes);
+ShadowCost shadow_cost(const std::vector<SceneLight>& lights, size_t occlusion_directions, const ShadowSizes& sizes);
 
 }  // namespace pmr

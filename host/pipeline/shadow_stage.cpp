@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "pipeline/scene_buffers.h"
+#include "shading/environment_occlusion.h"
 #include "pmr/error.h"
 
 namespace pmr {
@@ -41,7 +42,7 @@ PmrShadowMap orthographic_map(const glm::dvec3& axis, const glm::dvec3& lo, cons
   PmrShadowMap m{};
   set3(m.origin, origin), set3(m.right, x / half), set3(m.up, y / half), set3(m.axis, axis);
   m.size = size, m.perspective = 0, m.texel = float(2.0 * half / size);
-  m.translucent = PMR_NO_TRANSLUCENT;
+  m.translucent = PMR_NO_TRANSLUCENT, m.weight = 1.0f;
   return m;
 }
 
@@ -52,7 +53,7 @@ PmrShadowMap perspective_map(const glm::dvec3& origin, const glm::dvec3& axis, c
   PmrShadowMap m{};
   set3(m.origin, origin), set3(m.right, x / t), set3(m.up, y / t), set3(m.axis, axis);
   m.size = size, m.perspective = 1, m.texel = float(2.0 * t / size), m.near_z = float(near_z);
-  m.translucent = PMR_NO_TRANSLUCENT;
+  m.translucent = PMR_NO_TRANSLUCENT, m.weight = 1.0f;
   return m;
 }
 
@@ -148,6 +149,16 @@ void light_maps(const SceneLight& l, const glm::dvec3& lo, const glm::dvec3& hi,
   }
 }
 
+// The environment's occlusion maps (shading/environment_occlusion.h): one orthographic map of
+// kOcclusionSize a side along each direction, weighted by the environment's radiance about it.
+void occlusion_maps(const std::vector<OcclusionDirection>& occlusion, const glm::dvec3& lo, const glm::dvec3& hi,
+                    std::vector<PmrShadowMap>& maps) {
+  for (const OcclusionDirection& d : occlusion) {
+    maps.push_back(orthographic_map(-d.toward, lo, hi, kOcclusionSize));
+    maps.back().weight = float(d.weight);
+  }
+}
+
 // The texels of the maps of `lights` (the first kMaxShadowedLights) at `sizes`.
 uint64_t texels_needed(const std::vector<SceneLight>& lights, const ShadowSizes& sizes) {
   uint64_t n = 0;
@@ -161,23 +172,30 @@ uint64_t texels_needed(const std::vector<SceneLight>& lights, const ShadowSizes&
 
 }  // namespace
 
-std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& lights, const glm::dvec3& lo,
-                                            const glm::dvec3& hi, const ShadowSizes& wanted, bool translucent,
-                                            std::vector<ShadowSlot>& slots) {
+ShadowPlacement place_shadow_maps(const std::vector<SceneLight>& lights,
+                                  const std::vector<OcclusionDirection>& occlusion, const glm::dvec3& lo,
+                                  const glm::dvec3& hi, const ShadowSizes& wanted, bool translucent) {
   ShadowSizes sizes = wanted;
-  while (texels_needed(lights, sizes) * (translucent ? 3 : 1) > kShadowTexelBudget &&
+  const uint64_t occlusion_texels = uint64_t(occlusion.size()) * kOcclusionSize * kOcclusionSize;
+  while ((texels_needed(lights, sizes) + occlusion_texels) * (translucent ? 3 : 1) > kShadowTexelBudget &&
          std::max(sizes.directional, sizes.local) > kMinShadowSize) {
     sizes.directional = std::max(kMinShadowSize, sizes.directional / 2);
     sizes.local = std::max(kMinShadowSize, sizes.local / 2);
   }
-  std::vector<PmrShadowMap> maps;
-  slots.assign(lights.size(), ShadowSlot{});
+  ShadowPlacement out;
+  std::vector<PmrShadowMap>& maps = out.maps;
+  out.slots.assign(lights.size(), ShadowSlot{});
   for (size_t i = 0; i < lights.size() && i < size_t(kMaxShadowedLights); ++i) {
     const SceneLight& l = lights[i];
-    slots[i].first = int(maps.size());
+    out.slots[i].first = int(maps.size());
     light_maps(l, lo, hi, sizes, maps);
-    slots[i].count = int(maps.size()) - slots[i].first;
-    slots[i].samples = shadow_samples(l);
+    out.slots[i].count = int(maps.size()) - out.slots[i].first;
+    out.slots[i].samples = shadow_samples(l);
+  }
+  if (!occlusion.empty()) {
+    out.occlusion.first = int(maps.size());
+    occlusion_maps(occlusion, lo, hi, maps);
+    out.occlusion.count = out.occlusion.samples = int(occlusion.size());
   }
   uint64_t offset = 0;
   for (PmrShadowMap& m : maps) {
@@ -185,16 +203,18 @@ std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& light
     offset += uint64_t(m.size) * uint64_t(m.size);
   }
   if (translucent) add_translucent_layers(maps);
-  return maps;
+  return out;
 }
 
-ShadowCost shadow_cost(const std::vector<SceneLight>& lights, const ShadowSizes& sizes) {
+ShadowCost shadow_cost(const std::vector<SceneLight>& lights, size_t occlusion_directions, const ShadowSizes& sizes) {
   ShadowCost c;
   for (size_t i = 0; i < lights.size() && i < size_t(kMaxShadowedLights); ++i) {
     std::vector<PmrShadowMap> maps;
     light_maps(lights[i], glm::dvec3(-1.0), glm::dvec3(1.0), sizes, maps);
     c.maps += maps.size(), c.texels += shadow_texels(maps), c.lookups_per_point += uint64_t(shadow_samples(lights[i]));
   }
+  c.maps += occlusion_directions, c.lookups_per_point += occlusion_directions;
+  c.texels += uint64_t(occlusion_directions) * kOcclusionSize * kOcclusionSize;
   return c;
 }
 
@@ -215,7 +235,7 @@ uint64_t shadow_texels(const std::vector<PmrShadowMap>& maps) {
 }
 
 std::vector<float> ShadowStage::read_depth() const {
-  std::vector<float> out(size_t(shadow_texels(maps_)));
+  std::vector<float> out(size_t(shadow_texels(placed_.maps)));
   if (!out.empty()) rt_.read(depth_, out.data(), out.size() * sizeof(float));
   return out;
 }
@@ -231,19 +251,20 @@ ShadowStage::ShadowStage(Launcher& launcher, const ClProgram& program, const Sha
   depth_ = rt_.buffer(16, "shadow depths");
 }
 
-void ShadowStage::place(bool on, const std::vector<SceneLight>& lights, const SceneBuffers& scene) {
-  maps_.clear();
-  slots_.assign(lights.size(), ShadowSlot{});
+void ShadowStage::place(bool on, const std::vector<SceneLight>& lights,
+                        const std::vector<OcclusionDirection>& occlusion, const SceneBuffers& scene) {
+  placed_ = ShadowPlacement{};
+  placed_.slots.assign(lights.size(), ShadowSlot{});
   if (!on || scene.num_triangles() == 0) return;
-  maps_ = place_shadow_maps(lights, scene.bounds_lo(), scene.bounds_hi(), sizes_,
-                            scene.blended() || scene.translucent_casters(), slots_);
-  const uint64_t texels = shadow_texels(maps_);
+  placed_ = place_shadow_maps(lights, occlusion, scene.bounds_lo(), scene.bounds_hi(), sizes_,
+                              scene.blended() || scene.translucent_casters());
+  const uint64_t texels = shadow_texels(placed_.maps);
   if (texels >= (uint64_t(1) << 32)) throw Error("the lights' shadow maps need more than 2^32 texels");
   if (depth_.size() < texels * 4) {
     rendered_.clear();
     depth_ = ClBuffer(), depth_ = rt_.buffer(size_t(texels * 4), "shadow depths");
   }
-  rt_.rewrite(maps_buffer_, maps_, "shadow maps");
+  rt_.rewrite(maps_buffer_, placed_.maps, "shadow maps");
 }
 
 void ShadowStage::render(const SceneBuffers& scene, const PmrParams& P, const SourceBinding& source, FrameEvents& ev,
@@ -257,12 +278,13 @@ void ShadowStage::render(const SceneBuffers& scene, const PmrParams& P, const So
     ev.add(kShadow, launcher_.launch(raster_, 1, 64));
     return;
   }
-  const bool same = maps_.size() == rendered_.size() && rendered_generation_ == scene.geometry_generation() &&
-                    std::memcmp(maps_.data(), rendered_.data(), maps_.size() * sizeof(PmrShadowMap)) == 0;
+  const std::vector<PmrShadowMap>& maps = placed_.maps;
+  const bool same = maps.size() == rendered_.size() && rendered_generation_ == scene.geometry_generation() &&
+                    std::memcmp(maps.data(), rendered_.data(), maps.size() * sizeof(PmrShadowMap)) == 0;
   if (same) return;
-  rendered_ = maps_, rendered_generation_ = scene.geometry_generation();
-  for (size_t k = 0; k < maps_.size(); ++k) {
-    const PmrShadowMap& m = maps_[k];
+  rendered_ = maps, rendered_generation_ = scene.geometry_generation();
+  for (size_t k = 0; k < maps.size(); ++k) {
+    const PmrShadowMap& m = maps[k];
     const uint32_t texels = uint32_t(m.size) * uint32_t(m.size);
     clear_.args(depth_, cl_uint(m.offset), cl_uint(texels), cl_uint(0));
     ev.add(kShadow, launcher_.launch(clear_, texels, 64));

@@ -14,6 +14,7 @@
 #include "pmr/scene.h"
 #include "pmr/shared.h"
 #include "runtime/cl_runtime.h"
+#include "shading/environment_occlusion.h"
 
 namespace pmr {
 
@@ -32,15 +33,24 @@ struct ShadowSlot {
   int samples = 1;  // groups of count / samples maps, one per sample of a light's size
 };
 
+// A frame's maps: slots[i] says which are light i's, `occlusion` which are the environment's
+// occlusion maps (count 0: none).
+struct ShadowPlacement {
+  std::vector<PmrShadowMap> maps;
+  std::vector<ShadowSlot> slots;
+  ShadowSlot occlusion;
+};
+
 // The maps of `lights` (world space, posed) over the world box [lo, hi] of every caster and receiver:
 // a directional light's orthographic map covers the box seen along its direction; a point light's
 // cube and a spot light's map look from its position, their near plane 1e-4 of the farthest corner's
-// distance. slots[i]: light i's maps (none after the first kMaxShadowedLights). Sizes are halved
-// until all fit kShadowTexelBudget (not below kMinShadowSize). Depth offsets are packed in order.
+// distance. slots[i]: light i's maps (none after the first kMaxShadowedLights). Then one orthographic
+// map of kOcclusionSize a side per direction of the environment's occlusion. Sizes are halved until
+// all fit kShadowTexelBudget (not below kMinShadowSize). Depth offsets are packed in order.
 // `translucent`: every map gets a translucent layer (add_translucent_layers), counted in the budget.
-std::vector<PmrShadowMap> place_shadow_maps(const std::vector<SceneLight>& lights, const glm::dvec3& lo,
-                                            const glm::dvec3& hi, const ShadowSizes& sizes, bool translucent,
-                                            std::vector<ShadowSlot>& slots);
+ShadowPlacement place_shadow_maps(const std::vector<SceneLight>& lights,
+                                  const std::vector<OcclusionDirection>& occlusion, const glm::dvec3& lo,
+                                  const glm::dvec3& hi, const ShadowSizes& sizes, bool translucent);
 // Gives every map a translucent layer (two values a texel) after the depths of all maps.
 void add_translucent_layers(std::vector<PmrShadowMap>& maps);
 // Values (4 bytes each) of all of `maps`: depths, and the translucent layers' pairs.
@@ -50,18 +60,18 @@ class ShadowStage {
  public:
   // `program`: the main program (shadow.cl).
   ShadowStage(Launcher& launcher, const ClProgram& program, const ShadowSizes& sizes);
-  // Places the maps of the frame's lights over the scene's posed box (none when `on` is false or the
-  // scene is empty), with translucent layers when the scene has BLEND or transmissive materials:
-  // slots() then says which light has which maps.
-  void place(bool on, const std::vector<SceneLight>& lights, const SceneBuffers& scene);
+  // Places the maps of the frame's lights and of the environment's occlusion over the scene's posed
+  // box (none when `on` is false or the scene is empty), with translucent layers when the scene has
+  // BLEND or transmissive materials: placement() then says which maps are whose.
+  void place(bool on, const std::vector<SceneLight>& lights, const std::vector<OcclusionDirection>& occlusion,
+             const SceneBuffers& scene);
   // Renders the placed maps from the scene's posed triangles (the shading kernels' inputs: frame
   // parameters P, any pass's transmission source), unless the maps and the triangles are those of the
   // last frame rendered (a still scene renders its maps once). `warm`: the warm-up frame, which
   // launches each kernel once whatever was placed.
-  void render(const SceneBuffers& scene, const PmrParams& P, const SourceBinding& source, FrameEvents& ev,
-              bool warm);
-  const std::vector<ShadowSlot>& slots() const { return slots_; }
-  const std::vector<PmrShadowMap>& maps() const { return maps_; }
+  void render(const SceneBuffers& scene, const PmrParams& P, const SourceBinding& source, FrameEvents& ev, bool warm);
+  const ShadowPlacement& placement() const { return placed_; }
+  const std::vector<PmrShadowMap>& maps() const { return placed_.maps; }
   // The placed maps' depths as floats (after the frame).
   std::vector<float> read_depth() const;
   ShadowBinding binding() const { return {&maps_buffer_, &depth_}; }
@@ -72,8 +82,7 @@ class ShadowStage {
   const ClRuntime& rt_;
   ShadowSizes sizes_;
   ClKernel clear_, raster_;
-  std::vector<PmrShadowMap> maps_;
-  std::vector<ShadowSlot> slots_;
+  ShadowPlacement placed_;
   // what the depths hold: the maps and the geometry generation they were rendered from
   std::vector<PmrShadowMap> rendered_;
   uint64_t rendered_generation_ = 0;

@@ -256,9 +256,10 @@ FrameRenderer::Frame FrameRenderer::render(long frame) {
   out.rig = d.rig, out.lights = d.lights;
   const PipelineConfig& config = pipeline_->config();
   const bool shadows = config.shadows && config.shading == Shading::Pbr;
-  check_frame_work(estimate_frame_work(moves_ ? posed_ : rest_, d.rig, light_evaluations_per_point(d.lights), config,
-                                       shadows ? shadow_cost(d.lights, config.shadow_sizes) : ShadowCost{}),
-                   spec_.frame_work);
+  check_frame_work(
+      estimate_frame_work(moves_ ? posed_ : rest_, d.rig, light_evaluations_per_point(d.lights), config,
+                          shadows ? shadow_cost(d.lights, d.occlusion.size(), config.shadow_sizes) : ShadowCost{}),
+      spec_.frame_work);
   out.times = pipeline_->render(d);
   out.visible = out.times.mtas > 0;
   return out;

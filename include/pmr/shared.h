@@ -199,7 +199,9 @@ typedef struct {
   pmr_u32 texture_filter;            /* PMR_FILTER_BILINEAR or PMR_FILTER_TRILINEAR (DESIGN section 3b)   */
   float lod_scale_x, lod_scale_y;    /* view pixels per output pixel, x and y: 1 for view sampling; the
                                         display pixel's footprint in view pixels for subpixel sampling */
-  pmr_u32 pad_lod;
+  pmr_u32 env_occlusion;              /* pbr, shadows on: 1 when the light table holds one more entry,
+                                        lights[num_lights], whose maps give the environment's
+                                        occlusion (cl/lights.h environment_visibility_lanes) */
   pmr_i32 sample_x[PMR_MAX_SAMPLES]; /* sample s at (X + sample_x[s], Y + sample_y[s]) from pixel center */
   pmr_i32 sample_y[PMR_MAX_SAMPLES]; /* (X, Y), in 16.16 / 24.8 raster units                          */
   double view_anchor;                /* camera offset at view coordinate 0 over the baseline: -1/2 linear, 0 angular */
@@ -370,7 +372,9 @@ typedef struct {
   pmr_u32 translucent; /* PMR_NO_TRANSLUCENT, or where its translucent casters' pairs start in the depth
                           buffer: per texel the nearest one's depth and the sum of -ln(1 - opacity) of
                           all, in units of 1 / PMR_SHADOW_OPTICAL_ONE */
-  pmr_u32 pad1, pad2;
+  float weight;        /* an environment occlusion map: the environment's radiance about its direction
+                          (luminance); a light's map: 1 */
+  pmr_u32 pad2;
 } PmrShadowMap;
 #define PMR_NO_TRANSLUCENT 0xffffffffu
 #define PMR_SHADOW_OPTICAL_ONE 4096.0f /* -ln(1 - a) per caster at most 40: 26,000 layers fit 32 bits */

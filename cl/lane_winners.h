@@ -16,6 +16,7 @@ typedef struct {
   sint back;          /* -1: seen from behind                                            */
   sint smooth;        /* -1: vertex normals (else the face normal)                       */
   sint unlit;         /* pbr: KHR_materials_unlit                                        */
+  sint catcher;       /* the ground catcher (--ground shadow): its alpha is the shadow on it */
   sfloat3 e;          /* sign-corrected edge functions opposite MTA vertices 0, 1, 2     */
   sfloat inv_w[3];    /* the MTA vertices' 1 / w                                         */
   sfloat bary[3][2];  /* ... and barycentrics in the source triangle                     */
@@ -66,7 +67,7 @@ typedef struct {
 /* No lanes yet; idle lanes keep finite values so that the vector arithmetic stays cheap. */
 inline void lanes_clear(LaneWinners* L) {
   const sfloat zero = 0.0f, one = 1.0f;
-  L->act = L->back = L->smooth = L->unlit = (sint)(0);
+  L->act = L->back = L->smooth = L->unlit = L->catcher = (sint)(0);
   L->e = s3(one, one, one);
   L->face = s3(zero, zero, one);
   for (int k = 0; k < 3; ++k) {
@@ -175,6 +176,7 @@ inline void lanes_add(LaneWinners* L, const ShadeInputs* in, const PmrMta* m, si
     L->alpha[0] = blend(L->alpha[0], mat->base_color[3], take);
     for (int k = 0; k < 3; ++k) L->alpha[k + 1] = blend(L->alpha[k + 1], in->attrs[t.v[k]].color[3], take);
   }
+  if (mat->flags & PMR_MATERIAL_SHADOW_CATCHER) L->catcher |= take;
   /* lambert reads the base colour map alone, pbr every map */
   bool textured = mat->maps[PMR_MAP_BASE_COLOR].texture >= 0;
   if (pbr) {

@@ -59,12 +59,18 @@ inline void environment_occlusion_lanes(const ShadeInputs* in, const LaneWinners
                                L->act, vd, vs);
 }
 
+/* Rec. 709 luminance of linear colours. */
+inline sfloat luminance_lanes(sfloat3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
 /* What the light table's lights (the file's punctual lights, or the default light, or none) send toward
  * the view through the lanes' surfaces S, each light's irradiance E times its visibility (lights.h: the
  * same in every view) times the view's lobes: `direct` the sum of f E n.l (the sheen's layering in f), `through` the
  * transmissive lanes' BTDF times E (before their weights), `coat` the clear coat's GGX lobe times E. */
 typedef struct {
   sfloat3 direct, through, coat;
+  /* with ground catcher lanes: the luminance of the irradiance the lights send onto n, as it arrives
+     and as it would unoccluded */
+  sfloat received, unoccluded;
 } LightSums;
 
 inline LightSums light_table_lanes(const ShadeInputs* in, const LaneWinners* L, const Surface* S) {
@@ -76,6 +82,8 @@ inline LightSums light_table_lanes(const ShadeInputs* in, const LaneWinners* L, 
   const sfloat f90 = S->f90, metallic = S->metallic, r = S->r, transmission = S->transmission;
   const sfloat coat_a2 = coated ? (S->coat_r * S->coat_r) * (S->coat_r * S->coat_r) : 0.0f;
   sfloat3 direct = s3_splat((float3)(0.0f)), lights_through = direct, coat_lights = direct;
+  sfloat received = 0.0f, unoccluded = 0.0f;
+  const bool catcher = any(L->catcher);
   const uint num_lights = in->P->num_lights;
   for (uint i = 0; i < num_lights; ++i) {
     global const PmrLight* light = &in->lights[i];
@@ -89,8 +97,14 @@ inline LightSums light_table_lanes(const ShadeInputs* in, const LaneWinners* L, 
       E = light_irradiance((int)light->type, vload3(0, light->color), vload3(0, light->position),
                            vload3(0, light->direction), light->range, light->cos_inner, light->cos_outer, S->p, &l);
     }
-    if (light->shadow >= 0) /* (--shadows off: E as before, bit for bit) */
-      E = s3_scale(E, shadow_visibility_lanes(in->shadow_maps, in->shadow_depth, light, S->p, L->face, S->n, L->act));
+    const sfloat V = light->shadow >= 0
+                         ? shadow_visibility_lanes(in->shadow_maps, in->shadow_depth, light, S->p, L->face, S->n, L->act)
+                         : (sfloat)(1.0f);
+    if (catcher) {
+      const sfloat e = luminance_lanes(E) * fmax(s3_dot(n, l), 0.0f);
+      unoccluded += e, received += e * V;
+    }
+    if (light->shadow >= 0) E = s3_scale(E, V); /* (--shadows off: E as before, bit for bit) */
     /* an area light's lobes are integrated over its shape, but for anisotropic lanes (a point at l) */
     sfloat3 f = area ? area_brdf(S, &A, transmission, irid) : s3_splat((float3)(0.0f));
     if (!area || aniso) {
@@ -108,15 +122,25 @@ inline LightSums light_table_lanes(const ShadeInputs* in, const LaneWinners* L, 
       coat_lights = s3_add(coat_lights, s3_scale(E, coat));
     }
   }
-  const LightSums sums = {direct, lights_through, coat_lights};
+  const LightSums sums = {direct, lights_through, coat_lights, received, unoccluded};
   return sums;
+}
+
+/* The ground catcher's alpha (--ground shadow; DESIGN section 4d): 1 - the irradiance that reaches it
+ * over what would reach it unoccluded, the lights' (`sums`) and the environment's (`irradiance` I(n),
+ * times its diffuse visibility vd), each as luminance; 0 where nothing would reach it. */
+inline sfloat catcher_alpha(const LightSums* sums, sfloat3 irradiance, sfloat vd) {
+  const sfloat sky = luminance_lanes(irradiance) * M_PI_F;
+  const sfloat all = sums->unoccluded + sky, arrived = sums->received + sky * vd;
+  return select((sfloat)(0.0f), clamp(1.0f - arrived / all, 0.0f, 1.0f), all > 0.0f);
 }
 
 /* glTF metallic-roughness of the lanes' surfaces S seen from view `view`'s camera: the sum over the
  * light table of f E n.l (the file's punctual lights, or the default light, or none), the environment
  * times the occlusion, plus the emissive term, under the sheen and then the clear coat where there are
- * ones; an unlit material is its base colour. */
-inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surface* S, int view) {
+ * ones; an unlit material is its base colour; the ground catcher is black, and its opacity (*alpha,
+ * the lanes' alpha so far elsewhere) the shadow on it (catcher_alpha). */
+inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surface* S, int view, sfloat* alpha) {
   const bool glass = any(L->glass), coated = any(L->coated); /* their terms cost nothing to other lanes */
   const Iridescence* irid = any(L->irid) ? &S->irid : 0;
   const Sheen* sheen = any(L->sheen) ? &S->sheen : 0;
@@ -132,6 +156,7 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
   sfloat3 irradiance, prefiltered;
   const sfloat3 reflected = reflected_direction(S, L, nv);
   environment_lanes(in, n, reflected, metallic, r, L->act, &irradiance, &prefiltered);
+  const sfloat3 open_irradiance = irradiance;
   sfloat vd = 1.0f, vs = 1.0f; /* the environment's occlusion, with shadows on */
   if (in->P->env_occlusion) {
     environment_occlusion_lanes(in, L, S, reflected, &vd, &vs);
@@ -157,6 +182,10 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
   if (sheen) /* the sheen between the view and the rest (the lights' layering is in f) */
     lit = s3_select(lit, s3_add(direct, sheen_over_environment(in, L, S, s3_add(ambient, S->emissive), vd)), sheen->on);
   if (coated) lit = coated_lanes(in, L, S, lit, coat_lights, vs);
+  if (any(L->catcher)) { /* the shadow alone, as premultiplied black */
+    *alpha = select(*alpha, catcher_alpha(&sums, open_irradiance, vd), L->catcher);
+    lit = s3_select(lit, s3_splat((float3)(0.0f)), L->catcher);
+  }
   return s3_select(lit, base, L->unlit);
 }
 
@@ -211,9 +240,10 @@ inline sfloat3 shade_lanes(const ShadeInputs* in, const LaneWinners* L, float3 l
     n = s3_select(n, s3_neg(n), L->back); /* t, b and n together */
     Surface S = surface_material(L, &T, textured, b, n, coat_n, aniso_t, base, spread, coat_spread);
     surface_seen_from(&S, in, L, &T, textured, view);
-    return s3_half_range(s3_scale(shade_pbr(in, L, &S, view), exposure));
+    return s3_half_range(s3_scale(shade_pbr(in, L, &S, view, alpha), exposure));
   }
   n = s3_select(n, s3_neg(n), L->back);
+  *alpha = select(*alpha, (sfloat)(0.0f), L->catcher); /* lambert draws no shadow to catch */
   const sfloat lambert = 0.2f + 0.8f * max(s3_dot(n, s3_splat(light)), 0.0f);
   return s3_half_range(s3(base.x * lambert * exposure, base.y * lambert * exposure, base.z * lambert * exposure));
 }

@@ -180,7 +180,9 @@ kernel void shadow_raster(PMR_SHADE_PARAMS, uint map, global uint* depth) {
   global const PmrShadowMap* m = &shadow_maps[map];
   ShadowCorner poly[4];
   bool opaque = true;
-  const int n = t < P->num_triangles ? shadow_corners(in, m, t, poly, &opaque) : 0;
+  /* the ground catcher (--ground shadow) receives shadows and casts none */
+  const bool caster = t < P->num_triangles && !(materials[tris[t].material].flags & PMR_MATERIAL_SHADOW_CATCHER);
+  const int n = caster ? shadow_corners(in, m, t, poly, &opaque) : 0;
   if (shadow_box_texels(m, poly, n) > PMR_SHADOW_SHARED_TEXELS) shared[atomic_inc(&shared_count)] = t;
   else if (n >= 3) shadow_rows(in, m, t, poly, n, opaque, depth, 0, 1);
   barrier(CLK_LOCAL_MEM_FENCE);

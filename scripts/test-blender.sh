@@ -6,7 +6,8 @@
 # (the user's own Blender set-up is not touched): the add-on is installed from a zip and enabled, a
 # small scene (active camera, sun, point light, keyframed cube, ground) is rendered as a 3-frame quilt
 # sequence through the add-on's operator, and the script checks the files, the quilt layout, that
-# the active camera was used, the point light's brightness against Cycles, that a camera named "1" and
+# the active camera was used, the point light's brightness against Cycles, the whole scene under an HDRI
+# world against Cycles (mean |sRGB difference|), the shadow catcher, that a camera named "1" and
 # the pattern shot_%0d reach pmr as they are (pmr alone names the files), and that Blender reads the
 # quilt sequence frame by frame. Then, under Xvfb (xvfb is installed with blender when missing),
 # tests/blender/test_modal.py drives the interactive path in a Blender with a window: the modal

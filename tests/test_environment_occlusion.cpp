@@ -103,6 +103,26 @@ TEST(EnvironmentOcclusion, DiffuseVisibilityMatchesRayCasting) {
   EXPECT_LE(mean, 0.03);
 }
 
+// A plane alone shadows nothing of itself: from every direction above it, grazing ones included, its
+// own map must not hide it (no acne), so V_d and V_s read 1 over all of it.
+TEST(EnvironmentOcclusion, AFlatGroundDoesNotOccludeItself) {
+  Scene s = test::empty_scene(false);
+  test::add_quad(s, {-6.0f, 0.0f, 6.0f}, {6.0f, 0.0f, 6.0f}, {6.0f, 0.0f, -6.0f}, {-6.0f, 0.0f, -6.0f});
+  const test::ShadowMaps m = test::render_maps(s, nullptr, 1.0);
+  std::vector<test::Receiver> at;
+  for (double x = -5.9; x <= 5.9; x += 0.173)
+    for (double z = -5.9; z <= 5.9; z += 0.173) at.push_back({{x, 0.0, z}, {0, 1, 0}});
+  const glm::dvec3 r = glm::normalize(glm::dvec3(0.3, 0.2, 0.9));
+  const std::vector<glm::vec2> v =
+      test::probe_environment(m, kOcclusionDirections, at, std::vector<glm::dvec3>(at.size(), r), 16.0f);
+  float lowest_d = 1.0f, lowest_s = 1.0f;
+  for (const glm::vec2& x : v) lowest_d = std::min(lowest_d, x.x), lowest_s = std::min(lowest_s, x.y);
+  std::printf("[ env occl ] a lone plane: lowest V_d %.4f, V_s %.4f over %zu receivers\n", lowest_d, lowest_s,
+              at.size());
+  EXPECT_GE(lowest_d, 0.999f);
+  EXPECT_GE(lowest_s, 0.999f);
+}
+
 // The specular lobe's visibility, seen from 45 degrees above the ground: on a rough surface (r = 0.7,
 // whose GGX lobe is wider than the directions' spacing) the mean |V_s - exact| is at most 0.04; on a
 // glossy one (r = 0.3) the estimate's lobe is never narrower than the spacing allows, and the error is
@@ -131,7 +151,9 @@ TEST(EnvironmentOcclusion, SpecularVisibilityFollowsTheLobe) {
         "exact %.4f)\n",
         roughness, shaded, mean, bias / double(shaded));
     EXPECT_GT(shaded, 150u);
-    if (roughness >= 0.5) EXPECT_LE(mean, 0.04);
+    if (roughness >= 0.5) {
+      EXPECT_LE(mean, 0.04);
+    }
   }
 }
 

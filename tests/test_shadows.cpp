@@ -358,8 +358,8 @@ TEST(Shadows, NoGapAtContact) {
     EXPECT_LT(v[i], 0.5f) << "at x = 0.25 + " << (at[i].p.x - 0.25) / texel << " texels";
 }
 
-// The shaded result: every covered voxel of the box on the plane under a sun (in a black environment)
-// equals the reference's colour with the sun's term times the ray-cast visibility at the voxel's surface point (1% + 1e-3 per
+// The shaded result: every covered voxel of the box on the plane under a sun (and the uniform
+// environment, its occlusion off) equals the reference's colour with the sun's term times the ray-cast visibility at the voxel's surface point (1% + 1e-3 per
 // channel), except within a texel of a shadow's edge.
 TEST(Shadows, ShadedVoxelsMatchTheReferenceWithRayCastVisibility) {
   Scene s = box_on_plane_facing_the_camera();
@@ -367,11 +367,10 @@ TEST(Shadows, ShadedVoxelsMatchTheReferenceWithRayCastVisibility) {
   const Rig rig = test::small_rig(5, 96, 64);
   PipelineConfig pc = test::pbr_config(Method::Pmr, TextureFilter::Bilinear, nullptr);
   pc.shadows = true;
-  pc.environment_intensity = 0.0;  // the sun alone: the environment's occlusion is tested on its own
+  pc.environment_occlusion = false;  // tested on its own (tests/test_environment_occlusion.cpp)
   const test::Rendered out = test::render_with(s, rig, pc);
   test::VoxelReference lit(s, rig, out), ambient(s, rig, out);
   lit.lights = {test::reference_light(s.lights[0])};
-  lit.env = ambient.env = test::uniform_environment(0.0);
   ambient.lights.clear();
   const ref::PunctualLight exact = lit.lights[0];
   const double texel = render_maps(s).maps[0].texel;
@@ -551,8 +550,15 @@ TEST(Shadows, TheSidecarRecordsThemAndResumeCompares) {
   const std::string on = test::read_file(out + "/frame_0000.json");
   EXPECT_NE(on.find("\"map_size\": 2048"), std::string::npos) << on;
   EXPECT_NE(on.find("\"local_map_size\": 1024"), std::string::npos);
+  EXPECT_NE(on.find("\"directions\": 64"), std::string::npos) << on;
   EXPECT_EQ(test::run("render --resume" + small).status, 0);
+  // the environment's occlusion off is another shading: recorded, and resume tells them apart
+  test::expect_one_error_line(test::run("render --resume --environment-occlusion off" + small), "shading differs");
+  ASSERT_EQ(test::run("render --overwrite --environment-occlusion off" + small).status, 0);
+  const std::string unoccluded = test::read_file(out + "/frame_0000.json");
+  EXPECT_NE(unoccluded.find("\"directions\": 0"), std::string::npos) << unoccluded;
   test::expect_usage_error(test::run("render --shadows maybe" + small), "--shadows");
+  test::expect_usage_error(test::run("render --environment-occlusion maybe" + small), "--environment-occlusion");
 }
 
 }  // namespace

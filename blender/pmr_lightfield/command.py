@@ -34,6 +34,8 @@ def render_args(settings, scene_path, out_dir, camera, frames, fps, environment,
     first, last = frames
     args += ["--frames", str(first) if first == last else "%d:%d" % (first, last)]
     args += environment
+    if settings.shadow_catcher:
+        args += ["--ground", "shadow"]
     # a folder is one configuration for pmr; re-rendering with changed settings is the normal case here
     args += ["--overwrite"]
     try:

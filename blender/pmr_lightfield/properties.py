@@ -88,6 +88,10 @@ class PmrLightfieldSettings(bpy.types.PropertyGroup):
                ("NONE", "None", "Only the scene's lights")],
         default="WORLD",
     )
+    shadow_catcher: BoolProperty(
+        name="Shadow catcher", default=False,
+        description="A shadow catcher under the scene at its lowest point, showing only the shadows "
+                    "cast on it, as Blender's shadow catcher does (--ground shadow)")
     output_dir: StringProperty(name="Output folder", subtype='DIR_PATH', default="//pmr/")
     name: StringProperty(name="File name", default="frame_####",
                          description="File stem (--name); #### is the frame number")

@@ -28,6 +28,7 @@ class PMR_PT_lightfield(bpy.types.Panel):
         layout.prop(s, "samples")
         layout.prop(s, "texture_filter")
         layout.prop(s, "environment")
+        layout.prop(s, "shadow_catcher")
         layout.prop(s, "output_dir")
         layout.prop(s, "name")
         layout.prop(s, "write")

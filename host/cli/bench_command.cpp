@@ -67,6 +67,7 @@ PipelineConfig bench_config(const BenchOptions& o, Method method, Sampling sampl
   pc.samples = samples;
   pc.texture_filter = o.texture_filter;
   pc.shadows = o.shadows;
+  pc.environment_occlusion = o.environment_occlusion;
   pc.shading = o.shading, pc.exposure_ev = o.exposure_ev, pc.environment_intensity = o.environment_intensity;
   pc.environment = o.environment;
   pc.tile_queue_limit = o.limits.tile_queue;

@@ -70,11 +70,15 @@ const BenchSection kSweepOptions = {
 // Not listed one by one: the heading names them.
 const BenchSection kShadingOptions = {
     "  --shading S, --exposure EV, --environment E, --environment-rotation DEG,\n"
-    "  --environment-intensity X, --shadows on|off   as for pmr render (default pbr, studio,\n"
-    "  shadows on)",
+    "  --environment-intensity X, --shadows on|off, --environment-occlusion on|off   as for\n"
+    "  pmr render (default pbr, studio, shadows and the environment's occlusion on)",
     {
         {"--shadows", nullptr, "on|off", "",
          [](BenchOptions& o, const std::string& v, const std::string&) { o.shadows = parse_shadows(v); }},
+        {"--environment-occlusion", nullptr, "on|off", "",
+         [](BenchOptions& o, const std::string& v, const std::string& name) {
+           o.environment_occlusion = parse_on_off(v, name);
+         }},
         {"--shading", nullptr, "S", "",
          [](BenchOptions& o, const std::string& v, const std::string&) { o.shading = parse_shading(v); }},
         {"--exposure", nullptr, "EV", "",

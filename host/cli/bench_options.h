@@ -25,7 +25,8 @@ struct BenchOptions {
   std::vector<int> samples = {4};  // samples per pixel, as pmr render's --samples (and its default)
   TextureFilter texture_filter = TextureFilter::Trilinear;  // --texture-filter, as pmr render's
   Shading shading = Shading::Pbr;
-  bool shadows = true;  // pbr: --shadows, as pmr render's
+  bool shadows = true;                // pbr: --shadows, as pmr render's
+  bool environment_occlusion = true;  // pbr: --environment-occlusion, as pmr render's
   double exposure_ev = 0.0, environment_intensity = 1.0;
   bool views_given = false;
   int frames = 5;

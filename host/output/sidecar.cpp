@@ -15,6 +15,7 @@
 #include "pmr/printable.h"
 #include "pmr/version.h"
 #include "shading/lights.h"
+#include "scene/ground_catcher.h"
 #include "shading/environment_occlusion.h"
 
 namespace pmr {
@@ -146,10 +147,14 @@ json shading_json(const SidecarInfo& info) {
     s["environment"]["file_hex"] = to_hex(info.environment.file);
   s["lights"] = lights_json(info.lights);
   if (info.render.shadows)  // absent: off, as every sidecar before shadows
-    s["shadows"] = {{"map_size", info.render.shadow_sizes.directional},
-                    {"local_map_size", info.render.shadow_sizes.local},
-                    {"light_samples", kShadowSamples},
-                    {"environment_occlusion", {{"directions", kOcclusionDirections}, {"map_size", kOcclusionSize}}}};
+    s["shadows"] = {
+        {"map_size", info.render.shadow_sizes.directional},
+        {"local_map_size", info.render.shadow_sizes.local},
+        {"light_samples", kShadowSamples},
+        {"environment_occlusion",
+         {{"directions", info.render.environment_occlusion ? kOcclusionDirections : 0}, {"map_size", kOcclusionSize}}}};
+  if (info.render.ground_shadow)  // the catcher's plane (scene/ground_catcher.h); absent: none
+    s["ground"] = {{"kind", "shadow"}, {"height", ground_height(info.bounds_lo, info.bounds_hi)}};
   if (info.lights.size() > kSidecarLights) {
     s["lights_total"] = info.lights.size();
     s["lights_digest"] = lights_digest(info.lights);

@@ -40,6 +40,8 @@ struct RenderSettings {
   double exposure_ev = 0.0;
   double environment_intensity = 1.0;  // pbr
   bool shadows = false;                // pbr: --shadows (recorded only when on: an older sidecar is off)
+  bool environment_occlusion = false;  // pbr, shadows on: --environment-occlusion
+  bool ground_shadow = false;          // pbr, shadows on: --ground shadow (recorded only when on)
   ShadowSizes shadow_sizes;
   int tile_x = 16, tile_y = 2, tile_v = 16;
 };

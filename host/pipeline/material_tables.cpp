@@ -173,10 +173,9 @@ MaterialTables make_material_tables(const Scene& scene, bool mips) {
     const SceneMaterialInputs& in = scene.material_inputs[i];
     apply_material_inputs(in, m);  // the factors as the loader checked them (a scene's copies may be stale)
     for (int k = 0; k < PMR_MAPS; ++k) {
-      const SceneTextureSlot& slot = in.slots[size_t(k)];  // PMR_MAP_* is the slot's kind
+      const SceneTextureSlot& slot = in.slots[size_t(k)];   // PMR_MAP_* is the slot's kind
       if (slot.texture < 0 || slot.texcoord < 0) continue;  // no map, or no drawn primitive samples it
-      if (size_t(slot.texture) >= scene.textures.size() ||
-          size_t(slot.texcoord) >= scene.texcoords.size())
+      if (size_t(slot.texture) >= scene.textures.size() || size_t(slot.texcoord) >= scene.texcoords.size())
         throw InternalError("material " + std::to_string(i) + "'s " + texture_slot_name(k) +
                             " names a texture or TEXCOORD set the scene does not have");
       if (texture_slot_is_normal_map(k) && !has_tangents) continue;
@@ -186,7 +185,8 @@ MaterialTables make_material_tables(const Scene& scene, bool mips) {
       texture_transform_matrix(slot, map.uv_transform);
     }
   }
-  for (PmrMaterial& m : t.materials) m.flags = material_flags(m);
+  // the ground catcher's mark is the scene's (host/scene/ground_catcher.h); the rest is found here
+  for (PmrMaterial& m : t.materials) m.flags = material_flags(m) | (m.flags & PMR_MATERIAL_SHADOW_CATCHER);
   return t;
 }
 

@@ -108,9 +108,9 @@ Pipeline::Pipeline(const ClRuntime& runtime, const PipelineConfig& config) : con
 
 Pipeline::~Pipeline() = default;
 
-void Pipeline::set_scene(const Scene& scene) {
+void Pipeline::set_scene(const Scene& scene, const Scene* catcher) {
   Impl& m = *impl_;
-  m.scene.set_scene(scene);
+  m.scene.set_scene(scene, catcher);
   if (m.views > 0 && m.paths.fused && m.scene.blended()) {  // BLEND needs the volume path: choose again
     const std::unique_ptr<Display> display = std::move(m.display);
     configure(Rig(m.rig), display.get());
@@ -127,7 +127,8 @@ FrameDescription describe_frame(const Rig& rig, const std::vector<SceneLight>& s
   f.rig = rig;
   if (config.shading != Shading::Pbr) return f;
   f.lights = resolve_lights(scene_lights, rig, config.environment.get());
-  if (config.shadows) f.occlusion = occlusion_directions(config.environment.get(), config.environment_intensity);
+  if (config.shadows && config.environment_occlusion)
+    f.occlusion = occlusion_directions(config.environment.get(), config.environment_intensity);
   return f;
 }
 

@@ -39,8 +39,9 @@ class Pipeline {
   Pipeline(const ClRuntime& runtime, const PipelineConfig& config);
   ~Pipeline();
 
-  // Uploads geometry, materials and textures. Call again to switch scenes.
-  void set_scene(const Scene& scene);
+  // Uploads geometry, materials and textures, and with --ground shadow the catcher
+  // (make_ground_catcher) after them. Call again to switch scenes.
+  void set_scene(const Scene& scene, const Scene* catcher = nullptr);
   // Replaces positions, attributes and triangles (a posed frame of the scene given to set_scene: same
   // counts, same materials and textures). Only a copy: no buffer is reallocated.
   void update_geometry(const Scene& posed);

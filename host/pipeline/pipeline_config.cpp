@@ -41,11 +41,13 @@ Shading parse_shading(const std::string& name) {
 
 const char* to_string(Shading s) { return s == Shading::Pbr ? "pbr" : "lambert"; }
 
-bool parse_shadows(const std::string& name) {
+bool parse_on_off(const std::string& name, const std::string& option) {
   if (name == "on") return true;
   if (name == "off") return false;
-  throw Error("unknown --shadows '" + name + "' (expected on or off)");
+  throw Error("unknown " + option + " '" + name + "' (expected on or off)");
 }
+
+bool parse_shadows(const std::string& name) { return parse_on_off(name, "--shadows"); }
 
 TextureFilter parse_texture_filter(const std::string& name) {
   if (name == "bilinear") return TextureFilter::Bilinear;

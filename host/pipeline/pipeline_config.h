@@ -47,8 +47,9 @@ enum class Shading {
   Lambert,  // view-independent: base colour x (0.2 + 0.8 max(0, n.l)), one directional light
   Pbr,      // glTF metallic-roughness seen from each view's camera
 };
-Shading parse_shading(const std::string& name);  // "lambert", "pbr"
-bool parse_shadows(const std::string& name);     // "on", "off"
+Shading parse_shading(const std::string& name);                         // "lambert", "pbr"
+bool parse_on_off(const std::string& name, const std::string& option);  // "on", "off"
+bool parse_shadows(const std::string& name);                            // "on", "off"
 const char* to_string(Shading s);
 
 // How textures are filtered (DESIGN section 3b, --texture-filter).
@@ -88,6 +89,12 @@ struct PipelineConfig {
   // Off here (the library's images stay those of the tests that pin them); the command line's default
   // is on. Off: every visibility 1, the images bit for bit those before shadows.
   bool shadows = false;
+  // pbr, with shadows on: the environment's occlusion (shading/environment_occlusion.h); off leaves the
+  // environment unoccluded and reads none of its 64 maps (--environment-occlusion).
+  bool environment_occlusion = true;
+  // pbr, with shadows on: --ground shadow, a shadow catcher under the scene (scene/ground_catcher.h),
+  // placed by the framing (FrameRenderer::attach).
+  bool ground_shadow = false;
   ShadowSizes shadow_sizes;
   // pbr: an environment image, prefiltered once (Environment::make) and shared by every pipeline of
   // a process; its rotation and intensity are its own (the intensity must equal environment_intensity).

@@ -57,40 +57,90 @@ void SceneBuffers::upload_environment(const PipelineConfig& config) {
   env_data_ = rt_.upload(data, "environment tables");
 }
 
-void SceneBuffers::set_scene(const Scene& scene) {
-  if (scene.triangles.size() >= PMR_MAX_TRIANGLES)
-    throw Error("the scene has " + std::to_string(scene.triangles.size()) + " triangles; at most " +
+namespace {
+
+// `a`, then `b`.
+template <class T>
+std::vector<T> joined(const std::vector<T>& a, const std::vector<T>& b) {
+  std::vector<T> out;
+  out.reserve(a.size() + b.size());
+  out.insert(out.end(), a.begin(), a.end());
+  out.insert(out.end(), b.begin(), b.end());
+  return out;
+}
+
+// TEXCOORD set k of vertex v at k * vertices + v, for `added` more vertices (which sample no map) after
+// the scene's.
+std::vector<glm::vec2> texcoords_with(const std::vector<glm::vec2>& table, size_t vertices, size_t added) {
+  if (added == 0 || vertices == 0 || table.size() < vertices) return table;
+  std::vector<glm::vec2> out;
+  for (size_t k = 0; k < table.size() / vertices; ++k) {
+    out.insert(out.end(), table.begin() + ptrdiff_t(k * vertices), table.begin() + ptrdiff_t((k + 1) * vertices));
+    out.resize(out.size() + added, glm::vec2(0.0f));
+  }
+  return out;
+}
+
+}  // namespace
+
+void SceneBuffers::set_scene(const Scene& scene, const Scene* catcher) {
+  const size_t total = scene.triangles.size() + (catcher ? catcher->triangles.size() : 0);
+  if (total >= PMR_MAX_TRIANGLES)
+    throw Error("the scene has " + std::to_string(total) + " triangles; at most " +
                 std::to_string(PMR_MAX_TRIANGLES - 1) + " are supported");
-  num_vertices_ = uint32_t(scene.positions.size());
-  num_triangles_ = uint32_t(scene.triangles.size());
-  const MaterialTables tables = make_material_tables(scene, mips_);
+  catcher_positions_.clear(), catcher_attributes_.clear(), catcher_triangles_.clear();
+  MaterialTables tables = make_material_tables(scene, mips_);
+  if (catcher) {
+    catcher_positions_ = catcher->positions, catcher_attributes_ = catcher->attributes;
+    for (PmrTriangle t : catcher->triangles) {
+      for (uint32_t& v : t.v) v += uint32_t(scene.positions.size());
+      t.material += uint32_t(tables.materials.size());
+      catcher_triangles_.push_back(t);
+    }
+    tables.materials.insert(tables.materials.end(), catcher->materials.begin(), catcher->materials.end());
+    tables.texcoords = texcoords_with(tables.texcoords, scene.positions.size(), catcher->positions.size());
+  }
+  num_vertices_ = uint32_t(scene.positions.size() + catcher_positions_.size());
+  num_triangles_ = uint32_t(total);
+  caster_triangles_ = uint32_t(scene.triangles.size());
   has_tangents_ = scene.tangents.size() == scene.positions.size() && !scene.positions.empty();
   transmissive_ = pbr_ && scene_transmissive(scene);
   translucent_casters_ = scene_transmissive(scene);
-  blended_ = scene_blended(scene, pbr_);
+  blended_ = scene_blended(scene, pbr_) || !catcher_triangles_.empty();
   const std::vector<glm::vec4> no_tangents(1, glm::vec4(0.0f));
   scene_lights_ = scene.lights;
   set_bounds(scene.positions);
-  positions_ = rt_.upload(scene.positions, "vertex positions");
-  attrs_ = rt_.upload(scene.attributes, "vertex attributes");
-  tris_ = rt_.upload(scene.triangles, "triangles");
+  positions_ = rt_.upload(joined(scene.positions, catcher_positions_), "vertex positions");
+  attrs_ = rt_.upload(joined(scene.attributes, catcher_attributes_), "vertex attributes");
+  tris_ = rt_.upload(joined(scene.triangles, catcher_triangles_), "triangles");
   materials_ = rt_.upload(tables.materials, "materials");
   textures_ = rt_.upload(tables.textures, "texture table", 16);
   texels_ = rt_.upload(tables.texels, "texels", 16);
   texcoords_ = rt_.upload(tables.texcoords, "texture coordinates");
-  tangents_ = rt_.upload(has_tangents_ ? scene.tangents : no_tangents, "tangents");
+  const std::vector<glm::vec4> catcher_tangents(catcher_positions_.size(), glm::vec4(0.0f));
+  tangents_ = rt_.upload(has_tangents_ ? joined(scene.tangents, catcher_tangents) : no_tangents, "tangents");
 }
 
 void SceneBuffers::update_geometry(const Scene& posed) {
-  if (posed.positions.size() != num_vertices_ || posed.triangles.size() != num_triangles_ ||
-      posed.attributes.size() != posed.positions.size())
+  if (posed.positions.size() + catcher_positions_.size() != num_vertices_ ||
+      posed.triangles.size() != caster_triangles_ || posed.attributes.size() != posed.positions.size())
     throw InternalError("update_geometry: the posed scene does not match the scene given to set_scene");
   if (posed.triangles.empty()) return;
   set_bounds(posed.positions);
-  rt_.write(positions_, posed.positions);
-  rt_.write(attrs_, posed.attributes);
-  rt_.write(tris_, posed.triangles);
-  if (has_tangents_ && posed.tangents.size() == posed.positions.size()) rt_.write(tangents_, posed.tangents);
+  if (catcher_triangles_.empty()) {
+    rt_.write(positions_, posed.positions);
+    rt_.write(attrs_, posed.attributes);
+    rt_.write(tris_, posed.triangles);
+  } else {
+    rt_.write(positions_, joined(posed.positions, catcher_positions_));
+    rt_.write(attrs_, joined(posed.attributes, catcher_attributes_));
+    rt_.write(tris_, joined(posed.triangles, catcher_triangles_));
+  }
+  if (has_tangents_ && posed.tangents.size() == posed.positions.size()) {
+    if (catcher_positions_.empty()) rt_.write(tangents_, posed.tangents);
+    else
+      rt_.write(tangents_, joined(posed.tangents, std::vector<glm::vec4>(catcher_positions_.size(), glm::vec4(0.0f))));
+  }
 }
 
 void SceneBuffers::set_bounds(const std::vector<glm::vec3>& positions) {

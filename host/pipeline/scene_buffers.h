@@ -20,8 +20,11 @@ class SceneBuffers {
  public:
   // The run's tables: sRGB decoding, the split-sum table (pbr) and the environment image (pbr).
   SceneBuffers(const ClRuntime& rt, const PipelineConfig& config);
-  void set_scene(const Scene& scene);
-  // The posed geometry of a frame of the scene given to set_scene (same counts): copied, not reallocated.
+  // The scene's triangles, then those of `catcher` (--ground shadow: make_ground_catcher, a scene of
+  // its own), which cast no shadow and lie outside bounds_lo()..bounds_hi().
+  void set_scene(const Scene& scene, const Scene* catcher = nullptr);
+  // The posed geometry of a frame of the scene given to set_scene (same counts), and its catcher as it
+  // was: copied, not reallocated.
   void update_geometry(const Scene& posed);
   // The frame's light table (light i with its shadow maps shadows.slots[i], then an entry with the
   // environment's occlusion maps when there are any) and each view's camera position in world space
@@ -46,6 +49,8 @@ class SceneBuffers {
   // a triangle with a transmissive material, whatever the shading: casts a partial shadow
   bool translucent_casters() const { return translucent_casters_; }
   uint32_t num_triangles() const { return num_triangles_; }
+  // the scene's own triangles, which cast shadows: the first num_triangles() less the catcher's
+  uint32_t caster_triangles() const { return caster_triangles_; }
   const ClBuffer& positions() const { return positions_; }
   const ClBuffer& triangles() const { return tris_; }
   const ClBuffer& materials() const { return materials_; }
@@ -59,7 +64,11 @@ class SceneBuffers {
   bool mips_;  // --texture-filter trilinear: the textures' mip chains are built and uploaded
   bool pbr_;
   bool transmissive_ = false, blended_ = false, translucent_casters_ = false;
-  uint32_t num_vertices_ = 0, num_triangles_ = 0;
+  uint32_t num_vertices_ = 0, num_triangles_ = 0, caster_triangles_ = 0;
+  // the catcher's geometry, its indices already past the scene's vertices and materials
+  std::vector<glm::vec3> catcher_positions_;
+  std::vector<PmrVertexAttr> catcher_attributes_;
+  std::vector<PmrTriangle> catcher_triangles_;
   bool has_tangents_ = false;
   std::vector<SceneLight> scene_lights_;
   glm::dvec3 bounds_lo_{0.0}, bounds_hi_{0.0};

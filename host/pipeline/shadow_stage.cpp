@@ -255,7 +255,7 @@ void ShadowStage::place(bool on, const std::vector<SceneLight>& lights,
                         const std::vector<OcclusionDirection>& occlusion, const SceneBuffers& scene) {
   placed_ = ShadowPlacement{};
   placed_.slots.assign(lights.size(), ShadowSlot{});
-  if (!on || scene.num_triangles() == 0) return;
+  if (!on || scene.caster_triangles() == 0) return;
   placed_ = place_shadow_maps(lights, occlusion, scene.bounds_lo(), scene.bounds_hi(), sizes_,
                               scene.blended() || scene.translucent_casters());
   const uint64_t texels = shadow_texels(placed_.maps);
@@ -293,7 +293,7 @@ void ShadowStage::render(const SceneBuffers& scene, const PmrParams& P, const So
       ev.add(kShadow, launcher_.launch(clear_, texels, 64));
     }
     raster_.args_from(next, cl_uint(k), depth_);
-    ev.add(kShadow, launcher_.launch(raster_, scene.num_triangles(), 64));
+    ev.add(kShadow, launcher_.launch(raster_, scene.caster_triangles(), 64));  // not the ground catcher
   }
 }
 

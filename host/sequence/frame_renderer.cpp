@@ -6,6 +6,7 @@
 
 #include "pmr/error.h"
 #include "pmr/printable.h"
+#include "scene/ground_catcher.h"
 #include "scene/motion.h"
 #include "sequence/frame_work.h"
 
@@ -227,7 +228,14 @@ Rig FrameRenderer::rig_for(const Scene& posed, std::vector<std::string>* warning
 void FrameRenderer::attach(Pipeline& pipeline, const Display* encode_display) {
   pipeline_ = &pipeline;
   if (rest_.triangles.empty()) return;  // every frame is transparent: the pipeline is never run
-  pipeline.set_scene(rest_);
+  if (pipeline.config().ground_shadow) {
+    // over every view's footprint: as far from the pivot as the far plane reaches
+    const glm::dvec3 eye(glm::inverse(rig_.center_view)[3]);
+    const Scene catcher = make_ground_catcher(lo_, hi_, rig_.far + glm::length(eye - pivot()));
+    pipeline.set_scene(rest_, &catcher);
+  } else {
+    pipeline.set_scene(rest_);
+  }
   pipeline.configure(rig_, encode_display);
 }
 

@@ -194,9 +194,10 @@ void SequenceRun::check_frame_memory() const {
   const Rig& rig = renderer_->rig();
   const uint64_t voxels = uint64_t(rig.views) * uint64_t(rig.view_w) * uint64_t(rig.view_h);
   const uint64_t display = products_.encoded ? uint64_t(job_.display.width) * uint64_t(job_.display.height) * 14 : 0;
-  // (BLEND layers are composited in the view volume: such a scene keeps one even for the encoded image)
+  // (BLEND layers, the ground catcher's too, are composited in the view volume: such a scene keeps one
+  // even for the encoded image)
   const bool pbr = pc_.shading == Shading::Pbr;
-  const uint64_t volume = need_volume_ || scene_blended(scene_, pbr) ? voxels * 8 : 0;
+  const uint64_t volume = need_volume_ || scene_blended(scene_, pbr) || pc_.ground_shadow ? voxels * 8 : 0;
   const uint64_t depth = need_volume_ && products_.depth ? voxels * (24 * uint64_t(pc_.samples) + 3 * 4) : 0;
   const uint64_t glass =
       pbr && scene_transmissive(scene_) ? TransmissionStage::bytes_for(rig.views, rig.view_w, rig.view_h) : 0;
@@ -212,7 +213,8 @@ static RenderSettings render_settings(const PipelineConfig& p) {
   RenderSettings r;
   r.method = p.method, r.sampling = p.sampling, r.samples = p.samples, r.texture_filter = p.texture_filter;
   r.shading = p.shading, r.exposure_ev = p.exposure_ev, r.environment_intensity = p.environment_intensity;
-  r.shadows = p.shadows, r.shadow_sizes = p.shadow_sizes;
+  r.shadows = p.shadows, r.shadow_sizes = p.shadow_sizes, r.environment_occlusion = p.environment_occlusion;
+  r.ground_shadow = p.ground_shadow;
   r.tile_x = p.tile_x, r.tile_y = p.tile_y, r.tile_v = p.tile_v;
   return r;
 }

@@ -98,6 +98,8 @@ typedef uint64_t pmr_u64;
 #define PMR_MATERIAL_ANISOTROPY 4u /* KHR_materials_anisotropy with a strength above 0               */
 #define PMR_MATERIAL_IRIDESCENCE 8u /* KHR_materials_iridescence with a factor above 0               */
 #define PMR_MATERIAL_SHEEN 16u      /* KHR_materials_sheen with a colour factor above 0              */
+#define PMR_MATERIAL_SHADOW_CATCHER 32u /* --ground shadow's catcher (BLEND): black, of alpha the shadow
+                                           cast on it; casts none (DESIGN section 4d)               */
 
 /* Texture wrap modes (glTF sampler enums). */
 #define PMR_WRAP_REPEAT 10497

@@ -36,6 +36,15 @@ LIGHT_VIEW = (96, 128)
 # does not, so pmr is expected at 0.96-0.97 of Cycles where the plane is seen and lit near its normal
 # (there Cycles' Disney diffuse is Lambert's). 64 Cycles samples add < 1% noise to a patch mean.
 LIGHT_TOLERANCE = 0.05
+# The whole-scene comparison (check_scene_against_cycles): 192x256 views, and the mean |sRGB
+# difference| allowed without and with the area light, in 255ths (measured 4.0 and 4.2: pmr's (1 - F)
+# diffuse weight, docs/BLENDER.md; a missing light or a wrong unit is tens of 255ths). The lights and
+# the world are dimmed so that no pixel clips.
+SCENE_VIEW = (192, 256)
+SCENE_TOLERANCE = {False: 5.0, True: 5.0}
+SCENE_LIGHT_SCALE = {"Sun": 0.5, "Bulb": 0.15, "Panel": 0.05}
+SCENE_WORLD_STRENGTH = 0.3
+FOREST = "/usr/share/blender/datafiles/studiolights/world/forest.exr"
 
 
 def fail(message):
@@ -275,6 +284,108 @@ def check_area_light(scene, ops_module, work):
     return compare_center_view(scene, sidecar, out, work, "area light")
 
 
+def check_shadow_catcher(scene, ops_module, work):
+    """The panel's Shadow catcher reaches pmr as --ground shadow: the sidecar records the catcher, at
+    or below the lowest point of the framed scene."""
+    out = os.path.join(work, "catcher")
+    settings_for(scene, out, "STILL", LIGHT_VIEW).shadow_catcher = True
+    scene.frame_set(FRAMES[0])
+    try:
+        r = run_operator(ops_module)
+    finally:
+        scene.pmr_lightfield.shadow_catcher = False
+    check("--ground" in r.get("argv", []), "the shadow catcher is not passed to pmr: %s" % r.get("argv"))
+    sidecar = read_sidecar(out, FRAMES[0])
+    ground = sidecar["shading"].get("ground")
+    check(ground is not None and ground.get("kind") == "shadow", "pmr drew no shadow catcher: %s" % ground)
+    low = sidecar["scene_bounds"]["min"][1]
+    check(ground["height"] <= low, "the catcher (y = %g) is above the scene's lowest point (%g)"
+          % (ground["height"], low))
+    return ground["height"]
+
+
+def srgb(c):
+    c = min(max(c, 0.0), 1.0)
+    return 12.92 * c if c <= 0.0031308 else 1.055 * c ** (1.0 / 2.4) - 0.055
+
+
+def mean_srgb_difference(scene, sidecar, out, work, what):
+    """pmr's center view against Cycles with direct light only (max bounces 0: what pmr computes):
+    the mean |sRGB difference| over the pixels both cover (alpha above 0.99), and that count."""
+    q = sidecar["quilt"]
+    quilt = bpy.data.images.load(os.path.join(out, sidecar["outputs"]["quilt"]))
+    center = VIEWS // 2
+    col, row, tw, th = center % q["columns"], center // q["columns"], q["tile_width"], q["tile_height"]
+    plain_cycles(scene, 128)
+    scene.cycles.max_bounces = 0
+    scene.render.film_transparent = True
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.filepath = os.path.join(work, "cycles_%s.exr" % what)
+    bpy.ops.render.render(write_still=True)
+    ref = bpy.data.images.load(scene.render.filepath)
+    qw, _, qp = pixels(quilt)
+    rw, _, rp = pixels(ref)
+    total, signed, level, clipped, n = 0.0, 0.0, 0.0, 0, 0
+    for y in range(th):
+        for x in range(tw):
+            i, j = 4 * ((row * th + y) * qw + col * tw + x), 4 * (y * rw + x)
+            if qp[i + 3] > 0.99 and rp[j + 3] > 0.99:
+                total += sum(abs(srgb(qp[i + k]) - srgb(rp[j + k])) for k in range(3)) / 3.0
+                signed += sum(srgb(qp[i + k]) - srgb(rp[j + k]) for k in range(3)) / 3.0
+                level += sum(srgb(rp[j + k]) for k in range(3)) / 3.0
+                clipped += max(rp[j:j + 3]) >= 1.0
+                n += 1
+    scene.cycles.max_bounces, scene.render.film_transparent = 12, False
+    log("%s: Cycles' mean sRGB level %.3f (pmr - Cycles %+.4f), %d of %d pixels clipped at 1" % (
+        what, level / max(n, 1), signed / max(n, 1), clipped, n))
+    check(clipped < n // 10, "%s: %d of %d pixels are clipped: the comparison would see no difference" % (
+        what, clipped, n))
+    return total / max(n, 1), n
+
+
+def check_scene_against_cycles(scene, ops_module, work, with_area):
+    """The scene of objects on a ground plane, a sun, a point light and an HDRI world (Blender's
+    forest.exr), with the 2 m x 1 m area light when `with_area`, through the add-on, against Cycles
+    with direct light only, as DESIGN's quality goal measures it (docs/BLENDER.md)."""
+    for name in ("Mover", "Sun", "Bulb", "Ground"):
+        scene.objects[name].hide_render = False
+    scene.objects["Panel"].hide_render = not with_area
+    nodes, links = scene.world.node_tree.nodes, scene.world.node_tree.links
+    tex = nodes.new("ShaderNodeTexEnvironment")
+    tex.image = bpy.data.images.load(FOREST)
+    link = links.new(tex.outputs["Color"], nodes["Background"].inputs["Color"])
+    # dimmer lights and world than the light checks use, so that the grey ground stays below 1 (a clipped
+    # pixel compares equal whatever the light)
+    energies = {name: bpy.data.lights[name].energy for name in ("Sun", "Bulb", "Panel")}
+    for name, k in SCENE_LIGHT_SCALE.items():
+        bpy.data.lights[name].energy = energies[name] * k
+    strength = nodes["Background"].inputs["Strength"]
+    strength.default_value = SCENE_WORLD_STRENGTH
+    what = "scene_area" if with_area else "scene"
+    out = os.path.join(work, what)
+    settings_for(scene, out, "STILL", SCENE_VIEW)
+    scene.render.resolution_x, scene.render.resolution_y = SCENE_VIEW
+    scene.frame_set(FRAMES[0])
+    try:
+        run_operator(ops_module)
+        sidecar = read_sidecar(out, FRAMES[0])
+        diff, n = mean_srgb_difference(scene, sidecar, out, work, what)
+    finally:
+        links.remove(link)
+        nodes.remove(tex)
+        strength.default_value = 1.0
+        for name, e in energies.items():
+            bpy.data.lights[name].energy = e
+        scene.render.resolution_x, scene.render.resolution_y = LIGHT_VIEW
+    limit = SCENE_TOLERANCE[with_area]
+    log("%s: mean |sRGB difference| to Cycles (direct light) %.4f (%.1f/255) over %d pixels" % (
+        "sun, point light, area light and HDRI" if with_area else "sun, point light and HDRI", diff, 255 * diff, n))
+    check(n > SCENE_VIEW[0] * SCENE_VIEW[1] // 4, "pmr and Cycles cover only %d pixels in common" % n)
+    check(diff <= limit / 255.0, "%s: mean |sRGB difference| %.1f/255 > %.1f/255" % (what, 255 * diff, limit))
+    return diff
+
+
 def check_point_light(scene, ops_module, work):
     """A grey plane lit only by the point light: pmr's center view against Cycles."""
     for name in ("Mover", "Sun", "Panel"):
@@ -503,11 +614,20 @@ def main():
     err = check_camera(sidecars[FRAMES[0]], scene.camera)
     log("center view = the active camera (max error %.2g)" % err)
 
+    height = check_shadow_catcher(scene, ops_module, work)
+    log("the shadow catcher reaches pmr (--ground shadow at y = %.4g)" % height)
+
     check_point_light(scene, ops_module, work)
     log("point light matches Cycles within %.0f%%" % (100 * LIGHT_TOLERANCE))
 
     check_area_light(scene, ops_module, work)
     log("area light matches Cycles within %.0f%%" % (100 * LIGHT_TOLERANCE))
+
+    if os.path.isfile(FOREST):
+        check_scene_against_cycles(scene, ops_module, work, False)
+        check_scene_against_cycles(scene, ops_module, work, True)
+    else:
+        log("skipped the whole-scene comparison: %s is missing" % FOREST)
 
     check_environment(scene, ops_module, work)
     log("the world's HDRI lights the cube from the side Blender shows it")

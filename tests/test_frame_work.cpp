@@ -153,6 +153,23 @@ TEST(FrameWork, ShadowsCountTheirMapReadsAndPasses) {
                                          with.shadow_map_triangles * kUnitsPerShadowTriangle + soft.texels);
 }
 
+// The ground catcher (--ground shadow) is one more BLEND layer under every view pixel, shaded with the
+// lights and read through the shadow maps like any fragment.
+TEST(FrameWork, TheGroundCatcherIsABlendLayerOverEveryPixel) {
+  Scene s = test::empty_scene(false);
+  test::add_triangle(s, {-1, -1, 0}, {1, -1, 0}, {0, 1, 0});
+  const Rig rig = test::small_rig(4, 32, 16);
+  PipelineConfig config;
+  const ShadowCost shadows = shadow_cost({SceneLight()}, 64, ShadowSizes());
+  const FrameWork without = estimate_frame_work(s, rig, 2, config, shadows);
+  config.ground_shadow = true;
+  const FrameWork with = estimate_frame_work(s, rig, 2, config, shadows);
+  EXPECT_EQ(with.blend_fragments - without.blend_fragments, 4u * 32u * 16u);
+  EXPECT_EQ(with.light_evaluations - without.light_evaluations, 2u * 4u * 32u * 16u);
+  EXPECT_EQ(with.shadow_reads - without.shadow_reads, 65u * 4u * 32u * 16u);
+  EXPECT_GT(with.units, without.units);
+}
+
 // An area light weighs as the point-like lights its shading costs, and its shadow is sampled like any
 // light with a size.
 TEST(FrameWork, AreaLightsWeighTheirShading) {

@@ -67,6 +67,9 @@ FrameWork estimate_frame_work(const Scene& placed, const Rig& rig, uint64_t ligh
                              glm::dvec3(placed.positions[t.v[2]])};
     f.blend_fragments = add_sat(f.blend_fragments, blend_voxel_bound(p, rig, to_clip, config.tile_x, config.tile_y));
   }
+  // --ground shadow: the catcher (appended by the pipeline, not in `placed`) is a BLEND layer under every
+  // view pixel at most
+  if (config.ground_shadow) f.blend_fragments = add_sat(f.blend_fragments, f.pixels);
   f.light_evaluations = mul_sat(add_sat(f.pixels, f.blend_fragments), f.lights);
   const uint64_t per_fragment = kUnitsPerBlendFragment + f.samples * kUnitsPerBlendSample;
   f.units = add_sat(mul_sat(f.light_evaluations, kUnitsPerLightEvaluation), mul_sat(f.blend_fragments, per_fragment));

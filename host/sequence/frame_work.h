@@ -27,7 +27,7 @@ struct PipelineConfig;
 struct FrameWork {
   uint64_t pixels = 0;             // views x W x H
   uint64_t lights = 0;             // light evaluations per shaded point (light_evaluations_per_point)
-  uint64_t blend_fragments = 0;    // upper bound of the BLEND triangles' voxels
+  uint64_t blend_fragments = 0;    // upper bound of the BLEND triangles' voxels (the ground catcher's: every pixel)
   uint64_t samples = 1;            // per pixel
   uint64_t light_evaluations = 0;  // (pixels + blend_fragments) x lights
   uint64_t shadow_reads = 0;       // (pixels + blend_fragments) x maps read per point

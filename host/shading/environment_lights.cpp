@@ -5,12 +5,15 @@
 #include <cstdint>
 
 namespace pmr {
+
+double luminance(const glm::dvec3& rgb) { return 0.2126 * rgb.r + 0.7152 * rgb.g + 0.0722 * rgb.b; }
+
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// A texel's luminance (Rec. 709 weights, as the image's colour space is linear Rec. 709).
-double luminance(const float* rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
+// A texel's luminance.
+double luminance(const float* rgb) { return pmr::luminance(glm::dvec3(rgb[0], rgb[1], rgb[2])); }
 
 // The median luminance of the image, from a histogram of log2 luminance (1/64 of an octave a bin,
 // 2^-40 to 2^40): no copy of the image's values.

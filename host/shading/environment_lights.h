@@ -20,6 +20,9 @@
 
 namespace pmr {
 
+// Rec. 709 luminance of a linear colour (the images' colour space is linear Rec. 709).
+double luminance(const glm::dvec3& rgb);
+
 constexpr double kBrightOverMedian = 50.0;
 constexpr double kMaxRegionSolidAngle = 0.1;  // sr: a cap of 10 degrees' radius
 constexpr double kMinRegionShare = 0.05;

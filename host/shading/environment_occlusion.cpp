@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "shading/environment_lights.h"
+
 namespace pmr {
 
 std::vector<OcclusionDirection> occlusion_directions(const Environment* env, double uniform_intensity) {
@@ -13,10 +15,7 @@ std::vector<OcclusionDirection> occlusion_directions(const Environment* env, dou
     const double y = 1.0 - (2.0 * i + 1.0) / k, ring = std::sqrt(std::max(0.0, 1.0 - y * y)), a = i * 2.399963229728653;
     const glm::dvec3 d(ring * std::cos(a), y, ring * std::sin(a));
     double w = 1.0;
-    if (env) {
-      const glm::dvec3 c = env->prefiltered(d, kOcclusionWeightRoughness);
-      w = 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
-    }
+    if (env) w = luminance(env->prefiltered(d, kOcclusionWeightRoughness));
     if (w > 0.0 && std::isfinite(w)) out.push_back({d, w});
   }
   return out;

@@ -11,7 +11,7 @@ PACKAGES=(
   g++ cmake make pkg-config
   pocl-opencl-icd ocl-icd-opencl-dev opencl-headers clinfo
   libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
-  libopenexr-dev openexr libpng-dev libxxhash-dev libdeflate-dev libisal-dev
+  libopenexr-dev openexr libopencolorio-dev libpng-dev libxxhash-dev libdeflate-dev libisal-dev
   libgtest-dev
   libegl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri  # pmr_gl_bench (tests/bench/gl_multiview.cpp) only
   python3 python3-matplotlib
@@ -32,7 +32,8 @@ fi
 # scripts/fuzz.sh needs the packages only (it builds with clang in its own folder)
 [ "${PMR_SETUP_PACKAGES_ONLY:-0}" = 1 ] && exit 0
 
-cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release >/dev/null
+# PMR_WERROR=ON (set by .ci/run): warnings in pmr's own sources fail the build
+cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DPMR_WERROR="${PMR_WERROR:-OFF}" >/dev/null
 if [ ${#TARGETS[@]} -gt 0 ]; then
   cmake --build "$BUILD_DIR" -j "$(nproc)" --target "${TARGETS[@]}"
 else

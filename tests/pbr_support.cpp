@@ -212,7 +212,9 @@ double expect_feature_matches_reference(const Scene& s, const Scene& without,
   EXPECT_EQ(r.check.bad, 0u);
   for (uint32_t material = 1; material <= n; ++material) {
     EXPECT_GT(r.voxels[material], size_t(300)) << "material " << material;
-    if (material < n) EXPECT_GT(r.changed[material], r.voxels[material] / divisor) << "material " << material;
+    if (material < n) {
+      EXPECT_GT(r.changed[material], r.voxels[material] / divisor) << "material " << material;
+    }
   }
   EXPECT_EQ(r.changed[n], 0u) << "material " << n << " has no such feature";
   return r.check.worst;
@@ -244,7 +246,9 @@ void expect_paths_agree(const Scene& s, const Rig& rig, const PipelineConfig& pc
     changed += f.image[i] != bare[i];
   }
   EXPECT_GT(lit, size_t(1000));
-  if (other) EXPECT_GT(changed, lit / 4) << "the feature should change the image";
+  if (other) {
+    EXPECT_GT(changed, lit / 4) << "the feature should change the image";
+  }
   EXPECT_NEAR(sum_subpixel, sum_view, 0.05 * sum_view);
 }
 

@@ -148,7 +148,9 @@ TEST(EncodedAlpha, CompositesLikeTheViewsOverABackground) {
       const float a = sp.at(alpha[k])[px];
       ASSERT_TRUE(a == 0.0f || a == 1.0f) << a;
       mean += a / 3.0f;
-      if (a == 0.0f) ASSERT_EQ(sp.at(colour[k])[px], 0.0f);  // nothing covers it: no colour
+      if (a == 0.0f) {
+        ASSERT_EQ(sp.at(colour[k])[px], 0.0f);  // nothing covers it: no colour
+      }
     }
     ASSERT_NEAR(sp.at("A")[px], mean, 1e-3f);
   }

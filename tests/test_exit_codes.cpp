@@ -45,6 +45,8 @@ TEST(ExitCodes, UsageErrorsExitTwo) {
   expect_usage_error(run("render --yfov 0 --out " + out), "--yfov");
   expect_usage_error(run("render --yfov 180 --out " + out), "--yfov");
   expect_usage_error(run("render --compression lzma --out " + out), "lzma");
+  expect_usage_error(run("render --compression dwaa --out " + out), "encoded image");  // encoded by default
+  expect_usage_error(run("render --compression dwab --write quilt,encoded --out " + out), "crosstalk");
   expect_usage_error(run("render --frames 5:1 --out " + out), "5:1");
   expect_usage_error(run("render --preset lg-99 --out " + out), "lg-99");
   expect_usage_error(run("render --limit bogus=1 --out " + out), "bogus");
@@ -58,6 +60,8 @@ TEST(ExitCodes, UsageErrorsExitTwo) {
   expect_usage_error(run("verify " + out + " --frames x"), "x");
   expect_usage_error(run("render --blend-views --bilinear --out " + out + kSmall), "--blend-views");
   expect_usage_error(run("render --shard 3/2 --out " + out + kSmall), "--shard");
+  // outside an array job: the command, not the input, is wrong (tests never run inside one)
+  expect_usage_error(run("render --shard auto --out " + out + kSmall), "no array job");
   expect_usage_error(run("bench --keep always"), "--keep");
   expect_usage_error(run("quality --scale 1"), "--scale");
   EXPECT_EQ(run("").status, 2) << "no command: the usage text, status 2";
@@ -135,12 +139,14 @@ TEST(ExitCodes, SignalNExits128PlusN) {
     int status = 0;
     waitpid(pid, &status, 0);
     ASSERT_TRUE(WIFEXITED(status));
-    if (WEXITSTATUS(status) != 0)  // a very fast machine may have finished all 50 frames first
+    if (WEXITSTATUS(status) != 0) {  // a very fast machine may have finished all 50 frames first
       EXPECT_EQ(WEXITSTATUS(status), 128 + sig);
+    }
     for (const std::string& name : test::listing(out)) {
       EXPECT_EQ(name[0] == '.', false) << "left behind: " << name;
-      if (name.size() > 4 && name.compare(name.size() - 4, 4, ".exr") == 0)
+      if (name.size() > 4 && name.compare(name.size() - 4, 4, ".exr") == 0) {
         EXPECT_TRUE(exists(out + "/" + name.substr(0, name.size() - 4) + ".json")) << name << " has no sidecar";
+      }
     }
   }
 }
@@ -199,8 +205,9 @@ TEST(ExitCodes, TheFirstSignalEndsALongFrameWithinTwoSeconds) {
   EXPECT_LT(seconds, 2.0 + 1.0) << "1.5 s by design, and a margin for a loaded machine";
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM);
-  if (exists(out))
+  if (exists(out)) {
     EXPECT_EQ(test::listing(out), std::set<std::string>()) << "nothing left: no image, temporary or lock";
+  }
   std::filesystem::remove_all(dir);
 }
 

@@ -1,6 +1,8 @@
 // Render-farm pieces that need no scheduler: the shard arithmetic for every scheduler's array
 // environment (each frame to exactly one task), and `pmr verify` on broken folders.
 #include <gtest/gtest.h>
+
+#include <regex>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -384,6 +386,74 @@ TEST(Verify, DeepDecodesEveryPixelAndOldSidecarsAreDecoded) {
   EXPECT_NE(v.output.find("2 of 3 frame(s) complete"), std::string::npos) << v.output;
 }
 
+// A frame missing from a quilt sequence, re-rendered alone (--frames 5 --resume, what verify's list
+// says to resubmit) or in a list, keeps the sequence's names: the folder's sidecars decide, not the
+// command line's single frame number. The sequence readers (frame_qs..._NNNN) then see every frame.
+TEST(Verify, AFrameRenderedAgainKeepsTheSequencesNames) {
+  const std::string out = test::temp_dir("verify_names");
+  const std::string args =
+      " -q --turntable 360:12 --views 4 --view-size 32x32 --display 120x68 --write quilt --out " + out;
+  ASSERT_EQ(test::run("render --frames 0:11" + args).status, 0);
+  auto sequence_quilts = [&] {
+    size_t n = 0, stills = 0;
+    for (const auto& e : fs::directory_iterator(out)) {
+      const std::string name = e.path().filename().string();
+      n += std::regex_match(name, std::regex(R"(frame_qs2x2a[0-9.]+_[0-9]{4}\.exr)"));
+      stills += std::regex_match(name, std::regex(R"(frame_[0-9]{4}_qs.*\.exr)"));
+    }
+    EXPECT_EQ(stills, 0u) << "a still's name among a sequence's";
+    return n;
+  };
+  ASSERT_EQ(sequence_quilts(), 12u);
+  for (const auto& e : fs::directory_iterator(out))
+    if (e.path().filename().string().find("0005") != std::string::npos) fs::remove(e.path());
+  const test::CliRun v = test::run("verify " + out + " --frames 0:11 --write quilt");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("\n5\n"), std::string::npos) << v.output;
+  const test::CliRun one = test::run("render --frames 5 --resume" + args.substr(3));  // without -q: the note
+  ASSERT_EQ(one.status, 0) << one.output;
+  EXPECT_NE(one.output.find("quilts are named as a sequence's"), std::string::npos) << one.output;
+  EXPECT_EQ(sequence_quilts(), 12u);
+  // --print-outputs names the same files
+  const test::CliRun listed = test::run("render --frames 5 --print-outputs" + args);
+  EXPECT_NE(listed.output.find("frame_qs2x2a"), std::string::npos) << listed.output;
+  for (const auto& e : fs::directory_iterator(out)) {
+    const std::string name = e.path().filename().string();
+    if (name.find("0003") != std::string::npos || name.find("0007") != std::string::npos) fs::remove(e.path());
+  }
+  ASSERT_EQ(test::run("render --frames 3,7 --resume" + args).status, 0);
+  EXPECT_EQ(sequence_quilts(), 12u);
+  EXPECT_EQ(test::run("verify " + out + " --frames 0:11 --write quilt").status, 0);
+}
+
+// Frames of two configurations in one folder (a shard run without --preset overwrote some): verify
+// names both groups with their frames and main settings, judges the frames against the larger, names
+// its settings in the advice, and says which group has the settings given to it.
+TEST(Verify, AMixedFolderIsReportedGroupByGroup) {
+  const std::string out = test::temp_dir("verify_mixed");
+  const std::string common = " -q --turntable 360:6 --views 4 --write quilt --out " + out;
+  ASSERT_EQ(test::run("render --frames 0:5 --preset lg-portrait --view-size 30x40" + common).status, 0);
+  ASSERT_EQ(test::run("render --frames 2,4 --preset paper-8k --view-size 64x32 --overwrite" + common).status, 0);
+  const test::CliRun v = test::run("verify " + out + " --frames 0:5");
+  EXPECT_EQ(v.status, 1) << v.output;
+  EXPECT_NE(v.output.find("frames of 2 configurations"), std::string::npos) << v.output;
+  const size_t portrait = v.output.find("preset lg-portrait, 1536x2048 display, 4 views of 30x40");
+  const size_t paper = v.output.find("preset paper-8k, 7680x4320 display, 4 views of 64x32");
+  ASSERT_NE(portrait, std::string::npos) << v.output;
+  ASSERT_NE(paper, std::string::npos) << v.output;
+  const std::string portrait_line = v.output.substr(portrait, v.output.find('\n', portrait) - portrait);
+  EXPECT_NE(portrait_line.find("the largest"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("with the folder's configuration (preset lg-portrait"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("\n2,4\n"), std::string::npos) << "the paper-8k frames to redo: " << v.output;
+  const test::CliRun asked = test::run("verify " + out + " --frames 0:5 --preset paper-8k");
+  const size_t at = asked.output.find("preset paper-8k, 7680x4320");
+  ASSERT_NE(at, std::string::npos) << asked.output;
+  const std::string paper_line = asked.output.substr(at, asked.output.find('\n', at) - at);
+  EXPECT_NE(paper_line.find("matches the settings given"), std::string::npos) << asked.output;
+  EXPECT_EQ(asked.output.find("matches the settings given"), asked.output.rfind("matches the settings given"))
+      << "one group only: " << asked.output;
+}
+
 TEST(Verify, ReportsMissingAndBrokenFramesAsAFramesList) {
   const std::string out = test::temp_dir("verify");
   const std::string args = " --turntable 360:8 --views 4 --view-size 64x32 --display 240x135 --out " + out;
@@ -415,7 +485,10 @@ TEST(Verify, ReportsMissingAndBrokenFramesAsAFramesList) {
   EXPECT_NE(v.output.find("frame 6: frame_0006.json was rendered with another configuration (fps differs: fps 30"),
             std::string::npos)
       << v.output;
-  EXPECT_NE(v.output.find("with the folder's configuration and --overwrite"), std::string::npos) << v.output;
+  EXPECT_NE(v.output.find("with the folder's configuration (preset paper-8k, 240x135 display, 4 views of 64x32) and "
+                          "--overwrite"),
+            std::string::npos)
+      << v.output;
   // --resume redoes the missing and truncated frames (the other configuration needs --overwrite)
   test::CliRun r = test::run("render --frames 0:7 --resume --overwrite" + args);
   EXPECT_EQ(r.status, 0) << r.output;

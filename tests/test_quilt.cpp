@@ -5,6 +5,7 @@
 
 #include <Imath/half.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -181,6 +182,51 @@ TEST(Quilt, CliQuiltDepthAndPreviews) {
   EXPECT_NEAR(srgb_encode(0.002), 0.02584, 1e-6);
   EXPECT_EQ(srgb_encode(2.0), 1.0);
   EXPECT_EQ(srgb_encode(-1.0), 0.0);
+}
+
+// --depth-empty 1e10 (what Cycles writes) replaces +infinity where nothing was drawn, and only there;
+// the sidecar records it, so a resume with the default depth does not take the frame as its own.
+TEST(Quilt, DepthEmptyIsWrittenWhereNothingWasDrawn) {
+  const std::string out = temp_dir("depth_empty");
+  fs::create_directories(out);
+  const std::string scene = out + "/square.glb";
+  test::save_square_glb(scene);
+  const std::string args = "render '" + scene + "' --views 4 --view-size 48x24 --write views,depth -q --out " + out;
+  const CliRun r = run(args + " --depth-empty 1e10");
+  ASSERT_EQ(r.status, 0) << r.output;
+  int w = 0, h = 0;
+  std::vector<uint16_t> px;
+  std::vector<float> z;
+  size_t empty = 0, covered = 0;
+  for (int v = 0; v < 4; ++v) {
+    read_views_exr_part(out + "/frame_0000.views.exr", v, w, h, px, &z);
+    for (size_t i = 0; i < z.size(); ++i) {
+      if (px[i * 4 + 3] == 0) {
+        ++empty;
+        ASSERT_EQ(z[i], 1e10f) << "view " << v << " pixel " << i;
+      } else {
+        ++covered;
+        ASSERT_LT(z[i], 1e3f) << "view " << v << " pixel " << i;
+      }
+    }
+  }
+  EXPECT_GT(empty, 0u);
+  EXPECT_GT(covered, 0u);
+  std::ifstream sj(out + "/frame_0000.json");
+  std::stringstream text;
+  text << sj.rdbuf();
+  EXPECT_EQ(nlohmann::json::parse(text.str())["depth_empty"].get<double>(), 1e10);
+  const CliRun resumed = run(args + " --resume");  // a frame of another configuration: refused by name
+  EXPECT_EQ(resumed.status, 1) << resumed.output;
+  EXPECT_NE(resumed.output.find("depth_empty differs"), std::string::npos) << resumed.output;
+  const CliRun again = run(args + " --overwrite");
+  ASSERT_EQ(again.status, 0) << again.output;
+  read_views_exr_part(out + "/frame_0000.views.exr", 0, w, h, px, &z);
+  size_t empty0 = 0;
+  for (size_t i = 0; i < z.size(); ++i) empty0 += px[i * 4 + 3] == 0;
+  EXPECT_GT(empty0, 0u);
+  EXPECT_EQ(size_t(std::count(z.begin(), z.end(), INFINITY)), empty0) << "rendered again with the default, +infinity";
+  EXPECT_EQ(run(args + " --depth-empty -1").status, 2);
 }
 
 TEST(Quilt, BadQuiltOptionsFailWithOneLine) {

@@ -21,10 +21,11 @@ namespace {
 SceneTexture checker(int w, int h, int cell) {
   SceneTexture t;
   t.width = w, t.height = h;
+  t.rgba.assign(size_t(w) * size_t(h) * 4, 255);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const uint8_t c = (x / cell + y / cell) % 2 == 0 ? 255 : 0;
-      t.rgba.insert(t.rgba.end(), {c, c, c, 255});
+      for (int k = 0; k < 3; ++k) t.rgba[(size_t(y) * size_t(w) + size_t(x)) * 4 + size_t(k)] = c;
     }
   return t;
 }

@@ -348,8 +348,9 @@ TEST(Transmission, AThickSlabShiftsTheWallByTheModelsOffsetInEachView) {
         view, got, want, phys, bare);
     EXPECT_NEAR(got, want, 1.0) << "view " << view;
     shift[k] = got - bare, predicted_shift[k] = want - bare;
-    if (k != 1)
+    if (k != 1) {
       EXPECT_GT(std::abs(predicted_shift[k]), 2.0) << "the slab should visibly shift the wall in view " << view;
+    }
   }
   EXPECT_GT(std::abs(predicted_shift[0] - predicted_shift[2]), 1.0) << "the views should see different shifts";
   EXPECT_NEAR(shift[0] - shift[2], predicted_shift[0] - predicted_shift[2], 1.0);

@@ -194,6 +194,10 @@ PmrParams params_for(const Rig& rig, int tx, int ty, int tv) {
 
 namespace pmr::test {
 
+// The pmr runs of the tests see no $OCIO: a user's colour configuration must not change the previews
+// the tests expect (docs/COLOUR.md).
+const bool kOcioUnset = (::unsetenv("OCIO"), true);
+
 CliRun run(const std::string& args) { return run_env("", args); }
 
 pid_t start(const std::string& args, const std::string& log) {

@@ -7,12 +7,25 @@ import shlex
 WRITE = {"QUILT": "quilt", "ENCODED": "encoded", "BOTH": "encoded,quilt"}
 
 
-def render_args(settings, scene_path, out_dir, camera, frames, fps, environment, animated):
+def colour_args(config, display, view, look, exposure, gamma):
+    """pmr's options for Blender's colour management: the PNG previews through the same OpenColorIO
+    config, display, view, look, exposure and gamma as Blender's own view (docs/COLOUR.md)."""
+    args = ["--preview"]
+    if config:
+        args += ["--ocio", config, "--display-device", display, "--view", view]
+        if look and look != "None":
+            args += ["--look", look]
+    args += ["--view-exposure", "%.10g" % exposure, "--view-gamma", "%.10g" % gamma]
+    return args
+
+
+def render_args(settings, scene_path, out_dir, camera, frames, fps, environment, animated, colour=()):
     """The argument list of `pmr render` (without the program).
 
     settings: the scene's pmr_lightfield settings; camera: the camera object's name (its glTF node
     name); frames: (first, last); fps: frames per second; environment: its options from the world;
-    animated: whether the glTF has animations (pmr refuses --animation all without any)."""
+    animated: whether the glTF has animations (pmr refuses --animation all without any); colour:
+    colour_args' options."""
     args = ["render", scene_path, "--out", out_dir, "--name", settings.name or "frame_####"]
     if settings.display_source == "CONFIG" and settings.display_config:
         args += ["--display-config", settings.display_config]
@@ -34,6 +47,7 @@ def render_args(settings, scene_path, out_dir, camera, frames, fps, environment,
     first, last = frames
     args += ["--frames", str(first) if first == last else "%d:%d" % (first, last)]
     args += environment
+    args += list(colour)
     if settings.shadow_catcher:
         args += ["--ground", "shadow"]
     # a folder is one configuration for pmr; re-rendering with changed settings is the normal case here

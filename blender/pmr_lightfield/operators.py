@@ -38,7 +38,7 @@ class RenderJob:
             self.environment, more = self._world(scene)
             self.args = command.render_args(settings, self.scene_path, self.out_dir, self.camera,
                                             self.frames, self.fps, self.environment,
-                                            export.has_animations(self.scene_path))
+                                            export.has_animations(self.scene_path), _colour(scene, more))
             # the files each frame goes to, as pmr names them (the options are checked on the way)
             self.sidecars = runner.print_outputs(self.program, self.args, cwd=self.out_dir)
         except Exception:
@@ -80,6 +80,28 @@ class RenderJob:
                 with open(sidecar, encoding="utf-8") as f:
                     found[frame] = json.load(f).get("outputs", {})
         return found
+
+
+def _blender_ocio_config():
+    """The OpenColorIO config Blender itself uses: $OCIO when set, else the one it ships."""
+    if os.environ.get("OCIO"):
+        return os.environ["OCIO"]
+    datafiles = bpy.utils.system_resource("DATAFILES")  # its `path` argument finds folders only
+    path = os.path.join(datafiles, "colormanagement", "config.ocio") if datafiles else ""
+    return path if os.path.isfile(path) else ""
+
+
+def _colour(scene, warnings):
+    """pmr's colour options from the scene's Color Management panel, so that the quilt PNG shows what
+    Blender shows; a note in `warnings` for what cannot follow."""
+    view = scene.view_settings
+    config = _blender_ocio_config()
+    if not config:
+        warnings.append("Blender's OpenColorIO config was not found: the PNG previews use Standard")
+    if view.use_curve_mapping:
+        warnings.append("Color Management curves are not carried to pmr's PNG previews")
+    return command.colour_args(config, scene.display_settings.display_device, view.view_transform, view.look,
+                               view.exposure, view.gamma)
 
 
 def _output_dir(path):

@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <cstdlib>
 #include <sstream>
 
@@ -170,6 +171,19 @@ void set_frames(RenderOptions& o, const std::string& v, const std::string&) { o.
 // --preset and --display-config are applied before every other option (apply_display_source).
 void applied_first(RenderOptions&, const std::string&, const std::string&) {}
 
+// The view transform's options, marked as given on the command line.
+ViewTransformOptions& set_view(RenderOptions& o) {
+  o.job.view_transform_given = true;
+  return o.job.view_transform;
+}
+
+// Whether the panel PNG goes through a transform that needs every view's colour (an OpenColorIO one).
+bool previews_need_views(const RenderOptions& o) {
+  const char* env = std::getenv("OCIO");
+  const bool managed = !o.job.view_transform.config.empty() || (env && *env);
+  return managed && o.job.products.preview && o.job.products.encoded;
+}
+
 void set_write(RenderOptions& o, const std::string& v, const std::string&) {
   o.job.products.encoded = o.job.products.views = o.job.products.quilt = o.job.products.depth = false;
   std::stringstream ss(v);
@@ -199,9 +213,20 @@ const RenderSection kOutputOptions = {
          "the encoded image (half RGBA), DIR/frame_NNNN.views.exr one part per view,\n"
          "DIR/frame_NNNN_qsCxRaA.exr the views as a Looking Glass quilt (view 0 bottom\n"
          "left; in a sequence DIR/frame_qsCxRaA_NNNN.exr, see --name), depth a float\n"
-         "Z channel (view-space depth, +inf where empty) in the views and quilt files;\n"
+         "Z channel (view-space depth, --depth-empty where empty) in the views and quilt\n"
+         "files;\n"
          "DIR/frame_NNNN.json (rig, display, every view's matrices) is always written",
          set_write},
+        {"--depth-empty", nullptr, "inf|Z",
+         "depth where nothing was drawn (default inf, +infinity; Cycles writes 1e10,\n"
+         "which keeps compositing arithmetic such as 0 x Z finite)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           if (v == "inf") return void(o.job.products.depth_empty = std::numeric_limits<float>::infinity());
+           const double z = parse_double(v, name);
+           if (!(z > 0.0 && z <= 3.0e38))
+             throw Error("invalid " + name + " '" + v + "': expected inf or 0 < Z <= 3e38");
+           o.job.products.depth_empty = float(z);
+         }},
         {"--quilt", nullptr, "CxR", "quilt layout in tiles (default: the most square layout, e.g. 8x6 for 48)",
          [](RenderOptions& o, const std::string& v, const std::string&) { o.job.quilt_layout = v; }},
         {"--preview", nullptr, nullptr,
@@ -209,6 +234,30 @@ const RenderSection kOutputOptions = {
          "square pixels, as a view's pixels span the display's aspect) and the quilt\n"
          "(tiles as rendered; their pixel aspect in the PNG's pHYs chunk)",
          [](RenderOptions& o, const std::string&, const std::string&) { o.job.products.preview = true; }},
+        {"--ocio", nullptr, "CONFIG",
+         "the previews' colour management: an OpenColorIO config (default: $OCIO when\n"
+         "set; without one, Standard: the sRGB curve, clipped). EXRs stay scene-linear",
+         [](RenderOptions& o, const std::string& v, const std::string&) { set_view(o).config = v; }},
+        {"--display-device", nullptr, "NAME", "the config's display device (default: its default display)",
+         [](RenderOptions& o, const std::string& v, const std::string&) { set_view(o).display = v; }},
+        {"--view", nullptr, "NAME", "the display's view transform, e.g. Filmic (default: the display's default)",
+         [](RenderOptions& o, const std::string& v, const std::string&) { set_view(o).view = v; }},
+        {"--look", nullptr, "NAME", "a look of the config, e.g. 'Filmic - High Contrast' (default: none)",
+         [](RenderOptions& o, const std::string& v, const std::string&) { set_view(o).look = v; }},
+        {"--colorspace", nullptr, "NAME",
+         "the config's name for pmr's pixels, linear Rec. 709 (default: its scene_linear\n"
+         "role; name another when that role is not linear Rec. 709, e.g. ACEScg)",
+         [](RenderOptions& o, const std::string& v, const std::string&) { set_view(o).colorspace = v; }},
+        {"--view-exposure", nullptr, "EV",
+         "the previews' exposure (Blender's View exposure: x 2^EV before the view, not\n"
+         "in the EXRs; --exposure scales the render itself)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           set_view(o).exposure = parse_double(v, name);
+         }},
+        {"--view-gamma", nullptr, "G", "the previews' gamma (Blender's View gamma: ^(1 / G) after the display)",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           set_view(o).gamma = parse_double(v, name);
+         }},
         {"--name", nullptr, "PATTERN",
          "file stem (default frame_%04d); the frame number as %d, zero-padded %0Nd or\n"
          "Blender's #### (N '#': N digits), %% for a percent sign; without a frame\n"
@@ -223,7 +272,9 @@ const RenderSection kOutputOptions = {
          }},
         {"--compression", nullptr, "C",
          "EXR compression: none, zip, zip-fast (ZIP through ISA-L's igzip alone: a\n"
-         "third of zip's writer CPU, 10% larger files; any reader opens it), piz, rle\n"
+         "third of zip's writer CPU, 10% larger files; any reader opens it), piz, rle,\n"
+         "dwaa, dwab (lossy DCT of R, G, B at OpenEXR's level 45, for review renders; A\n"
+         "and Z stay exact; views and quilts only: refused for the encoded image)\n"
          "(default zip)",
          [](RenderOptions& o, const std::string& v, const std::string&) { o.compression = v; }},
     }};
@@ -611,6 +662,7 @@ void finalize_options(RenderOptions& o) {
                                         ? "--method " + std::string(to_string(o.job.pipeline.method))
                                     : o.job.display.bilinear    ? "--bilinear"
                                     : o.job.display.blend_views ? "--blend-views"
+                                    : previews_need_views(o)    ? "an OpenColorIO view transform (--ocio or $OCIO)"
                                                                 : "";
     if (!needs_views.empty()) {
       o.job.pipeline.sampling = Sampling::View;
@@ -623,6 +675,10 @@ void finalize_options(RenderOptions& o) {
   }
   if (o.job.pipeline.sampling == Sampling::Subpixel) {
     check_subpixel_sampling(o.job.pipeline.method, o.job.display);  // pmr unless --method says otherwise
+    if (previews_need_views(o))
+      throw UsageError(
+          "the panel PNG through an OpenColorIO view transform is encoded from the transformed views, "
+          "which --sampling subpixel does not render: use --sampling view");
     if (!o.job.products.encoded) {  // the views are rendered on their grids in either case
       o.job.pipeline.sampling = Sampling::View;
       o.job.warnings.push_back(

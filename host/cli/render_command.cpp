@@ -32,6 +32,11 @@ std::string exe_dir() {
 SequenceJob sequence_job(const RenderOptions& o) {
   SequenceJob job = o.job;
   job.compression = as_usage([&] { return parse_exr_compression(o.compression); });
+  if (is_lossy(job.compression) && job.products.encoded)
+    throw UsageError(std::string("--compression ") + to_string(job.compression) +
+                     " is lossy and the encoded image interleaves views subpixel by subpixel (its ringing would "
+                     "be crosstalk on the panel): write it with --write views or quilt, or choose a lossless "
+                     "compression");
   return job;
 }
 

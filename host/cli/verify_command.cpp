@@ -39,7 +39,7 @@ namespace fs = std::filesystem;
 
 std::string verify_help() {
   return "usage: pmr verify DIR [--frames LIST] [--write LIST] [--name PATTERN] [--preview] [--deep]\n"
-         "                  [--limit memory=N]\n"
+         "                  [--limit memory=N] [--preset NAME] [--views N] [--view-size WxH] [--display WxH]\n"
          "Checks that every listed frame in DIR is complete: its sidecar names the frame and its time, was\n"
          "rendered from the scene as it is now (the checksums it records of the scene file and the files it\n"
          "reads; where the scene cannot be read, the version most frames show) and with the same\n"
@@ -50,7 +50,9 @@ std::string verify_help() {
          "for the PNGs) checks just those kinds of output instead. Without --frames, the frames whose sidecars\n"
          "DIR holds are checked (a frame missing altogether is then not found). Prints the missing or broken\n"
          "frames on stdout as a --frames list to resubmit (with --resume; frames of another configuration\n"
-         "with --overwrite); exit code 1 if there are any.\n";
+         "with --overwrite); exit code 1 if there are any. A folder of several configurations is reported\n"
+         "group by group (frames and main settings); the frames are judged against the largest, and\n"
+         "--preset, --views, --view-size and --display say which group is the job's as it is now.\n";
 }
 
 // A listed output must be a plain file name in the frame's folder.
@@ -63,15 +65,51 @@ bool plain_file_name(const std::string& name) {
 
 // What the folder's frames were rendered from: the scene identity most sidecars record (ties: the
 // earliest frame's), the first frame showing it (the configuration reference) and the program versions.
+// Frames of one configuration (sidecar_config_difference finds none between them), named by the first.
+struct ConfigGroup {
+  std::string text;  // its first frame's sidecar
+  std::vector<long> frames;
+};
+constexpr size_t kMaxConfigGroups = 16;  // beyond, further configurations join the last group's report
+
 struct FolderScene {
   std::string scene;
   long reference_frame = -1;
   std::string reference_text;  // its sidecar
   std::vector<std::string> versions;
+  std::vector<ConfigGroup> groups;  // in the order of their first frames
+  size_t reference_group = 0;       // the largest: the frames are judged against it
 };
 
 std::string sidecar_path(const std::string& dir, const RenderOptions& o, long f) {
   return (fs::path(dir) / (frame_stem(o.job.products.name, f) + ".json")).string();
+}
+
+// Adds a readable sidecar to the group of its configuration, or starts one.
+void add_to_group(std::vector<ConfigGroup>& groups, long f, const std::string& text) {
+  const std::string scene = sidecar_provenance(text).scene;
+  for (ConfigGroup& g : groups)
+    if (sidecar_config_difference(text, g.text, sidecar_provenance(g.text).scene != scene).empty())
+      return g.frames.push_back(f);
+  if (groups.size() < kMaxConfigGroups) groups.push_back({text, {f}});
+}
+
+// The folder's largest configuration (ties: the earlier), and the first of its frames rendered from the
+// scene most frames were rendered from: the reference the frames are judged against.
+void choose_reference(FolderScene& folder, const std::string& dir, const RenderOptions& o) {
+  for (size_t g = 1; g < folder.groups.size(); ++g)
+    if (folder.groups[g].frames.size() > folder.groups[folder.reference_group].frames.size())
+      folder.reference_group = g;
+  if (folder.groups.empty()) return;
+  const ConfigGroup& best = folder.groups[folder.reference_group];
+  folder.reference_frame = best.frames.front();
+  for (long f : best.frames) {
+    const std::string text = read_sidecar_text(sidecar_path(dir, o, f));
+    if (sidecar_provenance(text).scene == folder.scene) {
+      folder.reference_frame = f;
+      break;
+    }
+  }
 }
 
 FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const std::vector<long>& frames) {
@@ -83,19 +121,21 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
     if (!fs::is_regular_file(path, ec)) continue;
     const std::string text = read_sidecar_text(path);
     if (!parse_json_text(text).is_object()) continue;
+    add_to_group(folder.groups, f, text);
     const SidecarProvenance p = sidecar_provenance(text);
     ++seen.try_emplace(p.scene, 0, f).first->second.first;
     const std::string v = p.version.empty() ? "unrecorded" : p.version;
     if (std::find(folder.versions.begin(), folder.versions.end(), v) == folder.versions.end())
       folder.versions.push_back(v);
   }
-  long best = 0;
+  long best = 0, first = -1;
   for (const auto& [scene, count_first] : seen)
-    if (count_first.first > best || (count_first.first == best && count_first.second < folder.reference_frame)) {
+    if (count_first.first > best || (count_first.first == best && count_first.second < first)) {
       best = count_first.first;
       folder.scene = scene;
-      folder.reference_frame = count_first.second;
+      first = count_first.second;
     }
+  choose_reference(folder, dir, o);
   if (folder.reference_frame >= 0)
     folder.reference_text = read_sidecar_text(sidecar_path(dir, o, folder.reference_frame));
   return folder;
@@ -107,9 +147,9 @@ FolderScene folder_scene(const std::string& dir, const RenderOptions& o, const s
 // scene the sidecars name and the files they list beside it. Only regular files are read, listed files
 // only inside the scene's folder.
 struct SceneNow {
-  std::map<std::string, std::string> by_path;                  // as named -> XXH3-64, "" when unreadable
-  std::map<std::pair<dev_t, ino_t>, std::string> by_file;      // each opened file's
-  uint64_t files_hashed = 0, bytes_hashed = 0;                 // what `sum` read, for the summary
+  std::map<std::string, std::string> by_path;              // as named -> XXH3-64, "" when unreadable
+  std::map<std::pair<dev_t, ino_t>, std::string> by_file;  // each opened file's
+  uint64_t files_hashed = 0, bytes_hashed = 0;             // what `sum` read, for the summary
   bool scene_unreadable = false;  // a sidecar's scene cannot be read: the folder's majority decides
 
   std::string sum(const std::string& path) {
@@ -125,8 +165,7 @@ struct SceneNow {
         uint64_t bytes = 0;
         try {
           s = checksum_descriptor(fd, path, &bytes);
-        } catch (const Error&) {
-        }
+        } catch (const Error&) {}
         ++files_hashed, bytes_hashed += bytes;
         by_file[{st.st_dev, st.st_ino}] = s;
       }
@@ -260,6 +299,57 @@ std::vector<long> frames_in_folder(const std::string& dir, const RenderOptions& 
   return frames;
 }
 
+// A configuration's main settings, from its sidecar: "preset lg-portrait, 1536x2048 display, 48 views of
+// 420x560".
+std::string group_settings(const std::string& text) {
+  const nlohmann::json j = parse_json_text(text);
+  auto at = [&](const char* a, const char* b) {
+    return j.is_object() && j.contains(a) && j[a].is_object() && j[a].contains(b) ? j[a][b] : nlohmann::json();
+  };
+  auto number = [](const nlohmann::json& v) { return v.is_number() ? std::to_string(v.get<long long>()) : "?"; };
+  const nlohmann::json source = at("display", "source");
+  return (source.is_string() ? printable_text(source.get<std::string>()) : std::string("display")) + ", " +
+         number(at("display", "width")) + "x" + number(at("display", "height")) + " display, " +
+         number(at("rig", "views")) + " views of " + number(at("rig", "view_width")) + "x" +
+         number(at("rig", "view_height"));
+}
+
+// The main settings given to verify (--preset, --views, --view-size, --display): which group is the
+// job's as it is now. Unset: not given.
+struct GivenSettings {
+  std::string source;  // "preset NAME"
+  long views = -1, view_w = -1, view_h = -1, width = -1, height = -1;
+  bool any() const { return !source.empty() || views > 0 || view_w > 0 || width > 0; }
+};
+
+bool matches_given(const GivenSettings& s, const std::string& text) {
+  const nlohmann::json j = parse_json_text(text);
+  auto at = [&](const char* a, const char* b) {
+    return j.is_object() && j.contains(a) && j[a].is_object() && j[a].contains(b) ? j[a][b] : nlohmann::json();
+  };
+  auto same = [](const nlohmann::json& v, long want) { return want < 0 || (v.is_number() && v.get<long>() == want); };
+  return (s.source.empty() || at("display", "source") == s.source) && same(at("rig", "views"), s.views) &&
+         same(at("rig", "view_width"), s.view_w) && same(at("rig", "view_height"), s.view_h) &&
+         same(at("display", "width"), s.width) && same(at("display", "height"), s.height);
+}
+
+// A folder of several configurations: each with its frames and main settings, which one the frames
+// are judged against, which were rendered from the scene as it is now, and which has the settings given.
+void report_groups(const FolderScene& folder, SceneNow& now, const GivenSettings& given) {
+  if (folder.groups.size() < 2) return;
+  std::fprintf(stderr, "pmr verify: the folder holds frames of %zu configurations%s:\n", folder.groups.size(),
+               folder.groups.size() == kMaxConfigGroups ? " or more" : "");
+  for (size_t g = 0; g < folder.groups.size(); ++g) {
+    const ConfigGroup& group = folder.groups[g];
+    const bool current = changed_scene_file(parse_json_text(group.text), now).empty();
+    const bool asked = given.any() && matches_given(given, group.text);
+    std::fprintf(stderr, "pmr verify:   frames %s: %s%s%s%s\n", format_frame_list(group.frames).c_str(),
+                 group_settings(group.text).c_str(), current ? "; rendered from the scene as it is now" : "",
+                 asked ? "; matches the settings given" : "",
+                 g == folder.reference_group ? "; the largest: the other frames are judged against it" : "");
+  }
+}
+
 // The temporary files writers leave when they are killed (temporary_name's ".NAME.tmp-HOST-PID-N"): no
 // frame needs them. One note per kind of owner, each naming the first file: this host's dead processes
 // (the next run here removes them), this host's running ones, and other hosts' (verify cannot tell
@@ -302,7 +392,8 @@ int run_verify(const std::vector<std::string>& args) {
       std::fputs(verify_help().c_str(), stdout);
       return 0;
     }
-    if (a == "--frames" || a == "--write" || a == "--name" || a == "--limit") {
+    if (a == "--frames" || a == "--write" || a == "--name" || a == "--limit" || a == "--preset" || a == "--views" ||
+        a == "--view-size" || a == "--display") {
       if (i + 1 >= args.size()) throw UsageError("option " + a + " needs a value (see pmr verify --help)");
       rest.push_back(a);
       rest.push_back(args[++i]);
@@ -322,6 +413,13 @@ int run_verify(const std::vector<std::string>& args) {
   bool frames_given = false;
   for (const std::string& r : rest) frames_given |= r == "--frames";
   const RenderOptions o = parse_render_options(rest);
+  GivenSettings given;
+  for (const std::string& r : rest) {
+    if (r == "--preset") given.source = o.job.display_source.name;
+    if (r == "--views") given.views = o.job.rig.views;
+    if (r == "--view-size") given.view_w = o.job.rig.view_w, given.view_h = o.job.rig.view_h;
+    if (r == "--display") given.width = o.job.display.width, given.height = o.job.display.height;
+  }
   set_memory_budget(o.job.input_limits.memory);  // sidecars are parsed within it (0: automatic)
   if (frames_given && o.job.frames == "all")
     throw UsageError("pmr verify needs the frames as a list (--frames all depends on the scene)");
@@ -344,6 +442,7 @@ int run_verify(const std::vector<std::string>& args) {
     configuration |= problem.find("rendered with another configuration") != std::string::npos;
     std::fprintf(stderr, "pmr verify: frame %ld: %s\n", f, problem.c_str());
   }
+  report_groups(folder, now, given);
   note_leftover_temporaries(dir);
   if (now.files_hashed > 0)
     std::fprintf(stderr, "pmr verify: read %llu scene file(s), %llu bytes, to compare with the sidecars' checksums\n",
@@ -360,8 +459,11 @@ int run_verify(const std::vector<std::string>& args) {
   }
   std::fprintf(stderr, "pmr verify: %zu of %zu frame(s) complete%s\n", frames.size() - bad.size(), frames.size(),
                bad.empty()     ? ""
-               : configuration ? "; resubmit the list below with the folder's configuration and --overwrite (some "
-                                 "frames were rendered with another configuration, which --resume refuses)"
+               : configuration ? ("; resubmit the list below with the folder's configuration (" +
+                                  group_settings(folder.reference_text) +
+                                  ") and --overwrite (some frames were rendered with another configuration, which "
+                                  "--resume refuses)")
+                                     .c_str()
                                : "; resubmit the list below with --resume");
   if (bad.empty()) return 0;
   std::printf("%s\n", format_frame_list(bad).c_str());

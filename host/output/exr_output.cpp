@@ -64,6 +64,10 @@ Imf::Compression to_imf(ExrCompression c, const std::string& path) {
       return Imf::PIZ_COMPRESSION;
     case ExrCompression::Rle:
       return Imf::RLE_COMPRESSION;
+    case ExrCompression::Dwaa:
+      return Imf::DWAA_COMPRESSION;
+    case ExrCompression::Dwab:
+      return Imf::DWAB_COMPRESSION;
   }
   throw Error("cannot write " + path + ": invalid EXR compression value " + std::to_string(int(c)));
 }
@@ -148,7 +152,9 @@ ExrCompression parse_exr_compression(const std::string& name) {
   if (name == "zip-fast") return ExrCompression::ZipFast;
   if (name == "piz") return ExrCompression::Piz;
   if (name == "rle") return ExrCompression::Rle;
-  throw Error("invalid EXR compression '" + name + "': expected none, zip, zip-fast, piz or rle");
+  if (name == "dwaa") return ExrCompression::Dwaa;
+  if (name == "dwab") return ExrCompression::Dwab;
+  throw Error("invalid EXR compression '" + name + "': expected none, zip, zip-fast, piz, rle, dwaa or dwab");
 }
 
 const char* to_string(ExrCompression c) {
@@ -163,9 +169,15 @@ const char* to_string(ExrCompression c) {
       return "piz";
     case ExrCompression::Rle:
       return "rle";
+    case ExrCompression::Dwaa:
+      return "dwaa";
+    case ExrCompression::Dwab:
+      return "dwab";
   }
   return "invalid";
 }
+
+bool is_lossy(ExrCompression c) { return c == ExrCompression::Dwaa || c == ExrCompression::Dwab; }
 
 std::string view_part_name(int i, int views) {
   int digits = 3;

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 
+#include "output/view_transform.h"
 #include "pmr/error.h"
 #include "pmr/output.h"
 
@@ -55,11 +56,78 @@ void straight_pixel(const uint16_t* src, const std::vector<uint8_t>& lut, uint8_
   }
 }
 
+// One row through a view transform other than Standard: halves -> straight (or over black, opaque)
+// floats -> the transform -> clipped bytes.
+void transformed_row(const uint16_t* src, size_t width, bool opaque, const ViewTransform& transform,
+                     std::vector<float>& scratch, uint8_t* out) {
+  scratch.resize(width * 4);
+  for (size_t x = 0; x < width; ++x) {
+    half h[4];
+    for (int c = 0; c < 4; ++c) h[c].setBits(src[4 * x + size_t(c)]);
+    const float a = float(h[3]), unpremultiply = !opaque && a > 0.0f && a < 1.0f ? 1.0f / a : 1.0f;
+    for (int c = 0; c < 3; ++c) scratch[4 * x + size_t(c)] = float(h[c]) * unpremultiply;
+    scratch[4 * x + 3] = a;
+  }
+  transform.apply(scratch.data(), width);
+  const size_t channels = opaque ? 3 : 4;
+  for (size_t x = 0; x < width; ++x)
+    for (size_t c = 0; c < channels; ++c) out[channels * x + c] = to_byte(double(scratch[4 * x + c]));
+}
+
+}  // namespace
+
+namespace {
+
+// What write_rows writes: the image and how its colour becomes bytes.
+struct PngRows {
+  const uint16_t* pixels;
+  int width, height;
+  png_uint_32 aspect_y;  // pHYs y per 100000 x; 0: square pixels, no chunk
+  bool opaque;
+  const ViewTransform* transform;  // null: Standard through `lut`
+  const std::vector<uint8_t>* lut;
+};
+
+// The libpng calls between setjmp and the end of the image; false after a libpng error (longjmp).
+// Kept apart so that nothing the caller holds lives across the setjmp.
+bool write_rows(png_structp png, png_infop info, FILE* f, const PngRows& job) {
+  const size_t width = size_t(job.width), channels = job.opaque ? 3 : 4;
+  std::vector<uint8_t> row(width * channels);
+  std::vector<float> scratch;
+  if (setjmp(png_jmpbuf(png)) != 0) return false;
+  png_init_io(png, f);
+  png_set_compression_level(png, 1);
+  png_set_IHDR(png, info, png_uint_32(job.width), png_uint_32(job.height), 8,
+               job.opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
+  if (!job.transform) png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+  // pixels per unit along x and y: a pixel is 1 / x wide and 1 / y tall, so y / x is its aspect
+  if (job.aspect_y) png_set_pHYs(png, info, 100000, job.aspect_y, PNG_RESOLUTION_UNKNOWN);
+  png_write_info(png, info);
+  for (int y = 0; y < job.height; ++y) {
+    const uint16_t* src = job.pixels + size_t(y) * width * 4;
+    if (job.transform) {
+      transformed_row(src, width, job.opaque, *job.transform, scratch, row.data());
+    } else if (job.opaque) {  // what a panel shows over black: the premultiplied colour as it is
+      for (size_t x = 0; x < width * 4; x += 4)
+        for (size_t c = 0; c < 3; ++c) row[x / 4 * 3 + c] = (*job.lut)[src[x + c]];
+    } else {
+      for (size_t x = 0; x < width; ++x) straight_pixel(src + 4 * x, *job.lut, &row[4 * x]);
+    }
+    png_write_row(png, row.data());
+  }
+  png_write_end(png, info);
+  return true;
+}
+
 }  // namespace
 
 void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half, double pixel_aspect,
-                       bool opaque) {
+                       bool opaque, const ViewTransform* transform) {
   if (width < 1 || height < 1 || !rgba_half) throw Error("cannot write " + path + ": empty image");
+  const double aspect_y = pixel_aspect == 1.0 ? 0.0 : double(std::lround(100000.0 * pixel_aspect));
+  if (pixel_aspect != 1.0 && !(aspect_y >= 1.0 && aspect_y <= 2147483647.0))
+    throw Error("cannot write " + path + ": pixel aspect out of range");
   // sRGB lookup for every half value: the curve is applied once per distinct input, not per pixel
   static const std::vector<uint8_t> lut = [] {  // thread-safe initialization
     std::vector<uint8_t> t(65536);
@@ -70,44 +138,17 @@ void write_png_preview(const std::string& path, int width, int height, const uin
     }
     return t;
   }();
+  const PngRows job{rgba_half, width,
+                    height,    png_uint_32(aspect_y),
+                    opaque,    transform && !transform->is_standard() ? transform : nullptr,
+                    &lut};
   AtomicFile file(path);
   FILE* f = std::fopen(file.temp_path().c_str(), "wb");
   if (!f) throw Error("cannot write " + path + ": " + write_failure(errno));
   PngError err;
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, on_error, on_warning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
-  const size_t channels = opaque ? 3 : 4;
-  std::vector<uint8_t> row(size_t(width) * channels);
-  bool ok = png && info;
-  if (ok && setjmp(png_jmpbuf(png)) == 0) {
-    png_init_io(png, f);
-    png_set_compression_level(png, 1);
-    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), 8,
-                 opaque ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-                 PNG_FILTER_TYPE_DEFAULT);
-    png_set_sRGB(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
-    if (pixel_aspect != 1.0) {
-      // pixels per unit along x and y: a pixel is 1 / x wide and 1 / y tall, so y / x is its aspect
-      const double y = std::lround(100000.0 * pixel_aspect);
-      if (!(y >= 1.0 && y <= 2147483647.0)) throw Error("cannot write " + path + ": pixel aspect out of range");
-      png_set_pHYs(png, info, 100000, png_uint_32(y), PNG_RESOLUTION_UNKNOWN);
-    }
-    png_write_info(png, info);
-    for (int y = 0; y < height; ++y) {
-      const uint16_t* src = rgba_half + size_t(y) * size_t(width) * 4;
-      for (size_t x = 0; x < size_t(width); ++x) {
-        if (opaque) {  // what a panel shows over black: the premultiplied colour as it is
-          for (int c = 0; c < 3; ++c) row[3 * x + size_t(c)] = lut[src[4 * x + size_t(c)]];
-        } else {
-          straight_pixel(src + 4 * x, lut, &row[4 * x]);
-        }
-      }
-      png_write_row(png, row.data());
-    }
-    png_write_end(png, info);
-  } else {
-    ok = false;
-  }
+  const bool ok = png && info && write_rows(png, info, f, job);
   png_destroy_write_struct(png ? &png : nullptr, info ? &info : nullptr);
   const bool closed = std::fclose(f) == 0;
   if (!ok || !closed)

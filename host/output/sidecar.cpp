@@ -322,7 +322,8 @@ json conventions_json() {
        "clip = proj * view * (x, y, z, 1); OpenGL clip space, NDC z in [-1, 1]"},
       {"depth",
        "the Z channel of the views and quilt EXRs (when written) is the view-space depth w: the distance "
-       "along the view's axis, positive in front of the camera; +infinity where nothing was drawn"},
+       "along the view's axis, positive in front of the camera; where nothing was drawn +infinity, or "
+       "depth_empty when recorded"},
       {"color", "linear-light RGB; alpha = coverage; background (0, 0, 0, 0)"},
       {"light",
        "light_dir_*: lambert's one directional light, toward the light, fixed in the center camera's "
@@ -363,6 +364,10 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   if (info.variant) j["variant"] = bounded_text(*info.variant), j["variant_index"] = info.variant_index;
   if (info.has_bounds) j["scene_bounds"] = {{"min", vec3_json(info.bounds_lo)}, {"max", vec3_json(info.bounds_hi)}};
   if (info.compression) j["compression"] = to_string(*info.compression);
+  if (const auto& t = info.view_transform)
+    j["view_transform"] = {{"config", t->config}, {"display", t->display},       {"view", t->view},
+                           {"look", t->look},     {"colorspace", t->colorspace}, {"exposure", t->exposure},
+                           {"gamma", t->gamma}};
   json outputs = json::object(), outputs_hex = json::object();
   for (const auto& [kind, file] : info.outputs) {
     outputs[kind] = file;
@@ -376,6 +381,8 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   if (info.quilt_columns > 0) j["quilt"] = quilt_json(rig, info);
   if (info.center_view >= 0) j["preview_center_view"] = info.center_view;
   j["depth_channel"] = info.depth;
+  // recorded when it is not the default +infinity (JSON has no infinity), so resume tells them apart
+  if (info.depth && std::isfinite(info.depth_empty)) j["depth_empty"] = info.depth_empty;
   // the scene's files were read without confinement to its folder (docs/SECURITY.md)
   if (info.input_limits.allow_outside_scene_folder) j["allow_outside_scene_folder"] = true;
   j["warnings"] = warnings_json(info.warnings);
@@ -453,7 +460,9 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   auto get = [](const json& o, const char* key) { return o.is_object() && o.contains(key) ? o[key] : json(); };
   for (const char* key : {"format", "scene", "method", "tile", "camera", "display", "fps", "depth_channel"})
     if (!a.contains(key) || get(a, key) != get(b, key)) return key;
-  if (get(a, "variant") != get(b, "variant")) return "variant";  // absent: the default materials
+  if (get(a, "variant") != get(b, "variant")) return "variant";                       // absent: the default materials
+  if (get(a, "depth_empty") != get(b, "depth_empty")) return "depth_empty";           // absent: +infinity
+  if (get(a, "view_transform") != get(b, "view_transform")) return "view_transform";  // absent: Standard
   // the selection by index as well as by name (recorded since names come first; absent in older sidecars)
   for (const char* key : {"variant_index", "camera_name"})
     if (a.contains(key) && b.contains(key) && get(a, key) != get(b, key)) return key;

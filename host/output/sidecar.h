@@ -2,12 +2,14 @@
 // comparison with another sidecar (--resume, the folder guard, pmr verify) and where a frame came from.
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "output/background.h"
+#include "output/view_transform.h"
 #include "pipeline/pipeline_config.h"
 #include "pmr/display_presets.h"
 #include "pmr/input_files.h"
@@ -59,8 +61,10 @@ struct SidecarInfo {
   DisplaySource display_source;               // the display's source and its calibration's values
   SequenceSpec sequence;                      // fps, animation, turntable
   std::optional<ExrCompression> compression;  // of the images (none: not recorded)
-  Background background;                      // transparent: not recorded
-  InputLimits input_limits;                   // allow_outside_scene_folder: recorded only when given
+  // the PNG previews' view transform, recorded when previews pass through another than Standard
+  std::optional<ViewTransformRecord> view_transform;
+  Background background;     // transparent: not recorded
+  InputLimits input_limits;  // allow_outside_scene_folder: recorded only when given
   // pbr: the environment (--environment: the studio, the uniform one or an image file as given), an
   // image's checksum, the rotation (its intensity is render.environment_intensity)
   EnvironmentSource environment;
@@ -83,10 +87,11 @@ struct SidecarInfo {
   std::vector<SceneLight> lights;  // pbr: the frame's lights as used (FrameRenderer::Frame::lights)
   // Files written for this frame, as (kind, file name) pairs, e.g. {"encoded", "frame_0000.exr"}.
   std::vector<std::pair<std::string, std::string>> outputs;
-  std::vector<OutputChecksum> output_checksums;  // of the written outputs (the sidecar is written last)
-  int quilt_columns = 0, quilt_rows = 0;         // of the quilt output (0: none)
-  int center_view = -1;                          // the view of the center preview (-1: none)
-  bool depth = false;                            // Z channels in the views / quilt files
+  std::vector<OutputChecksum> output_checksums;                // of the written outputs (the sidecar is written last)
+  int quilt_columns = 0, quilt_rows = 0;                       // of the quilt output (0: none)
+  int center_view = -1;                                        // the view of the center preview (-1: none)
+  bool depth = false;                                          // Z channels in the views / quilt files
+  float depth_empty = std::numeric_limits<float>::infinity();  // their Z where nothing was drawn
 };
 
 // The largest sidecar pmr reads back. Everything a sidecar lists from the scene is bounded (names cut,

@@ -91,10 +91,12 @@ void choose_spacing_q(Rig& rig, std::vector<std::string>* warnings) {
     if (ok) break;
     if (q >= q_max) throw InternalError("no fixed-point view coordinates for angular camera spacing");
   }
+  // below half a view pixel nobody can see it (the sequence job's --verbose notes it)
   const SpacingError e = spacing_error(rig);
-  if (warnings && e.view_px > kSpacingErrorPx)
+  if (warnings && e.view_px > kSpacingWarningPx)
     warnings->push_back("angular camera spacing: the cameras sit up to " + std::to_string(e.view_px) +
-                        " view pixels of disparity from their exact positions (the depth range is very deep)");
+                        " view pixels of disparity from their exact positions, because the depth range is very "
+                        "deep for the view cone: narrow --cone, or use --camera-spacing linear");
 }
 
 // The framing camera's view matrix (DESIGN section 2): at distance D from c along the orbit's direction
@@ -186,17 +188,13 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
       char values[160];
       std::snprintf(values, sizeof values, "a %g degree view cone and a vertical field of view of %g degrees%s",
                     glm::degrees(rig.cone), glm::degrees(rig.yfov), from_camera ? " (the glTF camera's yfov)" : "");
-      throw Error(std::string("the views' disparity would leave the fixed-point guard band with ") + values +
-                  " in a " + std::to_string(rig.view_w) +
+      throw Error(std::string("the views' disparity would leave the fixed-point guard band with ") + values + " in a " +
+                  std::to_string(rig.view_w) +
                   "-pixel view: widen the field of view (--yfov) or narrow the cone (--cone)");
     }
-    const double w_min = rig.focal / (1.0 + room);
-    if (w_min > rig.near_eff) {
-      if (warnings)
-        warnings->push_back("near plane raised from " + std::to_string(rig.near) + " to " + std::to_string(w_min) +
-                            " to keep the disparity within the fixed-point range");
-      rig.near_eff = w_min;
-    }
+    // the near plane moves out to keep the disparity within the fixed-point range; that matters only
+    // where it cuts a triangle, which the frame renderer counts (FrameRenderer::Frame::near_clipped)
+    rig.near_eff = std::max(rig.near_eff, rig.focal / (1.0 + room));
   }
   if (!(rig.near_eff < rig.far)) throw Error("near plane is not in front of the far plane");
   if (rig.angular && rig.views > 1) choose_spacing_q(rig, warnings);

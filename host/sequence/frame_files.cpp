@@ -18,6 +18,7 @@
 #include "pmr/memory_budget.h"
 #include "output/sidecar.h"
 #include "pmr/output.h"
+#include "sequence/folder_guard.h"
 #include "sequence/frame_names.h"
 
 namespace pmr {
@@ -50,6 +51,36 @@ FramePaths frame_paths(const FrameProducts& o, long frame, const QuiltLayout& qu
     p.center_png = base + ".center.png";
   }
   return p;
+}
+
+FolderNames folder_quilt_names(const FrameProducts& o, const QuiltLayout& quilt, double aspect) {
+  if (!o.quilt) return FolderNames::None;
+  std::error_code ec;
+  fs::directory_iterator it(o.out_dir, ec), end;
+  FrameProducts as_sequence = o, as_still = o;
+  as_sequence.sequence = true, as_still.sequence = false;
+  bool sequence = false, still = false;
+  size_t read = 0;
+  for (; !ec && it != end && read < kMaxFolderSidecars; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    const long f = sidecar_frame(o.name, name);
+    if (f < 0 || !it->is_regular_file(ec)) continue;
+    ++read;
+    const json j = parse_json_text(read_sidecar_text(it->path().string()));
+    if (!j.is_object() || !j.contains("outputs") || !j["outputs"].is_object()) continue;
+    const json& q = j["outputs"].contains("quilt") ? j["outputs"]["quilt"] : json();
+    if (!q.is_string()) continue;
+    const std::string recorded = q.get<std::string>();
+    const std::string seq_name = fs::path(frame_paths(as_sequence, f, quilt, aspect).quilt).filename().string();
+    const std::string still_name = fs::path(frame_paths(as_still, f, quilt, aspect).quilt).filename().string();
+    if (seq_name == still_name) continue;  // the pattern places the quilt's tag itself (%q): no evidence
+    sequence |= recorded == seq_name;
+    still |= recorded == still_name;
+  }
+  return sequence && still ? FolderNames::Mixed
+         : sequence        ? FolderNames::Sequence
+         : still           ? FolderNames::Still
+                           : FolderNames::None;
 }
 
 namespace {

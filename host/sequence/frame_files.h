@@ -2,6 +2,7 @@
 // Shared by the sequence job (--resume) and `pmr verify`.
 #pragma once
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,10 @@ struct FrameProducts {
   std::string name = "frame_%04d";  // --name pattern (frame_names.h)
   bool sequence = false;            // a sequence's names: the quilt's frame number last (quilt_file_stem)
   bool encoded = true, views = false, quilt = false;
-  bool depth = false;    // a Z channel in the views and quilt EXRs
+  bool depth = false;  // a Z channel in the views and quilt EXRs
+  // Z where nothing was drawn (--depth-empty): +infinity by default, as DESIGN section 6 says; Cycles
+  // writes 1e10, which keeps compositing arithmetic (0 x Z) finite
+  float depth_empty = std::numeric_limits<float>::infinity();
   bool preview = false;  // PNG previews of the encoded image, the center view and the quilt
 };
 
@@ -29,6 +33,14 @@ struct FramePaths {
 };
 
 FramePaths frame_paths(const FrameProducts& o, long frame, const QuiltLayout& quilt, double aspect);
+
+// How the quilts of the folder's frames (sidecars under o.name's pattern) are named: as a sequence's
+// (frame_qs8x6a0.75_0012.exr) or as stills' (frame_0012_qs8x6a0.75.exr), so that a frame re-rendered
+// alone into a sequence's folder keeps the sequence's names. None: no such frame with a quilt of this
+// layout, or the folder is missing; Mixed: both kinds. At most kMaxFolderSidecars sidecars are read.
+enum class FolderNames { None, Still, Sequence, Mixed };
+constexpr size_t kMaxFolderSidecars = 100000;
+FolderNames folder_quilt_names(const FrameProducts& o, const QuiltLayout& quilt, double aspect);
 
 // "" when the frame is whole, else what is wrong with it, e.g. "frame_0003.exr is missing". Whole: the
 // sidecar (written last) parses as a JSON object, and every image is the file the sidecar records

@@ -1,5 +1,7 @@
 #include "sequence/frame_renderer.h"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -187,6 +189,52 @@ bool frame_bounds(const Scene& rest, const SequenceSpec& spec, glm::dvec3& lo, g
   return any;
 }
 
+// Whether a part of the triangle lies where the raised near plane cut it off from some view: between
+// the requested and the raised near planes (w is the same in every view) and inside the union of the
+// views' frusta, which nearer than the focal plane is bounded by view 0's left plane and view N-1's right
+// one. The six bounds are affine in the point, so the triangle is clipped on their values alone.
+bool cut_by_raised_near(const double (&bounds)[6][3]) {
+  std::vector<std::array<double, 6>> poly(3), next;
+  for (int v = 0; v < 3; ++v)
+    for (int k = 0; k < 6; ++k) poly[size_t(v)][size_t(k)] = bounds[k][v];
+  for (size_t k = 0; k < 6 && poly.size() >= 3; ++k) {
+    next.clear();
+    for (size_t i = 0; i < poly.size(); ++i) {
+      const auto& a = poly[i];
+      const auto& b = poly[(i + 1) % poly.size()];
+      if (a[k] >= 0.0) next.push_back(a);
+      if ((a[k] >= 0.0) != (b[k] >= 0.0)) {
+        const double t = a[k] / (a[k] - b[k]);
+        std::array<double, 6> m;
+        for (size_t j = 0; j < 6; ++j) m[j] = a[j] + t * (b[j] - a[j]);
+        next.push_back(m);
+      }
+    }
+    poly.swap(next);
+  }
+  return poly.size() >= 3;
+}
+
+// Triangles of which the raised near plane hides a part that some view would show: what the raise cost.
+uint64_t count_near_clipped(const Scene& placed, const Rig& rig) {
+  if (!(rig.near_eff > rig.near) || rig.views < 1) return 0;
+  const glm::dmat4 first = rig.projection(0) * rig.view_matrix(0);
+  const glm::dmat4 last = rig.projection(rig.views - 1) * rig.view_matrix(rig.views - 1);
+  uint64_t n = 0;
+  for (const PmrTriangle& t : placed.triangles) {
+    double bounds[6][3];  // >= 0 inside
+    for (int v = 0; v < 3; ++v) {
+      const glm::dvec4 p(glm::dvec3(placed.positions[t.v[size_t(v)]]), 1.0);
+      const glm::dvec4 a = first * p, b = last * p;  // the same w and y in every view
+      bounds[0][v] = a.w - rig.near, bounds[1][v] = rig.near_eff - a.w;
+      bounds[2][v] = a.x + a.w, bounds[3][v] = b.w - b.x;
+      bounds[4][v] = a.w - a.y, bounds[5][v] = a.w + a.y;
+    }
+    n += cut_by_raised_near(bounds);
+  }
+  return n;
+}
+
 }  // namespace
 
 FrameRenderer::FrameRenderer(const Scene& rest, const SequenceSpec& spec, const RigConfig& rig_config,
@@ -270,6 +318,7 @@ FrameRenderer::Frame FrameRenderer::render(long frame) {
       spec_.frame_work);
   out.times = pipeline_->render(d);
   out.visible = out.times.mtas > 0;
+  out.near_clipped = count_near_clipped(moves_ ? posed_ : rest_, d.rig);
   return out;
 }
 

@@ -56,6 +56,9 @@ class FrameRenderer {
     double pose_ms = 0.0;    // posing (animation sampling, morphing, skinning, turntable) on the host
     double upload_ms = 0.0;  // copying the posed geometry to the device
     bool visible = false;    // some MTA was produced (false: a transparent image)
+    // triangles the near plane cuts only because it was raised (rig.near_eff > rig.near: the
+    // disparity's fixed-point range), partly or wholly not drawn
+    uint64_t near_clipped = 0;
     // pbr: the lights the frame was shaded with (FrameDescription::lights), as the sidecar records
     // them; empty under lambert
     std::vector<SceneLight> lights;

@@ -170,10 +170,9 @@ void FrameWriter::write(FrameFiles& f) {
       done(f.encoded_path);
     }
     if (!f.depth.empty()) {
-      // window depth -> view-space depth (DESIGN section 6); +infinity stays
+      // window depth -> view-space depth (DESIGN section 6); empty voxels (+infinity) get --depth-empty
       const double n = f.near, fa = f.far;
-      for (float& z : f.depth)
-        if (std::isfinite(z)) z = float(fa * n / (fa - double(z) * (fa - n)));
+      for (float& z : f.depth) z = std::isfinite(z) ? float(fa * n / (fa - double(z) * (fa - n))) : f.depth_empty;
     }
     const float* depth = f.depth.empty() ? nullptr : f.depth.data();
     if (!f.views_path.empty()) {
@@ -196,7 +195,12 @@ void FrameWriter::write(FrameFiles& f) {
     }
     if (!f.encoded_png.empty()) {
       check();
-      write_png_preview(f.encoded_png, f.display_w, f.display_h, f.display.data(), 1.0, true);  // opaque, over black
+      if (f.display_shown.empty()) {  // opaque, over black
+        write_png_preview(f.encoded_png, f.display_w, f.display_h, f.display.data(), 1.0, true, f.view_transform);
+      } else {
+        const ViewTransform shown = ViewTransform::display_referred();
+        write_png_preview(f.encoded_png, f.display_w, f.display_h, f.display_shown.data(), 1.0, true, &shown);
+      }
       done(f.encoded_png);
     }
     if (!f.center_png.empty()) {
@@ -205,12 +209,13 @@ void FrameWriter::write(FrameFiles& f) {
       int w = 0, h = 0;  // a view's pixels span the display's aspect: square them for viewers
       const std::vector<uint16_t> square =
           square_pixels(f.volume.data() + size_t(f.center_view) * plane, f.view_w, f.view_h, f.pixel_aspect, w, h);
-      write_png_preview(f.center_png, w, h, square.data());
+      write_png_preview(f.center_png, w, h, square.data(), 1.0, false, f.view_transform);
       done(f.center_png);
     }
     if (!f.quilt_png.empty()) {
       check();
-      write_png_preview(f.quilt_png, qw, qh, quilt.data(), f.pixel_aspect, f.quilt_png_opaque);  // tiles as rendered
+      write_png_preview(f.quilt_png, qw, qh, quilt.data(), f.pixel_aspect, f.quilt_png_opaque,
+                        f.view_transform);  // tiles as rendered
       done(f.quilt_png);
     }
     // last, the sidecar with what was written: from here on the frame is complete

@@ -33,6 +33,11 @@ struct FrameFiles {
   Rig sidecar_rig;
   Display sidecar_display;
   std::string encoded_path, encoded_png;
+  // The previews' view transform (null: Standard). A transform that mixes channels cannot follow the
+  // encoder's choice of one channel per subpixel: the panel PNG is then encoded from the transformed
+  // views (display_shown: half RGBA, display-referred, already over the background).
+  const ViewTransform* view_transform = nullptr;
+  std::vector<uint16_t> display_shown;
   std::vector<uint16_t> display;    // half RGBA, display_w x display_h
   std::vector<uint16_t> sub_alpha;  // each display subpixel's alpha: [y][x][3] halves (AR, AG, AB)
   int display_w = 0, display_h = 0;
@@ -46,6 +51,7 @@ struct FrameFiles {
   // Written as view-space depth w = f n / (f - z (f - n)) with the rig's near (used) and far planes.
   std::vector<float> depth;
   double near = 0.0, far = 0.0;
+  float depth_empty = 0.0f;  // written where the window depth is infinite (FrameProducts::depth_empty)
   ExrCompression compression = ExrCompression::Zip;
   // The frame's EXR header attributes (docs/OUTPUTS.md): every EXR of the frame gets them when
   // has_meta; the writer builds each header from it (a rig and a few numbers, no image data).

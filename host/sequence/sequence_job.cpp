@@ -69,6 +69,7 @@ class SequenceRun {
   void load_inputs();
   void choose_frames();
   void check_frame_memory() const;
+  void adopt_folder_names();
   void prepare_frames();
   SidecarInfo frame_info(long frame, const FramePaths& p, double angle, std::vector<SceneLight> lights) const;
   std::string expected_sidecar(long frame, const FramePaths& p) const {
@@ -81,11 +82,12 @@ class SequenceRun {
   int render_frames();
   void finish_writing(FrameWriter& writer, Progress& progress);
   FrameFiles frame_files(long f, const FrameRenderer::Frame& fr, Pipeline& pipeline, FrameWriter& writer) const;
+  void shown_display(FrameFiles& files, Pipeline& pipeline) const;
   void print_frame_stages(long f, const FrameRenderer::Frame& fr, const Pipeline& pipeline, Progress& progress) const;
   void print_summary(const FrameWriter& writer) const;
 
   const SequenceJob& job_;
-  const FrameProducts& products_;
+  FrameProducts products_;  // the job's, with the names the folder's frames have (adopt_folder_names)
   const std::chrono::steady_clock::time_point t0_ = std::chrono::steady_clock::now();
   PipelineConfig pc_;  // the job's, with the environment: the sidecars a resumed run expects need it too
   std::string environment_checksum_;
@@ -99,7 +101,9 @@ class SequenceRun {
   QuiltLayout quilt_;
   int center_view_ = 0;
   bool need_volume_ = false;
-  SidecarInfo info_;  // what every frame's sidecar shares
+  bool near_warned_ = false;                             // the raised near plane's warning was given
+  std::unique_ptr<const ViewTransform> view_transform_;  // the previews' (null: none written)
+  SidecarInfo info_;                                     // what every frame's sidecar shares
   ResumePlan plan_;
   // the summary's sums
   double render_s_ = 0.0, pose_s_ = 0.0, upload_s_ = 0.0, loop_s_ = 0.0, loop_cpu_s_ = 0.0;
@@ -118,6 +122,10 @@ void SequenceRun::check_before_loading() {
   check_output_dir(products_.out_dir);
   make_encode_params(job_.display, job_.rig.views, job_.rig.view_w, job_.rig.view_h);
   if (!job_.quilt_layout.empty() && !products_.quilt) throw UsageError("--quilt needs --write quilt");
+  if (products_.preview || job_.view_transform_given) {  // a bad config or name fails before the scene is read
+    view_transform_ = std::make_unique<const ViewTransform>(make_view_transform(job_.view_transform));
+    if (!products_.preview) warn("the view transform applies to the PNG previews, which need --preview: ignored");
+  }
   for (const auto& w : job_.warnings) warn(w);
 }
 
@@ -181,8 +189,22 @@ void SequenceRun::choose_frames() {
                  ? choose_quilt_layout(rig.views, rig.view_w, rig.view_h)
                  : as_usage([&] { return parse_quilt_layout(job_.quilt_layout, rig.views, rig.view_w, rig.view_h); });
   center_view_ = rig.views / 2;
+  adopt_folder_names();
   check_frame_file_names(products_, frames_, quilt_, rig.aspect);  // not after the first frame was rendered
   check_frame_memory();
+}
+
+// A frame re-rendered into a folder keeps the names its frames have: the command line alone cannot
+// tell a sequence's frame 12 (--frames 12) from a still, but the folder's sidecars can.
+void SequenceRun::adopt_folder_names() {
+  const FolderNames kind = folder_quilt_names(products_, quilt_, renderer_->rig().aspect);
+  const bool sequence = kind == FolderNames::Sequence;
+  if ((kind != FolderNames::Sequence && kind != FolderNames::Still) || sequence == products_.sequence) return;
+  products_.sequence = sequence;
+  if (!job_.quiet && !frames_.empty())
+    std::fprintf(stderr, "pmr: note: the folder's quilts are named as %s; these frames' are too (%s)\n",
+                 sequence ? "a sequence's" : "stills'",
+                 terminal_text(std::filesystem::path(paths(frames_.front()).quilt).filename().string()).c_str());
 }
 
 // The images of a frame, checked against the memory budget before anything is created: the view
@@ -231,6 +253,7 @@ void SequenceRun::prepare_frames() {
   info.display_source = job_.display_source;
   info.sequence = spec_;
   info.compression = job_.compression;
+  if (products_.preview && !view_transform_->is_standard()) info.view_transform = view_transform_->record();
   info.background = job_.background;
   info.input_limits = job_.input_limits;
   info.environment = job_.environment;
@@ -264,6 +287,7 @@ SidecarInfo SequenceRun::frame_info(long frame, const FramePaths& p, double angl
   if (products_.quilt) i.quilt_columns = quilt_.columns, i.quilt_rows = quilt_.rows;
   if (products_.preview) i.center_view = center_view_;
   i.depth = products_.depth;
+  i.depth_empty = products_.depth_empty;
   return i;
 }
 
@@ -287,6 +311,14 @@ void SequenceRun::print_header() const {
                job_.display.width, job_.display.height,
                job_.pipeline.sampling == Sampling::Subpixel ? " (subpixel sampling)" : "", plan_.todo.size(),
                plan_.kept ? (", " + std::to_string(plan_.kept) + " already complete").c_str() : "");
+  if (!job_.verbose) return;
+  // what is not worth a warning unless it shows (near_warned_, the rig's angular spacing warning)
+  if (rig.near_eff > rig.near)
+    std::fprintf(stderr, "pmr: note: near plane at %g, not %g: the views' disparity stays in its fixed-point range\n",
+                 rig.near_eff, rig.near);
+  if (rig.angular && rig.views > 1)
+    std::fprintf(stderr, "pmr: note: angular camera spacing within %.3g view pixels of the exact cameras\n",
+                 spacing_error(rig).view_px);
 }
 
 int SequenceRun::run() {
@@ -362,6 +394,7 @@ FrameFiles SequenceRun::frame_files(long f, const FrameRenderer::Frame& fr, Pipe
     }
   }
   files.encoded_png = p.encoded_png;
+  if (view_transform_) files.view_transform = view_transform_.get();
   if (need_volume_) {
     files.views_path = p.views;
     files.quilt_path = p.quilt;
@@ -377,11 +410,28 @@ FrameFiles SequenceRun::frame_files(long f, const FrameRenderer::Frame& fr, Pipe
     else files.volume.assign(size_t(rig.views) * rig.view_w * rig.view_h * 4, 0);
     if (products_.depth) {
       files.near = fr.rig.near_eff, files.far = fr.rig.far;
+      files.depth_empty = products_.depth_empty;
       if (renderer_->has_geometry()) pipeline.read_depth(files.depth);
       else files.depth.assign(size_t(rig.views) * rig.view_w * rig.view_h, std::numeric_limits<float>::infinity());
     }
   }
+  if (!files.encoded_png.empty() && view_transform_->mixes_channels()) shown_display(files, pipeline);
   return files;
+}
+
+// The panel PNG through a transform that mixes channels: every view transformed first (over the
+// background), then encoded by the pipeline's own encoder, so each subpixel takes its channel of its
+// view's transformed colour. Without geometry every subpixel shows the transformed background.
+void SequenceRun::shown_display(FrameFiles& files, Pipeline& pipeline) const {
+  if (!renderer_->has_geometry()) {
+    const std::vector<uint16_t> empty(files.display.size(), 0);
+    files.display_shown = shown_colours(empty.data(), empty.size() / 4, job_.background, *view_transform_);
+    return;
+  }
+  const std::vector<uint16_t> shown =
+      shown_colours(files.volume.data(), files.volume.size() / 4, job_.background, *view_transform_);
+  pipeline.encode_volume(shown);
+  pipeline.read_display(files.display_shown);
 }
 
 void SequenceRun::print_frame_stages(long f, const FrameRenderer::Frame& fr, const Pipeline& pipeline,
@@ -456,6 +506,13 @@ int SequenceRun::render_frames() {
     if (!fr.visible)
       progress.message("pmr: warning: frame " + std::to_string(f) +
                        ": nothing visible, written as a transparent image");
+    if (fr.near_clipped > 0 && !near_warned_) {  // once a run: the next frames say the same
+      near_warned_ = true;
+      progress.message("pmr: warning: frame " + std::to_string(f) + ": the near plane, moved from " +
+                       std::to_string(fr.rig.near) + " to " + std::to_string(fr.rig.near_eff) +
+                       " to keep the views' disparity in range, cuts " + std::to_string(fr.near_clipped) +
+                       " triangle(s) nearer than it: narrow --cone, widen --yfov or move the camera back");
+    }
     if (fr.times.blend_beyond > 0)
       progress.message("pmr: note: frame " + std::to_string(f) + ": " + std::to_string(fr.times.blend_beyond) +
                        " samples had more than 8 alphaMode BLEND fragments; those behind the nearest 8 were "

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "output/background.h"
+#include "output/view_transform.h"
 #include "pipeline/pipeline_config.h"
 #include "pmr/display_presets.h"
 #include "pmr/input_files.h"
@@ -41,9 +42,13 @@ struct SequenceJob {
   long shard_count = 0, shard_first = 0;
   bool resume = false, overwrite = false;
   bool quiet = false, verbose = false;
-  bool print_outputs = false;  // --print-outputs: list each frame's files (JSON lines) and render nothing
+  bool print_outputs = false;         // --print-outputs: list each frame's files (JSON lines) and render nothing
   std::vector<std::string> warnings;  // printed before the work starts (e.g. from the options)
   Background background;              // behind every output (output/background.h)
+  // the PNG previews' view transform (--ocio ...; output/view_transform.h): opened before the scene is
+  // read, when there are previews or an option names part of a config
+  ViewTransformOptions view_transform;
+  bool view_transform_given = false;  // an option of it was on the command line
   bool quilt_preview_opaque = false;  // the quilt PNG over opaque black when no background is given
 };
 

@@ -59,10 +59,10 @@ Shard parse_shard(const std::string& text, long shard_count, long shard_first, c
   bool has = false, h2 = false, h3 = false, h4 = false;
   auto with_count = [&](long index, long env_count, bool env_has, const std::string& source) {
     if (env_has && shard_count > 0 && shard_count != env_count)
-      throw Error(source + ": --shard-count " + std::to_string(shard_count) + " disagrees with the array's " +
-                  std::to_string(env_count) + " tasks");
+      throw UsageError(source + ": --shard-count " + std::to_string(shard_count) + " disagrees with the array's " +
+                       std::to_string(env_count) + " tasks");
     const long count = env_has ? env_count : shard_count;
-    if (count < 1) throw Error(source + ": the task count is not in the environment: give --shard-count N");
+    if (count < 1) throw UsageError(source + ": the task count is not in the environment: give --shard-count N");
     return checked(index, count, source);
   };
   // Slurm: SLURM_ARRAY_TASK_ID within MIN..MAX by STEP (COUNT when given)
@@ -122,7 +122,7 @@ Shard parse_shard(const std::string& text, long shard_count, long shard_first, c
                         false, src);
     }
   }
-  throw Error(
+  throw UsageError(
       "--shard auto: no array job in the environment (none of SLURM_ARRAY_TASK_ID, JOB_COMPLETION_INDEX, "
       "AWS_BATCH_JOB_ARRAY_INDEX, SGE_TASK_ID, LSB_JOBINDEX, PBS_ARRAY_INDEX, PBS_ARRAYID is set)");
 }

@@ -15,11 +15,18 @@
 
 namespace pmr {
 
-enum class ExrCompression { None, Zip, ZipFast, Piz, Rle };
-// "none", "zip", "zip-fast" (ZIP through a faster encoder), "piz", "rle" (lower case, as the CLI documents); pmr::Error otherwise.
+class ViewTransform;
+
+enum class ExrCompression { None, Zip, ZipFast, Piz, Rle, Dwaa, Dwab };
+// "none", "zip", "zip-fast" (ZIP through a faster encoder), "piz", "rle", "dwaa", "dwab" (lower case, as the
+// CLI documents); pmr::Error otherwise. DWAA and DWAB are lossy for the half R, G and B channels only (the
+// OpenEXR library's rule: A and the float Z stay lossless), at the library's default level 45.
 ExrCompression parse_exr_compression(const std::string& name);
 // The inverse of parse_exr_compression.
 const char* to_string(ExrCompression c);
+// Whether the compression loses data (DCT of R, G, B): refused for the encoded panel image, where
+// neighbouring subpixels come from different views and ringing would become crosstalk.
+bool is_lossy(ExrCompression c);
 
 // Ensures the directory exists (creating it and its parents) and is writable (creates and removes a
 // probe file). Throws pmr::Error "cannot write to output folder X: <reason>". Call it before long work.
@@ -154,8 +161,11 @@ void read_views_exr_part(const std::string& path, int part, int& width, int& hei
 // chunk. `opaque`: RGB only, what the pixels show over black. The encoded image is previewed so: its
 // three subpixels come from three views, so no one alpha per pixel composites it right (a viewer would
 // darken covered subpixels next to empty ones), while the display shows it over black.
+// `transform` (output/view_transform.h): the view transform in place of the sRGB curve (null = Standard);
+// it applies to the straight colour, or to the colour over black when opaque. A managed transform's PNG
+// carries no sRGB chunk: its display need not be sRGB.
 void write_png_preview(const std::string& path, int width, int height, const uint16_t* rgba_half,
-                       double pixel_aspect = 1.0, bool opaque = false);
+                       double pixel_aspect = 1.0, bool opaque = false, const ViewTransform* transform = nullptr);
 // The image resampled to square pixels (most viewers ignore a PNG's pixel aspect): stretched along one
 // axis, never shrunk (width x pixel_aspect when > 1, else height / pixel_aspect), bilinear in linear
 // light on the premultiplied values, edges clamped. Unchanged when the size stays.

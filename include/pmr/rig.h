@@ -110,6 +110,8 @@ SpacingError spacing_error(const Rig& rig);
 // The bound make_rig keeps spacing_error(rig).view_px within (unless a view-coordinate range of
 // +-PMR_MAX_VIEW_COORD cannot hold it; make_rig warns then).
 constexpr double kSpacingErrorPx = 0.01;
+// Above this error the user is warned (a visible half-pixel shift); below it --verbose notes it.
+constexpr double kSpacingWarningPx = 0.5;
 
 // Throws pmr::Error unless |az| <= 360 and |el| < 90 degrees (RigConfig's orbit).
 void check_orbit(double az_deg, double el_deg);

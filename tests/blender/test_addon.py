@@ -552,6 +552,44 @@ def check_fps_base(scene, ops_module, work):
           "key times %s, expected frame / 29.97 = %s" % (got, want))
 
 
+def check_colour_management(scene, ops_module, work):
+    """Blender's own view (Filmic, a look, exposure, gamma; dither 0) of pmr's quilt EXR, saved by
+    Blender as a PNG, equals pmr's quilt PNG within one 8-bit code wherever the quilt is covered."""
+    out = os.path.join(work, "colour")
+    settings_for(scene, out, "STILL", SEQ_VIEW)
+    vs = scene.view_settings
+    saved = (vs.view_transform, vs.look, vs.exposure, vs.gamma, scene.render.dither_intensity)
+    vs.view_transform, vs.look, vs.exposure, vs.gamma = "Filmic", "High Contrast", 0.5, 1.2
+    scene.render.dither_intensity = 0.0
+    try:
+        run_operator(ops_module)
+        sidecar = read_sidecar(out, scene.frame_current)
+        applied = sidecar.get("view_transform", {})
+        check(applied.get("view") == "Filmic" and applied.get("look") == "High Contrast"
+              and abs(applied.get("exposure", 0) - 0.5) < 1e-6 and abs(applied.get("gamma", 0) - 1.2) < 1e-6,
+              "the view settings did not reach pmr: %s" % applied)
+        exr = bpy.data.images.load(os.path.join(out, sidecar["outputs"]["quilt"]))
+        fmt = scene.render.image_settings
+        fmt.file_format, fmt.color_mode, fmt.color_depth = "PNG", "RGBA", "8"
+        theirs_path = os.path.join(work, "colour_blender.png")
+        exr.save_render(theirs_path, scene=scene)
+        ours = list(bpy.data.images.load(os.path.join(out, sidecar["outputs"]["preview_quilt"])).pixels)
+        theirs = list(bpy.data.images.load(theirs_path).pixels)
+        linear = list(exr.pixels)
+        check(len(ours) == len(theirs) == len(linear), "the PNGs and the EXR differ in size")
+        worst, covered = 0.0, 0
+        for i in range(0, len(linear), 4):
+            if linear[i + 3] < 1.0:
+                continue
+            covered += 1
+            worst = max(worst, max(abs(ours[i + c] - theirs[i + c]) for c in range(3)) * 255.0)
+    finally:
+        vs.view_transform, vs.look, vs.exposure, vs.gamma, scene.render.dither_intensity = saved
+    check(covered > len(linear) // 40, "only %d covered pixels in the quilt" % covered)
+    check(worst <= 1.0 + 1e-6, "pmr's quilt PNG differs from Blender's view of its EXR by %.1f codes" % worst)
+    return worst, covered
+
+
 def check_blender_sequence(out, sidecars):
     """Blender's own sequence logic (the last digit group of the file name is the frame) finds the
     quilt of every frame from the first file."""
@@ -640,6 +678,10 @@ def main():
 
     check_fps_base(scene, ops_module, work)
     log("fps 30 / 1.001: pmr --fps 29.97, the exported key times frame / 29.97")
+
+    worst, covered = check_colour_management(scene, ops_module, work)
+    log("the quilt PNG is Blender's own view (Filmic, High Contrast, exposure 0.5, gamma 1.2) of the "
+        "quilt EXR within %.2g codes over %d covered pixels" % (worst, covered))
 
     check_blender_sequence(out, sidecars)
     log("Blender reads the quilt sequence as frames %d..%d" % FRAMES)

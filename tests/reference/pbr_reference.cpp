@@ -130,7 +130,7 @@ glm::dvec3 thin_film_fresnel(double outside, double film, double cos1, double d,
   const double cos2 = std::sqrt(cos2sq);
   const double R12 = schlick(std::pow((ior - outside) / (ior + outside), 2.0), cos1), T121 = 1.0 - R12;
   const double phi21 = kPi - (ior < outside ? kPi : 0.0), opd = 2.0 * ior * d * cos2;
-  glm::dvec3 R23, phi;
+  glm::dvec3 R23(0.0), phi(0.0);
   for (int c = 0; c < 3; ++c) {
     const double s0 = std::sqrt(std::clamp(f0[c], 0.0, 0.9999)), base = (1.0 + s0) / (1.0 - s0);
     R23[c] = schlick(std::pow((base - ior) / (base + ior), 2.0), cos2);

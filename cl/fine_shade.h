@@ -41,7 +41,8 @@ inline void shade_batch(const ShadeInputs* in, global const PmrMta* mtas, MtaCac
 
 /* The lanes w of a row chunk whose winners (ids, covering `bits`, first met at sample 0, shares `weight`)
  * are shaded in pixel order, each lane its own pixel (the row forms of shade_center_lanes and
- * shade_point_lanes), into acc. One sample and no layers (`assign`): the winner's colour as shaded. */
+ * shade_point_lanes), into acc. One sample and no layers (`assign`): the winner's colour as shaded, times
+ * its opacity. */
 inline void shade_pixel_lanes(const ShadeInputs* in, global const PmrMta* mtas, MtaCache* cache, float3 light,
                               const int* ids, const int* w, const float* weight, const uint* bits, int px0, int py,
                               int view, bool assign, float acc[4][VW], float* alpha_of) {
@@ -53,9 +54,9 @@ inline void shade_pixel_lanes(const ShadeInputs* in, global const PmrMta* mtas, 
     else shade_point_lanes(in, mtas, cache, light, act, vload_s(0, ids + h), bits + h, px0 + h, py, view, c);
     for (int l = 0; l < SW && h + l < VW; ++l) {
       if (!w[h + l]) continue;
-      if (assign) {
-        for (int k = 0; k < 3; ++k) acc[k][h + l] = c[k][l];
-        acc[3][h + l] += 1.0f;
+      if (assign) { /* opaque winners have alpha exactly 1; clear glass less */
+        for (int k = 0; k < 3; ++k) acc[k][h + l] = c[k][l] * c[3][l];
+        acc[3][h + l] += c[3][l];
         continue;
       }
       const float cl[4] = {c[0][l], c[1][l], c[2][l], c[3][l]};

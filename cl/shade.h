@@ -162,6 +162,7 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
     environment_occlusion_lanes(in, L, S, reflected, &vd, &vs);
     irradiance = s3_scale(irradiance, vd), prefiltered = s3_scale(prefiltered, vs);
   }
+  sfloat keep = 1.0f; /* clear glass: the opacity left where the glass sees past the scene */
   /* transmission replaces the diffuse lobe */
   const sfloat kd = glass ? (1.0f - metallic) * (1.0f - transmission) : 1.0f - metallic;
   const sfloat ao = S->ao;
@@ -172,8 +173,12 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
   if (glass) { /* KHR_materials_transmission's BTDF: (1 - R) c_diff x the light through */
     const sfloat w = select((sfloat)(0.0f), transmission * (1.0f - metallic), L->glass);
     sfloat3 attenuation;
-    const sfloat3 through = transmitted_lanes(in, L, S->p, n, v, r, S->thickness, view, &attenuation);
-    ambient = s3_add(ambient, s3_mul(btdf_weight(ao * w, R, base), through));
+    sfloat escaped;
+    const sfloat3 through = transmitted_lanes(in, L, S->p, n, v, r, S->thickness, view, &attenuation, &escaped);
+    const sfloat3 weight = btdf_weight(ao * w, R, base);
+    ambient = s3_add(ambient, s3_mul(weight, through));
+    /* clear glass: what would have shown the environment lets the image's background through instead */
+    if (in->P->clear_glass) keep = fmax(1.0f - escaped * luminance_lanes(s3_mul(weight, attenuation)), 1.0f / 1024.0f);
     sfloat3 lights_in = s3_mul(s3_scale(s3_mul(base, attenuation), w), lights_through);
     if (sheen) lights_in = sheen_view_scaled(sheen, lights_in);
     direct = s3_add(direct, lights_in);
@@ -186,6 +191,8 @@ inline sfloat3 shade_pbr(const ShadeInputs* in, const LaneWinners* L, const Surf
     *alpha = select(*alpha, catcher_alpha(&sums, open_irradiance, vd), L->catcher);
     lit = s3_select(lit, s3_splat((float3)(0.0f)), L->catcher);
   }
+  /* the colour is returned straight (the raster multiplies it by alpha): the light drawn over `keep` */
+  if (glass && in->P->clear_glass) *alpha *= keep, lit = s3_scale(lit, 1.0f / keep);
   return s3_select(lit, base, L->unlit);
 }
 

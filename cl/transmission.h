@@ -67,11 +67,13 @@ inline sint project_lanes(global const PmrParams* P, sfloat3 q, int view, sfloat
 /* The light arriving through the transmissive lanes `glass` (DESIGN 4c step 2), before the BTDF's
  * weights: the view ray -v refracted at n (Snell, eta = 1 / ior; ior 0 or a thin surface: straight on),
  * travelled thickness along it, the end point's source (divided by the exposure it was drawn with) plus
- * (1 - its alpha) x the environment along the refracted ray, attenuated by Beer-Lambert,
+ * (1 - its alpha) x the environment along the refracted ray (*escaped: that 1 - alpha, the part that
+ * left the scene; with P->clear_glass the environment is not added: the caller lowers alpha by it),
+ * attenuated by Beer-Lambert,
  * attenuationColor^(distance / attenuationDistance) (*attenuation: that factor, which the lights seen
  * through the surface take too). r: the roughness; thickness: the volume's, textured and in world units. */
 inline sfloat3 transmitted_lanes(const ShadeInputs* in, const LaneWinners* L, sfloat3 p, sfloat3 n, sfloat3 v, sfloat r,
-                                 sfloat thickness, int view, sfloat3* attenuation) {
+                                 sfloat thickness, int view, sfloat3* attenuation, sfloat* escaped) {
   global const PmrParams* P = in->P;
   const sfloat ior = L->ior, nv = clamp(s3_dot(n, v), 0.0f, 1.0f);
   const sfloat eta = select((sfloat)(1.0f), 1.0f / ior, ior >= 1.0f);
@@ -98,7 +100,8 @@ inline sfloat3 transmitted_lanes(const ShadeInputs* in, const LaneWinners* L, sf
     c[0][l] = s.x, c[1][l] = s.y, c[2][l] = s.z, c[3][l] = s.w;
   }
   const sfloat uncovered = 1.0f - clamp(vload_s(0, c[3]), 0.0f, 1.0f);
-  const sfloat3 env = environment_along(in, d, blur, L->glass);
+  *escaped = select((sfloat)(0.0f), uncovered, L->glass);
+  const sfloat3 env = P->clear_glass ? s3_splat((float3)(0.0f)) : environment_along(in, d, blur, L->glass);
   const sfloat inv_exposure = (sfloat)(1.0f / P->exposure);
   const sfloat3 light = s3_add(s3_scale(LANE3(c), inv_exposure), s3_scale(env, uncovered));
   const sfloat3 ac = L->att_color;

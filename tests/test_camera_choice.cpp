@@ -50,6 +50,29 @@ std::string cameras_file(const std::string& dir) {
   return g.write(dir, "cameras");
 }
 
+// A camera whose frame is wider than the display's views (glTF aspectRatio: Blender writes its render
+// size's) keeps its whole frame: the vertical field of view widens until the frame's width fits, with
+// one warning that says what to do. A camera of the display's aspect, or narrower, keeps its yfov.
+TEST(CameraChoice, AWiderCameraFrameWidensTheFieldOfView) {
+  Display portrait;
+  portrait.size_w_cm = 30.0, portrait.size_h_cm = 40.0;
+  const double a = portrait.aspect(), yfov = 0.5;
+  const glm::dmat4 pose = glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 0.0, 10.0));
+  RigConfig rc;
+  rc.views = 4, rc.view_w = 60, rc.view_h = 80;
+  std::vector<std::string> warnings;
+  const Rig wide = make_rig(rc, portrait, glm::dvec3(-1.0), glm::dvec3(1.0), &pose, yfov, &warnings, 16.0 / 9.0);
+  EXPECT_NEAR(a * std::tan(wide.yfov / 2.0), 16.0 / 9.0 * std::tan(yfov / 2.0), 1e-12) << "the frame's width fits";
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("render size"), std::string::npos) << warnings[0];
+  for (double aspect : {0.0, a, 0.5}) {
+    warnings.clear();
+    const Rig same = make_rig(rc, portrait, glm::dvec3(-1.0), glm::dvec3(1.0), &pose, yfov, &warnings, aspect);
+    EXPECT_EQ(same.yfov, yfov) << aspect;
+    EXPECT_TRUE(warnings.empty()) << aspect;
+  }
+}
+
 TEST(CameraChoice, ByIndexNodeNameOrCameraName) {
   const std::string dir = temp_dir("camera_choice");
   std::filesystem::create_directories(dir);
@@ -119,7 +142,8 @@ TEST(CameraChoice, NamedCameraFromTheCommandLine) {
   EXPECT_FALSE(test::exists(dir + "/nobody"));
   const std::string info = run("info " + file).output;
   EXPECT_NE(info.find("placed by node 'Side' (--camera '#1')"), std::string::npos) << info;
-  EXPECT_NE(info.find("placed by node 'Second', a further node of camera 0 (--camera '#5')"), std::string::npos) << info;
+  EXPECT_NE(info.find("placed by node 'Second', a further node of camera 0 (--camera '#5')"), std::string::npos)
+      << info;
   // the further node drives the rig from its own pose
   ASSERT_EQ(run("render " + file + small + "--camera Second --out " + dir + "/second").status, 0);
   const json second = json::parse(test::read_file(dir + "/second/frame_0000.json"));

@@ -3,43 +3,16 @@
 // is absent (as in a user's clone).
 #include <gtest/gtest.h>
 
-#include <dirent.h>
-#include <sys/stat.h>
-
-#include <functional>
-
 #include "pmr/error.h"
 #include "test_util.h"
 
 namespace pmr {
 namespace {
 
-std::vector<std::string> corpus_files(const std::string& dir) {
-  std::vector<std::string> out;
-  std::function<void(const std::string&)> walk = [&](const std::string& d) {
-    DIR* h = opendir(d.c_str());
-    if (!h) return;
-    while (dirent* e = readdir(h)) {
-      const std::string name = e->d_name;
-      if (name == "." || name == "..") continue;
-      const std::string path = d + "/" + name;
-      struct stat st;
-      if (stat(path.c_str(), &st) != 0) continue;
-      if (S_ISDIR(st.st_mode)) walk(path);
-      else if (name.size() > 5 && (name.substr(name.size() - 5) == ".gltf" || name.substr(name.size() - 4) == ".glb"))
-        out.push_back(path);
-    }
-    closedir(h);
-  };
-  walk(dir);
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
 TEST(Corpus, EverySupportedModelRenders) {
   const std::string dir = test::corpus_dir();
   if (dir.empty()) GTEST_SKIP() << "../shared/gltf not found: corpus render test skipped";
-  const auto files = corpus_files(dir);
+  const auto files = test::corpus_files(dir);
   ASSERT_GT(files.size(), 20u);
   size_t rendered = 0;
   for (const std::string& f : files) {

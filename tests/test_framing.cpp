@@ -42,7 +42,24 @@ Rig framed(const Display& d, double zoom = 1.0) {
   rc.views = 1;  // the center camera alone: s_0 = 0
   rc.view_w = 64, rc.view_h = 64;
   rc.zoom = zoom;
+  rc.framing = Framing::Sphere;
   return make_rig(rc, d, kLo, kHi);
+}
+
+// How far the box's corners reach across views 0 .. N-1 (max |NDC| in x and y), and in front of the
+// cameras (min w).
+struct BoxReach {
+  double x = 0.0, y = 0.0, w = INFINITY;
+};
+BoxReach box_reach(const Rig& rig, const glm::dvec3& lo, const glm::dvec3& hi, int view) {
+  BoxReach r;
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 p((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+    const glm::dvec4 clip = rig.projection(view) * rig.view_matrix(view) * glm::dvec4(p, 1.0);
+    r.x = std::max(r.x, std::abs(clip.x / clip.w)), r.y = std::max(r.y, std::abs(clip.y / clip.w));
+    r.w = std::min(r.w, clip.w);
+  }
+  return r;
 }
 
 // NDC of a world point seen by the rig's center camera.
@@ -69,7 +86,63 @@ nlohmann::json sidecar(const std::string& path) {
 
 }  // namespace
 
-// Wide (2:1), square and portrait (3:4) displays: the sphere fits in both directions and touches the
+// The default, --framing box: every corner of the box inside every view, one pixel from the edges
+// (1 - 2 / W in NDC), and some corner in view 0 or N-1 on that bound: no smaller distance keeps them
+// all in. Wide, square and portrait displays, linear and angular spacing, orbits, a flat box.
+TEST(Framing, TheBoxFillsTheFirstAndLastViews) {
+  const std::pair<glm::dvec3, glm::dvec3> boxes[] = {{kLo, kHi}, {{-2.0, 0.0, -0.1}, {2.0, 3.0, 0.1}}};
+  for (const auto& [w, h] : {std::pair{200.0, 100.0}, std::pair{50.0, 50.0}, std::pair{30.0, 40.0}})
+    for (bool angular : {false, true})
+      for (const auto& [az, el] : {std::pair{0.0, 0.0}, std::pair{35.0, 20.0}})
+        for (const auto& [lo, hi] : boxes) {
+          RigConfig rc;
+          rc.views = 12, rc.view_w = 80, rc.view_h = 60, rc.cone_deg = 40.0;
+          rc.angular_spacing = angular, rc.orbit_az_deg = az, rc.orbit_el_deg = el;
+          rc.framing = Framing::Box;
+          const Rig rig = make_rig(rc, display_of_aspect(w, h), lo, hi);
+          SCOPED_TRACE("display " + std::to_string(w) + " x " + std::to_string(h) + (angular ? " angular" : "") +
+                       " orbit " + std::to_string(az) + "," + std::to_string(el));
+          EXPECT_EQ(rig.framing, Framing::Box);
+          const double bx = 1.0 - 2.0 / rc.view_w, by = 1.0 - 2.0 / rc.view_h;
+          double tight = INFINITY;
+          for (int v = 0; v < rc.views; ++v) {
+            const BoxReach r = box_reach(rig, lo, hi, v);
+            // the angular cameras sit on fixed-point view coordinates, within 0.01 view pixel
+            const double slack = angular ? 0.02 / rc.view_w : 1e-9;
+            EXPECT_LE(r.x, bx + slack) << "view " << v;
+            EXPECT_LE(r.y, by + 1e-9) << "view " << v;
+            EXPECT_GT(r.w, rig.near_eff) << "view " << v;
+            if (v == 0 || v == rc.views - 1) tight = std::min(tight, std::min(bx - r.x, by - r.y));
+          }
+          EXPECT_NEAR(tight, 0.0, angular ? 0.02 / rc.view_w : 1e-9) << "a corner touches the bound";
+          EXPECT_NEAR(-(rig.center_view * glm::dvec4(0.5 * (lo + hi), 1.0)).z, rig.focal, 1e-9)
+              << "the focal plane through the box's center";
+        }
+}
+
+// The box fills more of the picture than the sphere, and a turntable keeps the sphere unless asked.
+TEST(Framing, TheBoxIsCloserThanTheSphereAndTurntablesKeepTheSphere) {
+  RigConfig rc;
+  rc.views = 48, rc.view_w = 84, rc.view_h = 112, rc.cone_deg = 40.0;
+  rc.framing = Framing::Box;
+  const Display portrait = display_of_aspect(30, 40);
+  const Rig box = make_rig(rc, portrait, kLo, kHi);
+  rc.framing = Framing::Sphere;
+  const Rig sphere = make_rig(rc, portrait, kLo, kHi);
+  EXPECT_LT(box.focal, sphere.focal);
+  const std::string dir = temp_dir("framing_turntable");
+  const std::string small = " --views 4 --view-size 32x32 --display 120x68 -q --out " + dir;
+  ASSERT_EQ(run("render --turntable 360:4 --frames 0" + small).status, 0);
+  EXPECT_EQ(sidecar(dir + "/frame_0000.json")["rig"]["framing"], "sphere");
+  ASSERT_EQ(run("render --overwrite --frames 0" + small).status, 0);
+  EXPECT_EQ(sidecar(dir + "/frame_0000.json")["rig"]["framing"], "box");
+  ASSERT_EQ(run("render --overwrite --turntable 360:4 --framing box --frames 0" + small).status, 0);
+  EXPECT_EQ(sidecar(dir + "/frame_0000.json")["rig"]["framing"], "box");
+  expect_usage_error(run("render --framing cube" + small), "--framing");
+  expect_usage_error(run("render --framing box --camera 0" + small), "--framing");
+}
+
+// --framing sphere: wide (2:1), square and portrait (3:4) displays: the sphere fits in both directions and touches the
 // window's edge in the tighter one.
 TEST(Framing, TheBoundingSphereFitsBothDirections) {
   for (const auto& [w, h] : {std::pair{200.0, 100.0}, std::pair{50.0, 50.0}, std::pair{30.0, 40.0}}) {

@@ -159,7 +159,9 @@ TEST(Quilt, CliQuiltDepthAndPreviews) {
     ASSERT_EQ(ph, h);
     for (size_t i = 0; i < size_t(w) * h; ++i)
       for (int c = 0; c < 4; ++c) {
-        const double lin = half_value(exr[i * 4 + c]);
+        // PNG's alpha is straight: a partly covered pixel's colour is divided by its coverage
+        const double a = half_value(exr[i * 4 + 3]), straight = !opaque && a > 0.0 && a < 1.0 ? 1.0 / a : 1.0;
+        const double lin = half_value(exr[i * 4 + c]) * (c < 3 ? straight : 1.0);
         const double expect = 255.0 * (c < 3 ? srgb_encode(lin) : opaque ? 1.0 : std::min(1.0, std::max(0.0, lin)));
         ASSERT_LE(std::abs(double(rgba[i * 4 + c]) - expect), 1.0) << png << " pixel " << i << " channel " << c;
       }

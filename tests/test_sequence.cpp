@@ -98,13 +98,13 @@ TEST(Sequence, WritesExactlyTheExpectedFiles) {
   EXPECT_NE(r.output.find("4 frame(s)"), std::string::npos) << r.output;
 }
 
-// Turntable frame 0 is the static render, bit for bit; a frame rendered alone equals the same frame of
-// a longer sequence (pixels and sidecar).
+// Turntable frame 0 is the static render framed as turntables are (--framing sphere), bit for bit; a
+// frame rendered alone equals the same frame of a longer sequence (pixels and sidecar).
 TEST(Sequence, FramesAreIndependentOfTheSequence) {
   const std::string a = temp_dir("seq_alone"), b = temp_dir("seq_long"), s = temp_dir("seq_static");
   ASSERT_EQ(run("render --turntable 90:4 --frames 0:3" + kSmall + "--out " + b).status, 0);
   ASSERT_EQ(run("render --turntable 90:4 --frames 2" + kSmall + "--out " + a).status, 0);
-  ASSERT_EQ(run("render" + kSmall + "--out " + s).status, 0);
+  ASSERT_EQ(run("render --framing sphere" + kSmall + "--out " + s).status, 0);
   EXPECT_EQ(pixels(a + "/frame_0002.exr"), pixels(b + "/frame_0002.exr"));
   EXPECT_EQ(read_text(a + "/frame_0002.json"), read_text(b + "/frame_0002.json"));
   EXPECT_EQ(pixels(s + "/frame_0000.exr"), pixels(b + "/frame_0000.exr"));

@@ -4,12 +4,15 @@
 
 #include <Imath/half.h>
 
+#include <dirent.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -145,6 +148,28 @@ std::string corpus_dir() {
   const std::string d = std::string(PMR_SOURCE_DIR) + "/../shared/gltf";
   struct stat st;
   return stat(d.c_str(), &st) == 0 && S_ISDIR(st.st_mode) ? d : std::string();
+}
+
+std::vector<std::string> corpus_files(const std::string& dir) {
+  std::vector<std::string> out;
+  std::function<void(const std::string&)> walk = [&](const std::string& d) {
+    DIR* h = opendir(d.c_str());
+    if (!h) return;
+    while (dirent* e = readdir(h)) {
+      const std::string name = e->d_name;
+      if (name == "." || name == "..") continue;
+      const std::string path = d + "/" + name;
+      struct stat st;
+      if (stat(path.c_str(), &st) != 0) continue;
+      if (S_ISDIR(st.st_mode)) walk(path);
+      else if (name.size() > 5 && (name.substr(name.size() - 5) == ".gltf" || name.substr(name.size() - 4) == ".glb"))
+        out.push_back(path);
+    }
+    closedir(h);
+  };
+  walk(dir);
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 }  // namespace pmr::test

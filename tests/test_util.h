@@ -83,6 +83,8 @@ std::unique_ptr<Pipeline> encoder_pipeline(const Display& display, int views, in
 Rig subpixel_display_rig(Display& d);
 // Path of the shared glTF corpus (PMR_SOURCE_DIR/../shared/gltf), empty if absent.
 std::string corpus_dir();
+// The .gltf and .glb files under `dir`, recursively, sorted.
+std::vector<std::string> corpus_files(const std::string& dir);
 
 }  // namespace pmr::test
 

@@ -390,7 +390,7 @@ const RenderSection kRigOptions = {
          }},
         {"--camera", nullptr, "NAME|#K",
          "use the scene's glTF camera (pose and field of view) instead of framing the\n"
-         "scene's bounding sphere: NAME the name of the node that places it (as\n"
+         "scene itself (--framing): NAME the name of the node that places it (as\n"
          "Blender names the camera object), else the camera's own name; #K its index;\n"
          "a name several match is an error (pmr info lists the cameras)",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
@@ -403,10 +403,21 @@ const RenderSection kRigOptions = {
          "subpixel; its PNG preview is always opaque (over black). With a Looking Glass\n"
          "preset or --display-config the quilt PNG is opaque black by default",
          [](RenderOptions& o, const std::string& v, const std::string&) { o.job.background = parse_background(v); }},
+        {"--framing", nullptr, "box|sphere",
+         "how the camera frames the scene: box (default), the largest picture that keeps\n"
+         "the corners of the scene's box inside the first and last views; sphere (the\n"
+         "default of --turntable), its bounding sphere fits the view's height and width,\n"
+         "so the picture keeps its size as the scene turns. Not with --camera",
+         [](RenderOptions& o, const std::string& v, const std::string& name) {
+           if (v != "box" && v != "sphere") throw Error("invalid " + name + " '" + v + "': expected box or sphere");
+           o.job.rig.framing = v == "box" ? Framing::Box : Framing::Sphere;
+           o.framing_given = true;
+         }},
         {"--zoom", nullptr, "F",
-         "the scene appears F times larger (default 1: its bounding sphere fits the\n"
-         "view's height and width); the camera moves closer, the zero-parallax plane\n"
-         "stays through the sphere's center. Not with --camera",
+         "the scene appears F times larger than --framing fits it (default 1); the camera\n"
+         "moves closer along the same axis (--orbit's), the zero-parallax plane stays\n"
+         "through the box's center. F > 1 cuts the scene at the views' edges. Not with\n"
+         "--camera",
          [](RenderOptions& o, const std::string& v, const std::string& name) {
            o.job.rig.zoom = parse_double(v, name);
            if (!(o.job.rig.zoom >= 0.001 && o.job.rig.zoom <= 1000.0))
@@ -625,11 +636,17 @@ void parse_arguments(RenderOptions& o, const std::vector<std::string>& args) {
       !o.job.shard.empty() || o.job.frames.empty() || o.job.frames.find_first_not_of("0123456789") != std::string::npos;
   if (o.zoom_given && !o.job.camera.empty())
     throw Error(
-        "--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own: "
+        "--zoom scales the framing of the scene's box or sphere; a glTF camera (--camera) sets its own: "
         "give one of them");
+  if (o.framing_given && !o.job.camera.empty())
+    throw Error(
+        "--framing chooses how pmr's own camera frames the scene; a glTF camera (--camera) sets its own: "
+        "give one of them");
+  // the default frames the box; a turntable turns it, and its sphere keeps the picture the same size
+  if (!o.framing_given) o.job.rig.framing = o.job.sequence.turntable ? Framing::Sphere : Framing::Box;
   if (o.orbit_given && !o.job.camera.empty())
     throw Error(
-        "--orbit moves the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own: "
+        "--orbit moves the camera that frames the scene; a glTF camera (--camera) sets its own: "
         "give one of them");
 }
 
@@ -650,6 +667,8 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
 namespace {
 
 void finalize_options(RenderOptions& o) {
+  // glass over a transparent background lets it through where it sees past the scene (DESIGN 4c)
+  o.job.pipeline.clear_glass = o.job.background.transparent();
   if (o.job.display.blend_views && o.job.display.bilinear)
     throw UsageError("--blend-views and --bilinear cannot be combined");
   if (o.job.pipeline.ground_shadow && (o.job.pipeline.shading != Shading::Pbr || !o.job.pipeline.shadows))

@@ -35,8 +35,9 @@ struct RenderOptions {
   bool method_given = false;       // --method was on the command line
   bool environment_given = false;  // --environment was on the command line
   bool environment_rotation_given = false;
-  bool zoom_given = false;   // --zoom was on the command line (rig.zoom)
-  bool orbit_given = false;  // --orbit was on the command line (rig.orbit_*)
+  bool zoom_given = false;     // --zoom was on the command line (rig.zoom)
+  bool orbit_given = false;    // --orbit was on the command line (rig.orbit_*)
+  bool framing_given = false;  // --framing was on the command line (else box, sphere for turntables)
   // --sampling was on the command line; else pipeline.sampling is the preset's default, and subpixel
   // sampling gives way to view sampling (with a notice) where other options need the views
   bool sampling_given = false;

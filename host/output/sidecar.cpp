@@ -153,6 +153,9 @@ json shading_json(const SidecarInfo& info) {
         {"light_samples", kShadowSamples},
         {"environment_occlusion",
          {{"directions", info.render.environment_occlusion ? kOcclusionDirections : 0}, {"map_size", kOcclusionSize}}}};
+  // where glass sees past the scene: the background shows through (a lower alpha), or the environment
+  // is drawn there (absent: drawn, as every sidecar before clear glass)
+  if (info.render.clear_glass) s["glass"] = "clear";
   if (info.render.ground_shadow)  // the catcher's plane (scene/ground_catcher.h); absent: none
     s["ground"] = {{"kind", "shadow"}, {"height", ground_height(info.bounds_lo, info.bounds_hi)}};
   if (info.lights.size() > kSidecarLights) {
@@ -393,6 +396,7 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["turntable"] = turntable_json(info);
   j["display"] = display_json(display, info);
   j["rig"] = rig_json(rig);
+  if (info.rig_config.camera < 0) j["rig"]["framing"] = to_string(rig.framing);  // a glTF camera frames itself
   j["center_view"] = matrix_json(rig.center_view);
   j["light_dir_view"] = vec3_json(rig.light_view());
   j["light_dir_world"] = vec3_json(rig.light_world());
@@ -532,6 +536,9 @@ std::string sidecar_config_difference(const std::string& existing, const std::st
   // and before --orbit existed at 0,0
   auto orbit = [&](const json& r) { return get(r, "orbit_deg").is_null() ? json({0.0, 0.0}) : get(r, "orbit_deg"); };
   if (orbit(ra) != orbit(rb)) return "rig.orbit_deg";
+  // and before --framing existed by the sphere
+  auto framing = [&](const json& r) { return get(r, "framing").is_null() ? json("sphere") : get(r, "framing"); };
+  if (get(a, "camera") == -1 && framing(ra) != framing(rb)) return "rig.framing";
   // the framing (it follows from the scene file's content and the animation)
   if (!ignore_scene_derived && (!a.contains("scene_bounds") || get(a, "scene_bounds") != get(b, "scene_bounds")))
     return "scene_bounds";

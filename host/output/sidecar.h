@@ -44,6 +44,7 @@ struct RenderSettings {
   bool shadows = false;                // pbr: --shadows (recorded only when on: an older sidecar is off)
   bool environment_occlusion = false;  // pbr, shadows on: --environment-occlusion
   bool ground_shadow = false;          // pbr, shadows on: --ground shadow (recorded only when on)
+  bool clear_glass = false;            // pbr, a transparent background (PipelineConfig::clear_glass)
   ShadowSizes shadow_sizes;
   int tile_x = 16, tile_y = 2, tile_v = 16;
 };

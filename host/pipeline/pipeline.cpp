@@ -243,6 +243,7 @@ StageTimes Pipeline::render_frame(const FrameDescription& frame, bool empty) {
   m.shadows.place(config_.shadows && config_.shading == Shading::Pbr, frame.lights, frame.occlusion, m.scene);
   m.scene.upload_frame(frame, m.shadows.placement());
   P.env_occlusion = m.shadows.placement().occlusion.count > 0 ? 1u : 0u;
+  P.clear_glass = config_.clear_glass && config_.shading == Shading::Pbr ? 1u : 0u;
   m.fine.begin_frame();
   if (config_.shadows && config_.shading == Shading::Pbr)
     m.shadows.render(m.scene, P, m.transmission.full_pass(), ev, empty);

@@ -95,6 +95,11 @@ struct PipelineConfig {
   // pbr, with shadows on: --ground shadow, a shadow catcher under the scene (scene/ground_catcher.h),
   // placed by the framing (FrameRenderer::attach).
   bool ground_shadow = false;
+  // pbr: the output's background is transparent (the default; not with --background). The part of the
+  // light through glass that left the scene, the environment behind it, is then not drawn: the glass
+  // lowers alpha by that part's weight, so what is behind the image (a panel's black, a plate) shows
+  // through it, as with Cycles' Transparent Glass. Off: the environment is drawn there, alpha 1.
+  bool clear_glass = false;
   ShadowSizes shadow_sizes;
   // pbr: an environment image, prefiltered once (Environment::make) and shared by every pipeline of
   // a process; its rotation and intensity are its own (the intensity must equal environment_intensity).

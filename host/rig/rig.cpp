@@ -114,7 +114,35 @@ glm::dmat4 orbit_view(const glm::dvec3& c, double focal, double az_deg, double e
   return v;
 }
 
+// Framing::Box: the smallest distance D at which the box's 8 corners stay inside views 0 and N-1, one
+// pixel from their edges. Camera i sits at s_i = D sigma_i along the view's right; a corner at (x, y)
+// across and z toward the camera from c (w = D - z) lands at NDC x = (x - z sigma_i) / ((D - z) A t) and
+// y = y / ((D - z) t), t = tan(yfov / 2): both shrink as D grows, so each corner's bound is direct.
+double box_focal(const Rig& rig, const glm::dvec3& lo, const glm::dvec3& hi) {
+  const glm::dmat4 basis = orbit_view(glm::dvec3(0.0), 0.0, rig.orbit_az_deg, rig.orbit_el_deg);
+  const glm::dvec3 c = 0.5 * (lo + hi);
+  const double t = std::tan(rig.yfov / 2.0), n = double(rig.views);
+  const double mx = 1.0 - std::min(0.5, 2.0 / rig.view_w), my = 1.0 - std::min(0.5, 2.0 / rig.view_h);
+  auto sigma = [&](int i) {
+    if (rig.views < 2) return 0.0;
+    return rig.angular ? std::tan(rig.cone * ((double(i) + 0.5) / n - 0.5))
+                       : (double(i) / (n - 1.0) - 0.5) * 2.0 * std::tan(rig.cone / 2.0);
+  };
+  double focal = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    const glm::dvec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+    const glm::dvec3 p(basis * glm::dvec4(corner - c, 0.0));  // x right, y up, z toward the camera
+    for (int i : {0, rig.views - 1}) {
+      const double across = std::abs(p.x - p.z * sigma(i)) / (rig.aspect * t * mx);
+      focal = std::max(focal, p.z + std::max(across, std::abs(p.y) / (t * my)));
+    }
+  }
+  return focal;
+}
+
 }  // namespace
+
+const char* to_string(Framing f) { return f == Framing::Box ? "box" : "sphere"; }
 
 void check_orbit(double az_deg, double el_deg) {
   if (!(std::abs(el_deg) < 90.0) || !(std::abs(az_deg) <= 360.0))
@@ -122,7 +150,8 @@ void check_orbit(double az_deg, double el_deg) {
 }
 
 Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo, const glm::dvec3& hi,
-             const glm::dmat4* camera_pose, double camera_yfov, std::vector<std::string>* warnings) {
+             const glm::dmat4* camera_pose, double camera_yfov, std::vector<std::string>* warnings,
+             double camera_aspect) {
   if (config.views < 1) throw Error("invalid --views: need at least 1 view");
   if (config.views > PMR_MAX_VIEWS)
     throw Error("invalid --views: at most " + std::to_string(PMR_MAX_VIEWS) + " views are supported");
@@ -134,10 +163,10 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
   if (!(config.cone_deg > 0.0 && config.cone_deg < 180.0)) throw Error("invalid --cone: must be in (0, 180) degrees");
   check_positive(config.zoom, "--zoom");
   if (camera_pose && config.zoom != 1.0)
-    throw Error("--zoom scales the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own");
+    throw Error("--zoom scales the framing of the scene's box or sphere; a glTF camera (--camera) sets its own");
   check_orbit(config.orbit_az_deg, config.orbit_el_deg);
   if (camera_pose && (config.orbit_az_deg != 0.0 || config.orbit_el_deg != 0.0))
-    throw Error("--orbit moves the framing of the scene's bounding sphere; a glTF camera (--camera) sets its own");
+    throw Error("--orbit moves the camera that frames the scene; a glTF camera (--camera) sets its own");
 
   Rig rig;
   rig.views = config.views;
@@ -148,7 +177,21 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
   rig.angular = config.angular_spacing;
   rig.yfov = config.yfov_deg > 0.0 ? glm::radians(config.yfov_deg)
                                    : 2.0 * std::atan(0.5 * display.size_h_cm / display.viewing_distance_cm);
-  if (camera_pose && camera_yfov > 0.0 && !(config.yfov_deg > 0.0)) rig.yfov = camera_yfov;
+  if (camera_pose && camera_yfov > 0.0 && !(config.yfov_deg > 0.0)) {
+    rig.yfov = camera_yfov;
+    if (camera_aspect > rig.aspect * 1.001) {  // the camera's frame is wider than the views: fit its width
+      rig.yfov = 2.0 * std::atan(std::tan(camera_yfov / 2.0) * camera_aspect / rig.aspect);
+      if (warnings) {
+        char text[320];
+        std::snprintf(text, sizeof text,
+                      "the camera frames %.4g:1 (its aspectRatio), the views %.4g:1: the vertical field of view "
+                      "widens from %.4g to %.4g degrees so that the camera's whole frame shows; give the camera "
+                      "the display's aspect (in Blender, the render size) to fill the views with it",
+                      camera_aspect, rig.aspect, glm::degrees(camera_yfov), glm::degrees(rig.yfov));
+        warnings->push_back(text);
+      }
+    }
+  }
   if (!(rig.yfov > 0.0 && rig.yfov < glm::pi<double>())) throw Error("invalid --yfov: must be in (0, 180) degrees");
 
   const glm::dvec3 c = 0.5 * (lo + hi);
@@ -165,11 +208,15 @@ Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& 
     if (!(rig.focal > 0.0))
       throw Error("the selected camera looks away from the scene (its center is behind the camera)");
   } else {
-    // The sphere's cross-section through c fits the focal-plane window (half-height D tan(phi/2),
-    // half-width A D tan(phi/2)) in both directions: a portrait display frames by its width.
-    rig.focal = R / std::min(tan_half, rig.aspect * tan_half) / config.zoom;
     rig.zoom = config.zoom;
     rig.orbit_az_deg = config.orbit_az_deg, rig.orbit_el_deg = config.orbit_el_deg;
+    rig.framing = config.framing;
+    // Sphere: its cross-section through c fits the focal-plane window (half-height D tan(phi/2),
+    // half-width A D tan(phi/2)) in both directions: a portrait display frames by its width.
+    const double fit =
+        config.framing == Framing::Box ? box_focal(rig, lo, hi) : R / std::min(tan_half, rig.aspect * tan_half);
+    // a flat box seen edge-on: no closer than the sphere's near side allows
+    rig.focal = std::max(fit, 1e-3 * R) / config.zoom;
     rig.center_view = orbit_view(c, rig.focal, config.orbit_az_deg, config.orbit_el_deg);
   }
   rig.near = std::max(rig.focal - 1.001 * R, 1e-3 * rig.focal);

@@ -5,11 +5,12 @@
 
 #include "pmr/shared.h"
 
-static_assert(sizeof(PmrParams) == 16 * 8 + 9 * 8 + 16 + 22 * 4 + 2 * PMR_MAX_SAMPLES * 4 + 2 * 8 +
+static_assert(sizeof(PmrParams) == 16 * 8 + 9 * 8 + 16 + 24 * 4 + 2 * PMR_MAX_SAMPLES * 4 + 2 * 8 +
                                        4 * (PMR_MAX_VIEWS + PMR_VIEW_COORD_SLACK),
               "PmrParams layout");
-static_assert(offsetof(PmrParams, sample_x) == 304 && offsetof(PmrParams, view_anchor) == 432 &&
-                  offsetof(PmrParams, view_coord) == 448 && offsetof(PmrParams, lod_scale_x) == 292,
+static_assert(offsetof(PmrParams, sample_x) == 312 && offsetof(PmrParams, view_anchor) == 440 &&
+                  offsetof(PmrParams, view_coord) == 456 && offsetof(PmrParams, lod_scale_x) == 292 &&
+                  offsetof(PmrParams, clear_glass) == 304,
               "PmrParams layout");
 static_assert(offsetof(PmrParams, light_world) == 200, "PmrParams layout");
 static_assert(offsetof(PmrParams, view_w) == 216, "PmrParams layout");

@@ -270,7 +270,8 @@ Rig FrameRenderer::rig_for(const Scene& posed, std::vector<std::string>* warning
     pose = &posed.cameras[size_t(rig_config_.camera)].world_from_camera;
     yfov = posed.cameras[size_t(rig_config_.camera)].yfov;
   }
-  return make_rig(rig_config_, display_, lo_, hi_, pose, yfov, warnings);
+  const double aspect = rig_config_.camera >= 0 ? posed.cameras[size_t(rig_config_.camera)].aspect : 0.0;
+  return make_rig(rig_config_, display_, lo_, hi_, pose, yfov, warnings, aspect);
 }
 
 void FrameRenderer::attach(Pipeline& pipeline, const Display* encode_display) {

@@ -237,6 +237,7 @@ static RenderSettings render_settings(const PipelineConfig& p) {
   r.shading = p.shading, r.exposure_ev = p.exposure_ev, r.environment_intensity = p.environment_intensity;
   r.shadows = p.shadows, r.shadow_sizes = p.shadow_sizes, r.environment_occlusion = p.environment_occlusion;
   r.ground_shadow = p.ground_shadow;
+  r.clear_glass = p.clear_glass && p.shading == Shading::Pbr;
   r.tile_x = p.tile_x, r.tile_y = p.tile_y, r.tile_v = p.tile_v;
   return r;
 }

@@ -48,6 +48,13 @@ struct Display {
   double aspect() const { return size_w_cm / size_h_cm; }
 };
 
+// How the default camera frames the scene (DESIGN section 2): Box, the largest picture that keeps the
+// 8 corners of the scene's box inside views 0 and N-1 (one pixel from their edges); Sphere, the bounding
+// sphere's cross-section through its center fits the focal-plane window (turntables: the picture stays
+// the same size as the scene turns).
+enum class Framing { Box, Sphere };
+const char* to_string(Framing f);
+
 struct RigConfig {
   int views = 96;
   int view_w = 1024, view_h = 512;
@@ -64,6 +71,9 @@ struct RigConfig {
   // --orbit AZ,EL (degrees): the framing camera sits at c + D (sin az cos el, sin el, cos az cos el),
   // looking at c with +Y up (only when framing the bounding sphere, camera < 0).
   double orbit_az_deg = 0.0, orbit_el_deg = 0.0;
+  // --framing (only when framing the scene, camera < 0). Sphere here, so that the library's rigs stay
+  // those the tests pin; the command line's default is box (cli/options.cpp).
+  Framing framing = Framing::Sphere;
 };
 
 // The resolved rig of one frame.
@@ -78,6 +88,7 @@ struct Rig {
   glm::dmat4 center_view{1.0};                    // world -> center view space
   double zoom = 1.0;                              // RigConfig::zoom (1 with a glTF camera)
   double orbit_az_deg = 0.0, orbit_el_deg = 0.0;  // RigConfig's orbit (0 with a glTF camera)
+  Framing framing = Framing::Sphere;              // RigConfig's (unused with a glTF camera)
 
   // Angular spacing's view-coordinate resolution Q (1 with linear spacing): camera i sits at
   // view_coord(i) / Q view spacings B / (N - 1) from the center camera (make_rig chooses Q).
@@ -118,9 +129,12 @@ void check_orbit(double az_deg, double el_deg);
 
 // Builds the rig for a scene whose world bounds are [lo, hi]. `camera_pose` (world_from_camera) and
 // `camera_yfov` are used when config.camera >= 0. Throws pmr::Error on an impossible configuration.
+// camera_aspect: the aspect ratio the camera's yfov was made for (glTF's aspectRatio; 0 = not given).
+// Where it is wider than the display's, the field of view widens until the camera's whole frame fits the
+// views (with a warning): a Blender camera at a 16:9 render size keeps its frame on a 3:4 panel.
 Rig make_rig(const RigConfig& config, const Display& display, const glm::dvec3& lo, const glm::dvec3& hi,
              const glm::dmat4* camera_pose = nullptr, double camera_yfov = 0.0,
-             std::vector<std::string>* warnings = nullptr);
+             std::vector<std::string>* warnings = nullptr, double camera_aspect = 0.0);
 
 // Frame parameters for the kernels (tile grid and capacities are filled in by the pipeline).
 PmrParams make_params(const Rig& rig);

@@ -204,6 +204,9 @@ typedef struct {
   pmr_u32 env_occlusion;              /* pbr, shadows on: 1 when the light table holds one more entry,
                                         lights[num_lights], whose maps give the environment's
                                         occlusion (cl/lights.h environment_visibility_lanes) */
+  pmr_u32 clear_glass;               /* pbr, a transparent background: the light through glass that left the
+                                        scene is not drawn and lowers alpha instead (DESIGN 4c) */
+  pmr_u32 pad_params;                /* keeps sample_x and the doubles after it where they align      */
   pmr_i32 sample_x[PMR_MAX_SAMPLES]; /* sample s at (X + sample_x[s], Y + sample_y[s]) from pixel center */
   pmr_i32 sample_y[PMR_MAX_SAMPLES]; /* (X, Y), in 16.16 / 24.8 raster units                          */
   double view_anchor;                /* camera offset at view coordinate 0 over the baseline: -1/2 linear, 0 angular */

@@ -299,13 +299,16 @@ std::vector<long> frames_in_folder(const std::string& dir, const RenderOptions& 
   return frames;
 }
 
+// j[a][b], or null when the sidecar (a stranger's file) lacks it.
+nlohmann::json member(const nlohmann::json& j, const char* a, const char* b) {
+  return j.is_object() && j.contains(a) && j[a].is_object() && j[a].contains(b) ? j[a][b] : nlohmann::json();
+}
+
 // A configuration's main settings, from its sidecar: "preset lg-portrait, 1536x2048 display, 48 views of
 // 420x560".
 std::string group_settings(const std::string& text) {
   const nlohmann::json j = parse_json_text(text);
-  auto at = [&](const char* a, const char* b) {
-    return j.is_object() && j.contains(a) && j[a].is_object() && j[a].contains(b) ? j[a][b] : nlohmann::json();
-  };
+  auto at = [&](const char* a, const char* b) { return member(j, a, b); };
   auto number = [](const nlohmann::json& v) { return v.is_number() ? std::to_string(v.get<long long>()) : "?"; };
   const nlohmann::json source = at("display", "source");
   return (source.is_string() ? printable_text(source.get<std::string>()) : std::string("display")) + ", " +
@@ -324,9 +327,7 @@ struct GivenSettings {
 
 bool matches_given(const GivenSettings& s, const std::string& text) {
   const nlohmann::json j = parse_json_text(text);
-  auto at = [&](const char* a, const char* b) {
-    return j.is_object() && j.contains(a) && j[a].is_object() && j[a].contains(b) ? j[a][b] : nlohmann::json();
-  };
+  auto at = [&](const char* a, const char* b) { return member(j, a, b); };
   auto same = [](const nlohmann::json& v, long want) { return want < 0 || (v.is_number() && v.get<long>() == want); };
   return (s.source.empty() || at("display", "source") == s.source) && same(at("rig", "views"), s.views) &&
          same(at("rig", "view_width"), s.view_w) && same(at("rig", "view_height"), s.view_h) &&

@@ -121,13 +121,12 @@ glm::dmat4 orbit_view(const glm::dvec3& c, double focal, double az_deg, double e
 double box_focal(const Rig& rig, const glm::dvec3& lo, const glm::dvec3& hi) {
   const glm::dmat4 basis = orbit_view(glm::dvec3(0.0), 0.0, rig.orbit_az_deg, rig.orbit_el_deg);
   const glm::dvec3 c = 0.5 * (lo + hi);
-  const double t = std::tan(rig.yfov / 2.0), n = double(rig.views);
+  const double t = std::tan(rig.yfov / 2.0);
   const double mx = 1.0 - std::min(0.5, 2.0 / rig.view_w), my = 1.0 - std::min(0.5, 2.0 / rig.view_h);
-  auto sigma = [&](int i) {
-    if (rig.views < 2) return 0.0;
-    return rig.angular ? std::tan(rig.cone * ((double(i) + 0.5) / n - 0.5))
-                       : (double(i) / (n - 1.0) - 0.5) * 2.0 * std::tan(rig.cone / 2.0);
-  };
+  // the cameras' offsets at D = 1 (angular: the exact ones; their fixed-point coordinates come later)
+  Rig unit = rig;
+  unit.focal = 1.0;
+  auto sigma = [&](int i) { return unit.angular && unit.views > 1 ? unit.angular_offset(i) : unit.camera_offset(i); };
   double focal = 0.0;
   for (int k = 0; k < 8; ++k) {
     const glm::dvec3 corner((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);

@@ -4,6 +4,7 @@ import array
 import json
 import math
 import os
+import struct
 
 import bpy
 
@@ -276,12 +277,30 @@ def _environment_file(image, folder):
 
 
 def _write_exr(path, width, height, rgba):
-    """A float RGBA EXR; rgba is the pixels bottom row first (a single RGBA fills the image)."""
-    img = bpy.data.images.new("pmr_env_tmp", width, height, alpha=True, float_buffer=True)
-    try:
-        img.pixels = rgba * (width * height) if len(rgba) == 4 else rgba
-        img.filepath_raw = path
-        img.file_format = "OPEN_EXR"
-        img.save()
-    finally:
-        bpy.data.images.remove(img)
+    """A float RGB EXR (uncompressed scanlines) of the linear values as given; rgba is the pixels bottom
+    row first (a single RGBA fills the image). Written here rather than by Image.save(), which writes a
+    generated float image through the sRGB curve (a world colour of 0.2 became 0.48)."""
+    if len(rgba) == 4:
+        rgba = list(rgba) * (width * height)
+
+    def attribute(name, kind, value):
+        return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(value)) + value
+
+    channels = b"".join(c + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1) for c in (b"B", b"G", b"R")) + b"\0"
+    window = struct.pack("<4i", 0, 0, width - 1, height - 1)
+    header = (b"\x76\x2f\x31\x01" + struct.pack("<i", 2) + attribute("channels", "chlist", channels) +
+              attribute("compression", "compression", b"\0") + attribute("dataWindow", "box2i", window) +
+              attribute("displayWindow", "box2i", window) + attribute("lineOrder", "lineOrder", b"\0") +
+              attribute("pixelAspectRatio", "float", struct.pack("<f", 1.0)) +
+              attribute("screenWindowCenter", "v2f", struct.pack("<2f", 0.0, 0.0)) +
+              attribute("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
+    line_bytes = 8 + 3 * 4 * width
+    first = len(header) + 8 * height
+    body = []
+    for y in range(height):  # EXR's row 0 is the top one
+        row = rgba[4 * width * (height - 1 - y):4 * width * (height - y)]
+        data = b"".join(struct.pack("<%df" % width, *row[c::4]) for c in (2, 1, 0))
+        body.append(struct.pack("<ii", y, len(data)) + data)
+    offsets = struct.pack("<%dQ" % height, *(first + y * line_bytes for y in range(height)))
+    with open(path, "wb") as f:
+        f.write(header + offsets + b"".join(body))

@@ -36,6 +36,10 @@ class RenderJob:
         try:
             self.scene_path = self._export(context)
             self.environment, more = self._world(scene)
+            if not scene.render.film_transparent:
+                # Blender's film shows the world behind the scene: pmr draws its environment there, on
+                # the focal plane, where the panel shows it sharp
+                self.environment = self.environment + ["--background", "environment"]
             self.args = command.render_args(settings, self.scene_path, self.out_dir, self.camera,
                                             self.frames, self.fps, self.environment,
                                             export.has_animations(self.scene_path), _colour(scene, more))

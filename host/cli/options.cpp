@@ -397,12 +397,23 @@ const RenderSection kRigOptions = {
            if (v.empty()) throw Error("invalid " + name + ": expected a camera index or name");
            o.job.camera = v;
          }},
-        {"--background", nullptr, "R,G,B[,A]",
+        {"--background", nullptr, "R,G,B[,A]|environment",
          "a linear colour behind the encoded image, views, quilt and previews (default\n"
          "transparent black; A defaults to 1). The encoded image is composited per\n"
          "subpixel; its PNG preview is always opaque (over black). With a Looking Glass\n"
-         "preset or --display-config the quilt PNG is opaque black by default",
+         "preset or --display-config the quilt PNG is opaque black by default.\n"
+         "environment: the pbr model's environment (--environment), alpha 1, drawn on\n"
+         "a plane at --background-depth so that it stays sharp on the panel",
          [](RenderOptions& o, const std::string& v, const std::string&) { o.job.background = parse_background(v); }},
+        {"--background-depth", nullptr, "focal|inf|Z",
+         "where --background environment is drawn: on the focal plane (default; the\n"
+         "same picture in every view), at view-space depth Z from the center camera\n"
+         "(scene units), or at infinity (inf); its disparity is clamped to 1 view\n"
+         "pixel between neighbouring views, beyond which the panel doubles it",
+         [](RenderOptions& o, const std::string& v, const std::string&) {
+           parse_backdrop_depth(v);  // checked here, applied once --background is known
+           o.background_depth = v;
+         }},
         {"--framing", nullptr, "box|sphere",
          "how the camera frames the scene: box (default), the largest picture that keeps\n"
          "the corners of the scene's box inside the first and last views; sphere (the\n"
@@ -666,9 +677,20 @@ RenderOptions parse_render_options(const std::vector<std::string>& args) {
 
 namespace {
 
+// --background environment shows the pbr model's environment, on a plane at --background-depth.
+void check_background(RenderOptions& o) {
+  Background& bg = o.job.background;
+  if (!o.background_depth.empty() && !bg.environment)
+    throw UsageError("--background-depth places --background environment: add it");
+  if (!o.background_depth.empty()) bg.depth = parse_backdrop_depth(o.background_depth);
+  if (bg.environment && o.job.pipeline.shading != Shading::Pbr)
+    throw UsageError("--background environment shows the pbr model's environment: add --shading pbr");
+}
+
 void finalize_options(RenderOptions& o) {
   // glass over a transparent background lets it through where it sees past the scene (DESIGN 4c)
   o.job.pipeline.clear_glass = o.job.background.transparent();
+  check_background(o);
   if (o.job.display.blend_views && o.job.display.bilinear)
     throw UsageError("--blend-views and --bilinear cannot be combined");
   if (o.job.pipeline.ground_shadow && (o.job.pipeline.shading != Shading::Pbr || !o.job.pipeline.shadows))

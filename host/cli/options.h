@@ -38,6 +38,7 @@ struct RenderOptions {
   bool zoom_given = false;     // --zoom was on the command line (rig.zoom)
   bool orbit_given = false;    // --orbit was on the command line (rig.orbit_*)
   bool framing_given = false;  // --framing was on the command line (else box, sphere for turntables)
+  std::string background_depth;  // --background-depth as given ("": the focal plane)
   // --sampling was on the command line; else pipeline.sampling is the preset's default, and subpixel
   // sampling gives way to view sampling (with a notice) where other options need the views
   bool sampling_given = false;

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "output/sidecar.h"
+#include "output/backdrop.h"
 
 #include "output/checksum.h"
 #include "output/sidecar_names.h"
@@ -379,7 +380,12 @@ std::string sidecar_json(const Rig& rig, const Display& display, const SidecarIn
   j["outputs"] = outputs;
   if (!outputs_hex.empty()) j["outputs_hex"] = outputs_hex;
   const Background& bg = info.background;
-  if (!bg.transparent()) j["background"] = {bg.r, bg.g, bg.b, bg.a};
+  if (bg.environment)  // the plane it is drawn on: parallax f = 1 - D / depth, clamped (output/backdrop.h)
+    j["background"] = {{"kind", "environment"},
+                       {"depth", to_string(bg.depth)},
+                       {"parallax", backdrop_parallax(rig, bg.depth).fraction}};
+  else if (!bg.transparent())
+    j["background"] = {bg.r, bg.g, bg.b, bg.a};
   if (!info.output_checksums.empty()) j["output_checksums"] = output_checksums_json(info);
   if (info.quilt_columns > 0) j["quilt"] = quilt_json(rig, info);
   if (info.center_view >= 0) j["preview_center_view"] = info.center_view;

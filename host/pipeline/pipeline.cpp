@@ -340,13 +340,16 @@ void Pipeline::wait_reporting(const FrameEvents& ev, const StageTimes& t, std::c
 
 StageTimes Pipeline::encode_volume(const std::vector<uint16_t>& volume) {
   Impl& m = *impl_;
-  if (!m.encode.configured() || !m.paths.volume || m.paths.subpixel)
-    throw InternalError("no display configured, or a path without an encoder");
+  if (!m.encode.configured()) throw InternalError("no display configured");
   if (volume.size() * 2 != volume_bytes()) throw InternalError("volume size mismatch");
-  m.launcher.runtime().write(m.fine.volume(), volume.data(), volume_bytes());
+  // the paths that encode from screen tiles keep no view volume: the given one goes to a buffer of its own
+  const ClRuntime& rt = m.launcher.runtime();
+  ClBuffer scratch = m.paths.volume ? ClBuffer() : rt.buffer(volume_bytes(), "volume to encode");
+  const ClBuffer& target = m.paths.volume ? m.fine.volume() : scratch;
+  rt.write(target, volume.data(), volume_bytes());
   FrameEvents ev;
-  m.encode.encode(m.fine.volume(), ev);
-  m.launcher.runtime().finish();
+  m.encode.encode(target, ev);
+  rt.finish();
   StageTimes t;
   ev.collect(t);
   return t;

@@ -96,7 +96,8 @@ class Pipeline {
   PmrParams read_params() const;
   // Vertex-stage output of the last frame.
   std::vector<PmrVertex> read_vertices() const;
-  // Encodes a given view volume ([view][y][x][RGBA] halves) without rendering: the encoder alone.
+  // Encodes a given view volume ([view][y][x][RGBA] halves) without rendering: the encoder alone, in
+  // any path (those without a view volume encode it from a buffer of its own).
   StageTimes encode_volume(const std::vector<uint16_t>& volume);
   // The MTA queue capacity (for tests of the grow-and-redo path).
   void set_mta_capacity(uint32_t capacity);

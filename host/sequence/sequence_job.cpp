@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "output/backdrop.h"
 #include "output/checksum.h"
 #include "output/interrupt.h"
 #include "pipeline/transmission_stage.h"
@@ -67,6 +68,7 @@ class SequenceRun {
  private:
   void check_before_loading();
   void load_inputs();
+  std::shared_ptr<const Environment> make_backdrop_environment() const;
   void choose_frames();
   void check_frame_memory() const;
   void adopt_folder_names();
@@ -82,6 +84,7 @@ class SequenceRun {
   int render_frames();
   void finish_writing(FrameWriter& writer, Progress& progress);
   FrameFiles frame_files(long f, const FrameRenderer::Frame& fr, Pipeline& pipeline, FrameWriter& writer) const;
+  std::shared_ptr<const BackdropLayers> backdrop_layers(const Rig& rig, Pipeline& pipeline) const;
   void shown_display(FrameFiles& files, Pipeline& pipeline) const;
   void print_frame_stages(long f, const FrameRenderer::Frame& fr, const Pipeline& pipeline, Progress& progress) const;
   void print_summary(const FrameWriter& writer) const;
@@ -103,6 +106,11 @@ class SequenceRun {
   bool need_volume_ = false;
   bool near_warned_ = false;                             // the raised near plane's warning was given
   std::unique_ptr<const ViewTransform> view_transform_;  // the previews' (null: none written)
+  // --background environment: the environment it shows, and the last rig's backdrop
+  std::shared_ptr<const Environment> backdrop_environment_;
+  mutable Rig backdrop_rig_;
+  mutable std::shared_ptr<const BackdropLayers> backdrop_;
+  mutable bool backdrop_warned_ = false;
   SidecarInfo info_;                                     // what every frame's sidecar shares
   ResumePlan plan_;
   // the summary's sums
@@ -150,8 +158,17 @@ void SequenceRun::load_inputs() {
     if (job_.verbose)
       std::fprintf(stderr, "pmr: environment %s\n", environment_summary(source, pc_.environment.get()).c_str());
   }
+  if (job_.background.environment) backdrop_environment_ = make_backdrop_environment();
   scene_ = load_scene(job_.scene, job_.input_limits, job_.variant);
   for (const auto& w : scene_.warnings) warn(w);
+}
+
+// --background environment shows the whole environment: the pipeline's when it has nothing taken out as
+// lights (shadows off), else made again without taking them out.
+std::shared_ptr<const Environment> SequenceRun::make_backdrop_environment() const {
+  if (pc_.environment && !job_.pipeline.shadows) return pc_.environment;
+  EnvironmentOptions o{job_.environment, job_.environment_rotation_deg, job_.pipeline.environment_intensity, false};
+  return std::make_shared<const Environment>(Environment::make(o));
 }
 
 // The animation, --frames all, this shard's part; then the framing (FrameRenderer) and the layout.
@@ -223,8 +240,10 @@ void SequenceRun::check_frame_memory() const {
   const uint64_t depth = need_volume_ && products_.depth ? voxels * (24 * uint64_t(pc_.samples) + 3 * 4) : 0;
   const uint64_t glass =
       pbr && scene_transmissive(scene_) ? TransmissionStage::bytes_for(rig.views, rig.view_w, rig.view_h) : 0;
+  // --background environment: its volume on the host and, to encode it, on the device
+  const uint64_t backdrop = job_.background.environment ? 2 * voxels * 8 + display : 0;
   check_memory(
-      5 * volume + 5 * display + depth + glass,
+      5 * volume + 5 * display + depth + glass + backdrop,
       std::to_string(rig.views) + " views of " + std::to_string(rig.view_w) + "x" + std::to_string(rig.view_h) + " (" +
           std::to_string(volume >> 20) + " MiB a view volume, on the device and in up to four copies being written" +
           (glass ? ", and a " + std::to_string(glass >> 20) + " MiB transmission source for the glass" : "") + ")");
@@ -416,8 +435,44 @@ FrameFiles SequenceRun::frame_files(long f, const FrameRenderer::Frame& fr, Pipe
       else files.depth.assign(size_t(rig.views) * rig.view_w * rig.view_h, std::numeric_limits<float>::infinity());
     }
   }
+  if (job_.background.environment) files.background.layers = backdrop_layers(fr.rig, pipeline);
   if (!files.encoded_png.empty() && view_transform_->mixes_channels()) shown_display(files, pipeline);
   return files;
+}
+
+// --background environment: the frame's backdrop (output/backdrop.h), made again only when the rig
+// moved. Its encoded image comes from the pipeline's encoder, after the frame's own was read back.
+std::shared_ptr<const BackdropLayers> SequenceRun::backdrop_layers(const Rig& rig, Pipeline& pipeline) const {
+  if (backdrop_ && same_backdrop_rig(rig, backdrop_rig_)) return backdrop_;
+  if (products_.encoded && !renderer_->has_geometry())
+    throw Error("--background environment encodes its backdrop with the renderer's encoder, which a scene "
+                "without triangles does not start: write the views or the quilt (--write)");
+  const BackdropParallax p = backdrop_parallax(rig, job_.background.depth);
+  if (p.clamped && !backdrop_warned_ && job_.background.depth.kind != BackdropDepth::Kind::Focal) {
+    warn("--background-depth " + to_string(job_.background.depth) + ": the backdrop is drawn at " +
+         (p.fraction == 0.0 ? std::string("the focal plane (it is nearer)")
+                            : std::string("its largest depth with at most 1 view pixel of disparity between "
+                                          "neighbouring views, where the panel shows it without doubling")));
+    backdrop_warned_ = true;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto ms_since = [](auto t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  };
+  auto layers = std::make_shared<BackdropLayers>();
+  layers->volume = render_backdrop(rig, *backdrop_environment_, p.fraction);
+  const double drawn_ms = ms_since(t0);
+  if (products_.encoded) {
+    pipeline.encode_volume(layers->volume);
+    pipeline.read_display(layers->display);
+  }
+  if (job_.verbose)
+    std::fprintf(stderr, "pmr: backdrop: parallax %.4g (%.3g view px between neighbours), drawn in %.0f ms, encoded in %.0f ms\n",
+                 p.fraction, p.step_px, drawn_ms, ms_since(t0) - drawn_ms);
+  if (!need_volume_) layers->volume = {};
+  backdrop_rig_ = rig;
+  backdrop_ = layers;
+  return backdrop_;
 }
 
 // The panel PNG through a transform that mixes channels: every view transformed first (over the
@@ -426,11 +481,11 @@ FrameFiles SequenceRun::frame_files(long f, const FrameRenderer::Frame& fr, Pipe
 void SequenceRun::shown_display(FrameFiles& files, Pipeline& pipeline) const {
   if (!renderer_->has_geometry()) {
     const std::vector<uint16_t> empty(files.display.size(), 0);
-    files.display_shown = shown_colours(empty.data(), empty.size() / 4, job_.background, *view_transform_);
+    files.display_shown = shown_colours(empty.data(), empty.size() / 4, files.background, *view_transform_);
     return;
   }
   const std::vector<uint16_t> shown =
-      shown_colours(files.volume.data(), files.volume.size() / 4, job_.background, *view_transform_);
+      shown_colours(files.volume.data(), files.volume.size() / 4, files.background, *view_transform_);
   pipeline.encode_volume(shown);
   pipeline.read_display(files.display_shown);
 }

@@ -13,6 +13,7 @@ import json
 import math
 import os
 import shutil
+import subprocess
 import sys
 import traceback
 
@@ -469,6 +470,40 @@ def check_environment(scene, ops_module, work):
           "(--environment-rotation)" % (px, cx, py, cy))
 
 
+def check_backdrop(scene, ops_module, work):
+    """Blender's film not transparent: pmr draws the world behind the scene (--background environment),
+    opaque, in the world's colour where nothing covers it; a transparent film keeps pmr's transparent."""
+    saved, hidden = scene.world, {obj.name: obj.hide_render for obj in scene.objects}
+    for obj in scene.objects:  # the cube alone in front of the world
+        obj.hide_render = obj.type != "CAMERA" and obj.name != "Mover"
+    world = (0.2, 0.3, 0.5)
+    scene.world = bpy.data.worlds.new("Plain")
+    scene.world.use_nodes = True
+    scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = world + (1.0,)
+    out = os.path.join(work, "backdrop")
+    settings_for(scene, out, "STILL", SEQ_VIEW)
+    try:
+        scene.render.film_transparent = False
+        argv = run_operator(ops_module)["argv"]
+        check(" --background environment" in " ".join(argv), "an opaque film does not reach pmr: %s" % argv)
+        sidecar = read_sidecar(out, scene.frame_current)
+        _, _, px = pixels(bpy.data.images.load(os.path.join(out, sidecar["outputs"]["quilt"])))
+        opaque = all(px[i + 3] == 1.0 for i in range(0, len(px), 4))
+        sky = sum(all(abs(px[i + c] - world[c]) <= 0.01 * world[c] for c in range(3)) for i in range(0, len(px), 4))
+        scene.render.film_transparent = True
+        argv = run_operator(ops_module)["argv"]
+    finally:
+        scene.world = saved
+        scene.render.film_transparent = False
+        for obj in scene.objects:
+            obj.hide_render = hidden[obj.name]
+    check(opaque, "the quilt over the world is not opaque")
+    check(sky > len(px) // 4 // 2, "only %d of %d quilt pixels show the world's colour %s"
+          % (sky, len(px) // 4, world))
+    check("--background" not in argv, "a transparent film gave pmr a background: %s" % argv)
+    return sky, len(px) // 4
+
+
 def check_errors(scene, ops_module, work):
     """A missing pmr names the preference to set; pmr's own error lines reach Blender's reports."""
     prefs = bpy.context.preferences.addons[ADDON].preferences
@@ -610,6 +645,33 @@ def check_blender_sequence(out, sidecars):
                      "digit group of pmr's quilt names: " + "; ".join(wrong))
 
 
+def check_farm_names(pmr, work):
+    """A farm's repair loop on a 12-frame quilt sequence: delete frames, `pmr verify` lists them, the
+    list is rendered again with --resume; Blender's sequence reader then finds all 12 frames (the
+    re-rendered ones keep the sequence's names, not a still's). Once for one frame, once for two."""
+    out = os.path.join(work, "farm")
+    args = ["--turntable", "360:12", "--views", "4", "--view-size", "32x32", "--display", "120x68",
+            "--write", "quilt", "--out", out, "-q"]
+    subprocess.run([pmr, "render", "--frames", "1:12"] + args, check=True)
+    for deleted in ([5], [3, 8]):
+        for name in os.listdir(out):
+            if any("%04d" % f in name for f in deleted):
+                os.remove(os.path.join(out, name))
+        v = subprocess.run([pmr, "verify", out, "--frames", "1:12", "--write", "quilt"],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, universal_newlines=True)
+        frames = v.stdout.strip()  # pmr's frame list, as --frames takes it: "5", "3,8", "3:5"
+        listed = []
+        for part in frames.replace(",", " ").split():
+            first, _, last = part.partition(":")
+            listed += list(range(int(first), int(last or first) + 1))
+        check(v.returncode == 1 and listed == deleted, "pmr verify listed %r (exit %d) for deleted frames %s"
+              % (frames, v.returncode, deleted))
+        subprocess.run([pmr, "render", "--frames", frames, "--resume"] + args, check=True)
+        sidecars = {f: read_sidecar(out, f) for f in range(1, 13)}
+        check_blender_sequence(out, sidecars)
+        log("farm: frames %s deleted, listed by verify, rendered again: Blender reads 12 frames" % frames)
+
+
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
     parser = argparse.ArgumentParser()
@@ -667,6 +729,9 @@ def main():
     else:
         log("skipped the whole-scene comparison: %s is missing" % FOREST)
 
+    sky, total = check_backdrop(scene, ops_module, work)
+    log("an opaque film: pmr draws the world behind the scene (%d of %d quilt pixels in its colour)" % (sky, total))
+
     check_environment(scene, ops_module, work)
     log("the world's HDRI lights the cube from the side Blender shows it")
 
@@ -685,6 +750,8 @@ def main():
 
     check_blender_sequence(out, sidecars)
     log("Blender reads the quilt sequence as frames %d..%d" % FRAMES)
+
+    check_farm_names(args.pmr, work)
     log("PASSED")
 
 

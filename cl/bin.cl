@@ -12,9 +12,6 @@
  * next frame. Entry order within a tile is arbitrary; fine raster's result does not depend on it. */
 #include "common.h"
 
-inline long min3l(long a, long b, long c) { return min(a, min(b, c)); }
-inline long max3l(long a, long b, long c) { return max(a, max(b, c)); }
-
 /* Max over the 8 corners of sign * E_ab - bias (>= 0 means the tile may hold a covered voxel); i0 and
  * i1 are the view coordinates of the slab's end views (E is multilinear in the view coordinate, which
  * grows with the view index), f_lo that of the MTA's first view.
@@ -34,18 +31,10 @@ inline bool edge_may_pass(const PmrMta* m, int a, int b, long X0, long X1, long 
   return best >= bias;
 }
 
-/* The MTA's x extent [lo, hi] in the view with view coordinate i. */
-inline void x_extent(const PmrMta* m, long i, long* lo, long* hi) {
-  const long xa = (long)m->x0[0] + i * m->dx[0], xb = (long)m->x0[1] + i * m->dx[1];
-  const long xc = (long)m->x0[2] + i * m->dx[2];
-  *lo = min3l(xa, xb, xc);
-  *hi = max3l(xa, xb, xc);
-}
-
 /* The MTA's x extent in the view with view coordinate i reaches the sample range [X0, X1]. */
 inline bool in_view(const PmrMta* m, long i, long X0, long X1) {
   long lo, hi;
-  x_extent(m, i, &lo, &hi);
+  mta_x_extent(m, i, &lo, &hi);
   return hi >= X0 && lo <= X1;
 }
 
@@ -91,8 +80,8 @@ inline void pixel_sample_box(global const PmrParams* P, long* lo_x, long* hi_x, 
     /* x range over the slab: each vertex's x is linear in the view coordinate, so the extremes are at \
      * its end views; per view only when the views are more than a tile apart (in_view below) */ \
     long lo0, hi0, lo1, hi1;                                                                             \
-    x_extent(&(m), f0, &lo0, &hi0);                                                                      \
-    x_extent(&(m), f1, &lo1, &hi1);                                                                      \
+    mta_x_extent(&(m), f0, &lo0, &hi0);                                                                  \
+    mta_x_extent(&(m), f1, &lo1, &hi1);                                                                  \
     const long xlo = min(lo0, lo1), xhi = max(hi0, hi1);                                                 \
     const bool sheared = (xhi - xlo) - (hi0 - lo0) > (long)PMR_TILE_X * PMR_X_ONE;                       \
     int16 vlo, vhi; /* with `lanes`, the views' x extents from xlo, tested 16 at once */                 \

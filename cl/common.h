@@ -97,6 +97,17 @@ inline void project_vertex(global const PmrParams* P, double xv, double yv, doub
 /* The view coordinate F_i of view i (pmr/shared.h): x_i = x0 + F_i dx. F_i = i with linear spacing. */
 inline long view_coord(global const PmrParams* P, int i) { return (long)P->view_coord[i]; }
 
+inline long min3l(long a, long b, long c) { return min(a, min(b, c)); }
+inline long max3l(long a, long b, long c) { return max(a, max(b, c)); }
+
+/* The MTA's x extent [lo, hi] in the view with view coordinate f. */
+inline void mta_x_extent(const PmrMta* m, long f, long* lo, long* hi) {
+  const long xa = (long)m->x0[0] + f * m->dx[0], xb = (long)m->x0[1] + f * m->dx[1];
+  const long xc = (long)m->x0[2] + f * m->dx[2];
+  *lo = min3l(xa, xb, xc);
+  *hi = max3l(xa, xb, xc);
+}
+
 /* The view coordinates of views ib .. ib + 15 relative to view ib's, lanes from `count` on clamped to
  * the span of the first `count` (the table has slack past the last view, so the load stays inside). */
 inline int16 view_coord_lanes(global const PmrParams* P, int ib, int count, long* span) {

@@ -58,6 +58,46 @@ inline void emit_mta(global const PmrParams* P, global PmrMta* mtas, volatile gl
   if (slot < P->mta_capacity) mtas[slot] = *m;
 }
 
+/* Whether a sample at offset c from its pixel's corner (fixed point, `one` a pixel) lies in [lo, hi]
+ * for some pixel p in [0, n): the first p whose sample is at least lo decides. */
+inline bool sample_in_range(long lo, long hi, long c, long one, int n) {
+  const long p = max(0L, -floor_div_l(c - lo, one)); /* ceil((lo - c) / one) */
+  return p < (long)n && p * one + c <= hi;
+}
+
+/* The samples s (bit s) whose rows cross the MTA's y extent, the same in every view. */
+inline uint sample_rows_crossed(global const PmrParams* P, const PmrMta* m) {
+  const long ylo = min3l(m->y[0], m->y[1], m->y[2]), yhi = max3l(m->y[0], m->y[1], m->y[2]);
+  uint rows = 0u;
+  for (uint s = 0; s < P->samples; ++s)
+    if (sample_in_range(ylo, yhi, PMR_HALF_Y + P->sample_y[s], PMR_Y_ONE, P->view_h)) rows |= 1u << s;
+  return rows;
+}
+
+/* Whether view v's x extent holds the column of a sample among `rows`. */
+inline bool view_may_hold_sample(global const PmrParams* P, const PmrMta* m, int v, uint rows) {
+  long lo, hi;
+  mta_x_extent(m, view_coord(P, v), &lo, &hi);
+  for (uint s = 0; s < P->samples; ++s)
+    if (((rows >> s) & 1u) && sample_in_range(lo, hi, PMR_HALF_X + P->sample_x[s], PMR_X_ONE, P->view_w)) return true;
+  return false;
+}
+
+/* Trims the views [*lo, *hi] at both ends to those whose box around the MTA holds a sample position
+ * (around pixel centers: --sampling view; a subpixel's samples lie anywhere in its pixel, so those
+ * ranges are kept). A view without one cannot be covered, so no image changes; a micro-triangle
+ * between the sample rows, or between the columns in every view, makes no MTA at all. */
+inline void trim_to_samples(global const PmrParams* P, const PmrMta* m, int* lo, int* hi) {
+  if (P->sample_area != PMR_SAMPLES_CENTER || *lo > *hi) return;
+  const uint rows = sample_rows_crossed(P, m);
+  if (rows == 0u) {
+    *lo = *hi + 1;
+    return;
+  }
+  while (*lo <= *hi && !view_may_hold_sample(P, m, *lo, rows)) ++*lo;
+  while (*hi > *lo && !view_may_hold_sample(P, m, *hi, rows)) --*hi;
+}
+
 /* One (possibly clipped) triangle: its orientation ranges become MTAs. */
 inline void emit_triangle(global const PmrParams* P, global PmrMta* mtas, volatile global uint* counter,
                           const PmrVertex* a, const PmrVertex* b, const PmrVertex* c, const double* bary_a,
@@ -84,9 +124,11 @@ inline void emit_triangle(global const PmrParams* P, global PmrMta* mtas, volati
   const long a1 = (yb - ya) * ((long)m.dx[2] - m.dx[0]) - ((long)m.dx[1] - m.dx[0]) * (yc - ya);
   int lo, hi;
   positive_views(P, a0, a1, &lo, &hi);
+  trim_to_samples(P, &m, &lo, &hi);
   emit_mta(P, mtas, counter, &m, lo, hi, 1, mflag);
   if (double_sided) {
     positive_views(P, -a0, -a1, &lo, &hi);
+    trim_to_samples(P, &m, &lo, &hi);
     emit_mta(P, mtas, counter, &m, lo, hi, -1, mflag | PMR_MTA_BACK);
   }
 }

@@ -173,6 +173,34 @@ std::vector<ClippedTriangle> clip_triangles(const PmrParams& P, const Scene& sce
   return out;
 }
 
+namespace {
+
+// Whether view i's bounding box of the MTA holds a sample position, by brute force over the raster's
+// rows and columns: with --sampling view (PMR_SAMPLES_CENTER) the samples are the pixel centers plus
+// the pattern; a subpixel's samples lie anywhere in its pixel, so every view is kept then.
+bool box_holds_sample(const PmrParams& P, const PmrMta& m, int i) {
+  if (P.sample_area != PMR_SAMPLES_CENTER) return true;
+  int64_t xs[3];
+  for (int k = 0; k < 3; ++k) xs[k] = int64_t(m.x0[k]) + int64_t(P.view_coord[i]) * m.dx[k];
+  const int64_t xlo = std::min({xs[0], xs[1], xs[2]}), xhi = std::max({xs[0], xs[1], xs[2]});
+  const int64_t ylo = std::min({m.y[0], m.y[1], m.y[2]}), yhi = std::max({m.y[0], m.y[1], m.y[2]});
+  for (uint32_t s = 0; s < P.samples; ++s) {
+    bool row = false, column = false;
+    for (int py = 0; py < P.view_h && !row; ++py) {
+      const int64_t y = int64_t(py) * PMR_Y_ONE + PMR_Y_ONE / 2 + P.sample_y[s];
+      row = y >= ylo && y <= yhi;
+    }
+    for (int px = 0; px < P.view_w && !column; ++px) {
+      const int64_t x = int64_t(px) * PMR_X_ONE + PMR_X_ONE / 2 + P.sample_x[s];
+      column = x >= xlo && x <= xhi;
+    }
+    if (row && column) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 std::vector<PmrMta> make_mtas(const PmrParams& P, const std::vector<ClippedTriangle>& tris) {
   std::vector<PmrMta> out;
   for (const ClippedTriangle& c : tris) {
@@ -201,7 +229,10 @@ std::vector<PmrMta> make_mtas(const PmrParams& P, const std::vector<ClippedTrian
           hi = i;
         }
       }
-      if (lo < 0) continue;
+      // setup keeps the views from the first to the last whose box holds a sample
+      while (lo >= 0 && lo <= hi && !box_holds_sample(P, m, lo)) ++lo;
+      while (lo >= 0 && hi > lo && !box_holds_sample(P, m, hi)) --hi;
+      if (lo < 0 || lo > hi) continue;
       PmrMta r = m;
       r.view_lo = lo;
       r.view_hi = hi;

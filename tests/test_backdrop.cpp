@@ -205,6 +205,13 @@ TEST(Backdrop, OptionsAreCheckedAndTheSidecarIsCompared) {
   test::expect_usage_error(test::run("render --background environment --shading lambert" + small), "pbr");
   test::expect_usage_error(test::run("render --background sky" + small), "environment");
   test::expect_resume_compares("--background environment", "\"kind\": \"environment\"", "background");
+  // a scene without triangles never starts the encoder that draws the encoded image's backdrop
+  const std::string empty = test::temp_dir("backdrop_empty_scene");
+  std::system(("mkdir -p '" + empty + "'").c_str());
+  std::ofstream(empty + "/empty.gltf") << R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0]}], "nodes": [{}]})";
+  test::expect_one_error_line(test::run("render " + empty + "/empty.gltf --background environment" + small),
+                              "without triangles");
+  EXPECT_FALSE(test::exists(out)) << "nothing is written";
 }
 
 }  // namespace

@@ -199,6 +199,9 @@ void SequenceRun::choose_frames() {
   renderer_ = std::make_unique<FrameRenderer>(scene_, spec_, rig_config_, job_.display, &rig_warnings_);
   for (const auto& w : rig_warnings_) warn(w);
   if (const std::string w = frames_outside_animation(scene_, spec_, frames_, job_.frames == "all"); !w.empty()) warn(w);
+  if (job_.background.environment && products_.encoded && !renderer_->has_geometry())
+    throw Error("--background environment encodes its backdrop with the renderer's encoder, which a scene "
+                "without triangles does not start: write the views or the quilt (--write)");
   const Rig& rig = renderer_->rig();
   need_volume_ = products_.views || products_.quilt || products_.preview;
   if (products_.quilt)
@@ -444,9 +447,6 @@ FrameFiles SequenceRun::frame_files(long f, const FrameRenderer::Frame& fr, Pipe
 // moved. Its encoded image comes from the pipeline's encoder, after the frame's own was read back.
 std::shared_ptr<const BackdropLayers> SequenceRun::backdrop_layers(const Rig& rig, Pipeline& pipeline) const {
   if (backdrop_ && same_backdrop_rig(rig, backdrop_rig_)) return backdrop_;
-  if (products_.encoded && !renderer_->has_geometry())
-    throw Error("--background environment encodes its backdrop with the renderer's encoder, which a scene "
-                "without triangles does not start: write the views or the quilt (--write)");
   const BackdropParallax p = backdrop_parallax(rig, job_.background.depth);
   if (p.clamped && !backdrop_warned_ && job_.background.depth.kind != BackdropDepth::Kind::Focal) {
     warn("--background-depth " + to_string(job_.background.depth) + ": the backdrop is drawn at " +

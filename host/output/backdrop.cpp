@@ -45,25 +45,30 @@ bool same_backdrop_rig(const Rig& a, const Rig& b) {
          a.center_view == b.center_view;
 }
 
-glm::dvec3 backdrop_direction(const Rig& rig, double fraction, int view, int x, int y) {
-  const double t = std::tan(rig.yfov / 2.0);
-  const double sx =
-      (2.0 * (x + 0.5) / rig.view_w - 1.0) * rig.aspect * t - fraction * rig.camera_offset(view) / rig.focal;
-  const double sy = (1.0 - 2.0 * (y + 0.5) / rig.view_h) * t;
-  // directions turn with the inverse of the view matrix's linear part
-  return glm::inverse(glm::dmat3(rig.center_view)) * glm::dvec3(sx, sy, -1.0);
+BackdropRays::BackdropRays(const Rig& rig, double fraction)
+    : rig_(rig),
+      fraction_(fraction),
+      tan_half_(std::tan(rig.yfov / 2.0)),
+      to_world_(glm::inverse(glm::dmat3(rig.center_view))) {}  // directions turn with the inverse linear part
+
+glm::dvec3 BackdropRays::direction(int view, int x, int y) const {
+  const double sx = (2.0 * (x + 0.5) / rig_.view_w - 1.0) * rig_.aspect * tan_half_ -
+                    fraction_ * rig_.camera_offset(view) / rig_.focal;
+  const double sy = (1.0 - 2.0 * (y + 0.5) / rig_.view_h) * tan_half_;
+  return to_world_ * glm::dvec3(sx, sy, -1.0);
 }
 
 std::vector<uint16_t> render_backdrop(const Rig& rig, const Environment& environment, double fraction) {
   const size_t plane = size_t(rig.view_w) * size_t(rig.view_h);
   std::vector<uint16_t> out(plane * size_t(rig.views) * 4);
   const int computed = fraction == 0.0 ? 1 : rig.views;  // on the focal plane every view is view 0's
+  const BackdropRays rays(rig, fraction);
   parallel_for(size_t(computed) * size_t(rig.view_h), 8, [&](size_t begin, size_t end) {
     for (size_t row = begin; row < end; ++row) {
       const int view = int(row / size_t(rig.view_h)), y = int(row % size_t(rig.view_h));
       uint16_t* px = out.data() + row * size_t(rig.view_w) * 4;
       for (int x = 0; x < rig.view_w; ++x, px += 4) {
-        const glm::dvec3 c = environment.radiance(backdrop_direction(rig, fraction, view, x, y));
+        const glm::dvec3 c = environment.radiance(rays.direction(view, x, y));
         px[0] = half(float(c.r)).bits(), px[1] = half(float(c.g)).bits(), px[2] = half(float(c.b)).bits();
         px[3] = half(1.0f).bits();
       }

@@ -34,8 +34,18 @@ BackdropParallax backdrop_parallax(const Rig& rig, const BackdropDepth& depth);
 // Whether two rigs draw the same backdrop (the same cameras, rasters and window).
 bool same_backdrop_rig(const Rig& a, const Rig& b);
 
-// The world-space direction voxel (x, y, view) samples (not unit length).
-glm::dvec3 backdrop_direction(const Rig& rig, double fraction, int view, int x, int y);
+// The world-space directions the voxels sample (not unit length), with what every voxel shares
+// (tan(phi / 2), the inverse rotation) worked out once.
+class BackdropRays {
+ public:
+  BackdropRays(const Rig& rig, double fraction);
+  glm::dvec3 direction(int view, int x, int y) const;
+
+ private:
+  const Rig& rig_;
+  double fraction_, tan_half_;
+  glm::dmat3 to_world_;
+};
 
 // The backdrop volume (half RGBA, premultiplied, alpha 1, view-major as the pipeline's volume): one
 // environment lookup (Environment::radiance, bilinear in the image) per voxel; with f = 0 one view's,

@@ -467,7 +467,9 @@ std::shared_ptr<const BackdropLayers> SequenceRun::backdrop_layers(const Rig& ri
     pipeline.read_display(layers->display);
   }
   if (job_.verbose)
-    std::fprintf(stderr, "pmr: backdrop: parallax %.4g (%.3g view px between neighbours), drawn in %.0f ms, encoded in %.0f ms\n",
+    std::fprintf(stderr,
+                 "pmr: backdrop: parallax %.4g (%.3g view px between neighbours), drawn in %.0f ms, encoded in "
+                 "%.0f ms\n",
                  p.fraction, p.step_px, drawn_ms, ms_since(t0) - drawn_ms);
   if (!need_volume_) layers->volume = {};
   backdrop_rig_ = rig;
